@@ -1,0 +1,9 @@
+//! Oriented boxes and the exact test between two of them (thesis 2.4 and 3.1, SPEC §3).
+
+pub mod obb;
+pub mod sat;
+pub mod witness;
+
+pub use obb::Obb;
+pub use sat::{obbs_intersect, separating_axis, separating_axis_hinted, Axis};
+pub use witness::{first_intersecting_pair, WitnessCache};

@@ -1,0 +1,26 @@
+//! # delta-collide
+//!
+//! Tells a robot motion controller, every 1 ms tick, whether Delta3 packaging robots that
+//! share a conveyor are about to collide. The design follows the thesis in
+//! `shared/seed/000_463851a3086e019d.txt`; `shared/SPEC.md` fixes the conventions.
+//!
+//! | module | what | thesis | SPEC |
+//! |---|---|---|---|
+//! | [`math`] | scalar and vector aliases, named tolerances | | §1 |
+//! | [`geometry`] | oriented boxes, separating axis test, witness cache | 2.4, 3.1 | §3 |
+//! | [`robot`] | Delta3 kinematics, the box model of one robot | 2.2, 2.5, 2.6 | §2, §3 |
+//! | [`cell`] | robots, placements, the exact check of a whole cell | 2.3, 3.1.4 | §1, §5 |
+//! | [`ffi`] | the only `extern "C"` surface (opaque handle, POU lifecycle) | App. A | |
+//!
+//! Units: millimetres and radians everywhere. Frames: each robot's TCP is given in its own
+//! machine coordinate system (MCS); the world (WCS) is robot 0's MCS.
+#![deny(unsafe_code)]
+#![deny(unsafe_op_in_unsafe_fn)]
+#![warn(clippy::undocumented_unsafe_blocks)]
+#![warn(missing_docs)]
+
+pub mod cell;
+pub mod ffi;
+pub mod geometry;
+pub mod math;
+pub mod robot;

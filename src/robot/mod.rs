@@ -1,0 +1,7 @@
+//! One Delta3 robot: kinematics and the box model of its links (thesis chapter 2, SPEC §2-§3).
+
+pub mod delta3;
+pub mod model;
+
+pub use delta3::{ArmSolution, Delta3, Unreachable};
+pub use model::{BoxKind, ModelOptions, RobotBoxes, RobotModel, ToolBox};
