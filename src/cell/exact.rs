@@ -230,7 +230,7 @@ mod tests {
         let mut checker = ExactChecker::new(row_of_robots(3, 450.0, SatMethod::Sat));
         let home = Vec3::new(0.0, 0.0, -450.0);
         // Robot 1 reaches back toward robot 0 while robot 0 reaches forward: only (0, 1) meets.
-        let v = checker.check(&[Vec3::new(200.0, 0.0, -500.0), Vec3::new(-200.0, 0.0, -500.0), home]).unwrap();
+        let v = checker.check(&[Vec3::new(180.0, 0.0, -450.0), Vec3::new(-180.0, 0.0, -450.0), home]).unwrap();
         assert!(v.all_reachable());
         let states: Vec<_> = v.pairs.iter().map(|p| (p.a, p.b, matches!(p.state, PairState::Collides(..)))).collect();
         assert_eq!(states, vec![(0, 1, true), (0, 2, false), (1, 2, false)]);
