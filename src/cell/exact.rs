@@ -131,6 +131,11 @@ impl ExactChecker {
         &self.boxes[i]
     }
 
+    /// The result of the last check (all pairs undecided before the first).
+    pub fn verdict(&self) -> &CellVerdict {
+        &self.verdict
+    }
+
     /// Forgets the witness cache (answers never depend on it; only speed does).
     pub fn reset_cache(&mut self) {
         self.caches.iter_mut().for_each(|c| *c = WitnessCache::new());
