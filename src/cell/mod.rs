@@ -8,6 +8,7 @@ pub mod config;
 pub mod exact;
 pub mod placement;
 pub mod reference;
+pub mod trajectory;
 
 pub use config::parse_cell;
 pub use exact::{CellVerdict, ExactChecker, PairVerdict, QueryError};
