@@ -144,6 +144,16 @@ typedef struct RunResult {
     long exact_first;      /* first tick the plain SAT handle collides, unstopped, -1 if never */
 } RunResult;
 
+/* "none" for -1, else the tick number. */
+static void tick_text(long tick, char out[24])
+{
+    if (tick < 0) {
+        strcpy(out, "none");
+    } else {
+        sprintf(out, "%ld", tick);
+    }
+}
+
 static void to_dc(const MrTickState *st, size_t n, DcVec3 out[MR_MAX_ROBOTS])
 {
     size_t j;
@@ -326,10 +336,15 @@ static int run_scenario(const char *cell_name, const char *case_name, RunResult 
         check(not_held == 0, "%s collision: %lu ticks after the stop were not COLLISION at the held pose",
               cell_name, not_held);
     }
-    printf("%s %-9s: first collision tick %ld (POU stop), %ld (exact SAT, unstopped); FREE ticks %lu/%d; "
-           "max |dtheta| %.2e rad, max |FK C - FK lib| %.2e mm, max |FK(IK(p)) - p| %.2e mm\n",
-           cell_name, case_name, pou.stop_tick, result->exact_first, free_ticks, MR_TICKS_PER_RUN, kin.max_dtheta,
-           kin.max_fk_diff, kin.max_round_trip);
+    {
+        char stop_text[24], exact_text[24];
+        tick_text(pou.stop_tick, stop_text);
+        tick_text(result->exact_first, exact_text);
+        printf("%s %-9s: first collision tick %s (POU stop), %s (exact SAT, unstopped); FREE ticks %lu/%d; "
+               "max |dtheta| %.2e rad, max |FK C - FK lib| %.2e mm, max |FK(IK(p)) - p| %.2e mm\n",
+               cell_name, case_name, stop_text, exact_text, free_ticks, MR_TICKS_PER_RUN, kin.max_dtheta,
+               kin.max_fk_diff, kin.max_round_trip);
+    }
 
     pou_destroy(&pou);
     pou_destroy(&pou); /* twice: the POU must tolerate it */
@@ -535,8 +550,11 @@ static void bad_input(const char *tmp_dir)
     check(s == DC_STATUS_NULL_POINTER, "bad input, dc_pair_results NULL out: %u", (unsigned)s);
     s = dc_pair_results(h, pairs, 2, NULL);
     check(s == DC_STATUS_NULL_POINTER, "bad input, dc_pair_results NULL out_len: %u", (unsigned)s);
+    len = 99;
     s = dc_pair_results(h, pairs, 0, &len);
-    check(s == DC_STATUS_INVALID_ARGUMENT, "bad input, dc_pair_results capacity 0: %u", (unsigned)s);
+    check(s == DC_STATUS_INVALID_ARGUMENT && len == 1,
+          "bad input, dc_pair_results capacity 0: status %u, out_len %lu (expected the count needed, 1)", (unsigned)s,
+          (unsigned long)len);
     check(dc_robot_count(NULL) == 0 && dc_pair_count(NULL) == 0, "bad input: counts of a NULL handle are not 0");
     dc_destroy(h);
     h = NULL;
