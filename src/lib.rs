@@ -20,7 +20,9 @@
 #![warn(missing_docs)]
 
 pub mod cell;
+pub mod cspace;
 pub mod ffi;
 pub mod geometry;
 pub mod math;
 pub mod robot;
+pub mod table;

@@ -1,1 +1,203 @@
-//! Robots, their placements in the world, and the exact check of a whole cell (thesis 2.3, 3.1; SPEC §1, §5).
+//! Robots, their placements in the world, and the exact check of a whole cell
+//! (thesis 2.3 and 3.1; SPEC §1 and §5).
+//!
+//! A [`Cell`] is validated once; [`ExactChecker`] then answers, per tick and without
+//! allocating, which robot pairs collide for one TCP per robot.
+
+pub mod config;
+pub mod exact;
+pub mod placement;
+pub mod reference;
+
+pub use config::parse_cell;
+pub use exact::{CellVerdict, ExactChecker, PairVerdict, QueryError};
+pub use placement::Placement;
+
+use crate::math::Real;
+use crate::robot::RobotModel;
+
+/// Most robots in one cell (the unreachable mask of a report is a `u32`).
+pub const MAX_ROBOTS: usize = 32;
+
+/// Which exact test the checker runs (thesis 3.1.5 compares both).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SatMethod {
+    /// The plain separating axis test on every box pair.
+    Sat,
+    /// The same, with the two-layer witness cache of thesis 3.1.4.
+    SatCache,
+}
+
+/// One robot of a cell: its model and where it stands.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotSpec {
+    /// A name for reports.
+    pub name: String,
+    /// Geometry and box options.
+    pub model: RobotModel,
+    /// Its MCS in the WCS.
+    pub placement: Placement,
+}
+
+/// A validated cell: robots, placements and the exact test to use.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cell {
+    /// A name for reports.
+    pub name: String,
+    /// The robots; robot 0's MCS is the WCS by convention (not enforced).
+    pub robots: Vec<RobotSpec>,
+    /// Plain SAT or SAT with witness cache.
+    pub method: SatMethod,
+}
+
+/// Why a cell cannot be built.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CellError {
+    /// A cell file could not be read.
+    Io(String),
+    /// A cell file is not valid TOML or does not follow the schema.
+    Parse(String),
+    /// A value is out of range; the text names it.
+    Invalid(String),
+}
+
+impl std::fmt::Display for CellError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CellError::Io(m) => write!(f, "cannot read cell file: {m}"),
+            CellError::Parse(m) => write!(f, "invalid cell file: {m}"),
+            CellError::Invalid(m) => write!(f, "invalid cell: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for CellError {}
+
+fn check_length(what: &str, v: Real, allow_zero: bool) -> Result<(), CellError> {
+    if v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0)) {
+        Ok(())
+    } else {
+        let need = if allow_zero { ">= 0" } else { "> 0" };
+        Err(CellError::Invalid(format!("{what} = {v} must be finite and {need} (mm)")))
+    }
+}
+
+fn validate_robot(i: usize, r: &RobotSpec) -> Result<(), CellError> {
+    let name = format!("robot {i} ({})", r.name);
+    r.model.delta.validate().map_err(|m| CellError::Invalid(format!("{name}: {m}")))?;
+    let o = &r.model.options;
+    check_length(&format!("{name}: model.half_height"), o.half_height, true)?;
+    check_length(&format!("{name}: model.half_depth"), o.half_depth, true)?;
+    check_length(&format!("{name}: model.margin"), o.margin, true)?;
+    if let Some((h, d)) = o.upper_links {
+        check_length(&format!("{name}: model.upper_links.half_height"), h, true)?;
+        check_length(&format!("{name}: model.upper_links.half_depth"), d, true)?;
+    }
+    for (what, b) in [("platform", o.platform), ("tool", o.tool)] {
+        if let Some(b) = b {
+            for k in 0..3 {
+                check_length(&format!("{name}: model.{what}.half[{k}]"), b.half[k], true)?;
+                if !b.offset[k].is_finite() {
+                    return Err(CellError::Invalid(format!("{name}: model.{what}.offset[{k}] is not finite")));
+                }
+            }
+        }
+    }
+    let p = &r.placement;
+    if !(p.alpha.is_finite() && p.t.iter().all(|v| v.is_finite())) {
+        return Err(CellError::Invalid(format!("{name}: placement has a NaN or infinite value")));
+    }
+    Ok(())
+}
+
+impl Cell {
+    /// A validated cell.
+    ///
+    /// # Errors
+    /// [`CellError::Invalid`] naming the first bad value: no robots, more than
+    /// [`MAX_ROBOTS`], a non-positive length, a negative margin, bad motor limits or a
+    /// non-finite placement.
+    pub fn new(name: String, robots: Vec<RobotSpec>, method: SatMethod) -> Result<Cell, CellError> {
+        if robots.is_empty() || robots.len() > MAX_ROBOTS {
+            return Err(CellError::Invalid(format!(
+                "a cell needs 1 to {MAX_ROBOTS} robots, this one has {}",
+                robots.len()
+            )));
+        }
+        for (i, r) in robots.iter().enumerate() {
+            validate_robot(i, r)?;
+        }
+        Ok(Cell { name, robots, method })
+    }
+
+    /// Reads and validates a TOML cell file.
+    ///
+    /// # Errors
+    /// [`CellError::Io`] when the file cannot be read, else as [`parse_cell`].
+    pub fn from_file(path: &std::path::Path) -> Result<Cell, CellError> {
+        let text = std::fs::read_to_string(path).map_err(|e| CellError::Io(format!("{}: {e}", path.display())))?;
+        parse_cell(&text)
+    }
+
+    /// A horizontal radius around robot `i`'s base axis that holds every point of every box
+    /// of its model in any configuration: the elbow is within `f + rf` of the axis, every
+    /// link point within `re` more, plus the box cross-section and margin.
+    pub fn reach_radius(&self, i: usize) -> Real {
+        let m = &self.robots[i].model;
+        let (d, o) = (&m.delta, &m.options);
+        let lower = d.f + d.rf + d.re + (o.half_height + o.margin).hypot(o.half_depth + o.margin);
+        let upper = o.upper_links.map_or(0.0, |(h, dz)| d.f + d.rf + (h + o.margin).hypot(dz + o.margin));
+        let extra = [o.platform, o.tool]
+            .into_iter()
+            .flatten()
+            .map(|b| d.f + d.rf + d.re + b.offset.norm() + b.half.add_scalar(o.margin).norm())
+            .fold(0.0, Real::max);
+        lower.max(upper).max(extra)
+    }
+
+    /// The robot pairs `(a, b)`, `a < b`, whose reach can overlap; all others can never meet.
+    pub fn pairs_that_can_meet(&self) -> Vec<(usize, usize)> {
+        let n = self.robots.len();
+        let mut pairs = Vec::new();
+        for a in 0..n {
+            for b in a + 1..n {
+                let d = self.robots[b].placement.t - self.robots[a].placement.t;
+                if d.x.hypot(d.y) <= self.reach_radius(a) + self.reach_radius(b) {
+                    pairs.push((a, b));
+                }
+            }
+        }
+        pairs
+    }
+
+    /// A 64-bit FNV-1a hash of everything that decides a collision (geometry, boxes,
+    /// margins, placements; not names or the SAT method): tables record it to refuse being
+    /// used with another cell.
+    pub fn fingerprint(&self) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut eat = |v: Real| {
+            for byte in v.to_le_bytes() {
+                h = (h ^ byte as u64).wrapping_mul(0x0100_0000_01b3);
+            }
+        };
+        eat(self.robots.len() as Real);
+        for r in &self.robots {
+            let (d, o, p) = (&r.model.delta, &r.model.options, &r.placement);
+            for v in [d.f, d.rf, d.re, d.e, d.theta_min, d.theta_max, o.half_height, o.half_depth, o.margin] {
+                eat(v);
+            }
+            let (uh, ud) = o.upper_links.unwrap_or((-1.0, -1.0));
+            eat(uh);
+            eat(ud);
+            for b in [o.platform, o.tool] {
+                match b {
+                    Some(b) => b.offset.iter().chain(b.half.iter()).for_each(|&v| eat(v)),
+                    None => eat(-1.0),
+                }
+            }
+            eat(p.alpha);
+            p.t.iter().for_each(|&v| eat(v));
+        }
+        h
+    }
+}

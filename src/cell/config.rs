@@ -1,0 +1,191 @@
+//! Cell files: a human-edited TOML description of the robots of a cell (SPEC §1, §5).
+//!
+//! Lengths in mm; angles in degrees only where the key says so (`alpha_deg`,
+//! `theta_min_deg`). Every key but `[[robot]]` has a default: the thesis robot with the
+//! physical box sizes, placed at the WCS origin. Unknown keys are errors, so a typo never
+//! silently falls back to a default.
+//!
+//! ```toml
+//! name = "T1"
+//! method = "sat-cache"            # or "sat"
+//! [[robot]]
+//! name = "A"
+//! [[robot]]
+//! name = "B"
+//! placement = { alpha_deg = 0.0, t = [450.0, 0.0, 0.0] }
+//! model = { margin = 5.0, upper_links = { half_height = 30.0, half_depth = 15.0 } }
+//! ```
+
+use crate::cell::{Cell, CellError, RobotSpec, SatMethod};
+use crate::cell::placement::Placement;
+use crate::math::{Real, Vec3};
+use crate::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
+use serde::Deserialize;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CellFile {
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    method: Option<String>,
+    #[serde(rename = "robot")]
+    robots: Vec<RobotFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RobotFile {
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    geometry: GeometryFile,
+    #[serde(default)]
+    model: ModelFile,
+    #[serde(default)]
+    placement: PlacementFile,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GeometryFile {
+    f: Real,
+    rf: Real,
+    re: Real,
+    e: Real,
+    theta_min_deg: Real,
+    theta_max_deg: Real,
+}
+
+impl Default for GeometryFile {
+    fn default() -> Self {
+        let d = Delta3::THESIS;
+        GeometryFile {
+            f: d.f,
+            rf: d.rf,
+            re: d.re,
+            e: d.e,
+            theta_min_deg: d.theta_min.to_degrees(),
+            theta_max_deg: d.theta_max.to_degrees(),
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct ModelFile {
+    half_height: Real,
+    half_depth: Real,
+    margin: Real,
+    upper_links: Option<UpperLinksFile>,
+    platform: Option<BoxFile>,
+    tool: Option<BoxFile>,
+}
+
+impl Default for ModelFile {
+    fn default() -> Self {
+        let o = ModelOptions::THESIS;
+        ModelFile {
+            half_height: o.half_height,
+            half_depth: o.half_depth,
+            margin: o.margin,
+            upper_links: None,
+            platform: None,
+            tool: None,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UpperLinksFile {
+    half_height: Real,
+    half_depth: Real,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BoxFile {
+    #[serde(default)]
+    offset: [Real; 3],
+    half: [Real; 3],
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+struct PlacementFile {
+    alpha_deg: Real,
+    t: [Real; 3],
+}
+
+fn tool_box(b: &BoxFile) -> ToolBox {
+    ToolBox { offset: Vec3::from(b.offset), half: Vec3::from(b.half) }
+}
+
+/// Parses a cell file's text into a validated [`Cell`].
+///
+/// # Errors
+/// [`CellError::Parse`] for TOML or schema errors (with line and column), and the
+/// validation errors of [`Cell::new`].
+pub fn parse_cell(text: &str) -> Result<Cell, CellError> {
+    let file: CellFile = toml::from_str(text).map_err(|e| CellError::Parse(e.to_string()))?;
+    let method = match file.method.as_deref() {
+        None | Some("sat-cache") => SatMethod::SatCache,
+        Some("sat") => SatMethod::Sat,
+        Some(other) => {
+            return Err(CellError::Parse(format!("method = \"{other}\" is unknown; use \"sat\" or \"sat-cache\"")))
+        }
+    };
+    let robots = file
+        .robots
+        .iter()
+        .enumerate()
+        .map(|(i, r)| RobotSpec {
+            name: r.name.clone().unwrap_or_else(|| ((b'A' + (i % 26) as u8) as char).to_string()),
+            model: RobotModel {
+                delta: Delta3 {
+                    f: r.geometry.f,
+                    rf: r.geometry.rf,
+                    re: r.geometry.re,
+                    e: r.geometry.e,
+                    theta_min: r.geometry.theta_min_deg.to_radians(),
+                    theta_max: r.geometry.theta_max_deg.to_radians(),
+                },
+                options: ModelOptions {
+                    half_height: r.model.half_height,
+                    half_depth: r.model.half_depth,
+                    margin: r.model.margin,
+                    upper_links: r.model.upper_links.as_ref().map(|u| (u.half_height, u.half_depth)),
+                    platform: r.model.platform.as_ref().map(tool_box),
+                    tool: r.model.tool.as_ref().map(tool_box),
+                },
+            },
+            placement: Placement { alpha: r.placement.alpha_deg.to_radians(), t: Vec3::from(r.placement.t) },
+        })
+        .collect();
+    Cell::new(file.name.unwrap_or_else(|| "unnamed".into()), robots, method)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_thesis_robot() {
+        let cell = parse_cell("[[robot]]\n[[robot]]\nplacement = { t = [450.0, 0.0, 0.0] }\n").unwrap();
+        assert_eq!(cell.robots.len(), 2);
+        assert_eq!(cell.robots[0].model, RobotModel::THESIS);
+        assert_eq!(cell.robots[1].placement.t, Vec3::new(450.0, 0.0, 0.0));
+        assert_eq!(cell.robots[1].name, "B");
+    }
+
+    #[test]
+    fn typos_and_bad_values_are_named() {
+        let err = parse_cell("[[robot]]\nmodel = { margn = 3.0 }\n").unwrap_err().to_string();
+        assert!(err.contains("margn"), "{err}");
+        let err = parse_cell("[[robot]]\nmodel = { margin = -1.0 }\n").unwrap_err().to_string();
+        assert!(err.contains("margin"), "{err}");
+        let err = parse_cell("method = \"gjk\"\n[[robot]]\n").unwrap_err().to_string();
+        assert!(err.contains("gjk"), "{err}");
+    }
+}

@@ -1,0 +1,268 @@
+//! The exact check of a cell: every robot pair that can meet, every box pair, with the
+//! separating axis test (thesis 3.1, 3.1.4; SPEC §3).
+//!
+//! Per tick: one inverse kinematics and one box model per robot (each in its MCS, then moved
+//! to the WCS), then for every pair an axis-aligned bounding-box test of the two robots'
+//! boxes before the box-pair tests. All buffers live in the checker: a check never allocates.
+
+use crate::cell::{Cell, SatMethod};
+use crate::geometry::{first_intersecting_pair, WitnessCache};
+use crate::math::Vec3;
+use crate::robot::{RobotBoxes, Unreachable};
+
+/// What the check found for one robot pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PairState {
+    /// The robots' boxes do not intersect.
+    Free,
+    /// Box `.0` of robot `a` intersects box `.1` of robot `b`.
+    Collides(usize, usize),
+    /// A TCP of the pair is unreachable: no answer.
+    Undecided,
+}
+
+/// One robot pair's result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PairVerdict {
+    /// First robot (index in the cell), `a < b`.
+    pub a: usize,
+    /// Second robot.
+    pub b: usize,
+    /// The result.
+    pub state: PairState,
+}
+
+/// The result of one check: reachability per robot and a state per pair that can meet.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CellVerdict {
+    /// Bit `j` set: robot `j`'s TCP is unreachable (or not finite).
+    pub unreachable_mask: u32,
+    /// The first unreachable robot and why.
+    pub first_unreachable: Option<(usize, Unreachable)>,
+    /// One entry per pair that can meet, in the order of [`Cell::pairs_that_can_meet`].
+    pub pairs: Vec<PairVerdict>,
+}
+
+impl CellVerdict {
+    /// Whether every TCP was reachable (so every pair has an answer).
+    pub fn all_reachable(&self) -> bool {
+        self.unreachable_mask == 0
+    }
+
+    /// The first colliding pair, if any.
+    pub fn first_collision(&self) -> Option<&PairVerdict> {
+        self.pairs.iter().find(|p| matches!(p.state, PairState::Collides(..)))
+    }
+
+    /// Whether any pair collides.
+    pub fn collides(&self) -> bool {
+        self.first_collision().is_some()
+    }
+
+    /// How many pairs collide.
+    pub fn colliding_pairs(&self) -> usize {
+        self.pairs.iter().filter(|p| matches!(p.state, PairState::Collides(..))).count()
+    }
+}
+
+/// Why a check could not run at all.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QueryError {
+    /// The number of TCPs differs from the number of robots.
+    WrongRobotCount {
+        /// Robots in the cell.
+        expected: usize,
+        /// TCPs given.
+        found: usize,
+    },
+}
+
+impl std::fmt::Display for QueryError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            QueryError::WrongRobotCount { expected, found } => {
+                write!(f, "the cell has {expected} robots but {found} TCPs were given")
+            }
+        }
+    }
+}
+
+impl std::error::Error for QueryError {}
+
+/// The exact check of one cell, with every per-tick buffer preallocated.
+#[derive(Clone, Debug)]
+pub struct ExactChecker {
+    cell: Cell,
+    /// Robots placed at the WCS origin without rotation skip the box transform.
+    at_origin: Vec<bool>,
+    boxes: Vec<RobotBoxes>,
+    /// Per robot: centre and half-extents of the AABB of all its boxes (WCS).
+    aabb: Vec<(Vec3, Vec3)>,
+    caches: Vec<WitnessCache>,
+    verdict: CellVerdict,
+}
+
+impl ExactChecker {
+    /// A checker for `cell`; prunes, once, the robot pairs that can never meet.
+    pub fn new(cell: Cell) -> Self {
+        let n = cell.robots.len();
+        let pairs: Vec<PairVerdict> = cell
+            .pairs_that_can_meet()
+            .into_iter()
+            .map(|(a, b)| PairVerdict { a, b, state: PairState::Undecided })
+            .collect();
+        ExactChecker {
+            at_origin: cell.robots.iter().map(|r| r.placement.alpha == 0.0 && r.placement.t == Vec3::zeros()).collect(),
+            boxes: vec![RobotBoxes::empty(); n],
+            aabb: vec![(Vec3::zeros(), Vec3::zeros()); n],
+            caches: vec![WitnessCache::new(); pairs.len()],
+            verdict: CellVerdict { unreachable_mask: 0, first_unreachable: None, pairs },
+            cell,
+        }
+    }
+
+    /// The cell being checked.
+    pub fn cell(&self) -> &Cell {
+        &self.cell
+    }
+
+    /// Robot `i`'s boxes in the WCS as of the last check (meaningless if it was unreachable).
+    pub fn boxes(&self, i: usize) -> &RobotBoxes {
+        &self.boxes[i]
+    }
+
+    /// The result of the last check (all pairs undecided before the first).
+    pub fn verdict(&self) -> &CellVerdict {
+        &self.verdict
+    }
+
+    /// Forgets the witness cache (answers never depend on it; only speed does).
+    pub fn reset_cache(&mut self) {
+        self.caches.iter_mut().for_each(|c| *c = WitnessCache::new());
+    }
+
+    /// Checks one configuration: `tcps_mcs[j]` is robot `j`'s TCP in its own MCS.
+    ///
+    /// Unreachable or non-finite TCPs are reported in the verdict (their pairs are
+    /// [`PairState::Undecided`]), not as errors.
+    ///
+    /// # Errors
+    /// [`QueryError::WrongRobotCount`] when `tcps_mcs.len()` differs from the robot count.
+    pub fn check(&mut self, tcps_mcs: &[Vec3]) -> Result<&CellVerdict, QueryError> {
+        let n = self.cell.robots.len();
+        if tcps_mcs.len() != n {
+            return Err(QueryError::WrongRobotCount { expected: n, found: tcps_mcs.len() });
+        }
+        self.verdict.unreachable_mask = 0;
+        self.verdict.first_unreachable = None;
+        for (j, tcp) in tcps_mcs.iter().enumerate() {
+            let robot = &self.cell.robots[j];
+            match robot.model.boxes(tcp) {
+                Ok(mut boxes) => {
+                    if !self.at_origin[j] {
+                        let (rot, t) = (robot.placement.rotation(), robot.placement.t);
+                        for b in &mut boxes.boxes[..boxes.len] {
+                            *b = b.transformed(&rot, &t);
+                        }
+                    }
+                    self.aabb[j] = aabb_of(&boxes);
+                    self.boxes[j] = boxes;
+                }
+                Err(why) => {
+                    self.verdict.unreachable_mask |= 1 << j;
+                    self.verdict.first_unreachable.get_or_insert((j, why));
+                }
+            }
+        }
+        for (k, pair) in self.verdict.pairs.iter_mut().enumerate() {
+            let (a, b) = (pair.a, pair.b);
+            pair.state = if self.verdict.unreachable_mask & (1 << a | 1 << b) != 0 {
+                PairState::Undecided
+            } else if !aabbs_overlap(&self.aabb[a], &self.aabb[b]) {
+                PairState::Free
+            } else {
+                let (ba, bb) = (self.boxes[a].as_slice(), self.boxes[b].as_slice());
+                let hit = match self.cell.method {
+                    SatMethod::Sat => first_intersecting_pair(ba, bb),
+                    SatMethod::SatCache => self.caches[k].first_intersecting_pair(ba, bb),
+                };
+                hit.map_or(PairState::Free, |(i, j)| PairState::Collides(i, j))
+            };
+        }
+        Ok(&self.verdict)
+    }
+}
+
+/// Centre and half-extents of the axis-aligned box around all of a robot's boxes.
+fn aabb_of(boxes: &RobotBoxes) -> (Vec3, Vec3) {
+    let mut lo = Vec3::repeat(f64::INFINITY);
+    let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+    for b in boxes.as_slice() {
+        let h = b.aabb_half();
+        lo = lo.inf(&(b.center - h));
+        hi = hi.sup(&(b.center + h));
+    }
+    ((lo + hi) * 0.5, (hi - lo) * 0.5)
+}
+
+/// Closed overlap of two AABBs given as (centre, half-extents); errs toward overlap.
+fn aabbs_overlap(a: &(Vec3, Vec3), b: &(Vec3, Vec3)) -> bool {
+    let d = (a.0 - b.0).abs();
+    let r = a.1 + b.1;
+    d.x <= r.x * (1.0 + 1e-12) + 1e-9 && d.y <= r.y * (1.0 + 1e-12) + 1e-9 && d.z <= r.z * (1.0 + 1e-12) + 1e-9
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::{Placement, RobotSpec};
+    use crate::robot::RobotModel;
+
+    fn row_of_robots(n: usize, spacing: f64, method: SatMethod) -> Cell {
+        let robots = (0..n)
+            .map(|i| RobotSpec {
+                name: format!("R{i}"),
+                model: RobotModel::THESIS,
+                placement: Placement { alpha: 0.0, t: Vec3::new(spacing * i as f64, 0.0, 0.0) },
+            })
+            .collect();
+        Cell::new("row".into(), robots, method).unwrap()
+    }
+
+    #[test]
+    fn far_pairs_are_pruned_and_middle_robot_meets_one_neighbour() {
+        assert_eq!(row_of_robots(3, 800.0, SatMethod::Sat).pairs_that_can_meet(), vec![(0, 1), (1, 2)]);
+        let mut checker = ExactChecker::new(row_of_robots(3, 450.0, SatMethod::Sat));
+        let home = Vec3::new(0.0, 0.0, -450.0);
+        // Robot 1 reaches back toward robot 0 while robot 0 reaches forward: only (0, 1) meets.
+        let v = checker.check(&[Vec3::new(180.0, 0.0, -450.0), Vec3::new(-180.0, 0.0, -450.0), home]).unwrap();
+        assert!(v.all_reachable());
+        let states: Vec<_> = v.pairs.iter().map(|p| (p.a, p.b, matches!(p.state, PairState::Collides(..)))).collect();
+        assert_eq!(states, vec![(0, 1, true), (0, 2, false), (1, 2, false)]);
+    }
+
+    #[test]
+    fn unreachable_robot_leaves_its_pairs_undecided_and_wrong_count_is_an_error() {
+        let mut checker = ExactChecker::new(row_of_robots(3, 450.0, SatMethod::SatCache));
+        let home = Vec3::new(0.0, 0.0, -450.0);
+        let v = checker.check(&[home, Vec3::new(0.0, 0.0, 100.0), home]).unwrap();
+        assert_eq!(v.unreachable_mask, 0b010);
+        assert!(v.pairs.iter().filter(|p| p.a == 1 || p.b == 1).all(|p| p.state == PairState::Undecided));
+        assert_eq!(checker.check(&[home]).unwrap_err(), QueryError::WrongRobotCount { expected: 3, found: 1 });
+    }
+
+    #[test]
+    fn cached_and_plain_checks_agree_along_a_sweep() {
+        let mut plain = ExactChecker::new(row_of_robots(2, 450.0, SatMethod::Sat));
+        let mut cached = ExactChecker::new(row_of_robots(2, 450.0, SatMethod::SatCache));
+        let mut collisions = 0;
+        for k in 0..2000 {
+            let s = k as f64 / 2000.0;
+            let tcps = [Vec3::new(-150.0 + 350.0 * s, 40.0 * s, -450.0), Vec3::new(150.0 - 350.0 * s, -30.0, -420.0)];
+            let p = plain.check(&tcps).unwrap().collides();
+            assert_eq!(p, cached.check(&tcps).unwrap().collides(), "step {k}");
+            collisions += p as usize;
+        }
+        assert!(collisions > 0 && collisions < 2000);
+    }
+}

@@ -1,0 +1,42 @@
+//! The configuration space of two robots, discretised: workspace, sampling grid, labels
+//! (thesis 3.2.2-3.2.3, 3.2.7-3.2.8; SPEC §4, §6).
+//!
+//! A two-robot configuration is `c = (x, y, z, x', y', z')`: robot A's TCP in A's MCS and
+//! robot B's TCP in B's MCS. Each robot's TCP space is cut into cubic grid cells of side `r`
+//! aligned with the quadtree leaves; a sample is a cell centre.
+
+pub mod sampler;
+
+pub use sampler::{CellIndex, SampleGrid, Workspace};
+
+/// The label of one two-robot sample (one 6-D grid cell).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Label {
+    /// Proved free (or, for thesis-style tables, free at the cell centre with the margin).
+    Free = 0,
+    /// Collides (or could not be proved free).
+    Collision = 1,
+    /// One of the TCPs is unreachable: cannot occur in operation, "don't care".
+    Unreachable = 2,
+}
+
+/// Labels of every pair of samples of two robots' grids.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelledSpace {
+    /// Robot A's grid.
+    pub grid_a: SampleGrid,
+    /// Robot B's grid.
+    pub grid_b: SampleGrid,
+    /// `labels[ia * grid_b.cells.len() + ib]` for sample `ia` of A and `ib` of B.
+    pub labels: Vec<Label>,
+    /// The margin (mm) added to every box half-extent when labelling.
+    pub margin: f64,
+}
+
+impl LabelledSpace {
+    /// The label of sample pair `(ia, ib)`.
+    pub fn label(&self, ia: usize, ib: usize) -> Label {
+        self.labels[ia * self.grid_b.cells.len() + ib]
+    }
+}

@@ -1,0 +1,85 @@
+//! Safe conversions between the C structs and the crate's types (no `unsafe` here).
+
+use crate::cell::{Cell, CellError, Placement, RobotSpec, SatMethod};
+use crate::ffi::types::*;
+use crate::math::Vec3;
+use crate::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
+
+/// The status a cell error maps to.
+pub(crate) fn cell_error_status(e: &CellError) -> DcStatus {
+    match e {
+        CellError::Io(_) => DC_STATUS_IO,
+        CellError::Parse(_) => DC_STATUS_PARSE,
+        CellError::Invalid(_) => DC_STATUS_INVALID_CONFIG,
+    }
+}
+
+fn delta3(g: &DcDelta3) -> Delta3 {
+    Delta3 { f: g.f, rf: g.rf, re: g.re, e: g.e, theta_min: g.theta_min, theta_max: g.theta_max }
+}
+
+fn tool_box(flag: u32, b: &DcBox) -> Option<ToolBox> {
+    (flag != 0).then(|| ToolBox { offset: b.offset.to_vec3(), half: b.half.to_vec3() })
+}
+
+/// A robot from its C description (validated later by [`Cell::new`]).
+pub(crate) fn robot_spec(index: usize, r: &DcRobotConfig) -> RobotSpec {
+    RobotSpec {
+        name: format!("robot {index}"),
+        model: RobotModel {
+            delta: delta3(&r.geometry),
+            options: ModelOptions {
+                half_height: r.half_height,
+                half_depth: r.half_depth,
+                margin: r.margin,
+                upper_links: (r.has_upper_links != 0).then_some((r.upper_half_height, r.upper_half_depth)),
+                platform: tool_box(r.has_platform, &r.platform),
+                tool: tool_box(r.has_tool, &r.tool),
+            },
+        },
+        placement: Placement { alpha: r.alpha, t: r.translation.to_vec3() },
+    }
+}
+
+/// A validated cell from the C robots and method code.
+pub(crate) fn cell_from_c(robots: &[DcRobotConfig], method: u32) -> Result<Cell, DcStatus> {
+    let method = match method {
+        DC_METHOD_SAT => SatMethod::Sat,
+        DC_METHOD_SAT_CACHE => SatMethod::SatCache,
+        _ => return Err(DC_STATUS_INVALID_CONFIG),
+    };
+    let specs = robots.iter().enumerate().map(|(i, r)| robot_spec(i, r)).collect();
+    Cell::new("C config".into(), specs, method).map_err(|e| cell_error_status(&e))
+}
+
+/// The thesis robot as a C config, placed at the WCS origin.
+pub(crate) fn thesis_robot_config() -> DcRobotConfig {
+    let (d, o) = (Delta3::THESIS, ModelOptions::THESIS);
+    let zero = DcVec3::from_vec3(&Vec3::zeros());
+    DcRobotConfig {
+        geometry: DcDelta3 { f: d.f, rf: d.rf, re: d.re, e: d.e, theta_min: d.theta_min, theta_max: d.theta_max },
+        half_height: o.half_height,
+        half_depth: o.half_depth,
+        margin: o.margin,
+        has_upper_links: 0,
+        upper_half_height: 0.0,
+        upper_half_depth: 0.0,
+        has_platform: 0,
+        platform: DcBox { offset: zero, half: zero },
+        has_tool: 0,
+        tool: DcBox { offset: zero, half: zero },
+        alpha: 0.0,
+        translation: zero,
+    }
+}
+
+/// The C geometry as a validated [`Delta3`].
+pub(crate) fn delta3_from_c(g: &DcDelta3) -> Result<Delta3, DcStatus> {
+    let d = delta3(g);
+    let all = [g.f, g.rf, g.re, g.e, g.theta_min, g.theta_max];
+    if !all.iter().all(|v| v.is_finite()) {
+        return Err(DC_STATUS_NON_FINITE);
+    }
+    d.validate().map_err(|_| DC_STATUS_INVALID_CONFIG)?;
+    Ok(d)
+}

@@ -1,0 +1,192 @@
+//! The C-visible data types and codes of the ABI (thesis appendix A: the POU's interface).
+//!
+//! Numbers of statuses and verdicts are never reused. Enumerations are plain `u32` in C, so
+//! a C caller can pass any value: Rust validates every one it reads.
+
+use crate::math::Vec3;
+
+/// Result code of every fallible function; `DC_STATUS_OK` is 0.
+pub type DcStatus = u32;
+/// The call succeeded.
+pub const DC_STATUS_OK: DcStatus = 0;
+/// A required pointer argument is NULL.
+pub const DC_STATUS_NULL_POINTER: DcStatus = 1;
+/// An input number is NaN or infinite.
+pub const DC_STATUS_NON_FINITE: DcStatus = 2;
+/// A TCP cannot be reached; the report's `unreachable_mask` says which robot.
+pub const DC_STATUS_UNREACHABLE: DcStatus = 3;
+/// A configuration value is out of range (negative length, no robots, unknown method, ...).
+pub const DC_STATUS_INVALID_CONFIG: DcStatus = 4;
+/// The number of TCPs differs from the number of robots in the cell.
+pub const DC_STATUS_WRONG_ROBOT_COUNT: DcStatus = 5;
+/// A file could not be read.
+pub const DC_STATUS_IO: DcStatus = 6;
+/// A cell file is not valid TOML or does not follow the schema.
+pub const DC_STATUS_PARSE: DcStatus = 7;
+/// An internal error was caught at the boundary; destroy the handle.
+pub const DC_STATUS_PANIC: DcStatus = 8;
+/// An argument is malformed (path not UTF-8, capacity too small, ...).
+pub const DC_STATUS_INVALID_ARGUMENT: DcStatus = 9;
+
+/// What the controller should do; 0 is STOP so that zeroed memory fails closed.
+pub type DcVerdict = u32;
+/// Could not decide (any error): stop the robots.
+pub const DC_VERDICT_STOP: DcVerdict = 0;
+/// No pair of robots collides. Only ever written together with `DC_STATUS_OK`.
+pub const DC_VERDICT_FREE: DcVerdict = 1;
+/// At least one pair of robots collides.
+pub const DC_VERDICT_COLLISION: DcVerdict = 2;
+
+/// Plain separating axis test.
+pub const DC_METHOD_SAT: u32 = 0;
+/// Separating axis test with the two-layer witness cache (thesis 3.1.4).
+pub const DC_METHOD_SAT_CACHE: u32 = 1;
+
+/// "No box" / "no robot" in reports.
+pub const DC_BOX_NONE: u32 = 0xFFFF_FFFF;
+
+/// A point or offset in mm.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DcVec3 {
+    /// x (mm).
+    pub x: f64,
+    /// y (mm).
+    pub y: f64,
+    /// z (mm).
+    pub z: f64,
+}
+
+impl DcVec3 {
+    pub(crate) fn to_vec3(self) -> Vec3 {
+        Vec3::new(self.x, self.y, self.z)
+    }
+
+    pub(crate) fn from_vec3(v: &Vec3) -> Self {
+        DcVec3 { x: v.x, y: v.y, z: v.z }
+    }
+
+    pub(crate) fn is_finite(&self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.z.is_finite()
+    }
+}
+
+/// Delta3 geometry (SPEC section 2): lengths in mm, motor limits in rad.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DcDelta3 {
+    /// MCS origin to motor axis point.
+    pub f: f64,
+    /// Upper link length.
+    pub rf: f64,
+    /// Lower link length.
+    pub re: f64,
+    /// TCP to lower link joint.
+    pub e: f64,
+    /// Lower motor limit (rad).
+    pub theta_min: f64,
+    /// Upper motor limit (rad).
+    pub theta_max: f64,
+}
+
+/// A box at `TCP + offset`, aligned with the robot's MCS, with half-extents `half` (mm).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DcBox {
+    /// Centre relative to the TCP.
+    pub offset: DcVec3,
+    /// Half-extents.
+    pub half: DcVec3,
+}
+
+/// One robot of a cell: geometry, box model and placement.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DcRobotConfig {
+    /// Kinematic parameters.
+    pub geometry: DcDelta3,
+    /// Half-extent H of a lower link box across the parallelogram (70 for the thesis robot).
+    pub half_height: f64,
+    /// Half-extent D of a lower link box in the arm's plane (17.5).
+    pub half_depth: f64,
+    /// Safety margin added to every half-extent of every box (mm, >= 0).
+    pub margin: f64,
+    /// 1: model the upper links too; 0: not (the thesis's choice).
+    pub has_upper_links: u32,
+    /// Upper link half-extent across the motor axis direction.
+    pub upper_half_height: f64,
+    /// Upper link half-extent in the arm's plane.
+    pub upper_half_depth: f64,
+    /// 1: model the moving platform as `platform`.
+    pub has_platform: u32,
+    /// The platform box.
+    pub platform: DcBox,
+    /// 1: model the tool as `tool`.
+    pub has_tool: u32,
+    /// The tool box (must enclose the tool over its whole rotation).
+    pub tool: DcBox,
+    /// Placement: rotation about z (rad).
+    pub alpha: f64,
+    /// Placement: `p_wcs = Rz(alpha) p_mcs + translation` (mm).
+    pub translation: DcVec3,
+}
+
+/// A cell: `n_robots` robot configurations and the exact test to use.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct DcCellConfig {
+    /// Array of `n_robots` robots; robot 0's MCS is normally the WCS.
+    pub robots: *const DcRobotConfig,
+    /// Number of robots, 1 to 32.
+    pub n_robots: usize,
+    /// `DC_METHOD_SAT` or `DC_METHOD_SAT_CACHE`.
+    pub method: u32,
+}
+
+/// Summary of one query, written on every call when the pointer is not NULL.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DcQueryReport {
+    /// Same value as `*out_verdict`.
+    pub verdict: DcVerdict,
+    /// Number of robot pairs that collide.
+    pub colliding_pairs: u32,
+    /// Bit j set: robot j's TCP is unreachable or not finite.
+    pub unreachable_mask: u32,
+    /// First colliding pair's first robot, or `DC_BOX_NONE`.
+    pub first_robot_a: u32,
+    /// First colliding pair's second robot, or `DC_BOX_NONE`.
+    pub first_robot_b: u32,
+    /// Box of `first_robot_a`: 0..2 lower links, then upper links, platform, tool.
+    pub first_box_a: u32,
+    /// Box of `first_robot_b`.
+    pub first_box_b: u32,
+}
+
+impl DcQueryReport {
+    pub(crate) const STOP: DcQueryReport = DcQueryReport {
+        verdict: DC_VERDICT_STOP,
+        colliding_pairs: 0,
+        unreachable_mask: 0,
+        first_robot_a: DC_BOX_NONE,
+        first_robot_b: DC_BOX_NONE,
+        first_box_a: DC_BOX_NONE,
+        first_box_b: DC_BOX_NONE,
+    };
+}
+
+/// One robot pair's result of the last query.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DcPairResult {
+    /// First robot, `robot_a < robot_b`.
+    pub robot_a: u32,
+    /// Second robot.
+    pub robot_b: u32,
+    /// 1 when the pair collides; 0 when free or undecided (see `dc_query`'s status).
+    pub collides: u32,
+    /// Colliding box of `robot_a`, or `DC_BOX_NONE`.
+    pub box_a: u32,
+    /// Colliding box of `robot_b`, or `DC_BOX_NONE`.
+    pub box_b: u32,
+}
