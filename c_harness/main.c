@@ -587,11 +587,11 @@ static void bad_input(const char *tmp_dir)
     bad[1].geometry.theta_min = robots[1].geometry.theta_min;
     bad[1].geometry.theta_max = robots[1].geometry.theta_max;
     {
-        /* NaN in a configuration: INVALID_CONFIG or NON_FINITE are both documented refusals. */
+        /* NaN in a configuration: documented as INVALID_CONFIG. */
         DcCollider *hn = (DcCollider *)(void *)&dummy_object;
         bad[0].translation.x = qnan;
         s = dc_init(&broken, &hn);
-        check((s == DC_STATUS_INVALID_CONFIG || s == DC_STATUS_NON_FINITE) && hn == NULL,
+        check(s == DC_STATUS_INVALID_CONFIG && hn == NULL,
               "bad input, dc_init NaN translation: status %u, handle %s", (unsigned)s, hn == NULL ? "NULL" : "set");
         bad[0].translation.x = 0.0;
     }
@@ -621,7 +621,12 @@ static void bad_input(const char *tmp_dir)
     check(write_file(path, "name = \"bad\"\n[[robot]]\nname = \"A\"\nplacement = { alpha_deg = 30.0, t = [1.0, 2.0] }\n"), "cannot write %s",
           path);
     expect_init_file("wrong schema", path, DC_STATUS_PARSE);
+    check(write_file(path, "[[robot]]\nname = \"A\"\ngeometry = { f = -100.0, rf = 150.0, re = 400.0, e = 40.0, "
+                           "theta_min_deg = -90.0, theta_max_deg = 120.0 }\n"),
+          "cannot write %s", path);
+    expect_init_file("negative f in the file", path, DC_STATUS_INVALID_CONFIG);
     remove(path);
+    expect_init_file("path not UTF-8", "cells/\xff\xfe.toml", DC_STATUS_INVALID_ARGUMENT);
 
     /* Teardown and strings. */
     dc_destroy(NULL); /* a no-op: reaching the next line is the test */
@@ -648,6 +653,10 @@ static void bad_input(const char *tmp_dir)
     check(s == DC_STATUS_UNREACHABLE, "bad input, IK z = -900: %u", (unsigned)s);
     s = dc_delta3_forward_kinematics(&g, NULL, &tcps[0]);
     check(s == DC_STATUS_NULL_POINTER, "bad input, FK NULL theta: %u", (unsigned)s);
+    g.rf = -150.0;
+    s = dc_delta3_inverse_kinematics(&g, vec3(0.0, 0.0, -450.0), theta);
+    check(s == DC_STATUS_INVALID_CONFIG, "bad input, IK negative rf: %u", (unsigned)s);
+    g.rf = 150.0;
     theta[0] = theta[1] = theta[2] = 0.3;
     s = dc_delta3_forward_kinematics(&g, theta, NULL);
     check(s == DC_STATUS_NULL_POINTER, "bad input, FK NULL out_tcp: %u", (unsigned)s);

@@ -5,9 +5,9 @@
 //! is valid C89.
 //!
 //! The static library is the one cargo builds in the same run: the test executable is
-//! `target/<profile>/deps/c_harness-HASH`, the library `target/<profile>/libdelta_collide.a`.
+//! `target/<profile>/deps/c_harness-HASH` and the library lies next to it in `deps/`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, Output};
 
 /// Native libraries the static library needs on Linux (`--print native-static-libs`).
@@ -20,12 +20,19 @@ fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// The static library built in this cargo run. `cargo test` writes it next to the test
+/// executable (`target/<profile>/deps/libdelta_collide.a`) and does not copy it up to
+/// `target/<profile>/` (only `cargo build` does), so the copy there may be stale or absent.
 fn static_lib() -> PathBuf {
     let exe = std::env::current_exe().expect("path of the test executable");
-    let profile_dir = exe.parent().and_then(Path::parent).expect("exe lies in target/<profile>/deps");
-    let lib = profile_dir.join("libdelta_collide.a");
-    assert!(lib.is_file(), "static library not found at {} (crate-type staticlib?)", lib.display());
-    lib
+    let deps_dir = exe.parent().expect("exe lies in target/<profile>/deps");
+    let profile_dir = deps_dir.parent().expect("deps lies in target/<profile>");
+    let candidates = [deps_dir.join("libdelta_collide.a"), profile_dir.join("libdelta_collide.a")];
+    candidates
+        .iter()
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| panic!("static library not found at {candidates:?} (crate-type staticlib?)"))
+        .clone()
 }
 
 fn scratch_dir(name: &str) -> PathBuf {
