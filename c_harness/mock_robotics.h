@@ -1,0 +1,133 @@
+/*
+ * mock_robotics.h: a mock of the controller's robotics API (thesis appendix A.1).
+ *
+ * On the NJ-controller the collision project reaches the kinematics engine and the robot
+ * set-up through a small "robotics API". This mock stands in for it on a desktop:
+ *   - a robot registry: robots with their Delta3 geometry, box sizes and placement
+ *     (SPEC section 1, 2, 3), filled from a hard-coded table of the reference cells
+ *     T1, T2, T3 (SPEC section 5);
+ *   - its own kinematics engine in C (SPEC section 2), written independently of the Rust
+ *     one so that the harness can cross-check the two;
+ *   - a trajectory generator: linear moves between waypoints with the minimum-jerk
+ *     profile s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5, read from c_harness/scenarios.txt;
+ *   - a 1 ms tick clock.
+ * Units: mm and rad everywhere. TCPs are in each robot's own MCS.
+ * C99, no VLAs, no dynamic allocation: every buffer is a fixed-size array.
+ */
+#ifndef MOCK_ROBOTICS_H
+#define MOCK_ROBOTICS_H
+
+#include <stddef.h>
+
+#define MR_MAX_ROBOTS 4
+#define MR_MAX_WAYPOINTS 64
+#define MR_TICKS_PER_RUN 6000
+#define MR_TICK_PERIOD_US 1000
+#define MR_NAME_LEN 32
+
+/* Status of a mock call. */
+typedef enum MrStatus {
+    MR_OK = 0,
+    MR_NON_FINITE = 1,   /* an input is NaN or infinite */
+    MR_OUT_OF_REACH = 2, /* an arm cannot close its loop (b^2 > re^2 or |K| > R) */
+    MR_MOTOR_LIMIT = 3,  /* the elbow-out angle is outside the motor limits */
+    MR_NO_SOLUTION = 4,  /* forward kinematics: the three spheres do not meet */
+    MR_NOT_FOUND = 5,    /* unknown cell, case or robot */
+    MR_IO = 6,           /* a file could not be read */
+    MR_PARSE = 7,        /* a line of a file is malformed */
+    MR_FULL = 8          /* a fixed-size table is full */
+} MrStatus;
+
+/* Delta3 geometry (SPEC section 2). */
+typedef struct MrGeometry {
+    double f, rf, re, e;
+    double theta_min, theta_max;
+} MrGeometry;
+
+/* One registered robot: geometry, box model sizes and placement p_wcs = Rz(alpha) p_mcs + t. */
+typedef struct MrRobot {
+    char name[MR_NAME_LEN];
+    MrGeometry geometry;
+    double half_height; /* H of a lower link box */
+    double half_depth;  /* D of a lower link box */
+    double margin;
+    double alpha;
+    double translation[3];
+} MrRobot;
+
+/* A cell: the registry of robots the controller drives. */
+typedef struct MrCell {
+    char name[MR_NAME_LEN];
+    size_t n_robots;
+    MrRobot robots[MR_MAX_ROBOTS];
+} MrCell;
+
+/* The trajectory of one robot: waypoints (tick, TCP in its MCS) in increasing tick order. */
+typedef struct MrTrajectory {
+    size_t n_waypoints;
+    long tick[MR_MAX_WAYPOINTS];
+    double tcp[MR_MAX_WAYPOINTS][3];
+} MrTrajectory;
+
+/* A scenario: one cell and case, one trajectory per robot. */
+typedef struct MrScenario {
+    char cell[MR_NAME_LEN];
+    char name[MR_NAME_LEN];
+    size_t n_robots;
+    MrTrajectory robots[MR_MAX_ROBOTS];
+} MrScenario;
+
+/* The tick clock of the controller's motion task. */
+typedef struct MrClock {
+    long tick;
+    long period_us;
+} MrClock;
+
+/* Short text for a status. */
+const char *mr_status_str(MrStatus status);
+
+/* Registry: fills *out with the reference cell "T1", "T2" or "T3". */
+MrStatus mr_register_cell(const char *name, MrCell *out);
+
+/* The thesis robot (f 100, rf 150, re 400, e 40, limits [-pi/2, 2pi/3], H 70, D 17.5). */
+MrRobot mr_thesis_robot(const char *name, double alpha, double tx, double ty, double tz);
+
+/* Elbow-out inverse kinematics: motor angles theta[3] in (-pi, pi] for a TCP in the MCS. */
+MrStatus mr_inverse_kinematics(const MrGeometry *g, const double tcp[3], double theta[3]);
+
+/* Forward kinematics: the lower intersection of the three spheres, the TCP in the MCS. */
+MrStatus mr_forward_kinematics(const MrGeometry *g, const double theta[3], double tcp[3]);
+
+/* Minimum-jerk profile s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5, tau clamped to [0, 1]. */
+double mr_min_jerk(double tau);
+
+/* Commanded TCP of a trajectory at a tick: holds the first waypoint before its tick, moves
+ * linearly (min-jerk in time) between consecutive waypoints, holds the last one after it. */
+void mr_trajectory_tcp(const MrTrajectory *traj, long tick, double out[3]);
+
+/* Reads the scenario (cell, case) from a scenarios file (format at the top of the file).
+ * Every robot 0..n_robots-1 must have at least one waypoint. */
+MrStatus mr_load_scenario(const char *path, const char *cell, const char *name, size_t n_robots,
+                          MrScenario *out);
+
+/* Robotics API view of one tick: for each robot, the commanded TCP from its trajectory,
+ * the motor angles from the C inverse kinematics, and the TCP the forward kinematics
+ * delivers back (what the collision project reads). Robots with stopped[j] != 0 hold
+ * held_tcp[j] instead of following the trajectory. */
+typedef struct MrTickState {
+    double commanded[MR_MAX_ROBOTS][3];
+    double theta[MR_MAX_ROBOTS][3];
+    double tcp[MR_MAX_ROBOTS][3];
+    MrStatus status[MR_MAX_ROBOTS];
+} MrTickState;
+
+/* Fills *state for one tick; returns the first non-OK status of any robot (MR_OK if none). */
+MrStatus mr_robot_state(const MrCell *cell, const MrScenario *scenario, long tick,
+                        const int stopped[MR_MAX_ROBOTS],
+                        const double held_tcp[MR_MAX_ROBOTS][3], MrTickState *state);
+
+/* Clock: starts at tick 0 with a 1 ms period; advance moves one tick. */
+void mr_clock_start(MrClock *clock);
+void mr_clock_advance(MrClock *clock);
+
+#endif /* MOCK_ROBOTICS_H */
