@@ -26,7 +26,7 @@
 /*
  "No box" / "no robot" in reports.
  */
-#define DC_BOX_NONE 4294967295
+#define DC_BOX_NONE UINT32_MAX
 
 /*
  An initialised collision checker for one cell (opaque to C).

@@ -43,7 +43,7 @@ pub const DC_METHOD_SAT: u32 = 0;
 pub const DC_METHOD_SAT_CACHE: u32 = 1;
 
 /// "No box" / "no robot" in reports.
-pub const DC_BOX_NONE: u32 = 0xFFFF_FFFF;
+pub const DC_BOX_NONE: u32 = u32::MAX;
 
 /// A point or offset in mm.
 #[repr(C)]
