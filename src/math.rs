@@ -13,7 +13,7 @@ pub type Mat3 = nalgebra::Matrix3<Real>;
 
 /// Added to every `|R_ij|` of the separating axis test, so that nearly parallel edges
 /// (where the cross-product axis degenerates) err toward overlap (Gottschalk, Coal/FCL).
-pub const SAT_EPSILON: Real = 1e-6;
+pub const SAT_EPSILON: Real = 1e-12;
 
 /// Slack, in mm, added to every box half-extent comparison of the separating axis test: an
 /// axis separates only when the gap exceeds this, so touching boxes (and boxes whose gap is
