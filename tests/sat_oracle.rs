@@ -40,12 +40,19 @@ fn obb(q: &[Real; 4], c: &[Real; 3], h: &[Real; 3]) -> Obb {
 }
 
 fn pose(q: &[Real; 4], c: &[Real; 3]) -> Pose {
-    Pose::from_parts(Vector::new(c[0], c[1], c[2]), Rotation::from_xyzw(q[0], q[1], q[2], q[3]))
+    Pose::from_parts(
+        Vector::new(c[0], c[1], c[2]),
+        Rotation::from_xyzw(q[0], q[1], q[2], q[3]),
+    )
 }
 
 impl Case {
     fn ours_free(&self) -> bool {
-        separating_axis(&obb(&self.qa, &self.ca, &self.ha), &obb(&self.qb, &self.cb, &self.hb)).is_some()
+        separating_axis(
+            &obb(&self.qa, &self.ca, &self.ha),
+            &obb(&self.qb, &self.cb, &self.hb),
+        )
+        .is_some()
     }
 
     fn parry_parts(&self) -> (Pose, Cuboid, Pose, Cuboid) {
@@ -59,7 +66,9 @@ impl Case {
 
     fn parry_intersects(&self) -> bool {
         let (pa, sa, pb, sb) = self.parry_parts();
-        query::intersection_test(&pa, &sa, &pb, &sb).unwrap().intersecting
+        query::intersection_test(&pa, &sa, &pb, &sb)
+            .unwrap()
+            .intersecting
     }
 
     fn parry_distance(&self) -> Real {
@@ -71,7 +80,10 @@ impl Case {
     /// disjoint boxes and an upper bound on the distance always (a second opinion where parry's
     /// GJK distance stalls on nearly parallel faces).
     fn feature_distance(&self) -> Real {
-        let (a, b) = (obb(&self.qa, &self.ca, &self.ha), obb(&self.qb, &self.cb, &self.hb));
+        let (a, b) = (
+            obb(&self.qa, &self.ca, &self.ha),
+            obb(&self.qb, &self.cb, &self.hb),
+        );
         let (va, vb) = (a.vertices(), b.vertices());
         let mut d = Real::MAX;
         for v in &va {
@@ -97,7 +109,11 @@ fn point_box_distance(p: &Vec3, b: &Obb) -> Real {
 
 /// The 12 edges of a box from its vertices (indexed by sign bits, as `Obb::vertices`).
 fn box_edges(v: &[Vec3; 8]) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
-    (0..8).flat_map(move |i| (0..3).filter(move |k| i >> k & 1 == 0).map(move |k| (v[i], v[i | 1 << k])))
+    (0..8).flat_map(move |i| {
+        (0..3)
+            .filter(move |k| i >> k & 1 == 0)
+            .map(move |k| (v[i], v[i | 1 << k]))
+    })
 }
 
 /// Distance between segments `p0 p1` and `q0 q1` (Ericson, Real-Time Collision Detection 5.1.9).
@@ -107,7 +123,11 @@ fn segment_distance(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> Real {
     let c = d1.dot(&r);
     let b = d1.dot(&d2);
     let denom = a * e - b * b;
-    let mut s = if denom > 0.0 { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+    let mut s = if denom > 0.0 {
+        ((b * f - c * e) / denom).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let mut t = (b * s + f) / e;
     if t < 0.0 {
         t = 0.0;
@@ -155,7 +175,11 @@ fn axis_quat(k: usize, angle: Real) -> [Real; 4] {
 
 fn random_unit(rng: &mut StdRng) -> Vec3 {
     loop {
-        let v = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let v = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
         let n = v.norm();
         if n > 1e-3 && n <= 1.0 {
             return v / n;
@@ -171,8 +195,16 @@ fn random_half(rng: &mut StdRng) -> [Real; 3] {
             [200.0 * s, 70.0 * s, 17.5 * s]
         }
         1 => std::array::from_fn(|_| rng.random_range(1.0..300.0)),
-        2 => [rng.random_range(10.0..300.0), rng.random_range(10.0..300.0), rng.random_range(0.01..1.0)],
-        _ => [rng.random_range(10.0..300.0), rng.random_range(0.01..1.0), rng.random_range(0.01..1.0)],
+        2 => [
+            rng.random_range(10.0..300.0),
+            rng.random_range(10.0..300.0),
+            rng.random_range(0.01..1.0),
+        ],
+        _ => [
+            rng.random_range(10.0..300.0),
+            rng.random_range(0.01..1.0),
+            rng.random_range(0.01..1.0),
+        ],
     };
     let k = rng.random_range(0..3);
     h.swap(0, k);
@@ -191,12 +223,24 @@ fn uniform_case(rng: &mut StdRng) -> Case {
     let reach = ha.iter().chain(&hb).cloned().fold(0.0, Real::max) * 1.2;
     let ca: [Real; 3] = std::array::from_fn(|_| rng.random_range(-1000.0..1000.0));
     let cb: [Real; 3] = std::array::from_fn(|k| ca[k] + rng.random_range(-reach..reach));
-    Case { qa: random_quat(rng), ca, ha, qb: random_quat(rng), cb, hb }
+    Case {
+        qa: random_quat(rng),
+        ca,
+        ha,
+        qb: random_quat(rng),
+        cb,
+        hb,
+    }
 }
 
 /// B placed at a controlled gap `+-10^log10_gap` mm from A along a direction that is random,
 /// a face normal of A or B, or the cross product of an edge of each, with a lateral offset.
-fn near_touching(rng: &mut StdRng, qa: [Real; 4], qb: [Real; 4], log10_gap: std::ops::Range<Real>) -> Case {
+fn near_touching(
+    rng: &mut StdRng,
+    qa: [Real; 4],
+    qb: [Real; 4],
+    log10_gap: std::ops::Range<Real>,
+) -> Case {
     let (ha, hb) = (random_half(rng), random_half(rng));
     let (ma, mb) = (matrix(&qa), matrix(&qb));
     let sign = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
@@ -205,22 +249,41 @@ fn near_touching(rng: &mut StdRng, qa: [Real; 4], qb: [Real; 4], log10_gap: std:
         1 => ma.column(rng.random_range(0..3)).into_owned() * sign,
         2 => mb.column(rng.random_range(0..3)).into_owned() * sign,
         _ => {
-            let c = ma.column(rng.random_range(0..3)).cross(&mb.column(rng.random_range(0..3)));
-            if c.norm() < 1e-6 { random_unit(rng) } else { c.normalize() * sign }
+            let c = ma
+                .column(rng.random_range(0..3))
+                .cross(&mb.column(rng.random_range(0..3)));
+            if c.norm() < 1e-6 {
+                random_unit(rng)
+            } else {
+                c.normalize() * sign
+            }
         }
     };
-    let gap = 10f64.powf(rng.random_range(log10_gap)) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    let gap =
+        10f64.powf(rng.random_range(log10_gap)) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
     let ca: [Real; 3] = std::array::from_fn(|_| rng.random_range(-1000.0..1000.0));
     // A lateral shift orthogonal to n, up to a fraction of the smaller box.
     let lateral = {
         let v = random_unit(rng);
         let v = v - n * n.dot(&v);
-        let s = ha.iter().chain(&hb).cloned().fold(Real::MAX, Real::min).max(1.0);
+        let s = ha
+            .iter()
+            .chain(&hb)
+            .cloned()
+            .fold(Real::MAX, Real::min)
+            .max(1.0);
         v * rng.random_range(0.0..s)
     };
     let d = n * (support(&qa, &ha, &n) + support(&qb, &hb, &n) + gap) + lateral;
     let cb = [ca[0] + d.x, ca[1] + d.y, ca[2] + d.z];
-    Case { qa, ca, ha, qb, cb, hb }
+    Case {
+        qa,
+        ca,
+        ha,
+        qb,
+        cb,
+        hb,
+    }
 }
 
 /// B's orientation with one axis parallel or anti-parallel to one of A's axes, exactly (A
@@ -298,7 +361,10 @@ impl Tally {
                     self.ours_collide_parry_within_band += 1;
                     self.max_band_distance = self.max_band_distance.max(dist);
                 } else {
-                    self.fail(case, format!("ours collision, parry separated by {dist:e} mm"));
+                    self.fail(
+                        case,
+                        format!("ours collision, parry separated by {dist:e} mm"),
+                    );
                 }
             }
         }
@@ -324,7 +390,11 @@ impl Tally {
         for (case, why) in self.failures.iter().take(20) {
             println!("    // {why}\n    {case:?},");
         }
-        assert!(self.failures.is_empty(), "{name}: {} disagreements outside the policy", self.failures.len());
+        assert!(
+            self.failures.is_empty(),
+            "{name}: {} disagreements outside the policy",
+            self.failures.len()
+        );
     }
 }
 
@@ -341,7 +411,10 @@ fn run(name: &str, seed: u64, n: usize, mut gen: impl FnMut(&mut StdRng) -> Case
 #[test]
 fn uniform_random_pairs_agree_with_parry() {
     let t = run("uniform", 1, 400_000, uniform_case);
-    assert!(t.both_collide > 100_000 && t.both_free > 100_000, "a real mix of verdicts");
+    assert!(
+        t.both_collide > 100_000 && t.both_free > 100_000,
+        "a real mix of verdicts"
+    );
 }
 
 #[test]
@@ -350,7 +423,10 @@ fn near_touching_pairs_agree_with_parry() {
         let (qa, qb) = (random_quat(rng), random_quat(rng));
         near_touching(rng, qa, qb, -4.0..0.0)
     });
-    assert!(t.both_collide > 20_000 && t.both_free > 50_000, "a real mix of verdicts");
+    assert!(
+        t.both_collide > 20_000 && t.both_free > 50_000,
+        "a real mix of verdicts"
+    );
 }
 
 #[test]
@@ -360,10 +436,17 @@ fn parallel_and_antiparallel_pairs_agree_with_parry() {
         if rng.random_bool(0.5) {
             near_touching(rng, qa, qb, -4.0..0.0)
         } else {
-            Case { qa, qb, ..uniform_case(rng) }
+            Case {
+                qa,
+                qb,
+                ..uniform_case(rng)
+            }
         }
     });
-    assert!(t.both_collide > 20_000 && t.both_free > 20_000, "a real mix of verdicts");
+    assert!(
+        t.both_collide > 20_000 && t.both_free > 20_000,
+        "a real mix of verdicts"
+    );
 }
 
 #[test]
@@ -372,7 +455,10 @@ fn nearly_parallel_near_touching_pairs_agree_with_parry() {
         let (qa, qb) = nearly_parallel_orientations(rng);
         near_touching(rng, qa, qb, -4.0..0.0)
     });
-    assert!(t.both_collide > 5_000 && t.both_free > 5_000, "a real mix of verdicts");
+    assert!(
+        t.both_collide > 5_000 && t.both_free > 5_000,
+        "a real mix of verdicts"
+    );
 }
 
 /// Cases once found by the random runs, pasted back as printed.
@@ -381,11 +467,52 @@ fn regressions() {
     let cases = [
         // Parallel y axes, true gap 1e-4 mm along B's x: parry's GJK distance stalled at 5.03 mm,
         // and SAT_EPSILON = 1e-6 made ours report a collision.
-        Case { qa: [0.0, 0.0, 0.0, 1.0], ca: [-499.4063285323844, -513.1341135416737, 545.0559513704], ha: [68.35093023644366, 252.26136124196114, 136.05417091179672], qb: [0.0, 0.009245647161966375, 0.0, 0.9999572580908428], cb: [-419.1678508381914, -511.80217675208115, 552.3759287669375], hb: [9.234354021183707, 186.48194961734185, 213.8524478991838] },
+        Case {
+            qa: [0.0, 0.0, 0.0, 1.0],
+            ca: [-499.4063285323844, -513.1341135416737, 545.0559513704],
+            ha: [68.35093023644366, 252.26136124196114, 136.05417091179672],
+            qb: [0.0, 0.009245647161966375, 0.0, 0.9999572580908428],
+            cb: [-419.1678508381914, -511.80217675208115, 552.3759287669375],
+            hb: [9.234354021183707, 186.48194961734185, 213.8524478991838],
+        },
         // Anti-parallel needle, true gap 1.25e-4 mm: parry's GJK distance stalled at 79.7 mm.
-        Case { qa: [-0.3715170064936598, 0.8951385366866326, 0.10635967402752275, -0.2222380115220238], ca: [-18.64460092687409, 310.09414247025234, -38.19754448636604], ha: [67.46295673206116, 192.75130494874614, 16.86573918301529], qb: [-0.618093019075355, 0.09744506938078926, -0.688590859494412, -0.3664807040547061], cb: [23.846096168927048, 358.09413758955066, -60.507486903315424], hb: [0.6358309541148788, 0.4089801293336501, 299.2653327385397] },
+        Case {
+            qa: [
+                -0.3715170064936598,
+                0.8951385366866326,
+                0.10635967402752275,
+                -0.2222380115220238,
+            ],
+            ca: [-18.64460092687409, 310.09414247025234, -38.19754448636604],
+            ha: [67.46295673206116, 192.75130494874614, 16.86573918301529],
+            qb: [
+                -0.618093019075355,
+                0.09744506938078926,
+                -0.688590859494412,
+                -0.3664807040547061,
+            ],
+            cb: [23.846096168927048, 358.09413758955066, -60.507486903315424],
+            hb: [0.6358309541148788, 0.4089801293336501, 299.2653327385397],
+        },
         // Large boxes 2.4e-3 mm apart: SAT_EPSILON = 1e-6 on |R| reported a collision.
-        Case { qa: [0.43259627381925025, -0.256195703428533, 0.04268114038697688, -0.8633669820405031], ca: [-711.3121573668058, -977.959802334337, -577.9318842893724], ha: [128.53829367670915, 110.70228415126523, 217.22105916965006], qb: [0.6395188695689836, -0.6030284929141175, -0.03894701330515094, 0.47524244586689185], cb: [-1220.9420474569777, -1162.7152436951196, -605.8336859246883], hb: [259.05881398088934, 235.25881787681757, 197.60835048338032] },
+        Case {
+            qa: [
+                0.43259627381925025,
+                -0.256195703428533,
+                0.04268114038697688,
+                -0.8633669820405031,
+            ],
+            ca: [-711.3121573668058, -977.959802334337, -577.9318842893724],
+            ha: [128.53829367670915, 110.70228415126523, 217.22105916965006],
+            qb: [
+                0.6395188695689836,
+                -0.6030284929141175,
+                -0.03894701330515094,
+                0.47524244586689185,
+            ],
+            cb: [-1220.9420474569777, -1162.7152436951196, -605.8336859246883],
+            hb: [259.05881398088934, 235.25881787681757, 197.60835048338032],
+        },
     ];
     let mut tally = Tally::default();
     for case in cases {
@@ -400,7 +527,11 @@ fn regressions() {
 #[test]
 fn very_near_touching_pairs_err_toward_collision() {
     run("very near", 5, 50_000, |rng| {
-        let (qa, qb) = if rng.random_bool(0.5) { parallel_orientations(rng) } else { (random_quat(rng), random_quat(rng)) };
+        let (qa, qb) = if rng.random_bool(0.5) {
+            parallel_orientations(rng)
+        } else {
+            (random_quat(rng), random_quat(rng))
+        };
         near_touching(rng, qa, qb, -9.0..-4.0)
     });
 }
@@ -412,17 +543,33 @@ fn boxed(c: [Real; 3], m: Mat3, h: [Real; 3]) -> Obb {
 }
 
 fn assert_collide(a: &Obb, b: &Obb, what: &str) {
-    assert!(separating_axis(a, b).is_none(), "{what}: touching boxes must collide\n    a = {a:?}\n    b = {b:?}");
-    assert!(separating_axis(b, a).is_none(), "{what} (swapped): touching boxes must collide");
+    assert!(
+        separating_axis(a, b).is_none(),
+        "{what}: touching boxes must collide\n    a = {a:?}\n    b = {b:?}"
+    );
+    assert!(
+        separating_axis(b, a).is_none(),
+        "{what} (swapped): touching boxes must collide"
+    );
 }
 
 fn assert_free(a: &Obb, b: &Obb, what: &str) {
-    assert!(separating_axis(a, b).is_some(), "{what}: separated boxes must be free\n    a = {a:?}\n    b = {b:?}");
+    assert!(
+        separating_axis(a, b).is_some(),
+        "{what}: separated boxes must be free\n    a = {a:?}\n    b = {b:?}"
+    );
 }
 
 /// All 48 signed permutation matrices: exact rotations (and reflections, harmless here).
 fn signed_permutations() -> Vec<Mat3> {
-    let perms = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+    let perms = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
     let mut out = Vec::new();
     for p in perms {
         for s in 0..8 {
@@ -483,9 +630,17 @@ fn exactly_touching_faces_with_rotated_box_collide() {
             m[(k2, k2)] = angle.cos();
             let mut c = [0.0; 3];
             c[k] = ha[k] + hb[k];
-            assert_collide(&boxed([0.0; 3], Mat3::identity(), ha), &boxed(c, m, hb), "face-face rotated");
+            assert_collide(
+                &boxed([0.0; 3], Mat3::identity(), ha),
+                &boxed(c, m, hb),
+                "face-face rotated",
+            );
             c[k] += 1.0 / 1024.0;
-            assert_free(&boxed([0.0; 3], Mat3::identity(), ha), &boxed(c, m, hb), "face-face rotated, apart");
+            assert_free(
+                &boxed([0.0; 3], Mat3::identity(), ha),
+                &boxed(c, m, hb),
+                "face-face rotated, apart",
+            );
         }
     }
 }
@@ -502,18 +657,36 @@ fn rotation(roll: Real, pitch: Real, yaw: Real) -> Mat3 {
 #[test]
 fn crossed_edges_touching_collide() {
     let q = std::f64::consts::FRAC_PI_4;
-    for (s, &(ha, hb)) in [([200.0, 70.0, 70.0], [17.5, 200.0, 17.5]), ([50.0, 3.0, 8.0], [2.0, 90.0, 11.0])].iter().enumerate() {
+    for (s, &(ha, hb)) in [
+        ([200.0, 70.0, 70.0], [17.5, 200.0, 17.5]),
+        ([50.0, 3.0, 8.0], [2.0, 90.0, 11.0]),
+    ]
+    .iter()
+    .enumerate()
+    {
         let ma = rotation(q, 0.0, 0.0);
         let mb = rotation(0.0, q, 0.0);
         let top_a = (ha[1] + ha[2]) * q.sin();
         let bottom_b = (hb[0] + hb[2]) * q.sin();
         for step in 0..50 {
-            let scene = rotation(step as Real * 0.37, step as Real * 0.11 - 1.0, step as Real * 0.23);
+            let scene = rotation(
+                step as Real * 0.37,
+                step as Real * 0.11 - 1.0,
+                step as Real * 0.23,
+            );
             let shift = Vec3::new(step as Real * 13.0, -500.0, 250.0);
             let a = Obb::new(shift, scene * ma, Vec3::from(ha));
-            let b = Obb::new(scene * Vec3::new(3.0, -5.0, top_a + bottom_b) + shift, scene * mb, Vec3::from(hb));
+            let b = Obb::new(
+                scene * Vec3::new(3.0, -5.0, top_a + bottom_b) + shift,
+                scene * mb,
+                Vec3::from(hb),
+            );
             assert_collide(&a, &b, &format!("crossed edges, set {s}, step {step}"));
-            let b_up = Obb::new(scene * Vec3::new(3.0, -5.0, top_a + bottom_b + 1e-3) + shift, scene * mb, Vec3::from(hb));
+            let b_up = Obb::new(
+                scene * Vec3::new(3.0, -5.0, top_a + bottom_b + 1e-3) + shift,
+                scene * mb,
+                Vec3::from(hb),
+            );
             assert_free(&a, &b_up, "crossed edges 1e-3 mm apart");
         }
     }
@@ -529,13 +702,21 @@ fn vertex_on_face_touching_collides() {
         let spin = rotation(0.0, 0.0, step as Real * 0.031);
         // Turn B's diagonal (1, 1, 1)-corner direction onto -z.
         let diag = hb.normalize();
-        let tilt = *nalgebra::Rotation3::rotation_between(&diag, &-Vec3::z()).unwrap().matrix();
+        let tilt = *nalgebra::Rotation3::rotation_between(&diag, &-Vec3::z())
+            .unwrap()
+            .matrix();
         let mb = spin * tilt;
         let lowest = (0..3).map(|k| mb.column(k).z.abs() * hb[k]).sum::<Real>();
         let scene = rotation(step as Real * 0.05, -0.7, step as Real * 0.013);
         let shift = Vec3::new(-300.0, 400.0 + step as Real, 10.0);
         let a = Obb::new(shift, scene, Vec3::from(ha));
-        let place = |dz: Real| Obb::new(scene * Vec3::new(-50.0, 20.0, ha[2] + lowest + dz) + shift, scene * mb, hb);
+        let place = |dz: Real| {
+            Obb::new(
+                scene * Vec3::new(-50.0, 20.0, ha[2] + lowest + dz) + shift,
+                scene * mb,
+                hb,
+            )
+        };
         assert_collide(&a, &place(0.0), &format!("vertex on face, step {step}"));
         assert_collide(&a, &place(-1e-3), "vertex 1e-3 mm into the face");
         assert_free(&a, &place(1e-3), "vertex 1e-3 mm above the face");
@@ -548,7 +729,8 @@ fn vertex_on_face_touching_collides() {
 /// asserting every step: collision exactly when `|offset| <= touch`, touching included.
 fn sweep(a: &Obb, hb: Vec3, mb: Mat3, k: usize, touch: Real, lateral: Vec3) {
     let mut offsets: Vec<Real> = (-2000..=2000).map(|i| i as Real / 4.0).collect();
-    offsets.extend((-256..=256).flat_map(|i| [touch + i as Real / 64.0, -touch + i as Real / 64.0]));
+    offsets
+        .extend((-256..=256).flat_map(|i| [touch + i as Real / 64.0, -touch + i as Real / 64.0]));
     offsets.extend([touch, -touch]);
     for off in offsets {
         let mut c = lateral;
@@ -567,7 +749,10 @@ fn sweep(a: &Obb, hb: Vec3, mb: Mat3, k: usize, touch: Real, lateral: Vec3) {
 fn sweeps_through_a_box_along_each_axis() {
     let ha = Vec3::new(200.0, 70.0, 17.5);
     let hb = Vec3::new(10.0, 5.0, 2.0);
-    for (frame, center) in [(Mat3::identity(), Vec3::zeros()), (rotation(0.4, -1.2, 2.5), Vec3::new(812.0, -97.5, -430.25))] {
+    for (frame, center) in [
+        (Mat3::identity(), Vec3::zeros()),
+        (rotation(0.4, -1.2, 2.5), Vec3::new(812.0, -97.5, -430.25)),
+    ] {
         let a = Obb::new(center, frame, ha);
         for k in 0..3 {
             // B axis-aligned with A: exact touching offsets.

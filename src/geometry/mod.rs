@@ -5,5 +5,5 @@ pub mod sat;
 pub mod witness;
 
 pub use obb::Obb;
-pub use sat::{obbs_intersect, separating_axis, separating_axis_hinted, Axis, PreparedBox};
+pub use sat::{obbs_intersect, separating_axis, separating_axis_hinted, Axis};
 pub use witness::{first_intersecting_pair, WitnessCache};

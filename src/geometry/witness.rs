@@ -7,56 +7,34 @@
 //! separated it last time and tries it first. Both only reorder work: whether some pair
 //! intersects is always the plain test's answer.
 //!
-//! Each box is brought once per query into the flat [`PreparedBox`] form, and each pair
-//! first gets a world-AABB pre-reject (exact-safe: AABBs enclose their boxes).
+//! Each box's world AABB is computed once per query and each pair first gets an AABB
+//! pre-reject (exact-safe: AABBs enclose their boxes), then the 15-axis test.
 
 use crate::geometry::obb::Obb;
 use crate::geometry::sat::{
-    aabbs_disjoint, separating_axis_prepared, separating_axis_prepared_hinted, Axis, PreparedBox,
+    aabb_half_rounded_up, aabbs_disjoint, separating_axis, separating_axis_hinted, Axis,
 };
+use crate::math::Real;
 
 /// Most boxes one robot model may have (3 lower links, 3 upper links, platform, tool).
 pub const MAX_BOXES: usize = 8;
 
-/// Up to [`MAX_BOXES`] boxes in prepared form, on the stack.
-struct PreparedSet {
-    boxes: [PreparedBox; MAX_BOXES],
-    len: usize,
-}
-
-impl PreparedSet {
-    /// # Panics
-    /// When `boxes` holds more than [`MAX_BOXES`] boxes.
-    #[inline]
-    fn new(boxes: &[Obb]) -> Self {
-        assert!(boxes.len() <= MAX_BOXES, "at most {MAX_BOXES} boxes per robot, got {}", boxes.len());
-        let prepared = core::array::from_fn(|k| boxes.get(k).map_or(PreparedBox::ZERO, PreparedBox::new));
-        PreparedSet { boxes: prepared, len: boxes.len() }
-    }
-
-    #[inline]
-    fn as_slice(&self) -> &[PreparedBox] {
-        &self.boxes[..self.len]
-    }
-}
-
-/// Whether two prepared boxes intersect: AABB pre-reject, then the 15-axis test.
+/// The rounded-up AABB half-extents of up to [`MAX_BOXES`] boxes, filled in place.
+///
+/// # Panics
+/// When `boxes` holds more than [`MAX_BOXES`] boxes.
 #[inline(always)]
-fn prepared_intersect(a: &PreparedBox, b: &PreparedBox) -> bool {
-    !aabbs_disjoint(a, b) && separating_axis_prepared(a, b).is_none()
-}
-
-/// The first pair `(i, j)` in row-major order with `a[i]` intersecting `b[j]`, or `None`,
-/// for boxes already in prepared form.
-pub fn first_intersecting_pair_prepared(a: &[PreparedBox], b: &[PreparedBox]) -> Option<(usize, usize)> {
-    for (i, pa) in a.iter().enumerate() {
-        for (j, pb) in b.iter().enumerate() {
-            if prepared_intersect(pa, pb) {
-                return Some((i, j));
-            }
-        }
+fn aabbs(boxes: &[Obb]) -> [[Real; 3]; MAX_BOXES] {
+    assert!(
+        boxes.len() <= MAX_BOXES,
+        "at most {MAX_BOXES} boxes per robot, got {}",
+        boxes.len()
+    );
+    let mut out = [[0.0; 3]; MAX_BOXES];
+    for (e, b) in out.iter_mut().zip(boxes) {
+        *e = aabb_half_rounded_up(b);
     }
-    None
+    out
 }
 
 /// The first pair `(i, j)` in row-major order with `a[i]` intersecting `b[j]`, or `None`.
@@ -64,8 +42,15 @@ pub fn first_intersecting_pair_prepared(a: &[PreparedBox], b: &[PreparedBox]) ->
 /// # Panics
 /// When either slice holds more than [`MAX_BOXES`] boxes.
 pub fn first_intersecting_pair(a: &[Obb], b: &[Obb]) -> Option<(usize, usize)> {
-    let (pa, pb) = (PreparedSet::new(a), PreparedSet::new(b));
-    first_intersecting_pair_prepared(pa.as_slice(), pb.as_slice())
+    let (ea, eb) = (aabbs(a), aabbs(b));
+    for (i, x) in a.iter().enumerate() {
+        for (j, y) in b.iter().enumerate() {
+            if !aabbs_disjoint(x, &ea[i], y, &eb[j]) && separating_axis(x, y).is_none() {
+                return Some((i, j));
+            }
+        }
+    }
+    None
 }
 
 /// Per robot pair state of the two-layer witness cache (thesis 3.1.4).
@@ -77,7 +62,10 @@ pub struct WitnessCache {
 
 impl Default for WitnessCache {
     fn default() -> Self {
-        WitnessCache { colliding_pair: None, axis: [[Axis(0); MAX_BOXES]; MAX_BOXES] }
+        WitnessCache {
+            colliding_pair: None,
+            axis: [[Axis(0); MAX_BOXES]; MAX_BOXES],
+        }
     }
 }
 
@@ -95,28 +83,30 @@ impl WitnessCache {
     /// # Panics
     /// When either slice holds more than [`MAX_BOXES`] boxes.
     pub fn first_intersecting_pair(&mut self, a: &[Obb], b: &[Obb]) -> Option<(usize, usize)> {
-        let (pa, pb) = (PreparedSet::new(a), PreparedSet::new(b));
-        self.first_intersecting_pair_prepared(pa.as_slice(), pb.as_slice())
-    }
-
-    /// As [`Self::first_intersecting_pair`], for boxes already in prepared form.
-    pub fn first_intersecting_pair_prepared(
-        &mut self,
-        a: &[PreparedBox],
-        b: &[PreparedBox],
-    ) -> Option<(usize, usize)> {
-        assert!(a.len() <= MAX_BOXES && b.len() <= MAX_BOXES, "at most {MAX_BOXES} boxes per robot");
+        let (ea, eb) = (aabbs(a), aabbs(b));
+        let collides = |axis: &mut Axis, i: usize, j: usize| -> bool {
+            if aabbs_disjoint(&a[i], &ea[i], &b[j], &eb[j]) {
+                return false;
+            }
+            // Layer 2: the pair's last separating axis first; remember the new witness.
+            match separating_axis_hinted(&a[i], &b[j], *axis) {
+                Some(found) => {
+                    *axis = found;
+                    false
+                }
+                None => true,
+            }
+        };
         // Layer 1: the pair that collided last time.
-        if let Some((i, j)) = self.colliding_pair {
-            let (i, j) = (i as usize, j as usize);
-            if i < a.len() && j < b.len() && self.pair_collides(a, b, i, j) {
+        let last = self.colliding_pair.map(|(i, j)| (i as usize, j as usize));
+        if let Some((i, j)) = last {
+            if i < a.len() && j < b.len() && collides(&mut self.axis[i][j], i, j) {
                 return Some((i, j));
             }
         }
-        let skip = self.colliding_pair.map(|(i, j)| (i as usize, j as usize));
         for i in 0..a.len() {
             for j in 0..b.len() {
-                if Some((i, j)) != skip && self.pair_collides(a, b, i, j) {
+                if Some((i, j)) != last && collides(&mut self.axis[i][j], i, j) {
                     self.colliding_pair = Some((i as u8, j as u8));
                     return Some((i, j));
                 }
@@ -124,21 +114,6 @@ impl WitnessCache {
         }
         self.colliding_pair = None;
         None
-    }
-
-    /// Layer 2: the pair's last separating axis first; remembers the new witness.
-    #[inline]
-    fn pair_collides(&mut self, a: &[PreparedBox], b: &[PreparedBox], i: usize, j: usize) -> bool {
-        if aabbs_disjoint(&a[i], &b[j]) {
-            return false;
-        }
-        match separating_axis_prepared_hinted(&a[i], &b[j], self.axis[i][j]) {
-            Some(axis) => {
-                self.axis[i][j] = axis;
-                false
-            }
-            None => true,
-        }
     }
 }
 
@@ -200,7 +175,10 @@ mod tests {
                 }
             }
         }
-        assert!(hits > 5_000 && misses > 5_000, "both answers exercised: {hits} hits, {misses} misses");
+        assert!(
+            hits > 5_000 && misses > 5_000,
+            "both answers exercised: {hits} hits, {misses} misses"
+        );
     }
 
     #[test]
@@ -209,7 +187,9 @@ mod tests {
         for _ in 0..5_000 {
             let a: Vec<Obb> = (0..3).map(|_| link(rng.vec(300.0), rng.vec(3.0))).collect();
             let b: Vec<Obb> = (0..3).map(|_| link(rng.vec(300.0), rng.vec(3.0))).collect();
-            let expected = (0..9).map(|k| (k / 3, k % 3)).find(|&(i, j)| obbs_intersect(&a[i], &b[j]));
+            let expected = (0..9)
+                .map(|k| (k / 3, k % 3))
+                .find(|&(i, j)| obbs_intersect(&a[i], &b[j]));
             assert_eq!(first_intersecting_pair(&a, &b), expected);
         }
     }
