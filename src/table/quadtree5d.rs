@@ -28,18 +28,18 @@ fn column_intervals(column: impl Iterator<Item = (u16, Label)>, out: &mut Vec<[u
     let mut free_since = false;
     for (z, label) in column {
         match label {
-            Label::Collision => match open.as_mut() {
-                Some(iv) if !free_since => iv[1] = z as u8,
-                _ => {
-                    out.extend(open.take());
-                    open = Some([z as u8, z as u8]);
+            Label::Collision => {
+                match open.as_mut() {
+                    Some(iv) if !free_since => iv[1] = z as u8,
+                    _ => {
+                        out.extend(open.take());
+                        open = Some([z as u8, z as u8]);
+                    }
                 }
-            },
+                free_since = false;
+            }
             Label::Free => free_since = true,
-            Label::Unreachable => continue,
-        }
-        if label == Label::Collision {
-            free_since = false;
+            Label::Unreachable => {}
         }
     }
     out.extend(open);
