@@ -1,1 +1,99 @@
-//! Precomputed tables of the configuration space (thesis 3.2.4-3.2.6; SPEC §6).
+//! Precomputed tables of the configuration space: the three linear quadtrees of the thesis,
+//! their file format, and one [`Table`] enum to query them (thesis 3.2.4-3.2.6 and 3.2.8;
+//! SPEC §6; issue 3 items 3 and 5).
+//!
+//! A table answers "is the 6-D grid cell `(ix, iy, iz, ix', iy', iz')` a collision" without
+//! allocating. Built from a [`LabelledSpace`](crate::cspace::LabelledSpace), it reports
+//! `false` for every free sample and `true` for every collision sample (lossy 4-D tables with
+//! `t > 0` may also report `true` for free samples). Unreachable pairs and cells outside the
+//! sampled grid are "don't care": the answer there is whatever compressed best, so the caller
+//! must check reachability and the workspace itself. Indices `>= k` answer `true`.
+
+pub mod code;
+pub mod error;
+pub mod format;
+pub mod quadtree4d;
+pub mod quadtree5d;
+pub mod quadtree6d;
+mod space;
+pub mod synthetic;
+
+#[cfg(test)]
+mod agreement_tests;
+
+pub use error::TableError;
+pub use format::{from_bytes, to_bytes, Certification, Header};
+pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
+pub use quadtree5d::LinearQuadtree5d;
+pub use quadtree6d::LinearQuadtree6d;
+
+/// One of the three table variants (thesis 3.2.4, 3.2.5, 3.2.6).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Table {
+    /// Linear 6-D quadtree, condensed.
+    D6(LinearQuadtree6d),
+    /// Linear 5-D quadtree with `iz'` intervals.
+    D5(LinearQuadtree5d),
+    /// Linear 4-D quadtree with grouped 2-D slices.
+    D4(LinearQuadtree4d),
+}
+
+impl Table {
+    /// Whether the 6-D cell is stored as collision (`true` also for an index `>= k`).
+    /// Never allocates, never panics.
+    #[inline]
+    pub fn query(&self, cell6: [u16; 6]) -> bool {
+        match self {
+            Table::D6(t) => t.query(cell6),
+            Table::D5(t) => t.query(cell6),
+            Table::D4(t) => t.query(cell6),
+        }
+    }
+
+    /// Quadtree levels; cells per axis `k = 2^levels`.
+    pub fn levels(&self) -> u32 {
+        match self {
+            Table::D6(t) => t.levels(),
+            Table::D5(t) => t.levels(),
+            Table::D4(t) => t.levels(),
+        }
+    }
+
+    /// Whether only A's upper half is stored (reflection symmetry, thesis 3.2.8).
+    pub fn symmetric(&self) -> bool {
+        match self {
+            Table::D6(t) => t.symmetric(),
+            Table::D5(t) => t.symmetric(),
+            Table::D4(t) => t.symmetric(),
+        }
+    }
+
+    /// Bytes the table occupies in memory.
+    pub fn memory_bytes(&self) -> usize {
+        match self {
+            Table::D6(t) => t.memory_bytes(),
+            Table::D5(t) => t.memory_bytes(),
+            Table::D4(t) => t.memory_bytes(),
+        }
+    }
+
+    /// A short name: `6D`, `5D`, `4D/yy t=0`...
+    pub fn name(&self) -> String {
+        match self {
+            Table::D6(_) => "6D".into(),
+            Table::D5(_) => "5D".into(),
+            Table::D4(t) => format!("4D/{} t={}", if t.axes() == SliceAxes::YY { "yy" } else { "zz" }, t.threshold()),
+        }
+    }
+}
+
+/// Pairs of A's upper half (`iy >= k/2`) whose label and mirror image's label disagree as
+/// free/collision: 0 for a cell that is reflection symmetric (thesis 3.2.8). Symmetric
+/// tables stay safe either way (collision wins in the merge), but they answer some free
+/// samples with collision when this is not 0.
+///
+/// # Errors
+/// [`TableError::BadInput`] when the space is malformed.
+pub fn symmetry_mismatches(space: &crate::cspace::LabelledSpace) -> Result<usize, TableError> {
+    Ok(space::SpaceView::new(space, true)?.asymmetric_pairs())
+}

@@ -1,0 +1,98 @@
+//! Why a table cannot be built or loaded (issue 3 item 5; SPEC §6).
+//!
+//! Every variant names the field it is about and the message says how to fix it, in the
+//! manner of regex-automata's deserialisation errors.
+
+/// Why a table could not be built from a labelled space, or loaded from bytes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum TableError {
+    /// The buffer ends before `what` is complete: `needed` bytes, `have` bytes.
+    Truncated {
+        /// The field or section being read.
+        what: &'static str,
+        /// Bytes the field needs from the start of the buffer.
+        needed: usize,
+        /// Bytes the buffer has.
+        have: usize,
+    },
+    /// The buffer does not start with the table magic `b"DCTABLE\0"`.
+    BadMagic {
+        /// The first eight bytes found.
+        found: [u8; 8],
+    },
+    /// The format version is not one this library reads.
+    UnsupportedVersion {
+        /// The version in the file.
+        found: u32,
+        /// The version this library writes and reads.
+        supported: u32,
+    },
+    /// The endianness marker reads byte-swapped: the file was written big-endian.
+    WrongEndianness,
+    /// The checksum does not match, or a field breaks an invariant (`what` names it).
+    Corrupt {
+        /// The field and what is wrong with it.
+        what: String,
+    },
+    /// The table was built for another cell.
+    WrongCell {
+        /// The fingerprint of the cell the controller is configured for.
+        expected: u64,
+        /// The fingerprint recorded in the table.
+        found: u64,
+    },
+    /// The labelled space or the parameters given to a builder are not usable.
+    BadInput {
+        /// The input and what is wrong with it.
+        what: String,
+    },
+}
+
+impl std::fmt::Display for TableError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TableError::Truncated { what, needed, have } => write!(
+                f,
+                "table is truncated: {what} needs {needed} bytes, the buffer has {have}; \
+                 copy the whole table file again"
+            ),
+            TableError::BadMagic { found } => write!(
+                f,
+                "not a delta-collide table: magic is {found:02x?}, expected \"DCTABLE\\0\"; \
+                 check that the right file or buffer is given"
+            ),
+            TableError::UnsupportedVersion { found, supported } => write!(
+                f,
+                "table format version {found} is not supported (this library reads version \
+                 {supported}); rebuild the table with `delta-collide build`"
+            ),
+            TableError::WrongEndianness => write!(
+                f,
+                "table endianness marker is byte-swapped: the file is big-endian, this library \
+                 reads little-endian tables only; rebuild it with `delta-collide build`"
+            ),
+            TableError::Corrupt { what } => write!(
+                f,
+                "table is corrupt: {what}; rebuild it with `delta-collide build` or copy it again"
+            ),
+            TableError::WrongCell { expected, found } => write!(
+                f,
+                "table was built for cell {found:#018x}, this controller is configured for \
+                 {expected:#018x}; rebuild with `delta-collide build --cell ...` for this cell"
+            ),
+            TableError::BadInput { what } => write!(f, "cannot build a table: {what}"),
+        }
+    }
+}
+
+impl std::error::Error for TableError {}
+
+/// A [`TableError::Corrupt`] naming `what`.
+pub(crate) fn corrupt(what: impl Into<String>) -> TableError {
+    TableError::Corrupt { what: what.into() }
+}
+
+/// A [`TableError::BadInput`] naming `what`.
+pub(crate) fn bad_input(what: impl Into<String>) -> TableError {
+    TableError::BadInput { what: what.into() }
+}

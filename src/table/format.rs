@@ -1,0 +1,314 @@
+//! The table file format: a fixed little-endian header, up to three sections and a checksum,
+//! validated once when loaded from a memory buffer (issue 3 item 5; SPEC §6).
+//!
+//! # Layout (all integers and floats little-endian)
+//! ```text
+//! offset size  field
+//!      0    8  magic b"DCTABLE\0"
+//!      8    4  endianness marker 0x01020304 (reads 0x04030201 when byte-swapped)
+//!     12    4  format version (VERSION)
+//!     16    4  variant: 6, 5 or 4
+//!     20    4  levels        24  4  k = 2^levels
+//!     28    4  flags: bit 0 = symmetric (reflection, thesis 3.2.8); other bits 0
+//!     32    4  slice axes: 0 (6D, 5D), 1 = yy', 2 = zz' (4D)
+//!     36    4  similarity threshold t (0 unless 4D)
+//!     40    8  fingerprint of the cell (`Cell::fingerprint`)
+//!     48    8  r (mm)        56 24  origin of A's grid (mm)    80 24  origin of B's grid
+//!    104   40  workspace Zu, Hcy, Rcy, Hco, Rco (mm)
+//!    144    8  margin (mm)  152  4  certification kind       156  4  reserved, 0
+//!    160   24  element counts of sections 0, 1, 2 (u64 each)
+//!    184       section 0: codes, u64 each
+//!              section 1: 5D offsets (m + 1) / 4D slice index per code, u32 each; 6D none
+//!              section 2: 5D intervals [begin, end] u8 pairs / 4D slice words u64; 6D none
+//!    end-8  8  FNV-1a 64 of every byte before it
+//! ```
+//! Loading checks magic, endianness and version first (so those errors are specific), then
+//! every length with checked arithmetic, the checksum, and finally every field and index
+//! (via the variants' `from_parts`), so a loaded table never panics nor reads out of bounds.
+
+use super::error::{corrupt, TableError};
+use super::quadtree4d::{LinearQuadtree4d, SliceAxes};
+use super::quadtree5d::LinearQuadtree5d;
+use super::quadtree6d::LinearQuadtree6d;
+use super::Table;
+use crate::cspace::{LabelledSpace, Workspace};
+
+/// The first eight bytes of every table.
+pub const MAGIC: [u8; 8] = *b"DCTABLE\0";
+/// The format version written and read.
+pub const VERSION: u32 = 1;
+const ENDIAN_MARK: u32 = 0x0102_0304;
+const HEADER_LEN: usize = 184;
+
+/// How the margin the table was labelled with was obtained (SPEC §6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Certification {
+    /// Not recorded.
+    Unspecified = 0,
+    /// The thesis's blow-up by r / sqrt 2 (3.2.7): not a proof.
+    ThesisBlowUp = 1,
+    /// A per-cell bound on how far any link point moves within a grid cell: a proof.
+    SweptBound = 2,
+}
+
+/// Everything a table file records besides the table itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Header {
+    /// `Cell::fingerprint` of the cell the table was built for.
+    pub cell_fingerprint: u64,
+    /// Grid spacing (mm).
+    pub r: f64,
+    /// Corner of A's grid (mm, A's MCS).
+    pub origin_a: [f64; 3],
+    /// Corner of B's grid (mm, B's MCS).
+    pub origin_b: [f64; 3],
+    /// The workspace the grids sample.
+    pub workspace: Workspace,
+    /// Margin added to every box half-extent when labelling (mm).
+    pub margin: f64,
+    /// How the margin was obtained.
+    pub certification: Certification,
+}
+
+impl Header {
+    /// The header of a table built from `space` for the cell with `fingerprint`.
+    pub fn for_space(space: &LabelledSpace, fingerprint: u64, workspace: Workspace, certification: Certification) -> Header {
+        let o = |g: &crate::cspace::SampleGrid| [g.origin.x, g.origin.y, g.origin.z];
+        Header {
+            cell_fingerprint: fingerprint,
+            r: space.grid_a.r,
+            origin_a: o(&space.grid_a),
+            origin_b: o(&space.grid_b),
+            workspace,
+            margin: space.margin,
+            certification,
+        }
+    }
+
+    /// Checks that the table was built for the controller's cell.
+    ///
+    /// # Errors
+    /// [`TableError::WrongCell`] when the fingerprints differ.
+    pub fn check_cell(&self, expected: u64) -> Result<(), TableError> {
+        if self.cell_fingerprint == expected {
+            Ok(())
+        } else {
+            Err(TableError::WrongCell { expected, found: self.cell_fingerprint })
+        }
+    }
+}
+
+/// FNV-1a 64 of `bytes`.
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+}
+
+/// The bytes of `table` with `header` (see the module doc for the layout).
+pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
+    let (variant, axes, t, s0, s1, s2): (u32, u32, u32, &[u64], Vec<u32>, Vec<u8>) = match table {
+        Table::D6(q) => (6, 0, 0, q.codes(), vec![], vec![]),
+        Table::D5(q) => {
+            let (codes, offsets, ivs) = q.parts();
+            (5, 0, 0, codes, offsets.to_vec(), ivs.iter().flatten().copied().collect())
+        }
+        Table::D4(q) => {
+            let (codes, slice_of, words) = q.parts();
+            let axes = if q.axes() == SliceAxes::YY { 1 } else { 2 };
+            (4, axes, q.threshold(), codes, slice_of.to_vec(), words.iter().flat_map(|w| w.to_le_bytes()).collect())
+        }
+    };
+    let n2 = if variant == 5 { s2.len() / 2 } else { s2.len() / 8 };
+    let mut out = Vec::with_capacity(HEADER_LEN + 8 * s0.len() + 4 * s1.len() + s2.len() + 8);
+    out.extend_from_slice(&MAGIC);
+    let levels = table.levels();
+    for v in [ENDIAN_MARK, VERSION, variant, levels, 1 << levels, u32::from(table.symmetric()), axes, t] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&header.cell_fingerprint.to_le_bytes());
+    let w = &header.workspace;
+    let floats = [header.r].into_iter().chain(header.origin_a).chain(header.origin_b);
+    for v in floats.chain([w.zu, w.hcy, w.rcy, w.hco, w.rco, header.margin]) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&(header.certification as u32).to_le_bytes());
+    out.extend_from_slice(&0u32.to_le_bytes());
+    for n in [s0.len(), s1.len(), n2] {
+        out.extend_from_slice(&(n as u64).to_le_bytes());
+    }
+    s0.iter().for_each(|c| out.extend_from_slice(&c.to_le_bytes()));
+    s1.iter().for_each(|c| out.extend_from_slice(&c.to_le_bytes()));
+    out.extend_from_slice(&s2);
+    let sum = fnv1a64(&out);
+    out.extend_from_slice(&sum.to_le_bytes());
+    out
+}
+
+/// Bounds-checked little-endian reads; every error names the field.
+struct Reader<'a> {
+    buf: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8], TableError> {
+        let end = self.pos.checked_add(n).ok_or_else(|| corrupt(format!("{what}: length overflows")))?;
+        let bytes = self.buf.get(self.pos..end).ok_or(TableError::Truncated { what, needed: end, have: self.buf.len() })?;
+        self.pos = end;
+        Ok(bytes)
+    }
+
+    fn u32(&mut self, what: &'static str) -> Result<u32, TableError> {
+        self.take(4, what).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    }
+
+    fn u64(&mut self, what: &'static str) -> Result<u64, TableError> {
+        self.take(8, what).map(|b| u64::from_le_bytes(std::array::from_fn(|i| b[i])))
+    }
+
+    fn f64(&mut self, what: &'static str) -> Result<f64, TableError> {
+        let v = f64::from_bits(self.u64(what)?);
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(corrupt(format!("{what} = {v} is not finite")))
+        }
+    }
+
+    fn f64x3(&mut self, what: &'static str) -> Result<[f64; 3], TableError> {
+        Ok([self.f64(what)?, self.f64(what)?, self.f64(what)?])
+    }
+}
+
+/// Fixed header fields that decide the table's shape.
+struct Shape {
+    variant: u32,
+    levels: u32,
+    symmetric: bool,
+    axes: u32,
+    t: u32,
+}
+
+fn read_prefix(r: &mut Reader) -> Result<Shape, TableError> {
+    let magic = r.take(8, "magic")?;
+    if magic != MAGIC {
+        return Err(TableError::BadMagic { found: std::array::from_fn(|i| magic[i]) });
+    }
+    match r.u32("endianness marker")? {
+        ENDIAN_MARK => {}
+        m if m == ENDIAN_MARK.swap_bytes() => return Err(TableError::WrongEndianness),
+        m => return Err(corrupt(format!("endianness marker = {m:#010x}, expected 0x01020304"))),
+    }
+    let version = r.u32("version")?;
+    if version != VERSION {
+        return Err(TableError::UnsupportedVersion { found: version, supported: VERSION });
+    }
+    let variant = r.u32("variant")?;
+    let levels = r.u32("levels")?;
+    let k = r.u32("k")?;
+    let flags = r.u32("flags")?;
+    let axes = r.u32("slice axes")?;
+    let t = r.u32("threshold t")?;
+    if !matches!(variant, 4..=6) {
+        return Err(corrupt(format!("variant = {variant}, expected 6, 5 or 4")));
+    }
+    if levels == 0 || levels > super::code::MAX_LEVELS || k != 1 << levels {
+        return Err(corrupt(format!("levels = {levels}, k = {k}: k must be 2^levels, levels in 1..=8")));
+    }
+    if flags > 1 {
+        return Err(corrupt(format!("flags = {flags:#x}: only bit 0 (symmetric) is defined")));
+    }
+    if (variant == 4) != matches!(axes, 1 | 2) || (variant != 4 && t != 0) {
+        return Err(corrupt(format!("variant {variant} with slice axes = {axes}, t = {t}")));
+    }
+    Ok(Shape { variant, levels, symmetric: flags == 1, axes, t })
+}
+
+fn read_header(r: &mut Reader) -> Result<Header, TableError> {
+    let cell_fingerprint = r.u64("cell fingerprint")?;
+    let grid_r = r.f64("r")?;
+    let origin_a = r.f64x3("origin_a")?;
+    let origin_b = r.f64x3("origin_b")?;
+    let ws = [r.f64("workspace.zu")?, r.f64("workspace.hcy")?, r.f64("workspace.rcy")?, r.f64("workspace.hco")?, r.f64("workspace.rco")?];
+    let margin = r.f64("margin")?;
+    let certification = match r.u32("certification")? {
+        0 => Certification::Unspecified,
+        1 => Certification::ThesisBlowUp,
+        2 => Certification::SweptBound,
+        c => return Err(corrupt(format!("certification = {c}, expected 0, 1 or 2"))),
+    };
+    if r.u32("reserved")? != 0 {
+        return Err(corrupt("reserved field is not 0"));
+    }
+    if grid_r <= 0.0 || margin < 0.0 {
+        return Err(corrupt(format!("r = {grid_r} must be > 0 and margin = {margin} >= 0")));
+    }
+    let workspace = Workspace { zu: ws[0], hcy: ws[1], rcy: ws[2], hco: ws[3], rco: ws[4] };
+    Ok(Header { cell_fingerprint, r: grid_r, origin_a, origin_b, workspace, margin, certification })
+}
+
+fn words<const N: usize, T>(bytes: &[u8], f: impl Fn([u8; N]) -> T) -> Vec<T> {
+    bytes.chunks_exact(N).map(|c| f(std::array::from_fn(|i| c[i]))).collect()
+}
+
+/// Reads and validates a table (see the module doc); the cell is not checked here, call
+/// [`Header::check_cell`] or use [`from_bytes_for_cell`].
+///
+/// # Errors
+/// The specific [`TableError`]: `Truncated`, `BadMagic`, `WrongEndianness`,
+/// `UnsupportedVersion`, or `Corrupt` naming the field (checksum, lengths, order, indices).
+pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
+    let mut r = Reader { buf: bytes, pos: 0 };
+    let shape = read_prefix(&mut r)?;
+    let header = read_header(&mut r)?;
+    let counts = [r.u64("section 0 count")?, r.u64("section 1 count")?, r.u64("section 2 count")?];
+    let sizes: [usize; 3] = match shape.variant {
+        6 => [8, 4, 0],
+        5 => [8, 4, 2],
+        _ => [8, 4, 8],
+    };
+    let names = ["section 0 (codes)", "section 1 (offsets or slice indices)", "section 2 (intervals or slices)"];
+    let mut lens = [0usize; 3];
+    for i in 0..3 {
+        let n = usize::try_from(counts[i]).ok().and_then(|n| n.checked_mul(sizes[i]));
+        lens[i] = n.ok_or_else(|| corrupt(format!("{} count = {} overflows", names[i], counts[i])))?;
+        if sizes[i] == 0 && counts[i] != 0 || shape.variant == 6 && i > 0 && counts[i] != 0 {
+            return Err(corrupt(format!("{} count = {} must be 0 for variant {}", names[i], counts[i], shape.variant)));
+        }
+    }
+    let sections = [r.take(lens[0], names[0])?, r.take(lens[1], names[1])?, r.take(lens[2], names[2])?];
+    let body_end = r.pos;
+    let stored = r.u64("checksum")?;
+    if r.pos != bytes.len() {
+        return Err(corrupt(format!("{} trailing bytes after the checksum", bytes.len() - r.pos)));
+    }
+    let computed = fnv1a64(&bytes[..body_end]);
+    if stored != computed {
+        return Err(corrupt(format!("checksum = {stored:#018x}, the bytes give {computed:#018x}")));
+    }
+    let codes = words(sections[0], u64::from_le_bytes);
+    let aux = words(sections[1], u32::from_le_bytes);
+    let table = match shape.variant {
+        6 => Table::D6(LinearQuadtree6d::from_parts(shape.levels, shape.symmetric, codes)?),
+        5 => {
+            let ivs = words(sections[2], |b: [u8; 2]| b);
+            Table::D5(LinearQuadtree5d::from_parts(shape.levels, shape.symmetric, codes, aux, ivs)?)
+        }
+        _ => {
+            let axes = if shape.axes == 1 { SliceAxes::YY } else { SliceAxes::ZZ };
+            let slices = words(sections[2], u64::from_le_bytes);
+            Table::D4(LinearQuadtree4d::from_parts(shape.levels, shape.symmetric, axes, shape.t, codes, aux, slices)?)
+        }
+    };
+    Ok((header, table))
+}
+
+/// [`from_bytes`], then [`Header::check_cell`] against the controller's cell fingerprint.
+///
+/// # Errors
+/// As [`from_bytes`], or [`TableError::WrongCell`].
+pub fn from_bytes_for_cell(bytes: &[u8], fingerprint: u64) -> Result<(Header, Table), TableError> {
+    let (header, table) = from_bytes(bytes)?;
+    header.check_cell(fingerprint)?;
+    Ok((header, table))
+}

@@ -1,0 +1,281 @@
+//! The linear 4-D quadtree: location codes over four dimensions, each pointing to a shared
+//! 2-D bit slice of the two ignored ones, slices grouped by similarity (thesis 3.2.6,
+//! Algorithms 8 and 9, Observation 3.2.3; SPEC §6).
+//!
+//! # Conventions
+//! `SliceAxes::YY` ignores `(iy, iy')` (the quadtree runs over `(ix, iz, ix', iz')`),
+//! `SliceAxes::ZZ` ignores `(iz, iz')` (over `(ix, iy, ix', iy')`). Slice bit
+//! `(a - a0) * k + b` holds `(a, b)` = A's and B's ignored index; `a0 = k/2` for symmetric
+//! yy' slices, which then hold only A's upper half (`k/2` rows), else 0 (`k` rows).
+//!
+//! # Grouping (Algorithm 8)
+//! Ranges are visited in the thesis's order `x, x', z, z'` (`x, x', y, y'` for zz' slices).
+//! A range's slice `S` joins the first group whose representative `R` satisfies
+//! `|S \ R| < G_add` and `|R \ S| < G_sub` (the thesis's strict `<`), or matches exactly
+//! (both 0): with `t = 0` strict `<` would match nothing, and the thesis says `t = 0` groups
+//! exact matches. `R` becomes `R ∪ S` and `G_add -= |S \ R|`; `G_sub` stays `t`. Don't-care
+//! bits of `S` (unreachable or unsampled) are 0 in `S` and not counted in `|R \ S|`, so
+//! `t = 0` still answers every free and collision sample exactly.
+
+use super::code::{encode, MAX_LEVELS};
+use super::error::{corrupt, TableError};
+use super::space::{fold, SpaceView};
+use crate::cspace::{Label, LabelledSpace};
+use std::collections::BTreeMap;
+
+/// Which two dimensions a slice holds (the two the quadtree ignores).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SliceAxes {
+    /// `(iy, iy')` slices.
+    YY,
+    /// `(iz, iz')` slices.
+    ZZ,
+}
+
+impl SliceAxes {
+    /// (the quadtree's second dimension per robot, the ignored dimension per robot).
+    fn dims(self) -> (usize, usize) {
+        match self {
+            SliceAxes::YY => (2, 1),
+            SliceAxes::ZZ => (1, 2),
+        }
+    }
+}
+
+/// Sorted 4-D codes, each with the index of its slice (see the module doc).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LinearQuadtree4d {
+    levels: u32,
+    symmetric: bool,
+    axes: SliceAxes,
+    t: u32,
+    codes: Vec<u64>,
+    slice_of: Vec<u32>,
+    slices: Vec<u64>,
+}
+
+/// Slice shape for these parameters: (first row `a0`, words per slice).
+fn shape(levels: u32, symmetric: bool, axes: SliceAxes) -> (u32, usize) {
+    let k = 1u32 << levels;
+    let a0 = if symmetric && axes == SliceAxes::YY { k / 2 } else { 0 };
+    (a0, (((k - a0) * k) as usize).div_ceil(64))
+}
+
+/// `Some(|S \ R|)` when `S` (collision bits, care mask) may join a group with representative
+/// `R` and budgets `g_add`, `g_sub` (see the module doc).
+fn try_join(s: &[u64], care: &[u64], rep: &[u64], g_add: u32, g_sub: u32) -> Option<u32> {
+    let (mut add, mut sub) = (0u32, 0u32);
+    for ((&s, &c), &r) in s.iter().zip(care).zip(rep) {
+        add += (s & !r).count_ones();
+        sub += (r & !s & c).count_ones();
+        if (add > 0 && add >= g_add) || (sub > 0 && sub >= g_sub) {
+            return None;
+        }
+    }
+    Some(add)
+}
+
+/// Samples of one robot grouped by its two quadtree coordinates `(ix, second)`.
+fn ranges(cells: &[[u16; 3]], keep: impl Fn(usize) -> bool, second: usize) -> BTreeMap<(u16, u16), Vec<usize>> {
+    let mut m: BTreeMap<(u16, u16), Vec<usize>> = BTreeMap::new();
+    for (i, c) in cells.iter().enumerate().filter(|(i, _)| keep(*i)) {
+        m.entry((c[0], c[second])).or_default().push(i);
+    }
+    m
+}
+
+impl LinearQuadtree4d {
+    /// Builds the table of `space` with threshold `t` (thesis Algorithm 8); with
+    /// `symmetric`, only A's upper half `iy >= k/2` is stored.
+    ///
+    /// # Errors
+    /// [`TableError::BadInput`] when the grids differ or the label count is wrong.
+    pub fn build(space: &LabelledSpace, symmetric: bool, axes: SliceAxes, t: u32) -> Result<LinearQuadtree4d, TableError> {
+        let view = SpaceView::new(space, symmetric)?;
+        let (k, levels) = (view.k, view.levels);
+        let (second, ignored) = axes.dims();
+        let (a0, wps) = shape(levels, symmetric, axes);
+        let (ca, cb) = (&space.grid_a.cells, &space.grid_b.cells);
+        let ra = ranges(ca, |i| view.stored(i), second);
+        let rb = ranges(cb, |_| true, second);
+        let mut tree = LinearQuadtree4d { levels, symmetric, axes, t, codes: vec![], slice_of: vec![], slices: vec![] };
+        let mut g_add: Vec<u32> = Vec::new();
+        let mut nodes: Vec<(u64, u32)> = Vec::new();
+        let (mut s, mut care) = (vec![0u64; wps], vec![0u64; wps]);
+        // Thesis order x, x', z, z': the A and B maps are sorted by (ix, second).
+        let xs_a: Vec<u16> = ra.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
+        let xs_b: Vec<u16> = rb.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
+        for &xa in &xs_a {
+            for &xb in &xs_b {
+                for ((_, za), ias) in ra.range((xa, 0)..=(xa, u16::MAX)) {
+                    for ((_, zb), ibs) in rb.range((xb, 0)..=(xb, u16::MAX)) {
+                        s.fill(0);
+                        care.fill(0);
+                        let mut any = false;
+                        for &ia in ias {
+                            let row = (u32::from(ca[ia][ignored]) - a0) * k;
+                            for &ib in ibs {
+                                let bit = (row + u32::from(cb[ib][ignored])) as usize;
+                                let label = view.label(ia, ib);
+                                if label != Label::Unreachable {
+                                    care[bit / 64] |= 1 << (bit % 64);
+                                }
+                                if label == Label::Collision {
+                                    s[bit / 64] |= 1 << (bit % 64);
+                                    any = true;
+                                }
+                            }
+                        }
+                        if !any {
+                            continue;
+                        }
+                        let group = tree.group(&s, &care, &mut g_add, wps);
+                        nodes.push((encode([xa, *za, xb, *zb], 4), group));
+                    }
+                }
+            }
+        }
+        nodes.sort_unstable_by_key(|n| n.0);
+        (tree.codes, tree.slice_of) = nodes.into_iter().unzip();
+        Ok(tree)
+    }
+
+    /// The group `s` joins (its representative updated), or a new one (Algorithm 8 l. 7-19).
+    fn group(&mut self, s: &[u64], care: &[u64], g_add: &mut Vec<u32>, wps: usize) -> u32 {
+        for (g, rep) in self.slices.chunks_exact_mut(wps).enumerate() {
+            if let Some(add) = try_join(s, care, rep, g_add[g], self.t) {
+                rep.iter_mut().zip(s).for_each(|(r, &s)| *r |= s);
+                g_add[g] -= add;
+                return g as u32;
+            }
+        }
+        self.slices.extend_from_slice(s);
+        g_add.push(self.t);
+        (g_add.len() - 1) as u32
+    }
+
+    /// A table from stored parts, validated so that [`query`](Self::query) is exact and safe.
+    ///
+    /// # Errors
+    /// [`TableError::Corrupt`] naming the first bad field: levels, a code out of range or
+    /// out of order, a slice index `>=` the slice count, a slice array of the wrong length.
+    pub fn from_parts(
+        levels: u32,
+        symmetric: bool,
+        axes: SliceAxes,
+        t: u32,
+        codes: Vec<u64>,
+        slice_of: Vec<u32>,
+        slices: Vec<u64>,
+    ) -> Result<LinearQuadtree4d, TableError> {
+        if levels == 0 || levels > MAX_LEVELS {
+            return Err(corrupt(format!("levels = {levels} must be in 1..={MAX_LEVELS}")));
+        }
+        if let Some(i) = codes.iter().position(|&c| c >> (4 * levels) != 0) {
+            return Err(corrupt(format!("codes[{i}] = {:#x} has bits above {levels} 4-bit levels", codes[i])));
+        }
+        if let Some(i) = codes.windows(2).position(|w| w[0] >= w[1]) {
+            return Err(corrupt(format!("codes[{}] is not greater than codes[{i}]: codes are not sorted", i + 1)));
+        }
+        let (_, wps) = shape(levels, symmetric, axes);
+        if slices.len() % wps != 0 {
+            return Err(corrupt(format!("slices has {} words, not a multiple of {wps} per slice", slices.len())));
+        }
+        let count = slices.len() / wps;
+        if slice_of.len() != codes.len() {
+            return Err(corrupt(format!("slice_of has {} entries for {} codes", slice_of.len(), codes.len())));
+        }
+        if let Some(i) = slice_of.iter().position(|&s| s as usize >= count) {
+            return Err(corrupt(format!("slice_of[{i}] = {} is not below the slice count {count}", slice_of[i])));
+        }
+        Ok(LinearQuadtree4d { levels, symmetric, axes, t, codes, slice_of, slices })
+    }
+
+    /// Whether the 6-D cell is stored as collision (thesis Algorithm 9); an index `>= k`
+    /// answers `true`. Never allocates.
+    #[inline]
+    pub fn query(&self, cell: [u16; 6]) -> bool {
+        let k = 1u32 << self.levels;
+        let Some(c) = fold(cell, k, self.symmetric) else {
+            return true;
+        };
+        let (second, ignored) = self.axes.dims();
+        let Ok(i) = self.codes.binary_search(&encode([c[0], c[second], c[3], c[3 + second]], 4)) else {
+            return false;
+        };
+        let (a0, wps) = shape(self.levels, self.symmetric, self.axes);
+        let bit = ((u32::from(c[ignored]) - a0) * k + u32::from(c[3 + ignored])) as usize;
+        let Some(&s) = self.slice_of.get(i) else { return true };
+        self.slices.get(s as usize * wps + bit / 64).is_none_or(|w| (w >> (bit % 64)) & 1 != 0)
+    }
+
+    /// Quadtree levels (`k = 2^levels`).
+    pub fn levels(&self) -> u32 {
+        self.levels
+    }
+
+    /// Whether only A's upper half is stored.
+    pub fn symmetric(&self) -> bool {
+        self.symmetric
+    }
+
+    /// The ignored dimensions.
+    pub fn axes(&self) -> SliceAxes {
+        self.axes
+    }
+
+    /// The similarity threshold it was built with.
+    pub fn threshold(&self) -> u32 {
+        self.t
+    }
+
+    /// The stored parts: codes, slice index per code, slice words.
+    pub fn parts(&self) -> (&[u64], &[u32], &[u64]) {
+        (&self.codes, &self.slice_of, &self.slices)
+    }
+
+    /// Number of distinct slices (groups).
+    pub fn slice_count(&self) -> usize {
+        self.slices.len() / shape(self.levels, self.symmetric, self.axes).1
+    }
+
+    /// Bytes this table occupies in memory (struct plus its arrays).
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>() + 8 * self.codes.len() + 4 * self.slice_of.len() + 8 * self.slices.len()
+    }
+
+    /// The thesis's figure, `8 m + s b^2 / 8 + 8 b + 76` (Observation 3.2.3), for slices of
+    /// `b x b` squares (`b` = sampled coordinates along an ignored axis, 29 for the thesis's
+    /// yy' slices at k = 32).
+    pub fn thesis_bytes(&self, b: usize) -> usize {
+        8 * self.codes.len() + self.slice_count() * b * b / 8 + 8 * b + 76
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn join_rule_follows_algorithm_8() {
+        let rep = [0b0111u64];
+        let all = [!0u64];
+        assert_eq!(try_join(&[0b0111], &all, &rep, 0, 0), Some(0), "exact match joins at t = 0");
+        assert_eq!(try_join(&[0b1111], &all, &rep, 0, 0), None, "one bit more: no match at t = 0");
+        assert_eq!(try_join(&[0b1111], &all, &rep, 1, 1), None, "|add| = 1 is not < 1");
+        assert_eq!(try_join(&[0b1111], &all, &rep, 2, 2), Some(1));
+        assert_eq!(try_join(&[0b0011], &all, &rep, 2, 1), None, "|sub| = 1 is not < 1");
+        assert_eq!(try_join(&[0b0011], &[0b1011], &rep, 2, 1), Some(0), "a don't-care bit is not counted");
+    }
+
+    #[test]
+    fn from_parts_rejects_bad_slice_indices() {
+        let (_, wps) = shape(2, false, SliceAxes::YY);
+        let ok = LinearQuadtree4d::from_parts(2, false, SliceAxes::YY, 0, vec![3], vec![0], vec![0; wps]);
+        assert!(ok.is_ok());
+        let bad = LinearQuadtree4d::from_parts(2, false, SliceAxes::YY, 0, vec![3], vec![1], vec![0; wps]);
+        assert!(bad.is_err(), "slice index out of range");
+        let bad = LinearQuadtree4d::from_parts(2, false, SliceAxes::YY, 0, vec![3, 3], vec![0, 0], vec![0; wps]);
+        assert!(bad.is_err(), "duplicate code");
+    }
+}

@@ -1,0 +1,139 @@
+//! The labelled space as the table builders see it: validated, with the reflection symmetry
+//! folded in (thesis 3.2.8; SPEC §6 "unreachable cells: store whatever compresses best").
+//!
+//! # Conventions
+//! With `symmetric`, only configurations with A's `iy >= k/2` (TCP `y >= 0`, since the grid's
+//! y origin is `-k r / 2`) are stored; a query with `iy < k/2` is reflected first,
+//! `(iy, iy') -> (k-1-iy, k-1-iy')`, both robots together and keyed on A's `y` alone (the
+//! thesis's "y >= 0 and y' >= 0" would lose `y >= 0 > y'`). The stored label of an upper-half
+//! sample merges it with its mirror image (collision wins, then free), so a cell that is not
+//! exactly symmetric still loses no collision.
+
+use super::error::{bad_input, TableError};
+use super::code::MAX_LEVELS;
+use crate::cspace::{Label, LabelledSpace, SampleGrid};
+
+const NONE: u32 = u32::MAX;
+
+/// A validated labelled space with the symmetry fold (see the module doc).
+pub(crate) struct SpaceView<'a> {
+    pub space: &'a LabelledSpace,
+    pub k: u32,
+    pub levels: u32,
+    pub symmetric: bool,
+    refl_a: Vec<u32>,
+    refl_b: Vec<u32>,
+    nb: usize,
+}
+
+/// Collision wins over free, free over unreachable.
+pub(crate) fn merge(a: Label, b: Label) -> Label {
+    match (a, b) {
+        (Label::Collision, _) | (_, Label::Collision) => Label::Collision,
+        (Label::Free, _) | (_, Label::Free) => Label::Free,
+        _ => Label::Unreachable,
+    }
+}
+
+/// For each sample of `g`, the index of its mirror sample (`iy -> k-1-iy`), or `NONE`.
+fn reflections(g: &SampleGrid) -> Vec<u32> {
+    let k = g.k as usize;
+    let mut dense = vec![NONE; k * k * k];
+    for (i, c) in g.cells.iter().enumerate() {
+        dense[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] = i as u32;
+    }
+    g.cells
+        .iter()
+        .map(|c| dense[(c[0] as usize * k + (k - 1 - c[1] as usize)) * k + c[2] as usize])
+        .collect()
+}
+
+fn check_grid(name: &str, g: &SampleGrid) -> Result<(), TableError> {
+    if g.levels == 0 || g.levels > MAX_LEVELS || g.k != 1 << g.levels {
+        return Err(bad_input(format!(
+            "{name}: k = {} with levels = {} must be 2^levels with 1 <= levels <= {MAX_LEVELS}",
+            g.k, g.levels
+        )));
+    }
+    if let Some(c) = g.cells.iter().find(|c| c.iter().any(|&v| u32::from(v) >= g.k)) {
+        return Err(bad_input(format!("{name}: cell {c:?} has an index >= k = {}", g.k)));
+    }
+    Ok(())
+}
+
+impl<'a> SpaceView<'a> {
+    /// Validates `space` (equal k on both grids, indices below k, one label per pair).
+    pub fn new(space: &'a LabelledSpace, symmetric: bool) -> Result<SpaceView<'a>, TableError> {
+        check_grid("grid_a", &space.grid_a)?;
+        check_grid("grid_b", &space.grid_b)?;
+        let (ga, gb) = (&space.grid_a, &space.grid_b);
+        if ga.k != gb.k {
+            return Err(bad_input(format!("grid_a.k = {} differs from grid_b.k = {}", ga.k, gb.k)));
+        }
+        let nb = gb.cells.len();
+        if space.labels.len() != ga.cells.len() * nb {
+            return Err(bad_input(format!(
+                "labels has {} entries, the grids give {} x {nb} pairs",
+                space.labels.len(),
+                ga.cells.len()
+            )));
+        }
+        let (refl_a, refl_b) = if symmetric { (reflections(ga), reflections(gb)) } else { (vec![], vec![]) };
+        Ok(SpaceView { space, k: ga.k, levels: ga.levels, symmetric, refl_a, refl_b, nb })
+    }
+
+    /// Whether A's sample `ia` is in the stored half (always, without symmetry).
+    #[inline]
+    pub fn stored(&self, ia: usize) -> bool {
+        !self.symmetric || u32::from(self.space.grid_a.cells[ia][1]) >= self.k / 2
+    }
+
+    /// The label stored for the pair `(ia, ib)` of the stored half: merged with its mirror.
+    #[inline]
+    pub fn label(&self, ia: usize, ib: usize) -> Label {
+        let own = self.space.labels[ia * self.nb + ib];
+        if !self.symmetric {
+            return own;
+        }
+        let (ra, rb) = (self.refl_a[ia], self.refl_b[ib]);
+        if ra == NONE || rb == NONE {
+            return own;
+        }
+        merge(own, self.space.labels[ra as usize * self.nb + rb as usize])
+    }
+
+    /// Pairs of the stored half where the label and its mirror's disagree as free/collision.
+    pub fn asymmetric_pairs(&self) -> usize {
+        if !self.symmetric {
+            return 0;
+        }
+        let mut n = 0;
+        for ia in (0..self.space.grid_a.cells.len()).filter(|&ia| self.stored(ia)) {
+            for ib in 0..self.nb {
+                let own = self.space.labels[ia * self.nb + ib];
+                let (ra, rb) = (self.refl_a[ia], self.refl_b[ib]);
+                if ra != NONE && rb != NONE && own != Label::Unreachable {
+                    let other = self.space.labels[ra as usize * self.nb + rb as usize];
+                    n += usize::from(other != Label::Unreachable && other != own);
+                }
+            }
+        }
+        n
+    }
+}
+
+/// Maps a query cell into the stored half: `None` when an index is `>= k` (the caller then
+/// answers collision), else the cell, reflected when symmetric and `iy < k/2`.
+#[inline]
+pub(crate) fn fold(cell: [u16; 6], k: u32, symmetric: bool) -> Option<[u16; 6]> {
+    if cell.iter().any(|&v| u32::from(v) >= k) {
+        return None;
+    }
+    let mut c = cell;
+    if symmetric && u32::from(c[1]) < k / 2 {
+        let top = (k - 1) as u16;
+        c[1] = top - c[1];
+        c[4] = top - c[4];
+    }
+    Some(c)
+}

@@ -1,0 +1,159 @@
+//! The table file format (issue 3 item 5): round trips, and every kind of damage gives its
+//! specific `TableError`, never a panic nor a table that loads. Corrupted files kept in
+//! `tests/data/` are described in `tests/data/README.md`.
+
+use delta_collide::cspace::{LabelledSpace, Workspace};
+use delta_collide::table::format::{fnv1a64, from_bytes_for_cell};
+use delta_collide::table::synthetic::{space, Pattern};
+use delta_collide::table::*;
+
+const FINGERPRINT: u64 = 0x0123_4567_89ab_cdef;
+
+fn small_space() -> LabelledSpace {
+    space(2, Pattern::Noise { p: 0.3, seed: 4 })
+}
+
+fn tables(s: &LabelledSpace) -> Vec<Table> {
+    vec![
+        Table::D6(LinearQuadtree6d::build(s, false).unwrap()),
+        Table::D6(LinearQuadtree6d::build(s, true).unwrap()),
+        Table::D5(LinearQuadtree5d::build(s, false).unwrap()),
+        Table::D4(LinearQuadtree4d::build(s, true, SliceAxes::YY, 0).unwrap()),
+        Table::D4(LinearQuadtree4d::build(s, false, SliceAxes::ZZ, 3).unwrap()),
+    ]
+}
+
+fn header(s: &LabelledSpace) -> Header {
+    Header::for_space(s, FINGERPRINT, Workspace::THESIS, Certification::SweptBound)
+}
+
+/// Recomputes the checksum after a deliberate edit, so that only the field check can object.
+fn reseal(bytes: &mut [u8]) {
+    let n = bytes.len() - 8;
+    let sum = fnv1a64(&bytes[..n]);
+    bytes[n..].copy_from_slice(&sum.to_le_bytes());
+}
+
+#[test]
+fn every_variant_round_trips() {
+    let s = small_space();
+    for t in tables(&s) {
+        let bytes = to_bytes(&t, &header(&s));
+        let (h, back) = from_bytes_for_cell(&bytes, FINGERPRINT).unwrap();
+        assert_eq!(h, header(&s));
+        assert_eq!(back, t, "{} did not round trip", t.name());
+        assert_eq!(to_bytes(&back, &h), bytes);
+    }
+}
+
+#[test]
+fn truncation_at_every_offset_is_an_error() {
+    let s = small_space();
+    for t in tables(&s) {
+        let bytes = to_bytes(&t, &header(&s));
+        for n in 0..bytes.len() {
+            match from_bytes(&bytes[..n]) {
+                Err(TableError::Truncated { needed, have, .. }) => assert!(needed > have && have == n),
+                Err(TableError::Corrupt { .. }) => {}
+                other => panic!("{}: truncated to {n} bytes gave {other:?}", t.name()),
+            }
+        }
+    }
+}
+
+#[test]
+fn a_flipped_bit_anywhere_is_an_error() {
+    let s = small_space();
+    for t in tables(&s) {
+        let mut bytes = to_bytes(&t, &header(&s));
+        for bit in 0..8 * bytes.len() {
+            bytes[bit / 8] ^= 1 << (bit % 8);
+            assert!(from_bytes(&bytes).is_err(), "{}: bit {bit} flipped still loads", t.name());
+            bytes[bit / 8] ^= 1 << (bit % 8);
+        }
+        assert!(from_bytes(&bytes).is_ok());
+    }
+}
+
+#[test]
+fn magic_endianness_version_and_cell_give_their_errors() {
+    let s = small_space();
+    let good = to_bytes(&tables(&s)[0], &header(&s));
+    let mut b = good.clone();
+    b[0] = b'X';
+    assert!(matches!(from_bytes(&b), Err(TableError::BadMagic { .. })));
+    let mut b = good.clone();
+    b[8..12].copy_from_slice(&0x0102_0304u32.to_be_bytes());
+    assert_eq!(from_bytes(&b).unwrap_err(), TableError::WrongEndianness);
+    let mut b = good.clone();
+    b[12..16].copy_from_slice(&2u32.to_le_bytes());
+    assert_eq!(from_bytes(&b).unwrap_err(), TableError::UnsupportedVersion { found: 2, supported: format::VERSION });
+    let e = from_bytes_for_cell(&good, 42).unwrap_err();
+    assert_eq!(e, TableError::WrongCell { expected: 42, found: FINGERPRINT });
+    let msg = e.to_string();
+    assert!(msg.contains("0x0123456789abcdef") && msg.contains("delta-collide build --cell"), "{msg}");
+    let mut b = good.clone();
+    let last = b.len() - 1;
+    b[last] ^= 1;
+    assert!(matches!(from_bytes(&b), Err(TableError::Corrupt { what }) if what.contains("checksum")));
+}
+
+/// Checksum-valid files whose fields break an invariant (what a bad writer could produce).
+fn corrupted_files(s: &LabelledSpace) -> Vec<(&'static str, Vec<u8>, &'static str)> {
+    let ts = tables(s);
+    let mut out = Vec::new();
+    // 6D: the first two codes swapped.
+    let mut b = to_bytes(&ts[0], &header(s));
+    let (a, c) = (184, 192);
+    let first: [u8; 8] = b[a..a + 8].try_into().unwrap();
+    b.copy_within(c..c + 8, a);
+    b[c..c + 8].copy_from_slice(&first);
+    reseal(&mut b);
+    out.push(("unsorted_codes_6d.dctable", b, "not sorted"));
+    // 4D: the first slice index set past the slice count.
+    let mut b = to_bytes(&ts[3], &header(s));
+    let m = u64::from_le_bytes(b[160..168].try_into().unwrap()) as usize;
+    let at = 184 + 8 * m;
+    b[at..at + 4].copy_from_slice(&1000u32.to_le_bytes());
+    reseal(&mut b);
+    out.push(("slice_index_out_of_range_4d.dctable", b, "slice_of[0]"));
+    // 5D: the first interval's end set to k.
+    let mut b = to_bytes(&ts[2], &header(s));
+    let m = u64::from_le_bytes(b[160..168].try_into().unwrap()) as usize;
+    let at = 184 + 8 * m + 4 * (m + 1);
+    b[at + 1] = 4;
+    reseal(&mut b);
+    out.push(("interval_beyond_k_5d.dctable", b, "intervals[0]"));
+    out
+}
+
+#[test]
+fn checksum_valid_but_inconsistent_files_are_corrupt() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let regenerate = std::env::var_os("DC_REGENERATE_TABLE_DATA").is_some();
+    for (name, fresh, needle) in corrupted_files(&small_space()) {
+        let path = dir.join(name);
+        if regenerate {
+            std::fs::write(&path, &fresh).unwrap();
+        }
+        for bytes in [fresh, std::fs::read(&path).unwrap()] {
+            match from_bytes(&bytes) {
+                Err(TableError::Corrupt { what }) => assert!(what.contains(needle), "{name}: {what}"),
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn a_loaded_table_answers_as_the_built_one() {
+    let s = space(3, Pattern::Blobs);
+    let t = Table::D4(LinearQuadtree4d::build(&s, true, SliceAxes::ZZ, 10).unwrap());
+    let (_, back) = from_bytes(&to_bytes(&t, &header(&s))).unwrap();
+    for a in &s.grid_a.cells {
+        for b in &s.grid_b.cells {
+            let c = [a[0], a[1], a[2], b[0], b[1], b[2]];
+            assert_eq!(back.query(c), t.query(c));
+        }
+    }
+}
