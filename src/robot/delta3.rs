@@ -10,6 +10,8 @@
 //! Motor angles are normalised to (-pi, pi]; a motor is within its limits when `th_i` lies on
 //! the arc from `theta_min` to `theta_max`, i.e. `(th - theta_min) mod 2 pi <= theta_max -
 //! theta_min` (the plain interval test when both limits lie in (-pi, pi], as they should).
+//! A TCP must also lie below the base plane (`z < 0`, SPEC §1): above it the loop equations
+//! still close, with the platform through the base frame.
 //!
 //! # Numerics
 //! The inverse kinematics needs no trigonometric call on its fast path: `cos th` and `sin th`
@@ -43,6 +45,8 @@ pub struct Delta3 {
 pub enum Unreachable {
     /// A coordinate is NaN or infinite.
     NonFinite,
+    /// The TCP is not below the base plane (`z >= 0`; SPEC §1: the TCP works below the base).
+    AboveBase,
     /// The lower link of `arm` cannot span the distance (`b^2 > re^2` or `|K| > R`).
     OutOfReach {
         /// The arm that cannot close its loop.
@@ -61,6 +65,7 @@ impl std::fmt::Display for Unreachable {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Unreachable::NonFinite => write!(f, "TCP has a NaN or infinite coordinate"),
+            Unreachable::AboveBase => write!(f, "TCP is not below the base plane (z must be negative)"),
             Unreachable::OutOfReach { arm } => write!(f, "arm {arm} cannot reach the TCP"),
             Unreachable::MotorLimit { arm, theta } => {
                 write!(f, "arm {arm} would need motor angle {theta:.4} rad, outside its limits")
@@ -113,6 +118,8 @@ pub const APPROX_ANGLE_MAX_ERROR: Real = 2e-3;
 
 /// An approximate angle at least this far (rad) inside both limits is accepted without `atan2`.
 pub const LIMIT_FAST_MARGIN: Real = 1e-2;
+
+const _: () = assert!(APPROX_ANGLE_MAX_ERROR < LIMIT_FAST_MARGIN, "the fast limit test must be conservative");
 
 /// `u_i`, the radial unit of arm `i`.
 pub fn radial(arm: usize) -> Vec3 {
@@ -211,11 +218,16 @@ impl Delta3 {
     /// Elbow-out `cos th_i` and `sin th_i` for a TCP in the MCS, limits checked (SPEC §2).
     ///
     /// # Errors
-    /// [`Unreachable`] when a coordinate is not finite, an arm cannot close its loop, or a
-    /// motor would leave its limits; the first failing arm (0, 1, 2 in order) is reported.
+    /// [`Unreachable`] when a coordinate is not finite, the TCP is not below the base plane
+    /// (`z >= 0`), an arm cannot close its loop, or a motor would leave its limits; the first
+    /// failing arm (0, 1, 2 in order) is reported.
     pub fn inverse_kinematics_cos_sin(&self, tcp: &Vec3) -> Result<MotorCosSin, Unreachable> {
         if !(tcp.x.is_finite() && tcp.y.is_finite() && tcp.z.is_finite()) {
             return Err(Unreachable::NonFinite);
+        }
+        // The loop equations alone would also close above the base, through the base frame.
+        if tcp.z >= 0.0 {
+            return Err(Unreachable::AboveBase);
         }
         let (re2, rf2, ef) = (self.re * self.re, self.rf * self.rf, self.e - self.f);
         let half_inv_rf = 0.5 / self.rf;
@@ -267,6 +279,7 @@ impl Delta3 {
     /// spheres of radius `re` around `C_i = G_i - e u_i`. `None` when an angle is not finite,
     /// the spheres do not meet, their centres are collinear, or the plane of the centres is
     /// vertical (no lower intersection). Motor limits are not checked.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // written so that NaN fails the tests
     pub fn forward_kinematics(&self, theta: &[Real; 3]) -> Option<Vec3> {
         let c: [Vec3; 3] = std::array::from_fn(|i| {
             let (s, co) = theta[i].sin_cos();
@@ -343,7 +356,9 @@ mod tests {
     fn far_away_tcp_is_out_of_reach() {
         let d = Delta3::THESIS;
         assert!(matches!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, -900.0)), Err(Unreachable::OutOfReach { .. })));
-        assert!(matches!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, 0.0)), Err(Unreachable::OutOfReach { .. })));
+        assert_eq!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, 0.0)), Err(Unreachable::AboveBase));
+        // The loops would close here (elbows down, links pointing up through the base).
+        assert_eq!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, 300.0)), Err(Unreachable::AboveBase));
         assert!(matches!(d.inverse_kinematics(&Vec3::new(1e200, 0.0, -400.0)), Err(Unreachable::OutOfReach { .. })));
         assert!(matches!(d.inverse_kinematics(&Vec3::new(0.0, -1e200, -1e200)), Err(Unreachable::OutOfReach { .. })));
         assert_eq!(d.inverse_kinematics(&Vec3::new(f64::NAN, 0.0, -400.0)), Err(Unreachable::NonFinite));
@@ -387,7 +402,6 @@ mod tests {
             worst = worst.max(err.min((err - TAU).abs()));
         }
         assert!(worst < APPROX_ANGLE_MAX_ERROR, "worst error {worst}");
-        assert!(APPROX_ANGLE_MAX_ERROR < LIMIT_FAST_MARGIN);
     }
 
     #[test]
