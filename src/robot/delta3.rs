@@ -5,8 +5,8 @@
 //! `F_i = f u_i` is the motor axis point, `G_i = F_i + rf (cos th_i u_i - sin th_i z)` the
 //! elbow (positive `th_i` moves the elbow down), `E_i = p + e u_i` the platform joint of the
 //! TCP `p`, and the loop closes when `|G_i - E_i| = re`. The assembled robot is elbow-out:
-//! of the two solutions of each arm, the one with the larger `cos th_i` (on a tie, when the
-//! TCP is level with the motor axes, the one with `sin th_i` of the sign of `P.u_i`).
+//! of the two solutions of each arm, the one with the larger `cos th_i` (no tie: they tie
+//! only for a TCP level with the motor axes, and the TCP must be below the base).
 //! Motor angles are normalised to (-pi, pi]; a motor is within its limits when `th_i` lies on
 //! the arc from `theta_min` to `theta_max`, i.e. `(th - theta_min) mod 2 pi <= theta_max -
 //! theta_min` (the plain interval test when both limits lie in (-pi, pi], as they should).
@@ -141,13 +141,17 @@ fn normalized_angle(cos: Real, sin: Real) -> Real {
     }
 }
 
-/// `atan2(sin, cos)` to within [`APPROX_ANGLE_MAX_ERROR`], without a library call
-/// (octant reduction and the rational fit `atan x ~ pi/4 x - x (x - 1)(0.2447 + 0.0663 x)`).
-/// NaN when both arguments are zero or one is NaN.
+/// `atan2(sin, cos)` to within [`APPROX_ANGLE_MAX_ERROR`], without a library call (octant
+/// reduction and the fit `atan x ~ pi/4 x - x (x - 1)(0.2447 + 0.0663 x)`); the arguments
+/// need not be normalised. NaN when both are zero or one is NaN.
+#[inline]
 pub fn approx_angle(cos: Real, sin: Real) -> Real {
     let (ac, as_) = (cos.abs(), sin.abs());
     let fit = |x: Real| FRAC_PI_4 * x - x * (x - 1.0) * (0.2447 + 0.0663 * x);
-    let mut a = if ac >= as_ { fit(as_ / ac) } else { FRAC_PI_2 - fit(ac / as_) };
+    // Selects rather than min/max, so that a NaN in either argument reaches the result.
+    let (num, den) = if ac >= as_ { (as_, ac) } else { (ac, as_) };
+    let x = fit(num / den);
+    let mut a = if ac >= as_ { x } else { FRAC_PI_2 - x };
     if cos < 0.0 {
         a = PI - a;
     }
@@ -200,11 +204,16 @@ impl Delta3 {
         tcp + radial(arm) * self.e
     }
 
+    /// Whether an angle known to within [`APPROX_ANGLE_MAX_ERROR`] is surely within the limits.
+    #[inline]
+    fn clearly_within_limits(&self, approx: Real) -> bool {
+        approx >= self.theta_min + LIMIT_FAST_MARGIN && approx <= self.theta_max - LIMIT_FAST_MARGIN
+    }
+
     /// Whether the motor angle with this cosine and sine lies within the limits; `Err` carries
     /// the exact angle when it does not (NaN inputs give `Err(NaN)`).
     pub fn motor_within_limits(&self, cos_th: Real, sin_th: Real) -> Result<(), Real> {
-        let approx = approx_angle(cos_th, sin_th);
-        if approx >= self.theta_min + LIMIT_FAST_MARGIN && approx <= self.theta_max - LIMIT_FAST_MARGIN {
+        if self.clearly_within_limits(approx_angle(cos_th, sin_th)) {
             return Ok(());
         }
         let theta = normalized_angle(cos_th, sin_th);
@@ -245,16 +254,20 @@ impl Delta3 {
             }
             // th = -atan2(c, a) +/- acos(K / R): cos th = (a K +/- c S) / R^2 and
             // sin th = (-c K +/- a S) / R^2 with S = sqrt(R^2 - K^2); elbow-out takes the
-            // sign that makes cos th larger, i.e. +/- = sign(c) (+ when c = 0).
-            let s = if c < 0.0 { -(r2 - k * k).sqrt() } else { (r2 - k * k).sqrt() };
+            // sign that makes cos th larger, +/- = sign(c), and c = z < 0 here: minus.
+            let s = -(r2 - k * k).sqrt();
+            let (cos_n, sin_n) = (a * k + c * s, a * s - c * k); // R^2 (cos th, sin th)
+            // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
+            let fast_ok = self.clearly_within_limits(approx_angle(cos_n, sin_n));
             let inv_r2 = 1.0 / r2;
-            let cos_th = (a * k + c * s) * inv_r2;
-            let sin_th = (a * s - c * k) * inv_r2;
-            if let Err(theta) = self.motor_within_limits(cos_th, sin_th) {
-                if theta.is_nan() {
-                    return Err(Unreachable::OutOfReach { arm: arm as u8 });
+            let (cos_th, sin_th) = (cos_n * inv_r2, sin_n * inv_r2);
+            if !fast_ok {
+                if let Err(theta) = self.motor_within_limits(cos_th, sin_th) {
+                    if theta.is_nan() {
+                        return Err(Unreachable::OutOfReach { arm: arm as u8 });
+                    }
+                    return Err(Unreachable::MotorLimit { arm: arm as u8, theta });
                 }
-                return Err(Unreachable::MotorLimit { arm: arm as u8, theta });
             }
             out.cos[arm] = cos_th;
             out.sin[arm] = sin_th;
@@ -390,6 +403,14 @@ mod tests {
         assert!(d.motor_within_limits((-3.0f64).cos(), (-3.0f64).sin()).is_ok());
         assert!(d.motor_within_limits(1.0, 0.0).is_err());
         assert!(d.motor_within_limits(f64::NAN, 0.0).unwrap_err().is_nan());
+    }
+
+    #[test]
+    fn approximate_angle_propagates_nan() {
+        for (c, s) in [(f64::NAN, 1.0), (1.0, f64::NAN), (f64::NAN, 0.0), (0.0, 0.0), (f64::INFINITY, f64::NAN)] {
+            assert!(approx_angle(c, s).is_nan(), "({c}, {s})");
+        }
+        assert!((approx_angle(-3.0, 4.0) - 4.0f64.atan2(-3.0)).abs() < APPROX_ANGLE_MAX_ERROR);
     }
 
     #[test]

@@ -134,9 +134,22 @@ impl RobotModel {
     ///
     /// # Errors
     /// [`Unreachable`] from the inverse kinematics.
+    #[inline]
     pub fn boxes(&self, tcp: &Vec3) -> Result<RobotBoxes, Unreachable> {
+        let mut out = RobotBoxes::empty();
+        self.boxes_into(tcp, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`RobotModel::boxes`] written into a caller-owned buffer (no copy of the ~1 KB
+    /// [`RobotBoxes`]; the per-tick path). Boxes past `out.len` are left as they were.
+    ///
+    /// # Errors
+    /// [`Unreachable`] from the inverse kinematics; `out` is then left unchanged.
+    pub fn boxes_into(&self, tcp: &Vec3, out: &mut RobotBoxes) -> Result<(), Unreachable> {
         let sol = self.delta.inverse_kinematics_cos_sin(tcp)?;
-        Ok(self.boxes_from_cos_sin(tcp, &sol))
+        self.write_boxes(tcp, &sol, out);
+        Ok(())
     }
 
     /// The boxes for a TCP and its already solved motor angles (direct vector form).
@@ -147,24 +160,31 @@ impl RobotModel {
     /// The boxes for a TCP and the cosines and sines of its motor angles (direct vector form,
     /// SPEC §3: centre `(G + E) / 2`, `x = (E - G) / |E - G|`, `z = normalize(x cross t)`).
     pub fn boxes_from_cos_sin(&self, tcp: &Vec3, sol: &MotorCosSin) -> RobotBoxes {
+        let mut out = RobotBoxes::empty();
+        self.write_boxes(tcp, sol, &mut out);
+        out
+    }
+
+    fn write_boxes(&self, tcp: &Vec3, sol: &MotorCosSin, out: &mut RobotBoxes) {
         let (d, o) = (&self.delta, &self.options);
         let m = o.margin;
-        let mut out = RobotBoxes::empty();
+        // |E_i - G_i| = re once the loops close (IK: to ~1e-15 relative), so x = (E - G) / re.
+        let (inv_re, inv_rf) = (1.0 / d.re, 1.0 / d.rf);
         let lower_half = Vec3::new(0.5 * d.re + m, o.half_height + m, o.half_depth + m);
         let elbows: [Vec3; 3] = std::array::from_fn(|arm| d.elbow(arm, sol.cos[arm], sol.sin[arm]));
-        for (arm, g) in elbows.iter().enumerate() {
-            out.push(link_box(g, &d.platform_joint(arm, tcp), &tangent(arm), lower_half));
+        for (arm, slot) in out.boxes[..3].iter_mut().enumerate() {
+            *slot = link_box(&elbows[arm], &d.platform_joint(arm, tcp), inv_re, &tangent(arm), lower_half);
         }
+        out.len = 3;
         if let Some((h, dz)) = o.upper_links {
             let upper_half = Vec3::new(0.5 * d.rf + m, h + m, dz + m);
             for (arm, g) in elbows.iter().enumerate() {
-                out.push(link_box(&d.motor_point(arm), g, &tangent(arm), upper_half));
+                out.push(link_box(&d.motor_point(arm), g, inv_rf, &tangent(arm), upper_half));
             }
         }
         for extra in [o.platform, o.tool].into_iter().flatten() {
             out.push(Obb::new(tcp + extra.offset, Mat3::identity(), extra.half.add_scalar(m)));
         }
-        out
     }
 
     /// The same boxes as [`RobotModel::boxes`], computed through the chain of homogeneous
@@ -249,10 +269,12 @@ fn pose_box(m: &Mat4, half: Vec3) -> Obb {
     Obb::new(center, m.fixed_view::<3, 3>(0, 0).into_owned(), half)
 }
 
-/// The box around the segment `p -> q`: x along it, z = normalize(x cross t), y = z cross x.
-fn link_box(p: &Vec3, q: &Vec3, t: &Vec3, half: Vec3) -> Obb {
-    let x = (q - p).normalize();
-    let z = x.cross(t).normalize();
+/// The box around the segment `p -> q` of length `1 / inv_len`: x along it,
+/// z = normalize(x cross t), y = z cross x (SPEC §3).
+fn link_box(p: &Vec3, q: &Vec3, inv_len: Real, t: &Vec3, half: Vec3) -> Obb {
+    let x = (q - p) * inv_len;
+    let xt = x.cross(t);
+    let z = xt * (1.0 / xt.norm());
     let y = z.cross(&x);
     Obb::new((p + q) * 0.5, Mat3::from_columns(&[x, y, z]), half)
 }
