@@ -24,7 +24,11 @@ fn ring(seed: u64) -> Vec<Vec3> {
     let mut rng = StdRng::seed_from_u64(seed);
     let mut out = Vec::with_capacity(LEN);
     while out.len() < LEN {
-        let p = Vec3::new(rng.random_range(-225.0..=225.0), rng.random_range(-225.0..=225.0), -rng.random_range(365.0..=530.0));
+        let p = Vec3::new(
+            rng.random_range(-225.0..=225.0),
+            rng.random_range(-225.0..=225.0),
+            -rng.random_range(365.0..=530.0),
+        );
         let d = -p.z;
         let r = if d <= 500.0 { 225.0 } else { 225.0 - 52.0 * (d - 500.0) / 30.0 };
         if p.x.hypot(p.y) <= r && Delta3::THESIS.is_reachable(&p) {

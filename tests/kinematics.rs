@@ -95,8 +95,7 @@ fn loop_error(d: &Delta3, tcp: &Vec3) -> Real {
 /// singularity, where the spheres meet at a grazing angle and the FK is ill-conditioned.
 fn link_determinant(d: &Delta3, tcp: &Vec3) -> Real {
     let sol = d.inverse_kinematics(tcp).unwrap();
-    let n: [Vec3; 3] =
-        std::array::from_fn(|i| (d.platform_joint(i, tcp) - d.elbow(i, sol.cos[i], sol.sin[i])) / d.re);
+    let n: [Vec3; 3] = std::array::from_fn(|i| (d.platform_joint(i, tcp) - d.elbow(i, sol.cos[i], sol.sin[i])) / d.re);
     n[0].dot(&n[1].cross(&n[2])).abs()
 }
 
@@ -224,7 +223,8 @@ fn unreachable_points_are_reported_with_their_reason() {
         let p = dir.normalize() * rng.random_range(611.0..5_000.0);
         assert_eq!(d.inverse_kinematics(&p), Err(Unreachable::OutOfReach { arm: 0 }), "{p:?}");
         // Above (or on) the base plane.
-        let q = Vec3::new(rng.random_range(-300.0..300.0), rng.random_range(-300.0..300.0), rng.random_range(0.0..400.0));
+        let q =
+            Vec3::new(rng.random_range(-300.0..300.0), rng.random_range(-300.0..300.0), rng.random_range(0.0..400.0));
         assert_eq!(d.inverse_kinematics(&q), Err(Unreachable::AboveBase), "{q:?}");
     }
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {

@@ -107,11 +107,7 @@ impl MotorCosSin {
 }
 
 /// Radial unit vectors `u_i` of the three arms.
-pub const ARM_RADIAL: [[Real; 2]; 3] = [
-    [1.0, 0.0],
-    [-0.5, 0.866_025_403_784_438_6],
-    [-0.5, -0.866_025_403_784_438_6],
-];
+pub const ARM_RADIAL: [[Real; 2]; 3] = [[1.0, 0.0], [-0.5, 0.866_025_403_784_438_6], [-0.5, -0.866_025_403_784_438_6]];
 
 /// Bound on the error of the approximate angle used by the fast motor-limit test (rad).
 pub const APPROX_ANGLE_MAX_ERROR: Real = 2e-3;
@@ -257,7 +253,7 @@ impl Delta3 {
             // sign that makes cos th larger, +/- = sign(c), and c = z < 0 here: minus.
             let s = -(r2 - k * k).sqrt();
             let (cos_n, sin_n) = (a * k + c * s, a * s - c * k); // R^2 (cos th, sin th)
-            // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
+                                                                 // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
             let fast_ok = self.clearly_within_limits(approx_angle(cos_n, sin_n));
             let inv_r2 = 1.0 / r2;
             let (cos_th, sin_th) = (cos_n * inv_r2, sin_n * inv_r2);

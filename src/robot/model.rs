@@ -59,6 +59,40 @@ impl ModelOptions {
         platform: None,
         tool: None,
     };
+
+    /// Checks that every size is finite and non-negative (box half-extents positive).
+    ///
+    /// # Errors
+    /// A sentence naming the bad option.
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = |name: &str, v: Real| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("model option {name} = {v} must be a positive finite length in mm"))
+            }
+        };
+        positive("half_height", self.half_height)?;
+        positive("half_depth", self.half_depth)?;
+        if !(self.margin.is_finite() && self.margin >= 0.0) {
+            return Err(format!("safety margin {} must be a finite length >= 0 mm", self.margin));
+        }
+        if let Some((h, d)) = self.upper_links {
+            positive("upper link half height", h)?;
+            positive("upper link half depth", d)?;
+        }
+        for (name, b) in [("platform", self.platform), ("tool", self.tool)] {
+            if let Some(b) = b {
+                if !(b.offset.iter().all(|v| v.is_finite())) {
+                    return Err(format!("{name} box offset {:?} must be finite", b.offset));
+                }
+                for v in b.half.iter() {
+                    positive(&format!("{name} box half-extent"), *v)?;
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Which part of the robot a box models.
@@ -119,7 +153,7 @@ impl RobotModel {
         3 + if o.upper_links.is_some() { 3 } else { 0 } + o.platform.is_some() as usize + o.tool.is_some() as usize
     }
 
-    /// What box `index` models.
+    /// What box `index` (< [`RobotModel::box_count`]) models.
     pub fn box_kind(&self, index: usize) -> BoxKind {
         let upper = if self.options.upper_links.is_some() { 3 } else { 0 };
         match index {
@@ -343,6 +377,17 @@ mod tests {
     }
 
     #[test]
+    fn options_are_validated() {
+        assert!(ModelOptions::THESIS.validate().is_ok());
+        assert!(full_options(3.0).options.validate().is_ok());
+        assert!(ModelOptions { margin: -1.0, ..ModelOptions::THESIS }.validate().unwrap_err().contains("margin"));
+        assert!(ModelOptions { half_depth: f64::NAN, ..ModelOptions::THESIS }.validate().is_err());
+        let mut o = full_options(0.0).options;
+        o.tool = Some(ToolBox { offset: Vec3::zeros(), half: Vec3::new(1.0, 0.0, 1.0) });
+        assert!(o.validate().unwrap_err().contains("tool"));
+    }
+
+    #[test]
     fn margin_grows_every_half_extent_by_exactly_m() {
         let tcp = Vec3::new(-70.0, 15.0, -480.0);
         let plain = full_options(0.0).boxes(&tcp).unwrap();
@@ -376,7 +421,8 @@ mod tests {
     fn chain_and_direct_forms_agree() {
         for margin in [0.0, 7.0] {
             let model = full_options(margin);
-            for tcp in [Vec3::new(0.0, 0.0, -450.0), Vec3::new(150.0, -90.0, -410.0), Vec3::new(-120.0, 120.0, -470.0)] {
+            for tcp in [Vec3::new(0.0, 0.0, -450.0), Vec3::new(150.0, -90.0, -410.0), Vec3::new(-120.0, 120.0, -470.0)]
+            {
                 let (a, b) = (model.boxes(&tcp).unwrap(), model.boxes_chain(&tcp).unwrap());
                 for (x, y) in a.as_slice().iter().zip(b.as_slice()) {
                     assert!((x.center - y.center).norm() < 1e-9, "{x:?} vs {y:?}");
