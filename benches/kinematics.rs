@@ -116,7 +116,7 @@ fn bench_model(c: &mut Criterion) {
             let a = model.boxes(black_box(&ring_a[i])).unwrap();
             let bb = model.boxes(black_box(&ring_b[i])).unwrap();
             assert!(a.boxes[0].center == expected[i].0 && bb.boxes[2].center == expected[i].1);
-            (a, bb)
+            black_box((&a, &bb));
         })
     });
     let (mut buf_a, mut buf_b) = (RobotBoxes::empty(), RobotBoxes::empty());
@@ -136,7 +136,7 @@ fn bench_model(c: &mut Criterion) {
             let bb = model.boxes_chain(black_box(&ring_b[i])).unwrap();
             assert!((a.boxes[0].center - expected[i].0).norm() < 1e-9);
             assert!((bb.boxes[2].center - expected[i].1).norm() < 1e-9);
-            (a, bb)
+            black_box((&a, &bb));
         })
     });
     g.finish();

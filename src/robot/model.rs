@@ -170,9 +170,8 @@ impl RobotModel {
     /// [`Unreachable`] from the inverse kinematics.
     #[inline]
     pub fn boxes(&self, tcp: &Vec3) -> Result<RobotBoxes, Unreachable> {
-        let mut out = RobotBoxes::empty();
-        self.boxes_into(tcp, &mut out)?;
-        Ok(out)
+        let sol = self.delta.inverse_kinematics_cos_sin(tcp)?;
+        Ok(self.boxes_from_cos_sin(tcp, &sol))
     }
 
     /// [`RobotModel::boxes`] written into a caller-owned buffer (no copy of the ~1 KB
