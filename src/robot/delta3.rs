@@ -5,15 +5,23 @@
 //! `F_i = f u_i` is the motor axis point, `G_i = F_i + rf (cos th_i u_i - sin th_i z)` the
 //! elbow (positive `th_i` moves the elbow down), `E_i = p + e u_i` the platform joint of the
 //! TCP `p`, and the loop closes when `|G_i - E_i| = re`. The assembled robot is elbow-out:
-//! of the two solutions of each arm, the one with the larger `cos th_i`.
+//! of the two solutions of each arm, the one with the larger `cos th_i` (no tie: they tie
+//! only for a TCP level with the motor axes, and the TCP must be below the base).
+//! Motor angles are normalised to (-pi, pi]; a motor is within its limits when `th_i` lies on
+//! the arc from `theta_min` to `theta_max`, i.e. `(th - theta_min) mod 2 pi <= theta_max -
+//! theta_min` (the plain interval test when both limits lie in (-pi, pi], as they should).
+//! A TCP must also lie below the base plane (`z < 0`, SPEC §1): above it the loop equations
+//! still close, with the platform through the base frame.
 //!
 //! # Numerics
-//! The inverse kinematics needs no trigonometric call: `cos th` and `sin th` come from the
-//! half-angle-free closed form below, and the motor limits are checked as an arc test
-//! (`cos(th - mid) >= cos(half_span)`); `th` itself is one `atan2` per arm, kept for callers.
+//! The inverse kinematics needs no trigonometric call on its fast path: `cos th` and `sin th`
+//! come from the closed form below, and the limit test first uses a cheap approximate angle
+//! (error < [`APPROX_ANGLE_MAX_ERROR`]); only when that lands within [`LIMIT_FAST_MARGIN`] of a
+//! limit is the exact `atan2` taken. [`Delta3::inverse_kinematics_cos_sin`] stops there;
+//! [`Delta3::inverse_kinematics`] adds one `atan2` per arm for the angles themselves.
 
 use crate::math::{Real, Vec3};
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
 /// Parameters of one Delta3 robot, in mm and rad (SPEC §2).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,6 +45,8 @@ pub struct Delta3 {
 pub enum Unreachable {
     /// A coordinate is NaN or infinite.
     NonFinite,
+    /// The TCP is not below the base plane (`z >= 0`; SPEC §1: the TCP works below the base).
+    AboveBase,
     /// The lower link of `arm` cannot span the distance (`b^2 > re^2` or `|K| > R`).
     OutOfReach {
         /// The arm that cannot close its loop.
@@ -55,6 +65,7 @@ impl std::fmt::Display for Unreachable {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Unreachable::NonFinite => write!(f, "TCP has a NaN or infinite coordinate"),
+            Unreachable::AboveBase => write!(f, "TCP is not below the base plane (z must be negative)"),
             Unreachable::OutOfReach { arm } => write!(f, "arm {arm} cannot reach the TCP"),
             Unreachable::MotorLimit { arm, theta } => {
                 write!(f, "arm {arm} would need motor angle {theta:.4} rad, outside its limits")
@@ -74,12 +85,37 @@ pub struct ArmSolution {
     pub sin: [Real; 3],
 }
 
+/// The elbow-out solution without the angles: `cos th_i` and `sin th_i`, all the box model needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotorCosSin {
+    /// `cos th_i`.
+    pub cos: [Real; 3],
+    /// `sin th_i`.
+    pub sin: [Real; 3],
+}
+
+impl MotorCosSin {
+    /// The motor angle of `arm`, normalised to (-pi, pi].
+    pub fn theta(&self, arm: usize) -> Real {
+        normalized_angle(self.cos[arm], self.sin[arm])
+    }
+
+    /// The full solution, with the three angles.
+    pub fn with_angles(&self) -> ArmSolution {
+        ArmSolution { theta: std::array::from_fn(|i| self.theta(i)), cos: self.cos, sin: self.sin }
+    }
+}
+
 /// Radial unit vectors `u_i` of the three arms.
-pub const ARM_RADIAL: [[Real; 2]; 3] = [
-    [1.0, 0.0],
-    [-0.5, 0.866_025_403_784_438_6],
-    [-0.5, -0.866_025_403_784_438_6],
-];
+pub const ARM_RADIAL: [[Real; 2]; 3] = [[1.0, 0.0], [-0.5, 0.866_025_403_784_438_6], [-0.5, -0.866_025_403_784_438_6]];
+
+/// Bound on the error of the approximate angle used by the fast motor-limit test (rad).
+pub const APPROX_ANGLE_MAX_ERROR: Real = 2e-3;
+
+/// An approximate angle at least this far (rad) inside both limits is accepted without `atan2`.
+pub const LIMIT_FAST_MARGIN: Real = 1e-2;
+
+const _: () = assert!(APPROX_ANGLE_MAX_ERROR < LIMIT_FAST_MARGIN, "the fast limit test must be conservative");
 
 /// `u_i`, the radial unit of arm `i`.
 pub fn radial(arm: usize) -> Vec3 {
@@ -89,6 +125,37 @@ pub fn radial(arm: usize) -> Vec3 {
 /// `t_i`, the tangent unit of arm `i` (`z x u_i`, the motor axis direction).
 pub fn tangent(arm: usize) -> Vec3 {
     Vec3::new(-ARM_RADIAL[arm][1], ARM_RADIAL[arm][0], 0.0)
+}
+
+/// `atan2(sin, cos)` mapped to (-pi, pi] (`-pi` becomes `pi`).
+fn normalized_angle(cos: Real, sin: Real) -> Real {
+    let th = sin.atan2(cos);
+    if th <= -PI {
+        PI
+    } else {
+        th
+    }
+}
+
+/// `atan2(sin, cos)` to within [`APPROX_ANGLE_MAX_ERROR`], without a library call (octant
+/// reduction and the fit `atan x ~ pi/4 x - x (x - 1)(0.2447 + 0.0663 x)`); the arguments
+/// need not be normalised. NaN when both are zero or one is NaN.
+#[inline]
+pub fn approx_angle(cos: Real, sin: Real) -> Real {
+    let (ac, as_) = (cos.abs(), sin.abs());
+    let fit = |x: Real| FRAC_PI_4 * x - x * (x - 1.0) * (0.2447 + 0.0663 * x);
+    // Selects rather than min/max, so that a NaN in either argument reaches the result.
+    let (num, den) = if ac >= as_ { (as_, ac) } else { (ac, as_) };
+    let x = fit(num / den);
+    let mut a = if ac >= as_ { x } else { FRAC_PI_2 - x };
+    if cos < 0.0 {
+        a = PI - a;
+    }
+    if sin < 0.0 {
+        -a
+    } else {
+        a
+    }
 }
 
 impl Delta3 {
@@ -123,8 +190,9 @@ impl Delta3 {
 
     /// `G_i`, the elbow of arm `i` for a motor angle given by its cosine and sine.
     pub fn elbow(&self, arm: usize, cos_th: Real, sin_th: Real) -> Vec3 {
-        let u = radial(arm);
-        Vec3::new(u.x * (self.f + self.rf * cos_th), u.y * (self.f + self.rf * cos_th), -self.rf * sin_th)
+        let [ux, uy] = ARM_RADIAL[arm];
+        let r = self.f + self.rf * cos_th;
+        Vec3::new(ux * r, uy * r, -self.rf * sin_th)
     }
 
     /// `E_i`, the platform joint of arm `i` for the TCP `p`.
@@ -132,65 +200,111 @@ impl Delta3 {
         tcp + radial(arm) * self.e
     }
 
-    /// Elbow-out motor angles for a TCP in the MCS.
+    /// Whether an angle known to within [`APPROX_ANGLE_MAX_ERROR`] is surely within the limits.
+    #[inline]
+    fn clearly_within_limits(&self, approx: Real) -> bool {
+        approx >= self.theta_min + LIMIT_FAST_MARGIN && approx <= self.theta_max - LIMIT_FAST_MARGIN
+    }
+
+    /// Whether the motor angle with this cosine and sine lies within the limits; `Err` carries
+    /// the exact angle when it does not (NaN inputs give `Err(NaN)`).
+    pub fn motor_within_limits(&self, cos_th: Real, sin_th: Real) -> Result<(), Real> {
+        if self.clearly_within_limits(approx_angle(cos_th, sin_th)) {
+            return Ok(());
+        }
+        let theta = normalized_angle(cos_th, sin_th);
+        if (theta - self.theta_min).rem_euclid(TAU) <= self.theta_max - self.theta_min {
+            Ok(())
+        } else {
+            Err(theta)
+        }
+    }
+
+    /// Elbow-out `cos th_i` and `sin th_i` for a TCP in the MCS, limits checked (SPEC §2).
     ///
     /// # Errors
-    /// [`Unreachable`] when a coordinate is not finite, an arm cannot close its loop, or a
-    /// motor would leave its limits.
-    pub fn inverse_kinematics(&self, tcp: &Vec3) -> Result<ArmSolution, Unreachable> {
+    /// [`Unreachable`] when a coordinate is not finite, the TCP is not below the base plane
+    /// (`z >= 0`), an arm cannot close its loop, or a motor would leave its limits; the first
+    /// failing arm (0, 1, 2 in order) is reported.
+    pub fn inverse_kinematics_cos_sin(&self, tcp: &Vec3) -> Result<MotorCosSin, Unreachable> {
         if !(tcp.x.is_finite() && tcp.y.is_finite() && tcp.z.is_finite()) {
             return Err(Unreachable::NonFinite);
         }
-        let mid = 0.5 * (self.theta_min + self.theta_max);
-        let (cos_mid, sin_mid) = (mid.cos(), mid.sin());
-        let cos_half_span = (0.5 * (self.theta_max - self.theta_min)).cos();
-        let mut sol = ArmSolution { theta: [0.0; 3], cos: [0.0; 3], sin: [0.0; 3] };
-        for arm in 0..3 {
-            let [ux, uy] = ARM_RADIAL[arm];
-            // P = E_i - F_i = p + (e - f) u_i, in the arm's (u, t, z) frame.
-            let px = tcp.x + (self.e - self.f) * ux;
-            let py = tcp.y + (self.e - self.f) * uy;
-            let (a, b, c) = (px * ux + py * uy, -px * uy + py * ux, tcp.z);
+        // The loop equations alone would also close above the base, through the base frame.
+        if tcp.z >= 0.0 {
+            return Err(Unreachable::AboveBase);
+        }
+        let (re2, rf2, ef) = (self.re * self.re, self.rf * self.rf, self.e - self.f);
+        let half_inv_rf = 0.5 / self.rf;
+        let c = tcp.z;
+        let mut out = MotorCosSin { cos: [0.0; 3], sin: [0.0; 3] };
+        for (arm, &[ux, uy]) in ARM_RADIAL.iter().enumerate() {
+            // P = E_i - F_i = p + (e - f) u_i, in the arm's (u, t, z) frame: (a, b, c).
+            let a = tcp.x * ux + tcp.y * uy + ef;
+            let b = -tcp.x * uy + tcp.y * ux;
             let r2 = a * a + c * c;
-            let k = (r2 + self.rf * self.rf - (self.re * self.re - b * b)) / (2.0 * self.rf);
-            if b * b > self.re * self.re || k * k > r2 || r2 == 0.0 {
+            let k = (r2 + rf2 - (re2 - b * b)) * half_inv_rf;
+            // Written so that NaN (from overflowing squares) fails too.
+            if !(b * b <= re2 && k * k <= r2 && r2 > 0.0) {
                 return Err(Unreachable::OutOfReach { arm: arm as u8 });
             }
             // th = -atan2(c, a) +/- acos(K / R): cos th = (a K +/- c S) / R^2 and
             // sin th = (-c K +/- a S) / R^2 with S = sqrt(R^2 - K^2); elbow-out takes the
-            // sign that makes cos th larger, i.e. +/- = sign(c) (+ when c = 0).
-            let s = (r2 - k * k).sqrt();
-            let sign = if c < 0.0 { -1.0 } else { 1.0 };
-            let cos_th = (a * k + sign * c * s) / r2;
-            let sin_th = (-c * k + sign * a * s) / r2;
-            let theta = sin_th.atan2(cos_th);
-            if cos_th * cos_mid + sin_th * sin_mid < cos_half_span {
-                return Err(Unreachable::MotorLimit { arm: arm as u8, theta });
+            // sign that makes cos th larger, +/- = sign(c), and c = z < 0 here: minus.
+            let s = -(r2 - k * k).sqrt();
+            let (cos_n, sin_n) = (a * k + c * s, a * s - c * k); // R^2 (cos th, sin th)
+                                                                 // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
+            let fast_ok = self.clearly_within_limits(approx_angle(cos_n, sin_n));
+            let inv_r2 = 1.0 / r2;
+            let (cos_th, sin_th) = (cos_n * inv_r2, sin_n * inv_r2);
+            if !fast_ok {
+                if let Err(theta) = self.motor_within_limits(cos_th, sin_th) {
+                    if theta.is_nan() {
+                        return Err(Unreachable::OutOfReach { arm: arm as u8 });
+                    }
+                    return Err(Unreachable::MotorLimit { arm: arm as u8, theta });
+                }
             }
-            sol.theta[arm] = theta;
-            sol.cos[arm] = cos_th;
-            sol.sin[arm] = sin_th;
+            out.cos[arm] = cos_th;
+            out.sin[arm] = sin_th;
         }
-        Ok(sol)
+        Ok(out)
     }
 
-    /// The TCP for motor angles `theta`: the lower intersection of the three spheres of
-    /// radius `re` around `G_i - e u_i`, or `None` when the spheres do not meet.
+    /// Elbow-out motor angles for a TCP in the MCS (SPEC §2), with their cosines and sines.
+    ///
+    /// # Errors
+    /// As [`Delta3::inverse_kinematics_cos_sin`].
+    pub fn inverse_kinematics(&self, tcp: &Vec3) -> Result<ArmSolution, Unreachable> {
+        Ok(self.inverse_kinematics_cos_sin(tcp)?.with_angles())
+    }
+
+    /// Whether the TCP (MCS) is reachable: every loop closes and every motor is within limits.
+    pub fn is_reachable(&self, tcp: &Vec3) -> bool {
+        self.inverse_kinematics_cos_sin(tcp).is_ok()
+    }
+
+    /// The TCP for motor angles `theta`: the lower intersection (smaller z) of the three
+    /// spheres of radius `re` around `C_i = G_i - e u_i`. `None` when an angle is not finite,
+    /// the spheres do not meet, their centres are collinear, or the plane of the centres is
+    /// vertical (no lower intersection). Motor limits are not checked.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // written so that NaN fails the tests
     pub fn forward_kinematics(&self, theta: &[Real; 3]) -> Option<Vec3> {
         let c: [Vec3; 3] = std::array::from_fn(|i| {
-            self.elbow(i, theta[i].cos(), theta[i].sin()) - radial(i) * self.e
+            let (s, co) = theta[i].sin_cos();
+            self.elbow(i, co, s) - radial(i) * self.e
         });
         let (d1, d2) = (c[1] - c[0], c[2] - c[0]);
         let n = d1.cross(&d2);
-        let (n2, d11, d22, d12) = (n.norm_squared(), d1.norm_squared(), d2.norm_squared(), d1.dot(&d2));
-        if !(n2 > 0.0) {
+        let n2 = n.norm_squared();
+        let scale2 = d1.norm_squared().max(d2.norm_squared());
+        // Collinear (or non-finite) centres, or a vertical plane: no unique lower point.
+        if !(n2 > 1e-20 * scale2 * scale2) || n.z == 0.0 {
             return None;
         }
-        // q0 = alpha d1 + beta d2 with d1.q0 = |d1|^2 / 2 and d2.q0 = |d2|^2 / 2.
-        let det = d11 * d22 - d12 * d12;
-        let alpha = 0.5 * (d11 * d22 - d12 * d22) / det;
-        let beta = 0.5 * (d11 * d22 - d12 * d11) / det;
-        let q0 = d1 * alpha + d2 * beta;
+        // Circumcentre of the triangle relative to C_0 (Lagrange's identity: det = |n|^2):
+        // q0 = (|d1|^2 (d2 x n) + |d2|^2 (n x d1)) / (2 |n|^2).
+        let q0 = (d2.cross(&n) * d1.norm_squared() + n.cross(&d1) * d2.norm_squared()) * (0.5 / n2);
         let h2 = self.re * self.re - q0.norm_squared();
         if !(h2 >= 0.0) {
             return None;
@@ -212,17 +326,116 @@ mod tests {
         let sol = d.inverse_kinematics(&p).unwrap();
         // Symmetric TCP on the axis: all three motors agree.
         assert!((sol.theta[0] - sol.theta[1]).abs() < 1e-12);
+        assert!((sol.theta[0] - sol.theta[2]).abs() < 1e-12);
         let q = d.forward_kinematics(&sol.theta).unwrap();
         assert!((p - q).norm() < 1e-9, "{p} vs {q}");
     }
 
     #[test]
+    fn home_position_matches_hand_computation() {
+        // On the axis: a = e - f = -60, b = 0, c = -450. K = (60^2 + 450^2 + 150^2 - 400^2) / 300.
+        let d = Delta3::THESIS;
+        let (a, c): (Real, Real) = (-60.0, -450.0);
+        let k = (a * a + c * c + 150.0 * 150.0 - 400.0 * 400.0) / 300.0;
+        let r = a.hypot(c);
+        let th1 = -c.atan2(a) + (k / r).acos();
+        let th2 = -c.atan2(a) - (k / r).acos();
+        let wrap = |t: Real| (t + PI).rem_euclid(TAU) - PI;
+        let expected = if th1.cos() > th2.cos() { wrap(th1) } else { wrap(th2) };
+        let sol = d.inverse_kinematics(&Vec3::new(0.0, 0.0, -450.0)).unwrap();
+        assert!((sol.theta[0] - expected).abs() < 1e-12, "{} vs {expected}", sol.theta[0]);
+        assert!((sol.cos[0] - expected.cos()).abs() < 1e-12 && (sol.sin[0] - expected.sin()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn every_arm_closes_its_loop() {
+        let d = Delta3::THESIS;
+        for p in [Vec3::new(120.0, -80.0, -420.0), Vec3::new(-150.0, 30.0, -480.0), Vec3::new(0.0, 210.0, -380.0)] {
+            let sol = d.inverse_kinematics(&p).unwrap();
+            for arm in 0..3 {
+                let g = d.elbow(arm, sol.cos[arm], sol.sin[arm]);
+                let len = (g - d.platform_joint(arm, &p)).norm();
+                assert!((len - d.re).abs() < 1e-9, "arm {arm}: |GE| = {len}");
+                assert!((sol.cos[arm] - sol.theta[arm].cos()).abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
     fn far_away_tcp_is_out_of_reach() {
         let d = Delta3::THESIS;
-        assert!(matches!(
-            d.inverse_kinematics(&Vec3::new(0.0, 0.0, -900.0)),
-            Err(Unreachable::OutOfReach { .. })
-        ));
+        assert!(matches!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, -900.0)), Err(Unreachable::OutOfReach { .. })));
+        assert_eq!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, 0.0)), Err(Unreachable::AboveBase));
+        // The loops would close here (elbows down, links pointing up through the base).
+        assert_eq!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, 300.0)), Err(Unreachable::AboveBase));
+        assert!(matches!(d.inverse_kinematics(&Vec3::new(1e200, 0.0, -400.0)), Err(Unreachable::OutOfReach { .. })));
+        assert!(matches!(d.inverse_kinematics(&Vec3::new(0.0, -1e200, -1e200)), Err(Unreachable::OutOfReach { .. })));
         assert_eq!(d.inverse_kinematics(&Vec3::new(f64::NAN, 0.0, -400.0)), Err(Unreachable::NonFinite));
+        assert_eq!(d.inverse_kinematics(&Vec3::new(0.0, f64::INFINITY, -400.0)), Err(Unreachable::NonFinite));
+        assert!(!d.is_reachable(&Vec3::new(0.0, 0.0, -900.0)));
+        assert!(d.is_reachable(&Vec3::new(0.0, 0.0, -450.0)));
+    }
+
+    #[test]
+    fn tightened_limit_reports_the_needed_angle() {
+        let p = Vec3::new(0.0, 0.0, -450.0);
+        let th = Delta3::THESIS.inverse_kinematics(&p).unwrap().theta[0];
+        let below = Delta3 { theta_max: th - 1e-6, ..Delta3::THESIS };
+        match below.inverse_kinematics(&p) {
+            Err(Unreachable::MotorLimit { arm: 0, theta }) => assert!((theta - th).abs() < 1e-12),
+            other => panic!("expected a motor limit on arm 0, got {other:?}"),
+        }
+        let above = Delta3 { theta_min: th + 1e-6, theta_max: th + 1.0, ..Delta3::THESIS };
+        assert!(matches!(above.inverse_kinematics(&p), Err(Unreachable::MotorLimit { arm: 0, .. })));
+        // Exactly on a limit is within it.
+        let on = Delta3 { theta_max: th, ..Delta3::THESIS };
+        assert!(on.inverse_kinematics(&p).is_ok());
+    }
+
+    #[test]
+    fn limits_are_an_arc() {
+        let d = Delta3 { theta_min: 2.5, theta_max: 4.0, ..Delta3::THESIS };
+        // -3.0 rad is 3.28 rad on the circle, inside [2.5, 4.0]; 0 is not.
+        assert!(d.motor_within_limits((-3.0f64).cos(), (-3.0f64).sin()).is_ok());
+        assert!(d.motor_within_limits(1.0, 0.0).is_err());
+        assert!(d.motor_within_limits(f64::NAN, 0.0).unwrap_err().is_nan());
+    }
+
+    #[test]
+    fn approximate_angle_propagates_nan() {
+        for (c, s) in [(f64::NAN, 1.0), (1.0, f64::NAN), (f64::NAN, 0.0), (0.0, 0.0), (f64::INFINITY, f64::NAN)] {
+            assert!(approx_angle(c, s).is_nan(), "({c}, {s})");
+        }
+        assert!((approx_angle(-3.0, 4.0) - 4.0f64.atan2(-3.0)).abs() < APPROX_ANGLE_MAX_ERROR);
+    }
+
+    #[test]
+    fn approximate_angle_is_within_its_bound() {
+        let mut worst: Real = 0.0;
+        for i in 0..=200_000 {
+            let t = -PI + TAU * i as Real / 200_000.0;
+            let err = (approx_angle(t.cos(), t.sin()) - t).abs();
+            // Near +/- pi the two ends of the circle are the same angle.
+            worst = worst.max(err.min((err - TAU).abs()));
+        }
+        assert!(worst < APPROX_ANGLE_MAX_ERROR, "worst error {worst}");
+    }
+
+    #[test]
+    fn theta_is_normalised_to_the_half_open_interval() {
+        assert_eq!(normalized_angle(-1.0, -0.0), PI);
+        assert_eq!(normalized_angle(-1.0, 0.0), PI);
+        assert_eq!(normalized_angle(1.0, 0.0), 0.0);
+    }
+
+    #[test]
+    fn forward_kinematics_rejects_degenerate_input() {
+        let d = Delta3::THESIS;
+        assert_eq!(d.forward_kinematics(&[f64::NAN, 0.0, 0.0]), None);
+        // Horizontal upper links: the centres lie 210 mm from the axis, beyond a 10 mm lower link.
+        let short = Delta3 { re: 10.0, ..d };
+        assert_eq!(short.forward_kinematics(&[0.0, 0.0, 0.0]), None);
+        let p = d.forward_kinematics(&[0.3, 0.3, 0.3]).unwrap();
+        assert!(p.x.abs() < 1e-9 && p.y.abs() < 1e-9 && p.z < 0.0);
     }
 }

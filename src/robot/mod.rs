@@ -3,5 +3,5 @@
 pub mod delta3;
 pub mod model;
 
-pub use delta3::{ArmSolution, Delta3, Unreachable};
+pub use delta3::{ArmSolution, Delta3, MotorCosSin, Unreachable};
 pub use model::{BoxKind, ModelOptions, RobotBoxes, RobotModel, ToolBox};
