@@ -157,16 +157,16 @@ impl ExactChecker {
         self.verdict.first_unreachable = None;
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let robot = &self.cell.robots[j];
-            match robot.model.boxes(tcp) {
-                Ok(mut boxes) => {
+            match robot.model.boxes_into(tcp, &mut self.boxes[j]) {
+                Ok(()) => {
+                    let boxes = &mut self.boxes[j];
                     if !self.at_origin[j] {
                         let (rot, t) = (robot.placement.rotation(), robot.placement.t);
                         for b in &mut boxes.boxes[..boxes.len] {
                             *b = b.transformed(&rot, &t);
                         }
                     }
-                    self.aabb[j] = aabb_of(&boxes);
-                    self.boxes[j] = boxes;
+                    self.aabb[j] = aabb_of(boxes);
                 }
                 Err(why) => {
                     self.verdict.unreachable_mask |= 1 << j;
