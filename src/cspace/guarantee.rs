@@ -62,28 +62,35 @@ pub const SPLITS: u32 = 4;
 /// Added to every displacement bound (mm): covers rounding in the model's own arithmetic.
 pub const BOUND_SLACK: Real = 1e-6;
 
+/// What [`theta_range`] found over a box of TCPs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Enclosure {
+    /// No TCP of the box is reachable by the arm (the loop cannot close anywhere in it).
+    Empty,
+    /// The motor angle of every reachable TCP of the box lies in this interval.
+    Range(Interval),
+    /// No enclosure (the box reaches `z >= 0`, where the elbow-out branch changes formula).
+    Unbounded,
+}
+
 /// An enclosure of the elbow-out motor angle of `arm` over the reachable TCPs of the box
-/// `[lo, hi]` (MCS), split `splits` times per axis; `None` when it cannot be enclosed (the
-/// box reaches `z >= 0`, where the elbow-out branch changes formula).
-pub fn theta_range(delta: &Delta3, arm: usize, lo: &Vec3, hi: &Vec3, splits: u32) -> Option<Interval> {
+/// `[lo, hi]` (MCS), split `splits` times per axis and united.
+pub fn theta_range(delta: &Delta3, arm: usize, lo: &Vec3, hi: &Vec3, splits: u32) -> Enclosure {
     let (u, t) = (radial(arm), tangent(arm));
     let step = (hi - lo) / splits as Real;
-    let mut out: Option<Interval> = None;
+    let end = |i: u32, a: usize| if i == splits { hi[a] } else { lo[a] + step[a] * i as Real };
+    let mut out = Enclosure::Empty;
     for i in 0..splits {
         for j in 0..splits {
             for k in 0..splits {
-                let a0 = lo + step.component_mul(&Vec3::new(i as Real, j as Real, k as Real));
-                let a1 = if (i, j, k) == (splits - 1, splits - 1, splits - 1) { *hi } else { a0 + step };
-                let a1 = Vec3::new(
-                    if i + 1 == splits { hi.x } else { a1.x },
-                    if j + 1 == splits { hi.y } else { a1.y },
-                    if k + 1 == splits { hi.z } else { a1.z },
-                );
-                let (x, y, z) = (Interval::new(a0.x, a1.x), Interval::new(a0.y, a1.y), Interval::new(a0.z, a1.z));
-                match theta_over_box(delta, &u, &t, x, y, z) {
-                    SubBox::Empty => {}
-                    SubBox::Range(r) => out = Some(out.map_or(r, |o| o.hull(&r))),
-                    SubBox::Unbounded => return None,
+                let x = Interval::new(end(i, 0), end(i + 1, 0));
+                let y = Interval::new(end(j, 1), end(j + 1, 1));
+                let z = Interval::new(end(k, 2), end(k + 1, 2));
+                match (theta_over_box(delta, &u, &t, x, y, z), out) {
+                    (Enclosure::Unbounded, _) => return Enclosure::Unbounded,
+                    (Enclosure::Empty, _) => {}
+                    (Enclosure::Range(r), Enclosure::Range(o)) => out = Enclosure::Range(o.hull(&r)),
+                    (Enclosure::Range(r), _) => out = Enclosure::Range(r),
                 }
             }
         }
@@ -91,27 +98,20 @@ pub fn theta_range(delta: &Delta3, arm: usize, lo: &Vec3, hi: &Vec3, splits: u32
     out
 }
 
-enum SubBox {
-    /// No TCP of the sub-box is reachable by this arm.
-    Empty,
-    Range(Interval),
-    Unbounded,
-}
-
 /// `th = -atan2(c, a) - acos(K / R)` over one sub-box (SPEC §2, elbow-out with `c < 0`).
-fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> SubBox {
+fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> Enclosure {
     if z.hi >= 0.0 {
-        return SubBox::Unbounded;
+        return Enclosure::Unbounded;
     }
     let a = x.scale(u.x).add(y.scale(u.y)).shift(d.e - d.f);
     let b = x.scale(t.x).add(y.scale(t.y));
     let c = z;
     let b2 = b.sqr();
     if b2.lo > d.re * d.re {
-        return SubBox::Empty;
+        return Enclosure::Empty;
     }
     let r2 = a.sqr().add(c.sqr());
-    let Some(r) = r2.sqrt() else { return SubBox::Unbounded };
+    let Some(r) = r2.sqrt() else { return Enclosure::Unbounded };
     let cc = b2.shift(d.rf * d.rf - d.re * d.re);
     let two_rf = 2.0 * d.rf;
     let q = if cc.hi <= 0.0 {
@@ -121,47 +121,55 @@ fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: I
         Interval::new(glo.lo, ghi.hi)
     } else {
         let k = r2.add(cc).scale(1.0 / two_rf);
-        let Some(q) = k.div(r) else { return SubBox::Unbounded };
+        let Some(q) = k.div(r) else { return Enclosure::Unbounded };
         q
     };
-    let Some(psi) = q.acos() else { return SubBox::Empty };
-    let Some(phi) = Interval::atan2(c, a) else { return SubBox::Unbounded };
-    SubBox::Range(phi.neg().sub(psi))
-}
-
-/// The closed box of sample `sample`'s cell, widened by a relative 1e-12.
-fn cell_box(grid: &SampleGrid, sample: usize) -> (Vec3, Vec3) {
-    let c = grid.sample_center(sample);
-    let h = 0.5 * grid.r * (1.0 + 1e-12) + 1e-12;
-    (c.add_scalar(-h), c.add_scalar(h))
+    let Some(psi) = q.acos() else { return Enclosure::Empty };
+    let Some(phi) = Interval::atan2(c, a) else { return Enclosure::Unbounded };
+    Enclosure::Range(phi.neg().sub(psi))
 }
 
 /// Per box of `model` (in [`RobotModel::boxes`] order), a bound on how far any point of the
 /// box moves when the TCP moves from sample `sample`'s centre to any reachable point of its
-/// cell (mm; see the module doc). `INFINITY` for every box when the centre is unreachable or
-/// the motor angles cannot be enclosed; entries past `model.box_count()` are 0.
+/// closed cell (mm; see the module doc). `INFINITY` for every box when the centre is
+/// unreachable or the motor angles cannot be enclosed; entries past `model.box_count()` are 0.
 pub fn box_displacement_bounds(model: &RobotModel, grid: &SampleGrid, sample: usize) -> [Real; MAX_BOXES] {
-    let (d, o) = (&model.delta, &model.options);
-    let mut out = [0.0; MAX_BOXES];
-    let n = model.box_count();
     let c = grid.sample_center(sample);
-    let Ok(sol) = d.inverse_kinematics(&c) else {
-        out[..n].fill(Real::INFINITY);
-        return out;
-    };
-    let (lo, hi) = cell_box(grid, sample);
-    let h = 0.5 * (hi.x - lo.x);
-    let dp = h * 3f64.sqrt();
-    let mut dg = [0.0; 3];
-    for arm in 0..3 {
-        let Some(th) = theta_range(d, arm, &lo, &hi, SPLITS) else {
-            out[..n].fill(Real::INFINITY);
-            return out;
-        };
-        let dth = (th.hi - sol.theta[arm]).max(sol.theta[arm] - th.lo).clamp(0.0, std::f64::consts::PI);
-        dg[arm] = 2.0 * d.rf * (0.5 * dth).sin();
+    cube_box_bounds(model, &c, 0.5 * grid.r, SPLITS).unwrap_or_else(|| unknown(model))
+}
+
+fn unknown(model: &RobotModel) -> [Real; MAX_BOXES] {
+    let mut out = [0.0; MAX_BOXES];
+    out[..model.box_count()].fill(Real::INFINITY);
+    out
+}
+
+/// As [`box_displacement_bounds`] for the closed cube of centre `c` and half-side `h`
+/// (widened by a relative 1e-12), enclosing the motor angles with `splits^3` sub-boxes.
+/// `None` when no TCP of the cube is reachable (nothing to bound: the cube can never be
+/// occupied); `INFINITY` entries when the centre is unreachable but the cube is not empty, or
+/// the angles cannot be enclosed.
+pub fn cube_box_bounds(model: &RobotModel, c: &Vec3, h: Real, splits: u32) -> Option<[Real; MAX_BOXES]> {
+    let (d, o) = (&model.delta, &model.options);
+    let n = model.box_count();
+    let h = h * (1.0 + 1e-12) + 1e-12;
+    let (lo, hi) = (c.add_scalar(-h), c.add_scalar(h));
+    let mut th = [Interval::point(0.0); 3];
+    for (arm, slot) in th.iter_mut().enumerate() {
+        match theta_range(d, arm, &lo, &hi, splits) {
+            Enclosure::Empty => return None,
+            Enclosure::Unbounded => return Some(unknown(model)),
+            Enclosure::Range(r) => *slot = r,
+        }
     }
+    let Ok(sol) = d.inverse_kinematics(c) else { return Some(unknown(model)) };
+    let dp = h * 3f64.sqrt();
+    let dg: [Real; 3] = std::array::from_fn(|arm| {
+        let dth = (th[arm].hi - sol.theta[arm]).max(sol.theta[arm] - th[arm].lo).clamp(0.0, std::f64::consts::PI);
+        2.0 * d.rf * (0.5 * dth).sin()
+    });
     let m = o.margin;
+    let mut out = [0.0; MAX_BOXES];
     for (j, slot) in out[..n].iter_mut().enumerate() {
         let bound = match model.box_kind(j) {
             BoxKind::LowerLink(arm) => {
@@ -189,7 +197,7 @@ pub fn box_displacement_bounds(model: &RobotModel, grid: &SampleGrid, sample: us
         };
         *slot = bound + BOUND_SLACK;
     }
-    out
+    Some(out)
 }
 
 /// The largest of [`box_displacement_bounds`]: no point of the robot's model moves further
@@ -284,7 +292,7 @@ mod tests {
         let d = Delta3::THESIS;
         let (lo, hi) = (Vec3::new(150.0, -40.0, -520.0), Vec3::new(175.0, -10.0, -500.0));
         for arm in 0..3 {
-            let th = theta_range(&d, arm, &lo, &hi, 3).unwrap();
+            let Enclosure::Range(th) = theta_range(&d, arm, &lo, &hi, 3) else { panic!("arm {arm}") };
             for s in 0..1000 {
                 let f = |v: u32| (v % 10) as Real / 9.0;
                 let p = lo + (hi - lo).component_mul(&Vec3::new(f(s), f(s / 10), f(s / 100)));
@@ -293,7 +301,8 @@ mod tests {
                 }
             }
         }
-        assert!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -10.0), &Vec3::new(1.0, 1.0, 1.0), 2).is_none());
+        assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -10.0), &Vec3::new(1.0, 1.0, 1.0), 2), Enclosure::Unbounded);
+        assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -990.0), &Vec3::new(1.0, 1.0, -980.0), 2), Enclosure::Empty);
     }
 
     #[test]

@@ -8,83 +8,112 @@
 //! binary search). The candidates then go through the AABB test in y and z, a per-box AABB
 //! test and finally the separating axis test.
 //!
-//! Three labellings share the kernel [`label_pairs`]:
+//! The labellings share the kernel [`label_pairs`]:
 //! - [`label_space`]: every box enlarged by one global `margin` (the thesis's blown-up model
-//!   with `margin = r / sqrt(2)`, or the exact labelling of the centres with 0);
-//! - [`label_space_certified`]: every box enlarged by its own per-sample displacement bound
-//!   ([`crate::cspace::guarantee`]), so that a free label holds for the whole 6-D cell.
+//!   [`label_space_thesis`] with `margin = r / sqrt(2)`, or the exact labelling of the
+//!   centres with 0);
+//! - [`crate::cspace::certify::label_space_certified`]: every box enlarged by its own
+//!   displacement bound, so that a free label holds for the whole 6-D cell.
 //!
 //! # Numerics
 //! Every pre-test errs toward overlap (slack [`AABB_SLACK`]); only the separating axis test
 //! (itself conservative) can turn a candidate free.
 
 use crate::cell::{Cell, Placement};
-use crate::cspace::guarantee::{box_displacement_bounds, thesis_margin};
+use crate::cspace::guarantee::thesis_margin;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::sat::separating_axis;
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
-use crate::math::Real;
-use crate::cspace::symmetry::mirror_cell;
-use crate::robot::{BoxKind, ModelOptions, RobotModel};
+use crate::math::{Mat3, Real, Vec3};
+use crate::robot::{ModelOptions, RobotModel};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 /// Slack (mm) of every axis-aligned pre-test: boxes closer than this go on to the exact test.
 pub const AABB_SLACK: Real = 1e-6;
 
-/// One robot's boxes at every sample centre, in the WCS, with their axis-aligned bounds.
+/// What one entry (a sample, or a sub-cell of one) of [`SampleBoxes`] holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slot {
+    /// Boxes at the centre are built (enlarged as asked).
+    Boxes,
+    /// The centre is unreachable: a sample's pairs are labelled [`Label::Unreachable`].
+    Unreachable,
+    /// No TCP of the entry's cube is reachable: nothing there can collide (sub-cells only).
+    Vacuous,
+    /// Nothing could be proved (no displacement bound): every pair is a collision.
+    Unknown,
+}
+
+/// How to enlarge the boxes of one entry when building [`SampleBoxes`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Inflation {
+    /// Box `j` enlarged by `.0[j]` on every half-extent (on top of the model's margin).
+    By([Real; MAX_BOXES]),
+    /// See [`Slot::Vacuous`].
+    Vacuous,
+    /// See [`Slot::Unknown`].
+    Unknown,
+}
+
+/// One robot's boxes at a list of centres (sample centres, or sub-cell centres), in the WCS,
+/// with their axis-aligned bounds: built once, shared by every pair.
 #[derive(Clone, Debug)]
 pub struct SampleBoxes {
-    /// Boxes per sample.
-    pub per_sample: usize,
-    /// Box `j` of sample `s` at `s * per_sample + j` (meaningless when unreachable).
+    /// Boxes per entry.
+    pub per_entry: usize,
+    /// Box `j` of entry `s` at `s * per_entry + j` (meaningful when `slot[s]` is `Boxes`).
     pub boxes: Vec<Obb>,
-    /// Per box: AABB lower and upper corners.
+    /// Per box: AABB lower corner.
     pub box_lo: Vec<[Real; 3]>,
     /// Per box: AABB upper corner.
     pub box_hi: Vec<[Real; 3]>,
-    /// Per sample: the AABB of all its boxes, lower corner.
+    /// Per entry: the AABB of all its boxes, lower corner.
     pub lo: Vec<[Real; 3]>,
-    /// Per sample: upper corner.
+    /// Per entry: upper corner.
     pub hi: Vec<[Real; 3]>,
-    /// Whether the sample's centre is reachable.
-    pub reachable: Vec<bool>,
+    /// Per entry: what it holds.
+    pub slot: Vec<Slot>,
 }
 
 impl SampleBoxes {
-    /// The boxes of `model` placed by `placement` at every centre of `grid`, box `j` of sample
-    /// `s` enlarged by `inflate(s)[j]` on every half-extent (on top of the model's margin).
-    pub fn new<F>(model: &RobotModel, placement: &Placement, grid: &SampleGrid, inflate: F) -> SampleBoxes
+    /// The boxes of `model` placed by `placement` with the TCP at each of `centres` (MCS),
+    /// enlarged as `inflate(s)` says; an unreachable centre gives [`Slot::Unreachable`].
+    pub fn new<F>(model: &RobotModel, placement: &Placement, centres: &[Vec3], inflate: F) -> SampleBoxes
     where
-        F: Fn(usize) -> [Real; MAX_BOXES] + Sync,
+        F: Fn(usize) -> Inflation + Sync,
     {
         let nb = model.box_count();
-        let n = grid.cells.len();
-        let per: Vec<Option<Vec<Obb>>> = (0..n)
-            .into_par_iter()
-            .map(|s| {
-                let boxes = model.boxes(&grid.sample_center(s)).ok()?;
-                let extra = inflate(s);
-                Some(boxes.as_slice().iter().zip(extra).map(|(b, m)| placement.obb_to_wcs(&b.inflated(m))).collect())
+        let per: Vec<(Slot, Vec<Obb>)> = centres
+            .par_iter()
+            .enumerate()
+            .map(|(s, c)| match (inflate(s), model.boxes(c)) {
+                (Inflation::Vacuous, _) => (Slot::Vacuous, vec![]),
+                (Inflation::Unknown, Ok(_)) => (Slot::Unknown, vec![]),
+                (_, Err(_)) => (Slot::Unreachable, vec![]),
+                (Inflation::By(extra), Ok(boxes)) => {
+                    let b = boxes.as_slice().iter().zip(extra).map(|(b, m)| placement.obb_to_wcs(&b.inflated(m)));
+                    (Slot::Boxes, b.collect())
+                }
             })
             .collect();
-        let empty = Obb::new(Default::default(), crate::math::Mat3::identity(), Default::default());
+        let empty = Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::zeros());
+        let n = centres.len();
         let mut out = SampleBoxes {
-            per_sample: nb,
+            per_entry: nb,
             boxes: Vec::with_capacity(n * nb),
             box_lo: Vec::with_capacity(n * nb),
             box_hi: Vec::with_capacity(n * nb),
             lo: Vec::with_capacity(n),
             hi: Vec::with_capacity(n),
-            reachable: Vec::with_capacity(n),
+            slot: Vec::with_capacity(n),
         };
-        for p in per {
-            let reachable = p.as_ref().is_some_and(|b| b.iter().all(|o| o.half.iter().all(|h| h.is_finite())));
+        for (slot, boxes) in per {
             let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
             for j in 0..nb {
-                let b = if reachable { p.as_ref().unwrap()[j] } else { empty };
+                let b = boxes.get(j).copied().unwrap_or(empty);
                 let h = b.aabb_half();
                 let (bl, bh) = (b.center - h, b.center + h);
                 for a in 0..3 {
@@ -97,19 +126,19 @@ impl SampleBoxes {
             }
             out.lo.push(lo);
             out.hi.push(hi);
-            out.reachable.push(reachable);
+            out.slot.push(slot);
         }
         out
     }
 
-    /// Sample count.
+    /// Entry count.
     pub fn len(&self) -> usize {
-        self.reachable.len()
+        self.slot.len()
     }
 
-    /// Whether there are no samples.
+    /// Whether there are no entries.
     pub fn is_empty(&self) -> bool {
-        self.reachable.is_empty()
+        self.slot.is_empty()
     }
 }
 
@@ -119,10 +148,13 @@ fn aabbs_apart(alo: &[Real; 3], ahi: &[Real; 3], blo: &[Real; 3], bhi: &[Real; 3
     (0..3).any(|k| blo[k] > ahi[k] + AABB_SLACK || alo[k] > bhi[k] + AABB_SLACK)
 }
 
-/// Whether some box of A's sample `ia` intersects some box of B's sample `ib`.
+/// Whether some box of A's entry `ia` intersects some box of B's entry `ib` (both `Boxes`).
 #[inline]
-fn samples_collide(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize) -> bool {
-    let (na, nb) = (a.per_sample, b.per_sample);
+pub fn entries_collide(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize) -> bool {
+    if aabbs_apart(&a.lo[ia], &a.hi[ia], &b.lo[ib], &b.hi[ib]) {
+        return false;
+    }
+    let (na, nb) = (a.per_entry, b.per_entry);
     for i in ia * na..(ia + 1) * na {
         for j in ib * nb..(ib + 1) * nb {
             if !aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j])
@@ -135,14 +167,53 @@ fn samples_collide(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize) -> bo
     false
 }
 
+/// The box pairs among `mask` (bit `8 i + j`: box `i` of A, box `j` of B) that A's entry
+/// `ia` and B's entry `ib` (both `Boxes`) do not prove disjoint; 0 when all are disjoint.
+pub fn collision_mask(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize, mask: u64) -> u64 {
+    if mask == 0 || aabbs_apart(&a.lo[ia], &a.hi[ia], &b.lo[ib], &b.hi[ib]) {
+        return 0;
+    }
+    let (na, nb) = (a.per_entry, b.per_entry);
+    let mut out = 0;
+    let mut rest = mask;
+    while rest != 0 {
+        let bit = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        let (i, j) = (ia * na + bit / 8, ib * nb + bit % 8);
+        if !aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j])
+            && separating_axis(&a.boxes[i], &b.boxes[j]).is_none()
+        {
+            out |= 1 << bit;
+        }
+    }
+    out
+}
+
+/// Every box pair of models with `na` and `nb` boxes, as a [`collision_mask`] mask.
+pub fn all_box_pairs(na: usize, nb: usize) -> u64 {
+    (0..na).flat_map(|i| (0..nb).map(move |j| 1u64 << (8 * i + j))).fold(0, |m, b| m | b)
+}
+
 /// The label of every pair `(ia, ib)` at `ia * b.len() + ib`: `Unreachable` when either
-/// centre is unreachable, else `Collision` when some pair of boxes intersects, else `Free`.
+/// centre is unreachable, `Collision` when either is `Unknown` or some pair of boxes
+/// intersects and `second_look(ia, ib)` (called only then) confirms it, else `Free`.
 /// Rows are labelled in parallel; `progress` draws a bar on stderr.
-pub fn label_pairs(a: &SampleBoxes, b: &SampleBoxes, progress: bool) -> Vec<Label> {
+pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, progress: bool) -> Vec<Label>
+where
+    F: Fn(usize, usize) -> bool + Sync,
+{
     let (na, nb) = (a.len(), b.len());
-    let base: Vec<Label> = b.reachable.iter().map(|&r| if r { Label::Free } else { Label::Unreachable }).collect();
-    // Reachable samples of B sorted by the lower x of their AABB.
-    let mut order: Vec<u32> = (0..nb as u32).filter(|&i| b.reachable[i as usize]).collect();
+    let base: Vec<Label> = b
+        .slot
+        .iter()
+        .map(|s| match s {
+            Slot::Boxes | Slot::Vacuous => Label::Free,
+            Slot::Unreachable => Label::Unreachable,
+            Slot::Unknown => Label::Collision,
+        })
+        .collect();
+    // B's entries with boxes, sorted by the lower x of their AABB.
+    let mut order: Vec<u32> = (0..nb as u32).filter(|&i| b.slot[i as usize] == Slot::Boxes).collect();
     order.sort_by(|&i, &j| b.lo[i as usize][0].total_cmp(&b.lo[j as usize][0]));
     let keys: Vec<Real> = order.iter().map(|&i| b.lo[i as usize][0]).collect();
     let widest = order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
@@ -153,15 +224,20 @@ pub fn label_pairs(a: &SampleBoxes, b: &SampleBoxes, progress: bool) -> Vec<Labe
     let mut labels = vec![Label::Unreachable; na * nb];
     if nb > 0 {
         labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| {
-            if a.reachable[ia] {
-                row.copy_from_slice(&base);
-                let (alo, ahi) = (&a.lo[ia], &a.hi[ia]);
-                let first = keys.partition_point(|&x| x < alo[0] - widest - AABB_SLACK);
-                let last = keys.partition_point(|&x| x <= ahi[0] + AABB_SLACK);
-                for &ib in &order[first..last.max(first)] {
-                    let ib = ib as usize;
-                    if !aabbs_apart(alo, ahi, &b.lo[ib], &b.hi[ib]) && samples_collide(a, ia, b, ib) {
-                        row[ib] = Label::Collision;
+            match a.slot[ia] {
+                Slot::Unreachable => {}
+                Slot::Vacuous => row.iter_mut().zip(&base).for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Free }),
+                Slot::Unknown => row.iter_mut().zip(&base).for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Collision }),
+                Slot::Boxes => {
+                    row.copy_from_slice(&base);
+                    let (lo, hi) = (a.lo[ia][0], a.hi[ia][0]);
+                    let first = keys.partition_point(|&x| x < lo - widest - AABB_SLACK);
+                    let last = keys.partition_point(|&x| x <= hi + AABB_SLACK).max(first);
+                    for &ib in &order[first..last] {
+                        let ib = ib as usize;
+                        if entries_collide(a, ia, b, ib) && second_look(ia, ib) {
+                            row[ib] = Label::Collision;
+                        }
                     }
                 }
             }
@@ -173,13 +249,13 @@ pub fn label_pairs(a: &SampleBoxes, b: &SampleBoxes, progress: bool) -> Vec<Labe
 }
 
 /// Robot `i` of a two-robot cell with `margin` added to its model's margin.
-fn robot_with_margin(cell: &Cell, i: usize, margin: Real) -> (RobotModel, Placement) {
+pub(crate) fn robot_with_margin(cell: &Cell, i: usize, margin: Real) -> (RobotModel, Placement) {
     let r = &cell.robots[i];
     let options = ModelOptions { margin: r.model.options.margin + margin, ..r.model.options };
     (RobotModel { options, ..r.model }, r.placement)
 }
 
-fn two_robot_grids(cell: &Cell, k: u32, ws: &Workspace) -> Result<(SampleGrid, SampleGrid), String> {
+pub(crate) fn two_robot_grids(cell: &Cell, k: u32, ws: &Workspace) -> Result<(SampleGrid, SampleGrid), String> {
     if cell.robots.len() != 2 {
         return Err(format!(
             "cell '{}' has {} robots; tables are built for two-robot cells (split the cell into pairs)",
@@ -203,9 +279,9 @@ pub fn label_space(cell: &Cell, k: u32, ws: &Workspace, margin: Real, progress: 
     let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
     let (ma, pa) = robot_with_margin(cell, 0, margin);
     let (mb, pb) = robot_with_margin(cell, 1, margin);
-    let a = SampleBoxes::new(&ma, &pa, &grid_a, |_| [0.0; MAX_BOXES]);
-    let b = SampleBoxes::new(&mb, &pb, &grid_b, |_| [0.0; MAX_BOXES]);
-    let labels = label_pairs(&a, &b, progress);
+    let a = SampleBoxes::new(&ma, &pa, &centres(&grid_a), |_| Inflation::By([0.0; MAX_BOXES]));
+    let b = SampleBoxes::new(&mb, &pb, &centres(&grid_b), |_| Inflation::By([0.0; MAX_BOXES]));
+    let labels = label_pairs(&a, &b, |_, _| true, progress);
     Ok(LabelledSpace { grid_a, grid_b, labels, margin })
 }
 
@@ -219,86 +295,7 @@ pub fn label_space_thesis(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -
     label_space(cell, k, ws, thesis_margin(g.r), progress)
 }
 
-/// A labelling whose free labels are proofs for whole 6-D cells, with the bounds it used.
-#[derive(Clone, Debug, PartialEq)]
-pub struct CertifiedSpace {
-    /// The labels; `space.margin` is the largest per-box enlargement used (each box got its
-    /// own, never more than this).
-    pub space: LabelledSpace,
-    /// Per sample of A, per box: the displacement bound its box was enlarged by.
-    pub bounds_a: Vec<[Real; MAX_BOXES]>,
-    /// Per sample of B, per box.
-    pub bounds_b: Vec<[Real; MAX_BOXES]>,
-}
-
-impl CertifiedSpace {
-    /// The largest displacement bound of A's sample `ia` (`reach_a[ia]`, mm).
-    pub fn reach_a(&self, ia: usize) -> Real {
-        self.bounds_a[ia].iter().copied().fold(0.0, Real::max)
-    }
-
-    /// The largest displacement bound of B's sample `ib`.
-    pub fn reach_b(&self, ib: usize) -> Real {
-        self.bounds_b[ib].iter().copied().fold(0.0, Real::max)
-    }
-}
-
-/// Labels every sample pair of the two-robot `cell` so that a free label holds for every
-/// configuration of the 6-D grid cell (SPEC §6): each box at the cell centre is enlarged by
-/// its own displacement bound ([`box_displacement_bounds`]) and the pair is free only when no
-/// enlarged boxes meet. Pairs whose bound is unknown are labelled collision.
-///
-/// # Errors
-/// As [`label_space`].
-pub fn label_space_certified(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<CertifiedSpace, String> {
-    let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
-    let bounds = |i: usize, grid: &SampleGrid| -> Vec<[Real; MAX_BOXES]> {
-        let model = cell.robots[i].model;
-        let raw: Vec<_> = (0..grid.cells.len()).into_par_iter().map(|s| box_displacement_bounds(&model, grid, s)).collect();
-        mirror_max(&model, grid, &raw)
-    };
-    let (bounds_a, bounds_b) = (bounds(0, &grid_a), bounds(1, &grid_b));
-    let a = SampleBoxes::new(&cell.robots[0].model, &cell.robots[0].placement, &grid_a, |s| finite(bounds_a[s]));
-    let b = SampleBoxes::new(&cell.robots[1].model, &cell.robots[1].placement, &grid_b, |s| finite(bounds_b[s]));
-    let mut labels = label_pairs(&a, &b, progress);
-    // A reachable centre with an unknown bound: nothing is proved, every pair collides.
-    let unknown = |bs: &[Real; MAX_BOXES]| bs.iter().any(|v| v.is_infinite());
-    let nb = grid_b.cells.len();
-    let any_unknown = |bs: &[[Real; MAX_BOXES]], grid: &SampleGrid| bs.iter().zip(&grid.reachable).any(|(b, &r)| r && unknown(b));
-    if any_unknown(&bounds_a, &grid_a) || any_unknown(&bounds_b, &grid_b) {
-        for (ia, row) in labels.chunks_mut(nb.max(1)).enumerate() {
-            for (ib, l) in row.iter_mut().enumerate() {
-                if *l == Label::Free && (unknown(&bounds_a[ia]) || unknown(&bounds_b[ib])) {
-                    *l = Label::Collision;
-                }
-            }
-        }
-    }
-    let used = |bs: &[[Real; MAX_BOXES]]| bs.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0, Real::max);
-    let margin = used(&bounds_a).max(used(&bounds_b));
-    Ok(CertifiedSpace { space: LabelledSpace { grid_a, grid_b, labels, margin }, bounds_a, bounds_b })
-}
-
-/// Per sample, the larger of its own bounds and its mirror sample's (arms 1 and 2 swapped):
-/// still upper bounds, and exactly mirror-symmetric, so that the labels of a symmetric cell
-/// are exactly symmetric (thesis 3.2.8) despite rounding in the enclosures.
-fn mirror_max(model: &RobotModel, grid: &SampleGrid, raw: &[[Real; MAX_BOXES]]) -> Vec<[Real; MAX_BOXES]> {
-    let swap = |j: usize| match model.box_kind(j) {
-        BoxKind::LowerLink(1) | BoxKind::UpperLink(1) => j + 1,
-        BoxKind::LowerLink(2) | BoxKind::UpperLink(2) => j - 1,
-        _ => j,
-    };
-    (0..raw.len())
-        .map(|s| match grid.index_of(mirror_cell(grid, grid.cells[s])) {
-            Some(m) => std::array::from_fn(|j| if j < model.box_count() { raw[s][j].max(raw[m][swap(j)]) } else { raw[s][j] }),
-            None => raw[s],
-        })
-        .collect()
-}
-
-/// Infinite bounds (unreachable centres) replaced by 0 so the box can still be built; such
-/// samples are unreachable or relabelled by the caller.
-fn finite(mut b: [Real; MAX_BOXES]) -> [Real; MAX_BOXES] {
-    b.iter_mut().filter(|v| !v.is_finite()).for_each(|v| *v = 0.0);
-    b
+/// The centres of every sample of `grid`, in sample order.
+pub fn centres(grid: &SampleGrid) -> Vec<Vec3> {
+    (0..grid.cells.len()).map(|s| grid.sample_center(s)).collect()
 }

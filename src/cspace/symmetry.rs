@@ -78,4 +78,35 @@ mod tests {
             Some(crate::robot::ToolBox { offset: Vec3::new(0.0, 5.0, -30.0), half: Vec3::repeat(10.0) });
         assert!(!reflection_y(&tool));
     }
+
+    /// Labels of mirrored sample pairs that differ (both grids must be y-symmetric).
+    fn mirror_mismatches(space: &crate::cspace::LabelledSpace) -> usize {
+        let (ga, gb) = (&space.grid_a, &space.grid_b);
+        assert!(grid_is_y_symmetric(ga) && grid_is_y_symmetric(gb));
+        let mb: Vec<usize> = gb.cells.iter().map(|&c| gb.index_of(mirror_cell(gb, c)).unwrap()).collect();
+        let mut bad = 0;
+        for (ia, &c) in ga.cells.iter().enumerate() {
+            let ma = ga.index_of(mirror_cell(ga, c)).unwrap();
+            bad += (0..gb.cells.len()).filter(|&ib| space.label(ia, ib) != space.label(ma, mb[ib])).count();
+        }
+        bad
+    }
+
+    #[test]
+    fn labels_of_symmetric_cells_agree_with_their_mirrors() {
+        use crate::cspace::{label_space, label_space_certified, Workspace};
+        let ws = Workspace::THESIS;
+        for name in ["T1", "T2"] {
+            let cell = reference_cell(name).unwrap();
+            assert!(reflection_y(&cell));
+            let exact = label_space(&cell, 16, &ws, 0.0, false).unwrap();
+            assert_eq!(mirror_mismatches(&exact), 0, "{name} exact");
+            let certified = label_space_certified(&cell, 16, &ws, false).unwrap();
+            assert_eq!(mirror_mismatches(&certified.space), 0, "{name} certified");
+        }
+        // T3 is not symmetric, and its labels show it.
+        let t3 = reference_cell("T3").unwrap();
+        assert!(!reflection_y(&t3));
+        assert!(mirror_mismatches(&label_space(&t3, 16, &ws, 0.0, false).unwrap()) > 0);
+    }
 }
