@@ -189,3 +189,32 @@ fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>)
         .collect();
     (cs, inflation)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::reference::reference_cell;
+    use crate::cspace::{label_space, Label};
+
+    /// Certified labels only add collisions to the exact centre labels, and refinement only
+    /// removes collisions that level 1 could not prove free.
+    #[test]
+    fn certified_labels_contain_exact_collisions_and_refinement_only_frees() {
+        let ws = Workspace::THESIS;
+        for name in ["T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let exact = label_space(&cell, 16, &ws, 0.0, false).unwrap();
+            let coarse = label_space_certified_with(&cell, 16, &ws, false, false).unwrap();
+            let fine = label_space_certified(&cell, 16, &ws, false).unwrap();
+            let (mut freed, mut added) = (0, 0);
+            for ((e, c), f) in exact.labels.iter().zip(&coarse.space.labels).zip(&fine.space.labels) {
+                assert_eq!(*e == Label::Unreachable, *f == Label::Unreachable);
+                assert!(*e != Label::Collision || *f == Label::Collision);
+                assert!(*c != Label::Free || *f == Label::Free);
+                freed += (*c == Label::Collision && *f == Label::Free) as usize;
+                added += (*e == Label::Free && *f == Label::Collision) as usize;
+            }
+            assert!(freed > 0 && added > 0, "{name}: {freed} freed, {added} added");
+        }
+    }
+}
