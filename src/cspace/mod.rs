@@ -5,8 +5,16 @@
 //! robot B's TCP in B's MCS. Each robot's TCP space is cut into cubic grid cells of side `r`
 //! aligned with the quadtree leaves; a sample is a cell centre.
 
+pub mod certify;
+pub mod guarantee;
+pub mod interval;
+pub mod label;
 pub mod sampler;
+pub mod symmetry;
 
+pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};
+pub use certify::{label_space_certified, label_space_certified_with, CertifiedSpace};
+pub use label::{label_space, label_space_thesis};
 pub use sampler::{CellIndex, SampleGrid, Workspace};
 
 /// The label of one two-robot sample (one 6-D grid cell).

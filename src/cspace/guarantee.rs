@@ -1,0 +1,322 @@
+//! The safety guarantee of a table: how far any point of any box of a robot can move while
+//! its TCP stays inside one grid cell (thesis 3.2.7, SPEC §6; issue 3 item 4).
+//!
+//! The thesis blows the model up by `r / sqrt(2)`, the TCP's worst displacement in a 2-D
+//! square. That is not a proof: the cube's half-diagonal is `r sqrt(3) / 2`, and a link point
+//! moves further than the TCP when the elbow swings and the link turns. This module bounds,
+//! per sample and per box, the displacement `rho` of every point of the box (with the robot's
+//! own margin `m`) when the TCP moves from the cell centre `p0` to any reachable `p` of the
+//! closed cell. Then, for every `p` in the cell, box(p) lies in box(p0) inflated by `rho`
+//! (every point of box(p) is within `rho` of the point with the same box coordinates in
+//! box(p0), and a box inflated by `rho` on each half-extent holds the `rho`-ball around each
+//! of its points). So if the inflated centre boxes of A and B are disjoint, no configuration
+//! of the 6-D cell collides: a free label is a proof.
+//!
+//! # Derivation (lower link of arm i; `t = t_i`, `u = u_i`, `h = r/2`)
+//! Write `G, E` for the elbow and platform joint at `p`, `G0, E0` at `p0`, `D = p - p0`.
+//! 1. `|D| <= dp = h sqrt(3)` (the cube's half-diagonal; the thesis used `r/sqrt(2)`).
+//! 2. `E = p + e u`, so `|E - E0| = |D| <= dp`.
+//! 3. `G = F + rf (cos th u - sin th z)` moves on a circle of radius `rf`:
+//!    `|G - G0| = 2 rf sin(|th - th0| / 2) <= dG := 2 rf sin(dth / 2)`, with
+//!    `dth >= max |th(p) - th0|` over the reachable part of the cell, enclosed with interval
+//!    arithmetic ([`theta_range`]): `th = -atan2(c, a) - acos(K / R)` (elbow-out, `c < 0`),
+//!    `a = p.u + e - f`, `b = p.t`, `c = p.z`, `R = hypot(a, c)`,
+//!    `K / R = R / (2 rf) + C / (2 rf R)` with `C = rf^2 - re^2 + b^2`, which for `C <= 0` is
+//!    increasing in `R` and in `C`, so it is enclosed without dependency; the cell is split
+//!    into `SPLITS^3` sub-boxes and the enclosures united.
+//! 4. Box point `P = (1 - l) G + l E + s_y y + s_z z` with `l in [-mu, 1 + mu]`, `mu = m/re`
+//!    (the box spans `G - m x` to `E + m x` since `|E - G| = re`), `|s_y| <= H + m`,
+//!    `|s_z| <= D + m`. The displacement is affine in `(l, s_y, s_z)`, so by the triangle
+//!    inequality `|P - P0| <= ax + (H + m) |y - y0| + (D + m) |z - z0|` where
+//!    `ax = max((1 + mu) dG + mu dp, mu dG + (1 + mu) dp)` (the two ends of `l`).
+//! 5. `x = (E - G) / re`: `|x - x0| <= dx := (dp + dG) / re`.
+//! 6. `x.t = (E - G).t / re = p.t / re` (`G.t = 0`, `u.t = 0`), so over the cell
+//!    `|x.t| <= beta := (|p0.t| + h (|t_x| + |t_y|)) / re` and `|(x - x0).t| <= h (|t_x| + |t_y|) / re`.
+//! 7. Normalising is Lipschitz away from 0: for `|v|, |w| >= w0`,
+//!    `|v/|v| - w/|w|| <= |v - w| / w0` (`v -> w0 v/|v|` is the projection onto a convex ball).
+//! 8. `z = (x cross t) / |x cross t|`, `|x cross t| = sqrt(1 - (x.t)^2) >= w0 := sqrt(1 - beta^2)`,
+//!    `|(x - x0) cross t| <= dx`, so `|z - z0| <= dx / w0`.
+//! 9. `y = z cross x = (t - (x.t) x) / sqrt(1 - (x.t)^2)`; the numerator changes by
+//!    `(x.t) (x - x0) + ((x - x0).t) x0`, so `|y - y0| <= (beta dx + h (|t_x| + |t_y|) / re) / w0`.
+//!
+//! Upper links (`F` to `G`, fixed `F`): `x.t = 0` so `y = t` never turns, `|z - z0| = dG / rf`,
+//! and points move at most `(1 + m/rf) dG + (d_u + m) dG / rf`. Platform and tool boxes
+//! translate with the TCP: `dp`. Unit vectors differ by at most 2, so every `|.|` above is
+//! capped at 2.
+//!
+//! # Numerics
+//! The cell is widened by a relative 1e-12 before enclosing (so rounding in [`SampleGrid::cell_of`]
+//! is covered), the interval arithmetic is outward ([`Interval`]), and every bound gets
+//! `BOUND_SLACK` added: all err toward a larger bound, i.e. toward "collision".
+
+use crate::cspace::interval::Interval;
+use crate::cspace::sampler::SampleGrid;
+use crate::geometry::witness::MAX_BOXES;
+use crate::math::{Real, Vec3};
+use crate::robot::delta3::{radial, tangent};
+use crate::robot::{BoxKind, Delta3, RobotModel};
+
+/// Sub-boxes per axis when enclosing the motor angles over a cell (`SPLITS^3` per arm).
+pub const SPLITS: u32 = 4;
+
+/// Added to every displacement bound (mm): covers rounding in the model's own arithmetic.
+pub const BOUND_SLACK: Real = 1e-6;
+
+/// What [`theta_range`] found over a box of TCPs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Enclosure {
+    /// No TCP of the box is reachable by the arm (the loop cannot close anywhere in it).
+    Empty,
+    /// The motor angle of every reachable TCP of the box lies in this interval.
+    Range(Interval),
+    /// No enclosure (the box reaches `z >= 0`, where the elbow-out branch changes formula).
+    Unbounded,
+}
+
+/// An enclosure of the elbow-out motor angle of `arm` over the reachable TCPs of the box
+/// `[lo, hi]` (MCS), split `splits` times per axis and united.
+pub fn theta_range(delta: &Delta3, arm: usize, lo: &Vec3, hi: &Vec3, splits: u32) -> Enclosure {
+    let (u, t) = (radial(arm), tangent(arm));
+    let step = (hi - lo) / splits as Real;
+    let end = |i: u32, a: usize| if i == splits { hi[a] } else { lo[a] + step[a] * i as Real };
+    let mut out = Enclosure::Empty;
+    for i in 0..splits {
+        for j in 0..splits {
+            for k in 0..splits {
+                let x = Interval::new(end(i, 0), end(i + 1, 0));
+                let y = Interval::new(end(j, 1), end(j + 1, 1));
+                let z = Interval::new(end(k, 2), end(k + 1, 2));
+                match (theta_over_box(delta, &u, &t, x, y, z), out) {
+                    (Enclosure::Unbounded, _) => return Enclosure::Unbounded,
+                    (Enclosure::Empty, _) => {}
+                    (Enclosure::Range(r), Enclosure::Range(o)) => out = Enclosure::Range(o.hull(&r)),
+                    (Enclosure::Range(r), _) => out = Enclosure::Range(r),
+                }
+            }
+        }
+    }
+    out
+}
+
+/// `th = -atan2(c, a) - acos(K / R)` over one sub-box (SPEC §2, elbow-out with `c < 0`).
+fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> Enclosure {
+    if z.hi >= 0.0 {
+        return Enclosure::Unbounded;
+    }
+    let a = x.scale(u.x).add(y.scale(u.y)).shift(d.e - d.f);
+    let b = x.scale(t.x).add(y.scale(t.y));
+    let c = z;
+    let b2 = b.sqr();
+    if b2.lo > d.re * d.re {
+        return Enclosure::Empty;
+    }
+    let r2 = a.sqr().add(c.sqr());
+    let Some(r) = r2.sqrt() else { return Enclosure::Unbounded };
+    let cc = b2.shift(d.rf * d.rf - d.re * d.re);
+    let two_rf = 2.0 * d.rf;
+    let q = if cc.hi <= 0.0 {
+        // K/R = R/(2 rf) + C/(2 rf R): increasing in R (C <= 0) and in C (R > 0).
+        let g = |rv: Real, cv: Real| Interval::point(rv / two_rf).add(Interval::point(cv).div(Interval::point(two_rf * rv)).unwrap());
+        let (glo, ghi) = (g(r.lo, cc.lo), g(r.hi, cc.hi));
+        Interval::new(glo.lo, ghi.hi)
+    } else {
+        let k = r2.add(cc).scale(1.0 / two_rf);
+        let Some(q) = k.div(r) else { return Enclosure::Unbounded };
+        q
+    };
+    let Some(psi) = q.acos() else { return Enclosure::Empty };
+    let Some(phi) = Interval::atan2(c, a) else { return Enclosure::Unbounded };
+    Enclosure::Range(phi.neg().sub(psi))
+}
+
+/// Per box of `model` (in [`RobotModel::boxes`] order), a bound on how far any point of the
+/// box moves when the TCP moves from sample `sample`'s centre to any reachable point of its
+/// closed cell (mm; see the module doc). `INFINITY` for every box when the centre is
+/// unreachable or the motor angles cannot be enclosed; entries past `model.box_count()` are 0.
+pub fn box_displacement_bounds(model: &RobotModel, grid: &SampleGrid, sample: usize) -> [Real; MAX_BOXES] {
+    let c = grid.sample_center(sample);
+    cube_box_bounds(model, &c, 0.5 * grid.r, SPLITS).unwrap_or_else(|| unknown(model))
+}
+
+fn unknown(model: &RobotModel) -> [Real; MAX_BOXES] {
+    let mut out = [0.0; MAX_BOXES];
+    out[..model.box_count()].fill(Real::INFINITY);
+    out
+}
+
+/// As [`box_displacement_bounds`] for the closed cube of centre `c` and half-side `h`
+/// (widened by a relative 1e-12), enclosing the motor angles with `splits^3` sub-boxes.
+/// `None` when no TCP of the cube is reachable (nothing to bound: the cube can never be
+/// occupied); `INFINITY` entries when the centre is unreachable but the cube is not empty, or
+/// the angles cannot be enclosed.
+pub fn cube_box_bounds(model: &RobotModel, c: &Vec3, h: Real, splits: u32) -> Option<[Real; MAX_BOXES]> {
+    let (d, o) = (&model.delta, &model.options);
+    let n = model.box_count();
+    let h = h * (1.0 + 1e-12) + 1e-12;
+    let (lo, hi) = (c.add_scalar(-h), c.add_scalar(h));
+    let mut th = [Interval::point(0.0); 3];
+    for (arm, slot) in th.iter_mut().enumerate() {
+        match theta_range(d, arm, &lo, &hi, splits) {
+            Enclosure::Empty => return None,
+            Enclosure::Unbounded => return Some(unknown(model)),
+            Enclosure::Range(r) => *slot = r,
+        }
+    }
+    let Ok(sol) = d.inverse_kinematics(c) else { return Some(unknown(model)) };
+    let dp = h * 3f64.sqrt();
+    let dg: [Real; 3] = std::array::from_fn(|arm| {
+        let dth = (th[arm].hi - sol.theta[arm]).max(sol.theta[arm] - th[arm].lo).clamp(0.0, std::f64::consts::PI);
+        2.0 * d.rf * (0.5 * dth).sin()
+    });
+    let m = o.margin;
+    let mut out = [0.0; MAX_BOXES];
+    for (j, slot) in out[..n].iter_mut().enumerate() {
+        let bound = match model.box_kind(j) {
+            BoxKind::LowerLink(arm) => {
+                let (arm, t) = (arm as usize, tangent(arm as usize));
+                let mu = m / d.re;
+                let ax = ((1.0 + mu) * dg[arm] + mu * dp).max(mu * dg[arm] + (1.0 + mu) * dp);
+                let dx = ((dp + dg[arm]) / d.re).min(2.0);
+                let tt = h * (t.x.abs() + t.y.abs()) / d.re;
+                let beta = c.dot(&t).abs() / d.re + tt;
+                if beta >= 1.0 {
+                    Real::INFINITY
+                } else {
+                    let w0 = (1.0 - beta * beta).sqrt();
+                    let dz = (dx / w0).min(2.0);
+                    let dy = ((beta * dx + tt) / w0).min(2.0);
+                    ax + (o.half_height + m) * dy + (o.half_depth + m) * dz
+                }
+            }
+            BoxKind::UpperLink(arm) => {
+                let (_, du) = o.upper_links.expect("upper link boxes exist");
+                let g = dg[arm as usize];
+                (1.0 + m / d.rf) * g + (du + m) * (g / d.rf).min(2.0)
+            }
+            BoxKind::Platform | BoxKind::Tool => dp,
+        };
+        *slot = bound + BOUND_SLACK;
+    }
+    Some(out)
+}
+
+/// The largest of [`box_displacement_bounds`]: no point of the robot's model moves further
+/// than this while the TCP stays in sample `sample`'s cell (mm; `INFINITY` when unknown).
+pub fn displacement_bound(model: &RobotModel, grid: &SampleGrid, sample: usize) -> Real {
+    box_displacement_bounds(model, grid, sample).into_iter().fold(0.0, Real::max)
+}
+
+/// The thesis's global blow-up margin for spacing `r`: `r / sqrt(2)` (thesis 3.2.7; not a
+/// proof, kept for comparison).
+pub fn thesis_margin(r: Real) -> Real {
+    r * std::f64::consts::FRAC_1_SQRT_2
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cspace::Workspace;
+    use crate::robot::ModelOptions;
+    use rand::{rngs::StdRng, RngExt, SeedableRng};
+
+    /// The largest corner displacement of any box between the centre and `p`.
+    fn measured(model: &RobotModel, p0: &Vec3, p: &Vec3) -> Option<[Real; MAX_BOXES]> {
+        let (b0, b1) = (model.boxes(p0).ok()?, model.boxes(p).ok()?);
+        let mut out = [0.0; MAX_BOXES];
+        for j in 0..b0.len {
+            let (v0, v1) = (b0.boxes[j].vertices(), b1.boxes[j].vertices());
+            out[j] = v0.iter().zip(&v1).map(|(a, b)| (a - b).norm()).fold(0.0, Real::max);
+        }
+        Some(out)
+    }
+
+    fn check_bounds_against_brute_force(model: RobotModel, k: u32, cells: usize, points: usize, seed: u64) -> Real {
+        let grid = SampleGrid::new(&Workspace::THESIS, k, &model.delta).unwrap();
+        let mut rng = StdRng::seed_from_u64(seed);
+        let mut worst_ratio: Real = 0.0;
+        for _ in 0..cells {
+            let s = rng.random_range(0..grid.cells.len());
+            if !grid.reachable[s] {
+                assert!(displacement_bound(&model, &grid, s).is_infinite());
+                continue;
+            }
+            let bounds = box_displacement_bounds(&model, &grid, s);
+            let c = grid.sample_center(s);
+            let mut worst = [0.0; MAX_BOXES];
+            for q in 0..points {
+                // Corners and face centres of the cell first, then random points.
+                let off = if q < 8 {
+                    Vec3::new((q & 1) as Real - 0.5, ((q >> 1) & 1) as Real - 0.5, ((q >> 2) & 1) as Real - 0.5)
+                } else {
+                    Vec3::new(rng.random::<Real>() - 0.5, rng.random::<Real>() - 0.5, rng.random::<Real>() - 0.5)
+                };
+                let Some(m) = measured(&model, &c, &(c + off * grid.r)) else { continue };
+                for j in 0..model.box_count() {
+                    assert!(m[j] <= bounds[j], "sample {s} box {j}: moved {} > bound {}", m[j], bounds[j]);
+                    worst[j] = Real::max(worst[j], m[j]);
+                }
+            }
+            for j in 0..model.box_count() {
+                if worst[j] > 0.0 {
+                    worst_ratio = worst_ratio.max(worst[j] / bounds[j]);
+                }
+            }
+        }
+        worst_ratio
+    }
+
+    #[test]
+    fn bounds_hold_against_brute_force_corner_displacements() {
+        for (k, seed) in [(16, 1), (32, 2), (64, 3)] {
+            let ratio = check_bounds_against_brute_force(RobotModel::THESIS, k, 300, 60, seed);
+            println!("k = {k}: worst measured / bound = {ratio:.3}");
+            assert!(ratio > 0.3, "the bound should not be absurdly loose: {ratio}");
+        }
+    }
+
+    #[test]
+    fn bounds_hold_with_margin_and_extra_boxes() {
+        let options = ModelOptions {
+            margin: 5.0,
+            upper_links: Some((30.0, 15.0)),
+            platform: Some(crate::robot::ToolBox { offset: Vec3::zeros(), half: Vec3::new(50.0, 50.0, 10.0) }),
+            ..ModelOptions::THESIS
+        };
+        let model = RobotModel { options, ..RobotModel::THESIS };
+        let ratio = check_bounds_against_brute_force(model, 32, 150, 40, 4);
+        assert!(ratio <= 1.0);
+    }
+
+    #[test]
+    fn theta_enclosure_holds_the_sampled_angles() {
+        let d = Delta3::THESIS;
+        let (lo, hi) = (Vec3::new(150.0, -40.0, -520.0), Vec3::new(175.0, -10.0, -500.0));
+        for arm in 0..3 {
+            let Enclosure::Range(th) = theta_range(&d, arm, &lo, &hi, 3) else { panic!("arm {arm}") };
+            for s in 0..1000 {
+                let f = |v: u32| (v % 10) as Real / 9.0;
+                let p = lo + (hi - lo).component_mul(&Vec3::new(f(s), f(s / 10), f(s / 100)));
+                if let Ok(sol) = d.inverse_kinematics(&p) {
+                    assert!(th.contains(sol.theta[arm]), "arm {arm} {p:?}: {} not in {th:?}", sol.theta[arm]);
+                }
+            }
+        }
+        assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -10.0), &Vec3::new(1.0, 1.0, 1.0), 2), Enclosure::Unbounded);
+        assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -990.0), &Vec3::new(1.0, 1.0, -980.0), 2), Enclosure::Empty);
+    }
+
+    #[test]
+    fn bound_exceeds_the_cube_half_diagonal_and_shrinks_with_k() {
+        let mut last = Real::INFINITY;
+        for k in [16, 32, 64] {
+            let grid = SampleGrid::new(&Workspace::THESIS, k, &Delta3::THESIS).unwrap();
+            let worst = (0..grid.cells.len())
+                .filter(|&s| grid.reachable[s])
+                .map(|s| displacement_bound(&RobotModel::THESIS, &grid, s))
+                .fold(0.0, Real::max);
+            assert!(worst.is_finite() && worst > 0.5 * grid.r * 3f64.sqrt());
+            assert!(worst < last);
+            last = worst;
+        }
+    }
+}

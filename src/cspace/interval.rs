@@ -1,0 +1,170 @@
+//! A tiny closed-interval arithmetic, enough to enclose the inverse kinematics over a grid
+//! cell (SPEC §6; used by [`crate::cspace::guarantee`]).
+//!
+//! # Numerics
+//! Every operation is computed in round-to-nearest and its result widened outward by a few
+//! ulps (`widen`): IEEE `+ - * / sqrt` are correctly rounded (error <= 1/2 ulp), and the libm
+//! `acos`/`atan2` used are within a few ulps, so every returned interval encloses the exact
+//! range of its operation over its operands. An empty result is reported as `None`.
+
+use crate::math::Real;
+
+/// The closed interval `[lo, hi]`, `lo <= hi`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interval {
+    /// Lower end.
+    pub lo: Real,
+    /// Upper end.
+    pub hi: Real,
+}
+
+/// Outward slack of one operation: 4 ulps relative plus the smallest normal number.
+fn widen(lo: Real, hi: Real) -> Interval {
+    let slack = |v: Real| v.abs() * 4.0 * Real::EPSILON + Real::MIN_POSITIVE;
+    Interval { lo: lo - slack(lo), hi: hi + slack(hi) }
+}
+
+impl Interval {
+    /// `[lo, hi]` (the ends are sorted).
+    pub fn new(lo: Real, hi: Real) -> Interval {
+        Interval { lo: lo.min(hi), hi: lo.max(hi) }
+    }
+
+    /// The degenerate interval `[v, v]`.
+    pub fn point(v: Real) -> Interval {
+        Interval { lo: v, hi: v }
+    }
+
+    /// Whether `v` lies in the interval.
+    pub fn contains(&self, v: Real) -> bool {
+        self.lo <= v && v <= self.hi
+    }
+
+    /// The smallest interval holding both.
+    pub fn hull(&self, o: &Interval) -> Interval {
+        Interval { lo: self.lo.min(o.lo), hi: self.hi.max(o.hi) }
+    }
+
+    /// `self + o`.
+    pub fn add(self, o: Interval) -> Interval {
+        widen(self.lo + o.lo, self.hi + o.hi)
+    }
+
+    /// `self - o`.
+    pub fn sub(self, o: Interval) -> Interval {
+        widen(self.lo - o.hi, self.hi - o.lo)
+    }
+
+    /// `self * s` for a scalar.
+    pub fn scale(self, s: Real) -> Interval {
+        let (a, b) = (self.lo * s, self.hi * s);
+        widen(a.min(b), a.max(b))
+    }
+
+    /// `self + s` for a scalar.
+    pub fn shift(self, s: Real) -> Interval {
+        widen(self.lo + s, self.hi + s)
+    }
+
+    /// `self * o`.
+    pub fn mul(self, o: Interval) -> Interval {
+        let p = [self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi];
+        widen(p.iter().copied().fold(Real::INFINITY, Real::min), p.iter().copied().fold(Real::NEG_INFINITY, Real::max))
+    }
+
+    /// `self^2` (tighter than `self * self` when the interval holds 0).
+    pub fn sqr(self) -> Interval {
+        let (a, b) = (self.lo * self.lo, self.hi * self.hi);
+        if self.lo <= 0.0 && self.hi >= 0.0 {
+            widen(0.0, a.max(b)).clamp_lo(0.0)
+        } else {
+            widen(a.min(b), a.max(b)).clamp_lo(0.0)
+        }
+    }
+
+    /// `self / o`, or `None` when `o` holds 0.
+    pub fn div(self, o: Interval) -> Option<Interval> {
+        if o.lo <= 0.0 && o.hi >= 0.0 {
+            return None;
+        }
+        let q = [self.lo / o.lo, self.lo / o.hi, self.hi / o.lo, self.hi / o.hi];
+        Some(widen(q.iter().copied().fold(Real::INFINITY, Real::min), q.iter().copied().fold(Real::NEG_INFINITY, Real::max)))
+    }
+
+    /// `sqrt` over the non-negative part, or `None` when the interval is negative.
+    pub fn sqrt(self) -> Option<Interval> {
+        if self.hi < 0.0 {
+            return None;
+        }
+        Some(widen(self.lo.max(0.0).sqrt(), self.hi.sqrt()).clamp_lo(0.0))
+    }
+
+    /// `acos` over the part inside `[-1, 1]` (decreasing), or `None` when there is none.
+    pub fn acos(self) -> Option<Interval> {
+        let (lo, hi) = (self.lo.max(-1.0), self.hi.min(1.0));
+        if lo > hi {
+            return None;
+        }
+        Some(widen(hi.acos(), lo.acos()))
+    }
+
+    /// The range of `atan2(y, x)` over the box `y x x`; `None` (no useful bound) when the box
+    /// meets the origin or the branch cut (`x <= 0`, `y = 0`). Otherwise the box lies in an
+    /// open half-plane cut-free wedge and the angle is extreme at a corner.
+    pub fn atan2(y: Interval, x: Interval) -> Option<Interval> {
+        let meets_cut = x.lo <= 0.0 && y.lo <= 0.0 && y.hi >= 0.0;
+        if meets_cut {
+            return None;
+        }
+        let corners = [y.lo.atan2(x.lo), y.lo.atan2(x.hi), y.hi.atan2(x.lo), y.hi.atan2(x.hi)];
+        let lo = corners.iter().copied().fold(Real::INFINITY, Real::min);
+        let hi = corners.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+        Some(Interval { lo: lo - 1e-15, hi: hi + 1e-15 })
+    }
+
+    /// `-self`.
+    pub fn neg(self) -> Interval {
+        Interval { lo: -self.hi, hi: -self.lo }
+    }
+
+    fn clamp_lo(self, v: Real) -> Interval {
+        Interval { lo: self.lo.max(v), hi: self.hi.max(v) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every operation's result holds the operation applied to points of its operands.
+    #[test]
+    fn operations_enclose_pointwise_results() {
+        let pts = |i: &Interval| { let i = *i; (0..=10).map(move |s| i.lo + (i.hi - i.lo) * s as f64 / 10.0) };
+        let cases = [Interval::new(-3.0, 2.0), Interval::new(0.5, 4.0), Interval::new(-7.0, -0.25)];
+        for a in &cases {
+            for b in &cases {
+                for x in pts(a) {
+                    for y in pts(b) {
+                        assert!(a.add(*b).contains(x + y));
+                        assert!(a.sub(*b).contains(x - y));
+                        assert!(a.mul(*b).contains(x * y));
+                        if let Some(q) = a.div(*b) {
+                            assert!(q.contains(x / y));
+                        }
+                        if let Some(t) = Interval::atan2(*a, *b) {
+                            assert!(t.contains(x.atan2(y)), "atan2({x}, {y}) not in {t:?}");
+                        }
+                    }
+                }
+                assert!(a.sqr().contains(pts(a).map(|x| x * x).fold(0.0, f64::max)));
+            }
+        }
+        assert!(Interval::new(-1.0, 1.0).div(Interval::new(-1.0, 1.0)).is_none());
+        assert_eq!(Interval::new(-3.0, -2.0).sqrt(), None);
+        let ac = Interval::new(-0.5, 3.0).acos().unwrap();
+        assert!(ac.contains(0.0) && ac.contains(2.0 * std::f64::consts::FRAC_PI_3) && ac.hi < 2.1);
+        assert_eq!(Interval::new(1.5, 3.0).acos(), None);
+        assert!(Interval::atan2(Interval::new(-1.0, 1.0), Interval::new(-2.0, -1.0)).is_none(), "branch cut");
+        assert!(Interval::atan2(Interval::new(-1.0, 1.0), Interval::new(1.0, 2.0)).is_some());
+    }
+}

@@ -1,0 +1,301 @@
+//! Labelling every two-robot sample with the exact box test, in parallel (thesis 3.2.3,
+//! 3.2.7; SPEC §6; issue 3 items 2 and 4).
+//!
+//! The product structure is used twice: each robot's boxes are built once per sample (IK,
+//! boxes, placement, inflation, axis-aligned bounds), never once per pair; and for one sample
+//! of A, the samples of B whose robot AABB cannot reach A's along x are skipped wholesale (B's
+//! samples are sorted by their AABB's lower x, so the candidates form one slice found by
+//! binary search). The candidates then go through the AABB test in y and z, a per-box AABB
+//! test and finally the separating axis test.
+//!
+//! The labellings share the kernel [`label_pairs`]:
+//! - [`label_space`]: every box enlarged by one global `margin` (the thesis's blown-up model
+//!   [`label_space_thesis`] with `margin = r / sqrt(2)`, or the exact labelling of the
+//!   centres with 0);
+//! - [`crate::cspace::certify::label_space_certified`]: every box enlarged by its own
+//!   displacement bound, so that a free label holds for the whole 6-D cell.
+//!
+//! # Numerics
+//! Every pre-test errs toward overlap (slack [`AABB_SLACK`]); only the separating axis test
+//! (itself conservative) can turn a candidate free.
+
+use crate::cell::{Cell, Placement};
+use crate::cspace::guarantee::thesis_margin;
+use crate::cspace::sampler::{SampleGrid, Workspace};
+use crate::cspace::{Label, LabelledSpace};
+use crate::geometry::sat::separating_axis;
+use crate::geometry::witness::MAX_BOXES;
+use crate::geometry::Obb;
+use crate::math::{Mat3, Real, Vec3};
+use crate::robot::{ModelOptions, RobotModel};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+
+/// Slack (mm) of every axis-aligned pre-test: boxes closer than this go on to the exact test.
+pub const AABB_SLACK: Real = 1e-6;
+
+/// What one entry (a sample, or a sub-cell of one) of [`SampleBoxes`] holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slot {
+    /// Boxes at the centre are built (enlarged as asked).
+    Boxes,
+    /// The centre is unreachable: a sample's pairs are labelled [`Label::Unreachable`].
+    Unreachable,
+    /// No TCP of the entry's cube is reachable: nothing there can collide (sub-cells only).
+    Vacuous,
+    /// Nothing could be proved (no displacement bound): every pair is a collision.
+    Unknown,
+}
+
+/// How to enlarge the boxes of one entry when building [`SampleBoxes`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Inflation {
+    /// Box `j` enlarged by `.0[j]` on every half-extent (on top of the model's margin).
+    By([Real; MAX_BOXES]),
+    /// See [`Slot::Vacuous`].
+    Vacuous,
+    /// See [`Slot::Unknown`].
+    Unknown,
+}
+
+/// One robot's boxes at a list of centres (sample centres, or sub-cell centres), in the WCS,
+/// with their axis-aligned bounds: built once, shared by every pair.
+#[derive(Clone, Debug)]
+pub struct SampleBoxes {
+    /// Boxes per entry.
+    pub per_entry: usize,
+    /// Box `j` of entry `s` at `s * per_entry + j` (meaningful when `slot[s]` is `Boxes`).
+    pub boxes: Vec<Obb>,
+    /// Per box: AABB lower corner.
+    pub box_lo: Vec<[Real; 3]>,
+    /// Per box: AABB upper corner.
+    pub box_hi: Vec<[Real; 3]>,
+    /// Per entry: the AABB of all its boxes, lower corner.
+    pub lo: Vec<[Real; 3]>,
+    /// Per entry: upper corner.
+    pub hi: Vec<[Real; 3]>,
+    /// Per entry: what it holds.
+    pub slot: Vec<Slot>,
+}
+
+impl SampleBoxes {
+    /// The boxes of `model` placed by `placement` with the TCP at each of `centres` (MCS),
+    /// enlarged as `inflate(s)` says; an unreachable centre gives [`Slot::Unreachable`].
+    pub fn new<F>(model: &RobotModel, placement: &Placement, centres: &[Vec3], inflate: F) -> SampleBoxes
+    where
+        F: Fn(usize) -> Inflation + Sync,
+    {
+        let nb = model.box_count();
+        let per: Vec<(Slot, Vec<Obb>)> = centres
+            .par_iter()
+            .enumerate()
+            .map(|(s, c)| match (inflate(s), model.boxes(c)) {
+                (Inflation::Vacuous, _) => (Slot::Vacuous, vec![]),
+                (Inflation::Unknown, Ok(_)) => (Slot::Unknown, vec![]),
+                (_, Err(_)) => (Slot::Unreachable, vec![]),
+                (Inflation::By(extra), Ok(boxes)) => {
+                    let b = boxes.as_slice().iter().zip(extra).map(|(b, m)| placement.obb_to_wcs(&b.inflated(m)));
+                    (Slot::Boxes, b.collect())
+                }
+            })
+            .collect();
+        let empty = Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::zeros());
+        let n = centres.len();
+        let mut out = SampleBoxes {
+            per_entry: nb,
+            boxes: Vec::with_capacity(n * nb),
+            box_lo: Vec::with_capacity(n * nb),
+            box_hi: Vec::with_capacity(n * nb),
+            lo: Vec::with_capacity(n),
+            hi: Vec::with_capacity(n),
+            slot: Vec::with_capacity(n),
+        };
+        for (slot, boxes) in per {
+            let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
+            for j in 0..nb {
+                let b = boxes.get(j).copied().unwrap_or(empty);
+                let h = b.aabb_half();
+                let (bl, bh) = (b.center - h, b.center + h);
+                for a in 0..3 {
+                    lo[a] = lo[a].min(bl[a]);
+                    hi[a] = hi[a].max(bh[a]);
+                }
+                out.boxes.push(b);
+                out.box_lo.push([bl.x, bl.y, bl.z]);
+                out.box_hi.push([bh.x, bh.y, bh.z]);
+            }
+            out.lo.push(lo);
+            out.hi.push(hi);
+            out.slot.push(slot);
+        }
+        out
+    }
+
+    /// Entry count.
+    pub fn len(&self) -> usize {
+        self.slot.len()
+    }
+
+    /// Whether there are no entries.
+    pub fn is_empty(&self) -> bool {
+        self.slot.is_empty()
+    }
+}
+
+/// Whether the closed boxes `[alo, ahi]` and `[blo, bhi]` are apart by more than the slack.
+#[inline]
+fn aabbs_apart(alo: &[Real; 3], ahi: &[Real; 3], blo: &[Real; 3], bhi: &[Real; 3]) -> bool {
+    (0..3).any(|k| blo[k] > ahi[k] + AABB_SLACK || alo[k] > bhi[k] + AABB_SLACK)
+}
+
+/// Whether some box of A's entry `ia` intersects some box of B's entry `ib` (both `Boxes`).
+#[inline]
+pub fn entries_collide(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize) -> bool {
+    if aabbs_apart(&a.lo[ia], &a.hi[ia], &b.lo[ib], &b.hi[ib]) {
+        return false;
+    }
+    let (na, nb) = (a.per_entry, b.per_entry);
+    for i in ia * na..(ia + 1) * na {
+        for j in ib * nb..(ib + 1) * nb {
+            if !aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j])
+                && separating_axis(&a.boxes[i], &b.boxes[j]).is_none()
+            {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// The box pairs among `mask` (bit `8 i + j`: box `i` of A, box `j` of B) that A's entry
+/// `ia` and B's entry `ib` (both `Boxes`) do not prove disjoint; 0 when all are disjoint.
+pub fn collision_mask(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize, mask: u64) -> u64 {
+    if mask == 0 || aabbs_apart(&a.lo[ia], &a.hi[ia], &b.lo[ib], &b.hi[ib]) {
+        return 0;
+    }
+    let (na, nb) = (a.per_entry, b.per_entry);
+    let mut out = 0;
+    let mut rest = mask;
+    while rest != 0 {
+        let bit = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        let (i, j) = (ia * na + bit / 8, ib * nb + bit % 8);
+        if !aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j])
+            && separating_axis(&a.boxes[i], &b.boxes[j]).is_none()
+        {
+            out |= 1 << bit;
+        }
+    }
+    out
+}
+
+/// Every box pair of models with `na` and `nb` boxes, as a [`collision_mask`] mask.
+pub fn all_box_pairs(na: usize, nb: usize) -> u64 {
+    (0..na).flat_map(|i| (0..nb).map(move |j| 1u64 << (8 * i + j))).fold(0, |m, b| m | b)
+}
+
+/// The label of every pair `(ia, ib)` at `ia * b.len() + ib`: `Unreachable` when either
+/// centre is unreachable, `Collision` when either is `Unknown` or some pair of boxes
+/// intersects and `second_look(ia, ib)` (called only then) confirms it, else `Free`.
+/// Rows are labelled in parallel; `progress` draws a bar on stderr.
+pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, progress: bool) -> Vec<Label>
+where
+    F: Fn(usize, usize) -> bool + Sync,
+{
+    let (na, nb) = (a.len(), b.len());
+    let base: Vec<Label> = b
+        .slot
+        .iter()
+        .map(|s| match s {
+            Slot::Boxes | Slot::Vacuous => Label::Free,
+            Slot::Unreachable => Label::Unreachable,
+            Slot::Unknown => Label::Collision,
+        })
+        .collect();
+    // B's entries with boxes, sorted by the lower x of their AABB.
+    let mut order: Vec<u32> = (0..nb as u32).filter(|&i| b.slot[i as usize] == Slot::Boxes).collect();
+    order.sort_by(|&i, &j| b.lo[i as usize][0].total_cmp(&b.lo[j as usize][0]));
+    let keys: Vec<Real> = order.iter().map(|&i| b.lo[i as usize][0]).collect();
+    let widest = order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
+    let bar = if progress { ProgressBar::new(na as u64) } else { ProgressBar::hidden() };
+    if let Ok(style) = ProgressStyle::with_template("labelling {bar:40} {pos}/{len} rows of A, {elapsed} (eta {eta})") {
+        bar.set_style(style);
+    }
+    let mut labels = vec![Label::Unreachable; na * nb];
+    if nb > 0 {
+        labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| {
+            match a.slot[ia] {
+                Slot::Unreachable => {}
+                Slot::Vacuous => row.iter_mut().zip(&base).for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Free }),
+                Slot::Unknown => row.iter_mut().zip(&base).for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Collision }),
+                Slot::Boxes => {
+                    row.copy_from_slice(&base);
+                    let (lo, hi) = (a.lo[ia][0], a.hi[ia][0]);
+                    let first = keys.partition_point(|&x| x < lo - widest - AABB_SLACK);
+                    let last = keys.partition_point(|&x| x <= hi + AABB_SLACK).max(first);
+                    for &ib in &order[first..last] {
+                        let ib = ib as usize;
+                        if entries_collide(a, ia, b, ib) && second_look(ia, ib) {
+                            row[ib] = Label::Collision;
+                        }
+                    }
+                }
+            }
+            bar.inc(1);
+        });
+    }
+    bar.finish_and_clear();
+    labels
+}
+
+/// Robot `i` of a two-robot cell with `margin` added to its model's margin.
+pub(crate) fn robot_with_margin(cell: &Cell, i: usize, margin: Real) -> (RobotModel, Placement) {
+    let r = &cell.robots[i];
+    let options = ModelOptions { margin: r.model.options.margin + margin, ..r.model.options };
+    (RobotModel { options, ..r.model }, r.placement)
+}
+
+pub(crate) fn two_robot_grids(cell: &Cell, k: u32, ws: &Workspace) -> Result<(SampleGrid, SampleGrid), String> {
+    if cell.robots.len() != 2 {
+        return Err(format!(
+            "cell '{}' has {} robots; tables are built for two-robot cells (split the cell into pairs)",
+            cell.name,
+            cell.robots.len()
+        ));
+    }
+    Ok((SampleGrid::new(ws, k, &cell.robots[0].model.delta)?, SampleGrid::new(ws, k, &cell.robots[1].model.delta)?))
+}
+
+/// Labels every sample pair of the two-robot `cell` (robots 0 and 1) at `k` cells per axis,
+/// with `margin` added to every half-extent of both robots (on top of their own margins).
+///
+/// # Errors
+/// When the cell does not have exactly two robots, `margin` is not finite and >= 0, or the
+/// grid cannot be built ([`SampleGrid::new`]).
+pub fn label_space(cell: &Cell, k: u32, ws: &Workspace, margin: Real, progress: bool) -> Result<LabelledSpace, String> {
+    if !(margin.is_finite() && margin >= 0.0) {
+        return Err(format!("labelling margin = {margin} must be finite and >= 0 (mm)"));
+    }
+    let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
+    let (ma, pa) = robot_with_margin(cell, 0, margin);
+    let (mb, pb) = robot_with_margin(cell, 1, margin);
+    let a = SampleBoxes::new(&ma, &pa, &centres(&grid_a), |_| Inflation::By([0.0; MAX_BOXES]));
+    let b = SampleBoxes::new(&mb, &pb, &centres(&grid_b), |_| Inflation::By([0.0; MAX_BOXES]));
+    let labels = label_pairs(&a, &b, |_, _| true, progress);
+    Ok(LabelledSpace { grid_a, grid_b, labels, margin })
+}
+
+/// The thesis's labelling (3.2.7): every half-extent enlarged by `r / sqrt(2)`. Not a proof
+/// (see [`crate::cspace::guarantee`]); kept for comparison.
+///
+/// # Errors
+/// As [`label_space`].
+pub fn label_space_thesis(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<LabelledSpace, String> {
+    let (g, _) = two_robot_grids(cell, k, ws)?;
+    label_space(cell, k, ws, thesis_margin(g.r), progress)
+}
+
+/// The centres of every sample of `grid`, in sample order.
+pub fn centres(grid: &SampleGrid) -> Vec<Vec3> {
+    (0..grid.cells.len()).map(|s| grid.sample_center(s)).collect()
+}
