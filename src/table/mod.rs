@@ -9,9 +9,11 @@
 //! sampled grid are "don't care": the answer there is whatever compressed best, so the caller
 //! must check reachability and the workspace itself. Indices `>= k` answer `true`.
 
+pub mod build;
 pub mod code;
 pub mod error;
 pub mod format;
+pub mod lookup;
 pub mod quadtree4d;
 pub mod quadtree5d;
 pub mod quadtree6d;
@@ -21,7 +23,9 @@ pub mod synthetic;
 #[cfg(test)]
 mod agreement_tests;
 
+pub use build::{build_table, BuildReport, Labelling, Variant};
 pub use error::TableError;
+pub use lookup::{TableAnswer, TableChecker};
 pub use format::{from_bytes, to_bytes, Certification, Header};
 pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
 pub use quadtree5d::LinearQuadtree5d;

@@ -1,0 +1,108 @@
+//! Building a table for a two-robot cell: sample, label, make the labels safe, build the
+//! chosen linear quadtree (thesis 3.2.1's pipeline, Figure 3.4; SPEC §4, §6).
+//!
+//! # Safety of the labels
+//! A sample is labelled `Unreachable` when its cell's *centre* cannot be reached, but such a
+//! cell often holds reachable TCPs (2.7 % of random reachable configurations of T1 fall into
+//! one). The quadtrees treat `Unreachable` as "don't care" and may store it as free, so the
+//! builder turns every `Unreachable` label into `Collision` first: SPEC §6's "store whatever
+//! compresses best" holds only for cells proved wholly unreachable, which we do not prove.
+
+use crate::cell::Cell;
+use crate::cspace::certify::label_space_certified;
+use crate::cspace::label::label_space_thesis;
+use crate::cspace::symmetry::reflection_y;
+use crate::cspace::{Label, LabelledSpace, Workspace};
+use crate::table::{Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SliceAxes, Table};
+use std::time::Instant;
+
+/// Which linear quadtree to build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variant {
+    /// Thesis 3.2.4: condensed 6-D linear quadtree.
+    D6,
+    /// Thesis 3.2.5: 5-D quadtree with `z'` collision intervals.
+    D5,
+    /// Thesis 3.2.6: 4-D quadtree of 2-D slices grouped with similarity threshold `t`.
+    D4 {
+        /// The two ignored dimensions.
+        axes: SliceAxes,
+        /// Similarity threshold (0: lossless).
+        t: u32,
+    },
+}
+
+/// How the samples are labelled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Labelling {
+    /// Every box enlarged by its own proved displacement bound over the cell: no false
+    /// negatives anywhere in a free cell (SPEC §6).
+    Certified,
+    /// The thesis's global blow-up by `r / sqrt 2` (3.2.7): not a proof.
+    ThesisMargin,
+}
+
+/// What a build did, for the CLI's summary.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BuildReport {
+    /// Samples per robot (A, B).
+    pub samples: (usize, usize),
+    /// Two-robot samples.
+    pub pairs: usize,
+    /// Samples labelled collision (before unreachable ones are added).
+    pub collisions: usize,
+    /// Samples whose centre is unreachable (stored as collision).
+    pub unreachable: usize,
+    /// Whether the cell is mirror-symmetric (only half is stored).
+    pub symmetric: bool,
+    /// Seconds spent labelling.
+    pub label_secs: f64,
+    /// Seconds spent building the quadtree.
+    pub build_secs: f64,
+}
+
+/// Samples and labels `cell` (two robots) at resolution `k`, then builds `variant`.
+///
+/// # Errors
+/// A message when the cell does not have two robots, `k` is not a power of two, or the build
+/// fails.
+pub fn build_table(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    variant: Variant,
+    labelling: Labelling,
+    progress: bool,
+) -> Result<(Header, Table, BuildReport), String> {
+    if cell.robots.len() != 2 {
+        return Err(format!("tables are built for two-robot cells; {} has {}", cell.name, cell.robots.len()));
+    }
+    let start = Instant::now();
+    let (mut space, certification) = match labelling {
+        Labelling::Certified => (label_space_certified(cell, k, ws, progress)?.space, Certification::SweptBound),
+        Labelling::ThesisMargin => (label_space_thesis(cell, k, ws, progress)?, Certification::ThesisBlowUp),
+    };
+    let label_secs = start.elapsed().as_secs_f64();
+    let report = |space: &LabelledSpace, symmetric, build_secs| BuildReport {
+        samples: (space.grid_a.cells.len(), space.grid_b.cells.len()),
+        pairs: space.labels.len(),
+        collisions: space.labels.iter().filter(|&&l| l == Label::Collision).count(),
+        unreachable: space.labels.iter().filter(|&&l| l == Label::Unreachable).count(),
+        symmetric,
+        label_secs,
+        build_secs,
+    };
+    let symmetric = reflection_y(cell);
+    let mut summary = report(&space, symmetric, 0.0);
+    space.labels.iter_mut().filter(|l| **l == Label::Unreachable).for_each(|l| *l = Label::Collision);
+    let start = Instant::now();
+    let table = match variant {
+        Variant::D6 => Table::D6(LinearQuadtree6d::build(&space, symmetric).map_err(|e| e.to_string())?),
+        Variant::D5 => Table::D5(LinearQuadtree5d::build(&space, symmetric).map_err(|e| e.to_string())?),
+        Variant::D4 { axes, t } => {
+            Table::D4(LinearQuadtree4d::build(&space, symmetric, axes, t).map_err(|e| e.to_string())?)
+        }
+    };
+    summary.build_secs = start.elapsed().as_secs_f64();
+    Ok((Header::for_space(&space, cell.fingerprint(), *ws, certification), table, summary))
+}

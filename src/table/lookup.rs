@@ -1,0 +1,153 @@
+//! Table-backed queries for a two-robot cell: one lookup per tick (thesis 3.2.4-3.2.6 query
+//! phase; SPEC §6).
+//!
+//! Per tick: each TCP is checked for reachability (inverse kinematics, no box model), mapped
+//! to its grid cell, and the 6-D cell is looked up. A reachable TCP outside the sampled grid
+//! has no table entry: that tick falls back to the exact check (counted in
+//! [`TableChecker::fallbacks`]), so the answer is never a guess. Nothing allocates per tick.
+
+use crate::cell::{Cell, ExactChecker, QueryError};
+use crate::cspace::SampleGrid;
+use crate::math::Vec3;
+use crate::robot::RobotModel;
+use crate::table::format::from_bytes_for_cell;
+use crate::table::{Header, Table, TableError};
+
+/// The answer of one table-backed query.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TableAnswer {
+    /// The table proves the configuration free (or the exact fallback found it free).
+    Free,
+    /// The table stores the cell as collision (or the exact fallback found a collision).
+    Collision,
+    /// Bit j set: robot j's TCP is unreachable or not finite.
+    Unreachable(u32),
+}
+
+/// Which cells of one robot's grid were sampled: a dense bitmap over the `k^3` cells.
+#[derive(Clone, Debug)]
+struct SampledCells {
+    k: usize,
+    bits: Vec<u64>,
+}
+
+impl SampledCells {
+    fn new(grid: &SampleGrid) -> Self {
+        let k = grid.k as usize;
+        let mut bits = vec![0u64; (k * k * k).div_ceil(64)];
+        for c in &grid.cells {
+            let i = (c[0] as usize * k + c[1] as usize) * k + c[2] as usize;
+            bits[i / 64] |= 1 << (i % 64);
+        }
+        SampledCells { k, bits }
+    }
+
+    fn contains(&self, c: [u16; 3]) -> bool {
+        let i = (c[0] as usize * self.k + c[1] as usize) * self.k + c[2] as usize;
+        self.bits.get(i / 64).is_some_and(|w| w >> (i % 64) & 1 == 1)
+    }
+}
+
+/// A loaded, validated table with what each tick needs.
+#[derive(Clone, Debug)]
+pub struct TableChecker {
+    header: Header,
+    table: Table,
+    models: [RobotModel; 2],
+    origins: [Vec3; 2],
+    sampled: [SampledCells; 2],
+    exact: ExactChecker,
+    fallbacks: u64,
+}
+
+impl TableChecker {
+    /// Loads `bytes` (a table file's content) for `cell`, validating it once.
+    ///
+    /// # Errors
+    /// Every [`TableError`] of loading; [`TableError::WrongCell`] when the table was built for
+    /// another cell; [`TableError::BadInput`] when the cell does not have two robots or the
+    /// header's grid differs from the one its parameters define.
+    pub fn new(cell: Cell, bytes: &[u8]) -> Result<TableChecker, TableError> {
+        if cell.robots.len() != 2 {
+            return Err(TableError::BadInput { what: format!("tables serve two-robot cells; this one has {}", cell.robots.len()) });
+        }
+        let (header, table) = from_bytes_for_cell(bytes, cell.fingerprint())?;
+        let k = 1u32 << table.levels();
+        let grid = |j: usize| {
+            SampleGrid::new(&header.workspace, k, &cell.robots[j].model.delta)
+                .map_err(|e| TableError::Corrupt { what: format!("header grid parameters: {e}") })
+        };
+        let (grid_a, grid_b) = (grid(0)?, grid(1)?);
+        let same = |g: &SampleGrid, o: &[f64; 3]| g.r == header.r && g.origin == Vec3::from(*o);
+        if !same(&grid_a, &header.origin_a) || !same(&grid_b, &header.origin_b) {
+            return Err(TableError::Corrupt { what: "header r / grid origins disagree with its workspace and k".into() });
+        }
+        Ok(TableChecker {
+            models: [cell.robots[0].model, cell.robots[1].model],
+            origins: [grid_a.origin, grid_b.origin],
+            sampled: [SampledCells::new(&grid_a), SampledCells::new(&grid_b)],
+            exact: ExactChecker::new(cell),
+            header,
+            table,
+            fallbacks: 0,
+        })
+    }
+
+    /// The table's header.
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    /// The table.
+    pub fn table(&self) -> &Table {
+        &self.table
+    }
+
+    /// How many queries so far fell back to the exact check (TCP outside the sampled grid).
+    pub fn fallbacks(&self) -> u64 {
+        self.fallbacks
+    }
+
+    /// The grid cell of robot `j`'s TCP, or `None` outside the sampled cells.
+    fn cell_of(&self, j: usize, tcp: &Vec3) -> Option<[u16; 3]> {
+        let k = self.sampled[j].k as f64;
+        let mut c = [0u16; 3];
+        for (a, ci) in c.iter_mut().enumerate() {
+            let u = ((tcp[a] - self.origins[j][a]) / self.header.r).floor();
+            if !(u >= 0.0 && u < k) {
+                return None;
+            }
+            *ci = u as u16;
+        }
+        self.sampled[j].contains(c).then_some(c)
+    }
+
+    /// Answers one tick; `tcps_mcs[j]` is robot j's TCP in its own MCS.
+    ///
+    /// # Errors
+    /// [`QueryError::WrongRobotCount`] unless exactly two TCPs are given.
+    pub fn check(&mut self, tcps_mcs: &[Vec3]) -> Result<TableAnswer, QueryError> {
+        if tcps_mcs.len() != 2 {
+            return Err(QueryError::WrongRobotCount { expected: 2, found: tcps_mcs.len() });
+        }
+        let mask = (0..2).fold(0u32, |m, j| m | (!self.models[j].delta.is_reachable(&tcps_mcs[j]) as u32) << j);
+        if mask != 0 {
+            return Ok(TableAnswer::Unreachable(mask));
+        }
+        match (self.cell_of(0, &tcps_mcs[0]), self.cell_of(1, &tcps_mcs[1])) {
+            (Some(a), Some(b)) => {
+                let hit = self.table.query([a[0], a[1], a[2], b[0], b[1], b[2]]);
+                Ok(if hit { TableAnswer::Collision } else { TableAnswer::Free })
+            }
+            _ => {
+                self.fallbacks += 1;
+                let v = self.exact.check(tcps_mcs)?;
+                Ok(match (v.unreachable_mask, v.collides()) {
+                    (0, true) => TableAnswer::Collision,
+                    (0, false) => TableAnswer::Free,
+                    (m, _) => TableAnswer::Unreachable(m),
+                })
+            }
+        }
+    }
+}
