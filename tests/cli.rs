@@ -79,3 +79,31 @@ fn bad_arguments_and_rows_fail_with_a_message() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("line 2"));
 }
+
+#[test]
+fn build_inspect_eval_and_check_with_a_table() {
+    let dir = std::env::temp_dir().join(format!("dc-cli-table-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let table = dir.join("t3.dct");
+    let table = table.to_str().unwrap();
+    let out = cli(&["build", "--cell", "T3", "--k", "16", "--variant", "5d", "--output", table]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("symmetric: false"), "T3 has no symmetry");
+    let out = cli(&["inspect", table]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(out.status.success() && text.contains("5D") && text.contains("SweptBound"), "{text}");
+    let out = cli(&["eval", "--cell", "T3", "--table", table, "--random", "20000"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    println!("{text}");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let fns: Vec<&str> = text.lines().filter_map(|l| l.split("FN").nth(1)).map(|r| r.split_whitespace().next().unwrap()).collect();
+    assert_eq!(fns, vec!["0", "0", "0"], "practical, collision and random: no false negative");
+    let out = cli(&["eval", "--cell", "T1", "--table", table, "--random", "10"]);
+    assert_eq!(out.status.code(), Some(2), "a T3 table is refused for T1");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("rebuild"));
+    let input = dir.join("in.csv");
+    // Robots reaching toward each other (B's MCS is turned by 30 degrees), apart, unreachable.
+    std::fs::write(&input, "190,70,-450,-200,-20,-450\n-150,0,-450,150,0,-450\n0,0,-900,0,0,-450\n").unwrap();
+    let out = cli(&["check", "--cell", "T3", "--table", table, "--input", input.to_str().unwrap()]);
+    assert_eq!(String::from_utf8(out.stdout).unwrap(), "reachable,collide\n1,1\n1,0\n0,NA\n");
+}

@@ -3,13 +3,18 @@
 //!
 //! ```text
 //! delta-collide demo  [--cell T1|T2|T3|all|FILE.toml]
-//! delta-collide check --cell T1|FILE.toml [--input FILE.csv] [--output FILE.csv]
+//! delta-collide check --cell T1|FILE.toml [--table FILE.dct] [--input FILE.csv] [--output FILE.csv]
+//! delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz] [--t 0] [--labelling certified|thesis]
+//! delta-collide inspect FILE.dct
+//! delta-collide eval  --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S]
 //! ```
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
+use delta_collide::cspace::Workspace;
 use delta_collide::math::Vec3;
+use delta_collide::table::{build_table, from_bytes, to_bytes, Labelling, SliceAxes, Table, TableAnswer, TableChecker, Variant};
 use std::io::{BufRead, BufWriter, Write};
 use std::time::Instant;
 
@@ -20,16 +25,27 @@ const USAGE: &str = "usage:
   delta-collide demo  [--cell T1|T2|T3|all|FILE.toml]
       runs the practical and collision scenarios (c_harness/scenarios.txt) with SAT and
       SAT-cache; prints the first collision tick and per-tick query times
-  delta-collide check --cell T1|T2|T3|FILE.toml [--input FILE.csv] [--output FILE.csv]
+  delta-collide check --cell T1|T2|T3|FILE.toml [--table FILE.dct] [--input FILE.csv] [--output FILE.csv]
       reads rows x,y,z,x2,y2,z2 (one TCP per robot, each in its own MCS; stdin by default),
       writes one line `reachable,collide` per row (stdout by default); collide is NA when a
-      TCP is unreachable";
+      TCP is unreachable; with --table the answers come from the table
+  delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz]
+                      [--t 0] [--labelling certified|thesis]
+      samples, labels (certified per-cell bounds by default) and builds a table file
+  delta-collide inspect FILE.dct
+      prints what a table file holds
+  delta-collide eval --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S]
+      compares the table with the exact physical model (margin 0) on the cell's scenarios and
+      on N random reachable configurations: TP, TN, FP, FN, accuracy, query times";
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("demo") => demo(&args[1..]),
         Some("check") => check(&args[1..]),
+        Some("build") => build(&args[1..]),
+        Some("inspect") => inspect(&args[1..]),
+        Some("eval") => eval(&args[1..]),
         Some("-h" | "--help" | "help") => {
             println!("{USAGE}");
             Ok(())
@@ -140,8 +156,9 @@ fn demo(args: &[String]) -> Result<(), String> {
 }
 
 fn check(args: &[String]) -> Result<(), String> {
-    known_options(args, &["--cell", "--input", "--output"])?;
+    known_options(args, &["--cell", "--table", "--input", "--output"])?;
     let cell = load_cell(option(args, "--cell")?.ok_or("check needs --cell")?)?;
+    let mut table = option(args, "--table")?.map(|p| load_table(&cell, p)).transpose()?;
     let n = cell.robots.len();
     let input: Box<dyn BufRead> = match option(args, "--input")? {
         Some(p) => Box::new(std::io::BufReader::new(std::fs::File::open(p).map_err(|e| format!("{p}: {e}"))?)),
@@ -174,9 +191,168 @@ fn check(args: &[String]) -> Result<(), String> {
         for (j, t) in tcps.iter_mut().enumerate() {
             *t = Vec3::new(values[3 * j], values[3 * j + 1], values[3 * j + 2]);
         }
-        let v = checker.check(&tcps).map_err(|e| e.to_string())?;
-        let row = if !v.all_reachable() { "0,NA\n" } else if v.collides() { "1,1\n" } else { "1,0\n" };
+        let answer = match table.as_mut() {
+            Some(t) => t.check(&tcps),
+            None => checker.check(&tcps).map(exact_answer),
+        };
+        let row = match answer.map_err(|e| e.to_string())? {
+            TableAnswer::Unreachable(_) => "0,NA\n",
+            TableAnswer::Collision => "1,1\n",
+            TableAnswer::Free => "1,0\n",
+        };
         out.write_all(row.as_bytes()).map_err(write_err)?;
     }
     out.flush().map_err(write_err)
+}
+
+/// The exact verdict in the table's terms.
+fn exact_answer(v: &delta_collide::cell::CellVerdict) -> TableAnswer {
+    match (v.unreachable_mask, v.collides()) {
+        (0, true) => TableAnswer::Collision,
+        (0, false) => TableAnswer::Free,
+        (m, _) => TableAnswer::Unreachable(m),
+    }
+}
+
+fn load_table(cell: &Cell, path: &str) -> Result<TableChecker, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{path}: {e}"))?;
+    TableChecker::new(cell.clone(), &bytes).map_err(|e| format!("{path}: {e}"))
+}
+
+fn parse_num<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> Result<T, String> {
+    option(args, name)?.map_or(Ok(default), |v| v.parse().map_err(|_| format!("{name} {v}: not a number")))
+}
+
+fn build(args: &[String]) -> Result<(), String> {
+    known_options(args, &["--cell", "--output", "--k", "--variant", "--t", "--labelling"])?;
+    let cell = load_cell(option(args, "--cell")?.ok_or("build needs --cell")?)?;
+    let output = option(args, "--output")?.ok_or("build needs --output FILE.dct")?;
+    let k: u32 = parse_num(args, "--k", 32)?;
+    let t: u32 = parse_num(args, "--t", 0)?;
+    let variant = match option(args, "--variant")?.unwrap_or("6d") {
+        "6d" => Variant::D6,
+        "5d" => Variant::D5,
+        "4d-yy" => Variant::D4 { axes: SliceAxes::YY, t },
+        "4d-zz" => Variant::D4 { axes: SliceAxes::ZZ, t },
+        v => return Err(format!("--variant {v}: use 6d, 5d, 4d-yy or 4d-zz")),
+    };
+    let labelling = match option(args, "--labelling")?.unwrap_or("certified") {
+        "certified" => Labelling::Certified,
+        "thesis" => Labelling::ThesisMargin,
+        v => return Err(format!("--labelling {v}: use certified or thesis")),
+    };
+    let (header, table, r) = build_table(&cell, k, &Workspace::THESIS, variant, labelling, true)?;
+    let bytes = to_bytes(&table, &header);
+    std::fs::write(output, &bytes).map_err(|e| format!("{output}: {e}"))?;
+    println!("cell {} k {k}: {} x {} samples, {} pairs", cell.name, r.samples.0, r.samples.1, r.pairs);
+    println!("labels ({labelling:?}): {} collision, {} unreachable centre (stored as collision), symmetric: {}", r.collisions, r.unreachable, r.symmetric);
+    println!("labelling {:.2} s, building {:.2} s", r.label_secs, r.build_secs);
+    println!("{output}: {} ({} bytes in memory, {} bytes on disk)", describe(&table), table.memory_bytes(), bytes.len());
+    Ok(())
+}
+
+/// Variant, sizes and thesis-formula bytes of a table.
+fn describe(table: &Table) -> String {
+    match table {
+        Table::D6(q) => format!("{}: {} location codes, thesis formula {} bytes", table.name(), q.codes().len(), q.thesis_bytes()),
+        Table::D5(q) => format!("{}: thesis formula {} bytes", table.name(), q.thesis_bytes()),
+        Table::D4(q) => format!("{}: {} slices", table.name(), q.slice_count()),
+    }
+}
+
+fn inspect(args: &[String]) -> Result<(), String> {
+    let path = args.first().ok_or("inspect needs a table file")?;
+    let bytes = std::fs::read(path).map_err(|e| format!("{path}: {e}"))?;
+    let (h, table) = from_bytes(&bytes).map_err(|e| format!("{path}: {e}"))?;
+    println!("{path}: {} bytes", bytes.len());
+    println!("table: {}", describe(&table));
+    println!("k {} (levels {}), r {} mm, symmetric {}", 1u32 << table.levels(), table.levels(), h.r, table.symmetric());
+    println!("cell fingerprint {:#018x}, margin {} mm ({:?})", h.cell_fingerprint, h.margin, h.certification);
+    println!("grid origins A {:?} B {:?}; workspace {:?}", h.origin_a, h.origin_b, h.workspace);
+    println!("memory {} bytes", table.memory_bytes());
+    Ok(())
+}
+
+/// True/false positives and negatives of the table against the exact model.
+#[derive(Default)]
+struct Confusion {
+    tp: u64,
+    tn: u64,
+    fp: u64,
+    false_neg: u64,
+}
+
+impl Confusion {
+    fn add(&mut self, table_hit: bool, exact_hit: bool) {
+        match (table_hit, exact_hit) {
+            (true, true) => self.tp += 1,
+            (false, false) => self.tn += 1,
+            (true, false) => self.fp += 1,
+            (false, true) => self.false_neg += 1,
+        }
+    }
+
+    fn line(&self, what: &str) -> String {
+        let n = (self.tp + self.tn + self.fp + self.false_neg).max(1);
+        let acc = 100.0 * (self.tp + self.tn) as f64 / n as f64;
+        format!("{what:<28} TP {:>9} TN {:>9} FP {:>9} FN {:>3} accuracy {acc:6.2} %", self.tp, self.tn, self.fp, self.false_neg)
+    }
+}
+
+fn eval(args: &[String]) -> Result<(), String> {
+    known_options(args, &["--cell", "--table", "--random", "--seed"])?;
+    let cell = load_cell(option(args, "--cell")?.ok_or("eval needs --cell")?)?;
+    let mut table = load_table(&cell, option(args, "--table")?.ok_or("eval needs --table FILE.dct")?)?;
+    let n: u64 = parse_num(args, "--random", 1_000_000)?;
+    let mut seed: u64 = parse_num(args, "--seed", 1)?;
+    let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
+    let mut ns = Vec::new();
+    let mut compare = |tcps: &[Vec3], c: &mut Confusion, ns: &mut Vec<u64>| -> Result<bool, String> {
+        let start = Instant::now();
+        let answer = table.check(tcps).map_err(|e| e.to_string())?;
+        ns.push(start.elapsed().as_nanos() as u64);
+        let v = exact.check(tcps).map_err(|e| e.to_string())?;
+        match answer {
+            TableAnswer::Unreachable(_) => Ok(false),
+            a => {
+                c.add(a == TableAnswer::Collision, v.collides());
+                Ok(true)
+            }
+        }
+    };
+    let mut tcps = vec![Vec3::zeros(); 2];
+    for scenario in parse_scenarios(SCENARIOS)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)) {
+        let mut c = Confusion::default();
+        for tick in 0..RUN_TICKS {
+            scenario.tcps_at(tick, &mut tcps);
+            compare(&tcps, &mut c, &mut ns)?;
+        }
+        println!("{}", c.line(&format!("{} {}", scenario.cell, scenario.case)));
+    }
+    // Random reachable configurations, uniform in the workspace box (xorshift64*, seeded).
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let ws = Workspace::THESIS;
+    let (rmax, dmax) = (ws.rcy, ws.zu + ws.hcy + ws.hco);
+    let mut c = Confusion::default();
+    let mut kept = 0;
+    while kept < n {
+        for t in tcps.iter_mut() {
+            *t = Vec3::new(rmax * (2.0 * next() - 1.0), rmax * (2.0 * next() - 1.0), -(ws.zu + (dmax - ws.zu) * next()));
+        }
+        if tcps.iter().all(|t| ws.contains(t)) && compare(&tcps, &mut c, &mut ns)? {
+            kept += 1;
+        }
+    }
+    println!("{}", c.line(&format!("{n} random configurations")));
+    ns.sort_unstable();
+    println!(
+        "table query incl. IK reachability: median {} ns, p99.9 {} ns, max {} ns over {} queries; {} exact fallbacks",
+        percentile(&ns, 0.5), percentile(&ns, 0.999), ns[ns.len() - 1], ns.len(), table.fallbacks()
+    );
+    Ok(())
 }
