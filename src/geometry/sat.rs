@@ -296,20 +296,6 @@ pub fn obbs_intersect(a: &Obb, b: &Obb) -> bool {
     separating_axis(a, b).is_none()
 }
 
-/// The gap along the direction of the centres' difference, a cheap lower bound used only in
-/// tests and tools; `Real` in mm, negative when the boxes' projections overlap on it.
-pub fn gap_along_centres(a: &Obb, b: &Obb) -> Real {
-    let d = b.center - a.center;
-    let n = d.norm();
-    if n == 0.0 {
-        return Real::NEG_INFINITY;
-    }
-    let u = d / n;
-    let ra = (a.axes.transpose() * u).abs().dot(&a.half);
-    let rb = (b.axes.transpose() * u).abs().dot(&b.half);
-    n - ra - rb
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
