@@ -14,7 +14,9 @@ use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::Workspace;
 use delta_collide::math::Vec3;
-use delta_collide::table::{build_table, from_bytes, to_bytes, Labelling, SliceAxes, Table, TableAnswer, TableChecker, Variant};
+use delta_collide::table::{
+    build_table, from_bytes, to_bytes, Labelling, SliceAxes, Table, TableAnswer, TableChecker, Variant,
+};
 use std::io::{BufRead, BufWriter, Write};
 use std::time::Instant;
 
@@ -129,9 +131,17 @@ fn demo(args: &[String]) -> Result<(), String> {
     } else {
         vec![load_cell(which)?]
     };
-    println!("delta-collide {} demo: exact check (SAT on the box model), {RUN_TICKS} ticks of 1 ms per run", env!("CARGO_PKG_VERSION"));
-    println!("per-tick query time = 2 IK + box models + pair tests, measured with Instant (includes ~20 ns timer overhead)");
-    println!("{:<4} {:<10} {:<9} {:>15} {:>15} {:>10} {:>10} {:>10}", "cell", "case", "method", "first collision", "collision ticks", "median ns", "p99 ns", "max ns");
+    println!(
+        "delta-collide {} demo: exact check (SAT on the box model), {RUN_TICKS} ticks of 1 ms per run",
+        env!("CARGO_PKG_VERSION")
+    );
+    println!(
+        "per-tick query time = 2 IK + box models + pair tests, measured with Instant (includes ~20 ns timer overhead)"
+    );
+    println!(
+        "{:<4} {:<10} {:<9} {:>15} {:>15} {:>10} {:>10} {:>10}",
+        "cell", "case", "method", "first collision", "collision ticks", "median ns", "p99 ns", "max ns"
+    );
     for cell in &cells {
         let cases: Vec<&Scenario> = scenarios.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)).collect();
         if cases.is_empty() {
@@ -139,15 +149,27 @@ fn demo(args: &[String]) -> Result<(), String> {
         }
         for scenario in cases {
             if scenario.robots.len() != cell.robots.len() {
-                return Err(format!("scenario {} {} has {} robots, the cell {}", scenario.cell, scenario.case, scenario.robots.len(), cell.robots.len()));
+                return Err(format!(
+                    "scenario {} {} has {} robots, the cell {}",
+                    scenario.cell,
+                    scenario.case,
+                    scenario.robots.len(),
+                    cell.robots.len()
+                ));
             }
             for (name, method) in [("SAT", SatMethod::Sat), ("SAT-cache", SatMethod::SatCache)] {
                 let r = run(&with_method(cell, method), scenario)?;
                 let first = r.first_collision.map_or("none".to_string(), |t| format!("tick {t}"));
                 println!(
                     "{:<4} {:<10} {:<9} {:>15} {:>15} {:>10} {:>10} {:>10}",
-                    cell.name, scenario.case, name, first, r.collision_ticks,
-                    percentile(&r.ns, 0.5), percentile(&r.ns, 0.99), r.ns[r.ns.len() - 1]
+                    cell.name,
+                    scenario.case,
+                    name,
+                    first,
+                    r.collision_ticks,
+                    percentile(&r.ns, 0.5),
+                    percentile(&r.ns, 0.99),
+                    r.ns[r.ns.len() - 1]
                 );
             }
         }
@@ -181,7 +203,8 @@ fn check(args: &[String]) -> Result<(), String> {
             continue;
         }
         values.clear();
-        let parsed: Result<(), ()> = line.split(',').try_for_each(|f| f.trim().parse::<f64>().map(|v| values.push(v)).map_err(|_| ()));
+        let parsed: Result<(), ()> =
+            line.split(',').try_for_each(|f| f.trim().parse::<f64>().map(|v| values.push(v)).map_err(|_| ()));
         if parsed.is_err() && line_no == 0 {
             continue; // a header row
         }
@@ -245,16 +268,30 @@ fn build(args: &[String]) -> Result<(), String> {
     let bytes = to_bytes(&table, &header);
     std::fs::write(output, &bytes).map_err(|e| format!("{output}: {e}"))?;
     println!("cell {} k {k}: {} x {} samples, {} pairs", cell.name, r.samples.0, r.samples.1, r.pairs);
-    println!("labels ({labelling:?}): {} collision, {} unreachable centre (stored as collision), symmetric: {}", r.collisions, r.unreachable, r.symmetric);
+    let unreachable = match labelling {
+        Labelling::Certified => "cell proved unreachable (don't care)",
+        Labelling::ThesisMargin => "unreachable centre (stored as collision)",
+    };
+    println!(
+        "labels ({labelling:?}): {} collision, {} {unreachable}, symmetric: {}",
+        r.collisions, r.unreachable, r.symmetric
+    );
     println!("labelling {:.2} s, building {:.2} s", r.label_secs, r.build_secs);
-    println!("{output}: {} ({} bytes in memory, {} bytes on disk)", describe(&table), table.memory_bytes(), bytes.len());
+    println!(
+        "{output}: {} ({} bytes in memory, {} bytes on disk)",
+        describe(&table),
+        table.memory_bytes(),
+        bytes.len()
+    );
     Ok(())
 }
 
 /// Variant, sizes and thesis-formula bytes of a table.
 fn describe(table: &Table) -> String {
     match table {
-        Table::D6(q) => format!("{}: {} location codes, thesis formula {} bytes", table.name(), q.codes().len(), q.thesis_bytes()),
+        Table::D6(q) => {
+            format!("{}: {} location codes, thesis formula {} bytes", table.name(), q.codes().len(), q.thesis_bytes())
+        }
         Table::D5(q) => format!("{}: thesis formula {} bytes", table.name(), q.thesis_bytes()),
         Table::D4(q) => format!("{}: {} slices", table.name(), q.slice_count()),
     }
@@ -295,7 +332,10 @@ impl Confusion {
     fn line(&self, what: &str) -> String {
         let n = (self.tp + self.tn + self.fp + self.false_neg).max(1);
         let acc = 100.0 * (self.tp + self.tn) as f64 / n as f64;
-        format!("{what:<28} TP {:>9} TN {:>9} FP {:>9} FN {:>3} accuracy {acc:6.2} %", self.tp, self.tn, self.fp, self.false_neg)
+        format!(
+            "{what:<28} TP {:>9} TN {:>9} FP {:>9} FN {:>3} accuracy {acc:6.2} %",
+            self.tp, self.tn, self.fp, self.false_neg
+        )
     }
 }
 
@@ -342,7 +382,8 @@ fn eval(args: &[String]) -> Result<(), String> {
     let mut kept = 0;
     while kept < n {
         for t in tcps.iter_mut() {
-            *t = Vec3::new(rmax * (2.0 * next() - 1.0), rmax * (2.0 * next() - 1.0), -(ws.zu + (dmax - ws.zu) * next()));
+            *t =
+                Vec3::new(rmax * (2.0 * next() - 1.0), rmax * (2.0 * next() - 1.0), -(ws.zu + (dmax - ws.zu) * next()));
         }
         if tcps.iter().all(|t| ws.contains(t)) && compare(&tcps, &mut c, &mut ns)? {
             kept += 1;
@@ -352,7 +393,11 @@ fn eval(args: &[String]) -> Result<(), String> {
     ns.sort_unstable();
     println!(
         "table query incl. IK reachability: median {} ns, p99.9 {} ns, max {} ns over {} queries; {} exact fallbacks",
-        percentile(&ns, 0.5), percentile(&ns, 0.999), ns[ns.len() - 1], ns.len(), table.fallbacks()
+        percentile(&ns, 0.5),
+        percentile(&ns, 0.999),
+        ns[ns.len() - 1],
+        ns.len(),
+        table.fallbacks()
     );
     Ok(())
 }

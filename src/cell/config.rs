@@ -16,8 +16,8 @@
 //! model = { margin = 5.0, upper_links = { half_height = 30.0, half_depth = 15.0 } }
 //! ```
 
-use crate::cell::{Cell, CellError, RobotSpec, SatMethod};
 use crate::cell::placement::Placement;
+use crate::cell::{Cell, CellError, RobotSpec, SatMethod};
 use crate::math::{Real, Vec3};
 use crate::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
 use serde::Deserialize;

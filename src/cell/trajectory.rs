@@ -123,7 +123,10 @@ mod tests {
 
     #[test]
     fn parse_and_interpolate() {
-        let s = parse_scenarios("# c\nT1 practical 0 0 0 0 -400\nT1 practical 0 100 100 0 -400 # x\nT1 practical 1 0 0 0 -450\n").unwrap();
+        let s = parse_scenarios(
+            "# c\nT1 practical 0 0 0 0 -400\nT1 practical 0 100 100 0 -400 # x\nT1 practical 1 0 0 0 -450\n",
+        )
+        .unwrap();
         assert_eq!(s.len(), 1);
         let mut tcps = [Vec3::zeros(); 2];
         s[0].tcps_at(50, &mut tcps);

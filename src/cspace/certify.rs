@@ -15,15 +15,22 @@
 //! box sets, each of which contains the physical boxes for every TCP of its (sub)cell (see
 //! [`crate::cspace::guarantee`]). Anything not proved is a collision.
 //!
+//! A sample is labelled [`Label::Unreachable`](crate::cspace::Label) ("don't care") only
+//! when no TCP of its whole cell is reachable ([`cube_unreachable`]); a cell whose centre is
+//! unreachable but which holds reachable TCPs has no displacement bound and is a collision.
+//!
 //! Bounds are made exactly mirror-symmetric (the larger of an entry's bound and its mirror's,
 //! arms 1 and 2 swapped), so that a symmetric cell gets exactly symmetric labels (thesis 3.2.8).
 
 use crate::cell::Cell;
-use crate::cspace::guarantee::{box_displacement_bounds, cube_box_bounds, SPLITS};
-use crate::cspace::label::{all_box_pairs, centres, collision_mask, entries_collide, label_pairs, two_robot_grids, Inflation, SampleBoxes, Slot};
+use crate::cspace::guarantee::{box_displacement_bounds, cube_box_bounds, cube_unreachable, reference_point, SPLITS};
+use crate::cspace::label::{
+    aabbs_apart, all_box_pairs, collision_mask, entries_apart, entries_collide, label_pairs, two_robot_grids,
+    Inflation, SampleBoxes, Slot,
+};
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::symmetry::mirror_cell;
-use crate::cspace::LabelledSpace;
+use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::witness::MAX_BOXES;
 use crate::math::{Real, Vec3};
 use crate::robot::{BoxKind, RobotModel};
@@ -72,30 +79,45 @@ pub fn label_space_certified(cell: &Cell, k: u32, ws: &Workspace, progress: bool
 ///
 /// # Errors
 /// As [`crate::cspace::label_space`].
-pub fn label_space_certified_with(cell: &Cell, k: u32, ws: &Workspace, refine: bool, progress: bool) -> Result<CertifiedSpace, String> {
+pub fn label_space_certified_with(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    refine: bool,
+    progress: bool,
+) -> Result<CertifiedSpace, String> {
     let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
     let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
     let (bounds_a, bounds_b) = (cell_bounds(&ra.model, &grid_a), cell_bounds(&rb.model, &grid_b));
-    let level1 = |b: &[[Real; MAX_BOXES]], s: usize| {
-        if b[s].iter().any(|v| v.is_infinite()) {
+    let (empty_a, empty_b) = (unreachable_cells(&ra.model, &grid_a), unreachable_cells(&rb.model, &grid_b));
+    let level1 = |b: &[[Real; MAX_BOXES]], empty: &[bool], s: usize| {
+        if empty[s] {
+            Inflation::Unreachable
+        } else if b[s].iter().any(|v| v.is_infinite()) {
             Inflation::Unknown
         } else {
             Inflation::By(b[s])
         }
     };
-    let a0 = SampleBoxes::new(&ra.model, &ra.placement, &centres(&grid_a), |s| level1(&bounds_a, s));
-    let b0 = SampleBoxes::new(&rb.model, &rb.placement, &centres(&grid_b), |s| level1(&bounds_b, s));
+    let (refs_a, refs_b) = (references(&ra.model, &grid_a), references(&rb.model, &grid_b));
+    let a0 = SampleBoxes::new(&ra.model, &ra.placement, &refs_a, |s| level1(&bounds_a, &empty_a, s));
+    let b0 = SampleBoxes::new(&rb.model, &rb.placement, &refs_b, |s| level1(&bounds_b, &empty_b, s));
     let labels = if refine {
         let (ca, ea) = octants(&ra.model, &grid_a);
         let (cb, eb) = octants(&rb.model, &grid_b);
         let a1 = SampleBoxes::new(&ra.model, &ra.placement, &ca, |s| ea[s]);
         let b1 = SampleBoxes::new(&rb.model, &rb.placement, &cb, |s| eb[s]);
-        // The physical boxes at the centres: a pair that collides there is a collision
-        // without refinement.
+        // The physical boxes at the reference points: a pair that collides there is a
+        // collision without refinement.
         let none = |_| Inflation::By([0.0; MAX_BOXES]);
-        let (xa, xb) = (SampleBoxes::new(&ra.model, &ra.placement, &centres(&grid_a), none), SampleBoxes::new(&rb.model, &rb.placement, &centres(&grid_b), none));
+        let (xa, xb) = (
+            SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
+            SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
+        );
         let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&a0, &a1, &b0, &b1, ia, ib);
-        label_pairs(&a0, &b0, collides, progress)
+        let mut labels = label_pairs(&a0, &b0, collides, progress);
+        refine_unknown_cells(&a0, &a1, &b0, &b1, &mut labels);
+        labels
     } else {
         label_pairs(&a0, &b0, |_, _| true, progress)
     };
@@ -104,19 +126,29 @@ pub fn label_space_certified_with(cell: &Cell, k: u32, ws: &Workspace, refine: b
     Ok(CertifiedSpace { space: LabelledSpace { grid_a, grid_b, labels, margin }, bounds_a, bounds_b, refined: refine })
 }
 
-/// Level 2 for a pair whose whole-cell test failed. Only the box pairs that level 1 left
-/// open need a proof (the others are disjoint for every configuration of the 6-D cell);
-/// each octant of A narrows them against B's whole cell, and what stays open must be proved
-/// disjoint against every octant of B.
-fn octants_prove_free(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBoxes, ia: usize, ib: usize) -> bool {
-    let open = collision_mask(a0, ia, b0, ib, all_box_pairs(a0.per_entry, b0.per_entry));
+/// Level 2 for a pair whose whole-cell test failed or could not run (a sample without a
+/// whole-cell bound, [`Slot::Unknown`]: its centre is unreachable but its cell is not).
+/// Only the box pairs that level 1 left open need a proof (the others are disjoint for every
+/// configuration of the 6-D cell); each octant of A narrows them against B's whole cell, and
+/// what stays open must be proved disjoint against every octant of B.
+fn octants_prove_free(
+    a0: &SampleBoxes,
+    a1: &SampleBoxes,
+    b0: &SampleBoxes,
+    b1: &SampleBoxes,
+    ia: usize,
+    ib: usize,
+) -> bool {
+    let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
+    let all = all_box_pairs(a0.per_entry, b0.per_entry);
+    let open = if whole_a && whole_b { collision_mask(a0, ia, b0, ib, all) } else { all };
     for sa in ia * 8..ia * 8 + 8 {
         match a1.slot[sa] {
             Slot::Vacuous => continue,
             Slot::Boxes => {}
             Slot::Unreachable | Slot::Unknown => return false,
         }
-        let open = collision_mask(a1, sa, b0, ib, open);
+        let open = if whole_b { collision_mask(a1, sa, b0, ib, open) } else { open };
         if open == 0 {
             continue;
         }
@@ -126,12 +158,79 @@ fn octants_prove_free(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: 
                 Slot::Boxes => {}
                 Slot::Unreachable | Slot::Unknown => return false,
             }
-            if collision_mask(a1, sa, b1, sb, open) != 0 {
+            if !entries_apart(a1, sa, b1, sb) && collision_mask(a1, sa, b1, sb, open) != 0 {
                 return false;
             }
         }
     }
     true
+}
+
+/// Level 2 for the pairs that [`label_pairs`] made collisions because a sample has no
+/// whole-cell bound ([`Slot::Unknown`]): each is retried octant by octant.
+fn refine_unknown_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBoxes, labels: &mut [Label]) {
+    let unknown_b: Vec<usize> = (0..b0.len()).filter(|&ib| b0.slot[ib] == Slot::Unknown).collect();
+    let (cover_a, cover_b) = (octant_covers(a1), octant_covers(b1));
+    let nb = b0.len();
+    if nb == 0 {
+        return;
+    }
+    labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| {
+        let mut retry = |ib: usize| {
+            if row[ib] == Label::Collision
+                && b0.slot[ib] != Slot::Unreachable
+                && (cover_apart(&cover_a[ia], &cover_b[ib]) || octants_prove_free(a0, a1, b0, b1, ia, ib))
+            {
+                row[ib] = Label::Free;
+            }
+        };
+        match a0.slot[ia] {
+            Slot::Unknown => (0..nb).for_each(&mut retry),
+            Slot::Boxes => unknown_b.iter().for_each(|&ib| retry(ib)),
+            Slot::Unreachable | Slot::Vacuous => {}
+        }
+    });
+}
+
+/// Per sample: the AABB of its 8 octants' boxes (empty when every octant is vacuous), or
+/// `None` when an octant has no bound (nothing can be proved from it).
+fn octant_covers(octs: &SampleBoxes) -> Vec<Option<([Real; 3], [Real; 3])>> {
+    (0..octs.len() / 8)
+        .map(|s| {
+            let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
+            for e in s * 8..s * 8 + 8 {
+                match octs.slot[e] {
+                    Slot::Vacuous => continue,
+                    Slot::Boxes => {}
+                    Slot::Unreachable | Slot::Unknown => return None,
+                }
+                for a in 0..3 {
+                    lo[a] = lo[a].min(octs.lo[e][a]);
+                    hi[a] = hi[a].max(octs.hi[e][a]);
+                }
+            }
+            Some((lo, hi))
+        })
+        .collect()
+}
+
+/// Whether two octant covers are apart (AABBs disjoint by more than the slack).
+fn cover_apart(a: &Option<([Real; 3], [Real; 3])>, b: &Option<([Real; 3], [Real; 3])>) -> bool {
+    match (a, b) {
+        (Some((alo, ahi)), Some((blo, bhi))) => aabbs_apart(alo, ahi, blo, bhi),
+        _ => false,
+    }
+}
+
+/// Per sample: whether its whole cell is proved unreachable ([`cube_unreachable`]; only
+/// samples whose centre is unreachable are tried). Mirror-symmetric: a sample counts only
+/// when its mirror is proved too.
+fn unreachable_cells(model: &RobotModel, grid: &SampleGrid) -> Vec<bool> {
+    let raw: Vec<bool> = (0..grid.cells.len())
+        .into_par_iter()
+        .map(|s| !grid.reachable[s] && cube_unreachable(&model.delta, &grid.sample_center(s), 0.5 * grid.r))
+        .collect();
+    (0..raw.len()).map(|s| raw[s] && grid.index_of(mirror_cell(grid, grid.cells[s])).is_none_or(|m| raw[m])).collect()
 }
 
 /// Box index of the mirror image under `y -> -y` (arms 1 and 2 swap).
@@ -148,6 +247,18 @@ fn mirror_max(model: &RobotModel, a: &[Real; MAX_BOXES], b: &[Real; MAX_BOXES]) 
     std::array::from_fn(|j| if j < model.box_count() { a[j].max(b[mirror_box(model, j)]) } else { a[j] })
 }
 
+/// Every sample's reference point ([`reference_point`]; its centre when none).
+fn references(model: &RobotModel, grid: &SampleGrid) -> Vec<Vec3> {
+    let h = 0.5 * grid.r;
+    (0..grid.cells.len())
+        .into_par_iter()
+        .map(|s| {
+            let c = grid.sample_center(s);
+            reference_point(&model.delta, &c, h).unwrap_or(c)
+        })
+        .collect()
+}
+
 /// Whole-cell bounds of every sample, made mirror-symmetric.
 fn cell_bounds(model: &RobotModel, grid: &SampleGrid) -> Vec<[Real; MAX_BOXES]> {
     let raw: Vec<_> = (0..grid.cells.len()).into_par_iter().map(|s| box_displacement_bounds(model, grid, s)).collect();
@@ -159,8 +270,9 @@ fn cell_bounds(model: &RobotModel, grid: &SampleGrid) -> Vec<[Real; MAX_BOXES]> 
         .collect()
 }
 
-/// Centres and enlargements of the 8 octants of every sample (entry `8 s + i`, octant `i`
-/// offset by `+/- r/4` along x, y, z for bits 0, 1, 2 of `i`), made mirror-symmetric.
+/// Reference points and enlargements of the 8 octants of every sample (entry `8 s + i`,
+/// octant `i` offset by `+/- r/4` along x, y, z for bits 0, 1, 2 of `i`), made
+/// mirror-symmetric.
 fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>) {
     let q = 0.25 * grid.r;
     let centre = |e: usize| {
@@ -170,7 +282,12 @@ fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>)
     };
     let n = grid.cells.len() * 8;
     let cs: Vec<Vec3> = (0..n).map(centre).collect();
-    let raw: Vec<Option<[Real; MAX_BOXES]>> = cs.par_iter().map(|c| cube_box_bounds(model, c, q, OCTANT_SPLITS)).collect();
+    let vacuous = |c: &Vec3| !model.delta.is_reachable(c) && cube_unreachable(&model.delta, c, q);
+    let refs: Vec<Vec3> = cs.par_iter().map(|c| reference_point(&model.delta, c, q).unwrap_or(*c)).collect();
+    let raw: Vec<Option<[Real; MAX_BOXES]>> = (0..n)
+        .into_par_iter()
+        .map(|e| if vacuous(&cs[e]) { None } else { cube_box_bounds(model, &cs[e], q, &refs[e], OCTANT_SPLITS) })
+        .collect();
     let inflation = (0..n)
         .map(|e| {
             let mirror = grid.index_of(mirror_cell(grid, grid.cells[e / 8])).map(|m| 8 * m + (e % 8 ^ 2));
@@ -178,7 +295,9 @@ fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>)
                 (None, None) => return Inflation::Vacuous,
                 (Some(a), Some(b)) => mirror_max(model, &a, &b),
                 (Some(a), None) => a,
-                (None, Some(b)) => std::array::from_fn(|j| if j < model.box_count() { b[mirror_box(model, j)] } else { 0.0 }),
+                (None, Some(b)) => {
+                    std::array::from_fn(|j| if j < model.box_count() { b[mirror_box(model, j)] } else { 0.0 })
+                }
             };
             if b.iter().any(|v| v.is_infinite()) {
                 Inflation::Unknown
@@ -187,7 +306,7 @@ fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>)
             }
         })
         .collect();
-    (cs, inflation)
+    (refs, inflation)
 }
 
 #[cfg(test)]
@@ -196,8 +315,9 @@ mod tests {
     use crate::cell::reference::reference_cell;
     use crate::cspace::{label_space, Label};
 
-    /// Certified labels only add collisions to the exact centre labels, and refinement only
-    /// removes collisions that level 1 could not prove free.
+    /// Certified labels only add collisions to the exact centre labels, are "unreachable" only
+    /// where the centre is, and refinement only removes collisions that level 1 could not
+    /// prove free.
     #[test]
     fn certified_labels_contain_exact_collisions_and_refinement_only_frees() {
         let ws = Workspace::THESIS;
@@ -208,7 +328,8 @@ mod tests {
             let fine = label_space_certified(&cell, 16, &ws, false).unwrap();
             let (mut freed, mut added) = (0, 0);
             for ((e, c), f) in exact.labels.iter().zip(&coarse.space.labels).zip(&fine.space.labels) {
-                assert_eq!(*e == Label::Unreachable, *f == Label::Unreachable);
+                assert!(*f != Label::Unreachable || *e == Label::Unreachable);
+                assert_eq!(*c == Label::Unreachable, *f == Label::Unreachable);
                 assert!(*e != Label::Collision || *f == Label::Collision);
                 assert!(*c != Label::Free || *f == Label::Free);
                 freed += (*c == Label::Collision && *f == Label::Free) as usize;

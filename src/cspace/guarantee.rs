@@ -12,9 +12,16 @@
 //! of its points). So if the inflated centre boxes of A and B are disjoint, no configuration
 //! of the 6-D cell collides: a free label is a proof.
 //!
-//! # Derivation (lower link of arm i; `t = t_i`, `u = u_i`, `h = r/2`)
+//! # Reference point
+//! Displacements are measured from a reachable TCP `p0` of the cell: its centre when that is
+//! reachable, else a reachable lattice point near it ([`reference_point`]); the cell's boxes
+//! are built at `p0`. Below, `h = r/2` is the cube's half-side and `h_a = h + |c_a - p0_a|`
+//! bounds `|p_a - p0_a|` on axis `a` for every `p` of the cube (`h_a = h` at the centre `c`).
+//!
+//! # Derivation (lower link of arm i; `t = t_i`, `u = u_i`)
 //! Write `G, E` for the elbow and platform joint at `p`, `G0, E0` at `p0`, `D = p - p0`.
-//! 1. `|D| <= dp = h sqrt(3)` (the cube's half-diagonal; the thesis used `r/sqrt(2)`).
+//! 1. `|D| <= dp = |(h_x, h_y, h_z)|` (at the centre the cube's half-diagonal `h sqrt(3)`;
+//!    the thesis used `r/sqrt(2)`).
 //! 2. `E = p + e u`, so `|E - E0| = |D| <= dp`.
 //! 3. `G = F + rf (cos th u - sin th z)` moves on a circle of radius `rf`:
 //!    `|G - G0| = 2 rf sin(|th - th0| / 2) <= dG := 2 rf sin(dth / 2)`, with
@@ -31,13 +38,14 @@
 //!    `ax = max((1 + mu) dG + mu dp, mu dG + (1 + mu) dp)` (the two ends of `l`).
 //! 5. `x = (E - G) / re`: `|x - x0| <= dx := (dp + dG) / re`.
 //! 6. `x.t = (E - G).t / re = p.t / re` (`G.t = 0`, `u.t = 0`), so over the cell
-//!    `|x.t| <= beta := (|p0.t| + h (|t_x| + |t_y|)) / re` and `|(x - x0).t| <= h (|t_x| + |t_y|) / re`.
+//!    `|x.t| <= beta := (|p0.t| + h_x |t_x| + h_y |t_y|) / re` and
+//!    `|(x - x0).t| <= (h_x |t_x| + h_y |t_y|) / re`.
 //! 7. Normalising is Lipschitz away from 0: for `|v|, |w| >= w0`,
 //!    `|v/|v| - w/|w|| <= |v - w| / w0` (`v -> w0 v/|v|` is the projection onto a convex ball).
 //! 8. `z = (x cross t) / |x cross t|`, `|x cross t| = sqrt(1 - (x.t)^2) >= w0 := sqrt(1 - beta^2)`,
 //!    `|(x - x0) cross t| <= dx`, so `|z - z0| <= dx / w0`.
 //! 9. `y = z cross x = (t - (x.t) x) / sqrt(1 - (x.t)^2)`; the numerator changes by
-//!    `(x.t) (x - x0) + ((x - x0).t) x0`, so `|y - y0| <= (beta dx + h (|t_x| + |t_y|) / re) / w0`.
+//!    `(x.t) (x - x0) + ((x - x0).t) x0`, so `|y - y0| <= (beta dx + (h_x |t_x| + h_y |t_y|) / re) / w0`.
 //!
 //! Upper links (`F` to `G`, fixed `F`): `x.t = 0` so `y = t` never turns, `|z - z0| = dG / rf`,
 //! and points move at most `(1 + m/rf) dG + (d_u + m) dG / rf`. Platform and tool boxes
@@ -98,6 +106,59 @@ pub fn theta_range(delta: &Delta3, arm: usize, lo: &Vec3, hi: &Vec3, splits: u32
     out
 }
 
+/// Absolute widening (mm) of a cube before proving it unreachable: a TCP that the
+/// floating-point inverse kinematics calls reachable is, in exact arithmetic, reachable or
+/// within far less than this of a reachable point, so the proof covers every TCP that
+/// [`Delta3::is_reachable`] accepts.
+pub const REACH_SLACK: Real = 1e-6;
+
+/// Deepest bisection of [`cube_unreachable`] (a cube is cut into at most `8^depth` boxes).
+pub const UNREACHABLE_DEPTH: u32 = 4;
+
+/// Whether no TCP of the closed cube of centre `c` and half-side `h` (widened by
+/// [`REACH_SLACK`]) is reachable, proved by interval inverse kinematics: the cube is bisected
+/// (up to [`UNREACHABLE_DEPTH`] times) until, in every piece, some arm either cannot close
+/// its loop anywhere ([`Enclosure::Empty`]) or has its whole motor-angle enclosure outside
+/// its limits. `false` means "not proved", not "reachable".
+///
+/// A table may store a cube proved unreachable as anything ("don't care", SPEC §6): a query
+/// reaches the table only for a TCP that passed [`Delta3::is_reachable`], and that TCP does
+/// not lie in such a cube.
+pub fn cube_unreachable(delta: &Delta3, c: &Vec3, h: Real) -> bool {
+    let h = h * (1.0 + 1e-12) + REACH_SLACK;
+    box_unreachable(delta, &c.add_scalar(-h), &c.add_scalar(h), UNREACHABLE_DEPTH)
+}
+
+fn box_unreachable(delta: &Delta3, lo: &Vec3, hi: &Vec3, depth: u32) -> bool {
+    let iv = |a: usize| Interval::new(lo[a], hi[a]);
+    let arm_excludes = |arm: usize| match theta_over_box(delta, &radial(arm), &tangent(arm), iv(0), iv(1), iv(2)) {
+        Enclosure::Empty => true,
+        Enclosure::Range(th) => outside_limits(delta, th),
+        Enclosure::Unbounded => false,
+    };
+    if (0..3).any(arm_excludes) {
+        return true;
+    }
+    if depth == 0 {
+        return false;
+    }
+    let mid = (lo + hi) * 0.5;
+    (0..8).all(|i: usize| {
+        let pick = |a: usize| if i >> a & 1 == 0 { (lo[a], mid[a]) } else { (mid[a], hi[a]) };
+        let (x, y, z) = (pick(0), pick(1), pick(2));
+        box_unreachable(delta, &Vec3::new(x.0, y.0, z.0), &Vec3::new(x.1, y.1, z.1), depth - 1)
+    })
+}
+
+/// Whether every angle of `th` lies outside the motor's arc `[theta_min, theta_max]` (mod
+/// `2 pi`, as [`Delta3::motor_within_limits`]): `th` fits strictly inside the complement arc
+/// that starts at `theta_max`.
+fn outside_limits(delta: &Delta3, th: Interval) -> bool {
+    let gap = std::f64::consts::TAU - (delta.theta_max - delta.theta_min);
+    let start = (th.lo - delta.theta_max).rem_euclid(std::f64::consts::TAU);
+    start > 1e-12 && start + (th.hi - th.lo) < gap - 1e-12
+}
+
 /// `th = -atan2(c, a) - acos(K / R)` over one sub-box (SPEC §2, elbow-out with `c < 0`).
 fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> Enclosure {
     if z.hi >= 0.0 {
@@ -116,7 +177,9 @@ fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: I
     let two_rf = 2.0 * d.rf;
     let q = if cc.hi <= 0.0 {
         // K/R = R/(2 rf) + C/(2 rf R): increasing in R (C <= 0) and in C (R > 0).
-        let g = |rv: Real, cv: Real| Interval::point(rv / two_rf).add(Interval::point(cv).div(Interval::point(two_rf * rv)).unwrap());
+        let g = |rv: Real, cv: Real| {
+            Interval::point(rv / two_rf).add(Interval::point(cv).div(Interval::point(two_rf * rv)).unwrap())
+        };
         let (glo, ghi) = (g(r.lo, cc.lo), g(r.hi, cc.hi));
         Interval::new(glo.lo, ghi.hi)
     } else {
@@ -129,13 +192,41 @@ fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: I
     Enclosure::Range(phi.neg().sub(psi))
 }
 
+/// Lattice points per half-axis searched by [`reference_point`] (`(2 n + 1)^3` in all).
+pub const REFERENCE_STEPS: i32 = 3;
+
+/// The point of the closed cube of centre `c` and half-side `h` that displacements are
+/// measured from: the centre when it is reachable, otherwise the reachable point nearest the
+/// centre on the lattice `c + h (i, j, l) / n` (`|i|, |j|, |l| <= n = REFERENCE_STEPS`), ties
+/// broken the same way in mirror cells (`y -> -y`). `None` when no lattice point is reachable.
+pub fn reference_point(delta: &Delta3, c: &Vec3, h: Real) -> Option<Vec3> {
+    if delta.is_reachable(c) {
+        return Some(*c);
+    }
+    let n = REFERENCE_STEPS;
+    let side = if c.y < 0.0 { -1 } else { 1 };
+    let mut offsets: Vec<[i32; 3]> =
+        (-n..=n).flat_map(|i| (-n..=n).flat_map(move |j| (-n..=n).map(move |l| [i, j, l]))).collect();
+    offsets.sort_by_key(|o| {
+        (o[0] * o[0] + o[1] * o[1] + o[2] * o[2], o[0].abs(), o[1].abs(), o[2].abs(), o[0], o[2], -side * o[1])
+    });
+    let step = h / n as Real;
+    offsets
+        .iter()
+        .map(|o| c + Vec3::new(o[0] as Real, o[1] as Real, o[2] as Real) * step)
+        .find(|p| delta.is_reachable(p))
+}
+
 /// Per box of `model` (in [`RobotModel::boxes`] order), a bound on how far any point of the
-/// box moves when the TCP moves from sample `sample`'s centre to any reachable point of its
-/// closed cell (mm; see the module doc). `INFINITY` for every box when the centre is
-/// unreachable or the motor angles cannot be enclosed; entries past `model.box_count()` are 0.
+/// box moves when the TCP moves from sample `sample`'s reference point ([`reference_point`]
+/// of its cell) to any reachable point of its closed cell (mm; see the module doc).
+/// `INFINITY` for every box when the cell has no reference point or the motor angles cannot
+/// be enclosed; entries past `model.box_count()` are 0.
 pub fn box_displacement_bounds(model: &RobotModel, grid: &SampleGrid, sample: usize) -> [Real; MAX_BOXES] {
-    let c = grid.sample_center(sample);
-    cube_box_bounds(model, &c, 0.5 * grid.r, SPLITS).unwrap_or_else(|| unknown(model))
+    let (c, h) = (grid.sample_center(sample), 0.5 * grid.r);
+    reference_point(&model.delta, &c, h)
+        .and_then(|p0| cube_box_bounds(model, &c, h, &p0, SPLITS))
+        .unwrap_or_else(|| unknown(model))
 }
 
 fn unknown(model: &RobotModel) -> [Real; MAX_BOXES] {
@@ -145,11 +236,11 @@ fn unknown(model: &RobotModel) -> [Real; MAX_BOXES] {
 }
 
 /// As [`box_displacement_bounds`] for the closed cube of centre `c` and half-side `h`
-/// (widened by a relative 1e-12), enclosing the motor angles with `splits^3` sub-boxes.
-/// `None` when no TCP of the cube is reachable (nothing to bound: the cube can never be
-/// occupied); `INFINITY` entries when the centre is unreachable but the cube is not empty, or
-/// the angles cannot be enclosed.
-pub fn cube_box_bounds(model: &RobotModel, c: &Vec3, h: Real, splits: u32) -> Option<[Real; MAX_BOXES]> {
+/// (widened by a relative 1e-12), measured from the reference TCP `p0` (a reachable point
+/// of the cube), enclosing the motor angles with `splits^3` sub-boxes. `None` when no TCP of
+/// the cube is reachable (nothing to bound: the cube can never be occupied); `INFINITY`
+/// entries when `p0` is unreachable or the angles cannot be enclosed.
+pub fn cube_box_bounds(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, splits: u32) -> Option<[Real; MAX_BOXES]> {
     let (d, o) = (&model.delta, &model.options);
     let n = model.box_count();
     let h = h * (1.0 + 1e-12) + 1e-12;
@@ -162,8 +253,10 @@ pub fn cube_box_bounds(model: &RobotModel, c: &Vec3, h: Real, splits: u32) -> Op
             Enclosure::Range(r) => *slot = r,
         }
     }
-    let Ok(sol) = d.inverse_kinematics(c) else { return Some(unknown(model)) };
-    let dp = h * 3f64.sqrt();
+    let Ok(sol) = d.inverse_kinematics(p0) else { return Some(unknown(model)) };
+    // Per axis, the farthest any TCP of the cube lies from p0 (h at the centre).
+    let reach = (p0 - c).abs().add_scalar(h);
+    let dp = reach.norm();
     let dg: [Real; 3] = std::array::from_fn(|arm| {
         let dth = (th[arm].hi - sol.theta[arm]).max(sol.theta[arm] - th[arm].lo).clamp(0.0, std::f64::consts::PI);
         2.0 * d.rf * (0.5 * dth).sin()
@@ -177,8 +270,8 @@ pub fn cube_box_bounds(model: &RobotModel, c: &Vec3, h: Real, splits: u32) -> Op
                 let mu = m / d.re;
                 let ax = ((1.0 + mu) * dg[arm] + mu * dp).max(mu * dg[arm] + (1.0 + mu) * dp);
                 let dx = ((dp + dg[arm]) / d.re).min(2.0);
-                let tt = h * (t.x.abs() + t.y.abs()) / d.re;
-                let beta = c.dot(&t).abs() / d.re + tt;
+                let tt = (reach.x * t.x.abs() + reach.y * t.y.abs()) / d.re;
+                let beta = p0.dot(&t).abs() / d.re + tt;
                 if beta >= 1.0 {
                     Real::INFINITY
                 } else {
@@ -234,14 +327,22 @@ mod tests {
         let grid = SampleGrid::new(&Workspace::THESIS, k, &model.delta).unwrap();
         let mut rng = StdRng::seed_from_u64(seed);
         let mut worst_ratio: Real = 0.0;
-        for _ in 0..cells {
-            let s = rng.random_range(0..grid.cells.len());
-            if !grid.reachable[s] {
-                assert!(displacement_bound(&model, &grid, s).is_infinite());
-                continue;
-            }
+        // Half of the cells are drawn from those with an unreachable centre (the boundary of
+        // the reachable space), where the bound is measured from an off-centre reference.
+        let boundary: Vec<usize> = (0..grid.cells.len()).filter(|&s| !grid.reachable[s]).collect();
+        for i in 0..cells {
+            let s = if i % 2 == 0 {
+                rng.random_range(0..grid.cells.len())
+            } else {
+                boundary[rng.random_range(0..boundary.len())]
+            };
             let bounds = box_displacement_bounds(&model, &grid, s);
             let c = grid.sample_center(s);
+            let Some(p0) = reference_point(&model.delta, &c, 0.5 * grid.r) else {
+                assert!(bounds[..model.box_count()].iter().all(|b| b.is_infinite()));
+                continue;
+            };
+            assert_eq!(p0 == c, grid.reachable[s]);
             let mut worst = [0.0; MAX_BOXES];
             for q in 0..points {
                 // Corners and face centres of the cell first, then random points.
@@ -250,7 +351,7 @@ mod tests {
                 } else {
                     Vec3::new(rng.random::<Real>() - 0.5, rng.random::<Real>() - 0.5, rng.random::<Real>() - 0.5)
                 };
-                let Some(m) = measured(&model, &c, &(c + off * grid.r)) else { continue };
+                let Some(m) = measured(&model, &p0, &(c + off * grid.r)) else { continue };
                 for j in 0..model.box_count() {
                     assert!(m[j] <= bounds[j], "sample {s} box {j}: moved {} > bound {}", m[j], bounds[j]);
                     worst[j] = Real::max(worst[j], m[j]);
@@ -285,6 +386,56 @@ mod tests {
         let model = RobotModel { options, ..RobotModel::THESIS };
         let ratio = check_bounds_against_brute_force(model, 32, 150, 40, 4);
         assert!(ratio <= 1.0);
+    }
+
+    /// A cube proved unreachable holds no TCP that the inverse kinematics accepts (dense
+    /// lattice and random points, on the cells of k = 32 whose centre is unreachable), and the
+    /// proof succeeds for most such cells far from the reachable space.
+    #[test]
+    fn cubes_proved_unreachable_hold_no_reachable_tcp() {
+        let d = Delta3::THESIS;
+        let grid = SampleGrid::new(&Workspace::THESIS, 32, &d).unwrap();
+        let mut rng = StdRng::seed_from_u64(7);
+        let (mut proved, mut tried) = (0, 0);
+        for s in (0..grid.cells.len()).filter(|&s| !grid.reachable[s]) {
+            tried += 1;
+            let (c, h) = (grid.sample_center(s), 0.5 * grid.r);
+            if !cube_unreachable(&d, &c, h) {
+                continue;
+            }
+            proved += 1;
+            for q in 0..2000 {
+                let off = if q < 729 {
+                    Vec3::new((q % 9) as Real, (q / 9 % 9) as Real, (q / 81) as Real) / 4.0 - Vec3::repeat(1.0)
+                } else {
+                    Vec3::new(rng.random::<Real>(), rng.random::<Real>(), rng.random::<Real>()) * 2.0
+                        - Vec3::repeat(1.0)
+                };
+                let p = c + off * h;
+                assert!(!d.is_reachable(&p), "sample {s}: {p:?} is reachable in a cube proved unreachable");
+            }
+        }
+        println!("{proved} of {tried} cells with an unreachable centre proved unreachable");
+        assert!(proved * 2 > tried, "{proved} of {tried}");
+        // A cube around a reachable point is never proved unreachable.
+        assert!(!cube_unreachable(&d, &Vec3::new(0.0, 0.0, -450.0), 1.0));
+    }
+
+    #[test]
+    fn reference_points_are_reachable_and_in_the_cell() {
+        let d = Delta3::THESIS;
+        let grid = SampleGrid::new(&Workspace::THESIS, 32, &d).unwrap();
+        let (mut found, mut boundary) = (0, 0);
+        for s in (0..grid.cells.len()).filter(|&s| !grid.reachable[s]) {
+            let (c, h) = (grid.sample_center(s), 0.5 * grid.r);
+            boundary += 1;
+            if let Some(p) = reference_point(&d, &c, h) {
+                found += 1;
+                assert!(d.is_reachable(&p));
+                assert!((p - c).amax() <= h * (1.0 + 1e-12), "{p:?} outside the cell of {c:?}");
+            }
+        }
+        assert!(found > 0 && found < boundary, "{found} of {boundary}");
     }
 
     #[test]

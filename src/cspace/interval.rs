@@ -88,7 +88,10 @@ impl Interval {
             return None;
         }
         let q = [self.lo / o.lo, self.lo / o.hi, self.hi / o.lo, self.hi / o.hi];
-        Some(widen(q.iter().copied().fold(Real::INFINITY, Real::min), q.iter().copied().fold(Real::NEG_INFINITY, Real::max)))
+        Some(widen(
+            q.iter().copied().fold(Real::INFINITY, Real::min),
+            q.iter().copied().fold(Real::NEG_INFINITY, Real::max),
+        ))
     }
 
     /// `sqrt` over the non-negative part, or `None` when the interval is negative.
@@ -139,7 +142,10 @@ mod tests {
     /// Every operation's result holds the operation applied to points of its operands.
     #[test]
     fn operations_enclose_pointwise_results() {
-        let pts = |i: &Interval| { let i = *i; (0..=10).map(move |s| i.lo + (i.hi - i.lo) * s as f64 / 10.0) };
+        let pts = |i: &Interval| {
+            let i = *i;
+            (0..=10).map(move |s| i.lo + (i.hi - i.lo) * s as f64 / 10.0)
+        };
         let cases = [Interval::new(-3.0, 2.0), Interval::new(0.5, 4.0), Interval::new(-7.0, -0.25)];
         for a in &cases {
             for b in &cases {

@@ -39,7 +39,9 @@ pub const AABB_SLACK: Real = 1e-6;
 pub enum Slot {
     /// Boxes at the centre are built (enlarged as asked).
     Boxes,
-    /// The centre is unreachable: a sample's pairs are labelled [`Label::Unreachable`].
+    /// The centre is unreachable (exact and thesis-style labelling) or no TCP of the cell is
+    /// ([`Inflation::Unreachable`], certified labelling): the pairs are labelled
+    /// [`Label::Unreachable`].
     Unreachable,
     /// No TCP of the entry's cube is reachable: nothing there can collide (sub-cells only).
     Vacuous,
@@ -54,7 +56,9 @@ pub enum Inflation {
     By([Real; MAX_BOXES]),
     /// See [`Slot::Vacuous`].
     Vacuous,
-    /// See [`Slot::Unknown`].
+    /// Proved: no TCP of the cell is reachable (a [`Slot::Unreachable`] sample).
+    Unreachable,
+    /// See [`Slot::Unknown`] (whether or not the centre is reachable).
     Unknown,
 }
 
@@ -91,7 +95,8 @@ impl SampleBoxes {
             .enumerate()
             .map(|(s, c)| match (inflate(s), model.boxes(c)) {
                 (Inflation::Vacuous, _) => (Slot::Vacuous, vec![]),
-                (Inflation::Unknown, Ok(_)) => (Slot::Unknown, vec![]),
+                (Inflation::Unreachable, _) => (Slot::Unreachable, vec![]),
+                (Inflation::Unknown, _) => (Slot::Unknown, vec![]),
                 (_, Err(_)) => (Slot::Unreachable, vec![]),
                 (Inflation::By(extra), Ok(boxes)) => {
                     let b = boxes.as_slice().iter().zip(extra).map(|(b, m)| placement.obb_to_wcs(&b.inflated(m)));
@@ -144,14 +149,20 @@ impl SampleBoxes {
 
 /// Whether the closed boxes `[alo, ahi]` and `[blo, bhi]` are apart by more than the slack.
 #[inline]
-fn aabbs_apart(alo: &[Real; 3], ahi: &[Real; 3], blo: &[Real; 3], bhi: &[Real; 3]) -> bool {
+pub(crate) fn aabbs_apart(alo: &[Real; 3], ahi: &[Real; 3], blo: &[Real; 3], bhi: &[Real; 3]) -> bool {
     (0..3).any(|k| blo[k] > ahi[k] + AABB_SLACK || alo[k] > bhi[k] + AABB_SLACK)
+}
+
+/// Whether the AABBs of A's entry `ia` and B's entry `ib` (all their boxes) are apart.
+#[inline]
+pub(crate) fn entries_apart(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize) -> bool {
+    aabbs_apart(&a.lo[ia], &a.hi[ia], &b.lo[ib], &b.hi[ib])
 }
 
 /// Whether some box of A's entry `ia` intersects some box of B's entry `ib` (both `Boxes`).
 #[inline]
 pub fn entries_collide(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize) -> bool {
-    if aabbs_apart(&a.lo[ia], &a.hi[ia], &b.lo[ib], &b.hi[ib]) {
+    if entries_apart(a, ia, b, ib) {
         return false;
     }
     let (na, nb) = (a.per_entry, b.per_entry);
@@ -226,8 +237,14 @@ where
         labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| {
             match a.slot[ia] {
                 Slot::Unreachable => {}
-                Slot::Vacuous => row.iter_mut().zip(&base).for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Free }),
-                Slot::Unknown => row.iter_mut().zip(&base).for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Collision }),
+                Slot::Vacuous => row
+                    .iter_mut()
+                    .zip(&base)
+                    .for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Free }),
+                Slot::Unknown => row
+                    .iter_mut()
+                    .zip(&base)
+                    .for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Collision }),
                 Slot::Boxes => {
                     row.copy_from_slice(&base);
                     let (lo, hi) = (a.lo[ia][0], a.hi[ia][0]);

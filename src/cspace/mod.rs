@@ -12,8 +12,8 @@ pub mod label;
 pub mod sampler;
 pub mod symmetry;
 
-pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};
 pub use certify::{label_space_certified, label_space_certified_with, CertifiedSpace};
+pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};
 pub use label::{label_space, label_space_thesis};
 pub use sampler::{CellIndex, SampleGrid, Workspace};
 
@@ -25,7 +25,9 @@ pub enum Label {
     Free = 0,
     /// Collides (or could not be proved free).
     Collision = 1,
-    /// One of the TCPs is unreachable: cannot occur in operation, "don't care".
+    /// One of the TCPs is unreachable: "don't care". Exact and thesis-style labellings mean
+    /// the cell's *centre* (the thesis's convention: the cell may still hold reachable TCPs);
+    /// the certified labelling means the *whole cell*, proved, so it cannot occur in operation.
     Unreachable = 2,
 }
 

@@ -137,7 +137,8 @@ impl SampleGrid {
                 let k_min = (side / (half_extent - ws.max_radius())).ceil() as u32;
                 format!("use k >= {} (a power of two)", k_min.next_power_of_two())
             } else {
-                "no k can: the workspace must be at least twice as deep (Zu + Hcy + Hco) as it is wide (Rcy, Rco)".into()
+                "no k can: the workspace must be at least twice as deep (Zu + Hcy + Hco) as it is wide (Rcy, Rco)"
+                    .into()
             };
             return Err(format!(
                 "the grid's x/y half-extent k r / 2 = {half_extent} mm cannot hold the workspace radius {} mm plus one cell r = {r} mm; {fix}",

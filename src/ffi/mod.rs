@@ -39,7 +39,11 @@ fn boundary(f: impl FnOnce() -> DcStatus) -> DcStatus {
 
 fn new_handle(cell: Cell) -> *mut DcCollider {
     let n = cell.robots.len();
-    Box::into_raw(Box::new(DcCollider { checker: ExactChecker::new(cell), tcps: vec![Vec3::zeros(); n], poisoned: false }))
+    Box::into_raw(Box::new(DcCollider {
+        checker: ExactChecker::new(cell),
+        tcps: vec![Vec3::zeros(); n],
+        poisoned: false,
+    }))
 }
 
 /// The thesis robot (f 100, rf 150, re 400, e 40, limits [-pi/2, 2 pi/3], H 70, D 17.5,

@@ -57,11 +57,7 @@ fn flat(b: &Obb) -> Flat {
     let m = &b.axes;
     Flat {
         c: [b.center.x, b.center.y, b.center.z],
-        u: [
-            [m[(0, 0)], m[(1, 0)], m[(2, 0)]],
-            [m[(0, 1)], m[(1, 1)], m[(2, 1)]],
-            [m[(0, 2)], m[(1, 2)], m[(2, 2)]],
-        ],
+        u: [[m[(0, 0)], m[(1, 0)], m[(2, 0)]], [m[(0, 1)], m[(1, 1)], m[(2, 1)]], [m[(0, 2)], m[(1, 2)], m[(2, 2)]]],
         h: [b.half.x, b.half.y, b.half.z],
     }
 }
@@ -72,8 +68,7 @@ fn flat(b: &Obb) -> Flat {
 pub fn aabb_half_rounded_up(b: &Obb) -> [Real; 3] {
     let m = &b.axes;
     std::array::from_fn(|k| {
-        (m[(k, 0)].abs() * b.half.x + m[(k, 1)].abs() * b.half.y + m[(k, 2)].abs() * b.half.z)
-            * (1.0 + 1e-12)
+        (m[(k, 0)].abs() * b.half.x + m[(k, 1)].abs() * b.half.y + m[(k, 2)].abs() * b.half.z) * (1.0 + 1e-12)
     })
 }
 
@@ -91,20 +86,12 @@ pub fn aabbs_disjoint(a: &Obb, ea: &[Real; 3], b: &Obb, eb: &[Real; 3]) -> bool 
 /// `A_i . B_j` for j = 0..3: row `i` of `r_ab`.
 #[inline(always)]
 fn r_row(a: &Flat, b: &Flat, i: usize) -> [Real; 3] {
-    [
-        dot(&a.u[i], &b.u[0]),
-        dot(&a.u[i], &b.u[1]),
-        dot(&a.u[i], &b.u[2]),
-    ]
+    [dot(&a.u[i], &b.u[0]), dot(&a.u[i], &b.u[1]), dot(&a.u[i], &b.u[2])]
 }
 
 #[inline(always)]
 fn guarded(row: &[Real; 3]) -> [Real; 3] {
-    [
-        row[0].abs() + SAT_EPSILON,
-        row[1].abs() + SAT_EPSILON,
-        row[2].abs() + SAT_EPSILON,
-    ]
+    [row[0].abs() + SAT_EPSILON, row[1].abs() + SAT_EPSILON, row[2].abs() + SAT_EPSILON]
 }
 
 #[inline(always)]
@@ -116,22 +103,12 @@ fn translation(a: &Flat, b: &Flat) -> [Real; 3] {
 #[inline(always)]
 fn relative(a: &Flat, b: &Flat) -> Relative {
     let r = [r_row(a, b, 0), r_row(a, b, 1), r_row(a, b, 2)];
-    Relative {
-        ar: [guarded(&r[0]), guarded(&r[1]), guarded(&r[2])],
-        r,
-        t: translation(a, b),
-    }
+    Relative { ar: [guarded(&r[0]), guarded(&r[1]), guarded(&r[2])], r, t: translation(a, b) }
 }
 
 /// Face axis `A_i`: `|t_i| > a_i + sum_j b_j |R_ij|` (the optimised form of thesis 3.1.3).
 #[inline(always)]
-fn face_a_separates(
-    i: usize,
-    t: &[Real; 3],
-    ar_i: &[Real; 3],
-    a: &[Real; 3],
-    b: &[Real; 3],
-) -> bool {
+fn face_a_separates(i: usize, t: &[Real; 3], ar_i: &[Real; 3], a: &[Real; 3], b: &[Real; 3]) -> bool {
     t[i].abs() > a[i] + b[0] * ar_i[0] + b[1] * ar_i[1] + b[2] * ar_i[2] + SAT_TOUCH_TOLERANCE
 }
 
@@ -151,12 +128,7 @@ fn edge_separates(i: usize, j: usize, a: &[Real; 3], b: &[Real; 3], rel: &Relati
     let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
     let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
     let s = t[i2] * r[i1][j] - t[i1] * r[i2][j];
-    s.abs()
-        > a[i1] * ar[i2][j]
-            + a[i2] * ar[i1][j]
-            + b[j1] * ar[i][j2]
-            + b[j2] * ar[i][j1]
-            + SAT_TOUCH_TOLERANCE
+    s.abs() > a[i1] * ar[i2][j] + a[i2] * ar[i1][j] + b[j1] * ar[i][j2] + b[j2] * ar[i][j1] + SAT_TOUCH_TOLERANCE
 }
 
 /// Whether the single axis `axis` separates the boxes (beyond the touch tolerance).
@@ -246,15 +218,7 @@ fn first_separating_axis(a: &Flat, b: &Flat) -> Option<Axis> {
     if face_a_separates(2, &t, &ar2, ha, hb) {
         return Some(Axis(2));
     }
-    first_separating_b_and_edges(
-        ha,
-        hb,
-        &Relative {
-            r: [r0, r1, r2],
-            ar: [ar0, ar1, ar2],
-            t,
-        },
-    )
+    first_separating_b_and_edges(ha, hb, &Relative { r: [r0, r1, r2], ar: [ar0, ar1, ar2], t })
 }
 
 /// As [`first_separating_axis`], but tries `hint` first.
@@ -309,10 +273,7 @@ mod tests {
     fn face_touching_boxes_collide_and_a_gap_separates() {
         let a = unit_box(Vec3::zeros());
         assert!(obbs_intersect(&a, &unit_box(Vec3::new(2.0, 0.0, 0.0))));
-        assert_eq!(
-            separating_axis(&a, &unit_box(Vec3::new(2.001, 0.0, 0.0))),
-            Some(Axis(0))
-        );
+        assert_eq!(separating_axis(&a, &unit_box(Vec3::new(2.001, 0.0, 0.0))), Some(Axis(0)));
     }
 
     #[test]
@@ -329,20 +290,12 @@ mod tests {
         let (dist, ra, rb) = match axis {
             0..=2 => {
                 let i = axis as usize;
-                (
-                    t[i].abs(),
-                    a[i],
-                    b[0] * ar[i][0] + b[1] * ar[i][1] + b[2] * ar[i][2],
-                )
+                (t[i].abs(), a[i], b[0] * ar[i][0] + b[1] * ar[i][1] + b[2] * ar[i][2])
             }
             3..=5 => {
                 let j = axis as usize - 3;
                 let tb = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
-                (
-                    tb.abs(),
-                    a[0] * ar[0][j] + a[1] * ar[1][j] + a[2] * ar[2][j],
-                    b[j],
-                )
+                (tb.abs(), a[0] * ar[0][j] + a[1] * ar[1][j] + a[2] * ar[2][j], b[j])
             }
             _ => {
                 let k = axis as usize - 6;
@@ -372,39 +325,26 @@ mod tests {
         };
         let mut seen = [0usize; 16];
         for _ in 0..200_000 {
-            let rot = |x: Real, y: Real, z: Real| {
-                *nalgebra::Rotation3::from_euler_angles(x * 3.2, y * 3.2, z * 3.2).matrix()
-            };
+            let rot =
+                |x: Real, y: Real, z: Real| *nalgebra::Rotation3::from_euler_angles(x * 3.2, y * 3.2, z * 3.2).matrix();
             let a = Obb::new(
                 Vec3::zeros(),
                 rot(next(), next(), next()),
                 Vec3::new(3.0 + next(), 2.0 + next(), 1.5 + next()),
             );
             let c = Vec3::new(next(), next(), next()) * 6.0;
-            let b = Obb::new(
-                c,
-                rot(next(), next(), next()),
-                Vec3::new(3.0 + next(), 2.0 + next(), 1.5 + next()),
-            );
+            let b = Obb::new(c, rot(next(), next(), next()), Vec3::new(3.0 + next(), 2.0 + next(), 1.5 + next()));
             let (pa, pb) = (flat(&a), flat(&b));
             let rel = relative(&pa, &pb);
-            let generic = (0..Axis::COUNT)
-                .find(|&k| generic_separates(k, &pa.h, &pb.h, &rel))
-                .map(Axis);
+            let generic = (0..Axis::COUNT).find(|&k| generic_separates(k, &pa.h, &pb.h, &rel)).map(Axis);
             let got = separating_axis(&a, &b);
             assert_eq!(got, generic, "{a:?} {b:?}");
             seen[got.map_or(15, |k| k.0 as usize)] += 1;
             for hint in 0..Axis::COUNT {
-                assert_eq!(
-                    separating_axis_hinted(&a, &b, Axis(hint)).is_none(),
-                    got.is_none()
-                );
+                assert_eq!(separating_axis_hinted(&a, &b, Axis(hint)).is_none(), got.is_none());
             }
         }
-        assert!(
-            seen.iter().all(|&n| n > 0),
-            "every axis (and 'intersect') is exercised: {seen:?}"
-        );
+        assert!(seen.iter().all(|&n| n > 0), "every axis (and 'intersect') is exercised: {seen:?}");
     }
 
     #[test]
@@ -412,11 +352,7 @@ mod tests {
         let a = unit_box(Vec3::zeros());
         let rot = *nalgebra::Rotation3::from_euler_angles(0.3, 0.2, 0.9).matrix();
         for k in 0..200 {
-            let b = Obb::new(
-                Vec3::new(k as Real * 0.02, 0.3, -0.1),
-                rot,
-                Vec3::new(1.0, 0.5, 0.25),
-            );
+            let b = Obb::new(Vec3::new(k as Real * 0.02, 0.3, -0.1), rot, Vec3::new(1.0, 0.5, 0.25));
             if aabbs_disjoint(&a, &aabb_half_rounded_up(&a), &b, &aabb_half_rounded_up(&b)) {
                 assert!(separating_axis(&a, &b).is_some());
             }

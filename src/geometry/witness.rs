@@ -11,9 +11,7 @@
 //! pre-reject (exact-safe: AABBs enclose their boxes), then the 15-axis test.
 
 use crate::geometry::obb::Obb;
-use crate::geometry::sat::{
-    aabb_half_rounded_up, aabbs_disjoint, separating_axis, separating_axis_hinted, Axis,
-};
+use crate::geometry::sat::{aabb_half_rounded_up, aabbs_disjoint, separating_axis, separating_axis_hinted, Axis};
 use crate::math::Real;
 
 /// Most boxes one robot model may have (3 lower links, 3 upper links, platform, tool).
@@ -25,11 +23,7 @@ pub const MAX_BOXES: usize = 8;
 /// When `boxes` holds more than [`MAX_BOXES`] boxes.
 #[inline(always)]
 fn aabbs(boxes: &[Obb]) -> [[Real; 3]; MAX_BOXES] {
-    assert!(
-        boxes.len() <= MAX_BOXES,
-        "at most {MAX_BOXES} boxes per robot, got {}",
-        boxes.len()
-    );
+    assert!(boxes.len() <= MAX_BOXES, "at most {MAX_BOXES} boxes per robot, got {}", boxes.len());
     let mut out = [[0.0; 3]; MAX_BOXES];
     for (e, b) in out.iter_mut().zip(boxes) {
         *e = aabb_half_rounded_up(b);
@@ -62,10 +56,7 @@ pub struct WitnessCache {
 
 impl Default for WitnessCache {
     fn default() -> Self {
-        WitnessCache {
-            colliding_pair: None,
-            axis: [[Axis(0); MAX_BOXES]; MAX_BOXES],
-        }
+        WitnessCache { colliding_pair: None, axis: [[Axis(0); MAX_BOXES]; MAX_BOXES] }
     }
 }
 
@@ -175,10 +166,7 @@ mod tests {
                 }
             }
         }
-        assert!(
-            hits > 5_000 && misses > 5_000,
-            "both answers exercised: {hits} hits, {misses} misses"
-        );
+        assert!(hits > 5_000 && misses > 5_000, "both answers exercised: {hits} hits, {misses} misses");
     }
 
     #[test]
@@ -187,9 +175,7 @@ mod tests {
         for _ in 0..5_000 {
             let a: Vec<Obb> = (0..3).map(|_| link(rng.vec(300.0), rng.vec(3.0))).collect();
             let b: Vec<Obb> = (0..3).map(|_| link(rng.vec(300.0), rng.vec(3.0))).collect();
-            let expected = (0..9)
-                .map(|k| (k / 3, k % 3))
-                .find(|&(i, j)| obbs_intersect(&a[i], &b[j]));
+            let expected = (0..9).map(|k| (k / 3, k % 3)).find(|&(i, j)| obbs_intersect(&a[i], &b[j]));
             assert_eq!(first_intersecting_pair(&a, &b), expected);
         }
     }

@@ -72,7 +72,13 @@ fn symmetric_tables_answer_as_full_tables_and_store_less() {
     let full = variants(&s, false, 0);
     let half = variants(&s, true, 0);
     for (f, h) in full.iter().zip(&half) {
-        assert!(h.memory_bytes() < f.memory_bytes(), "{}: {} not below {}", f.name(), h.memory_bytes(), f.memory_bytes());
+        assert!(
+            h.memory_bytes() < f.memory_bytes(),
+            "{}: {} not below {}",
+            f.name(),
+            h.memory_bytes(),
+            f.memory_bytes()
+        );
     }
     // Every sample of the full grid (reachable or not) agrees where the labels decide it.
     check_all(&s, &half, false);

@@ -2,11 +2,13 @@
 //! chosen linear quadtree (thesis 3.2.1's pipeline, Figure 3.4; SPEC §4, §6).
 //!
 //! # Safety of the labels
-//! A sample is labelled `Unreachable` when its cell's *centre* cannot be reached, but such a
-//! cell often holds reachable TCPs (2.7 % of random reachable configurations of T1 fall into
-//! one). The quadtrees treat `Unreachable` as "don't care" and may store it as free, so the
-//! builder turns every `Unreachable` label into `Collision` first: SPEC §6's "store whatever
-//! compresses best" holds only for cells proved wholly unreachable, which we do not prove.
+//! The quadtrees treat `Unreachable` as "don't care" and may store it as free, which is safe
+//! only where no reachable TCP can be queried. The certified labelling marks a sample
+//! `Unreachable` only when its whole cell is proved unreachable
+//! ([`crate::cspace::guarantee::cube_unreachable`]), and stores a cell whose centre is
+//! unreachable but which holds reachable TCPs as collision. The thesis-style labelling marks
+//! cells by their *centre* (2.7 % of random reachable configurations of T1 fall into such a
+//! cell), so for it the builder turns every `Unreachable` into `Collision` first.
 
 use crate::cell::Cell;
 use crate::cspace::certify::label_space_certified;
@@ -49,9 +51,10 @@ pub struct BuildReport {
     pub samples: (usize, usize),
     /// Two-robot samples.
     pub pairs: usize,
-    /// Samples labelled collision (before unreachable ones are added).
+    /// Samples labelled collision (before thesis-style unreachable ones are added).
     pub collisions: usize,
-    /// Samples whose centre is unreachable (stored as collision).
+    /// Samples labelled unreachable: certified, whole cell proved unreachable (stored as
+    /// "don't care"); thesis-style, centre unreachable (stored as collision).
     pub unreachable: usize,
     /// Whether the cell is mirror-symmetric (only half is stored).
     pub symmetric: bool,
@@ -94,7 +97,9 @@ pub fn build_table(
     };
     let symmetric = reflection_y(cell);
     let mut summary = report(&space, symmetric, 0.0);
-    space.labels.iter_mut().filter(|l| **l == Label::Unreachable).for_each(|l| *l = Label::Collision);
+    if labelling == Labelling::ThesisMargin {
+        space.labels.iter_mut().filter(|l| **l == Label::Unreachable).for_each(|l| *l = Label::Collision);
+    }
     let start = Instant::now();
     let table = match variant {
         Variant::D6 => Table::D6(LinearQuadtree6d::build(&space, symmetric).map_err(|e| e.to_string())?),

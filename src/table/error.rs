@@ -71,10 +71,9 @@ impl std::fmt::Display for TableError {
                 "table endianness marker is byte-swapped: the file is big-endian, this library \
                  reads little-endian tables only; rebuild it with `delta-collide build`"
             ),
-            TableError::Corrupt { what } => write!(
-                f,
-                "table is corrupt: {what}; rebuild it with `delta-collide build` or copy it again"
-            ),
+            TableError::Corrupt { what } => {
+                write!(f, "table is corrupt: {what}; rebuild it with `delta-collide build` or copy it again")
+            }
             TableError::WrongCell { expected, found } => write!(
                 f,
                 "table was built for cell {found:#018x}, this controller is configured for \

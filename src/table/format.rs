@@ -73,7 +73,12 @@ pub struct Header {
 
 impl Header {
     /// The header of a table built from `space` for the cell with `fingerprint`.
-    pub fn for_space(space: &LabelledSpace, fingerprint: u64, workspace: Workspace, certification: Certification) -> Header {
+    pub fn for_space(
+        space: &LabelledSpace,
+        fingerprint: u64,
+        workspace: Workspace,
+        certification: Certification,
+    ) -> Header {
         let o = |g: &crate::cspace::SampleGrid| [g.origin.x, g.origin.y, g.origin.z];
         Header {
             cell_fingerprint: fingerprint,
@@ -153,7 +158,8 @@ struct Reader<'a> {
 impl<'a> Reader<'a> {
     fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8], TableError> {
         let end = self.pos.checked_add(n).ok_or_else(|| corrupt(format!("{what}: length overflows")))?;
-        let bytes = self.buf.get(self.pos..end).ok_or(TableError::Truncated { what, needed: end, have: self.buf.len() })?;
+        let bytes =
+            self.buf.get(self.pos..end).ok_or(TableError::Truncated { what, needed: end, have: self.buf.len() })?;
         self.pos = end;
         Ok(bytes)
     }
@@ -229,7 +235,13 @@ fn read_header(r: &mut Reader) -> Result<Header, TableError> {
     let grid_r = r.f64("r")?;
     let origin_a = r.f64x3("origin_a")?;
     let origin_b = r.f64x3("origin_b")?;
-    let ws = [r.f64("workspace.zu")?, r.f64("workspace.hcy")?, r.f64("workspace.rcy")?, r.f64("workspace.hco")?, r.f64("workspace.rco")?];
+    let ws = [
+        r.f64("workspace.zu")?,
+        r.f64("workspace.hcy")?,
+        r.f64("workspace.rcy")?,
+        r.f64("workspace.hco")?,
+        r.f64("workspace.rco")?,
+    ];
     let margin = r.f64("margin")?;
     let certification = match r.u32("certification")? {
         0 => Certification::Unspecified,

@@ -69,7 +69,9 @@ impl TableChecker {
     /// header's grid differs from the one its parameters define.
     pub fn new(cell: Cell, bytes: &[u8]) -> Result<TableChecker, TableError> {
         if cell.robots.len() != 2 {
-            return Err(TableError::BadInput { what: format!("tables serve two-robot cells; this one has {}", cell.robots.len()) });
+            return Err(TableError::BadInput {
+                what: format!("tables serve two-robot cells; this one has {}", cell.robots.len()),
+            });
         }
         let (header, table) = from_bytes_for_cell(bytes, cell.fingerprint())?;
         let k = 1u32 << table.levels();
@@ -80,7 +82,9 @@ impl TableChecker {
         let (grid_a, grid_b) = (grid(0)?, grid(1)?);
         let same = |g: &SampleGrid, o: &[f64; 3]| g.r == header.r && g.origin == Vec3::from(*o);
         if !same(&grid_a, &header.origin_a) || !same(&grid_b, &header.origin_b) {
-            return Err(TableError::Corrupt { what: "header r / grid origins disagree with its workspace and k".into() });
+            return Err(TableError::Corrupt {
+                what: "header r / grid origins disagree with its workspace and k".into(),
+            });
         }
         Ok(TableChecker {
             models: [cell.robots[0].model, cell.robots[1].model],

@@ -25,8 +25,8 @@ mod agreement_tests;
 
 pub use build::{build_table, BuildReport, Labelling, Variant};
 pub use error::TableError;
-pub use lookup::{TableAnswer, TableChecker};
 pub use format::{from_bytes, to_bytes, Certification, Header};
+pub use lookup::{TableAnswer, TableChecker};
 pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
 pub use quadtree5d::LinearQuadtree5d;
 pub use quadtree6d::LinearQuadtree6d;

@@ -90,7 +90,12 @@ impl LinearQuadtree4d {
     ///
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or the label count is wrong.
-    pub fn build(space: &LabelledSpace, symmetric: bool, axes: SliceAxes, t: u32) -> Result<LinearQuadtree4d, TableError> {
+    pub fn build(
+        space: &LabelledSpace,
+        symmetric: bool,
+        axes: SliceAxes,
+        t: u32,
+    ) -> Result<LinearQuadtree4d, TableError> {
         let view = SpaceView::new(space, symmetric)?;
         let (k, levels) = (view.k, view.levels);
         let (second, ignored) = axes.dims();

@@ -74,7 +74,8 @@ impl LinearQuadtree5d {
             }
         }
         nodes.sort_unstable_by_key(|n| n.0);
-        let mut t = LinearQuadtree5d { levels: view.levels, symmetric, codes: vec![], offsets: vec![0], intervals: vec![] };
+        let mut t =
+            LinearQuadtree5d { levels: view.levels, symmetric, codes: vec![], offsets: vec![0], intervals: vec![] };
         for (code, ivs) in nodes {
             t.codes.push(code);
             t.intervals.extend(ivs);

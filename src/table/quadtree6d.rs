@@ -199,7 +199,11 @@ mod tests {
                 }
             }
             if must_condense {
-                assert!(t.condensed() > 0 && t.codes().len() < collisions, "{} codes for {collisions}", t.codes().len());
+                assert!(
+                    t.condensed() > 0 && t.codes().len() < collisions,
+                    "{} codes for {collisions}",
+                    t.codes().len()
+                );
             }
             assert!(LinearQuadtree6d::from_parts(3, false, t.codes().to_vec()).is_ok());
         }

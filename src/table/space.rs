@@ -9,8 +9,8 @@
 //! sample merges it with its mirror image (collision wins, then free), so a cell that is not
 //! exactly symmetric still loses no collision.
 
-use super::error::{bad_input, TableError};
 use super::code::MAX_LEVELS;
+use super::error::{bad_input, TableError};
 use crate::cspace::{Label, LabelledSpace, SampleGrid};
 
 const NONE: u32 = u32::MAX;
@@ -42,10 +42,7 @@ fn reflections(g: &SampleGrid) -> Vec<u32> {
     for (i, c) in g.cells.iter().enumerate() {
         dense[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] = i as u32;
     }
-    g.cells
-        .iter()
-        .map(|c| dense[(c[0] as usize * k + (k - 1 - c[1] as usize)) * k + c[2] as usize])
-        .collect()
+    g.cells.iter().map(|c| dense[(c[0] as usize * k + (k - 1 - c[1] as usize)) * k + c[2] as usize]).collect()
 }
 
 fn check_grid(name: &str, g: &SampleGrid) -> Result<(), TableError> {

@@ -83,7 +83,8 @@ fn label_of(pattern: Pattern, cell: [u16; 6], k: u16, pa: Vec3, pb: Vec3) -> boo
         Pattern::Blobs => {
             let gap = 450.0 + pb.x - pa.x;
             let reach = 110.0 + 0.25 * ((-pa.z - 365.0) + (-pb.z - 365.0)) - 0.2 * (pa.y - pb.y).abs();
-            gap < reach || (pa.y - 120.0).abs() + (pb.y - 120.0).abs() + (gap - 260.0).abs() < 40.0
+            gap < reach
+                || (pa.y - 120.0).abs() + (pb.y - 120.0).abs() + (gap - 260.0).abs() < 40.0
                 || (pa.y + 120.0).abs() + (pb.y + 120.0).abs() + (gap - 260.0).abs() < 40.0
         }
         Pattern::Noise { p, seed } => {
