@@ -4,7 +4,7 @@
 //! ```text
 //! delta-collide demo  [--cell T1|T2|T3|all|FILE.toml]
 //! delta-collide check --cell T1|FILE.toml [--table FILE.dct] [--input FILE.csv] [--output FILE.csv]
-//! delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz] [--t 0] [--labelling certified|thesis]
+//! delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz|shared] [--t 0] [--labelling certified|thesis]
 //! delta-collide inspect FILE.dct
 //! delta-collide eval  --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S]
 //! ```
@@ -31,7 +31,7 @@ const USAGE: &str = "usage:
       reads rows x,y,z,x2,y2,z2 (one TCP per robot, each in its own MCS; stdin by default),
       writes one line `reachable,collide` per row (stdout by default); collide is NA when a
       TCP is unreachable; with --table the answers come from the table
-  delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz]
+  delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz|shared]
                       [--t 0] [--labelling certified|thesis]
       samples, labels (certified per-cell bounds by default) and builds a table file
   delta-collide inspect FILE.dct
@@ -257,7 +257,8 @@ fn build(args: &[String]) -> Result<(), String> {
         "5d" => Variant::D5,
         "4d-yy" => Variant::D4 { axes: SliceAxes::YY, t },
         "4d-zz" => Variant::D4 { axes: SliceAxes::ZZ, t },
-        v => return Err(format!("--variant {v}: use 6d, 5d, 4d-yy or 4d-zz")),
+        "shared" => Variant::Shared,
+        v => return Err(format!("--variant {v}: use 6d, 5d, 4d-yy, 4d-zz or shared")),
     };
     let labelling = match option(args, "--labelling")?.unwrap_or("certified") {
         "certified" => Labelling::Certified,
@@ -294,6 +295,7 @@ fn describe(table: &Table) -> String {
         }
         Table::D5(q) => format!("{}: thesis formula {} bytes", table.name(), q.thesis_bytes()),
         Table::D4(q) => format!("{}: {} slices", table.name(), q.slice_count()),
+        Table::Shared(q) => format!("{}: nodes per depth then leaves {:?}", table.name(), q.nodes_per_depth()),
     }
 }
 

@@ -15,7 +15,9 @@ use crate::cspace::certify::label_space_certified;
 use crate::cspace::label::label_space_thesis;
 use crate::cspace::symmetry::reflection_y;
 use crate::cspace::{Label, LabelledSpace, Workspace};
-use crate::table::{Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SliceAxes, Table};
+use crate::table::{
+    Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
+};
 use std::time::Instant;
 
 /// Which linear quadtree to build.
@@ -32,6 +34,8 @@ pub enum Variant {
         /// Similarity threshold (0: lossless).
         t: u32,
     },
+    /// Issue 4: the 6-D quadtree with shared subtrees ([`SharedQuadtree6d`]).
+    Shared,
 }
 
 /// How the samples are labelled.
@@ -107,6 +111,7 @@ pub fn build_table(
         Variant::D4 { axes, t } => {
             Table::D4(LinearQuadtree4d::build(&space, symmetric, axes, t).map_err(|e| e.to_string())?)
         }
+        Variant::Shared => Table::Shared(SharedQuadtree6d::build(&space, symmetric).map_err(|e| e.to_string())?),
     };
     summary.build_secs = start.elapsed().as_secs_f64();
     Ok((Header::for_space(&space, cell.fingerprint(), *ws, certification), table, summary))

@@ -7,7 +7,7 @@
 //!      0    8  magic b"DCTABLE\0"
 //!      8    4  endianness marker 0x01020304 (reads 0x04030201 when byte-swapped)
 //!     12    4  format version (VERSION)
-//!     16    4  variant: 6, 5 or 4
+//!     16    4  variant: 6, 5, 4, or 7 (the shared 6-D quadtree)
 //!     20    4  levels        24  4  k = 2^levels
 //!     28    4  flags: bit 0 = symmetric (reflection, thesis 3.2.8); other bits 0
 //!     32    4  slice axes: 0 (6D, 5D), 1 = yy', 2 = zz' (4D)
@@ -20,6 +20,9 @@
 //!    184       section 0: codes, u64 each
 //!              section 1: 5D offsets (m + 1) / 4D slice index per code, u32 each; 6D none
 //!              section 2: 5D intervals [begin, end] u8 pairs / 4D slice words u64; 6D none
+//!              variant 7: section 0 = node masks [nonuniform, collision] then leaves (u64);
+//!              section 1 = depth starts (levels entries) then per-node bases (u32);
+//!              section 2 = child indices (u32)
 //!    end-8  8  FNV-1a 64 of every byte before it
 //! ```
 //! Loading checks magic, endianness and version first (so those errors are specific), then
@@ -30,6 +33,7 @@ use super::error::{corrupt, TableError};
 use super::quadtree4d::{LinearQuadtree4d, SliceAxes};
 use super::quadtree5d::LinearQuadtree5d;
 use super::quadtree6d::LinearQuadtree6d;
+use super::shared6d::SharedQuadtree6d;
 use super::Table;
 use crate::cspace::{LabelledSpace, Workspace};
 
@@ -111,6 +115,7 @@ pub fn fnv1a64(bytes: &[u8]) -> u64 {
 
 /// The bytes of `table` with `header` (see the module doc for the layout).
 pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
+    let owned: Vec<u64>;
     let (variant, axes, t, s0, s1, s2): (u32, u32, u32, &[u64], Vec<u32>, Vec<u8>) = match table {
         Table::D6(q) => (6, 0, 0, q.codes(), vec![], vec![]),
         Table::D5(q) => {
@@ -122,8 +127,18 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
             let axes = if q.axes() == SliceAxes::YY { 1 } else { 2 };
             (4, axes, q.threshold(), codes, slice_of.to_vec(), words.iter().flat_map(|w| w.to_le_bytes()).collect())
         }
+        Table::Shared(q) => {
+            let (masks, bases, starts, children, leaves) = q.parts();
+            owned = masks.iter().flatten().chain(leaves).copied().collect();
+            let aux = starts.iter().chain(bases).copied().collect();
+            (7, 0, 0, &owned[..], aux, children.to_u32().iter().flat_map(|c| c.to_le_bytes()).collect())
+        }
     };
-    let n2 = if variant == 5 { s2.len() / 2 } else { s2.len() / 8 };
+    let n2 = match variant {
+        5 => s2.len() / 2,
+        7 => s2.len() / 4,
+        _ => s2.len() / 8,
+    };
     let mut out = Vec::with_capacity(HEADER_LEN + 8 * s0.len() + 4 * s1.len() + s2.len() + 8);
     out.extend_from_slice(&MAGIC);
     let levels = table.levels();
@@ -215,8 +230,8 @@ fn read_prefix(r: &mut Reader) -> Result<Shape, TableError> {
     let flags = r.u32("flags")?;
     let axes = r.u32("slice axes")?;
     let t = r.u32("threshold t")?;
-    if !matches!(variant, 4..=6) {
-        return Err(corrupt(format!("variant = {variant}, expected 6, 5 or 4")));
+    if !matches!(variant, 4..=7) {
+        return Err(corrupt(format!("variant = {variant}, expected 6, 5, 4 or 7")));
     }
     if levels == 0 || levels > super::code::MAX_LEVELS || k != 1 << levels {
         return Err(corrupt(format!("levels = {levels}, k = {k}: k must be 2^levels, levels in 1..=8")));
@@ -277,6 +292,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
     let sizes: [usize; 3] = match shape.variant {
         6 => [8, 4, 0],
         5 => [8, 4, 2],
+        7 => [8, 4, 4],
         _ => [8, 4, 8],
     };
     let names = ["section 0 (codes)", "section 1 (offsets or slice indices)", "section 2 (intervals or slices)"];
@@ -305,6 +321,35 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
         5 => {
             let ivs = words(sections[2], |b: [u8; 2]| b);
             Table::D5(LinearQuadtree5d::from_parts(shape.levels, shape.symmetric, codes, aux, ivs)?)
+        }
+        7 => {
+            let starts = shape.levels as usize;
+            if aux.len() < starts {
+                return Err(corrupt(format!(
+                    "section 1 has {} entries, fewer than the {starts} depth starts",
+                    aux.len()
+                )));
+            }
+            let nodes = aux.len() - starts;
+            if codes.len() < 2 * nodes {
+                return Err(corrupt(format!(
+                    "section 0 has {} words, fewer than 2 per node ({nodes} nodes)",
+                    codes.len()
+                )));
+            }
+            let masks = codes[..2 * nodes].chunks_exact(2).map(|m| [m[0], m[1]]).collect();
+            let leaves = codes[2 * nodes..].to_vec();
+            let children = words(sections[2], u32::from_le_bytes);
+            let (starts, bases) = (aux[..starts].to_vec(), aux[starts..].to_vec());
+            Table::Shared(SharedQuadtree6d::from_parts(
+                shape.levels,
+                shape.symmetric,
+                masks,
+                bases,
+                starts,
+                children,
+                leaves,
+            )?)
         }
         _ => {
             let axes = if shape.axes == 1 { SliceAxes::YY } else { SliceAxes::ZZ };

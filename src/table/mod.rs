@@ -17,6 +17,7 @@ pub mod lookup;
 pub mod quadtree4d;
 pub mod quadtree5d;
 pub mod quadtree6d;
+pub mod shared6d;
 mod space;
 pub mod synthetic;
 
@@ -30,8 +31,10 @@ pub use lookup::{TableAnswer, TableChecker};
 pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
 pub use quadtree5d::LinearQuadtree5d;
 pub use quadtree6d::LinearQuadtree6d;
+pub use shared6d::SharedQuadtree6d;
 
-/// One of the three table variants (thesis 3.2.4, 3.2.5, 3.2.6).
+/// One of the three table variants of the thesis (3.2.4, 3.2.5, 3.2.6) or the shared 6-D
+/// quadtree (issue 4).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Table {
     /// Linear 6-D quadtree, condensed.
@@ -40,6 +43,8 @@ pub enum Table {
     D5(LinearQuadtree5d),
     /// Linear 4-D quadtree with grouped 2-D slices.
     D4(LinearQuadtree4d),
+    /// 6-D quadtree with shared subtrees (issue 4; beyond the thesis).
+    Shared(SharedQuadtree6d),
 }
 
 impl Table {
@@ -51,6 +56,7 @@ impl Table {
             Table::D6(t) => t.query(cell6),
             Table::D5(t) => t.query(cell6),
             Table::D4(t) => t.query(cell6),
+            Table::Shared(t) => t.query(cell6),
         }
     }
 
@@ -60,6 +66,7 @@ impl Table {
             Table::D6(t) => t.levels(),
             Table::D5(t) => t.levels(),
             Table::D4(t) => t.levels(),
+            Table::Shared(t) => t.levels(),
         }
     }
 
@@ -69,6 +76,7 @@ impl Table {
             Table::D6(t) => t.symmetric(),
             Table::D5(t) => t.symmetric(),
             Table::D4(t) => t.symmetric(),
+            Table::Shared(t) => t.symmetric(),
         }
     }
 
@@ -78,15 +86,17 @@ impl Table {
             Table::D6(t) => t.memory_bytes(),
             Table::D5(t) => t.memory_bytes(),
             Table::D4(t) => t.memory_bytes(),
+            Table::Shared(t) => t.memory_bytes(),
         }
     }
 
-    /// A short name: `6D`, `5D`, `4D/yy t=0`...
+    /// A short name: `6D`, `5D`, `4D/yy t=0`, `6D-shared`.
     pub fn name(&self) -> String {
         match self {
             Table::D6(_) => "6D".into(),
             Table::D5(_) => "5D".into(),
             Table::D4(t) => format!("4D/{} t={}", if t.axes() == SliceAxes::YY { "yy" } else { "zz" }, t.threshold()),
+            Table::Shared(_) => "6D-shared".into(),
         }
     }
 }
