@@ -90,6 +90,33 @@ impl Table {
         }
     }
 
+    /// The address and byte length of every array a query may read (for benchmarks that
+    /// flush them from the caches between queries).
+    pub fn memory_regions(&self) -> Vec<(usize, usize)> {
+        fn region<T>(v: &[T]) -> (usize, usize) {
+            (v.as_ptr() as usize, std::mem::size_of_val(v))
+        }
+        match self {
+            Table::D6(t) => vec![region(t.codes())],
+            Table::D5(t) => {
+                let (codes, offsets, intervals) = t.parts();
+                vec![region(codes), region(offsets), region(intervals)]
+            }
+            Table::D4(t) => {
+                let (codes, slice_of, slices) = t.parts();
+                vec![region(codes), region(slice_of), region(slices)]
+            }
+            Table::Shared(t) => {
+                let (masks, bases, starts, children, leaves) = t.parts();
+                let children = match children {
+                    shared6d::ChildIndices::Narrow(v) => region(v),
+                    shared6d::ChildIndices::Wide(v) => region(v),
+                };
+                vec![region(masks), region(bases), region(starts), children, region(leaves)]
+            }
+        }
+    }
+
     /// A short name: `6D`, `5D`, `4D/yy t=0`, `6D-shared`.
     pub fn name(&self) -> String {
         match self {
