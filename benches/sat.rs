@@ -14,9 +14,7 @@
 //! Run: `cargo bench --bench sat -- --warm-up-time 1 --measurement-time 3`.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use delta_collide::geometry::{
-    first_intersecting_pair, obbs_intersect, separating_axis, Obb, WitnessCache,
-};
+use delta_collide::geometry::{first_intersecting_pair, obbs_intersect, separating_axis, Obb, WitnessCache};
 use delta_collide::math::{Mat3, Real, Vec3};
 use delta_collide::robot::model::RobotModel;
 use parry3d_f64::math::{Pose, Rotation, Vector};
@@ -59,24 +57,14 @@ fn pair_ring() -> Vec<Pair> {
             .matrix()
     };
     let pose = |q: [Real; 4], c: Vec3| {
-        Pose::from_parts(
-            Vector::new(c.x, c.y, c.z),
-            Rotation::from_xyzw(q[0], q[1], q[2], q[3]),
-        )
+        Pose::from_parts(Vector::new(c.x, c.y, c.z), Rotation::from_xyzw(q[0], q[1], q[2], q[3]))
     };
     (0..RING)
         .map(|_| {
             let (qa, qb) = (random_quat(&mut rng), random_quat(&mut rng));
-            let ca = Vec3::new(
-                rng.random_range(-500.0..500.0),
-                rng.random_range(-500.0..500.0),
-                -430.0,
-            );
-            let offset = Vec3::new(
-                rng.random_range(-1.0..1.0),
-                rng.random_range(-1.0..1.0),
-                rng.random_range(-1.0..1.0),
-            );
+            let ca = Vec3::new(rng.random_range(-500.0..500.0), rng.random_range(-500.0..500.0), -430.0);
+            let offset =
+                Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
             let cb = ca + offset * 220.0;
             let (pose_a, pose_b) = (pose(qa, ca), pose(qb, cb));
             Pair {
@@ -96,11 +84,7 @@ fn box_pair(c: &mut Criterion) {
     let ours: Vec<bool> = ring.iter().map(|p| obbs_intersect(&p.a, &p.b)).collect();
     let parry: Vec<bool> = ring
         .iter()
-        .map(|p| {
-            query::intersection_test(&p.pose_a, &p.cuboid, &p.pose_b, &p.cuboid)
-                .unwrap()
-                .intersecting
-        })
+        .map(|p| query::intersection_test(&p.pose_a, &p.cuboid, &p.pose_b, &p.cuboid).unwrap().intersecting)
         .collect();
     let agree = ours.iter().zip(&parry).filter(|(a, b)| a == b).count();
     println!(
@@ -121,13 +105,8 @@ fn box_pair(c: &mut Criterion) {
         bench.iter(|| {
             k = (k + 1) % RING;
             let p = &ring[k];
-            let hit = query::intersection_test(
-                black_box(&p.pose_a),
-                &p.cuboid,
-                black_box(&p.pose_b),
-                &p.cuboid,
-            )
-            .unwrap();
+            let hit =
+                query::intersection_test(black_box(&p.pose_a), &p.cuboid, black_box(&p.pose_b), &p.cuboid).unwrap();
             assert_eq!(hit.intersecting, parry[k]);
         })
     });
@@ -135,11 +114,7 @@ fn box_pair(c: &mut Criterion) {
         bench.iter(|| {
             k = (k + 1) % RING;
             let p = &ring[k];
-            let hit = query::details::intersection_test_cuboid_cuboid(
-                black_box(&p.pose_ab),
-                &p.cuboid,
-                &p.cuboid,
-            );
+            let hit = query::details::intersection_test_cuboid_cuboid(black_box(&p.pose_ab), &p.cuboid, &p.cuboid);
             assert_eq!(hit, parry[k]);
         })
     });
@@ -149,10 +124,7 @@ fn box_pair(c: &mut Criterion) {
 /// TCP uniformly in the thesis workspace's cylinder part (radius 225, depth 365..500).
 fn random_tcp(rng: &mut StdRng) -> Vec3 {
     loop {
-        let (x, y) = (
-            rng.random_range(-225.0..225.0),
-            rng.random_range(-225.0..225.0),
-        );
+        let (x, y) = (rng.random_range(-225.0..225.0), rng.random_range(-225.0..225.0));
         if x * x + y * y <= 225.0 * 225.0 {
             return Vec3::new(x, y, -rng.random_range(365.0..500.0));
         }
@@ -160,12 +132,7 @@ fn random_tcp(rng: &mut StdRng) -> Vec3 {
 }
 
 /// The three lower-link boxes of robot A (at the origin) and of robot B (at `(d, 0, 0)`).
-fn lower_links(
-    model: &RobotModel,
-    tcp_a: &Vec3,
-    tcp_b: &Vec3,
-    d: Real,
-) -> Option<([Obb; 3], [Obb; 3])> {
+fn lower_links(model: &RobotModel, tcp_a: &Vec3, tcp_b: &Vec3, d: Real) -> Option<([Obb; 3], [Obb; 3])> {
     let a = model.boxes(tcp_a).ok()?;
     let b = model.boxes(tcp_b).ok()?;
     let shift = Vec3::new(d, 0.0, 0.0);
@@ -197,14 +164,8 @@ fn nine_pairs(c: &mut Criterion) {
             ring.push(boxes);
         }
     }
-    let expected: Vec<bool> = ring
-        .iter()
-        .map(|(a, b)| plain_loop(a, b).is_some())
-        .collect();
-    println!(
-        "nine_pairs ring: {} of {RING} configurations collide",
-        expected.iter().filter(|&&v| v).count()
-    );
+    let expected: Vec<bool> = ring.iter().map(|(a, b)| plain_loop(a, b).is_some()).collect();
+    println!("nine_pairs ring: {} of {RING} configurations collide", expected.iter().filter(|&&v| v).count());
 
     let mut g = c.benchmark_group("nine_pairs");
     let mut k = 0;
@@ -212,20 +173,14 @@ fn nine_pairs(c: &mut Criterion) {
         bench.iter(|| {
             k = (k + 1) % RING;
             let (a, b) = &ring[k];
-            assert_eq!(
-                plain_loop(black_box(a), black_box(b)).is_some(),
-                expected[k]
-            );
+            assert_eq!(plain_loop(black_box(a), black_box(b)).is_some(), expected[k]);
         })
     });
     g.bench_function("first_intersecting_pair", |bench| {
         bench.iter(|| {
             k = (k + 1) % RING;
             let (a, b) = &ring[k];
-            assert_eq!(
-                first_intersecting_pair(black_box(a), black_box(b)).is_some(),
-                expected[k]
-            );
+            assert_eq!(first_intersecting_pair(black_box(a), black_box(b)).is_some(), expected[k]);
         })
     });
     let mut cache = WitnessCache::new();
@@ -233,12 +188,7 @@ fn nine_pairs(c: &mut Criterion) {
         bench.iter(|| {
             k = (k + 1) % RING;
             let (a, b) = &ring[k];
-            assert_eq!(
-                cache
-                    .first_intersecting_pair(black_box(a), black_box(b))
-                    .is_some(),
-                expected[k]
-            );
+            assert_eq!(cache.first_intersecting_pair(black_box(a), black_box(b)).is_some(), expected[k]);
         })
     });
     g.finish();
@@ -260,34 +210,19 @@ fn trajectory(reach: Real) -> Vec<([Obb; 3], [Obb; 3])> {
 
 fn trajectories(c: &mut Criterion) {
     let (practical, collision) = (trajectory(300.0), trajectory(400.0));
-    assert!(
-        practical.iter().all(|(a, b)| plain_loop(a, b).is_none()),
-        "the practical case never collides"
-    );
-    let colliding = collision
-        .iter()
-        .filter(|(a, b)| plain_loop(a, b).is_some())
-        .count();
+    assert!(practical.iter().all(|(a, b)| plain_loop(a, b).is_none()), "the practical case never collides");
+    let colliding = collision.iter().filter(|(a, b)| plain_loop(a, b).is_some()).count();
     println!("trajectory: practical 0 of 6000 ticks collide, collision case {colliding} of 6000");
-    assert!(
-        colliding > 300,
-        "the collision case collides in its last part"
-    );
+    assert!(colliding > 300, "the collision case collides in its last part");
 
     let mut g = c.benchmark_group("trajectory");
     g.throughput(Throughput::Elements(6000));
     for (name, run) in [("practical", &practical), ("collision", &collision)] {
-        let expected: Vec<bool> = run
-            .iter()
-            .map(|(a, b)| plain_loop(a, b).is_some())
-            .collect();
+        let expected: Vec<bool> = run.iter().map(|(a, b)| plain_loop(a, b).is_some()).collect();
         g.bench_function(format!("{name}/sat"), |bench| {
             bench.iter(|| {
                 for ((a, b), &e) in run.iter().zip(&expected) {
-                    assert_eq!(
-                        first_intersecting_pair(black_box(a), black_box(b)).is_some(),
-                        e
-                    );
+                    assert_eq!(first_intersecting_pair(black_box(a), black_box(b)).is_some(), e);
                 }
             })
         });
@@ -296,12 +231,7 @@ fn trajectories(c: &mut Criterion) {
                 WitnessCache::new,
                 |cache| {
                     for ((a, b), &e) in run.iter().zip(&expected) {
-                        assert_eq!(
-                            cache
-                                .first_intersecting_pair(black_box(a), black_box(b))
-                                .is_some(),
-                            e
-                        );
+                        assert_eq!(cache.first_intersecting_pair(black_box(a), black_box(b)).is_some(), e);
                     }
                 },
                 BatchSize::SmallInput,

@@ -52,7 +52,10 @@ impl<'a> LabelArray<'a> {
         let k = space.grid_a.k as usize;
         let dense = |cells: &[[u16; 3]]| {
             let mut m = vec![u32::MAX; k * k * k];
-            cells.iter().enumerate().for_each(|(i, c)| m[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] = i as u32);
+            cells
+                .iter()
+                .enumerate()
+                .for_each(|(i, c)| m[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] = i as u32);
             m
         };
         LabelArray { k, index_a: dense(&space.grid_a.cells), index_b: dense(&space.grid_b.cells), space }
@@ -83,11 +86,13 @@ fn build(s: &LabelledSpace) -> Vec<Table> {
             Table::D6(q) => q.thesis_bytes(),
             Table::D5(q) => q.thesis_bytes(),
             Table::D4(q) => q.thesis_bytes(b),
+            Table::Shared(q) => q.memory_bytes(),
         };
         let detail = match &t {
             Table::D6(q) => format!("{} codes ({} condensed)", q.codes().len(), q.condensed()),
             Table::D5(q) => format!("{} codes, {} intervals", q.parts().0.len(), q.parts().2.len()),
             Table::D4(q) => format!("{} codes, {} slices", q.parts().0.len(), q.slice_count()),
+            Table::Shared(q) => format!("nodes per depth, leaves {:?}", q.nodes_per_depth()),
         };
         eprintln!(
             "  {name:<22} build {:>7.3} s  {detail:<32} ours {:>10} B  thesis formula {:>10} B",
@@ -102,8 +107,11 @@ fn build(s: &LabelledSpace) -> Vec<Table> {
         timed(&format!("6D{tag}"), &|| Table::D6(LinearQuadtree6d::build(s, symmetric).unwrap()));
         timed(&format!("5D{tag}"), &|| Table::D5(LinearQuadtree5d::build(s, symmetric).unwrap()));
         for (axes, t) in [(SliceAxes::YY, 0), (SliceAxes::YY, 150), (SliceAxes::ZZ, 0)] {
-            timed(&format!("4D/{axes:?} t={t}{tag}"), &|| Table::D4(LinearQuadtree4d::build(s, symmetric, axes, t).unwrap()));
+            timed(&format!("4D/{axes:?} t={t}{tag}"), &|| {
+                Table::D4(LinearQuadtree4d::build(s, symmetric, axes, t).unwrap())
+            });
         }
+        timed(&format!("6D-shared{tag}"), &|| Table::Shared(SharedQuadtree6d::build(s, symmetric).unwrap()));
         if !sym {
             break;
         }

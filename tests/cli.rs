@@ -6,7 +6,11 @@ use delta_collide::math::Vec3;
 use std::process::Command;
 
 fn cli(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_delta-collide")).args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+    Command::new(env!("CARGO_BIN_EXE_delta-collide"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
 }
 
 #[test]
@@ -16,11 +20,8 @@ fn demo_reports_no_collision_when_practical_and_the_same_first_tick_for_both_met
     let text = String::from_utf8(out.stdout).unwrap();
     println!("{text}");
     for cell in ["T1", "T2", "T3"] {
-        let rows: Vec<Vec<&str>> = text
-            .lines()
-            .filter(|l| l.starts_with(cell))
-            .map(|l| l.split_whitespace().collect())
-            .collect();
+        let rows: Vec<Vec<&str>> =
+            text.lines().filter(|l| l.starts_with(cell)).map(|l| l.split_whitespace().collect()).collect();
         assert_eq!(rows.len(), 4, "{cell}: practical and collision, SAT and SAT-cache");
         for r in rows.iter().filter(|r| r[1] == "practical") {
             assert_eq!((r[3], r[4]), ("none", "0"), "{cell} practical never collides");
@@ -46,15 +47,25 @@ fn check_writes_one_line_per_row_matching_the_exact_checker() {
         let tcps = [Vec3::new(-200.0 + 400.0 * s, 20.0, z), Vec3::new(180.0 - 380.0 * s, -10.0, -470.0)];
         rows.push(format!("{},{},{},{},{},{}", tcps[0].x, tcps[0].y, tcps[0].z, tcps[1].x, tcps[1].y, tcps[1].z));
         let v = checker.check(&tcps).unwrap();
-        expected.push(match (v.all_reachable(), v.collides()) {
-            (false, _) => "0,NA",
-            (true, true) => "1,1",
-            (true, false) => "1,0",
-        }
-        .to_string());
+        expected.push(
+            match (v.all_reachable(), v.collides()) {
+                (false, _) => "0,NA",
+                (true, true) => "1,1",
+                (true, false) => "1,0",
+            }
+            .to_string(),
+        );
     }
     std::fs::write(&input, rows.join("\n")).unwrap();
-    let out = cli(&["check", "--cell", "cells/t2.toml", "--input", input.to_str().unwrap(), "--output", output.to_str().unwrap()]);
+    let out = cli(&[
+        "check",
+        "--cell",
+        "cells/t2.toml",
+        "--input",
+        input.to_str().unwrap(),
+        "--output",
+        output.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let got = std::fs::read_to_string(&output).unwrap();
     let got: Vec<&str> = got.lines().collect();
@@ -96,7 +107,8 @@ fn build_inspect_eval_and_check_with_a_table() {
     let text = String::from_utf8(out.stdout).unwrap();
     println!("{text}");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let fns: Vec<&str> = text.lines().filter_map(|l| l.split("FN").nth(1)).map(|r| r.split_whitespace().next().unwrap()).collect();
+    let fns: Vec<&str> =
+        text.lines().filter_map(|l| l.split("FN").nth(1)).map(|r| r.split_whitespace().next().unwrap()).collect();
     assert_eq!(fns, vec!["0", "0", "0"], "practical, collision and random: no false negative");
     let out = cli(&["eval", "--cell", "T1", "--table", table, "--random", "10"]);
     assert_eq!(out.status.code(), Some(2), "a T3 table is refused for T1");

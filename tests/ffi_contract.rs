@@ -3,8 +3,8 @@
 
 use delta_collide::ffi::*;
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::ffi::CStr;
 use std::cell::Cell;
+use std::ffi::CStr;
 
 /// Counts allocations per thread (tests run in parallel threads of one process).
 struct Counting;
@@ -85,7 +85,15 @@ fn query_does_not_allocate_over_a_million_ticks() {
     for method in [DC_METHOD_SAT, DC_METHOD_SAT_CACHE] {
         let h = two_robot_cell(450.0, method);
         let mut verdict = DC_VERDICT_STOP;
-        let mut report = DcQueryReport { verdict: 0, colliding_pairs: 0, unreachable_mask: 0, first_robot_a: 0, first_robot_b: 0, first_box_a: 0, first_box_b: 0 };
+        let mut report = DcQueryReport {
+            verdict: 0,
+            colliding_pairs: 0,
+            unreachable_mask: 0,
+            first_robot_a: 0,
+            first_robot_b: 0,
+            first_box_a: 0,
+            first_box_b: 0,
+        };
         let ring: Vec<[DcVec3; 2]> = (0..128)
             .map(|i| {
                 let s = i as f64 / 127.0;
@@ -99,7 +107,11 @@ fn query_does_not_allocate_over_a_million_ticks() {
             // SAFETY: live handle, valid slices and outputs.
             let s = unsafe { dc_query(h, tcps.as_ptr(), 2, &mut verdict, &mut report) };
             assert_eq!(s, DC_STATUS_OK);
-            if verdict == DC_VERDICT_FREE { free += 1 } else { hit += 1 }
+            if verdict == DC_VERDICT_FREE {
+                free += 1
+            } else {
+                hit += 1
+            }
         }
         let after = allocations();
         assert_eq!(after - before, 0, "dc_query allocated");
@@ -127,7 +139,10 @@ fn every_bad_input_gets_its_status_and_stop() {
     unsafe {
         assert_eq!(dc_query(h, std::ptr::null(), 2, &mut verdict, std::ptr::null_mut()), DC_STATUS_NULL_POINTER);
         assert_eq!(verdict, DC_VERDICT_STOP);
-        assert_eq!(dc_query(h, [home, home].as_ptr(), 2, std::ptr::null_mut(), std::ptr::null_mut()), DC_STATUS_NULL_POINTER);
+        assert_eq!(
+            dc_query(h, [home, home].as_ptr(), 2, std::ptr::null_mut(), std::ptr::null_mut()),
+            DC_STATUS_NULL_POINTER
+        );
         dc_destroy(h);
         dc_destroy(std::ptr::null_mut());
     }
@@ -155,7 +170,7 @@ fn init_rejects_bad_configs_and_clears_the_handle() {
     ] {
         let config = DcCellConfig { robots: robots.as_ptr(), n_robots: robots.len(), method };
         let mut h: *mut DcCollider = 8 as *mut DcCollider; // garbage that must be overwritten
-        // SAFETY: valid pointers; the config content is what is under test.
+                                                           // SAFETY: valid pointers; the config content is what is under test.
         assert_eq!(unsafe { dc_init(&config, &mut h) }, want);
         assert!(h.is_null());
     }
@@ -203,7 +218,7 @@ fn cell_files_init_the_same_checker_as_configs() {
     unsafe {
         let mut h = std::ptr::null_mut();
         assert_eq!(dc_init_from_cell_file(std::ptr::null(), &mut h), DC_STATUS_NULL_POINTER);
-        assert_eq!(dc_init_from_cell_file(b"\xff\xfe.toml\0".as_ptr().cast(), &mut h), DC_STATUS_INVALID_ARGUMENT);
+        assert_eq!(dc_init_from_cell_file(c"\xff\xfe.toml".as_ptr(), &mut h), DC_STATUS_INVALID_ARGUMENT);
         dc_destroy(from_config);
     }
 }
@@ -223,7 +238,10 @@ fn reports_name_the_colliding_boxes_and_pair_results_match() {
         assert_eq!(dc_pair_results(h, out.as_mut_ptr(), 0, &mut len), DC_STATUS_INVALID_ARGUMENT);
         assert_eq!(len, 1);
     }
-    assert_eq!(out[0], DcPairResult { robot_a: 0, robot_b: 1, collides: 1, box_a: r.first_box_a, box_b: r.first_box_b });
+    assert_eq!(
+        out[0],
+        DcPairResult { robot_a: 0, robot_b: 1, collides: 1, box_a: r.first_box_a, box_b: r.first_box_b }
+    );
     let (s, verdict, r) = query(h, &[v(-150.0, 0.0, -450.0), v(150.0, 0.0, -450.0)]);
     assert_eq!((s, verdict, r.first_box_a), (DC_STATUS_OK, DC_VERDICT_FREE, DC_BOX_NONE));
     // SAFETY: live handle.
@@ -248,8 +266,14 @@ fn status_strings_cover_every_code_and_kinematics_round_trip() {
         assert_eq!(dc_delta3_inverse_kinematics(&g, v(30.0, -20.0, -460.0), theta.as_mut_ptr()), DC_STATUS_OK);
         assert_eq!(dc_delta3_forward_kinematics(&g, theta.as_ptr(), &mut back), DC_STATUS_OK);
         assert_eq!(dc_delta3_inverse_kinematics(&g, v(0.0, 0.0, -900.0), theta.as_mut_ptr()), DC_STATUS_UNREACHABLE);
-        assert_eq!(dc_delta3_inverse_kinematics(&g, v(0.0, f64::NAN, -400.0), theta.as_mut_ptr()), DC_STATUS_NON_FINITE);
-        assert_eq!(dc_delta3_inverse_kinematics(std::ptr::null(), v(0.0, 0.0, -400.0), theta.as_mut_ptr()), DC_STATUS_NULL_POINTER);
+        assert_eq!(
+            dc_delta3_inverse_kinematics(&g, v(0.0, f64::NAN, -400.0), theta.as_mut_ptr()),
+            DC_STATUS_NON_FINITE
+        );
+        assert_eq!(
+            dc_delta3_inverse_kinematics(std::ptr::null(), v(0.0, 0.0, -400.0), theta.as_mut_ptr()),
+            DC_STATUS_NULL_POINTER
+        );
     }
     assert!((back.x - 30.0).abs() < 1e-9 && (back.y + 20.0).abs() < 1e-9 && (back.z + 460.0).abs() < 1e-9);
 }

@@ -6,9 +6,7 @@
 //! they may disagree only inside a thin band around touching, measured by an independent
 //! gap computed from the boxes' vertices.
 
-use delta_collide::geometry::{
-    first_intersecting_pair, obbs_intersect, separating_axis, Obb, WitnessCache,
-};
+use delta_collide::geometry::{first_intersecting_pair, obbs_intersect, separating_axis, Obb, WitnessCache};
 use delta_collide::math::{Mat3, Real, Vec3};
 use nalgebra::Rotation3;
 use proptest::prelude::*;
@@ -32,20 +30,13 @@ fn half_extents() -> impl Strategy<Value = Vec3> {
 
 /// A box anywhere in a cell-sized region, any orientation, realistic or thin.
 fn obb() -> impl Strategy<Value = Obb> {
-    (
-        (-400.0..400.0, -400.0..400.0, -400.0..400.0),
-        rotation(),
-        half_extents(),
-    )
+    ((-400.0..400.0, -400.0..400.0, -400.0..400.0), rotation(), half_extents())
         .prop_map(|((x, y, z), axes, half)| Obb::new(Vec3::new(x, y, z), axes, half))
 }
 
 /// A rigid motion `p -> rot p + t`.
 fn rigid_motion() -> impl Strategy<Value = (Mat3, Vec3)> {
-    (
-        rotation(),
-        (-3000.0..3000.0, -3000.0..3000.0, -3000.0..3000.0),
-    )
+    (rotation(), (-3000.0..3000.0, -3000.0..3000.0, -3000.0..3000.0))
         .prop_map(|(rot, (x, y, z))| (rot, Vec3::new(x, y, z)))
 }
 
@@ -53,15 +44,8 @@ fn rigid_motion() -> impl Strategy<Value = (Mat3, Vec3)> {
 /// zero, tiny, or up to a millimetre either way.
 fn near_pair() -> impl Strategy<Value = (Obb, Obb)> {
     let gap = prop_oneof![Just(0.0), -1e-6..1e-6, -1.0..1.0];
-    (
-        obb(),
-        rotation(),
-        half_extents(),
-        0usize..4,
-        gap,
-        (-1.0..1.0, -1.0..1.0, -1.0..1.0),
-    )
-        .prop_map(|(a, axes, half, dir, gap, (x, y, z))| {
+    (obb(), rotation(), half_extents(), 0usize..4, gap, (-1.0..1.0, -1.0..1.0, -1.0..1.0)).prop_map(
+        |(a, axes, half, dir, gap, (x, y, z))| {
             let v = Vec3::new(x, y, z);
             let n = if dir < 3 {
                 a.axes.column(dir).into_owned()
@@ -70,15 +54,12 @@ fn near_pair() -> impl Strategy<Value = (Obb, Obb)> {
             } else {
                 Vec3::x()
             };
-            let support = |b: &Obb| {
-                (0..3)
-                    .map(|k| b.axes.column(k).dot(&n).abs() * b.half[k])
-                    .sum::<Real>()
-            };
+            let support = |b: &Obb| (0..3).map(|k| b.axes.column(k).dot(&n).abs() * b.half[k]).sum::<Real>();
             let b = Obb::new(Vec3::zeros(), axes, half);
             let center = a.center + n * (support(&a) + support(&b) + gap);
             (a, Obb { center, ..b })
-        })
+        },
+    )
 }
 
 fn pair() -> impl Strategy<Value = (Obb, Obb)> {
@@ -102,9 +83,7 @@ fn vertex_gap(a: &Obb, b: &Obb) -> Real {
     }
     let (va, vb) = (a.vertices(), b.vertices());
     let range = |vs: &[Vec3; 8], l: &Vec3| {
-        vs.iter()
-            .map(|v| v.dot(l))
-            .fold((Real::MAX, Real::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)))
+        vs.iter().map(|v| v.dot(l)).fold((Real::MAX, Real::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)))
     };
     axes.iter()
         .map(|l| {
@@ -115,13 +94,7 @@ fn vertex_gap(a: &Obb, b: &Obb) -> Real {
 }
 
 /// Two verdicts on the same geometry may differ only near touching.
-fn assert_same_or_near_touching(
-    a: &Obb,
-    b: &Obb,
-    first: bool,
-    second: bool,
-    what: &str,
-) -> Result<(), TestCaseError> {
+fn assert_same_or_near_touching(a: &Obb, b: &Obb, first: bool, second: bool, what: &str) -> Result<(), TestCaseError> {
     if first != second {
         let gap = vertex_gap(a, b);
         prop_assert!(

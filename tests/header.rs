@@ -8,10 +8,7 @@ fn committed_header_matches_a_fresh_generation() {
     let fresh = include_str!(concat!(env!("OUT_DIR"), "/delta_collide.h"));
     let committed = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/include/delta_collide.h"))
         .expect("include/delta_collide.h is committed");
-    assert!(
-        fresh == committed,
-        "include/delta_collide.h is stale: run `cargo build` (outside CI) and commit include/"
-    );
+    assert!(fresh == committed, "include/delta_collide.h is stale: run `cargo build` (outside CI) and commit include/");
 }
 
 #[test]

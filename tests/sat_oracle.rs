@@ -41,19 +41,12 @@ fn obb(q: &[Real; 4], c: &[Real; 3], h: &[Real; 3]) -> Obb {
 }
 
 fn pose(q: &[Real; 4], c: &[Real; 3]) -> Pose {
-    Pose::from_parts(
-        Vector::new(c[0], c[1], c[2]),
-        Rotation::from_xyzw(q[0], q[1], q[2], q[3]),
-    )
+    Pose::from_parts(Vector::new(c[0], c[1], c[2]), Rotation::from_xyzw(q[0], q[1], q[2], q[3]))
 }
 
 impl Case {
     fn ours_free(&self) -> bool {
-        separating_axis(
-            &obb(&self.qa, &self.ca, &self.ha),
-            &obb(&self.qb, &self.cb, &self.hb),
-        )
-        .is_some()
+        separating_axis(&obb(&self.qa, &self.ca, &self.ha), &obb(&self.qb, &self.cb, &self.hb)).is_some()
     }
 
     fn parry_parts(&self) -> (Pose, Cuboid, Pose, Cuboid) {
@@ -67,9 +60,7 @@ impl Case {
 
     fn parry_intersects(&self) -> bool {
         let (pa, sa, pb, sb) = self.parry_parts();
-        query::intersection_test(&pa, &sa, &pb, &sb)
-            .unwrap()
-            .intersecting
+        query::intersection_test(&pa, &sa, &pb, &sb).unwrap().intersecting
     }
 
     fn parry_distance(&self) -> Real {
@@ -81,10 +72,7 @@ impl Case {
     /// disjoint boxes and an upper bound on the distance always (a second opinion where parry's
     /// GJK distance stalls on nearly parallel faces).
     fn feature_distance(&self) -> Real {
-        let (a, b) = (
-            obb(&self.qa, &self.ca, &self.ha),
-            obb(&self.qb, &self.cb, &self.hb),
-        );
+        let (a, b) = (obb(&self.qa, &self.ca, &self.ha), obb(&self.qb, &self.cb, &self.hb));
         let (va, vb) = (a.vertices(), b.vertices());
         let mut d = Real::MAX;
         for v in &va {
@@ -110,11 +98,7 @@ fn point_box_distance(p: &Vec3, b: &Obb) -> Real {
 
 /// The 12 edges of a box from its vertices (indexed by sign bits, as `Obb::vertices`).
 fn box_edges(v: &[Vec3; 8]) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
-    (0..8).flat_map(move |i| {
-        (0..3)
-            .filter(move |k| i >> k & 1 == 0)
-            .map(move |k| (v[i], v[i | 1 << k]))
-    })
+    (0..8).flat_map(move |i| (0..3).filter(move |k| i >> k & 1 == 0).map(move |k| (v[i], v[i | 1 << k])))
 }
 
 /// Distance between segments `p0 p1` and `q0 q1` (Ericson, Real-Time Collision Detection 5.1.9).
@@ -124,11 +108,7 @@ fn segment_distance(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> Real {
     let c = d1.dot(&r);
     let b = d1.dot(&d2);
     let denom = a * e - b * b;
-    let mut s = if denom > 0.0 {
-        ((b * f - c * e) / denom).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let mut s = if denom > 0.0 { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
     let mut t = (b * s + f) / e;
     if t < 0.0 {
         t = 0.0;
@@ -176,11 +156,7 @@ fn axis_quat(k: usize, angle: Real) -> [Real; 4] {
 
 fn random_unit(rng: &mut StdRng) -> Vec3 {
     loop {
-        let v = Vec3::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        );
+        let v = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
         let n = v.norm();
         if n > 1e-3 && n <= 1.0 {
             return v / n;
@@ -196,16 +172,8 @@ fn random_half(rng: &mut StdRng) -> [Real; 3] {
             [200.0 * s, 70.0 * s, 17.5 * s]
         }
         1 => std::array::from_fn(|_| rng.random_range(1.0..300.0)),
-        2 => [
-            rng.random_range(10.0..300.0),
-            rng.random_range(10.0..300.0),
-            rng.random_range(0.01..1.0),
-        ],
-        _ => [
-            rng.random_range(10.0..300.0),
-            rng.random_range(0.01..1.0),
-            rng.random_range(0.01..1.0),
-        ],
+        2 => [rng.random_range(10.0..300.0), rng.random_range(10.0..300.0), rng.random_range(0.01..1.0)],
+        _ => [rng.random_range(10.0..300.0), rng.random_range(0.01..1.0), rng.random_range(0.01..1.0)],
     };
     let k = rng.random_range(0..3);
     h.swap(0, k);
@@ -224,24 +192,12 @@ fn uniform_case(rng: &mut StdRng) -> Case {
     let reach = ha.iter().chain(&hb).cloned().fold(0.0, Real::max) * 1.2;
     let ca: [Real; 3] = std::array::from_fn(|_| rng.random_range(-1000.0..1000.0));
     let cb: [Real; 3] = std::array::from_fn(|k| ca[k] + rng.random_range(-reach..reach));
-    Case {
-        qa: random_quat(rng),
-        ca,
-        ha,
-        qb: random_quat(rng),
-        cb,
-        hb,
-    }
+    Case { qa: random_quat(rng), ca, ha, qb: random_quat(rng), cb, hb }
 }
 
 /// B placed at a controlled gap `+-10^log10_gap` mm from A along a direction that is random,
 /// a face normal of A or B, or the cross product of an edge of each, with a lateral offset.
-fn near_touching(
-    rng: &mut StdRng,
-    qa: [Real; 4],
-    qb: [Real; 4],
-    log10_gap: std::ops::Range<Real>,
-) -> Case {
+fn near_touching(rng: &mut StdRng, qa: [Real; 4], qb: [Real; 4], log10_gap: std::ops::Range<Real>) -> Case {
     let (ha, hb) = (random_half(rng), random_half(rng));
     let (ma, mb) = (matrix(&qa), matrix(&qb));
     let sign = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
@@ -250,9 +206,7 @@ fn near_touching(
         1 => ma.column(rng.random_range(0..3)).into_owned() * sign,
         2 => mb.column(rng.random_range(0..3)).into_owned() * sign,
         _ => {
-            let c = ma
-                .column(rng.random_range(0..3))
-                .cross(&mb.column(rng.random_range(0..3)));
+            let c = ma.column(rng.random_range(0..3)).cross(&mb.column(rng.random_range(0..3)));
             if c.norm() < 1e-6 {
                 random_unit(rng)
             } else {
@@ -260,31 +214,18 @@ fn near_touching(
             }
         }
     };
-    let gap =
-        10f64.powf(rng.random_range(log10_gap)) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    let gap = 10f64.powf(rng.random_range(log10_gap)) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
     let ca: [Real; 3] = std::array::from_fn(|_| rng.random_range(-1000.0..1000.0));
     // A lateral shift orthogonal to n, up to a fraction of the smaller box.
     let lateral = {
         let v = random_unit(rng);
         let v = v - n * n.dot(&v);
-        let s = ha
-            .iter()
-            .chain(&hb)
-            .cloned()
-            .fold(Real::MAX, Real::min)
-            .max(1.0);
+        let s = ha.iter().chain(&hb).cloned().fold(Real::MAX, Real::min).max(1.0);
         v * rng.random_range(0.0..s)
     };
     let d = n * (support(&qa, &ha, &n) + support(&qb, &hb, &n) + gap) + lateral;
     let cb = [ca[0] + d.x, ca[1] + d.y, ca[2] + d.z];
-    Case {
-        qa,
-        ca,
-        ha,
-        qb,
-        cb,
-        hb,
-    }
+    Case { qa, ca, ha, qb, cb, hb }
 }
 
 /// B's orientation with one axis parallel or anti-parallel to one of A's axes, exactly (A
@@ -362,10 +303,7 @@ impl Tally {
                     self.ours_collide_parry_within_band += 1;
                     self.max_band_distance = self.max_band_distance.max(dist);
                 } else {
-                    self.fail(
-                        case,
-                        format!("ours collision, parry separated by {dist:e} mm"),
-                    );
+                    self.fail(case, format!("ours collision, parry separated by {dist:e} mm"));
                 }
             }
         }
@@ -391,11 +329,7 @@ impl Tally {
         for (case, why) in self.failures.iter().take(20) {
             println!("    // {why}\n    {case:?},");
         }
-        assert!(
-            self.failures.is_empty(),
-            "{name}: {} disagreements outside the policy",
-            self.failures.len()
-        );
+        assert!(self.failures.is_empty(), "{name}: {} disagreements outside the policy", self.failures.len());
     }
 }
 
@@ -412,10 +346,7 @@ fn run(name: &str, seed: u64, n: usize, mut gen: impl FnMut(&mut StdRng) -> Case
 #[test]
 fn uniform_random_pairs_agree_with_parry() {
     let t = run("uniform", 1, 400_000, uniform_case);
-    assert!(
-        t.both_collide > 100_000 && t.both_free > 100_000,
-        "a real mix of verdicts"
-    );
+    assert!(t.both_collide > 100_000 && t.both_free > 100_000, "a real mix of verdicts");
 }
 
 #[test]
@@ -424,10 +355,7 @@ fn near_touching_pairs_agree_with_parry() {
         let (qa, qb) = (random_quat(rng), random_quat(rng));
         near_touching(rng, qa, qb, -4.0..0.0)
     });
-    assert!(
-        t.both_collide > 20_000 && t.both_free > 50_000,
-        "a real mix of verdicts"
-    );
+    assert!(t.both_collide > 20_000 && t.both_free > 50_000, "a real mix of verdicts");
 }
 
 #[test]
@@ -437,17 +365,10 @@ fn parallel_and_antiparallel_pairs_agree_with_parry() {
         if rng.random_bool(0.5) {
             near_touching(rng, qa, qb, -4.0..0.0)
         } else {
-            Case {
-                qa,
-                qb,
-                ..uniform_case(rng)
-            }
+            Case { qa, qb, ..uniform_case(rng) }
         }
     });
-    assert!(
-        t.both_collide > 20_000 && t.both_free > 20_000,
-        "a real mix of verdicts"
-    );
+    assert!(t.both_collide > 20_000 && t.both_free > 20_000, "a real mix of verdicts");
 }
 
 #[test]
@@ -456,10 +377,7 @@ fn nearly_parallel_near_touching_pairs_agree_with_parry() {
         let (qa, qb) = nearly_parallel_orientations(rng);
         near_touching(rng, qa, qb, -4.0..0.0)
     });
-    assert!(
-        t.both_collide > 5_000 && t.both_free > 5_000,
-        "a real mix of verdicts"
-    );
+    assert!(t.both_collide > 5_000 && t.both_free > 5_000, "a real mix of verdicts");
 }
 
 /// Cases once found by the random runs, pasted back as printed.
@@ -478,39 +396,19 @@ fn regressions() {
         },
         // Anti-parallel needle, true gap 1.25e-4 mm: parry's GJK distance stalled at 79.7 mm.
         Case {
-            qa: [
-                -0.3715170064936598,
-                0.8951385366866326,
-                0.10635967402752275,
-                -0.2222380115220238,
-            ],
+            qa: [-0.3715170064936598, 0.8951385366866326, 0.10635967402752275, -0.2222380115220238],
             ca: [-18.64460092687409, 310.09414247025234, -38.19754448636604],
             ha: [67.46295673206116, 192.75130494874614, 16.86573918301529],
-            qb: [
-                -0.618093019075355,
-                0.09744506938078926,
-                -0.688590859494412,
-                -0.3664807040547061,
-            ],
+            qb: [-0.618093019075355, 0.09744506938078926, -0.688590859494412, -0.3664807040547061],
             cb: [23.846096168927048, 358.09413758955066, -60.507486903315424],
             hb: [0.6358309541148788, 0.4089801293336501, 299.2653327385397],
         },
         // Large boxes 2.4e-3 mm apart: SAT_EPSILON = 1e-6 on |R| reported a collision.
         Case {
-            qa: [
-                0.43259627381925025,
-                -0.256195703428533,
-                0.04268114038697688,
-                -0.8633669820405031,
-            ],
+            qa: [0.43259627381925025, -0.256195703428533, 0.04268114038697688, -0.8633669820405031],
             ca: [-711.3121573668058, -977.959802334337, -577.9318842893724],
             ha: [128.53829367670915, 110.70228415126523, 217.22105916965006],
-            qb: [
-                0.6395188695689836,
-                -0.6030284929141175,
-                -0.03894701330515094,
-                0.47524244586689185,
-            ],
+            qb: [0.6395188695689836, -0.6030284929141175, -0.03894701330515094, 0.47524244586689185],
             cb: [-1220.9420474569777, -1162.7152436951196, -605.8336859246883],
             hb: [259.05881398088934, 235.25881787681757, 197.60835048338032],
         },
@@ -528,11 +426,8 @@ fn regressions() {
 #[test]
 fn very_near_touching_pairs_err_toward_collision() {
     run("very near", 5, 50_000, |rng| {
-        let (qa, qb) = if rng.random_bool(0.5) {
-            parallel_orientations(rng)
-        } else {
-            (random_quat(rng), random_quat(rng))
-        };
+        let (qa, qb) =
+            if rng.random_bool(0.5) { parallel_orientations(rng) } else { (random_quat(rng), random_quat(rng)) };
         near_touching(rng, qa, qb, -9.0..-4.0)
     });
 }

@@ -24,7 +24,8 @@ const CHUNK: usize = 10_000;
 fn random_tcp(rng: &mut StdRng, ws: &Workspace, delta: &Delta3) -> Vec3 {
     let r = ws.max_radius();
     loop {
-        let p = Vec3::new(rng.random_range(-r..=r), rng.random_range(-r..=r), -rng.random_range(ws.zu..=ws.max_depth()));
+        let p =
+            Vec3::new(rng.random_range(-r..=r), rng.random_range(-r..=r), -rng.random_range(ws.zu..=ws.max_depth()));
         if ws.contains(&p) && delta.inverse_kinematics(&p).is_ok() {
             return p;
         }
@@ -94,7 +95,11 @@ fn classify(label: Label, collides: bool) -> Confusion {
 /// the least clearance (collision once the margin grows by a quarter), checked at the 64
 /// corners of their 6-D cell (pulled in by 1e-9 mm). Returns (pairs searched, pairs with a
 /// colliding corner, example).
-fn hunt_thesis_false_negatives(cell: &delta_collide::cell::Cell, thesis: &LabelledSpace, tighter: &LabelledSpace) -> (usize, usize, Option<(Vec3, Vec3)>) {
+fn hunt_thesis_false_negatives(
+    cell: &delta_collide::cell::Cell,
+    thesis: &LabelledSpace,
+    tighter: &LabelledSpace,
+) -> (usize, usize, Option<(Vec3, Vec3)>) {
     let nb = thesis.grid_b.cells.len();
     let band: Vec<usize> = (0..thesis.labels.len())
         .filter(|&i| thesis.labels[i] == Label::Free && tighter.labels[i] == Label::Collision)
@@ -171,6 +176,13 @@ fn check_cell(name: &str, seed: u64) {
     theirs.print("thesis margin r/sqrt(2)");
     assert_eq!(ours.total(), CONFIGS as u64);
     assert_eq!(ours.fn_, 0, "{name}: certified labels gave false negatives");
+    // Certified "unreachable" means the whole cell was proved unreachable: no reachable TCP
+    // may land there.
+    assert_eq!(
+        ours.unreachable_collide + ours.unreachable_free,
+        0,
+        "{name}: a reachable TCP in a cell proved unreachable"
+    );
     // The test must be able to fail: collisions and free configurations both occur, and the
     // certified labels are not trivially "collision everywhere".
     assert!(ours.tp > 1000 && ours.tn > CONFIGS as u64 / 4, "{ours:?}");
@@ -232,7 +244,8 @@ fn sample_counts_and_unreachable_volume() {
     let (mut inside, mut unreachable) = (0u32, 0u32);
     while inside < 200_000 {
         let r = ws.max_radius();
-        let p = Vec3::new(rng.random_range(-r..=r), rng.random_range(-r..=r), -rng.random_range(ws.zu..=ws.max_depth()));
+        let p =
+            Vec3::new(rng.random_range(-r..=r), rng.random_range(-r..=r), -rng.random_range(ws.zu..=ws.max_depth()));
         if ws.contains(&p) {
             inside += 1;
             unreachable += d.inverse_kinematics(&p).is_err() as u32;

@@ -6,7 +6,9 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::ExactChecker;
 use delta_collide::cspace::Workspace;
 use delta_collide::math::Vec3;
-use delta_collide::table::{build_table, to_bytes, Labelling, SliceAxes, TableAnswer, TableChecker, TableError, Variant};
+use delta_collide::table::{
+    build_table, to_bytes, Labelling, SliceAxes, TableAnswer, TableChecker, TableError, Variant,
+};
 use rand::{RngExt, SeedableRng};
 
 fn random_tcp(rng: &mut rand::rngs::StdRng) -> Vec3 {
@@ -28,7 +30,8 @@ fn every_variant_has_no_false_negative_on_random_configurations() {
     let mut checkers: Vec<TableChecker> = variants
         .iter()
         .map(|&v| {
-            let (header, table, _) = build_table(&cell, 16, &Workspace::THESIS, v, Labelling::Certified, false).unwrap();
+            let (header, table, _) =
+                build_table(&cell, 16, &Workspace::THESIS, v, Labelling::Certified, false).unwrap();
             TableChecker::new(cell.clone(), &to_bytes(&table, &header)).unwrap()
         })
         .collect();
@@ -58,7 +61,8 @@ fn every_variant_has_no_false_negative_on_random_configurations() {
 #[test]
 fn a_table_refuses_another_cell() {
     let t1 = reference_cell("T1").unwrap();
-    let (header, table, report) = build_table(&t1, 16, &Workspace::THESIS, Variant::D6, Labelling::Certified, false).unwrap();
+    let (header, table, report) =
+        build_table(&t1, 16, &Workspace::THESIS, Variant::D6, Labelling::Certified, false).unwrap();
     assert!(report.symmetric, "T1 is mirror-symmetric (SPEC section 5)");
     let bytes = to_bytes(&table, &header);
     let err = TableChecker::new(reference_cell("T2").unwrap(), &bytes).unwrap_err();

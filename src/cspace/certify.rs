@@ -290,7 +290,7 @@ fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>)
         .collect();
     let inflation = (0..n)
         .map(|e| {
-            let mirror = grid.index_of(mirror_cell(grid, grid.cells[e / 8])).map(|m| 8 * m + (e % 8 ^ 2));
+            let mirror = grid.index_of(mirror_cell(grid, grid.cells[e / 8])).map(|m| 8 * m + ((e % 8) ^ 2));
             let b = match (raw[e], mirror.and_then(|m| raw[m])) {
                 (None, None) => return Inflation::Vacuous,
                 (Some(a), Some(b)) => mirror_max(model, &a, &b),

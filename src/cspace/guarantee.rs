@@ -312,13 +312,13 @@ mod tests {
     use crate::robot::ModelOptions;
     use rand::{rngs::StdRng, RngExt, SeedableRng};
 
-    /// The largest corner displacement of any box between the centre and `p`.
+    /// The largest corner displacement of any box between the reference `p0` and `p`.
     fn measured(model: &RobotModel, p0: &Vec3, p: &Vec3) -> Option<[Real; MAX_BOXES]> {
         let (b0, b1) = (model.boxes(p0).ok()?, model.boxes(p).ok()?);
         let mut out = [0.0; MAX_BOXES];
-        for j in 0..b0.len {
+        for (j, slot) in out.iter_mut().enumerate().take(b0.len) {
             let (v0, v1) = (b0.boxes[j].vertices(), b1.boxes[j].vertices());
-            out[j] = v0.iter().zip(&v1).map(|(a, b)| (a - b).norm()).fold(0.0, Real::max);
+            *slot = v0.iter().zip(&v1).map(|(a, b)| (a - b).norm()).fold(0.0, Real::max);
         }
         Some(out)
     }

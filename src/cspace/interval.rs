@@ -24,6 +24,9 @@ fn widen(lo: Real, hi: Real) -> Interval {
     Interval { lo: lo - slack(lo), hi: hi + slack(hi) }
 }
 
+// The operations are outward-rounded enclosures, not the exact arithmetic `std::ops` promises,
+// so they keep their own names.
+#[allow(clippy::should_implement_trait)]
 impl Interval {
     /// `[lo, hi]` (the ends are sorted).
     pub fn new(lo: Real, hi: Real) -> Interval {

@@ -128,10 +128,10 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
             (4, axes, q.threshold(), codes, slice_of.to_vec(), words.iter().flat_map(|w| w.to_le_bytes()).collect())
         }
         Table::Shared(q) => {
-            let (masks, bases, starts, children, leaves) = q.parts();
-            owned = masks.iter().flatten().chain(leaves).copied().collect();
-            let aux = starts.iter().chain(bases).copied().collect();
-            (7, 0, 0, &owned[..], aux, children.to_u32().iter().flat_map(|c| c.to_le_bytes()).collect())
+            let p = q.parts();
+            owned = p.masks.iter().flatten().chain(p.leaves).copied().collect();
+            let aux = p.depth_start.iter().chain(p.bases).copied().collect();
+            (7, 0, 0, &owned[..], aux, p.children.to_u32().iter().flat_map(|c| c.to_le_bytes()).collect())
         }
     };
     let n2 = match variant {

@@ -31,7 +31,7 @@ pub use lookup::{TableAnswer, TableChecker};
 pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
 pub use quadtree5d::LinearQuadtree5d;
 pub use quadtree6d::LinearQuadtree6d;
-pub use shared6d::SharedQuadtree6d;
+pub use shared6d::{SharedParts, SharedQuadtree6d};
 
 /// One of the three table variants of the thesis (3.2.4, 3.2.5, 3.2.6) or the shared 6-D
 /// quadtree (issue 4).
@@ -107,12 +107,12 @@ impl Table {
                 vec![region(codes), region(slice_of), region(slices)]
             }
             Table::Shared(t) => {
-                let (masks, bases, starts, children, leaves) = t.parts();
-                let children = match children {
+                let p = t.parts();
+                let children = match p.children {
                     shared6d::ChildIndices::Narrow(v) => region(v),
                     shared6d::ChildIndices::Wide(v) => region(v),
                 };
-                vec![region(masks), region(bases), region(starts), children, region(leaves)]
+                vec![region(p.masks), region(p.bases), region(p.depth_start), children, region(p.leaves)]
             }
         }
     }

@@ -88,6 +88,21 @@ impl ChildIndices {
     }
 }
 
+/// The arrays of a [`SharedQuadtree6d`] (see its fields).
+#[derive(Clone, Copy, Debug)]
+pub struct SharedParts<'a> {
+    /// Inner nodes, depth by depth: `[nonuniform, collision]`.
+    pub masks: &'a [[u64; 2]],
+    /// Per inner node: where its non-uniform children start in `children`.
+    pub bases: &'a [u32],
+    /// First node of each depth, then the node count.
+    pub depth_start: &'a [u32],
+    /// Child indices.
+    pub children: &'a ChildIndices,
+    /// Leaves.
+    pub leaves: &'a [u64],
+}
+
 /// The shared 6-D quadtree (see the module doc).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SharedQuadtree6d {
@@ -112,6 +127,9 @@ fn child_index(c: &[u16; 6], shift: u32) -> u32 {
     c.iter().fold(0, |i, &v| i << 1 | (u32::from(v) >> shift & 1))
 }
 
+/// An inner node while building: non-uniform mask, collision mask, child ids.
+type InnerNode = (u64, u64, Vec<u32>);
+
 /// A child while building: don't care, uniform, or a stored node of the next depth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Part {
@@ -132,8 +150,8 @@ struct Builder<'a> {
     occ_a: Vec<Vec<bool>>,
     occ_b: Vec<Vec<bool>>,
     /// Per inner depth: node -> id within the depth, and the nodes in id order.
-    inner: Vec<HashMap<(u64, u64, Vec<u32>), u32>>,
-    inner_nodes: Vec<Vec<(u64, u64, Vec<u32>)>>,
+    inner: Vec<HashMap<InnerNode, u32>>,
+    inner_nodes: Vec<Vec<InnerNode>>,
     leaf_ids: HashMap<u64, u32>,
     leaves: Vec<u64>,
 }
@@ -408,9 +426,15 @@ impl SharedQuadtree6d {
         self.symmetric
     }
 
-    /// The stored parts: masks, bases, depth starts, child indices, leaves.
-    pub fn parts(&self) -> (&[[u64; 2]], &[u32], &[u32], &ChildIndices, &[u64]) {
-        (&self.masks, &self.bases, &self.depth_start, &self.children, &self.leaves)
+    /// The stored arrays (as [`from_parts`](Self::from_parts) takes them).
+    pub fn parts(&self) -> SharedParts<'_> {
+        SharedParts {
+            masks: &self.masks,
+            bases: &self.bases,
+            depth_start: &self.depth_start,
+            children: &self.children,
+            leaves: &self.leaves,
+        }
     }
 
     /// Inner nodes per depth, then the leaf count.
@@ -469,11 +493,11 @@ mod tests {
             let again = SharedQuadtree6d::from_parts(
                 levels,
                 symmetric,
-                p.0.to_vec(),
-                p.1.to_vec(),
-                p.2.to_vec(),
-                p.3.to_u32(),
-                p.4.to_vec(),
+                p.masks.to_vec(),
+                p.bases.to_vec(),
+                p.depth_start.to_vec(),
+                p.children.to_u32(),
+                p.leaves.to_vec(),
             )
             .unwrap();
             assert_eq!(again, shared);
@@ -492,8 +516,9 @@ mod tests {
     fn malformed_parts_are_rejected() {
         let space = space(3, Pattern::Noise { p: 0.2, seed: 4 });
         let t = SharedQuadtree6d::build(&space, false).unwrap();
-        let (m, b, ds, c, l) = t.parts();
-        let (m, b, ds, c, l) = (m.to_vec(), b.to_vec(), ds.to_vec(), c.to_u32(), l.to_vec());
+        let p = t.parts();
+        let (m, b, ds, c, l) =
+            (p.masks.to_vec(), p.bases.to_vec(), p.depth_start.to_vec(), p.children.to_u32(), p.leaves.to_vec());
         let ok = |m: Vec<[u64; 2]>, b: Vec<u32>, ds: Vec<u32>, c: Vec<u32>, l: Vec<u64>| {
             SharedQuadtree6d::from_parts(3, false, m, b, ds, c, l).is_ok()
         };
