@@ -172,13 +172,23 @@ fn time_queries(table: &Table, cells: &[[u16; 6]], cold: usize) -> ((u64, u64, u
     (percentiles(&mut warm), percentiles(&mut flushed))
 }
 
+/// What a table holds, in the thesis's terms (Tables 3.3-3.5).
+fn contents(table: &Table) -> String {
+    match table {
+        Table::D6(q) => format!("{} codes", q.codes().len()),
+        Table::D5(q) => format!("{} codes", q.parts().0.len()),
+        Table::D4(q) => format!("{} codes / {} slices", q.parts().0.len(), q.slice_count()),
+        Table::Shared(q) => format!("{} nodes", q.nodes_per_depth().iter().sum::<usize>()),
+    }
+}
+
 fn main() {
     let opt = options();
     let ws = Workspace::THESIS;
     println!(
-        "| cell | k | table | bytes in memory | build s | warm median / p99.9 / max ns | flushed median / p99.9 / max ns (queries) | TP | TN | FP | FN |"
+        "| cell | k | table | location codes / slices / nodes | bytes in memory | build s | warm median / p99.9 / max ns | flushed median / p99.9 / max ns (queries) | TP | TN | FP | FN | accuracy |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for name in &opt.cells {
         let cell = reference_cell(name).expect("a reference cell");
         let symmetric = reflection_y(&cell);
@@ -251,7 +261,7 @@ fn main() {
             })
             .collect();
         let (m, p, x) = percentiles(&mut timer);
-        println!("| {name} | {} | timer (two clock reads) | | | {m} / {p} / {x} | | | | | |", opt.k);
+        println!("| {name} | {} | timer (two clock reads) | | | | {m} / {p} / {x} | | | | | | |", opt.k);
         let mut d6: Option<Table> = None;
         for (label, space, secs, build) in &variants {
             let start = Instant::now();
@@ -275,9 +285,11 @@ fn main() {
             } else {
                 format!("{} / {} / {} ({})", f.0, f.1, f.2, cold.min(cells.len()))
             };
+            let accuracy = 100.0 * (tp + tn) as f64 / (tp + tn + fp + fn_).max(1) as f64;
             println!(
-                "| {name} | {} | {label} | {} | {build_secs:.2} | {} / {} / {} | {flushed} | {tp} | {tn} | {fp} | {fn_} |",
+                "| {name} | {} | {label} | {} | {} | {build_secs:.2} | {} / {} / {} | {flushed} | {tp} | {tn} | {fp} | {fn_} | {accuracy:.2} % |",
                 opt.k,
+                contents(&table),
                 table.memory_bytes(),
                 w.0,
                 w.1,
