@@ -6,7 +6,7 @@
 //!
 //! Run: `cargo bench --bench table_report -- [--cells T1,T2,T3] [--k 32] [--random 1000000]
 //! [--cold 100000] [--cold-shared 1000000]`. Without `--bench` (as `cargo test` runs it) it
-//! does a small smoke run (T2, k = 8) that still checks FN = 0 and the shared table's
+//! does a small smoke run (T2, k = 16) that still checks FN = 0 and the shared table's
 //! agreement with the 6-D table.
 //!
 //! A query here is the table lookup alone (`Table::query` on a precomputed 6-D cell). Each is
@@ -40,7 +40,7 @@ fn options() -> Options {
     let value = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
     let num = |name: &str, default: usize| value(name).map_or(default, |v| v.parse().expect("a number"));
     if !args.iter().any(|a| a == "--bench") {
-        return Options { cells: vec!["T2".into()], k: 8, random: 2000, cold: 200, cold_shared: 200, smoke: true };
+        return Options { cells: vec!["T2".into()], k: 16, random: 2000, cold: 200, cold_shared: 200, smoke: true };
     }
     let cells = value("--cells").unwrap_or("T1,T2,T3".into()).split(',').map(str::to_string).collect();
     Options {
