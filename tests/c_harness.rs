@@ -3,8 +3,8 @@
 //! `include/delta_collide.h` and the static library, builds the table files of T1, T2 and T3
 //! (k = 32, 6-D, certified labels), runs the harness from the repository root in exact and
 //! table mode and checks its verdict line. The same harness runs clean under AddressSanitizer
-//! + UndefinedBehaviorSanitizer (+ LeakSanitizer where it can run) and, with `--quick`, under
-//! valgrind memcheck. Also compiles the header into two C++ translation units (wasmtime's
+//! with UndefinedBehaviorSanitizer (and LeakSanitizer where it can run) and, with `--quick`,
+//! under valgrind memcheck. Also compiles the header into two C++ translation units (wasmtime's
 //! double-include check) and records whether it is valid C89.
 //!
 //! The static library is the one cargo builds in the same run: the test executable is
