@@ -104,3 +104,29 @@ pub(crate) fn delta3_from_c(g: &DcDelta3) -> Result<Delta3, DcStatus> {
     d.validate().map_err(|_| DC_STATUS_INVALID_CONFIG)?;
     Ok(d)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::ffi::CStr;
+
+    #[test]
+    fn each_table_error_has_its_own_status_from_10_with_a_text() {
+        let errors = [
+            TableError::Truncated { what: "magic", needed: 8, have: 0 },
+            TableError::BadMagic { found: *b"XCTABLE\0" },
+            TableError::UnsupportedVersion { found: 2, supported: 1 },
+            TableError::WrongEndianness,
+            TableError::Corrupt { what: "checksum".into() },
+            TableError::WrongCell { expected: 1, found: 2 },
+            TableError::BadInput { what: "three robots".into() },
+        ];
+        let statuses: Vec<DcStatus> = errors.iter().map(table_error_status).collect();
+        assert_eq!(statuses, (10..=16).collect::<Vec<_>>(), "one status per variant, in order, from 10");
+        for s in statuses {
+            // SAFETY: dc_status_str returns a static NUL-terminated string.
+            let text = unsafe { CStr::from_ptr(crate::ffi::dc_status_str(s)) }.to_str().unwrap();
+            assert!(text.contains("table"), "status {s}: {text}");
+        }
+    }
+}
