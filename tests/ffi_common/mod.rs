@@ -66,6 +66,7 @@ pub fn last_init_error() -> String {
     String::from_utf8(buf[..n].to_vec()).unwrap()
 }
 
+/// A report with every field 0 (to be overwritten by `dc_query`).
 pub fn zero_report() -> DcQueryReport {
     DcQueryReport {
         verdict: 0,
@@ -78,6 +79,7 @@ pub fn zero_report() -> DcQueryReport {
     }
 }
 
+/// A `DcVec3` (mm).
 pub fn v(x: f64, y: f64, z: f64) -> DcVec3 {
     DcVec3 { x, y, z }
 }
@@ -103,7 +105,8 @@ pub fn query(h: *mut DcCollider, tcps: &[DcVec3]) -> (DcStatus, DcVerdict, DcQue
     (s, verdict, report)
 }
 
-/// T1 as a C config (thesis robots 450 mm apart) kept alive with its robots array.
+/// A C config of `n` thesis robots `dx` mm apart along x, owning its robots array (keep it
+/// alive while the `DcCellConfig` from [`Config::c`] is used).
 pub struct Config {
     pub robots: Vec<DcRobotConfig>,
 }
