@@ -235,7 +235,7 @@ pub unsafe extern "C" fn dc_init_from_files(
 /// Copies the message of the calling thread's last failed `dc_init*` into `buf`
 /// (NUL-terminated, cut to `capacity - 1` bytes) and returns the message's full length
 /// without the NUL: it names the field at fault and the fix, e.g. "table is truncated:
-/// section 0 (codes) needs 21151272 bytes, the buffer has 4096; copy the whole table file
+/// section 0 (codes) needs 3139976 bytes, the buffer has 4096; copy the whole table file
 /// again". Returns 0 (and writes "" when it can) after a successful init or before any.
 /// `buf` may be NULL or `capacity` 0 to ask for the length only. Not for the tick loop.
 ///
