@@ -8,77 +8,26 @@
  *     lies after tick 3000 and equals the first tick at which the exact model (a second
  *     handle with DC_METHOD_SAT, run alongside DC_METHOD_SAT_CACHE over the unstopped
  *     trajectory) collides.
- * On every tick the mock's own C kinematics is cross-checked against the library's. Then a
- * bad-input scenario checks every documented error status and the fail-closed outputs.
+ * On every tick the mock's own C kinematics is cross-checked against the library's. When a
+ * table file is given for the cell, each scenario runs once more with the POU in table mode
+ * (table_mode.c). Then the bad-input scenarios (bad_input.c) check every documented error
+ * status and the fail-closed outputs, in both modes.
  *
- * Usage: c_harness [TMP_DIR]   (run from the repository root; TMP_DIR for a scratch file)
+ * Usage (from the repository root):
+ *   c_harness [--quick] [--tmp DIR] [--table T1=PATH] [--table T2=PATH] [--table T3=PATH]
+ * --quick runs only the T1 collision scenario (for valgrind); see harness.h.
  * Prints one line per failed check, a summary per scenario, and finally `N passed, N failed`;
  * exits 0 only when nothing failed.
  */
-#include "delta_collide.h"
-#include "mock_robotics.h"
+#include "harness.h"
 #include "pou.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
-#define SCENARIO_FILE "c_harness/scenarios.txt"
 #define IK_TOLERANCE 1e-9      /* rad: C IK vs dc_delta3_inverse_kinematics */
 #define FK_TOLERANCE 1e-6      /* mm: C FK vs library FK, and FK(IK(p)) vs p */
-#define STOP_AFTER_TICK 3000L  /* the collision case collides only in the last part of the run */
-
-static int g_passed;
-static int g_failed;
-
-/* Counts one check; prints the message when it fails. */
-static void check(int ok, const char *fmt, ...)
-{
-    va_list args;
-    if (ok) {
-        g_passed++;
-        return;
-    }
-    g_failed++;
-    fputs("FAIL: ", stdout);
-    va_start(args, fmt);
-    vprintf(fmt, args);
-    va_end(args);
-    fputc('\n', stdout);
-}
-
-static DcVec3 vec3(double x, double y, double z)
-{
-    DcVec3 v;
-    v.x = x;
-    v.y = y;
-    v.z = z;
-    return v;
-}
-
-static DcDelta3 dc_geometry(const MrGeometry *g)
-{
-    DcDelta3 d;
-    d.f = g->f;
-    d.rf = g->rf;
-    d.re = g->re;
-    d.e = g->e;
-    d.theta_min = g->theta_min;
-    d.theta_max = g->theta_max;
-    return d;
-}
-
-static const char *cell_file(const char *cell)
-{
-    if (strcmp(cell, "T1") == 0) {
-        return "cells/t1.toml";
-    }
-    if (strcmp(cell, "T2") == 0) {
-        return "cells/t2.toml";
-    }
-    return "cells/t3.toml";
-}
 
 /* ------------------------------------------------------------ kinematics cross-check */
 
@@ -139,29 +88,6 @@ static void cross_check_kinematics(const MrRobot *robot, const double commanded[
 
 /* ------------------------------------------------------------ one trajectory scenario */
 
-typedef struct RunResult {
-    long stop_tick;        /* POU stop tick, -1 if never stopped */
-    long exact_first;      /* first tick the plain SAT handle collides, unstopped, -1 if never */
-} RunResult;
-
-/* "none" for -1, else the tick number. */
-static void tick_text(long tick, char out[24])
-{
-    if (tick < 0) {
-        strcpy(out, "none");
-    } else {
-        sprintf(out, "%ld", tick);
-    }
-}
-
-static void to_dc(const MrTickState *st, size_t n, DcVec3 out[MR_MAX_ROBOTS])
-{
-    size_t j;
-    for (j = 0; j < n; ++j) {
-        out[j] = vec3(st->tcp[j][0], st->tcp[j][1], st->tcp[j][2]);
-    }
-}
-
 static int run_scenario(const char *cell_name, const char *case_name, RunResult *result)
 {
     MrCell cell;
@@ -203,7 +129,8 @@ static int run_scenario(const char *cell_name, const char *case_name, RunResult 
     pou_cell_config(&cell, DC_METHOD_SAT_CACHE, robots_cache, &config_cache);
     pou_cell_config(&cell, DC_METHOD_SAT, robots_plain, &config_plain);
     s = pou_init(&pou, &config_cache);
-    check(s == DC_STATUS_OK && pou.handle != NULL, "%s: pou_init: %s", cell_name, dc_status_str(s));
+    check(s == DC_STATUS_OK && pou.handle != NULL && dc_mode(pou.handle) == DC_MODE_EXACT, "%s: pou_init: %s",
+          cell_name, dc_status_str(s));
     s = dc_init_from_cell_file(cell_file(cell_name), &from_file);
     check(s == DC_STATUS_OK && from_file != NULL, "%s: dc_init_from_cell_file(%s): %s", cell_name,
           cell_file(cell_name), dc_status_str(s));
@@ -399,288 +326,53 @@ static void kinematics_grid(void)
     printf("kinematics grid: %lu TCPs, %lu reachable, max |dtheta| %.2e rad\n", n, reach, max_d);
 }
 
-/* ------------------------------------------------------------ bad input */
-
-/* A query that must fail: checks status, that the pre-set FREE verdict became STOP, and the report. */
-static void expect_query(const char *what, DcCollider *h, const DcVec3 *tcps, size_t n, DcStatus expected,
-                         int expect_mask, uint32_t mask)
-{
-    DcVerdict v = DC_VERDICT_FREE;
-    DcQueryReport rep;
-    DcStatus s;
-    memset(&rep, 0, sizeof rep);
-    rep.verdict = DC_VERDICT_FREE;
-    s = dc_query(h, tcps, n, &v, &rep);
-    check(s == expected, "bad input, %s: status %u (%s), expected %u", what, (unsigned)s, dc_status_str(s),
-          (unsigned)expected);
-    check(v == DC_VERDICT_STOP, "bad input, %s: verdict %u, expected STOP", what, (unsigned)v);
-    check(rep.verdict == DC_VERDICT_STOP, "bad input, %s: report verdict %u, expected STOP", what,
-          (unsigned)rep.verdict);
-    if (expect_mask) {
-        check(rep.unreachable_mask == mask, "bad input, %s: unreachable_mask %u, expected %u", what,
-              (unsigned)rep.unreachable_mask, (unsigned)mask);
-    }
-    /* The same call without a report must give the same status and verdict. */
-    v = DC_VERDICT_FREE;
-    s = dc_query(h, tcps, n, &v, NULL);
-    check(s == expected && v == DC_VERDICT_STOP, "bad input, %s (no report): status %u verdict %u", what,
-          (unsigned)s, (unsigned)v);
-}
-
-static int dummy_object;
-
-/* dc_init must fail with `expected` and leave *out_handle NULL (pre-set to a dangling value). */
-static void expect_init(const char *what, const DcCellConfig *config, DcStatus expected)
-{
-    DcCollider *h = (DcCollider *)(void *)&dummy_object;
-    DcStatus s = dc_init(config, &h);
-    DcVerdict v = DC_VERDICT_FREE;
-    DcVec3 tcps[2];
-    check(s == expected, "bad input, dc_init %s: status %u (%s), expected %u", what, (unsigned)s, dc_status_str(s),
-          (unsigned)expected);
-    check(h == NULL, "bad input, dc_init %s: out_handle not NULL after a failed init", what);
-    if (h == NULL) {
-        tcps[0] = vec3(0.0, 0.0, -450.0);
-        tcps[1] = vec3(0.0, 0.0, -450.0);
-        s = dc_query(h, tcps, 2, &v, NULL);
-        check(s == DC_STATUS_NULL_POINTER && v == DC_VERDICT_STOP,
-              "bad input, query after failed dc_init %s: status %u verdict %u", what, (unsigned)s, (unsigned)v);
-    } else if (h != (DcCollider *)(void *)&dummy_object) {
-        dc_destroy(h);
-    }
-}
-
-static void expect_init_file(const char *what, const char *path, DcStatus expected)
-{
-    DcCollider *h = (DcCollider *)(void *)&dummy_object;
-    DcStatus s = dc_init_from_cell_file(path, &h);
-    check(s == expected, "bad input, dc_init_from_cell_file %s: status %u (%s), expected %u", what, (unsigned)s,
-          dc_status_str(s), (unsigned)expected);
-    check(h == NULL, "bad input, dc_init_from_cell_file %s: out_handle not NULL after a failed init", what);
-    if (h != NULL && h != (DcCollider *)(void *)&dummy_object) {
-        dc_destroy(h);
-    }
-}
-
-static int write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    if (f == NULL) {
-        return 0;
-    }
-    fputs(text, f);
-    return fclose(f) == 0;
-}
-
-static DcRobotConfig many_robots[33];
-
-static void bad_input(const char *tmp_dir)
-{
-    MrCell cell;
-    DcRobotConfig robots[MR_MAX_ROBOTS], bad[MR_MAX_ROBOTS];
-    DcCellConfig config, broken;
-    DcCollider *h = NULL;
-    DcVec3 tcps[3];
-    DcVerdict v;
-    DcQueryReport rep;
-    DcStatus s;
-    DcDelta3 g;
-    DcPairResult pairs[2];
-    double theta[3];
-    char path[512];
-    unsigned code;
-    size_t len;
-    const double qnan = NAN;
-    const double pinf = INFINITY;
-
-    mr_register_cell("T1", &cell);
-    pou_cell_config(&cell, DC_METHOD_SAT_CACHE, robots, &config);
-    s = dc_init(&config, &h);
-    check(s == DC_STATUS_OK && h != NULL, "bad input: dc_init T1: %s", dc_status_str(s));
-    if (h == NULL) {
-        return;
-    }
-    tcps[0] = vec3(0.0, 0.0, -450.0);
-    tcps[1] = vec3(0.0, 0.0, -450.0);
-    tcps[2] = vec3(0.0, 0.0, -450.0);
-
-    /* A good query first: OK and a decided verdict. */
-    v = DC_VERDICT_STOP;
-    s = dc_query(h, tcps, 2, &v, NULL);
-    check(s == DC_STATUS_OK && (v == DC_VERDICT_FREE || v == DC_VERDICT_COLLISION),
-          "bad input: the good query gave status %u verdict %u", (unsigned)s, (unsigned)v);
-
-    expect_query("NULL handle", NULL, tcps, 2, DC_STATUS_NULL_POINTER, 0, 0);
-    expect_query("NULL tcps", h, NULL, 2, DC_STATUS_NULL_POINTER, 0, 0);
-    rep.verdict = DC_VERDICT_FREE;
-    s = dc_query(h, tcps, 2, NULL, &rep);
-    check(s == DC_STATUS_NULL_POINTER && rep.verdict == DC_VERDICT_STOP,
-          "bad input, NULL out_verdict: status %u, report verdict %u", (unsigned)s, (unsigned)rep.verdict);
-
-    tcps[0] = vec3(qnan, 0.0, -450.0);
-    expect_query("NaN TCP of robot 0", h, tcps, 2, DC_STATUS_NON_FINITE, 1, 1u);
-    tcps[0] = vec3(0.0, 0.0, -450.0);
-    tcps[1] = vec3(0.0, pinf, -450.0);
-    expect_query("infinite TCP of robot 1", h, tcps, 2, DC_STATUS_NON_FINITE, 1, 2u);
-    tcps[1] = vec3(0.0, 0.0, -pinf);
-    expect_query("-infinite z of robot 1", h, tcps, 2, DC_STATUS_NON_FINITE, 1, 2u);
-    tcps[1] = vec3(0.0, 0.0, -900.0);
-    expect_query("unreachable z = -900 of robot 1", h, tcps, 2, DC_STATUS_UNREACHABLE, 1, 2u);
-    tcps[1] = vec3(0.0, 0.0, -450.0);
-    tcps[0] = vec3(0.0, 0.0, 100.0);
-    expect_query("unreachable z = +100 of robot 0", h, tcps, 2, DC_STATUS_UNREACHABLE, 1, 1u);
-    tcps[1] = vec3(0.0, 0.0, 100.0);
-    expect_query("both unreachable", h, tcps, 2, DC_STATUS_UNREACHABLE, 1, 3u);
-    tcps[0] = vec3(0.0, 0.0, -450.0);
-    tcps[1] = vec3(0.0, 0.0, -450.0);
-    expect_query("n_tcps = 1", h, tcps, 1, DC_STATUS_WRONG_ROBOT_COUNT, 0, 0);
-    expect_query("n_tcps = 3", h, tcps, 3, DC_STATUS_WRONG_ROBOT_COUNT, 0, 0);
-    expect_query("n_tcps = 0", h, tcps, 0, DC_STATUS_WRONG_ROBOT_COUNT, 0, 0);
-
-    /* After all that the handle still answers good queries. */
-    v = DC_VERDICT_STOP;
-    s = dc_query(h, tcps, 2, &v, NULL);
-    check(s == DC_STATUS_OK && v != DC_VERDICT_STOP, "bad input: handle unusable after errors (status %u)",
-          (unsigned)s);
-
-    /* dc_pair_results */
-    s = dc_pair_results(NULL, pairs, 2, &len);
-    check(s == DC_STATUS_NULL_POINTER, "bad input, dc_pair_results NULL handle: %u", (unsigned)s);
-    s = dc_pair_results(h, NULL, 2, &len);
-    check(s == DC_STATUS_NULL_POINTER, "bad input, dc_pair_results NULL out: %u", (unsigned)s);
-    s = dc_pair_results(h, pairs, 2, NULL);
-    check(s == DC_STATUS_NULL_POINTER, "bad input, dc_pair_results NULL out_len: %u", (unsigned)s);
-    len = 99;
-    s = dc_pair_results(h, pairs, 0, &len);
-    check(s == DC_STATUS_INVALID_ARGUMENT && len == 1,
-          "bad input, dc_pair_results capacity 0: status %u, out_len %lu (expected the count needed, 1)", (unsigned)s,
-          (unsigned long)len);
-    check(dc_robot_count(NULL) == 0 && dc_pair_count(NULL) == 0, "bad input: counts of a NULL handle are not 0");
-    dc_destroy(h);
-    h = NULL;
-
-    /* dc_init */
-    expect_init("NULL config", NULL, DC_STATUS_NULL_POINTER);
-    s = dc_init(&config, NULL);
-    check(s == DC_STATUS_NULL_POINTER, "bad input, dc_init NULL out_handle: %u", (unsigned)s);
-    broken = config;
-    broken.n_robots = 0;
-    expect_init("zero robots", &broken, DC_STATUS_INVALID_CONFIG);
-    broken = config;
-    broken.robots = NULL;
-    expect_init("NULL robots", &broken, DC_STATUS_NULL_POINTER);
-    memcpy(bad, robots, sizeof bad);
-    broken = config;
-    broken.robots = bad;
-    bad[1].geometry.rf = -150.0;
-    expect_init("negative rf", &broken, DC_STATUS_INVALID_CONFIG);
-    bad[1].geometry.rf = 150.0;
-    bad[0].half_depth = -17.5;
-    expect_init("negative half_depth", &broken, DC_STATUS_INVALID_CONFIG);
-    bad[0].half_depth = 17.5;
-    bad[0].margin = -1.0;
-    expect_init("negative margin", &broken, DC_STATUS_INVALID_CONFIG);
-    bad[0].margin = 0.0;
-    bad[1].geometry.theta_min = 1.0;
-    bad[1].geometry.theta_max = -1.0;
-    expect_init("empty motor range", &broken, DC_STATUS_INVALID_CONFIG);
-    bad[1].geometry.theta_min = robots[1].geometry.theta_min;
-    bad[1].geometry.theta_max = robots[1].geometry.theta_max;
-    {
-        /* NaN in a configuration: documented as INVALID_CONFIG. */
-        DcCollider *hn = (DcCollider *)(void *)&dummy_object;
-        bad[0].translation.x = qnan;
-        s = dc_init(&broken, &hn);
-        check(s == DC_STATUS_INVALID_CONFIG && hn == NULL,
-              "bad input, dc_init NaN translation: status %u, handle %s", (unsigned)s, hn == NULL ? "NULL" : "set");
-        bad[0].translation.x = 0.0;
-    }
-    broken = config;
-    broken.method = 7;
-    expect_init("unknown method", &broken, DC_STATUS_INVALID_CONFIG);
-    {
-        size_t i;
-        for (i = 0; i < 33; ++i) {
-            many_robots[i] = robots[0];
-            many_robots[i].translation.x = 450.0 * (double)i;
-        }
-        broken = config;
-        broken.robots = many_robots;
-        broken.n_robots = 33;
-        expect_init("33 robots", &broken, DC_STATUS_INVALID_CONFIG);
-    }
-
-    /* dc_init_from_cell_file */
-    expect_init_file("NULL path", NULL, DC_STATUS_NULL_POINTER);
-    s = dc_init_from_cell_file("cells/t1.toml", NULL);
-    check(s == DC_STATUS_NULL_POINTER, "bad input, dc_init_from_cell_file NULL out_handle: %u", (unsigned)s);
-    expect_init_file("missing path", "cells/no_such_cell_file.toml", DC_STATUS_IO);
-    sprintf(path, "%.400s/c_harness_malformed_cell.toml", tmp_dir);
-    check(write_file(path, "[[robot]\nname = \"A\"\nf = 100.0 = 3\n"), "cannot write %s", path);
-    expect_init_file("malformed TOML", path, DC_STATUS_PARSE);
-    check(write_file(path, "name = \"bad\"\n[[robot]]\nname = \"A\"\nplacement = { alpha_deg = 30.0, t = [1.0, 2.0] }\n"), "cannot write %s",
-          path);
-    expect_init_file("wrong schema", path, DC_STATUS_PARSE);
-    check(write_file(path, "[[robot]]\nname = \"A\"\ngeometry = { f = -100.0, rf = 150.0, re = 400.0, e = 40.0, "
-                           "theta_min_deg = -90.0, theta_max_deg = 120.0 }\n"),
-          "cannot write %s", path);
-    expect_init_file("negative f in the file", path, DC_STATUS_INVALID_CONFIG);
-    remove(path);
-    expect_init_file("path not UTF-8", "cells/\xff\xfe.toml", DC_STATUS_INVALID_ARGUMENT);
-
-    /* Teardown and strings. */
-    dc_destroy(NULL); /* a no-op: reaching the next line is the test */
-    for (code = 0; code <= 9; ++code) {
-        const char *text = dc_status_str(code);
-        check(text != NULL && text[0] != '\0', "dc_status_str(%u) is empty", code);
-    }
-    {
-        const char *unknown = dc_status_str(12345u);
-        check(unknown != NULL && unknown[0] != '\0' && strcmp(unknown, dc_status_str(DC_STATUS_OK)) != 0,
-              "dc_status_str(12345) does not say unknown");
-    }
-    check(dc_version() != NULL && dc_version()[0] != '\0', "dc_version is empty");
-
-    /* Kinematics entry points. */
-    g = dc_geometry(&cell.robots[0].geometry);
-    s = dc_delta3_inverse_kinematics(NULL, vec3(0.0, 0.0, -450.0), theta);
-    check(s == DC_STATUS_NULL_POINTER, "bad input, IK NULL geometry: %u", (unsigned)s);
-    s = dc_delta3_inverse_kinematics(&g, vec3(0.0, 0.0, -450.0), NULL);
-    check(s == DC_STATUS_NULL_POINTER, "bad input, IK NULL out_theta: %u", (unsigned)s);
-    s = dc_delta3_inverse_kinematics(&g, vec3(qnan, 0.0, -450.0), theta);
-    check(s == DC_STATUS_NON_FINITE, "bad input, IK NaN: %u", (unsigned)s);
-    s = dc_delta3_inverse_kinematics(&g, vec3(0.0, 0.0, -900.0), theta);
-    check(s == DC_STATUS_UNREACHABLE, "bad input, IK z = -900: %u", (unsigned)s);
-    s = dc_delta3_forward_kinematics(&g, NULL, &tcps[0]);
-    check(s == DC_STATUS_NULL_POINTER, "bad input, FK NULL theta: %u", (unsigned)s);
-    g.rf = -150.0;
-    s = dc_delta3_inverse_kinematics(&g, vec3(0.0, 0.0, -450.0), theta);
-    check(s == DC_STATUS_INVALID_CONFIG, "bad input, IK negative rf: %u", (unsigned)s);
-    g.rf = 150.0;
-    theta[0] = theta[1] = theta[2] = 0.3;
-    s = dc_delta3_forward_kinematics(&g, theta, NULL);
-    check(s == DC_STATUS_NULL_POINTER, "bad input, FK NULL out_tcp: %u", (unsigned)s);
-    theta[1] = qnan;
-    s = dc_delta3_forward_kinematics(&g, theta, &tcps[0]);
-    check(s == DC_STATUS_NON_FINITE, "bad input, FK NaN angle: %u", (unsigned)s);
-    printf("bad input: done\n");
-}
-
 int main(int argc, char **argv)
 {
     static const char *cells[] = { "T1", "T2", "T3" };
     static const char *cases[] = { "practical", "collision" };
-    const char *tmp_dir = argc > 1 ? argv[1] : ".";
+    HarnessOptions options;
+    RunResult exact[3][2], table[3][2];
+    int ran_table[3][2] = { { 0 } };
     size_t c, k;
-    printf("delta-collide C harness, library %s\n", dc_version());
+
+    if (!parse_options(argc, argv, &options) || !load_tables(&options)) {
+        free_tables(&options);
+        printf("0 passed, 1 failed\n");
+        return 2;
+    }
+    printf("delta-collide C harness, library %s%s\n", dc_version(),
+           options.quick ? " (--quick: T1 collision only)" : "");
     kinematics_grid();
     for (c = 0; c < 3; ++c) {
         for (k = 0; k < 2; ++k) {
-            RunResult result;
-            run_scenario(cells[c], cases[k], &result);
+            exact[c][k].stop_tick = exact[c][k].exact_first = -1;
+            if (options.quick && (c != 0 || k != 1)) {
+                continue;
+            }
+            run_scenario(cells[c], cases[k], &exact[c][k]);
+            if (options.tables[c].path != NULL) {
+                ran_table[c][k] = run_table_scenario(cells[c], cases[k], &options.tables[c], &table[c][k]);
+                check(table[c][k].exact_first == exact[c][k].exact_first,
+                      "%s %s: the exact first collision tick differs between the exact (%ld) and table (%ld) runs",
+                      cells[c], cases[k], exact[c][k].exact_first, table[c][k].exact_first);
+            }
         }
     }
-    bad_input(tmp_dir);
-    printf("%d passed, %d failed\n", g_passed, g_failed);
-    return g_failed == 0 ? 0 : 1;
+    bad_input(&options);
+    for (c = 0; c < 3; ++c) {
+        for (k = 0; k < 2; ++k) {
+            char t[24], e[24], x[24];
+            if (!ran_table[c][k]) {
+                continue;
+            }
+            tick_text(table[c][k].stop_tick, t);
+            tick_text(exact[c][k].stop_tick, x);
+            tick_text(exact[c][k].exact_first, e);
+            printf("summary %s %-9s: stop tick table %s, exact POU %s, first exact collision %s\n", cells[c], cases[k],
+                   t, x, e);
+        }
+    }
+    free_tables(&options);
+    printf("%d passed, %d failed\n", harness_passed(), harness_failed());
+    return harness_failed() == 0 ? 0 : 1;
 }

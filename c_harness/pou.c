@@ -62,6 +62,22 @@ DcStatus pou_init_from_file(Pou *pou, const char *path)
     return pou->last_status;
 }
 
+DcStatus pou_init_with_table(Pou *pou, const DcCellConfig *config, const uint8_t *table, size_t table_len)
+{
+    pou_reset(pou);
+    pou->last_status = dc_init_with_table(config, table, table_len, &pou->handle);
+    pou->n_robots = dc_robot_count(pou->handle);
+    return pou->last_status;
+}
+
+DcStatus pou_init_from_files(Pou *pou, const char *cell_path, const char *table_path)
+{
+    pou_reset(pou);
+    pou->last_status = dc_init_from_files(cell_path, table_path, &pou->handle);
+    pou->n_robots = dc_robot_count(pou->handle);
+    return pou->last_status;
+}
+
 DcVerdict pou_query(Pou *pou, long tick, const DcVec3 *tcps_mcs, size_t n_tcps)
 {
     DcVerdict verdict = DC_VERDICT_STOP;

@@ -3,9 +3,10 @@
  *
  * On the NJ-controller the collision project lives in a POU: it is initialised at system
  * start-up, queried once per 1 ms tick with the TCPs the robotics API delivers, and destroyed
- * at termination. This POU does the same: pou_init (dc_init or dc_init_from_cell_file),
- * pou_query (dc_query; anything but FREE requests a stop of all robots) and pou_destroy
- * (dc_destroy). It allocates nothing per tick.
+ * at termination. This POU does the same: pou_init* (exact mode: dc_init or
+ * dc_init_from_cell_file; table mode: dc_init_with_table or dc_init_from_files), pou_query
+ * (dc_query, the same in both modes; anything but FREE requests a stop of all robots) and
+ * pou_destroy (dc_destroy). It allocates nothing per tick.
  */
 #ifndef POU_H
 #define POU_H
@@ -37,6 +38,14 @@ DcStatus pou_init(Pou *pou, const DcCellConfig *config);
 
 /* Start-up from a TOML cell file; returns the dc_init_from_cell_file status. */
 DcStatus pou_init_from_file(Pou *pou, const char *path);
+
+/* Start-up in table mode from a table file's bytes (copied by the library: the caller may
+ * free them afterwards); returns the dc_init_with_table status. */
+DcStatus pou_init_with_table(Pou *pou, const DcCellConfig *config, const uint8_t *table, size_t table_len);
+
+/* Start-up in table mode from a TOML cell file and a table file; returns the
+ * dc_init_from_files status. */
+DcStatus pou_init_from_files(Pou *pou, const char *cell_path, const char *table_path);
 
 /* One tick: queries the TCPs (each in its robot's MCS) and returns the verdict. The first
  * verdict that is not FREE latches stop_requested and stop_tick. */

@@ -29,7 +29,7 @@
 #define DC_BOX_NONE UINT32_MAX
 
 /*
- An initialised collision checker for one cell (opaque to C).
+ An initialised collision checker for one cell, in exact or table mode (opaque to C).
  */
 typedef struct DcCollider DcCollider;
 
@@ -242,6 +242,11 @@ typedef struct DcPairResult {
 } DcPairResult;
 
 /*
+ How a handle answers (`dc_mode`).
+ */
+typedef uint32_t DcMode;
+
+/*
  The call succeeded.
  */
 #define DC_STATUS_OK 0
@@ -292,6 +297,45 @@ typedef struct DcPairResult {
 #define DC_STATUS_INVALID_ARGUMENT 9
 
 /*
+ Table mode: the table buffer or file ends before its header, a section or the checksum is
+ complete. Copy the whole table file again.
+ */
+#define DC_STATUS_TABLE_TRUNCATED 10
+
+/*
+ Table mode: the buffer does not start with the table magic `DCTABLE\0`: not a table.
+ */
+#define DC_STATUS_TABLE_BAD_MAGIC 11
+
+/*
+ Table mode: the table's format version is not the one this library reads; rebuild it
+ with `delta-collide build`.
+ */
+#define DC_STATUS_TABLE_UNSUPPORTED_VERSION 12
+
+/*
+ Table mode: the table was written big-endian; this library reads little-endian tables.
+ */
+#define DC_STATUS_TABLE_WRONG_ENDIANNESS 13
+
+/*
+ Table mode: the checksum does not match or a field breaks an invariant (a flipped bit, a
+ bad copy); rebuild the table or copy it again.
+ */
+#define DC_STATUS_TABLE_CORRUPT 14
+
+/*
+ Table mode: the table was built for another cell than the configured one (geometry, boxes,
+ margins or placements differ); rebuild it with `delta-collide build --cell ...`.
+ */
+#define DC_STATUS_TABLE_WRONG_CELL 15
+
+/*
+ Table mode: tables serve two-robot cells only; use `dc_init` (exact mode) for this cell.
+ */
+#define DC_STATUS_TABLE_NOT_TWO_ROBOTS 16
+
+/*
  Could not decide (any error): stop the robots.
  */
 #define DC_VERDICT_STOP 0
@@ -306,6 +350,22 @@ typedef struct DcPairResult {
  */
 #define DC_VERDICT_COLLISION 2
 
+/*
+ No handle (`dc_mode(NULL)`).
+ */
+#define DC_MODE_NONE 0
+
+/*
+ Exact mode (`dc_init`, `dc_init_from_cell_file`): every box pair, separating axis test.
+ */
+#define DC_MODE_EXACT 1
+
+/*
+ Table mode (`dc_init_with_table`, `dc_init_from_files`): one lookup in a precomputed
+ table of a two-robot cell, which never answers FREE where the robots collide.
+ */
+#define DC_MODE_TABLE 2
+
 #ifdef __cplusplus
 extern "C" {
 #endif /* __cplusplus */
@@ -317,13 +377,15 @@ extern "C" {
 struct DcRobotConfig dc_robot_config_thesis(void);
 
 /*
- Creates a checker for the cell described by `config` (POU start-up).
+ Creates an exact-mode checker for the cell described by `config` (POU start-up): every
+ query tests every box pair that can meet (`dc_mode` gives `DC_MODE_EXACT`).
 
  On success `*out_handle` holds a handle to pass to `dc_query` and finally to
  `dc_destroy`; on any failure `*out_handle` is set to NULL (when `out_handle` is not
- NULL). Statuses: `DC_STATUS_NULL_POINTER` (config, its robots array or out_handle is
- NULL), `DC_STATUS_INVALID_CONFIG` (no robots or more than 32, a length <= 0, a negative
- margin or box extent, motor limits not a proper range, NaN/inf, unknown method).
+ NULL) and `dc_last_init_error` tells why. Statuses: `DC_STATUS_NULL_POINTER` (config, its
+ robots array or out_handle is NULL), `DC_STATUS_INVALID_CONFIG` (no robots or more than
+ 32, a length <= 0, a negative margin or box extent, motor limits not a proper range,
+ NaN/inf, unknown method).
 
  # Safety
  `config` must be NULL or point to a valid `DcCellConfig` whose `robots` points to
@@ -332,8 +394,8 @@ struct DcRobotConfig dc_robot_config_thesis(void);
 DcStatus dc_init(const struct DcCellConfig *config, struct DcCollider **out_handle);
 
 /*
- Creates a checker from a TOML cell file (see `cells/t1.toml`); the file is read once,
- here, never during a tick.
+ Creates an exact-mode checker from a TOML cell file (see `cells/t1.toml`); the file is
+ read once, here, never during a tick.
 
  `*out_handle` as for `dc_init`. Statuses: `DC_STATUS_NULL_POINTER`,
  `DC_STATUS_INVALID_ARGUMENT` (path not UTF-8), `DC_STATUS_IO` (cannot read),
@@ -345,7 +407,55 @@ DcStatus dc_init(const struct DcCellConfig *config, struct DcCollider **out_hand
 DcStatus dc_init_from_cell_file(const char *path, struct DcCollider **out_handle);
 
 /*
+ Creates a table-mode checker (POU start-up) for the two-robot cell `config` from the bytes
+ of a table file built offline for that cell (`delta-collide build --cell ...`): each
+ query is then one table lookup (`dc_mode` gives `DC_MODE_TABLE`). The table never answers
+ FREE where the exact model collides; it may answer COLLISION where the exact model is
+ free (the price of a 1 ms-safe lookup).
+
+ The buffer is validated once, here (magic, endianness, version, lengths, checksum, every
+ index, and that it was built for this cell), and copied: the caller may free it as soon
+ as this returns. `*out_handle` as for `dc_init`; `dc_last_init_error` names the field at
+ fault. Statuses: those of `dc_init`, and `DC_STATUS_NULL_POINTER` (table is NULL),
+ `DC_STATUS_TABLE_NOT_TWO_ROBOTS`, `DC_STATUS_TABLE_TRUNCATED` (also for table_len 0),
+ `DC_STATUS_TABLE_BAD_MAGIC`, `DC_STATUS_TABLE_UNSUPPORTED_VERSION`,
+ `DC_STATUS_TABLE_WRONG_ENDIANNESS`, `DC_STATUS_TABLE_CORRUPT`, `DC_STATUS_TABLE_WRONG_CELL`.
+
+ # Safety
+ `config` as for `dc_init`; `table` must be NULL or point to `table_len` readable bytes;
+ `out_handle` must be NULL or writable.
+ */
+DcStatus dc_init_with_table(const struct DcCellConfig *config, const uint8_t *table, size_t table_len, struct DcCollider **out_handle);
+
+/*
+ Creates a table-mode checker from a TOML cell file and a table file, both read once,
+ here: `dc_init_from_cell_file` followed by `dc_init_with_table` on the file's bytes.
+
+ `*out_handle` as for `dc_init`. Statuses: those of `dc_init_from_cell_file` (for either
+ path; `DC_STATUS_IO` when a file cannot be read) and those of `dc_init_with_table`.
+
+ # Safety
+ `cell_path` and `table_path` must be NULL or NUL-terminated strings; `out_handle` must be
+ NULL or writable.
+ */
+DcStatus dc_init_from_files(const char *cell_path, const char *table_path, struct DcCollider **out_handle);
+
+/*
+ Copies the message of the calling thread's last failed `dc_init*` into `buf`
+ (NUL-terminated, cut to `capacity - 1` bytes) and returns the message's full length
+ without the NUL: it names the field at fault and the fix, e.g. "table is truncated:
+ section 0 (codes) needs 3139976 bytes, the buffer has 4096; copy the whole table file
+ again". Returns 0 (and writes "" when it can) after a successful init or before any.
+ `buf` may be NULL or `capacity` 0 to ask for the length only. Not for the tick loop.
+
+ # Safety
+ `buf` must be NULL or hold `capacity` writable bytes.
+ */
+size_t dc_last_init_error(char *buf, size_t capacity);
+
+/*
  The per-tick query: do the robots collide with robot j's TCP at `tcps_mcs[j]` (its MCS)?
+ Works the same in exact and table mode.
 
  Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
  `DC_VERDICT_FREE` or `DC_VERDICT_COLLISION` with `DC_STATUS_OK`, else `DC_VERDICT_STOP`.
@@ -353,7 +463,8 @@ DcStatus dc_init_from_cell_file(const char *path, struct DcCollider **out_handle
  `DC_STATUS_WRONG_ROBOT_COUNT`, `DC_STATUS_NON_FINITE` (a NaN/inf coordinate; the
  report's `unreachable_mask` names the robot), `DC_STATUS_UNREACHABLE` (a TCP outside
  the robot's reach or motor limits; mask as before), `DC_STATUS_PANIC` (destroy the
- handle). Never allocates, locks or does I/O.
+ handle). In table mode a COLLISION report names robots 0 and 1 and no boxes
+ (`DC_BOX_NONE`). Never allocates, locks or does I/O.
 
  # Safety
  `handle` must be NULL or a live handle from `dc_init*` not used by another thread;
@@ -364,15 +475,36 @@ DcStatus dc_query(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size
 
 /*
  Copies the per-pair results of the last query into `out[0..]` and their number into
- `*out_len`. Only pairs whose reach can overlap are listed (`dc_pair_count`).
- Statuses: `DC_STATUS_NULL_POINTER`, `DC_STATUS_INVALID_ARGUMENT` (`capacity` smaller
- than `dc_pair_count`; `*out_len` then holds the count needed).
+ `*out_len`. Exact mode: the pairs whose reach can overlap (`dc_pair_count`), with the
+ colliding boxes. Table mode: one pair (robots 0 and 1), `collides` as the last verdict,
+ boxes `DC_BOX_NONE`. After a query that did not return `DC_STATUS_OK` the results are
+ not a decision (table mode: `collides` 0). Statuses: `DC_STATUS_NULL_POINTER`,
+ `DC_STATUS_INVALID_ARGUMENT` (`capacity` smaller than `dc_pair_count`; `*out_len` then
+ holds the count needed).
 
  # Safety
  `handle` must be NULL or live; `out` must be NULL or hold `capacity` writable elements;
  `out_len` must be NULL or writable.
  */
 DcStatus dc_pair_results(const struct DcCollider *handle, struct DcPairResult *out, size_t capacity, size_t *out_len);
+
+/*
+ How the handle answers: `DC_MODE_EXACT` or `DC_MODE_TABLE`; `DC_MODE_NONE` for NULL.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+DcMode dc_mode(const struct DcCollider *handle);
+
+/*
+ Table mode: how many queries so far were answered by the exact model because a TCP lay
+ reachable but outside the table's sampled grid (the answer is then exact, never a
+ guess). 0 in exact mode and for NULL.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+uint64_t dc_table_fallbacks(const struct DcCollider *handle);
 
 /*
  Number of robots of the handle's cell; 0 for NULL.
@@ -383,7 +515,8 @@ DcStatus dc_pair_results(const struct DcCollider *handle, struct DcPairResult *o
 size_t dc_robot_count(const struct DcCollider *handle);
 
 /*
- Number of robot pairs that can meet (kept after pruning at init); 0 for NULL.
+ Number of robot pairs `dc_pair_results` reports: exact mode, the pairs that can meet
+ (kept after pruning at init); table mode, 1; 0 for NULL.
 
  # Safety
  `handle` must be NULL or live.

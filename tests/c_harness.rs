@@ -1,20 +1,37 @@
-//! The C harness (thesis appendix A.1, SPEC §5): builds `c_harness/*.c` with the system C
-//! compiler against the generated header `include/delta_collide.h` and the static library,
-//! runs it from the repository root and checks its verdict line. Also compiles the header
-//! into two C++ translation units (wasmtime's double-include check) and records whether it
-//! is valid C89.
+//! The C harness (thesis appendix A.1, SPEC §5; issue 3 item 6, issue 5 item 3): builds
+//! `c_harness/*.c` with the system C compiler against the generated header
+//! `include/delta_collide.h` and the static library, builds the table files of T1, T2 and T3
+//! (k = 32, 6-D, certified labels), runs the harness from the repository root in exact and
+//! table mode and checks its verdict line. The same harness runs clean under AddressSanitizer
+//! with UndefinedBehaviorSanitizer (and LeakSanitizer where it can run) and, with `--quick`,
+//! under valgrind memcheck. Also compiles the header into two C++ translation units (wasmtime's
+//! double-include check) and records whether it is valid C89.
 //!
 //! The static library is the one cargo builds in the same run: the test executable is
 //! `target/<profile>/deps/c_harness-HASH` and the library lies next to it in `deps/`.
 
-use std::path::PathBuf;
+use delta_collide::cell::reference::reference_cell;
+use delta_collide::cspace::Workspace;
+use delta_collide::table::{build_table, to_bytes, Labelling, Variant};
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::OnceLock;
 
 /// Native libraries the static library needs on Linux (`--print native-static-libs`).
 const NATIVE_LIBS: &[&str] = &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"];
 
 /// Strict C flags of the house style (rustls-ffi's CI).
 const C_FLAGS: &[&str] = &["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2"];
+
+/// Sanitizer flags (gcc): every report aborts the run.
+const SANITIZE_FLAGS: &[&str] =
+    &["-g", "-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all"];
+
+/// Resolution of the tables the harness runs on (SPEC §4: k = 32 gives r = 16.5625 mm).
+const TABLE_K: u32 = 32;
+
+/// The reference cells, in the order of the harness's `--table` arguments.
+const CELLS: [&str; 3] = ["T1", "T2", "T3"];
 
 fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -59,40 +76,242 @@ fn verdict_line(stdout: &str) -> Option<(u64, u64)> {
     })
 }
 
-#[test]
-fn c_harness_builds_with_strict_flags_and_passes() {
-    let root = repo_root();
-    let dir = scratch_dir("c_harness");
-    let exe = dir.join("c_harness");
-    let mut sources: Vec<PathBuf> = std::fs::read_dir(root.join("c_harness"))
+/// The C sources of the harness, sorted.
+fn harness_sources() -> Vec<PathBuf> {
+    let mut sources: Vec<PathBuf> = std::fs::read_dir(repo_root().join("c_harness"))
         .expect("c_harness/ exists")
         .map(|e| e.expect("dir entry").path())
         .filter(|p| p.extension().is_some_and(|x| x == "c"))
         .collect();
     sources.sort();
-    assert_eq!(sources.len(), 3, "expected main.c, mock_robotics.c, pou.c; found {sources:?}");
+    let names: Vec<_> = sources.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    let expected = ["bad_input.c", "harness.c", "main.c", "mock_robotics.c", "pou.c", "table_mode.c"];
+    assert_eq!(names, expected, "c_harness/ sources changed: update this list and the README");
+    sources
+}
 
+/// Compiles the harness with the strict flags plus `extra` into `dir/name`.
+fn compile_harness(name: &str, extra: &[&str]) -> PathBuf {
+    let root = repo_root();
+    let exe = scratch_dir("c_harness").join(name);
     let out = run(Command::new("cc")
         .args(C_FLAGS)
+        .args(extra)
         .arg("-I")
         .arg(root.join("include"))
         .arg("-I")
         .arg(root.join("c_harness"))
-        .args(&sources)
+        .args(harness_sources())
         .arg(static_lib())
         .args(NATIVE_LIBS)
         .arg("-o")
         .arg(&exe));
-    assert!(out.status.success(), "cc failed:\n{}{}", text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "cc {extra:?} failed:\n{}{}", text(&out.stdout), text(&out.stderr));
+    exe
+}
 
-    let out = run(Command::new(&exe).arg(&dir).current_dir(&root));
+/// The plain harness binary, compiled once per test process.
+fn plain_harness() -> &'static Path {
+    static EXE: OnceLock<PathBuf> = OnceLock::new();
+    EXE.get_or_init(|| compile_harness("c_harness", &[]))
+}
+
+/// The table file of `CELLS[c]` (the same pipeline as `delta-collide build --cell T1 --k 32
+/// --variant 6d`). Building T1, T2, T3 takes about 3 s, 10 s and 3 s in release on two idle
+/// cores, so the file is kept in `CARGO_TARGET_TMPDIR` and reused while this test executable
+/// (which holds the table builder) is unchanged: a rebuilt executable rebuilds the tables.
+/// Each cell has its own lock, so a test that needs T1's table only does not wait for others.
+fn table_file(c: usize) -> &'static Path {
+    static FILES: [OnceLock<PathBuf>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    FILES[c].get_or_init(|| {
+        let name = CELLS[c];
+        let path = scratch_dir("c_harness_tables").join(format!("{name}_k{TABLE_K}_6d.dct"));
+        let stamp = path.with_extension("dct.builder");
+        let exe = std::fs::metadata(std::env::current_exe().expect("test executable")).expect("stat test executable");
+        let modified = exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+        let builder = format!("{} bytes, modified {:?}, k = {TABLE_K}", exe.len(), modified.unwrap_or_default());
+        if path.is_file() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder) {
+            println!("{name}: table reused from {} (same test executable)", path.display());
+            return path;
+        }
+        let cell = reference_cell(name).expect("reference cell");
+        let start = std::time::Instant::now();
+        let (header, table, _) =
+            build_table(&cell, TABLE_K, &Workspace::THESIS, Variant::D6, Labelling::Certified, false)
+                .unwrap_or_else(|e| panic!("building the {name} table: {e}"));
+        let bytes = to_bytes(&table, &header);
+        let _ = std::fs::remove_file(&stamp);
+        std::fs::write(&path, &bytes).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+        std::fs::write(&stamp, builder).unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
+        println!("{name}: table k = {TABLE_K}, {} bytes, built in {:.1} s", bytes.len(), start.elapsed().as_secs_f64());
+        path
+    })
+}
+
+/// `--table T1=... --table T2=... --table T3=...` for the given cells.
+fn table_args(cells: &[usize]) -> Vec<String> {
+    cells.iter().flat_map(|&c| ["--table".to_string(), format!("{}={}", CELLS[c], table_file(c).display())]).collect()
+}
+
+/// Checks the harness's verdict line and exit status; returns its stdout.
+fn assert_harness_passed(what: &str, out: &Output) -> String {
     let stdout = text(&out.stdout);
-    println!("{stdout}");
+    println!("{what}:\n{stdout}");
     eprintln!("{}", text(&out.stderr));
-    let (passed, failed) = verdict_line(&stdout).expect("harness prints `N passed, N failed` last");
-    assert!(passed > 0, "the harness ran no checks");
-    assert_eq!(failed, 0, "the harness reported failures (see above)");
-    assert!(out.status.success(), "harness exit status {:?} with 0 failures", out.status);
+    let (passed, failed) = verdict_line(&stdout).unwrap_or_else(|| panic!("{what}: no `N passed, N failed` line"));
+    assert!(passed > 0, "{what}: the harness ran no checks");
+    assert_eq!(failed, 0, "{what}: the harness reported failures (see above)");
+    assert!(out.status.success(), "{what}: exit status {:?} with 0 failures", out.status);
+    stdout
+}
+
+/// The harness's `summary` lines: (cell, case, table stop tick, first exact collision tick).
+fn summaries(stdout: &str) -> Vec<(String, String, Option<u64>, Option<u64>)> {
+    let tick = |s: &str| s.trim_end_matches(',').parse().ok();
+    stdout
+        .lines()
+        .filter_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            // summary T1 collision: stop tick table 3691, exact POU 3711, first exact collision 3711
+            (w.len() == 14 && w[0] == "summary")
+                .then(|| (w[1].to_string(), w[2].trim_end_matches(':').to_string(), tick(w[6]), tick(w[13])))
+        })
+        .collect()
+}
+
+#[test]
+fn c_harness_passes_in_exact_and_table_mode() {
+    let exe = plain_harness();
+    let tmp = scratch_dir("c_harness");
+    let out = run(Command::new(exe).arg("--tmp").arg(&tmp).args(table_args(&[0, 1, 2])).current_dir(repo_root()));
+    let stdout = assert_harness_passed("c_harness (exact and table mode, T1 T2 T3)", &out);
+    assert!(stdout.contains("bad input: done (exact and table mode)"), "table-mode bad inputs did not run");
+    let runs = summaries(&stdout);
+    assert_eq!(runs.len(), 6, "one table-mode summary per cell and case: {runs:?}");
+    for (cell, case, table_stop, exact_first) in &runs {
+        if case == "collision" {
+            let (t, e) = (table_stop.expect("the table stops"), exact_first.expect("the exact model collides"));
+            assert!(t <= e, "{cell}: table stop tick {t} after the exact first collision tick {e}");
+            assert!(t > 3000, "{cell}: table stop tick {t} in the collision-free first half of the run");
+        } else {
+            assert_eq!(*exact_first, None, "{cell} practical: the exact model collides");
+        }
+    }
+}
+
+/// Whether LeakSanitizer can run here: it needs ptrace-like access that some containers deny.
+/// Ok(()) when a leaking probe is reported; Err(why) when LSan reports it cannot run.
+fn leak_sanitizer_works(dir: &Path) -> Result<(), String> {
+    let out = run(Command::new(dir.join("probe")).arg("leak").env("ASAN_OPTIONS", "detect_leaks=1"));
+    let stderr = text(&out.stderr);
+    if stderr.contains("detected memory leaks") {
+        assert!(!out.status.success(), "LSan found the probe's leak but the run succeeded");
+        return Ok(());
+    }
+    assert!(
+        stderr.contains("LeakSanitizer"),
+        "LSan neither found the probe's leak nor said why it cannot run:\n{stderr}"
+    );
+    Err(stderr.lines().find(|l| l.contains("LeakSanitizer")).unwrap_or("").to_string())
+}
+
+/// A probe that leaks, overflows a heap buffer or overflows a signed int (argv[1]).
+const PROBE_C: &str = r#"#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
+int main(int argc, char **argv) {
+    char *volatile p = malloc(32);
+    int big = INT_MAX;
+    if (argc < 2) return 2;
+    if (strcmp(argv[1], "overflow") == 0) p[32 + argc] = 1;
+    if (strcmp(argv[1], "signed") == 0) big += argc;
+    if (strcmp(argv[1], "leak") == 0) { p = NULL; return 0; }
+    free(p);
+    return big == INT_MAX ? 0 : 3;
+}
+"#;
+
+/// Compiles the probe with `flags` into `dir/probe`.
+fn compile_probe(dir: &Path, flags: &[&str]) {
+    let src = dir.join("probe.c");
+    std::fs::write(&src, PROBE_C).unwrap();
+    let out = run(Command::new("cc").args(["-std=c99", "-O0"]).args(flags).arg(&src).arg("-o").arg(dir.join("probe")));
+    assert!(out.status.success(), "cc probe failed:\n{}", text(&out.stderr));
+}
+
+#[test]
+fn c_harness_is_clean_under_address_and_undefined_behavior_sanitizers() {
+    let probe_dir = scratch_dir("c_harness_asan_probe");
+    compile_probe(&probe_dir, SANITIZE_FLAGS);
+    // The sanitizers are live: each probe's fault is reported and ends the run.
+    for (arg, report) in [("overflow", "heap-buffer-overflow"), ("signed", "signed integer overflow")] {
+        let out = run(Command::new(probe_dir.join("probe")).arg(arg).env("ASAN_OPTIONS", "detect_leaks=0"));
+        assert!(!out.status.success() && text(&out.stderr).contains(report), "probe {arg}: {}", text(&out.stderr));
+    }
+    let detect_leaks = match leak_sanitizer_works(&probe_dir) {
+        Ok(()) => true,
+        Err(why) => {
+            println!(
+                "NOTE: LeakSanitizer cannot run in this environment ({why}); the sanitizer run below checks \
+                 ASan and UBSan only, leaks are checked by the valgrind test"
+            );
+            false
+        }
+    };
+    let exe = compile_harness("c_harness_asan", SANITIZE_FLAGS);
+    let tmp = scratch_dir("c_harness");
+    let out = run(Command::new(&exe)
+        .arg("--tmp")
+        .arg(&tmp)
+        .args(table_args(&[0, 1, 2]))
+        .current_dir(repo_root())
+        .env("ASAN_OPTIONS", format!("detect_leaks={}:abort_on_error=0:exitcode=98", u8::from(detect_leaks)))
+        .env("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1"));
+    let stderr = text(&out.stderr);
+    for report in ["AddressSanitizer", "LeakSanitizer", "runtime error:"] {
+        assert!(!stderr.contains(report), "{report} reported in the harness:\n{stderr}");
+    }
+    assert_harness_passed(
+        &format!("c_harness under ASan + UBSan (LSan {})", if detect_leaks { "on" } else { "off" }),
+        &out,
+    );
+}
+
+/// Whether this run is in CI, where a missing tool is an error rather than a skip.
+fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0")
+}
+
+#[test]
+fn c_harness_is_clean_under_valgrind_memcheck() {
+    let version = Command::new("valgrind").arg("--version").output();
+    let Ok(version) = version.map(|o| text(&o.stdout)) else {
+        assert!(!in_ci(), "valgrind is not installed: .ci/run installs it (apt-get install valgrind)");
+        println!("SKIPPED: valgrind is not installed (outside CI; under CI=true this test fails)");
+        return;
+    };
+    let memcheck =
+        ["--tool=memcheck", "--error-exitcode=99", "--leak-check=full", "--errors-for-leak-kinds=definite,possible"];
+    // The flags catch a leak: the probe's exit code becomes 99.
+    let probe_dir = scratch_dir("c_harness_valgrind_probe");
+    compile_probe(&probe_dir, &[]);
+    let out = run(Command::new("valgrind").args(memcheck).arg(probe_dir.join("probe")).arg("leak"));
+    assert_eq!(out.status.code(), Some(99), "valgrind missed the probe's leak:\n{}", text(&out.stderr));
+    // The harness: the T1 collision scenario in both modes, all bad inputs, T1's table.
+    let tmp = scratch_dir("c_harness");
+    let out = run(Command::new("valgrind")
+        .args(memcheck)
+        .arg(plain_harness())
+        .args(["--quick", "--tmp"])
+        .arg(&tmp)
+        .args(table_args(&[0]))
+        .current_dir(repo_root()));
+    let stderr = text(&out.stderr);
+    assert_ne!(out.status.code(), Some(99), "valgrind {} found errors:\n{stderr}", version.trim());
+    assert!(stderr.contains("ERROR SUMMARY: 0 errors"), "valgrind summary:\n{stderr}");
+    let stdout = assert_harness_passed(&format!("c_harness --quick under {}", version.trim()), &out);
+    assert!(stdout.contains("T1 collision table: stop tick"), "the table-mode scenario did not run under valgrind");
+    assert!(stdout.contains("bad input: done (exact and table mode)"), "bad inputs did not all run under valgrind");
 }
 
 #[test]
@@ -170,4 +389,62 @@ fn header_as_c89_is_recorded() {
             );
         }
     }
+}
+
+/// The README's table-mode example, compiled with the strict flags and run on T1's table: a
+/// colliding configuration stops the robots; a truncated table is reported with the field at
+/// fault and fails closed.
+#[test]
+fn readme_table_mode_example_compiles_and_runs() {
+    let readme = std::fs::read_to_string(repo_root().join("README.md")).expect("README.md");
+    let section = readme.split("### Table mode").nth(1).expect("README has a `### Table mode` section");
+    let snippet = section.split("```c\n").nth(1).and_then(|s| s.split("```").next()).expect("a ```c block");
+    let program = format!(
+        r#"#include <stdio.h>
+#include <stdlib.h>
+#include "delta_collide.h"
+static int stops;
+static void stop_all_robots(void) {{ stops++; }}
+#define log_error(...) (fprintf(stdout, __VA_ARGS__), fputc('\n', stdout))
+static DcStatus example(const uint8_t *table_bytes, size_t table_len, const DcVec3 *tcps_mcs)
+{{
+{snippet}    return s;
+}}
+int main(int argc, char **argv)
+{{
+    DcVec3 tcps[2] = {{ {{ 180.0, 0.0, -450.0 }}, {{ -180.0, 0.0, -450.0 }} }};
+    FILE *f = fopen(argv[1], "rb");
+    static uint8_t table[64 << 20];
+    size_t len = f == NULL ? 0 : fread(table, 1, sizeof table, f);
+    DcStatus whole, cut;
+    (void)argc;
+    whole = example(table, len, tcps);
+    cut = example(table, 4096, tcps);
+    printf("whole %u, cut %u, stops %d\n", (unsigned)whole, (unsigned)cut, stops);
+    return f == NULL;
+}}
+"#
+    );
+    let dir = scratch_dir("c_harness_readme");
+    let (src, exe) = (dir.join("readme_example.c"), dir.join("readme_example"));
+    std::fs::write(&src, program).unwrap();
+    let out = run(Command::new("cc")
+        .args(C_FLAGS)
+        .arg("-I")
+        .arg(repo_root().join("include"))
+        .arg(&src)
+        .arg(static_lib())
+        .args(NATIVE_LIBS)
+        .arg("-o")
+        .arg(&exe));
+    assert!(out.status.success(), "the README example does not compile:\n{}", text(&out.stderr));
+    let out = run(Command::new(&exe).arg(table_file(0)));
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "README example failed: {stdout}");
+    assert!(stdout.contains("delta-collide: the table is truncated"), "error line: {stdout}");
+    assert!(stdout.contains("section 0 (codes) needs"), "dc_last_init_error names the field: {stdout}");
+    assert!(stdout.contains("bytes, the buffer has 4096; copy the whole table file again"), "{stdout}");
+    // The failed init leaves h NULL, so the example's query returns DC_STATUS_NULL_POINTER (1)
+    // with STOP: the collision and the failed init both stop the robots.
+    assert!(stdout.contains("whole 0, cut 1, stops 2"), "a collision and an error both stop: {stdout}");
 }

@@ -1,7 +1,12 @@
 //! The C ABI's contract, exercised from Rust through the exported functions themselves:
-//! fail-closed outputs, every bad input's status, and no allocation in `dc_query`.
+//! fail-closed outputs, every bad input's status, and no allocation in `dc_query`, in exact
+//! and in table mode (a T1 table built here at k = 16). Table-mode init errors and answers:
+//! `ffi_table_contract.rs`.
+
+mod ffi_common;
 
 use delta_collide::ffi::*;
+use ffi_common::*;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::ffi::CStr;
@@ -42,58 +47,12 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-fn two_robot_cell(dx: f64, method: u32) -> *mut DcCollider {
-    let a = dc_robot_config_thesis();
-    let mut b = dc_robot_config_thesis();
-    b.translation = DcVec3 { x: dx, y: 0.0, z: 0.0 };
-    let robots = [a, b];
-    let config = DcCellConfig { robots: robots.as_ptr(), n_robots: 2, method };
-    let mut h = std::ptr::null_mut();
-    // SAFETY: valid config and out pointer.
-    assert_eq!(unsafe { dc_init(&config, &mut h) }, DC_STATUS_OK);
-    assert!(!h.is_null());
-    h
-}
-
-fn v(x: f64, y: f64, z: f64) -> DcVec3 {
-    DcVec3 { x, y, z }
-}
-
-/// Queries `h`, with the verdict pre-set to FREE to prove it is always written.
-fn query(h: *mut DcCollider, tcps: &[DcVec3]) -> (DcStatus, DcVerdict, DcQueryReport) {
-    let mut verdict = DC_VERDICT_FREE;
-    let mut report = DcQueryReport {
-        verdict: DC_VERDICT_FREE,
-        colliding_pairs: 7,
-        unreachable_mask: 7,
-        first_robot_a: 7,
-        first_robot_b: 7,
-        first_box_a: 7,
-        first_box_b: 7,
-    };
-    // SAFETY: h is NULL or live; slices and outputs are valid.
-    let s = unsafe { dc_query(h, tcps.as_ptr(), tcps.len(), &mut verdict, &mut report) };
-    assert_eq!(report.verdict, verdict, "report and out_verdict agree");
-    if s != DC_STATUS_OK {
-        assert_eq!(verdict, DC_VERDICT_STOP, "fail closed on status {s}");
-    }
-    (s, verdict, report)
-}
-
 #[test]
 fn query_does_not_allocate_over_a_million_ticks() {
     for method in [DC_METHOD_SAT, DC_METHOD_SAT_CACHE] {
         let h = two_robot_cell(450.0, method);
         let mut verdict = DC_VERDICT_STOP;
-        let mut report = DcQueryReport {
-            verdict: 0,
-            colliding_pairs: 0,
-            unreachable_mask: 0,
-            first_robot_a: 0,
-            first_robot_b: 0,
-            first_box_a: 0,
-            first_box_b: 0,
-        };
+        let mut report = zero_report();
         let ring: Vec<[DcVec3; 2]> = (0..128)
             .map(|i| {
                 let s = i as f64 / 127.0;
@@ -119,6 +78,43 @@ fn query_does_not_allocate_over_a_million_ticks() {
         // SAFETY: live handle, destroyed once.
         unsafe { dc_destroy(h) };
     }
+}
+
+#[test]
+fn table_mode_query_does_not_allocate_over_a_million_ticks() {
+    let h = t1_table_handle();
+    let mut verdict = DC_VERDICT_STOP;
+    let mut report = zero_report();
+    // Toward each other through the shared space; every 16th tick robot A is above the
+    // sampled workspace (z = -340, reachable): the exact fallback must not allocate either.
+    let ring: Vec<[DcVec3; 2]> = (0..128)
+        .map(|i| {
+            let s = i as f64 / 127.0;
+            let z = if i % 16 == 0 { -340.0 } else { -450.0 };
+            [v(-150.0 + 330.0 * s, 30.0, z), v(150.0 - 330.0 * s, -20.0, -430.0)]
+        })
+        .collect();
+    let (mut free, mut hit) = (0, 0);
+    let before = allocations();
+    for i in 0..1_000_000 {
+        let tcps = &ring[i % ring.len()];
+        // SAFETY: live handle, valid slices and outputs.
+        let s = unsafe { dc_query(h, tcps.as_ptr(), 2, &mut verdict, &mut report) };
+        assert_eq!(s, DC_STATUS_OK);
+        if verdict == DC_VERDICT_FREE {
+            free += 1
+        } else {
+            hit += 1
+        }
+    }
+    let after = allocations();
+    assert_eq!(after - before, 0, "dc_query allocated in table mode");
+    assert!(free > 0 && hit > 0, "the ring covers both verdicts ({free} free, {hit} collisions)");
+    // SAFETY: live handle.
+    let fallbacks = unsafe { dc_table_fallbacks(h) };
+    assert_eq!(fallbacks, 1_000_000 / 16, "one exact fallback per out-of-grid tick");
+    // SAFETY: live handle, destroyed once.
+    unsafe { dc_destroy(h) };
 }
 
 #[test]
@@ -250,11 +246,11 @@ fn reports_name_the_colliding_boxes_and_pair_results_match() {
 
 #[test]
 fn status_strings_cover_every_code_and_kinematics_round_trip() {
-    for s in 0..=10u32 {
+    for s in 0..=17u32 {
         // SAFETY: dc_status_str returns a static NUL-terminated string.
         let text = unsafe { CStr::from_ptr(dc_status_str(s)) }.to_str().unwrap();
         assert!(!text.is_empty());
-        assert_eq!(text == "unknown status", s == 10, "code {s}");
+        assert_eq!(text == "unknown status", s == 17, "code {s}");
     }
     // SAFETY: static NUL-terminated string.
     assert_eq!(unsafe { CStr::from_ptr(dc_version()) }.to_str().unwrap(), env!("CARGO_PKG_VERSION"));

@@ -1,9 +1,11 @@
 //! Safe conversions between the C structs and the crate's types (no `unsafe` here).
 
 use crate::cell::{Cell, CellError, Placement, RobotSpec, SatMethod};
+use crate::ffi::collider::InitError;
 use crate::ffi::types::*;
 use crate::math::Vec3;
 use crate::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
+use crate::table::TableError;
 
 /// The status a cell error maps to.
 pub(crate) fn cell_error_status(e: &CellError) -> DcStatus {
@@ -11,6 +13,20 @@ pub(crate) fn cell_error_status(e: &CellError) -> DcStatus {
         CellError::Io(_) => DC_STATUS_IO,
         CellError::Parse(_) => DC_STATUS_PARSE,
         CellError::Invalid(_) => DC_STATUS_INVALID_CONFIG,
+    }
+}
+
+/// The status a table error maps to, one per [`TableError`] variant.
+pub(crate) fn table_error_status(e: &TableError) -> DcStatus {
+    match e {
+        TableError::Truncated { .. } => DC_STATUS_TABLE_TRUNCATED,
+        TableError::BadMagic { .. } => DC_STATUS_TABLE_BAD_MAGIC,
+        TableError::UnsupportedVersion { .. } => DC_STATUS_TABLE_UNSUPPORTED_VERSION,
+        TableError::WrongEndianness => DC_STATUS_TABLE_WRONG_ENDIANNESS,
+        TableError::Corrupt { .. } => DC_STATUS_TABLE_CORRUPT,
+        TableError::WrongCell { .. } => DC_STATUS_TABLE_WRONG_CELL,
+        // `TableChecker::new` reports a cell without two robots as bad input.
+        TableError::BadInput { .. } => DC_STATUS_TABLE_NOT_TWO_ROBOTS,
     }
 }
 
@@ -42,14 +58,19 @@ pub(crate) fn robot_spec(index: usize, r: &DcRobotConfig) -> RobotSpec {
 }
 
 /// A validated cell from the C robots and method code.
-pub(crate) fn cell_from_c(robots: &[DcRobotConfig], method: u32) -> Result<Cell, DcStatus> {
+pub(crate) fn cell_from_c(robots: &[DcRobotConfig], method: u32) -> Result<Cell, InitError> {
     let method = match method {
         DC_METHOD_SAT => SatMethod::Sat,
         DC_METHOD_SAT_CACHE => SatMethod::SatCache,
-        _ => return Err(DC_STATUS_INVALID_CONFIG),
+        m => {
+            return Err(InitError::new(
+                DC_STATUS_INVALID_CONFIG,
+                format!("config->method = {m}: use DC_METHOD_SAT (0) or DC_METHOD_SAT_CACHE (1)"),
+            ))
+        }
     };
     let specs = robots.iter().enumerate().map(|(i, r)| robot_spec(i, r)).collect();
-    Cell::new("C config".into(), specs, method).map_err(|e| cell_error_status(&e))
+    Cell::new("C config".into(), specs, method).map_err(|e| InitError::new(cell_error_status(&e), e.to_string()))
 }
 
 /// The thesis robot as a C config, placed at the WCS origin.
@@ -82,4 +103,30 @@ pub(crate) fn delta3_from_c(g: &DcDelta3) -> Result<Delta3, DcStatus> {
     }
     d.validate().map_err(|_| DC_STATUS_INVALID_CONFIG)?;
     Ok(d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::ffi::CStr;
+
+    #[test]
+    fn each_table_error_has_its_own_status_from_10_with_a_text() {
+        let errors = [
+            TableError::Truncated { what: "magic", needed: 8, have: 0 },
+            TableError::BadMagic { found: *b"XCTABLE\0" },
+            TableError::UnsupportedVersion { found: 2, supported: 1 },
+            TableError::WrongEndianness,
+            TableError::Corrupt { what: "checksum".into() },
+            TableError::WrongCell { expected: 1, found: 2 },
+            TableError::BadInput { what: "three robots".into() },
+        ];
+        let statuses: Vec<DcStatus> = errors.iter().map(table_error_status).collect();
+        assert_eq!(statuses, (10..=16).collect::<Vec<_>>(), "one status per variant, in order, from 10");
+        for s in statuses {
+            // SAFETY: dc_status_str returns a static NUL-terminated string.
+            let text = unsafe { CStr::from_ptr(crate::ffi::dc_status_str(s)) }.to_str().unwrap();
+            assert!(text.contains("table"), "status {s}: {text}");
+        }
+    }
 }

@@ -9,27 +9,33 @@
 //! - `*out_verdict` and `*out_report`, when not NULL, are written on every call, and read
 //!   `DC_VERDICT_FREE` only together with `DC_STATUS_OK` (fail closed).
 //! - `dc_init*` allocate; `dc_query` never allocates, locks or does I/O.
+//! - Two modes behind one handle: exact (`dc_init`, `dc_init_from_cell_file`) and table
+//!   (`dc_init_with_table`, `dc_init_from_files`; two-robot cells); `dc_query` is the same.
 //! - A handle is used by one thread at a time; distinct handles are independent.
 #![allow(unsafe_code)]
 
+mod collider;
 mod convert;
 pub mod types;
 
 pub use types::*;
 
-use crate::cell::exact::PairState;
-use crate::cell::{Cell, ExactChecker};
-use crate::math::Vec3;
+use collider::{Collider, InitError};
+use std::cell::RefCell;
 use std::ffi::{c_char, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::Path;
 
-/// An initialised collision checker for one cell (opaque to C).
+/// An initialised collision checker for one cell, in exact or table mode (opaque to C).
 pub struct DcCollider {
-    checker: ExactChecker,
-    /// The TCPs of the current query, converted; sized once at init.
-    tcps: Vec<Vec3>,
+    inner: Collider,
     /// Set when a panic was caught inside a query: the handle's state is not trusted.
     poisoned: bool,
+}
+
+thread_local! {
+    /// The message of this thread's last failed `dc_init*` (empty after a success).
+    static LAST_INIT_ERROR: RefCell<String> = const { RefCell::new(String::new()) };
 }
 
 /// Runs `f`, turning a panic into `DC_STATUS_PANIC`.
@@ -37,13 +43,77 @@ fn boundary(f: impl FnOnce() -> DcStatus) -> DcStatus {
     catch_unwind(AssertUnwindSafe(f)).unwrap_or(DC_STATUS_PANIC)
 }
 
-fn new_handle(cell: Cell) -> *mut DcCollider {
-    let n = cell.robots.len();
-    Box::into_raw(Box::new(DcCollider {
-        checker: ExactChecker::new(cell),
-        tcps: vec![Vec3::zeros(); n],
-        poisoned: false,
-    }))
+/// The common part of every `dc_init*`: sets `*out_handle` to NULL, runs `make`, stores the
+/// new handle or records the error message for `dc_last_init_error`, returns the status.
+///
+/// # Safety
+/// `out_handle` must be NULL or writable.
+unsafe fn init_handle(
+    out_handle: *mut *mut DcCollider,
+    make: impl FnOnce() -> Result<Collider, InitError>,
+) -> DcStatus {
+    boundary(|| {
+        let result = if out_handle.is_null() {
+            Err(InitError::new(
+                DC_STATUS_NULL_POINTER,
+                "out_handle is NULL: pass the address of a DcCollider * variable",
+            ))
+        } else {
+            // SAFETY: checked non-null above; the caller guarantees it is writable.
+            unsafe { *out_handle = std::ptr::null_mut() };
+            catch_unwind(AssertUnwindSafe(make)).unwrap_or_else(|_| {
+                Err(InitError::new(DC_STATUS_PANIC, "internal error (a panic) caught during init; please report it"))
+            })
+        };
+        let (status, message) = match result {
+            Ok(inner) => {
+                // SAFETY: `result` is Ok only when `out_handle` was checked non-null above.
+                unsafe { *out_handle = Box::into_raw(Box::new(DcCollider { inner, poisoned: false })) };
+                (DC_STATUS_OK, String::new())
+            }
+            Err(e) => (e.status, e.message),
+        };
+        let _ = LAST_INIT_ERROR.try_with(|m| *m.borrow_mut() = message);
+        status
+    })
+}
+
+/// The validated cell of a C configuration.
+///
+/// # Safety
+/// `config` must be NULL or point to a valid `DcCellConfig` whose `robots` points to
+/// `n_robots` valid `DcRobotConfig`.
+unsafe fn cell_from_config(config: *const DcCellConfig) -> Result<crate::cell::Cell, InitError> {
+    // SAFETY: the caller guarantees `config` is NULL or valid.
+    let Some(config) = (unsafe { config.as_ref() }) else {
+        return Err(InitError::new(DC_STATUS_NULL_POINTER, "config is NULL: pass a DcCellConfig"));
+    };
+    if config.robots.is_null() {
+        return Err(InitError::new(DC_STATUS_NULL_POINTER, "config->robots is NULL: point it at n_robots robots"));
+    }
+    if config.n_robots == 0 || config.n_robots > crate::cell::MAX_ROBOTS {
+        let message =
+            format!("config->n_robots = {}: a cell has 1 to {} robots", config.n_robots, crate::cell::MAX_ROBOTS);
+        return Err(InitError::new(DC_STATUS_INVALID_CONFIG, message));
+    }
+    // SAFETY: non-null, and the caller guarantees `n_robots` valid elements.
+    let robots = unsafe { std::slice::from_raw_parts(config.robots, config.n_robots) };
+    convert::cell_from_c(robots, config.method)
+}
+
+/// A path argument as a `Path`; `what` names the argument in the error.
+///
+/// # Safety
+/// `path` must be NULL or a NUL-terminated string that outlives `'a`.
+unsafe fn path_arg<'a>(path: *const c_char, what: &str) -> Result<&'a Path, InitError> {
+    if path.is_null() {
+        return Err(InitError::new(DC_STATUS_NULL_POINTER, format!("{what} is NULL: pass a NUL-terminated path")));
+    }
+    // SAFETY: non-null, and the caller guarantees NUL termination.
+    let Ok(text) = unsafe { CStr::from_ptr(path) }.to_str() else {
+        return Err(InitError::new(DC_STATUS_INVALID_ARGUMENT, format!("{what} is not UTF-8: rename the file")));
+    };
+    Ok(Path::new(text))
 }
 
 /// The thesis robot (f 100, rf 150, re 400, e 40, limits [-pi/2, 2 pi/3], H 70, D 17.5,
@@ -53,48 +123,32 @@ pub extern "C" fn dc_robot_config_thesis() -> DcRobotConfig {
     convert::thesis_robot_config()
 }
 
-/// Creates a checker for the cell described by `config` (POU start-up).
+/// Creates an exact-mode checker for the cell described by `config` (POU start-up): every
+/// query tests every box pair that can meet (`dc_mode` gives `DC_MODE_EXACT`).
 ///
 /// On success `*out_handle` holds a handle to pass to `dc_query` and finally to
 /// `dc_destroy`; on any failure `*out_handle` is set to NULL (when `out_handle` is not
-/// NULL). Statuses: `DC_STATUS_NULL_POINTER` (config, its robots array or out_handle is
-/// NULL), `DC_STATUS_INVALID_CONFIG` (no robots or more than 32, a length <= 0, a negative
-/// margin or box extent, motor limits not a proper range, NaN/inf, unknown method).
+/// NULL) and `dc_last_init_error` tells why. Statuses: `DC_STATUS_NULL_POINTER` (config, its
+/// robots array or out_handle is NULL), `DC_STATUS_INVALID_CONFIG` (no robots or more than
+/// 32, a length <= 0, a negative margin or box extent, motor limits not a proper range,
+/// NaN/inf, unknown method).
 ///
 /// # Safety
 /// `config` must be NULL or point to a valid `DcCellConfig` whose `robots` points to
 /// `n_robots` valid `DcRobotConfig`; `out_handle` must be NULL or writable.
 #[no_mangle]
 pub unsafe extern "C" fn dc_init(config: *const DcCellConfig, out_handle: *mut *mut DcCollider) -> DcStatus {
-    boundary(|| {
-        if out_handle.is_null() {
-            return DC_STATUS_NULL_POINTER;
-        }
-        // SAFETY: checked non-null above; the caller guarantees it is writable.
-        unsafe { *out_handle = std::ptr::null_mut() };
+    let make = || {
         // SAFETY: the caller guarantees `config` is NULL or valid.
-        let Some(config) = (unsafe { config.as_ref() }) else { return DC_STATUS_NULL_POINTER };
-        if config.robots.is_null() {
-            return DC_STATUS_NULL_POINTER;
-        }
-        if config.n_robots == 0 || config.n_robots > crate::cell::MAX_ROBOTS {
-            return DC_STATUS_INVALID_CONFIG;
-        }
-        // SAFETY: non-null, and the caller guarantees `n_robots` valid elements.
-        let robots = unsafe { std::slice::from_raw_parts(config.robots, config.n_robots) };
-        match convert::cell_from_c(robots, config.method) {
-            Ok(cell) => {
-                // SAFETY: checked non-null above.
-                unsafe { *out_handle = new_handle(cell) };
-                DC_STATUS_OK
-            }
-            Err(status) => status,
-        }
-    })
+        let cell = unsafe { cell_from_config(config) }?;
+        Ok(Collider::exact(cell))
+    };
+    // SAFETY: the caller guarantees `out_handle` is NULL or writable.
+    unsafe { init_handle(out_handle, make) }
 }
 
-/// Creates a checker from a TOML cell file (see `cells/t1.toml`); the file is read once,
-/// here, never during a tick.
+/// Creates an exact-mode checker from a TOML cell file (see `cells/t1.toml`); the file is
+/// read once, here, never during a tick.
 ///
 /// `*out_handle` as for `dc_init`. Statuses: `DC_STATUS_NULL_POINTER`,
 /// `DC_STATUS_INVALID_ARGUMENT` (path not UTF-8), `DC_STATUS_IO` (cannot read),
@@ -104,29 +158,111 @@ pub unsafe extern "C" fn dc_init(config: *const DcCellConfig, out_handle: *mut *
 /// `path` must be NULL or a NUL-terminated string; `out_handle` must be NULL or writable.
 #[no_mangle]
 pub unsafe extern "C" fn dc_init_from_cell_file(path: *const c_char, out_handle: *mut *mut DcCollider) -> DcStatus {
-    boundary(|| {
-        if out_handle.is_null() {
-            return DC_STATUS_NULL_POINTER;
+    let make = || {
+        // SAFETY: the caller guarantees `path` is NULL or NUL-terminated.
+        let path = unsafe { path_arg(path, "path") }?;
+        crate::cell::Cell::from_file(path)
+            .map(Collider::exact)
+            .map_err(|e| InitError::new(convert::cell_error_status(&e), e.to_string()))
+    };
+    // SAFETY: the caller guarantees `out_handle` is NULL or writable.
+    unsafe { init_handle(out_handle, make) }
+}
+
+/// Creates a table-mode checker (POU start-up) for the two-robot cell `config` from the bytes
+/// of a table file built offline for that cell (`delta-collide build --cell ...`): each
+/// query is then one table lookup (`dc_mode` gives `DC_MODE_TABLE`). The table never answers
+/// FREE where the exact model collides; it may answer COLLISION where the exact model is
+/// free (the price of a 1 ms-safe lookup).
+///
+/// The buffer is validated once, here (magic, endianness, version, lengths, checksum, every
+/// index, and that it was built for this cell), and copied: the caller may free it as soon
+/// as this returns. `*out_handle` as for `dc_init`; `dc_last_init_error` names the field at
+/// fault. Statuses: those of `dc_init`, and `DC_STATUS_NULL_POINTER` (table is NULL),
+/// `DC_STATUS_TABLE_NOT_TWO_ROBOTS`, `DC_STATUS_TABLE_TRUNCATED` (also for table_len 0),
+/// `DC_STATUS_TABLE_BAD_MAGIC`, `DC_STATUS_TABLE_UNSUPPORTED_VERSION`,
+/// `DC_STATUS_TABLE_WRONG_ENDIANNESS`, `DC_STATUS_TABLE_CORRUPT`, `DC_STATUS_TABLE_WRONG_CELL`.
+///
+/// # Safety
+/// `config` as for `dc_init`; `table` must be NULL or point to `table_len` readable bytes;
+/// `out_handle` must be NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn dc_init_with_table(
+    config: *const DcCellConfig,
+    table: *const u8,
+    table_len: usize,
+    out_handle: *mut *mut DcCollider,
+) -> DcStatus {
+    let make = || {
+        // SAFETY: the caller guarantees `config` is NULL or valid.
+        let cell = unsafe { cell_from_config(config) }?;
+        if table.is_null() {
+            return Err(InitError::new(DC_STATUS_NULL_POINTER, "table is NULL: pass the table file's bytes"));
         }
-        // SAFETY: checked non-null above; the caller guarantees it is writable.
-        unsafe { *out_handle = std::ptr::null_mut() };
-        if path.is_null() {
-            return DC_STATUS_NULL_POINTER;
-        }
-        // SAFETY: non-null, and the caller guarantees NUL termination.
-        let Ok(path) = unsafe { CStr::from_ptr(path) }.to_str() else { return DC_STATUS_INVALID_ARGUMENT };
-        match Cell::from_file(std::path::Path::new(path)) {
-            Ok(cell) => {
-                // SAFETY: checked non-null above.
-                unsafe { *out_handle = new_handle(cell) };
-                DC_STATUS_OK
+        // SAFETY: non-null, and the caller guarantees `table_len` readable bytes.
+        let bytes = unsafe { std::slice::from_raw_parts(table, table_len) };
+        Collider::table(cell, bytes)
+    };
+    // SAFETY: the caller guarantees `out_handle` is NULL or writable.
+    unsafe { init_handle(out_handle, make) }
+}
+
+/// Creates a table-mode checker from a TOML cell file and a table file, both read once,
+/// here: `dc_init_from_cell_file` followed by `dc_init_with_table` on the file's bytes.
+///
+/// `*out_handle` as for `dc_init`. Statuses: those of `dc_init_from_cell_file` (for either
+/// path; `DC_STATUS_IO` when a file cannot be read) and those of `dc_init_with_table`.
+///
+/// # Safety
+/// `cell_path` and `table_path` must be NULL or NUL-terminated strings; `out_handle` must be
+/// NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn dc_init_from_files(
+    cell_path: *const c_char,
+    table_path: *const c_char,
+    out_handle: *mut *mut DcCollider,
+) -> DcStatus {
+    let make = || {
+        // SAFETY: the caller guarantees both paths are NULL or NUL-terminated.
+        let (cell_path, table_path) =
+            unsafe { (path_arg(cell_path, "cell_path")?, path_arg(table_path, "table_path")?) };
+        Collider::from_files(cell_path, table_path)
+    };
+    // SAFETY: the caller guarantees `out_handle` is NULL or writable.
+    unsafe { init_handle(out_handle, make) }
+}
+
+/// Copies the message of the calling thread's last failed `dc_init*` into `buf`
+/// (NUL-terminated, cut to `capacity - 1` bytes) and returns the message's full length
+/// without the NUL: it names the field at fault and the fix, e.g. "table is truncated:
+/// section 0 (codes) needs 3139976 bytes, the buffer has 4096; copy the whole table file
+/// again". Returns 0 (and writes "" when it can) after a successful init or before any.
+/// `buf` may be NULL or `capacity` 0 to ask for the length only. Not for the tick loop.
+///
+/// # Safety
+/// `buf` must be NULL or hold `capacity` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn dc_last_init_error(buf: *mut c_char, capacity: usize) -> usize {
+    let copy = || {
+        LAST_INIT_ERROR.with(|m| {
+            let m = m.borrow();
+            if !buf.is_null() && capacity > 0 {
+                let n = m.len().min(capacity - 1);
+                // SAFETY: non-null; the caller guarantees `capacity > n` writable bytes, and
+                // a thread-local String never overlaps the caller's buffer.
+                unsafe {
+                    std::ptr::copy_nonoverlapping(m.as_ptr().cast::<c_char>(), buf, n);
+                    *buf.add(n) = 0;
+                }
             }
-            Err(e) => convert::cell_error_status(&e),
-        }
-    })
+            m.len()
+        })
+    };
+    catch_unwind(AssertUnwindSafe(copy)).unwrap_or(0)
 }
 
 /// The per-tick query: do the robots collide with robot j's TCP at `tcps_mcs[j]` (its MCS)?
+/// Works the same in exact and table mode.
 ///
 /// Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
 /// `DC_VERDICT_FREE` or `DC_VERDICT_COLLISION` with `DC_STATUS_OK`, else `DC_VERDICT_STOP`.
@@ -134,7 +270,8 @@ pub unsafe extern "C" fn dc_init_from_cell_file(path: *const c_char, out_handle:
 /// `DC_STATUS_WRONG_ROBOT_COUNT`, `DC_STATUS_NON_FINITE` (a NaN/inf coordinate; the
 /// report's `unreachable_mask` names the robot), `DC_STATUS_UNREACHABLE` (a TCP outside
 /// the robot's reach or motor limits; mask as before), `DC_STATUS_PANIC` (destroy the
-/// handle). Never allocates, locks or does I/O.
+/// handle). In table mode a COLLISION report names robots 0 and 1 and no boxes
+/// (`DC_BOX_NONE`). Never allocates, locks or does I/O.
 ///
 /// # Safety
 /// `handle` must be NULL or a live handle from `dc_init*` not used by another thread;
@@ -160,7 +297,7 @@ pub unsafe extern "C" fn dc_query(
         }
         // SAFETY: non-null, and the caller guarantees `n_tcps` readable elements.
         let tcps = unsafe { std::slice::from_raw_parts(tcps_mcs, n_tcps) };
-        let status = catch_unwind(AssertUnwindSafe(|| query(h, tcps, &mut report)));
+        let status = catch_unwind(AssertUnwindSafe(|| h.inner.query(tcps, &mut report)));
         status.unwrap_or_else(|_| {
             h.poisoned = true;
             DC_STATUS_PANIC
@@ -180,40 +317,13 @@ pub unsafe extern "C" fn dc_query(
     status
 }
 
-/// The safe body of `dc_query`: fills `report`, returns the status.
-fn query(h: &mut DcCollider, tcps: &[DcVec3], report: &mut DcQueryReport) -> DcStatus {
-    if tcps.len() != h.tcps.len() {
-        return DC_STATUS_WRONG_ROBOT_COUNT;
-    }
-    let mut non_finite = 0u32;
-    for (j, (dst, src)) in h.tcps.iter_mut().zip(tcps).enumerate() {
-        non_finite |= (!src.is_finite() as u32) << j;
-        *dst = src.to_vec3();
-    }
-    if non_finite != 0 {
-        report.unreachable_mask = non_finite;
-        return DC_STATUS_NON_FINITE;
-    }
-    let Ok(v) = h.checker.check(&h.tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };
-    report.unreachable_mask = v.unreachable_mask;
-    report.colliding_pairs = v.colliding_pairs() as u32;
-    if let Some(p) = v.first_collision() {
-        if let PairState::Collides(ba, bb) = p.state {
-            (report.first_robot_a, report.first_robot_b) = (p.a as u32, p.b as u32);
-            (report.first_box_a, report.first_box_b) = (ba as u32, bb as u32);
-        }
-    }
-    if !v.all_reachable() {
-        return DC_STATUS_UNREACHABLE;
-    }
-    report.verdict = if v.collides() { DC_VERDICT_COLLISION } else { DC_VERDICT_FREE };
-    DC_STATUS_OK
-}
-
 /// Copies the per-pair results of the last query into `out[0..]` and their number into
-/// `*out_len`. Only pairs whose reach can overlap are listed (`dc_pair_count`).
-/// Statuses: `DC_STATUS_NULL_POINTER`, `DC_STATUS_INVALID_ARGUMENT` (`capacity` smaller
-/// than `dc_pair_count`; `*out_len` then holds the count needed).
+/// `*out_len`. Exact mode: the pairs whose reach can overlap (`dc_pair_count`), with the
+/// colliding boxes. Table mode: one pair (robots 0 and 1), `collides` as the last verdict,
+/// boxes `DC_BOX_NONE`. After a query that did not return `DC_STATUS_OK` the results are
+/// not a decision (table mode: `collides` 0). Statuses: `DC_STATUS_NULL_POINTER`,
+/// `DC_STATUS_INVALID_ARGUMENT` (`capacity` smaller than `dc_pair_count`; `*out_len` then
+/// holds the count needed).
 ///
 /// # Safety
 /// `handle` must be NULL or live; `out` must be NULL or hold `capacity` writable elements;
@@ -231,23 +341,39 @@ pub unsafe extern "C" fn dc_pair_results(
         if out.is_null() || out_len.is_null() {
             return DC_STATUS_NULL_POINTER;
         }
-        let pairs = &h.checker.verdict().pairs;
+        let n = h.inner.pair_count();
         // SAFETY: non-null; the caller guarantees it is writable.
-        unsafe { *out_len = pairs.len() };
-        if capacity < pairs.len() {
+        unsafe { *out_len = n };
+        if capacity < n {
             return DC_STATUS_INVALID_ARGUMENT;
         }
-        // SAFETY: non-null, and the caller guarantees `capacity >= pairs.len()` elements.
-        let out = unsafe { std::slice::from_raw_parts_mut(out, pairs.len()) };
-        for (o, p) in out.iter_mut().zip(pairs) {
-            let (collides, box_a, box_b) = match p.state {
-                PairState::Collides(a, b) => (1, a as u32, b as u32),
-                _ => (0, DC_BOX_NONE, DC_BOX_NONE),
-            };
-            *o = DcPairResult { robot_a: p.a as u32, robot_b: p.b as u32, collides, box_a, box_b };
-        }
+        // SAFETY: non-null, and the caller guarantees `capacity >= n` writable elements.
+        let out = unsafe { std::slice::from_raw_parts_mut(out, n) };
+        h.inner.pair_results(out);
         DC_STATUS_OK
     })
+}
+
+/// How the handle answers: `DC_MODE_EXACT` or `DC_MODE_TABLE`; `DC_MODE_NONE` for NULL.
+///
+/// # Safety
+/// `handle` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn dc_mode(handle: *const DcCollider) -> DcMode {
+    // SAFETY: the caller guarantees `handle` is NULL or live.
+    unsafe { handle.as_ref() }.map_or(DC_MODE_NONE, |h| h.inner.mode())
+}
+
+/// Table mode: how many queries so far were answered by the exact model because a TCP lay
+/// reachable but outside the table's sampled grid (the answer is then exact, never a
+/// guess). 0 in exact mode and for NULL.
+///
+/// # Safety
+/// `handle` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn dc_table_fallbacks(handle: *const DcCollider) -> u64 {
+    // SAFETY: the caller guarantees `handle` is NULL or live.
+    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.table_fallbacks())
 }
 
 /// Number of robots of the handle's cell; 0 for NULL.
@@ -257,17 +383,18 @@ pub unsafe extern "C" fn dc_pair_results(
 #[no_mangle]
 pub unsafe extern "C" fn dc_robot_count(handle: *const DcCollider) -> usize {
     // SAFETY: the caller guarantees `handle` is NULL or live.
-    unsafe { handle.as_ref() }.map_or(0, |h| h.tcps.len())
+    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.robot_count())
 }
 
-/// Number of robot pairs that can meet (kept after pruning at init); 0 for NULL.
+/// Number of robot pairs `dc_pair_results` reports: exact mode, the pairs that can meet
+/// (kept after pruning at init); table mode, 1; 0 for NULL.
 ///
 /// # Safety
 /// `handle` must be NULL or live.
 #[no_mangle]
 pub unsafe extern "C" fn dc_pair_count(handle: *const DcCollider) -> usize {
     // SAFETY: the caller guarantees `handle` is NULL or live.
-    unsafe { handle.as_ref() }.map_or(0, |h| h.checker.verdict().pairs.len())
+    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.pair_count())
 }
 
 /// Frees a handle (POU shut-down). NULL is a no-op. The handle must not be used afterwards.
@@ -296,6 +423,21 @@ pub extern "C" fn dc_status_str(status: DcStatus) -> *const c_char {
         DC_STATUS_PARSE => c"the cell file is not valid TOML or does not follow the schema",
         DC_STATUS_PANIC => c"internal error caught at the library boundary; destroy the handle",
         DC_STATUS_INVALID_ARGUMENT => c"an argument is malformed (path not UTF-8, capacity too small)",
+        DC_STATUS_TABLE_TRUNCATED => c"the table is truncated: copy the whole table file again",
+        DC_STATUS_TABLE_BAD_MAGIC => {
+            c"not a delta-collide table (bad magic): check that the right file or buffer is given"
+        }
+        DC_STATUS_TABLE_UNSUPPORTED_VERSION => {
+            c"the table's format version is not supported: rebuild it with `delta-collide build`"
+        }
+        DC_STATUS_TABLE_WRONG_ENDIANNESS => {
+            c"the table is big-endian, this library reads little-endian tables: rebuild it with `delta-collide build`"
+        }
+        DC_STATUS_TABLE_CORRUPT => c"the table is corrupt (checksum or a field): rebuild it or copy it again",
+        DC_STATUS_TABLE_WRONG_CELL => {
+            c"the table was built for another cell: rebuild it with `delta-collide build --cell ...` for this cell"
+        }
+        DC_STATUS_TABLE_NOT_TWO_ROBOTS => c"tables serve two-robot cells only: use dc_init (exact mode) for this cell",
         _ => c"unknown status",
     };
     s.as_ptr()

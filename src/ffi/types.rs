@@ -27,6 +27,24 @@ pub const DC_STATUS_PARSE: DcStatus = 7;
 pub const DC_STATUS_PANIC: DcStatus = 8;
 /// An argument is malformed (path not UTF-8, capacity too small, ...).
 pub const DC_STATUS_INVALID_ARGUMENT: DcStatus = 9;
+/// Table mode: the table buffer or file ends before its header, a section or the checksum is
+/// complete. Copy the whole table file again.
+pub const DC_STATUS_TABLE_TRUNCATED: DcStatus = 10;
+/// Table mode: the buffer does not start with the table magic `DCTABLE\0`: not a table.
+pub const DC_STATUS_TABLE_BAD_MAGIC: DcStatus = 11;
+/// Table mode: the table's format version is not the one this library reads; rebuild it
+/// with `delta-collide build`.
+pub const DC_STATUS_TABLE_UNSUPPORTED_VERSION: DcStatus = 12;
+/// Table mode: the table was written big-endian; this library reads little-endian tables.
+pub const DC_STATUS_TABLE_WRONG_ENDIANNESS: DcStatus = 13;
+/// Table mode: the checksum does not match or a field breaks an invariant (a flipped bit, a
+/// bad copy); rebuild the table or copy it again.
+pub const DC_STATUS_TABLE_CORRUPT: DcStatus = 14;
+/// Table mode: the table was built for another cell than the configured one (geometry, boxes,
+/// margins or placements differ); rebuild it with `delta-collide build --cell ...`.
+pub const DC_STATUS_TABLE_WRONG_CELL: DcStatus = 15;
+/// Table mode: tables serve two-robot cells only; use `dc_init` (exact mode) for this cell.
+pub const DC_STATUS_TABLE_NOT_TWO_ROBOTS: DcStatus = 16;
 
 /// What the controller should do; 0 is STOP so that zeroed memory fails closed.
 pub type DcVerdict = u32;
@@ -36,6 +54,16 @@ pub const DC_VERDICT_STOP: DcVerdict = 0;
 pub const DC_VERDICT_FREE: DcVerdict = 1;
 /// At least one pair of robots collides.
 pub const DC_VERDICT_COLLISION: DcVerdict = 2;
+
+/// How a handle answers (`dc_mode`).
+pub type DcMode = u32;
+/// No handle (`dc_mode(NULL)`).
+pub const DC_MODE_NONE: DcMode = 0;
+/// Exact mode (`dc_init`, `dc_init_from_cell_file`): every box pair, separating axis test.
+pub const DC_MODE_EXACT: DcMode = 1;
+/// Table mode (`dc_init_with_table`, `dc_init_from_files`): one lookup in a precomputed
+/// table of a two-robot cell, which never answers FREE where the robots collide.
+pub const DC_MODE_TABLE: DcMode = 2;
 
 /// Plain separating axis test.
 pub const DC_METHOD_SAT: u32 = 0;

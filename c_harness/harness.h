@@ -1,0 +1,82 @@
+/*
+ * harness.h: what the C harness's translation units share (thesis appendix A.1): the check
+ * counter behind the final `N passed, M failed` line, the command line, and small helpers.
+ */
+#ifndef HARNESS_H
+#define HARNESS_H
+
+#include "delta_collide.h"
+#include "mock_robotics.h"
+
+#include <stddef.h>
+
+#define HARNESS_N_CELLS 3
+#define SCENARIO_FILE "c_harness/scenarios.txt"
+#define STOP_AFTER_TICK 3000L /* the collision case collides only in the last part of the run */
+
+/* One reference cell's table file (given on the command line) and its bytes, read once at
+ * start-up (never during a tick). */
+typedef struct HarnessTable {
+    const char *path;      /* NULL when no table was given for the cell */
+    unsigned char *bytes;  /* malloc'd copy of the file, NULL when not read */
+    size_t len;
+} HarnessTable;
+
+/* The command line: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]...
+ *   --quick  runs the T1 collision scenario only (exact and table mode), for valgrind;
+ *            the kinematics grid and every bad-input scenario still run;
+ *   --tmp    a directory for scratch files (default ".");
+ *   --table  the table file of reference cell CELL (T1, T2 or T3): enables table mode. */
+typedef struct HarnessOptions {
+    int quick;
+    const char *tmp_dir;
+    HarnessTable tables[HARNESS_N_CELLS]; /* T1, T2, T3 */
+} HarnessOptions;
+
+/* Counts one check; prints `FAIL: <message>` when it fails. Returns ok. */
+int check(int ok, const char *fmt, ...);
+
+/* The counts behind the verdict line. */
+int harness_passed(void);
+int harness_failed(void);
+
+DcVec3 vec3(double x, double y, double z);
+DcDelta3 dc_geometry(const MrGeometry *g);
+
+/* "T1" -> 0, "T2" -> 1, "T3" -> 2, else -1. */
+int cell_index(const char *cell);
+
+/* The TOML file of a reference cell, relative to the repository root. */
+const char *cell_file(const char *cell);
+
+/* "none" for -1, else the tick number. */
+void tick_text(long tick, char out[24]);
+
+/* The TCPs the robotics API delivered this tick, as the C ABI takes them. */
+void to_dc(const MrTickState *st, size_t n, DcVec3 out[MR_MAX_ROBOTS]);
+
+/* Reads a whole file into a malloc'd buffer (start-up only); returns 0 when it cannot. */
+int read_file(const char *path, unsigned char **out, size_t *out_len);
+
+/* Parses argv into *out; returns 0 (after printing why) on a malformed command line. */
+int parse_options(int argc, char **argv, HarnessOptions *out);
+
+/* Reads every given table file into its bytes; returns 0 when one cannot be read. */
+int load_tables(HarnessOptions *options);
+void free_tables(HarnessOptions *options);
+
+/* First ticks of one scenario run. */
+typedef struct RunResult {
+    long stop_tick;   /* POU stop tick, -1 if never stopped */
+    long exact_first; /* first tick the plain SAT handle collides, unstopped, -1 if never */
+} RunResult;
+
+/* A trajectory scenario in table mode (table_mode.c): the POU runs on the table, the exact
+ * model beside it; returns 0 when it could not start. */
+int run_table_scenario(const char *cell_name, const char *case_name, const HarnessTable *table, RunResult *result);
+
+/* The bad-input scenarios (bad_input.c): every documented error status, fail-closed outputs;
+ * table-mode ones when T1's table is loaded. */
+void bad_input(const HarnessOptions *options);
+
+#endif /* HARNESS_H */

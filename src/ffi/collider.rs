@@ -1,0 +1,196 @@
+//! The safe state behind the opaque `DcCollider` handle: an exact checker or a precomputed
+//! table, plus the per-tick buffers (thesis appendix A; table mode: thesis 3.2 query phase,
+//! SPEC §6). No `unsafe` here: `ffi/mod.rs` checks the pointers and calls these functions.
+//!
+//! Everything a tick needs is allocated when the collider is made; [`Collider::query`]
+//! allocates nothing in either mode.
+
+use crate::cell::exact::PairState;
+use crate::cell::{Cell, ExactChecker};
+use crate::ffi::convert::{cell_error_status, table_error_status};
+use crate::ffi::types::*;
+use crate::math::Vec3;
+use crate::table::{TableAnswer, TableChecker};
+use std::path::Path;
+
+/// Why a collider could not be made: the status for C and a message naming the cause and
+/// the fix (kept for `dc_last_init_error`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct InitError {
+    pub status: DcStatus,
+    pub message: String,
+}
+
+impl InitError {
+    pub(crate) fn new(status: DcStatus, message: impl Into<String>) -> Self {
+        InitError { status, message: message.into() }
+    }
+}
+
+/// How a collider answers.
+enum Checker {
+    /// Every box pair with the separating axis test (thesis 3.1).
+    Exact(ExactChecker),
+    /// One lookup in a table built offline for a two-robot cell (thesis 3.2).
+    Table(Box<TableChecker>),
+}
+
+/// A collider: its checker and the buffers of one tick.
+pub(crate) struct Collider {
+    checker: Checker,
+    /// The TCPs of the current query, converted; sized once.
+    tcps: Vec<Vec3>,
+    /// Table mode: whether the last query answered COLLISION (for `dc_pair_results`).
+    table_collides: bool,
+}
+
+impl Collider {
+    /// An exact-mode collider for `cell`.
+    pub(crate) fn exact(cell: Cell) -> Collider {
+        let n = cell.robots.len();
+        Collider {
+            checker: Checker::Exact(ExactChecker::new(cell)),
+            tcps: vec![Vec3::zeros(); n],
+            table_collides: false,
+        }
+    }
+
+    /// A table-mode collider for the two-robot `cell` from a table file's bytes, validated
+    /// and copied here (the caller's buffer is not kept).
+    pub(crate) fn table(cell: Cell, bytes: &[u8]) -> Result<Collider, InitError> {
+        if cell.robots.len() != 2 {
+            return Err(InitError::new(
+                DC_STATUS_TABLE_NOT_TWO_ROBOTS,
+                format!(
+                    "tables serve two-robot cells, this cell has {} robots; use dc_init (exact mode) for it",
+                    cell.robots.len()
+                ),
+            ));
+        }
+        let checker =
+            TableChecker::new(cell, bytes).map_err(|e| InitError::new(table_error_status(&e), e.to_string()))?;
+        Ok(Collider { checker: Checker::Table(Box::new(checker)), tcps: vec![Vec3::zeros(); 2], table_collides: false })
+    }
+
+    /// A table-mode collider from a TOML cell file and a table file, each read once, here.
+    pub(crate) fn from_files(cell_path: &Path, table_path: &Path) -> Result<Collider, InitError> {
+        let cell = Cell::from_file(cell_path).map_err(|e| InitError::new(cell_error_status(&e), e.to_string()))?;
+        let bytes = std::fs::read(table_path).map_err(|e| {
+            InitError::new(DC_STATUS_IO, format!("cannot read table file {}: {e}", table_path.display()))
+        })?;
+        Collider::table(cell, &bytes)
+    }
+
+    /// `DC_MODE_EXACT` or `DC_MODE_TABLE`.
+    pub(crate) fn mode(&self) -> DcMode {
+        match self.checker {
+            Checker::Exact(_) => DC_MODE_EXACT,
+            Checker::Table(_) => DC_MODE_TABLE,
+        }
+    }
+
+    /// Robots of the cell.
+    pub(crate) fn robot_count(&self) -> usize {
+        self.tcps.len()
+    }
+
+    /// Robot pairs reported by [`Collider::pair_results`]: those that can meet (exact mode),
+    /// or the one pair a table covers.
+    pub(crate) fn pair_count(&self) -> usize {
+        match &self.checker {
+            Checker::Exact(c) => c.verdict().pairs.len(),
+            Checker::Table(_) => 1,
+        }
+    }
+
+    /// Table mode: queries so far answered by the exact check because a TCP lay outside the
+    /// table's sampled grid; 0 in exact mode.
+    pub(crate) fn table_fallbacks(&self) -> u64 {
+        match &self.checker {
+            Checker::Exact(_) => 0,
+            Checker::Table(t) => t.fallbacks(),
+        }
+    }
+
+    /// The per-tick query: fills `report` (which starts as [`DcQueryReport::STOP`]) and
+    /// returns the status; the verdict in `report` is decided only with `DC_STATUS_OK`.
+    pub(crate) fn query(&mut self, tcps: &[DcVec3], report: &mut DcQueryReport) -> DcStatus {
+        self.table_collides = false;
+        if tcps.len() != self.tcps.len() {
+            return DC_STATUS_WRONG_ROBOT_COUNT;
+        }
+        let mut non_finite = 0u32;
+        for (j, (dst, src)) in self.tcps.iter_mut().zip(tcps).enumerate() {
+            non_finite |= (!src.is_finite() as u32) << j;
+            *dst = src.to_vec3();
+        }
+        if non_finite != 0 {
+            report.unreachable_mask = non_finite;
+            return DC_STATUS_NON_FINITE;
+        }
+        match &mut self.checker {
+            Checker::Exact(c) => query_exact(c, &self.tcps, report),
+            Checker::Table(t) => {
+                let status = query_table(t, &self.tcps, report);
+                self.table_collides = status == DC_STATUS_OK && report.verdict == DC_VERDICT_COLLISION;
+                status
+            }
+        }
+    }
+
+    /// Writes the per-pair results of the last query into `out[..pair_count()]`, which the
+    /// caller sized.
+    pub(crate) fn pair_results(&self, out: &mut [DcPairResult]) {
+        match &self.checker {
+            Checker::Exact(c) => {
+                for (o, p) in out.iter_mut().zip(&c.verdict().pairs) {
+                    let (collides, box_a, box_b) = match p.state {
+                        PairState::Collides(a, b) => (1, a as u32, b as u32),
+                        _ => (0, DC_BOX_NONE, DC_BOX_NONE),
+                    };
+                    *o = DcPairResult { robot_a: p.a as u32, robot_b: p.b as u32, collides, box_a, box_b };
+                }
+            }
+            Checker::Table(_) => {
+                let collides = u32::from(self.table_collides);
+                out[0] = DcPairResult { robot_a: 0, robot_b: 1, collides, box_a: DC_BOX_NONE, box_b: DC_BOX_NONE };
+            }
+        }
+    }
+}
+
+fn query_exact(checker: &mut ExactChecker, tcps: &[Vec3], report: &mut DcQueryReport) -> DcStatus {
+    let Ok(v) = checker.check(tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };
+    report.unreachable_mask = v.unreachable_mask;
+    report.colliding_pairs = v.colliding_pairs() as u32;
+    if let Some(p) = v.first_collision() {
+        if let PairState::Collides(ba, bb) = p.state {
+            (report.first_robot_a, report.first_robot_b) = (p.a as u32, p.b as u32);
+            (report.first_box_a, report.first_box_b) = (ba as u32, bb as u32);
+        }
+    }
+    if !v.all_reachable() {
+        return DC_STATUS_UNREACHABLE;
+    }
+    report.verdict = if v.collides() { DC_VERDICT_COLLISION } else { DC_VERDICT_FREE };
+    DC_STATUS_OK
+}
+
+fn query_table(checker: &mut TableChecker, tcps: &[Vec3], report: &mut DcQueryReport) -> DcStatus {
+    match checker.check(tcps) {
+        Err(_) => DC_STATUS_WRONG_ROBOT_COUNT,
+        Ok(TableAnswer::Unreachable(mask)) => {
+            report.unreachable_mask = mask;
+            DC_STATUS_UNREACHABLE
+        }
+        Ok(TableAnswer::Free) => {
+            report.verdict = DC_VERDICT_FREE;
+            DC_STATUS_OK
+        }
+        Ok(TableAnswer::Collision) => {
+            (report.verdict, report.colliding_pairs) = (DC_VERDICT_COLLISION, 1);
+            (report.first_robot_a, report.first_robot_b) = (0, 1);
+            DC_STATUS_OK
+        }
+    }
+}

@@ -1,0 +1,241 @@
+//! The C ABI's table mode (issue 3 item 6), exercised from Rust through the exported
+//! functions: every table error's own status and message with no handle, fail-closed
+//! reports and pair results, no FREE where the exact model collides, files like buffers.
+//! Tables of T1 and T2 are built here at k = 16.
+
+mod ffi_common;
+
+use delta_collide::ffi::*;
+use ffi_common::*;
+
+#[test]
+fn table_init_gives_each_table_error_its_own_status_and_no_handle() {
+    let t1 = table_bytes("T1");
+    let t1_config = Config::cell(450.0, 2);
+    let config = t1_config.c();
+    let with = |f: &dyn Fn(&mut Vec<u8>)| {
+        let mut b = t1.to_vec();
+        f(&mut b);
+        b
+    };
+    let mut cases: Vec<(String, Vec<u8>, DcStatus, &str)> = vec![
+        ("T2's table for T1".into(), table_bytes("T2").to_vec(), DC_STATUS_TABLE_WRONG_CELL, "built for cell"),
+        ("bad magic".into(), with(&|b| b[0] = b'X'), DC_STATUS_TABLE_BAD_MAGIC, "magic"),
+        (
+            "byte-swapped endianness marker".into(),
+            with(&|b| b[8..12].reverse()),
+            DC_STATUS_TABLE_WRONG_ENDIANNESS,
+            "big-endian",
+        ),
+        ("version 99".into(), with(&|b| b[12] = 99), DC_STATUS_TABLE_UNSUPPORTED_VERSION, "version 99"),
+        ("one trailing byte".into(), with(&|b| b.push(0)), DC_STATUS_TABLE_CORRUPT, "trailing"),
+        (
+            "flipped bit in the checksum".into(),
+            with(&|b| *b.last_mut().unwrap() ^= 0x10),
+            DC_STATUS_TABLE_CORRUPT,
+            "checksum",
+        ),
+    ];
+    for at in [200, t1.len() / 2, t1.len() - 9] {
+        cases.push((format!("bit flipped at {at}"), with(&|b| b[at] ^= 1), DC_STATUS_TABLE_CORRUPT, "corrupt"));
+    }
+    for len in [0, 1, 7, 8, 100, 183, 184, 191, t1.len() / 2, t1.len() - 8, t1.len() - 1] {
+        cases.push((format!("truncated to {len} bytes"), t1[..len].to_vec(), DC_STATUS_TABLE_TRUNCATED, "truncated"));
+    }
+    for (what, bytes, want, says) in &cases {
+        let (s, h) = init_table(&config, bytes);
+        assert_eq!(s, *want, "{what}");
+        assert!(h.is_null(), "{what}: no handle on failure");
+        let message = last_init_error();
+        assert!(message.contains(says), "{what}: message {message:?} does not say {says:?}");
+        assert!(
+            ["rebuild", "copy", "check"].iter().any(|fix| message.contains(fix)),
+            "{what}: message {message:?} names no fix"
+        );
+        // A failed init leaves a NULL handle, which queries as NULL_POINTER and STOP.
+        let (s, verdict, _) = query(h, &[v(0.0, 0.0, -450.0); 2]);
+        assert_eq!((s, verdict), (DC_STATUS_NULL_POINTER, DC_VERDICT_STOP), "{what}");
+    }
+    // Tables serve two-robot cells only; a bad config is reported before the table is read.
+    for (n, want) in
+        [(1, DC_STATUS_TABLE_NOT_TWO_ROBOTS), (3, DC_STATUS_TABLE_NOT_TWO_ROBOTS), (0, DC_STATUS_INVALID_CONFIG)]
+    {
+        let (s, h) = init_table(&Config::cell(450.0, n).c(), t1);
+        assert_eq!((s, h.is_null()), (want, true), "{n} robots");
+    }
+    assert!(last_init_error().contains("n_robots = 0"), "{}", last_init_error());
+    let mut h = std::ptr::null_mut();
+    // SAFETY: NULL config, NULL table and NULL out_handle are the inputs under test.
+    unsafe {
+        assert_eq!(dc_init_with_table(std::ptr::null(), t1.as_ptr(), t1.len(), &mut h), DC_STATUS_NULL_POINTER);
+        assert_eq!(dc_init_with_table(&config, std::ptr::null(), 0, &mut h), DC_STATUS_NULL_POINTER);
+        assert!(last_init_error().contains("table is NULL"));
+        assert_eq!(dc_init_with_table(&config, t1.as_ptr(), t1.len(), std::ptr::null_mut()), DC_STATUS_NULL_POINTER);
+        assert!(last_init_error().contains("out_handle"));
+        // Asking for the length only, and a buffer too small: cut, NUL-terminated.
+        let n = dc_last_init_error(std::ptr::null_mut(), 0);
+        let mut small = [0x55u8; 8];
+        assert_eq!(dc_last_init_error(small.as_mut_ptr().cast(), small.len()), n);
+        assert_eq!(&small[..], b"out_han\0");
+    }
+    let h = t1_table_handle();
+    assert_eq!(last_init_error(), "", "a successful init clears the message");
+    // SAFETY: live handle, destroyed once.
+    unsafe { dc_destroy(h) };
+}
+
+#[test]
+fn table_mode_reports_fail_closed_and_pair_results() {
+    let h = t1_table_handle();
+    let exact = two_robot_cell(450.0, DC_METHOD_SAT);
+    // SAFETY: live handles and NULL.
+    unsafe {
+        assert_eq!(
+            (dc_mode(h), dc_mode(exact), dc_mode(std::ptr::null())),
+            (DC_MODE_TABLE, DC_MODE_EXACT, DC_MODE_NONE)
+        );
+        assert_eq!((dc_robot_count(h), dc_pair_count(h), dc_table_fallbacks(exact)), (2, 1, 0));
+    }
+    let pair = |h| {
+        let mut out = [DcPairResult { robot_a: 9, robot_b: 9, collides: 9, box_a: 9, box_b: 9 }; 2];
+        let mut len = 0;
+        // SAFETY: live handle, valid buffers.
+        assert_eq!(unsafe { dc_pair_results(h, out.as_mut_ptr(), 2, &mut len) }, DC_STATUS_OK);
+        assert_eq!(len, 1);
+        out[0]
+    };
+    let none = |collides| DcPairResult { robot_a: 0, robot_b: 1, collides, box_a: DC_BOX_NONE, box_b: DC_BOX_NONE };
+    let (s, verdict, r) = query(h, &[v(180.0, 0.0, -450.0), v(-180.0, 0.0, -450.0)]);
+    assert_eq!(
+        (s, verdict, r.colliding_pairs, r.first_robot_a, r.first_robot_b),
+        (DC_STATUS_OK, DC_VERDICT_COLLISION, 1, 0, 1)
+    );
+    assert_eq!((r.first_box_a, r.first_box_b, r.unreachable_mask), (DC_BOX_NONE, DC_BOX_NONE, 0));
+    assert_eq!(pair(h), none(1));
+    let (s, verdict, r) = query(h, &[v(-150.0, 0.0, -450.0), v(150.0, 0.0, -450.0)]);
+    assert_eq!((s, verdict, r.colliding_pairs, r.first_robot_a), (DC_STATUS_OK, DC_VERDICT_FREE, 0, DC_BOX_NONE));
+    assert_eq!(pair(h), none(0));
+    let home = v(0.0, 0.0, -450.0);
+    assert_eq!(query(h, &[v(180.0, 0.0, -450.0), v(-180.0, 0.0, -450.0)]).1, DC_VERDICT_COLLISION);
+    for (tcps, want, mask) in [
+        (vec![home, v(f64::NAN, 0.0, -450.0)], DC_STATUS_NON_FINITE, 0b10),
+        (vec![v(0.0, f64::NEG_INFINITY, -450.0), home], DC_STATUS_NON_FINITE, 0b01),
+        (vec![v(0.0, 0.0, -900.0), home], DC_STATUS_UNREACHABLE, 0b01),
+        (vec![v(0.0, 0.0, 100.0), v(400.0, 0.0, -450.0)], DC_STATUS_UNREACHABLE, 0b11),
+        (vec![home], DC_STATUS_WRONG_ROBOT_COUNT, 0),
+        (vec![home; 3], DC_STATUS_WRONG_ROBOT_COUNT, 0),
+    ] {
+        let (s, _, r) = query(h, &tcps);
+        assert_eq!((s, r.unreachable_mask), (want, mask), "{tcps:?}");
+        assert_eq!(pair(h), none(0), "after a failed query the pair is not reported colliding");
+    }
+    let mut verdict = DC_VERDICT_FREE;
+    // SAFETY: NULL tcps and NULL out_verdict are the inputs under test.
+    unsafe {
+        assert_eq!(dc_query(h, std::ptr::null(), 2, &mut verdict, std::ptr::null_mut()), DC_STATUS_NULL_POINTER);
+        assert_eq!(verdict, DC_VERDICT_STOP);
+        assert_eq!(
+            dc_query(h, [home, home].as_ptr(), 2, std::ptr::null_mut(), std::ptr::null_mut()),
+            DC_STATUS_NULL_POINTER
+        );
+        dc_destroy(h);
+        dc_destroy(exact);
+    }
+}
+
+#[test]
+fn table_mode_never_answers_free_where_the_exact_model_collides() {
+    let h = t1_table_handle();
+    let exact = two_robot_cell(450.0, DC_METHOD_SAT);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = |lo: f64, hi: f64| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut both, mut table_only, mut free, mut unreachable) = (0, 0, 0, 0);
+    for i in 0..100_000 {
+        // Robot A's TCP reaching toward B and B's toward A, often overlapping.
+        let tcps = [
+            v(uniform(-100.0, 260.0), uniform(-200.0, 200.0), uniform(-540.0, -360.0)),
+            v(uniform(-260.0, 100.0), uniform(-200.0, 200.0), uniform(-540.0, -360.0)),
+        ];
+        let (st, vt, _) = query(h, &tcps);
+        let (se, ve, _) = query(exact, &tcps);
+        assert_eq!(st, se, "case {i}: {tcps:?}: both modes agree on reachability");
+        match (se, ve, vt) {
+            (DC_STATUS_UNREACHABLE, ..) => unreachable += 1,
+            (_, DC_VERDICT_COLLISION, DC_VERDICT_COLLISION) => both += 1,
+            (_, DC_VERDICT_COLLISION, _) => panic!("case {i}: the table says FREE, the exact model collides: {tcps:?}"),
+            (_, _, DC_VERDICT_COLLISION) => table_only += 1,
+            _ => free += 1,
+        }
+    }
+    println!("100,000 configurations: {both} collide, {table_only} only the table stops, {free} free, {unreachable} unreachable");
+    assert!(both > 1000 && free > 1000 && unreachable > 0, "the sample covers every outcome");
+    // SAFETY: live handles.
+    unsafe {
+        dc_destroy(h);
+        dc_destroy(exact);
+    }
+}
+
+#[test]
+fn table_files_init_the_same_checker_as_buffers() {
+    let dir = std::env::temp_dir().join(format!("dc-ffi-table-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let table_path = dir.join("t1_k16.dct");
+    std::fs::write(&table_path, table_bytes("T1")).unwrap();
+    std::fs::write(dir.join("t1_cut.dct"), &table_bytes("T1")[..1000]).unwrap();
+    std::fs::write(dir.join("bad.toml"), "[[robot]]\nmodel = { margn = 1 }\n").unwrap();
+    let c = |p: std::path::PathBuf| format!("{}\0", p.display());
+    let t1_cell = concat!(env!("CARGO_MANIFEST_DIR"), "/cells/t1.toml\0").to_string();
+    let t2_cell = concat!(env!("CARGO_MANIFEST_DIR"), "/cells/t2.toml\0").to_string();
+    let cases = [
+        (t1_cell.clone(), c(table_path.clone()), DC_STATUS_OK),
+        (t2_cell, c(table_path.clone()), DC_STATUS_TABLE_WRONG_CELL),
+        (t1_cell.clone(), c(dir.join("t1_cut.dct")), DC_STATUS_TABLE_TRUNCATED),
+        (t1_cell.clone(), c(dir.join("missing.dct")), DC_STATUS_IO),
+        (c(dir.join("missing.toml")), c(table_path.clone()), DC_STATUS_IO),
+        (c(dir.join("bad.toml")), c(table_path.clone()), DC_STATUS_PARSE),
+    ];
+    let from_buffer = t1_table_handle();
+    for (cell, table, want) in &cases {
+        let mut h = 8 as *mut DcCollider;
+        // SAFETY: NUL-terminated paths, valid out pointer.
+        let s = unsafe { dc_init_from_files(cell.as_ptr().cast(), table.as_ptr().cast(), &mut h) };
+        assert_eq!((s, h.is_null()), (*want, *want != DC_STATUS_OK), "{cell} {table}: {}", last_init_error());
+        if *want == DC_STATUS_IO {
+            assert!(last_init_error().contains("missing"), "the message names the file: {}", last_init_error());
+        }
+        if s == DC_STATUS_OK {
+            // SAFETY: live handle.
+            assert_eq!(unsafe { dc_mode(h) }, DC_MODE_TABLE);
+            for k in 0..400 {
+                let s = k as f64 / 400.0;
+                let tcps = [v(-150.0 + 350.0 * s, 0.0, -450.0), v(150.0 - 350.0 * s, 10.0, -450.0)];
+                assert_eq!(query(h, &tcps).1, query(from_buffer, &tcps).1, "step {k}");
+            }
+        }
+        // SAFETY: live or NULL handle.
+        unsafe { dc_destroy(h) };
+    }
+    let mut h = std::ptr::null_mut();
+    // SAFETY: NULL and non-UTF-8 paths are the inputs under test.
+    unsafe {
+        assert_eq!(dc_init_from_files(std::ptr::null(), cases[0].1.as_ptr().cast(), &mut h), DC_STATUS_NULL_POINTER);
+        assert!(last_init_error().contains("cell_path"));
+        assert_eq!(dc_init_from_files(t1_cell.as_ptr().cast(), std::ptr::null(), &mut h), DC_STATUS_NULL_POINTER);
+        assert!(last_init_error().contains("table_path"));
+        let not_utf8 = c"/tmp/\xff\xfe.dct";
+        assert_eq!(dc_init_from_files(t1_cell.as_ptr().cast(), not_utf8.as_ptr(), &mut h), DC_STATUS_INVALID_ARGUMENT);
+        assert_eq!(
+            dc_init_from_files(t1_cell.as_ptr().cast(), cases[0].1.as_ptr().cast(), std::ptr::null_mut()),
+            DC_STATUS_NULL_POINTER
+        );
+        assert!(h.is_null());
+        dc_destroy(from_buffer);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
