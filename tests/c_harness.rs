@@ -12,7 +12,7 @@
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::Workspace;
-use delta_collide::table::{build_table, to_bytes, Labelling, Variant};
+use delta_collide::table::{build_tables, to_bytes, Labelling, Variant};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
@@ -116,41 +116,66 @@ fn plain_harness() -> &'static Path {
     EXE.get_or_init(|| compile_harness("c_harness", &[]))
 }
 
-/// The table file of `CELLS[c]` (the same pipeline as `delta-collide build --cell T1 --k 32
-/// --variant 6d`). Building T1, T2, T3 takes about 3 s, 10 s and 3 s in release on two idle
-/// cores, so the file is kept in `CARGO_TARGET_TMPDIR` and reused while this test executable
-/// (which holds the table builder) is unchanged: a rebuilt executable rebuilds the tables.
-/// Each cell has its own lock, so a test that needs T1's table only does not wait for others.
-fn table_file(c: usize) -> &'static Path {
-    static FILES: [OnceLock<PathBuf>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+/// The table kinds the harness runs on: the thesis's 6-D linear quadtree and the shared 6-D
+/// quadtree (issue 4), both built from one certified labelling.
+const KINDS: [(&str, Variant); 2] = [("6d", Variant::D6), ("shared", Variant::Shared)];
+
+/// The table files of `CELLS[c]`, one per [`KINDS`] (the pipeline of `delta-collide build
+/// --cell T1 --k 32 --variant 6d|shared`). Labelling T1, T2, T3 takes about 3 s, 10 s and
+/// 3 s in release on two idle cores, so the files are kept in `CARGO_TARGET_TMPDIR` and reused
+/// while this test executable (which holds the table builder) is unchanged: a rebuilt
+/// executable rebuilds the tables. Each cell has its own lock, so a test that needs T1's
+/// tables only does not wait for others.
+fn table_files(c: usize) -> &'static [PathBuf] {
+    static FILES: [OnceLock<Vec<PathBuf>>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
     FILES[c].get_or_init(|| {
         let name = CELLS[c];
-        let path = scratch_dir("c_harness_tables").join(format!("{name}_k{TABLE_K}_6d.dct"));
-        let stamp = path.with_extension("dct.builder");
+        let dir = scratch_dir("c_harness_tables");
+        let paths: Vec<PathBuf> =
+            KINDS.iter().map(|(kind, _)| dir.join(format!("{name}_k{TABLE_K}_{kind}.dct"))).collect();
+        let stamp = dir.join(format!("{name}_k{TABLE_K}.builder"));
         let exe = std::fs::metadata(std::env::current_exe().expect("test executable")).expect("stat test executable");
         let modified = exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
         let builder = format!("{} bytes, modified {:?}, k = {TABLE_K}", exe.len(), modified.unwrap_or_default());
-        if path.is_file() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder) {
-            println!("{name}: table reused from {} (same test executable)", path.display());
-            return path;
+        if paths.iter().all(|p| p.is_file()) && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder) {
+            println!("{name}: tables reused from {} (same test executable)", dir.display());
+            return paths;
         }
         let cell = reference_cell(name).expect("reference cell");
         let start = std::time::Instant::now();
-        let (header, table, _) =
-            build_table(&cell, TABLE_K, &Workspace::THESIS, Variant::D6, Labelling::Certified, false)
-                .unwrap_or_else(|e| panic!("building the {name} table: {e}"));
-        let bytes = to_bytes(&table, &header);
+        let variants: Vec<Variant> = KINDS.iter().map(|&(_, v)| v).collect();
+        let (header, tables, _) =
+            build_tables(&cell, TABLE_K, &Workspace::THESIS, &variants, Labelling::Certified, false)
+                .unwrap_or_else(|e| panic!("building the {name} tables: {e}"));
         let _ = std::fs::remove_file(&stamp);
-        std::fs::write(&path, &bytes).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+        for (path, table) in paths.iter().zip(&tables) {
+            let bytes = to_bytes(table, &header);
+            std::fs::write(path, &bytes).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+            println!("{name}: {} table k = {TABLE_K}, {} bytes", table.name(), bytes.len());
+        }
         std::fs::write(&stamp, builder).unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
-        println!("{name}: table k = {TABLE_K}, {} bytes, built in {:.1} s", bytes.len(), start.elapsed().as_secs_f64());
-        path
+        println!("{name}: tables built in {:.1} s", start.elapsed().as_secs_f64());
+        paths
     })
 }
 
-/// `--table T1=... --table T2=... --table T3=...` for the given cells.
+/// The 6-D table file of `CELLS[c]`.
+fn table_file(c: usize) -> &'static Path {
+    &table_files(c)[0]
+}
+
+/// `--table T1=... --table T2=... --table T3=...` for the given cells, table kind `kind`
+/// (an index into [`KINDS`]).
+fn table_args_of(cells: &[usize], kind: usize) -> Vec<String> {
+    cells
+        .iter()
+        .flat_map(|&c| ["--table".to_string(), format!("{}={}", CELLS[c], table_files(c)[kind].display())])
+        .collect()
+}
+
+/// `--table` arguments of the 6-D tables.
 fn table_args(cells: &[usize]) -> Vec<String> {
-    cells.iter().flat_map(|&c| ["--table".to_string(), format!("{}={}", CELLS[c], table_file(c).display())]).collect()
+    table_args_of(cells, 0)
 }
 
 /// Checks the harness's verdict line and exit status; returns its stdout.
@@ -181,10 +206,21 @@ fn summaries(stdout: &str) -> Vec<(String, String, Option<u64>, Option<u64>)> {
 
 #[test]
 fn c_harness_passes_in_exact_and_table_mode() {
+    harness_passes_with_tables(0);
+}
+
+/// The same scenarios on the shared 6-D quadtree (issue 4 item 3).
+#[test]
+fn c_harness_passes_on_the_shared_table() {
+    harness_passes_with_tables(1);
+}
+
+fn harness_passes_with_tables(kind: usize) {
     let exe = plain_harness();
-    let tmp = scratch_dir("c_harness");
-    let out = run(Command::new(exe).arg("--tmp").arg(&tmp).args(table_args(&[0, 1, 2])).current_dir(repo_root()));
-    let stdout = assert_harness_passed("c_harness (exact and table mode, T1 T2 T3)", &out);
+    let tmp = scratch_dir(&format!("c_harness_{}", KINDS[kind].0));
+    let out =
+        run(Command::new(exe).arg("--tmp").arg(&tmp).args(table_args_of(&[0, 1, 2], kind)).current_dir(repo_root()));
+    let stdout = assert_harness_passed(&format!("c_harness (exact and {} table mode, T1 T2 T3)", KINDS[kind].0), &out);
     assert!(stdout.contains("bad input: done (exact and table mode)"), "table-mode bad inputs did not run");
     let runs = summaries(&stdout);
     assert_eq!(runs.len(), 6, "one table-mode summary per cell and case: {runs:?}");

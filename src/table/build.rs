@@ -14,7 +14,7 @@ use crate::cell::Cell;
 use crate::cspace::certify::label_space_certified;
 use crate::cspace::label::label_space_thesis;
 use crate::cspace::symmetry::reflection_y;
-use crate::cspace::{Label, LabelledSpace, Workspace};
+use crate::cspace::{Label, Workspace};
 use crate::table::{
     Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
 };
@@ -81,6 +81,24 @@ pub fn build_table(
     labelling: Labelling,
     progress: bool,
 ) -> Result<(Header, Table, BuildReport), String> {
+    let (header, mut tables, report) = build_tables(cell, k, ws, &[variant], labelling, progress)?;
+    let table = tables.pop().ok_or("no table built")?;
+    Ok((header, table, report))
+}
+
+/// As [`build_table`] for several variants from one labelling (the tables in `variants`'
+/// order; `build_secs` is their sum).
+///
+/// # Errors
+/// As [`build_table`].
+pub fn build_tables(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    variants: &[Variant],
+    labelling: Labelling,
+    progress: bool,
+) -> Result<(Header, Vec<Table>, BuildReport), String> {
     if cell.robots.len() != 2 {
         return Err(format!("tables are built for two-robot cells; {} has {}", cell.name, cell.robots.len()));
     }
@@ -90,29 +108,32 @@ pub fn build_table(
         Labelling::ThesisMargin => (label_space_thesis(cell, k, ws, progress)?, Certification::ThesisBlowUp),
     };
     let label_secs = start.elapsed().as_secs_f64();
-    let report = |space: &LabelledSpace, symmetric, build_secs| BuildReport {
+    let symmetric = reflection_y(cell);
+    let mut report = BuildReport {
         samples: (space.grid_a.cells.len(), space.grid_b.cells.len()),
         pairs: space.labels.len(),
         collisions: space.labels.iter().filter(|&&l| l == Label::Collision).count(),
         unreachable: space.labels.iter().filter(|&&l| l == Label::Unreachable).count(),
         symmetric,
         label_secs,
-        build_secs,
+        build_secs: 0.0,
     };
-    let symmetric = reflection_y(cell);
-    let mut summary = report(&space, symmetric, 0.0);
     if labelling == Labelling::ThesisMargin {
         space.labels.iter_mut().filter(|l| **l == Label::Unreachable).for_each(|l| *l = Label::Collision);
     }
     let start = Instant::now();
-    let table = match variant {
-        Variant::D6 => Table::D6(LinearQuadtree6d::build(&space, symmetric).map_err(|e| e.to_string())?),
-        Variant::D5 => Table::D5(LinearQuadtree5d::build(&space, symmetric).map_err(|e| e.to_string())?),
-        Variant::D4 { axes, t } => {
-            Table::D4(LinearQuadtree4d::build(&space, symmetric, axes, t).map_err(|e| e.to_string())?)
-        }
-        Variant::Shared => Table::Shared(SharedQuadtree6d::build(&space, symmetric).map_err(|e| e.to_string())?),
-    };
-    summary.build_secs = start.elapsed().as_secs_f64();
-    Ok((Header::for_space(&space, cell.fingerprint(), *ws, certification), table, summary))
+    let tables = variants
+        .iter()
+        .map(|&variant| {
+            let table = match variant {
+                Variant::D6 => LinearQuadtree6d::build(&space, symmetric).map(Table::D6),
+                Variant::D5 => LinearQuadtree5d::build(&space, symmetric).map(Table::D5),
+                Variant::D4 { axes, t } => LinearQuadtree4d::build(&space, symmetric, axes, t).map(Table::D4),
+                Variant::Shared => SharedQuadtree6d::build(&space, symmetric).map(Table::Shared),
+            };
+            table.map_err(|e| e.to_string())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    report.build_secs = start.elapsed().as_secs_f64();
+    Ok((Header::for_space(&space, cell.fingerprint(), *ws, certification), tables, report))
 }

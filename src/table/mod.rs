@@ -24,7 +24,7 @@ pub mod synthetic;
 #[cfg(test)]
 mod agreement_tests;
 
-pub use build::{build_table, BuildReport, Labelling, Variant};
+pub use build::{build_table, build_tables, BuildReport, Labelling, Variant};
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
 pub use lookup::{TableAnswer, TableChecker};
