@@ -7,7 +7,7 @@ use delta_collide::cell::ExactChecker;
 use delta_collide::cspace::Workspace;
 use delta_collide::math::Vec3;
 use delta_collide::table::{
-    build_table, to_bytes, Labelling, SliceAxes, TableAnswer, TableChecker, TableError, Variant,
+    build_table, build_tables, to_bytes, Labelling, SliceAxes, TableAnswer, TableChecker, TableError, Variant,
 };
 use rand::{RngExt, SeedableRng};
 
@@ -26,17 +26,15 @@ fn every_variant_has_no_false_negative_on_random_configurations() {
         Variant::D4 { axes: SliceAxes::YY, t: 0 },
         Variant::D4 { axes: SliceAxes::ZZ, t: 0 },
         Variant::D4 { axes: SliceAxes::YY, t: 50 },
+        Variant::Shared,
+        Variant::SharedSubdivided,
     ];
-    let mut checkers: Vec<TableChecker> = variants
-        .iter()
-        .map(|&v| {
-            let (header, table, _) =
-                build_table(&cell, 16, &Workspace::THESIS, v, Labelling::Certified, false).unwrap();
-            TableChecker::new(cell.clone(), &to_bytes(&table, &header)).unwrap()
-        })
-        .collect();
+    let (header, tables, _) =
+        build_tables(&cell, 16, &Workspace::THESIS, &variants, Labelling::Certified, false).unwrap();
+    let mut checkers: Vec<TableChecker> =
+        tables.iter().map(|t| TableChecker::new(cell.clone(), &to_bytes(t, &header)).unwrap()).collect();
     let mut rng = rand::rngs::StdRng::seed_from_u64(7);
-    let (mut hits, mut frees) = (0, 0);
+    let (mut hits, mut frees, mut sub_freed) = (0, 0, 0);
     for _ in 0..200_000 {
         let tcps = [random_tcp(&mut rng), random_tcp(&mut rng)];
         let v = exact.check(&tcps).unwrap();
@@ -49,13 +47,17 @@ fn every_variant_has_no_false_negative_on_random_configurations() {
                 TableAnswer::Collision => assert!(reachable),
             }
         }
-        // Lossless variants answer alike.
+        // Lossless variants answer alike; sub-cells only turn collisions into free.
         assert!(answers[..4].windows(2).all(|w| w[0] == w[1]), "lossless variants disagree at {tcps:?}");
+        assert_eq!(answers[5], answers[0], "the shared table disagrees with the 6-D table at {tcps:?}");
+        assert!(answers[6] == answers[0] || answers[0] == TableAnswer::Collision, "sub-cells freed a free cell?");
+        sub_freed += usize::from(answers[6] == TableAnswer::Free && answers[0] == TableAnswer::Collision);
         hits += collides as usize;
         frees += (answers[0] == TableAnswer::Free) as usize;
     }
     assert!(hits > 1000 && frees > 10_000, "the sample covers both sides ({hits} collisions, {frees} table-free)");
     assert!(checkers.iter().all(|c| c.fallbacks() > 0), "some TCPs fall outside the sampled grid");
+    assert!(sub_freed > 100, "sub-cells prove some configurations of collision cells free ({sub_freed})");
 }
 
 #[test]

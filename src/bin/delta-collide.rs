@@ -4,7 +4,7 @@
 //! ```text
 //! delta-collide demo  [--cell T1|T2|T3|all|FILE.toml]
 //! delta-collide check --cell T1|FILE.toml [--table FILE.dct] [--input FILE.csv] [--output FILE.csv]
-//! delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz|shared] [--t 0] [--labelling certified|thesis]
+//! delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz|shared|shared-sub] [--t 0] [--labelling certified|thesis]
 //! delta-collide inspect FILE.dct
 //! delta-collide eval  --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S]
 //! ```
@@ -31,7 +31,7 @@ const USAGE: &str = "usage:
       reads rows x,y,z,x2,y2,z2 (one TCP per robot, each in its own MCS; stdin by default),
       writes one line `reachable,collide` per row (stdout by default); collide is NA when a
       TCP is unreachable; with --table the answers come from the table
-  delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz|shared]
+  delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz|shared|shared-sub]
                       [--t 0] [--labelling certified|thesis]
       samples, labels (certified per-cell bounds by default) and builds a table file
   delta-collide inspect FILE.dct
@@ -258,7 +258,8 @@ fn build(args: &[String]) -> Result<(), String> {
         "4d-yy" => Variant::D4 { axes: SliceAxes::YY, t },
         "4d-zz" => Variant::D4 { axes: SliceAxes::ZZ, t },
         "shared" => Variant::Shared,
-        v => return Err(format!("--variant {v}: use 6d, 5d, 4d-yy, 4d-zz or shared")),
+        "shared-sub" => Variant::SharedSubdivided,
+        v => return Err(format!("--variant {v}: use 6d, 5d, 4d-yy, 4d-zz, shared or shared-sub")),
     };
     let labelling = match option(args, "--labelling")?.unwrap_or("certified") {
         "certified" => Labelling::Certified,

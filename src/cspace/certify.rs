@@ -52,6 +52,39 @@ pub struct CertifiedSpace {
     pub bounds_b: Vec<[Real; MAX_BOXES]>,
     /// Whether level 2 (octant refinement) was used.
     pub refined: bool,
+    /// With [`label_space_subdivided`]: the sub-cell labels of every pair labelled collision.
+    pub sub: Option<SubCells>,
+}
+
+/// Sub-cell labels of the pairs labelled collision: each such 6-D cell cut into its 64
+/// sub-cells (A's octant `i` x B's octant `j`), each proved free or not with the octants'
+/// own bounds (issue 4: adaptive resolution where the labels change).
+///
+/// Bit `c` of a mask is the sub-cell with child index `c = ax << 5 | ay << 4 | az << 3 |
+/// bx << 2 | by << 1 | bz` (octant bits x, y, z of A then B; the order of
+/// [`crate::table::code`]). A sub-cell outside `care` holds no reachable TCP of A or of B
+/// ("don't care"); one in `collision` could not be proved free.
+#[derive(Clone, Debug, PartialEq, Eq, Default)]
+pub struct SubCells {
+    /// Pair indices `ia * nb + ib`, increasing.
+    pub pairs: Vec<u64>,
+    /// Per pair: the sub-cells that hold reachable TCPs of both robots.
+    pub care: Vec<u64>,
+    /// Per pair: the sub-cells not proved free.
+    pub collision: Vec<u64>,
+}
+
+impl SubCells {
+    /// `(care, collision)` of pair `(ia, ib)`, or `None` when it was not subdivided.
+    pub fn get(&self, pair: u64) -> Option<(u64, u64)> {
+        self.pairs.binary_search(&pair).ok().map(|i| (self.care[i], self.collision[i]))
+    }
+}
+
+/// The child index of A's octant `i` and B's octant `j` (octant bits x, y, z = 0, 1, 2).
+pub fn sub_cell_index(i: usize, j: usize) -> u32 {
+    let b = |o: usize, bit: usize| (o >> bit & 1) as u32;
+    b(i, 0) << 5 | b(i, 1) << 4 | b(i, 2) << 3 | b(j, 0) << 2 | b(j, 1) << 1 | b(j, 2)
 }
 
 impl CertifiedSpace {
@@ -75,6 +108,15 @@ pub fn label_space_certified(cell: &Cell, k: u32, ws: &Workspace, progress: bool
     label_space_certified_with(cell, k, ws, true, progress)
 }
 
+/// As [`label_space_certified`], and every pair labelled collision is subdivided into its 64
+/// sub-cells, each certified with the octants' bounds ([`CertifiedSpace::sub`]).
+///
+/// # Errors
+/// As [`crate::cspace::label_space`].
+pub fn label_space_subdivided(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<CertifiedSpace, String> {
+    label_space_certified_inner(cell, k, ws, true, true, progress)
+}
+
 /// As [`label_space_certified`]; `refine = false` stops at level 1 (whole-cell bounds only).
 ///
 /// # Errors
@@ -84,6 +126,17 @@ pub fn label_space_certified_with(
     k: u32,
     ws: &Workspace,
     refine: bool,
+    progress: bool,
+) -> Result<CertifiedSpace, String> {
+    label_space_certified_inner(cell, k, ws, refine, false, progress)
+}
+
+fn label_space_certified_inner(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    refine: bool,
+    subdivide: bool,
     progress: bool,
 ) -> Result<CertifiedSpace, String> {
     let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
@@ -117,13 +170,87 @@ pub fn label_space_certified_with(
         let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&a0, &a1, &b0, &b1, ia, ib);
         let mut labels = label_pairs(&a0, &b0, collides, progress);
         refine_unknown_cells(&a0, &a1, &b0, &b1, &mut labels);
-        labels
+        let sub = subdivide.then(|| sub_cells(&a0, &a1, &b0, &b1, &labels));
+        (labels, sub)
     } else {
-        label_pairs(&a0, &b0, |_, _| true, progress)
+        (label_pairs(&a0, &b0, |_, _| true, progress), None)
     };
+    let (labels, sub) = labels;
     let used = |bs: &[[Real; MAX_BOXES]]| bs.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0, Real::max);
     let margin = used(&bounds_a).max(used(&bounds_b));
-    Ok(CertifiedSpace { space: LabelledSpace { grid_a, grid_b, labels, margin }, bounds_a, bounds_b, refined: refine })
+    let space = LabelledSpace { grid_a, grid_b, labels, margin };
+    Ok(CertifiedSpace { space, bounds_a, bounds_b, refined: refine, sub })
+}
+
+/// The sub-cell labels of every pair labelled collision (see [`SubCells`]).
+fn sub_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBoxes, labels: &[Label]) -> SubCells {
+    let nb = b0.len();
+    if nb == 0 {
+        return SubCells::default();
+    }
+    let rows: Vec<Vec<(u64, u64, u64)>> = labels
+        .par_chunks(nb)
+        .enumerate()
+        .map(|(ia, row)| {
+            row.iter()
+                .enumerate()
+                .filter(|&(_, &l)| l == Label::Collision)
+                .map(|(ib, _)| {
+                    let (care, collision) = octant_pairs(a0, a1, b0, b1, ia, ib);
+                    ((ia * nb + ib) as u64, care, collision)
+                })
+                .collect()
+        })
+        .collect();
+    let mut out = SubCells::default();
+    for (pair, care, collision) in rows.into_iter().flatten() {
+        out.pairs.push(pair);
+        out.care.push(care);
+        out.collision.push(collision);
+    }
+    out
+}
+
+/// `(care, collision)` over the 64 octant pairs of `(ia, ib)`: an octant pair is free when
+/// every box pair is proved disjoint by one of the tests (A cell, B cell), (A octant,
+/// B cell), (A cell, B octant) or (A octant, B octant), each valid for all of it.
+fn octant_pairs(
+    a0: &SampleBoxes,
+    a1: &SampleBoxes,
+    b0: &SampleBoxes,
+    b1: &SampleBoxes,
+    ia: usize,
+    ib: usize,
+) -> (u64, u64) {
+    let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
+    let all = all_box_pairs(a0.per_entry, b0.per_entry);
+    let open0 = if whole_a && whole_b { collision_mask(a0, ia, b0, ib, all) } else { all };
+    let (mut care, mut collision) = (0u64, 0u64);
+    for i in 0..8 {
+        let sa = 8 * ia + i;
+        let a_slot = a1.slot[sa];
+        if a_slot == Slot::Vacuous {
+            continue;
+        }
+        let open_a = if a_slot == Slot::Boxes && whole_b { collision_mask(a1, sa, b0, ib, open0) } else { open0 };
+        for j in 0..8 {
+            let sb = 8 * ib + j;
+            let b_slot = b1.slot[sb];
+            if b_slot == Slot::Vacuous {
+                continue;
+            }
+            let bit = 1u64 << sub_cell_index(i, j);
+            care |= bit;
+            let proved = a_slot == Slot::Boxes && b_slot == Slot::Boxes && {
+                let open = if whole_a { collision_mask(a0, ia, b1, sb, open_a) } else { open_a };
+                open == 0 || entries_apart(a1, sa, b1, sb) || collision_mask(a1, sa, b1, sb, open) == 0
+            };
+            if !proved {
+                collision |= bit;
+            }
+        }
+    }
+    (care, collision)
 }
 
 /// Level 2 for a pair whose whole-cell test failed or could not run (a sample without a

@@ -12,7 +12,9 @@ pub mod label;
 pub mod sampler;
 pub mod symmetry;
 
-pub use certify::{label_space_certified, label_space_certified_with, CertifiedSpace};
+pub use certify::{
+    label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, SubCells,
+};
 pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};
 pub use label::{label_space, label_space_thesis};
 pub use sampler::{CellIndex, SampleGrid, Workspace};

@@ -11,12 +11,13 @@
 //! cell), so for it the builder turns every `Unreachable` into `Collision` first.
 
 use crate::cell::Cell;
-use crate::cspace::certify::label_space_certified;
+use crate::cspace::certify::{label_space_certified, label_space_subdivided};
 use crate::cspace::label::label_space_thesis;
 use crate::cspace::symmetry::reflection_y;
 use crate::cspace::{Label, Workspace};
 use crate::table::{
     Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
+    TableError,
 };
 use std::time::Instant;
 
@@ -36,6 +37,10 @@ pub enum Variant {
     },
     /// Issue 4: the 6-D quadtree with shared subtrees ([`SharedQuadtree6d`]).
     Shared,
+    /// Issue 4: as `Shared`, with every certified collision cell cut into 64 sub-cells
+    /// certified on their own ([`crate::cspace::label_space_subdivided`]; certified labelling
+    /// only).
+    SharedSubdivided,
 }
 
 /// How the samples are labelled.
@@ -103,9 +108,17 @@ pub fn build_tables(
         return Err(format!("tables are built for two-robot cells; {} has {}", cell.name, cell.robots.len()));
     }
     let start = Instant::now();
-    let (mut space, certification) = match labelling {
-        Labelling::Certified => (label_space_certified(cell, k, ws, progress)?.space, Certification::SweptBound),
-        Labelling::ThesisMargin => (label_space_thesis(cell, k, ws, progress)?, Certification::ThesisBlowUp),
+    let subdivide = variants.contains(&Variant::SharedSubdivided);
+    let (mut space, sub, certification) = match labelling {
+        Labelling::Certified if subdivide => {
+            let c = label_space_subdivided(cell, k, ws, progress)?;
+            (c.space, c.sub, Certification::SweptBound)
+        }
+        Labelling::Certified => (label_space_certified(cell, k, ws, progress)?.space, None, Certification::SweptBound),
+        Labelling::ThesisMargin if subdivide => {
+            return Err("sub-cells are certified; use the certified labelling".into())
+        }
+        Labelling::ThesisMargin => (label_space_thesis(cell, k, ws, progress)?, None, Certification::ThesisBlowUp),
     };
     let label_secs = start.elapsed().as_secs_f64();
     let symmetric = reflection_y(cell);
@@ -130,6 +143,10 @@ pub fn build_tables(
                 Variant::D5 => LinearQuadtree5d::build(&space, symmetric).map(Table::D5),
                 Variant::D4 { axes, t } => LinearQuadtree4d::build(&space, symmetric, axes, t).map(Table::D4),
                 Variant::Shared => SharedQuadtree6d::build(&space, symmetric).map(Table::Shared),
+                Variant::SharedSubdivided => match &sub {
+                    Some(sub) => SharedQuadtree6d::build_subdivided(&space, sub, symmetric).map(Table::Shared),
+                    None => Err(TableError::BadInput { what: "no sub-cells were labelled".into() }),
+                },
             };
             table.map_err(|e| e.to_string())
         })

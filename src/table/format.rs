@@ -9,7 +9,8 @@
 //!     12    4  format version (VERSION)
 //!     16    4  variant: 6, 5, 4, or 7 (the shared 6-D quadtree)
 //!     20    4  levels        24  4  k = 2^levels
-//!     28    4  flags: bit 0 = symmetric (reflection, thesis 3.2.8); other bits 0
+//!     28    4  flags: bit 0 = symmetric (reflection, thesis 3.2.8); bit 1 = sub-cells (one
+//!              extra level, variant 7 only); other bits 0
 //!     32    4  slice axes: 0 (6D, 5D), 1 = yy', 2 = zz' (4D)
 //!     36    4  similarity threshold t (0 unless 4D)
 //!     40    8  fingerprint of the cell (`Cell::fingerprint`)
@@ -142,7 +143,8 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
     let mut out = Vec::with_capacity(HEADER_LEN + 8 * s0.len() + 4 * s1.len() + s2.len() + 8);
     out.extend_from_slice(&MAGIC);
     let levels = table.levels();
-    for v in [ENDIAN_MARK, VERSION, variant, levels, 1 << levels, u32::from(table.symmetric()), axes, t] {
+    let flags = u32::from(table.symmetric()) | table.sub_levels() << 1;
+    for v in [ENDIAN_MARK, VERSION, variant, levels, 1 << levels, flags, axes, t] {
         out.extend_from_slice(&v.to_le_bytes());
     }
     out.extend_from_slice(&header.cell_fingerprint.to_le_bytes());
@@ -205,6 +207,7 @@ impl<'a> Reader<'a> {
 struct Shape {
     variant: u32,
     levels: u32,
+    sub_levels: u32,
     symmetric: bool,
     axes: u32,
     t: u32,
@@ -236,13 +239,15 @@ fn read_prefix(r: &mut Reader) -> Result<Shape, TableError> {
     if levels == 0 || levels > super::code::MAX_LEVELS || k != 1 << levels {
         return Err(corrupt(format!("levels = {levels}, k = {k}: k must be 2^levels, levels in 1..=8")));
     }
-    if flags > 1 {
-        return Err(corrupt(format!("flags = {flags:#x}: only bit 0 (symmetric) is defined")));
+    if flags > 3 || (flags & 2 != 0 && variant != 7) {
+        return Err(corrupt(format!(
+            "flags = {flags:#x}: only bit 0 (symmetric) and, for variant 7, bit 1 (sub-cells) are defined"
+        )));
     }
     if (variant == 4) != matches!(axes, 1 | 2) || (variant != 4 && t != 0) {
         return Err(corrupt(format!("variant {variant} with slice axes = {axes}, t = {t}")));
     }
-    Ok(Shape { variant, levels, symmetric: flags == 1, axes, t })
+    Ok(Shape { variant, levels, sub_levels: flags >> 1, symmetric: flags & 1 == 1, axes, t })
 }
 
 fn read_header(r: &mut Reader) -> Result<Header, TableError> {
@@ -323,7 +328,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
             Table::D5(LinearQuadtree5d::from_parts(shape.levels, shape.symmetric, codes, aux, ivs)?)
         }
         7 => {
-            let starts = shape.levels as usize;
+            let starts = (shape.levels + shape.sub_levels) as usize;
             if aux.len() < starts {
                 return Err(corrupt(format!(
                     "section 1 has {} entries, fewer than the {starts} depth starts",
@@ -343,6 +348,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
             let (starts, bases) = (aux[..starts].to_vec(), aux[starts..].to_vec());
             Table::Shared(SharedQuadtree6d::from_parts(
                 shape.levels,
+                shape.sub_levels,
                 shape.symmetric,
                 masks,
                 bases,

@@ -112,18 +112,21 @@ impl TableChecker {
         self.fallbacks
     }
 
-    /// The grid cell of robot `j`'s TCP, or `None` outside the sampled cells.
+    /// The cell of robot `j`'s TCP at the table's query resolution (`2^sub_levels` per grid
+    /// cell and axis), or `None` when its grid cell is not sampled.
     fn cell_of(&self, j: usize, tcp: &Vec3) -> Option<[u16; 3]> {
-        let k = self.sampled[j].k as f64;
+        let sub = self.table.sub_levels();
+        let kq = f64::from(self.sampled[j].k as u32 * (1 << sub));
+        let rq = self.header.r / f64::from(1u32 << sub);
         let mut c = [0u16; 3];
         for (a, ci) in c.iter_mut().enumerate() {
-            let u = ((tcp[a] - self.origins[j][a]) / self.header.r).floor();
-            if !(u >= 0.0 && u < k) {
+            let u = ((tcp[a] - self.origins[j][a]) / rq).floor();
+            if !(u >= 0.0 && u < kq) {
                 return None;
             }
             *ci = u as u16;
         }
-        self.sampled[j].contains(c).then_some(c)
+        self.sampled[j].contains(c.map(|v| v >> sub)).then_some(c)
     }
 
     /// Answers one tick; `tcps_mcs[j]` is robot j's TCP in its own MCS.

@@ -48,8 +48,8 @@ pub enum Table {
 }
 
 impl Table {
-    /// Whether the 6-D cell is stored as collision (`true` also for an index `>= k`).
-    /// Never allocates, never panics.
+    /// Whether the 6-D cell is stored as collision, its indices at `2^(levels + sub_levels)`
+    /// per axis (`true` also for an index beyond). Never allocates, never panics.
     #[inline]
     pub fn query(&self, cell6: [u16; 6]) -> bool {
         match self {
@@ -67,6 +67,15 @@ impl Table {
             Table::D5(t) => t.levels(),
             Table::D4(t) => t.levels(),
             Table::Shared(t) => t.levels(),
+        }
+    }
+
+    /// Extra levels of sub-cells below the sampled grid (the subdivided shared table: 1;
+    /// otherwise 0): [`query`](Self::query) takes indices at `2^(levels + sub_levels)`.
+    pub fn sub_levels(&self) -> u32 {
+        match self {
+            Table::Shared(t) => t.sub_levels(),
+            _ => 0,
         }
     }
 
@@ -123,6 +132,7 @@ impl Table {
             Table::D6(_) => "6D".into(),
             Table::D5(_) => "5D".into(),
             Table::D4(t) => format!("4D/{} t={}", if t.axes() == SliceAxes::YY { "yy" } else { "zz" }, t.threshold()),
+            Table::Shared(t) if t.sub_levels() > 0 => "6D-shared/sub".into(),
             Table::Shared(_) => "6D-shared".into(),
         }
     }

@@ -29,7 +29,7 @@
 use super::code::MAX_LEVELS;
 use super::error::{bad_input, corrupt, TableError};
 use super::space::{fold, SpaceView};
-use crate::cspace::{Label, LabelledSpace};
+use crate::cspace::{Label, LabelledSpace, SubCells};
 use std::collections::HashMap;
 
 /// Child indices of the pool, as narrow as the table allows.
@@ -106,7 +106,10 @@ pub struct SharedParts<'a> {
 /// The shared 6-D quadtree (see the module doc).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SharedQuadtree6d {
+    /// Levels of the sampled grid (`k = 2^levels`).
     levels: u32,
+    /// Extra levels of sub-cells (0, or 1 for [`SharedQuadtree6d::build_subdivided`]).
+    sub_levels: u32,
     symmetric: bool,
     /// Inner nodes, depth by depth (the root is node 0): `[nonuniform, collision]`.
     masks: Vec<[u64; 2]>,
@@ -142,6 +145,8 @@ enum Part {
 /// Hash-consing builder over a [`SpaceView`].
 struct Builder<'a> {
     view: SpaceView<'a>,
+    /// Sub-cells of the pairs labelled collision, when subdividing.
+    sub: Option<&'a SubCells>,
     k: usize,
     /// Dense `k^3` maps from cell to sample index (`u32::MAX`: none, or not stored).
     dense_a: Vec<u32>,
@@ -198,17 +203,79 @@ impl Builder<'_> {
         if !self.occ_a[d as usize][at(a)] || !self.occ_b[d as usize][at(b)] {
             return Part::DontCare;
         }
-        let levels = self.view.levels;
-        if d == levels - 1 {
-            return self.leaf(a, b);
-        }
+        let last = d == self.view.levels - 1;
         let mut kids = [Part::DontCare; 64];
         for (i, kid) in kids.iter_mut().enumerate() {
             let bit = |j: usize| (i >> (5 - j)) & 1;
             let ca = [2 * a[0] + bit(0), 2 * a[1] + bit(1), 2 * a[2] + bit(2)];
             let cb = [2 * b[0] + bit(3), 2 * b[1] + bit(4), 2 * b[2] + bit(5)];
-            *kid = self.build(d + 1, ca, cb);
+            *kid = match (last, self.sub) {
+                (false, _) => self.build(d + 1, ca, cb),
+                (true, None) => self.cell(ca, cb).0,
+                (true, Some(_)) => self.subdivided_cell(ca, cb),
+            };
         }
+        if last && self.sub.is_none() {
+            // The children are cells: this block is a leaf.
+            let (mut care, mut value) = (0u64, 0u64);
+            for (i, p) in kids.iter().enumerate() {
+                match p {
+                    Part::Free => care |= 1 << i,
+                    Part::Collision => (care, value) = (care | 1 << i, value | 1 << i),
+                    Part::DontCare | Part::Node(_) => {}
+                }
+            }
+            return self.leaf(care, value);
+        }
+        self.node(d as usize, &kids)
+    }
+
+    /// The part of one cell pair without sub-cells, and its sample pair when both are sampled.
+    fn cell(&self, ca: [usize; 3], cb: [usize; 3]) -> (Part, Option<(usize, usize)>) {
+        let k = self.k;
+        let ia = self.dense_a[(ca[0] * k + ca[1]) * k + ca[2]];
+        let ib = self.dense_b[(cb[0] * k + cb[1]) * k + cb[2]];
+        if ia == NONE || ib == NONE {
+            return (Part::DontCare, None);
+        }
+        let (ia, ib) = (ia as usize, ib as usize);
+        let part = match self.view.label(ia, ib) {
+            Label::Free => Part::Free,
+            Label::Collision => Part::Collision,
+            Label::Unreachable => Part::DontCare,
+        };
+        (part, Some((ia, ib)))
+    }
+
+    /// The part of one cell pair cut into its 64 sub-cells ([`SubCells`]), merged with its
+    /// mirror pair under symmetry as [`SpaceView::label`] merges labels (collision wins).
+    fn subdivided_cell(&mut self, ca: [usize; 3], cb: [usize; 3]) -> Part {
+        let (part, Some((ia, ib))) = self.cell(ca, cb) else { return Part::DontCare };
+        if part != Part::Collision {
+            return part;
+        }
+        let (mut care, mut value) = self.sub_masks(ia, ib);
+        if let Some((ma, mb)) = self.view.mirror_pair(ia, ib) {
+            let (c, v) = self.sub_masks(ma, mb);
+            (care, value) = (care | mirror_sub_cells(c), value | mirror_sub_cells(v));
+        }
+        self.leaf(care, value)
+    }
+
+    /// `(care, collision)` of the sub-cells of one pair, by its own label.
+    fn sub_masks(&self, ia: usize, ib: usize) -> (u64, u64) {
+        match self.view.own_label(ia, ib) {
+            Label::Free => (u64::MAX, 0),
+            Label::Unreachable => (0, 0),
+            Label::Collision => {
+                let pair = (ia * self.view.space.grid_b.cells.len() + ib) as u64;
+                self.sub.and_then(|s| s.get(pair)).unwrap_or((u64::MAX, u64::MAX))
+            }
+        }
+    }
+
+    /// An inner node of depth `d` with these children (hash-consed), or the uniform part.
+    fn node(&mut self, d: usize, kids: &[Part; 64]) -> Part {
         let has = |p: Part| kids.contains(&p);
         let nodes = kids.iter().any(|p| matches!(p, Part::Node(_)));
         match (has(Part::Free), has(Part::Collision), nodes) {
@@ -229,38 +296,19 @@ impl Builder<'_> {
             }
         }
         let key = (nonuniform, collision, ids);
-        let depth = d as usize;
-        if let Some(&id) = self.inner[depth].get(&key) {
+        if let Some(&id) = self.inner[d].get(&key) {
             return Part::Node(id);
         }
-        let id = self.inner_nodes[depth].len() as u32;
-        self.inner_nodes[depth].push(key.clone());
-        self.inner[depth].insert(key, id);
+        let id = self.inner_nodes[d].len() as u32;
+        self.inner_nodes[d].push(key.clone());
+        self.inner[d].insert(key, id);
         Part::Node(id)
     }
 
-    /// The 2x2x2 x 2x2x2 block of cells at per-robot leaf-block coordinates `a`, `b`.
-    fn leaf(&mut self, a: [usize; 3], b: [usize; 3]) -> Part {
-        let k = self.k;
-        let (mut care, mut value) = (0u64, 0u64);
-        for i in 0..64usize {
-            let bit = |j: usize| (i >> (5 - j)) & 1;
-            let ca = [2 * a[0] + bit(0), 2 * a[1] + bit(1), 2 * a[2] + bit(2)];
-            let cb = [2 * b[0] + bit(3), 2 * b[1] + bit(4), 2 * b[2] + bit(5)];
-            let ia = self.dense_a[(ca[0] * k + ca[1]) * k + ca[2]];
-            let ib = self.dense_b[(cb[0] * k + cb[1]) * k + cb[2]];
-            if ia == NONE || ib == NONE {
-                continue;
-            }
-            match self.view.label(ia as usize, ib as usize) {
-                Label::Free => care |= 1 << i,
-                Label::Collision => {
-                    care |= 1 << i;
-                    value |= 1 << i;
-                }
-                Label::Unreachable => {}
-            }
-        }
+    /// A leaf of 64 cells, `care` the cells that are not "don't care" and `value` the
+    /// collisions among them (hash-consed; see the module doc for the don't-care choice).
+    fn leaf(&mut self, care: u64, value: u64) -> Part {
+        let value = value & care;
         if care == 0 {
             return Part::DontCare;
         }
@@ -282,6 +330,12 @@ impl Builder<'_> {
     }
 }
 
+/// A sub-cell mask of a pair mapped to its mirror pair's (`y -> -y` flips the y octant bit of
+/// both robots: child index bits 4 and 1).
+fn mirror_sub_cells(mask: u64) -> u64 {
+    (0..64).filter(|&c| mask >> c & 1 == 1).fold(0, |m, c| m | 1 << (c ^ 0b01_0010))
+}
+
 impl SharedQuadtree6d {
     /// Builds the table of `space` (see the module doc); with `symmetric`, only A's upper
     /// half `iy >= k/2` is stored, as the other variants do.
@@ -290,18 +344,45 @@ impl SharedQuadtree6d {
     /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
     /// `2 <= levels <= MAX_LEVELS`, or the label count is wrong.
     pub fn build(space: &LabelledSpace, symmetric: bool) -> Result<SharedQuadtree6d, TableError> {
+        Self::build_with(space, None, symmetric)
+    }
+
+    /// As [`build`](Self::build) with every pair labelled collision cut into the sub-cells of
+    /// `sub` ([`crate::cspace::label_space_subdivided`]): one more level, queried with cell
+    /// indices at `2 k` per axis.
+    ///
+    /// # Errors
+    /// As [`build`](Self::build).
+    pub fn build_subdivided(
+        space: &LabelledSpace,
+        sub: &SubCells,
+        symmetric: bool,
+    ) -> Result<SharedQuadtree6d, TableError> {
+        Self::build_with(space, Some(sub), symmetric)
+    }
+
+    fn build_with(
+        space: &LabelledSpace,
+        sub: Option<&SubCells>,
+        symmetric: bool,
+    ) -> Result<SharedQuadtree6d, TableError> {
         let view = SpaceView::new(space, symmetric)?;
         let levels = view.levels;
-        if levels < 2 {
-            return Err(bad_input(format!("the shared 6-D quadtree needs k >= 4, got k = {}", view.k)));
+        let sub_levels = u32::from(sub.is_some());
+        if levels < 2 || levels + sub_levels > MAX_LEVELS {
+            return Err(bad_input(format!(
+                "the shared 6-D quadtree needs 4 <= k <= 2^{MAX_LEVELS}, got k = {}",
+                view.k
+            )));
         }
         let k = view.k as usize;
         let dense_a = dense_map(&space.grid_a.cells, k, |ia| view.stored(ia));
         let dense_b = dense_map(&space.grid_b.cells, k, |_| true);
         let (occ_a, occ_b) = (occupancy(&dense_a, k, levels), occupancy(&dense_b, k, levels));
-        let inner_depths = levels as usize - 1;
+        let inner_depths = (levels + sub_levels) as usize - 1;
         let mut b = Builder {
             view,
+            sub,
             k,
             dense_a,
             dense_b,
@@ -332,6 +413,7 @@ impl SharedQuadtree6d {
         depth_start.push(masks.len() as u32);
         let t = SharedQuadtree6d {
             levels,
+            sub_levels,
             symmetric,
             masks,
             bases,
@@ -349,8 +431,10 @@ impl SharedQuadtree6d {
     ///
     /// # Errors
     /// [`TableError::Corrupt`] naming the first bad field.
+    #[allow(clippy::too_many_arguments)] // one per stored array, as the file holds them
     pub fn from_parts(
         levels: u32,
+        sub_levels: u32,
         symmetric: bool,
         masks: Vec<[u64; 2]>,
         bases: Vec<u32>,
@@ -358,10 +442,12 @@ impl SharedQuadtree6d {
         children: Vec<u32>,
         leaves: Vec<u64>,
     ) -> Result<SharedQuadtree6d, TableError> {
-        if !(2..=MAX_LEVELS).contains(&levels) {
-            return Err(corrupt(format!("levels = {levels} must be in 2..={MAX_LEVELS} for the shared 6-D quadtree")));
+        if levels < 2 || sub_levels > 1 || levels + sub_levels > MAX_LEVELS {
+            return Err(corrupt(format!(
+                "levels = {levels}, sub-levels = {sub_levels}: need levels >= 2, sub-levels 0 or 1, at most {MAX_LEVELS} in all"
+            )));
         }
-        let depths = levels as usize - 1;
+        let depths = (levels + sub_levels) as usize - 1;
         if depth_start.len() != depths + 1 {
             return Err(corrupt(format!("depth_start has {} entries, expected {}", depth_start.len(), depths + 1)));
         }
@@ -391,20 +477,22 @@ impl SharedQuadtree6d {
             }
         }
         let children = ChildIndices::from_u32(children);
-        Ok(SharedQuadtree6d { levels, symmetric, masks, bases, depth_start, children, leaves })
+        Ok(SharedQuadtree6d { levels, sub_levels, symmetric, masks, bases, depth_start, children, leaves })
     }
 
-    /// Whether the 6-D cell is stored as collision (`true` for an index `>= k`). Reads at most
-    /// `levels - 1` nodes and one leaf; never allocates, never panics on a validated table.
+    /// Whether the 6-D cell is stored as collision, its indices at `2^(levels + sub_levels)`
+    /// per axis (`true` for an index beyond). Reads at most `levels + sub_levels - 1` nodes
+    /// and one leaf; never allocates, never panics on a validated table.
     #[inline]
     pub fn query(&self, cell: [u16; 6]) -> bool {
-        let Some(c) = fold(cell, 1 << self.levels, self.symmetric) else {
+        let fine = self.levels + self.sub_levels;
+        let Some(c) = fold(cell, 1 << fine, self.symmetric) else {
             return true;
         };
         let mut node = 0usize;
-        let depths = self.levels - 1;
+        let depths = fine - 1;
         for d in 0..depths {
-            let bit = 1u64 << child_index(&c, self.levels - 1 - d);
+            let bit = 1u64 << child_index(&c, fine - 1 - d);
             let [nonuniform, collision] = self.masks[node];
             if nonuniform & bit == 0 {
                 return collision & bit != 0;
@@ -419,6 +507,12 @@ impl SharedQuadtree6d {
     /// Quadtree levels (`k = 2^levels`).
     pub fn levels(&self) -> u32 {
         self.levels
+    }
+
+    /// Extra levels of sub-cells: [`query`](Self::query) takes cell indices at
+    /// `2^(levels + sub_levels)` per axis.
+    pub fn sub_levels(&self) -> u32 {
+        self.sub_levels
     }
 
     /// Whether only A's upper half is stored.
@@ -492,6 +586,7 @@ mod tests {
             let p = shared.parts();
             let again = SharedQuadtree6d::from_parts(
                 levels,
+                0,
                 symmetric,
                 p.masks.to_vec(),
                 p.bases.to_vec(),
@@ -501,6 +596,105 @@ mod tests {
             )
             .unwrap();
             assert_eq!(again, shared);
+        }
+    }
+
+    /// Sub-cells of every collision pair from a seeded hash (some "don't care").
+    fn random_sub_cells(space: &LabelledSpace, seed: u64) -> SubCells {
+        let mut out = SubCells::default();
+        let mut x = seed;
+        let mut next = || {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            x ^ x >> 29
+        };
+        for (pair, &l) in space.labels.iter().enumerate() {
+            if l == Label::Collision {
+                let care = next() | next();
+                out.pairs.push(pair as u64);
+                out.care.push(care);
+                out.collision.push(match pair % 3 {
+                    0 => care,
+                    1 => next() & care,
+                    _ => next() & next() & care,
+                });
+            }
+        }
+        out
+    }
+
+    /// With sub-cells, every sub-cell that is free or collision in its pair and in its mirror
+    /// pair's merge is answered exactly at the fine indices, and coarse free cells stay free.
+    #[test]
+    fn subdivided_table_answers_every_sub_cell() {
+        for (pattern, levels, symmetric) in
+            [(Pattern::Blobs, 3, false), (Pattern::Blobs, 4, true), (Pattern::Noise { p: 0.2, seed: 9 }, 3, true)]
+        {
+            let space = space(levels, pattern);
+            let sub = random_sub_cells(&space, u64::from(levels));
+            let t = SharedQuadtree6d::build_subdivided(&space, &sub, symmetric).unwrap();
+            assert_eq!(t.sub_levels(), 1);
+            let view = SpaceView::new(&space, symmetric).unwrap();
+            let nb = space.grid_b.cells.len();
+            let masks = |ia: usize, ib: usize| match view.own_label(ia, ib) {
+                Label::Free => (u64::MAX, 0),
+                Label::Unreachable => (0, 0),
+                Label::Collision => sub.get((ia * nb + ib) as u64).unwrap(),
+            };
+            let (mut checked, mut free, mut hit) = (0, 0, 0);
+            for (ia, ca) in space.grid_a.cells.iter().enumerate().filter(|&(ia, _)| view.stored(ia)) {
+                for (ib, cb) in space.grid_b.cells.iter().enumerate() {
+                    let (mut care, mut coll) = masks(ia, ib);
+                    if let Some((ma, mb)) = view.mirror_pair(ia, ib) {
+                        let (c, v) = masks(ma, mb);
+                        (care, coll) = (care | mirror_sub_cells(c), coll | mirror_sub_cells(v));
+                    }
+                    for c in 0..64u32 {
+                        if care >> c & 1 == 0 {
+                            continue;
+                        }
+                        let bit = |j: u32| (c >> (5 - j) & 1) as u16;
+                        let fine = [
+                            2 * ca[0] + bit(0),
+                            2 * ca[1] + bit(1),
+                            2 * ca[2] + bit(2),
+                            2 * cb[0] + bit(3),
+                            2 * cb[1] + bit(4),
+                            2 * cb[2] + bit(5),
+                        ];
+                        let want = coll >> c & 1 == 1;
+                        assert_eq!(t.query(fine), want, "{pattern:?}: pair ({ia}, {ib}) sub-cell {c}");
+                        checked += 1;
+                        free += usize::from(!want);
+                        hit += usize::from(want);
+                    }
+                }
+            }
+            assert!(free > 0 && hit > 0, "{pattern:?}: {checked} checked, {free} free, {hit} collision");
+            // The file round trip keeps the sub-level.
+            let p = t.parts();
+            let again = SharedQuadtree6d::from_parts(
+                levels,
+                1,
+                symmetric,
+                p.masks.to_vec(),
+                p.bases.to_vec(),
+                p.depth_start.to_vec(),
+                p.children.to_u32(),
+                p.leaves.to_vec(),
+            )
+            .unwrap();
+            assert_eq!(again, t);
+        }
+    }
+
+    #[test]
+    fn mirror_of_sub_cells_flips_both_y_octant_bits() {
+        use crate::cspace::certify::sub_cell_index;
+        for i in 0..8 {
+            for j in 0..8 {
+                let m = mirror_sub_cells(1 << sub_cell_index(i, j));
+                assert_eq!(m, 1 << sub_cell_index(i ^ 2, j ^ 2));
+            }
         }
     }
 
@@ -520,7 +714,7 @@ mod tests {
         let (m, b, ds, c, l) =
             (p.masks.to_vec(), p.bases.to_vec(), p.depth_start.to_vec(), p.children.to_u32(), p.leaves.to_vec());
         let ok = |m: Vec<[u64; 2]>, b: Vec<u32>, ds: Vec<u32>, c: Vec<u32>, l: Vec<u64>| {
-            SharedQuadtree6d::from_parts(3, false, m, b, ds, c, l).is_ok()
+            SharedQuadtree6d::from_parts(3, 0, false, m, b, ds, c, l).is_ok()
         };
         assert!(ok(m.clone(), b.clone(), ds.clone(), c.clone(), l.clone()));
         assert!(!ok(m.clone(), b.clone(), ds.clone(), c.clone(), vec![]), "children point past the leaves");

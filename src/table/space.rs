@@ -99,6 +99,21 @@ impl<'a> SpaceView<'a> {
         merge(own, self.space.labels[ra as usize * self.nb + rb as usize])
     }
 
+    /// The label of `(ia, ib)` itself, not merged with its mirror.
+    #[inline]
+    pub fn own_label(&self, ia: usize, ib: usize) -> Label {
+        self.space.labels[ia * self.nb + ib]
+    }
+
+    /// The mirror pair whose label [`label`](Self::label) merges in, if any.
+    pub fn mirror_pair(&self, ia: usize, ib: usize) -> Option<(usize, usize)> {
+        if !self.symmetric {
+            return None;
+        }
+        let (ra, rb) = (self.refl_a[ia], self.refl_b[ib]);
+        (ra != NONE && rb != NONE).then_some((ra as usize, rb as usize))
+    }
+
     /// Pairs of the stored half where the label and its mirror's disagree as free/collision.
     pub fn asymmetric_pairs(&self) -> usize {
         if !self.symmetric {
