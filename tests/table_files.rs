@@ -20,7 +20,22 @@ fn tables(s: &LabelledSpace) -> Vec<Table> {
         Table::D5(LinearQuadtree5d::build(s, false).unwrap()),
         Table::D4(LinearQuadtree4d::build(s, true, SliceAxes::YY, 0).unwrap()),
         Table::D4(LinearQuadtree4d::build(s, false, SliceAxes::ZZ, 3).unwrap()),
+        Table::Shared(SharedQuadtree6d::build(s, true).unwrap()),
+        Table::Shared(SharedQuadtree6d::build_subdivided(s, &sub_cells(s), false).unwrap()),
     ]
+}
+
+/// Sub-cells of every collision pair: every other sub-cell a collision, some "don't care".
+fn sub_cells(s: &LabelledSpace) -> delta_collide::cspace::SubCells {
+    let mut sub = delta_collide::cspace::SubCells::default();
+    for (pair, l) in s.labels.iter().enumerate() {
+        if *l == delta_collide::cspace::Label::Collision {
+            sub.pairs.push(pair as u64);
+            sub.care.push(!0xff00u64.rotate_left(pair as u32 % 64));
+            sub.collision.push(0x5555_5555_5555_5555u64.rotate_left(pair as u32 % 2));
+        }
+    }
+    sub
 }
 
 fn header(s: &LabelledSpace) -> Header {
@@ -124,6 +139,13 @@ fn corrupted_files(s: &LabelledSpace) -> Vec<(&'static str, Vec<u8>, &'static st
     b[at + 1] = 4;
     reseal(&mut b);
     out.push(("interval_beyond_k_5d.dctable", b, "intervals[0]"));
+    // Shared 6-D: the first child index set past the nodes of its depth.
+    let mut b = to_bytes(&ts[5], &header(s));
+    let count = |i: usize| u64::from_le_bytes(b[160 + 8 * i..168 + 8 * i].try_into().unwrap()) as usize;
+    let at = 184 + 8 * count(0) + 4 * count(1);
+    b[at..at + 4].copy_from_slice(&60_000u32.to_le_bytes());
+    reseal(&mut b);
+    out.push(("child_index_out_of_range_shared.dctable", b, "child index"));
     out
 }
 
