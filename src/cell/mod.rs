@@ -175,12 +175,8 @@ impl Cell {
     /// margins, placements; not names or the SAT method): tables record it to refuse being
     /// used with another cell.
     pub fn fingerprint(&self) -> u64 {
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        let mut eat = |v: Real| {
-            for byte in v.to_le_bytes() {
-                h = (h ^ byte as u64).wrapping_mul(0x0100_0000_01b3);
-            }
-        };
+        let mut bytes = Vec::new();
+        let mut eat = |v: Real| bytes.extend_from_slice(&v.to_le_bytes());
         eat(self.robots.len() as Real);
         for r in &self.robots {
             let (d, o, p) = (&r.model.delta, &r.model.options, &r.placement);
@@ -199,6 +195,11 @@ impl Cell {
             eat(p.alpha);
             p.t.iter().for_each(|&v| eat(v));
         }
-        h
+        fnv1a64(&bytes)
     }
+}
+
+/// FNV-1a 64 of `bytes` (cell fingerprints, table checksums).
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
 }

@@ -109,10 +109,7 @@ impl Header {
     }
 }
 
-/// FNV-1a 64 of `bytes`.
-pub fn fnv1a64(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
-}
+pub use crate::cell::fnv1a64;
 
 /// The bytes of `table` with `header` (see the module doc for the layout).
 pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
