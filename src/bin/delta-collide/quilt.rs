@@ -113,7 +113,7 @@ pub fn quilt(args: &[String]) -> Result<(), String> {
         }
     };
     let output = output_option(args, "quilt.png")?;
-    let size = size_option(args, (1200, 1200), (300, 300))?;
+    let size = size_option(args, (1200, 1200), (200, 200))?;
     let counts = count(&quilt, &maps, table);
     draw_png(output, size, |root| draw(root, &quilt, &maps, table))?;
     println!(
