@@ -152,12 +152,13 @@ fn render_of_an_unreachable_tcp_and_bad_arguments() {
     let text = ok(&cli(&["render", "--cell", "T2", "--tcp", "0,0,-900", "--tcp", "0,0,-450", "--output", &file]));
     assert!(text.contains("unreachable: robot A"), "{text}");
     assert_picture(&file, 1400, 700);
-    let out = cli(&["render", "--cell", "T1", "--tcp", "0,0,-450"]);
+    let out = cli(&["render", "--cell", "T1", "--tcp", "0,0,-450", "--output", &file]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("one --tcp x,y,z per robot"));
-    let out = cli(&["render", "--cell", "T1", "--tcp", "0,0", "--tcp", "0,0,-450"]);
+    let out = cli(&["render", "--cell", "T1", "--tcp", "0,0", "--tcp", "0,0,-450", "--output", &file]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("three numbers"));
-    let out = cli(&["render", "--cell", "T1", "--tcp", "0,0,-450", "--tcp", "0,0,-450", "--width", "10"]);
+    let out =
+        cli(&["render", "--cell", "T1", "--tcp", "0,0,-450", "--tcp", "0,0,-450", "--width", "10", "--output", &file]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("at least"));
 }
@@ -212,12 +213,15 @@ fn quilt_with_a_fixed_cell_of_a_shows_b_slices_per_depth_and_works_on_a_4d_table
     }
     let out = cli(&["quilt", "--cell", "T1", "--table", &table, "--a", "12,8", "--output", &file]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("expected 3 grid indices"));
-    let out = cli(&["quilt", "--cell", "T1", "--table", &table, "--axes", "zz", "--width", "200", "--height", "200"]);
+    let out = cli(&[
+        "quilt", "--cell", "T1", "--table", &table, "--axes", "zz", "--width", "200", "--height", "200", "--output",
+        &file,
+    ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("too small"), "{}", String::from_utf8_lossy(&out.stderr));
-    let out = cli(&["quilt", "--cell", "T1", "--table", &table, "--axes", "xy"]);
+    let out = cli(&["quilt", "--cell", "T1", "--table", &table, "--axes", "xy", "--output", &file]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("use yy"));
-    let out = cli(&["quilt", "--cell", "T3", "--table", &table]);
+    let out = cli(&["quilt", "--cell", "T3", "--table", &table, "--output", &file]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("rebuild"), "a T1 table is refused for T3");
 }
 

@@ -143,8 +143,11 @@ fn describe(cell: &Cell, verdict: &CellVerdict, robots: &[RobotPicture], tcps: &
     if let Some((j, why)) = verdict.first_unreachable {
         return format!("{head}unreachable: robot {} ({why})", robots[j].name);
     }
-    if let Some(p) = verdict.first_collision() {
-        let PairState::Collides(i, k) = p.state else { unreachable!() };
+    let first = verdict.pairs.iter().find_map(|p| match p.state {
+        PairState::Collides(i, k) => Some((p, i, k)),
+        _ => None,
+    });
+    if let Some((p, i, k)) = first {
         let (a, b) = (&robots[p.a], &robots[p.b]);
         let more = verdict.colliding_pairs() - 1;
         let more = if more > 0 { format!(" (and {more} more robot pairs)") } else { String::new() };
