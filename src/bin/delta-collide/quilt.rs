@@ -10,17 +10,20 @@
 //! x'y'-slice of B's grid at one depth `z'`: where B may go while A is in that cell.
 //!
 //! Colours: black where the table stores a collision, white where it stores free, orange
-//! where either cell's centre is unreachable (the builder stores those as collision), grey
-//! where either cell lies outside the sampled grid (no table entry: queries there fall back
-//! to the exact check).
+//! where either robot's cell is proved wholly unreachable ([`cube_unreachable`]: no query can
+//! land there, the table may store anything), grey where either cell lies outside the sampled
+//! grid (no table entry: queries there fall back to the exact check). A cell whose centre is
+//! unreachable but which may hold reachable TCPs shows the table's answer.
 
 use crate::picture::{
     draw_png, legend, output_option, plot_err, size_option, text, Swatch, COLLISION, FREE, OUTSIDE, UNREACHABLE,
 };
 use crate::{known_options, load_cell, load_table, option};
 use delta_collide::cell::Cell;
+use delta_collide::cspace::guarantee::cube_unreachable;
 use delta_collide::cspace::{SampleGrid, Workspace};
 use delta_collide::math::Vec3;
+use delta_collide::robot::Delta3;
 use delta_collide::table::Table;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -31,8 +34,8 @@ const LEFT: u32 = 78;
 const BOTTOM: u32 = 44;
 const PAD: u32 = 12;
 
-/// What a grid cell of one robot is: outside the sampled grid, sampled with an unreachable
-/// centre, or sampled and reachable.
+/// What a grid cell of one robot is: outside the sampled grid, sampled but proved wholly
+/// unreachable, or sampled and (possibly partly) reachable.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Sampled {
     Outside,
@@ -48,13 +51,15 @@ struct GridMap {
 }
 
 impl GridMap {
-    fn new(grid: SampleGrid) -> Self {
+    /// The map of `grid` for a robot of geometry `delta`.
+    fn new(grid: SampleGrid, delta: &Delta3) -> Self {
         let k = grid.k as usize;
         let mut state = vec![Sampled::Outside; k * k * k];
         let mut range = [(u16::MAX, 0u16); 3];
-        for (c, &ok) in grid.cells.iter().zip(&grid.reachable) {
+        for (c, &centre_reachable) in grid.cells.iter().zip(&grid.reachable) {
+            let unreachable = !centre_reachable && cube_unreachable(delta, &grid.center(*c), 0.5 * grid.r);
             state[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] =
-                if ok { Sampled::Reachable } else { Sampled::Unreachable };
+                if unreachable { Sampled::Unreachable } else { Sampled::Reachable };
             for a in 0..3 {
                 range[a] = (range[a].0.min(c[a]), range[a].1.max(c[a]));
             }
@@ -97,7 +102,10 @@ pub fn quilt(args: &[String]) -> Result<(), String> {
     let checker = load_table(&cell, path)?;
     let (header, table) = (checker.header(), checker.table());
     let k = 1u32 << table.levels();
-    let grid = |j: usize| SampleGrid::new(&header.workspace, k, &cell.robots[j].model.delta).map(GridMap::new);
+    let grid = |j: usize| {
+        let delta = &cell.robots[j].model.delta;
+        SampleGrid::new(&header.workspace, k, delta).map(|g| GridMap::new(g, delta))
+    };
     let maps = [grid(0)?, grid(1)?];
     let what = format!("cell {}, table {} ({}, k = {k}, r = {:.2} mm)", cell.name, path, table.name(), header.r);
     let quilt = match option(args, "--a")? {
@@ -117,7 +125,7 @@ pub fn quilt(args: &[String]) -> Result<(), String> {
     let counts = count(&quilt, &maps, table);
     draw_png(output, size, |root| draw(root, &quilt, &maps, table))?;
     println!(
-        "{output}: {} x {} pixels, {} slices of {} x {} cells: {} collision, {} free, {} unreachable centre, {} outside the grid",
+        "{output}: {} x {} pixels, {} slices of {} x {} cells: {} collision, {} free, {} unreachable, {} outside the grid",
         size.0,
         size.1,
         quilt.panels.len(),
@@ -241,7 +249,7 @@ fn b_slices(maps: &[GridMap; 2], a: [u16; 3], what: &str) -> Quilt {
     let centre = maps[0].grid.center(a);
     let state = match maps[0].at(a) {
         Sampled::Outside => " (outside A's sampled grid)",
-        Sampled::Unreachable => " (centre unreachable)",
+        Sampled::Unreachable => " (proved unreachable)",
         Sampled::Reachable => "",
     };
     Quilt {
@@ -301,7 +309,7 @@ fn draw(root: &DrawingArea<BitMapBackend, Shift>, q: &Quilt, maps: &[GridMap; 2]
     let entries = [
         (Swatch::Square(COLLISION), "collision"),
         (Swatch::Square(FREE), "free"),
-        (Swatch::Square(UNREACHABLE), "a cell centre unreachable"),
+        (Swatch::Square(UNREACHABLE), "a cell proved unreachable (don't care)"),
         (Swatch::Square(OUTSIDE), "outside the sampled grid"),
     ];
     legend(root, (PAD as i32, TITLE as i32 - 20), &entries)?;
