@@ -1,9 +1,12 @@
-//! Oriented boxes and the exact test between two of them (thesis 2.4 and 3.1, SPEC §3).
+//! Oriented boxes, the exact test between two of them (thesis 2.4 and 3.1, SPEC §3), and their
+//! distance (for reports and pictures).
 
+pub mod distance;
 pub mod obb;
 pub mod sat;
 pub mod witness;
 
+pub use distance::obb_distance;
 pub use obb::Obb;
 pub use sat::{obbs_intersect, separating_axis, separating_axis_hinted, Axis};
 pub use witness::{first_intersecting_pair, WitnessCache};

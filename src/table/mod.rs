@@ -60,6 +60,16 @@ impl Table {
         }
     }
 
+    /// Whether any configuration of the grid cell `cell` (indices at `k`) is stored as
+    /// collision: [`query`](Self::query) itself, or over its 64 sub-cells for a subdivided
+    /// table. For pictures and reports, not the per-tick path.
+    pub fn query_grid_cell(&self, cell: [u16; 6]) -> bool {
+        match self.sub_levels() {
+            0 => self.query(cell),
+            _ => (0..64u16).any(|c| self.query(std::array::from_fn(|j| 2 * cell[j] + (c >> (5 - j) & 1)))),
+        }
+    }
+
     /// Quadtree levels; cells per axis `k = 2^levels`.
     pub fn levels(&self) -> u32 {
         match self {

@@ -6,8 +6,18 @@
 //! delta-collide check --cell T1|FILE.toml [--table FILE.dct] [--input FILE.csv] [--output FILE.csv]
 //! delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz|shared|shared-sub] [--t 0] [--labelling certified|thesis]
 //! delta-collide inspect FILE.dct
-//! delta-collide eval  --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S]
+//! delta-collide eval  --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S] [--plot FILE.png]
+//! delta-collide render --cell T1|FILE.toml --tcp x,y,z --tcp x,y,z [--output FILE.png]
+//! delta-collide quilt --cell T1|FILE.toml --table FILE.dct [--axes yy|zz|xx] [--fix i,j] [--a ix,iy,iz] [--output FILE.png]
 //! ```
+//!
+//! The pictures (`render`, `quilt`, `eval --plot`) are PNG files drawn in-process (modules
+//! [`render`], [`quilt`], [`plot`]; shared parts in [`picture`]).
+
+mod picture;
+mod plot;
+mod quilt;
+mod render;
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
@@ -21,7 +31,7 @@ use std::io::{BufRead, BufWriter, Write};
 use std::time::Instant;
 
 /// The scenario file shared with the C harness.
-const SCENARIOS: &str = include_str!("../../c_harness/scenarios.txt");
+const SCENARIOS: &str = include_str!("../../../c_harness/scenarios.txt");
 
 const USAGE: &str = "usage:
   delta-collide demo  [--cell T1|T2|T3|all|FILE.toml]
@@ -36,9 +46,25 @@ const USAGE: &str = "usage:
       samples, labels (certified per-cell bounds by default) and builds a table file
   delta-collide inspect FILE.dct
       prints what a table file holds
-  delta-collide eval --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S]
+  delta-collide eval --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S] [--plot FILE.png]
+                     [--width W] [--height H]
       compares the table with the exact physical model (margin 0) on the cell's scenarios and
-      on N random reachable configurations: TP, TN, FP, FN, accuracy, query times";
+      on N random reachable configurations: TP, TN, FP, FN, accuracy, query times; --plot
+      draws, per scenario and tick, the distance between the robots' boxes and the labels
+      reported by the table and by the exact model
+  delta-collide render --cell T1|FILE.toml --tcp x,y,z --tcp x,y,z [--output render.png]
+                       [--width 1400] [--height 700]
+      draws the cell at one configuration (one --tcp per robot, each in its own MCS) in top
+      and side view: every box of the model, the colliding ones in red
+  delta-collide quilt --cell T1|FILE.toml --table FILE.dct [--axes yy|zz|xx] [--fix i,j]
+                      [--output quilt.png] [--width 1200] [--height 1200]
+  delta-collide quilt --cell T1|FILE.toml --table FILE.dct --a ix,iy,iz [--output quilt.png]
+      draws the table's 2-D slices as in the thesis's Figures 3.16-3.17: --axes yy puts
+      yy'-slices in a quilt over (z, z'), zz puts zz'-slices in a quilt over (y, y'), xx puts
+      xx'-slices over (z, z'); --fix gives the grid indices of the remaining pair (default: half
+      the workspace radius toward the other robot). With --a, A's grid cell is fixed and each
+      panel is an x'y'-slice of B's grid at one depth z'. Black: collision, white: free, orange:
+      a cell proved unreachable (don't care), grey: outside the sampled grid";
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -48,6 +74,8 @@ fn main() {
         Some("build") => build(&args[1..]),
         Some("inspect") => inspect(&args[1..]),
         Some("eval") => eval(&args[1..]),
+        Some("render") => render::render(&args[1..]),
+        Some("quilt") => quilt::quilt(&args[1..]),
         Some("-h" | "--help" | "help") => {
             println!("{USAGE}");
             Ok(())
@@ -343,34 +371,47 @@ impl Confusion {
 }
 
 fn eval(args: &[String]) -> Result<(), String> {
-    known_options(args, &["--cell", "--table", "--random", "--seed"])?;
+    known_options(args, &["--cell", "--table", "--random", "--seed", "--plot", "--width", "--height"])?;
     let cell = load_cell(option(args, "--cell")?.ok_or("eval needs --cell")?)?;
-    let mut table = load_table(&cell, option(args, "--table")?.ok_or("eval needs --table FILE.dct")?)?;
+    let table_path = option(args, "--table")?.ok_or("eval needs --table FILE.dct")?;
+    let mut table = load_table(&cell, table_path)?;
     let n: u64 = parse_num(args, "--random", 1_000_000)?;
     let mut seed: u64 = parse_num(args, "--seed", 1)?;
+    let plot = option(args, "--plot")?;
+    let plot_size = picture::size_option(args, (1400, 900), (500, 400))?;
+    let table_name = format!("{} k = {}", table.table().name(), 1u32 << table.table().levels());
     let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
     let mut ns = Vec::new();
-    let mut compare = |tcps: &[Vec3], c: &mut Confusion, ns: &mut Vec<u64>| -> Result<bool, String> {
+    // The table's answer and the exact verdict; counted in `c` unless a TCP is unreachable.
+    let mut compare = |tcps: &[Vec3], c: &mut Confusion, ns: &mut Vec<u64>| -> Result<TableAnswer, String> {
         let start = Instant::now();
         let answer = table.check(tcps).map_err(|e| e.to_string())?;
         ns.push(start.elapsed().as_nanos() as u64);
         let v = exact.check(tcps).map_err(|e| e.to_string())?;
-        match answer {
-            TableAnswer::Unreachable(_) => Ok(false),
-            a => {
-                c.add(a == TableAnswer::Collision, v.collides());
-                Ok(true)
-            }
+        if !matches!(answer, TableAnswer::Unreachable(_)) {
+            c.add(answer == TableAnswer::Collision, v.collides());
         }
+        Ok(answer)
     };
     let mut tcps = vec![Vec3::zeros(); 2];
+    let mut traces = Vec::new();
     for scenario in parse_scenarios(SCENARIOS)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)) {
         let mut c = Confusion::default();
+        let mut trace = plot.map(|_| plot::Trace::new(&cell, format!("{} {}", scenario.cell, scenario.case)));
         for tick in 0..RUN_TICKS {
             scenario.tcps_at(tick, &mut tcps);
-            compare(&tcps, &mut c, &mut ns)?;
+            let answer = compare(&tcps, &mut c, &mut ns)?;
+            if let Some(t) = trace.as_mut() {
+                t.push(&tcps, answer)?;
+            }
         }
         println!("{}", c.line(&format!("{} {}", scenario.cell, scenario.case)));
+        traces.extend(trace);
+    }
+    if let Some(path) = plot {
+        let title = format!("cell {}, table {table_path} ({table_name}): box distance and labels per tick", cell.name);
+        plot::draw_plot(path, plot_size, &title, &traces)?;
+        println!("{path}: {} x {} pixels, {} scenarios", plot_size.0, plot_size.1, traces.len());
     }
     // Random reachable configurations, uniform in the workspace box (xorshift64*, seeded).
     let mut next = move || {
@@ -388,7 +429,9 @@ fn eval(args: &[String]) -> Result<(), String> {
             *t =
                 Vec3::new(rmax * (2.0 * next() - 1.0), rmax * (2.0 * next() - 1.0), -(ws.zu + (dmax - ws.zu) * next()));
         }
-        if tcps.iter().all(|t| ws.contains(t)) && compare(&tcps, &mut c, &mut ns)? {
+        if tcps.iter().all(|t| ws.contains(t))
+            && !matches!(compare(&tcps, &mut c, &mut ns)?, TableAnswer::Unreachable(_))
+        {
             kept += 1;
         }
     }

@@ -1,0 +1,176 @@
+//! What the three pictures share: an RGB canvas that plotters draws into, the font compiled
+//! into the binary, PNG output, `--width`/`--height`, colours and a 2-D convex hull.
+//!
+//! No system font or external program is used: text is drawn with DejaVu Sans (a subset, see
+//! `font/LICENSE`) through plotters' `ab_glyph` backend, and the PNG is encoded by the `png`
+//! crate.
+
+use crate::{option, parse_num};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::sync::Once;
+
+/// DejaVu Sans, printable ASCII and a few symbols (`font/LICENSE` says how it was cut).
+const FONT: &[u8] = include_bytes!("font/DejaVuSans-subset.ttf");
+
+/// Free configurations and boxes.
+pub const FREE: RGBColor = RGBColor(255, 255, 255);
+/// Collisions (thesis Figures 3.16-3.17 draw them black).
+pub const COLLISION: RGBColor = RGBColor(0, 0, 0);
+/// Colliding boxes and collision ticks.
+pub const HIT: RGBColor = RGBColor(220, 30, 30);
+/// Cells whose centre is unreachable.
+pub const UNREACHABLE: RGBColor = RGBColor(240, 170, 60);
+/// Cells outside the sampled grid.
+pub const OUTSIDE: RGBColor = RGBColor(200, 200, 200);
+/// One colour per robot (cycled).
+pub const ROBOT: [RGBColor; 4] =
+    [RGBColor(40, 90, 200), RGBColor(20, 150, 80), RGBColor(150, 60, 170), RGBColor(180, 120, 20)];
+
+/// The largest width or height accepted (pixels).
+const MAX_SIDE: u32 = 8192;
+
+/// Makes the compiled-in font the `sans-serif` family of plotters (once per process).
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        if plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_err() {
+            panic!("the compiled-in font is not a valid TrueType file");
+        }
+    });
+}
+
+/// A plotters error as a message.
+pub fn plot_err<E: std::fmt::Debug>(e: E) -> String {
+    format!("drawing failed: {e:?}")
+}
+
+/// `--width` and `--height` (pixels), with defaults and bounds.
+pub fn size_option(args: &[String], default: (u32, u32), min: (u32, u32)) -> Result<(u32, u32), String> {
+    let w: u32 = parse_num(args, "--width", default.0)?;
+    let h: u32 = parse_num(args, "--height", default.1)?;
+    if !(min.0..=MAX_SIDE).contains(&w) || !(min.1..=MAX_SIDE).contains(&h) {
+        return Err(format!(
+            "--width {w} --height {h}: this picture needs at least {} x {} and at most {MAX_SIDE} x {MAX_SIDE} pixels",
+            min.0, min.1
+        ));
+    }
+    Ok((w, h))
+}
+
+/// `--output`, or `default` when not given.
+pub fn output_option<'a>(args: &'a [String], default: &'a str) -> Result<&'a str, String> {
+    Ok(option(args, "--output")?.unwrap_or(default))
+}
+
+/// Draws with `draw` on a white `width` x `height` RGB canvas and writes it to `path` as PNG.
+///
+/// # Errors
+/// The drawing's error, or the file's.
+pub fn draw_png(
+    path: &str,
+    (width, height): (u32, u32),
+    draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<(), String>,
+) -> Result<(), String> {
+    register_font();
+    let mut rgb = vec![255u8; width as usize * height as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
+        draw(&root)?;
+        root.present().map_err(plot_err)?;
+    }
+    write_png(path, &rgb, width, height)
+}
+
+/// Encodes an 8-bit RGB buffer as a PNG file.
+fn write_png(path: &str, rgb: &[u8], width: u32, height: u32) -> Result<(), String> {
+    let file = std::fs::File::create(path).map_err(|e| format!("{path}: {e}"))?;
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::High);
+    let mut writer = encoder.write_header().map_err(|e| format!("{path}: {e}"))?;
+    writer.write_image_data(rgb).map_err(|e| format!("{path}: {e}"))?;
+    writer.finish().map_err(|e| format!("{path}: {e}"))
+}
+
+/// A text style of the compiled-in font.
+pub fn text(size: u32, color: RGBColor) -> TextStyle<'static> {
+    ("sans-serif", size).into_font().color(&color)
+}
+
+/// What a legend entry shows before its label.
+pub enum Swatch {
+    /// A filled square with a thin black border.
+    Square(RGBColor),
+    /// A filled square (translucent fill) with a border of its own colour.
+    Outlined(RGBAColor, RGBColor),
+    /// A short line.
+    Line(RGBColor),
+}
+
+/// Draws legend entries in a row from `(x, y)` (top left); returns the x after the last one.
+pub fn legend(
+    area: &DrawingArea<BitMapBackend, Shift>,
+    (mut x, y): (i32, i32),
+    entries: &[(Swatch, &str)],
+) -> Result<i32, String> {
+    let style = text(13, BLACK);
+    for (swatch, label) in entries {
+        let square = [(x, y + 1), (x + 14, y + 13)];
+        match swatch {
+            Swatch::Square(c) => {
+                area.draw(&Rectangle::new(square, c.filled())).map_err(plot_err)?;
+                area.draw(&Rectangle::new(square, BLACK.stroke_width(1))).map_err(plot_err)?;
+            }
+            Swatch::Outlined(fill, c) => {
+                area.draw(&Rectangle::new(square, fill.filled())).map_err(plot_err)?;
+                area.draw(&Rectangle::new(square, c.stroke_width(2))).map_err(plot_err)?;
+            }
+            Swatch::Line(c) => {
+                area.draw(&PathElement::new(vec![(x, y + 7), (x + 14, y + 7)], c.stroke_width(2))).map_err(plot_err)?;
+            }
+        }
+        area.draw(&Text::new(label.to_string(), (x + 20, y), style.clone())).map_err(plot_err)?;
+        let (w, _) = area.estimate_text_size(label, &style).map_err(plot_err)?;
+        x += 20 + w as i32 + 18;
+    }
+    Ok(x)
+}
+
+/// The convex hull of 2-D points, counter-clockwise, without repeated points (Andrew's
+/// monotone chain).
+pub fn convex_hull(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut p: Vec<(f64, f64)> = points.to_vec();
+    p.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
+    p.dedup();
+    if p.len() < 3 {
+        return p;
+    }
+    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0);
+    let mut hull: Vec<(f64, f64)> = Vec::with_capacity(2 * p.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &(f64, f64)>> =
+            if pass == 0 { Box::new(p.iter()) } else { Box::new(p.iter().rev()) };
+        for &q in iter {
+            while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hull_of_a_square_with_inner_points() {
+        let pts = [(0.0, 0.0), (1.0, 0.0), (0.5, 0.5), (1.0, 1.0), (0.0, 1.0), (0.2, 0.8), (1.0, 0.5)];
+        assert_eq!(convex_hull(&pts), vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
+    }
+}
