@@ -18,8 +18,8 @@ pub use exact::{CellVerdict, ExactChecker, PairVerdict, QueryError};
 pub use placement::Placement;
 
 use crate::math::{float, Real};
-use alloc::{format, string::String, vec::Vec};
 use crate::robot::RobotModel;
+use alloc::{format, string::String, vec::Vec};
 
 /// Most robots in one cell (the unreachable mask of a report is a `u32`).
 pub const MAX_ROBOTS: usize = 32;

@@ -21,8 +21,8 @@
 //! [`Delta3::inverse_kinematics`] adds one `atan2` per arm for the angles themselves.
 
 use crate::math::{float, Real, Vec3};
-use core::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 use alloc::{format, string::String};
+use core::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
 /// Parameters of one Delta3 robot, in mm and rad (SPEC §2).
 #[derive(Clone, Copy, Debug, PartialEq)]

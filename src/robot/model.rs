@@ -20,8 +20,8 @@ use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{float, Mat3, Real, Vec3};
 use crate::robot::delta3::{radial, tangent, ArmSolution, Delta3, MotorCosSin, Unreachable};
-use core::f64::consts::PI;
 use alloc::{format, string::String};
+use core::f64::consts::PI;
 
 /// A box hanging from the TCP: centre `tcp + offset`, world-aligned axes, `half` extents.
 /// It must enclose the tool over its whole rotation about the fourth axis.
