@@ -12,17 +12,30 @@
 //! | [`cell`] | robots, placements, the exact check of a whole cell | 2.3, 3.1.4 | §1, §5 |
 //! | [`ffi`] | the only `extern "C"` surface (opaque handle, POU lifecycle) | App. A | |
 //!
+//! # Features
+//! - `std` (default): everything above plus [`cspace`], the table builders and the C ABI.
+//!   Without it the crate is `#![no_std]` (with `alloc`, maths from `libm`) and holds the
+//!   per-tick code only: [`math`], [`geometry`], [`robot`], the exact check of [`cell`] and
+//!   the table queries (README "Portability and cross-compiling").
+//! - `pictures` (default): the CLI's PNG pictures; the controller's library does not need it.
+//!
 //! Units: millimetres and radians everywhere. Frames: each robot's TCP is given in its own
 //! machine coordinate system (MCS); the world (WCS) is robot 0's MCS.
+#![cfg_attr(not(feature = "std"), no_std)]
 #![deny(unsafe_code)]
 #![deny(unsafe_op_in_unsafe_fn)]
 #![warn(clippy::undocumented_unsafe_blocks)]
 #![warn(missing_docs)]
 
+extern crate alloc;
+
 pub mod cell;
+#[cfg(feature = "std")]
 pub mod cspace;
+#[cfg(feature = "std")]
 pub mod ffi;
 pub mod geometry;
 pub mod math;
 pub mod robot;
+#[cfg(feature = "std")]
 pub mod table;

@@ -22,3 +22,119 @@ pub const SAT_EPSILON: Real = 1e-12;
 /// axis separates only when the gap exceeds this, so touching boxes (and boxes whose gap is
 /// lost in rounding) report a collision.
 pub const SAT_TOUCH_TOLERANCE: Real = 1e-9;
+
+/// The float functions the per-tick code needs that `core` lacks (SPEC §1 units: rad).
+///
+/// With the `std` feature they are `f64`'s own methods, so results are exactly those of
+/// std; without it (`no_std`) they are `libm`'s, correctly rounded where libm is (sqrt,
+/// floor) and within an ulp or so elsewhere. Per-tick code calls these, never the methods.
+pub mod float {
+    use super::Real;
+
+    macro_rules! unary {
+        ($($(#[$doc:meta])* $name:ident),*) => {$(
+            $(#[$doc])*
+            #[inline]
+            pub fn $name(x: Real) -> Real {
+                #[cfg(feature = "std")]
+                return x.$name();
+                #[cfg(not(feature = "std"))]
+                return libm::$name(x);
+            }
+        )*};
+    }
+    unary!(
+        /// Square root.
+        sqrt,
+        /// Sine.
+        sin,
+        /// Cosine.
+        cos,
+        /// Arc cosine, in [0, pi]; NaN outside [-1, 1].
+        acos,
+        /// Largest integer not above `x`.
+        floor
+    );
+
+    /// `(sin x, cos x)`.
+    #[inline]
+    pub fn sin_cos(x: Real) -> (Real, Real) {
+        #[cfg(feature = "std")]
+        return x.sin_cos();
+        #[cfg(not(feature = "std"))]
+        return libm::sincos(x);
+    }
+
+    /// The angle of `(x, y)` from the x axis, in [-pi, pi] (`y.atan2(x)`).
+    #[inline]
+    pub fn atan2(y: Real, x: Real) -> Real {
+        #[cfg(feature = "std")]
+        return y.atan2(x);
+        #[cfg(not(feature = "std"))]
+        return libm::atan2(y, x);
+    }
+
+    /// `sqrt(x^2 + y^2)` without undue overflow.
+    #[inline]
+    pub fn hypot(x: Real, y: Real) -> Real {
+        #[cfg(feature = "std")]
+        return x.hypot(y);
+        #[cfg(not(feature = "std"))]
+        return libm::hypot(x, y);
+    }
+
+    /// The least non-negative remainder of `x / m` (`x.rem_euclid(m)`, same formula).
+    #[inline]
+    pub fn rem_euclid(x: Real, m: Real) -> Real {
+        #[cfg(feature = "std")]
+        return x.rem_euclid(m);
+        #[cfg(not(feature = "std"))]
+        {
+            let r = x % m;
+            if r < 0.0 {
+                r + m.abs()
+            } else {
+                r
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::float;
+
+    /// Distance in units in the last place between two finite doubles of the same sign.
+    fn ulps(a: f64, b: f64) -> u64 {
+        assert!(a.is_finite() && b.is_finite() && (a == b || a.signum() == b.signum()), "{a} vs {b}");
+        (a.to_bits() as i64).abs_diff(b.to_bits() as i64)
+    }
+
+    /// The `no_std` build takes libm's functions: on the arguments the kinematics see they
+    /// agree with std's to within 1 ulp (sqrt and floor exactly), and with `std` the shim
+    /// is std's methods themselves.
+    #[test]
+    fn libm_agrees_with_std_within_one_ulp() {
+        let mut x = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..100_000 {
+            let (a, b) = (1000.0 * next(), 1000.0 * next());
+            assert_eq!(libm::sqrt(a.abs()), a.abs().sqrt());
+            assert_eq!(libm::floor(a), a.floor());
+            assert!(ulps(libm::atan2(a, b), a.atan2(b)) <= 1, "atan2({a}, {b})");
+            assert!(ulps(libm::hypot(a, b), a.hypot(b)) <= 1, "hypot({a}, {b})");
+            assert!(ulps(libm::acos(a / 1000.0), (a / 1000.0).acos()) <= 1, "acos({a} / 1000)");
+            let (t, (s, c)) = (a / 100.0, libm::sincos(a / 100.0));
+            assert!((s - t.sin()).abs() <= 2.0 * f64::EPSILON && (c - t.cos()).abs() <= 2.0 * f64::EPSILON, "{t}");
+            assert_eq!(float::sqrt(a.abs()), a.abs().sqrt());
+            assert_eq!(float::atan2(a, b), a.atan2(b));
+            assert_eq!(float::sin_cos(t), t.sin_cos());
+            assert_eq!(float::rem_euclid(a, 7.0), a.rem_euclid(7.0));
+        }
+    }
+}

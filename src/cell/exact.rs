@@ -9,6 +9,7 @@ use crate::cell::{Cell, SatMethod};
 use crate::geometry::{first_intersecting_pair, WitnessCache};
 use crate::math::Vec3;
 use crate::robot::{RobotBoxes, Unreachable};
+use alloc::{vec, vec::Vec};
 
 /// What the check found for one robot pair.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,8 +78,8 @@ pub enum QueryError {
     },
 }
 
-impl std::fmt::Display for QueryError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl core::fmt::Display for QueryError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             QueryError::WrongRobotCount { expected, found } => {
                 write!(f, "the cell has {expected} robots but {found} TCPs were given")
@@ -87,7 +88,7 @@ impl std::fmt::Display for QueryError {
     }
 }
 
-impl std::error::Error for QueryError {}
+impl core::error::Error for QueryError {}
 
 /// The exact check of one cell, with every per-tick buffer preallocated.
 #[derive(Clone, Debug)]

@@ -4,18 +4,22 @@
 //! A [`Cell`] is validated once; [`ExactChecker`] then answers, per tick and without
 //! allocating, which robot pairs collide for one TCP per robot.
 
+#[cfg(feature = "std")]
 pub mod config;
 pub mod exact;
 pub mod placement;
+#[cfg(feature = "std")]
 pub mod reference;
 pub mod trajectory;
 
+#[cfg(feature = "std")]
 pub use config::parse_cell;
 pub use exact::{CellVerdict, ExactChecker, PairVerdict, QueryError};
 pub use placement::Placement;
 
-use crate::math::Real;
+use crate::math::{float, Real};
 use crate::robot::RobotModel;
+use alloc::{format, string::String, vec::Vec};
 
 /// Most robots in one cell (the unreachable mask of a report is a `u32`).
 pub const MAX_ROBOTS: usize = 32;
@@ -62,8 +66,8 @@ pub enum CellError {
     Invalid(String),
 }
 
-impl std::fmt::Display for CellError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl core::fmt::Display for CellError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             CellError::Io(m) => write!(f, "cannot read cell file: {m}"),
             CellError::Parse(m) => write!(f, "invalid cell file: {m}"),
@@ -72,7 +76,7 @@ impl std::fmt::Display for CellError {
     }
 }
 
-impl std::error::Error for CellError {}
+impl core::error::Error for CellError {}
 
 fn check_length(what: &str, v: Real, allow_zero: bool) -> Result<(), CellError> {
     if v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0)) {
@@ -135,6 +139,7 @@ impl Cell {
     ///
     /// # Errors
     /// [`CellError::Io`] when the file cannot be read, else as [`parse_cell`].
+    #[cfg(feature = "std")]
     pub fn from_file(path: &std::path::Path) -> Result<Cell, CellError> {
         let text = std::fs::read_to_string(path).map_err(|e| CellError::Io(format!("{}: {e}", path.display())))?;
         parse_cell(&text)
@@ -146,8 +151,8 @@ impl Cell {
     pub fn reach_radius(&self, i: usize) -> Real {
         let m = &self.robots[i].model;
         let (d, o) = (&m.delta, &m.options);
-        let lower = d.f + d.rf + d.re + (o.half_height + o.margin).hypot(o.half_depth + o.margin);
-        let upper = o.upper_links.map_or(0.0, |(h, dz)| d.f + d.rf + (h + o.margin).hypot(dz + o.margin));
+        let lower = d.f + d.rf + d.re + float::hypot(o.half_height + o.margin, o.half_depth + o.margin);
+        let upper = o.upper_links.map_or(0.0, |(h, dz)| d.f + d.rf + float::hypot(h + o.margin, dz + o.margin));
         let extra = [o.platform, o.tool]
             .into_iter()
             .flatten()
@@ -163,7 +168,7 @@ impl Cell {
         for a in 0..n {
             for b in a + 1..n {
                 let d = self.robots[b].placement.t - self.robots[a].placement.t;
-                if d.x.hypot(d.y) <= self.reach_radius(a) + self.reach_radius(b) {
+                if float::hypot(d.x, d.y) <= self.reach_radius(a) + self.reach_radius(b) {
                     pairs.push((a, b));
                 }
             }

@@ -3,7 +3,7 @@
 //! `p_wcs = Rz(alpha) p_mcs + t`. Robots are never tilted about x or y.
 
 use crate::geometry::Obb;
-use crate::math::{Mat3, Real, Vec3};
+use crate::math::{float, Mat3, Real, Vec3};
 
 /// A robot's placement: its MCS expressed in the WCS.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,7 +20,7 @@ impl Placement {
 
     /// `Rz(alpha)`.
     pub fn rotation(&self) -> Mat3 {
-        let (s, c) = self.alpha.sin_cos();
+        let (s, c) = float::sin_cos(self.alpha);
         Mat3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
     }
 
@@ -46,7 +46,7 @@ mod tests {
 
     #[test]
     fn round_trip_and_rotation_sense() {
-        let pl = Placement { alpha: std::f64::consts::FRAC_PI_2, t: Vec3::new(450.0, 0.0, 0.0) };
+        let pl = Placement { alpha: core::f64::consts::FRAC_PI_2, t: Vec3::new(450.0, 0.0, 0.0) };
         // MCS x axis points along WCS +y after a quarter turn.
         assert!((pl.to_wcs(&Vec3::new(1.0, 0.0, 0.0)) - Vec3::new(450.0, 1.0, 0.0)).norm() < 1e-12);
         let p = Vec3::new(12.0, -7.0, -400.0);

@@ -8,6 +8,7 @@
 //! `s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5`, and holds the last waypoint afterwards.
 
 use crate::math::{Real, Vec3};
+use alloc::{format, string::String, vec::Vec};
 
 /// Ticks of one run (6 s at 1 ms, SPEC §5).
 pub const RUN_TICKS: u32 = 6000;

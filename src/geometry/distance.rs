@@ -101,7 +101,7 @@ mod tests {
     fn crossing_edges_of_two_turned_cubes() {
         // A turned 45 degrees about y has a top edge along y at z = sqrt 2; B turned 45 degrees
         // about x has a bottom edge along x: the closest features are these two crossing edges.
-        let s = std::f64::consts::FRAC_1_SQRT_2;
+        let s = core::f64::consts::FRAC_1_SQRT_2;
         let about_y = Mat3::new(s, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, s);
         let about_x = Mat3::new(1.0, 0.0, 0.0, 0.0, s, -s, 0.0, s, s);
         let a = Obb::new(Vec3::zeros(), about_y, Vec3::repeat(1.0));

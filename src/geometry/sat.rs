@@ -67,7 +67,7 @@ fn flat(b: &Obb) -> Flat {
 #[inline]
 pub fn aabb_half_rounded_up(b: &Obb) -> [Real; 3] {
     let m = &b.axes;
-    std::array::from_fn(|k| {
+    core::array::from_fn(|k| {
         (m[(k, 0)].abs() * b.half.x + m[(k, 1)].abs() * b.half.y + m[(k, 2)].abs() * b.half.z) * (1.0 + 1e-12)
     })
 }

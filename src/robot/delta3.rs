@@ -20,8 +20,9 @@
 //! limit is the exact `atan2` taken. [`Delta3::inverse_kinematics_cos_sin`] stops there;
 //! [`Delta3::inverse_kinematics`] adds one `atan2` per arm for the angles themselves.
 
-use crate::math::{Real, Vec3};
-use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
+use crate::math::{float, Real, Vec3};
+use alloc::{format, string::String};
+use core::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
 /// Parameters of one Delta3 robot, in mm and rad (SPEC §2).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,8 +62,8 @@ pub enum Unreachable {
     },
 }
 
-impl std::fmt::Display for Unreachable {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl core::fmt::Display for Unreachable {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Unreachable::NonFinite => write!(f, "TCP has a NaN or infinite coordinate"),
             Unreachable::AboveBase => write!(f, "TCP is not below the base plane (z must be negative)"),
@@ -102,7 +103,7 @@ impl MotorCosSin {
 
     /// The full solution, with the three angles.
     pub fn with_angles(&self) -> ArmSolution {
-        ArmSolution { theta: std::array::from_fn(|i| self.theta(i)), cos: self.cos, sin: self.sin }
+        ArmSolution { theta: core::array::from_fn(|i| self.theta(i)), cos: self.cos, sin: self.sin }
     }
 }
 
@@ -129,7 +130,7 @@ pub fn tangent(arm: usize) -> Vec3 {
 
 /// `atan2(sin, cos)` mapped to (-pi, pi] (`-pi` becomes `pi`).
 fn normalized_angle(cos: Real, sin: Real) -> Real {
-    let th = sin.atan2(cos);
+    let th = float::atan2(sin, cos);
     if th <= -PI {
         PI
     } else {
@@ -213,7 +214,7 @@ impl Delta3 {
             return Ok(());
         }
         let theta = normalized_angle(cos_th, sin_th);
-        if (theta - self.theta_min).rem_euclid(TAU) <= self.theta_max - self.theta_min {
+        if float::rem_euclid(theta - self.theta_min, TAU) <= self.theta_max - self.theta_min {
             Ok(())
         } else {
             Err(theta)
@@ -251,7 +252,7 @@ impl Delta3 {
             // th = -atan2(c, a) +/- acos(K / R): cos th = (a K +/- c S) / R^2 and
             // sin th = (-c K +/- a S) / R^2 with S = sqrt(R^2 - K^2); elbow-out takes the
             // sign that makes cos th larger, +/- = sign(c), and c = z < 0 here: minus.
-            let s = -(r2 - k * k).sqrt();
+            let s = -float::sqrt(r2 - k * k);
             let (cos_n, sin_n) = (a * k + c * s, a * s - c * k); // R^2 (cos th, sin th)
                                                                  // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
             let fast_ok = self.clearly_within_limits(approx_angle(cos_n, sin_n));
@@ -290,8 +291,8 @@ impl Delta3 {
     /// vertical (no lower intersection). Motor limits are not checked.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // written so that NaN fails the tests
     pub fn forward_kinematics(&self, theta: &[Real; 3]) -> Option<Vec3> {
-        let c: [Vec3; 3] = std::array::from_fn(|i| {
-            let (s, co) = theta[i].sin_cos();
+        let c: [Vec3; 3] = core::array::from_fn(|i| {
+            let (s, co) = float::sin_cos(theta[i]);
             self.elbow(i, co, s) - radial(i) * self.e
         });
         let (d1, d2) = (c[1] - c[0], c[2] - c[0]);
@@ -309,7 +310,7 @@ impl Delta3 {
         if !(h2 >= 0.0) {
             return None;
         }
-        let gamma = (h2 / n2).sqrt();
+        let gamma = float::sqrt(h2 / n2);
         let gamma = if n.z > 0.0 { -gamma } else { gamma };
         Some(c[0] + q0 + n * gamma)
     }

@@ -18,9 +18,10 @@
 
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
-use crate::math::{Mat3, Real, Vec3};
+use crate::math::{float, Mat3, Real, Vec3};
 use crate::robot::delta3::{radial, tangent, ArmSolution, Delta3, MotorCosSin, Unreachable};
-use std::f64::consts::PI;
+use alloc::{format, string::String};
+use core::f64::consts::PI;
 
 /// A box hanging from the TCP: centre `tcp + offset`, world-aligned axes, `half` extents.
 /// It must enclose the tool over its whole rotation about the fourth axis.
@@ -204,7 +205,7 @@ impl RobotModel {
         // |E_i - G_i| = re once the loops close (IK: to ~1e-15 relative), so x = (E - G) / re.
         let (inv_re, inv_rf) = (1.0 / d.re, 1.0 / d.rf);
         let lower_half = Vec3::new(0.5 * d.re + m, o.half_height + m, o.half_depth + m);
-        let elbows: [Vec3; 3] = std::array::from_fn(|arm| d.elbow(arm, sol.cos[arm], sol.sin[arm]));
+        let elbows: [Vec3; 3] = core::array::from_fn(|arm| d.elbow(arm, sol.cos[arm], sol.sin[arm]));
         for (arm, slot) in out.boxes[..3].iter_mut().enumerate() {
             *slot = link_box(&elbows[arm], &d.platform_joint(arm, tcp), inv_re, &tangent(arm), lower_half);
         }
@@ -233,7 +234,7 @@ impl RobotModel {
         let m = o.margin;
         let m1 = homogeneous(0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
         // Body frames of the upper links after the motor rotation: x along F_i G_i, y = t_i.
-        let motor_frames: [Mat4; 3] = std::array::from_fn(|arm| {
+        let motor_frames: [Mat4; 3] = core::array::from_fn(|arm| {
             let f = d.motor_point(arm);
             let m2 = homogeneous(f.x, f.y, f.z, 0.0, 0.0, arm as Real * 2.0 * PI / 3.0);
             let m3 = homogeneous(0.0, 0.0, 0.0, 0.0, sol.theta[arm], 0.0);
@@ -270,9 +271,9 @@ pub type Mat4 = nalgebra::Matrix4<Real>;
 /// The thesis's `M(x, y, z, alpha, beta, gamma)` (2.4.2): rotate by `alpha` about x, then
 /// `beta` about y, then `gamma` about z (`Rz Ry Rx`), then translate by `(x, y, z)`.
 pub fn homogeneous(x: Real, y: Real, z: Real, alpha: Real, beta: Real, gamma: Real) -> Mat4 {
-    let (sa, ca) = alpha.sin_cos();
-    let (sb, cb) = beta.sin_cos();
-    let (sg, cg) = gamma.sin_cos();
+    let (sa, ca) = float::sin_cos(alpha);
+    let (sb, cb) = float::sin_cos(beta);
+    let (sg, cg) = float::sin_cos(gamma);
     #[rustfmt::skip]
     let m = Mat4::new(
         cg * cb, cg * sb * sa - sg * ca, cg * sb * ca + sg * sa, x,
@@ -291,8 +292,8 @@ pub fn leg_angles(arm: usize, g: &Vec3, e: &Vec3) -> (Real, Real) {
     let x = (e - g).normalize();
     let (xu, xt, xz) = (x.dot(&radial(arm)), x.dot(&tangent(arm)), x.z);
     // Ry(pi - beta) x = (-cos beta, 0, -sin beta); Rz(gamma) mixes in t with sin gamma.
-    let gamma = xt.atan2(xu.hypot(xz));
-    let beta = (-xz).atan2(-xu);
+    let gamma = float::atan2(xt, float::hypot(xu, xz));
+    let beta = float::atan2(-xz, -xu);
     (beta, gamma)
 }
 

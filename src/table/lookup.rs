@@ -8,7 +8,7 @@
 
 use crate::cell::{Cell, ExactChecker, QueryError};
 use crate::cspace::SampleGrid;
-use crate::math::Vec3;
+use crate::math::{float, Vec3};
 use crate::robot::RobotModel;
 use crate::table::format::from_bytes_for_cell;
 use crate::table::{Header, Table, TableError};
@@ -120,7 +120,7 @@ impl TableChecker {
         let rq = self.header.r / f64::from(1u32 << sub);
         let mut c = [0u16; 3];
         for (a, ci) in c.iter_mut().enumerate() {
-            let u = ((tcp[a] - self.origins[j][a]) / rq).floor();
+            let u = float::floor((tcp[a] - self.origins[j][a]) / rq);
             if !(u >= 0.0 && u < kq) {
                 return None;
             }
