@@ -1,13 +1,15 @@
 //! Precomputed tables of the configuration space: the three linear quadtrees of the thesis,
-//! their file format, and one [`Table`] enum to query them (thesis 3.2.4-3.2.6 and 3.2.8;
-//! SPEC §6; issue 3 items 3 and 5).
+//! the shared 6-D quadtree (issue 4), their file format, and one [`Table`] enum to query them
+//! (thesis 3.2.4-3.2.6 and 3.2.8; SPEC §6; issues 3 and 4).
 //!
 //! A table answers "is the 6-D grid cell `(ix, iy, iz, ix', iy', iz')` a collision" without
 //! allocating. Built from a [`LabelledSpace`](crate::cspace::LabelledSpace), it reports
 //! `false` for every free sample and `true` for every collision sample (lossy 4-D tables with
-//! `t > 0` may also report `true` for free samples). Unreachable pairs and cells outside the
-//! sampled grid are "don't care": the answer there is whatever compressed best, so the caller
-//! must check reachability and the workspace itself. Indices `>= k` answer `true`.
+//! `t > 0` may also report `true` for free samples; a subdivided shared table answers per
+//! sub-cell, [`Table::sub_levels`]). Unreachable pairs and cells outside the sampled grid are
+//! "don't care": the answer there is whatever compressed best, so the caller must check
+//! reachability and the workspace itself ([`TableChecker`] does). Indices beyond the grid
+//! answer `true`.
 
 pub mod build;
 pub mod code;
