@@ -79,15 +79,21 @@ impl<'a> Input<'a> {
         }
     }
 
-    /// A TCP-like point: mostly below the base (`z < 0`) within about a metre of the axis,
-    /// sometimes any [`Input::f64`] per coordinate.
+    /// A TCP-like point (mm): a tag byte picks any [`Input::f64`] per coordinate (1 in 8),
+    /// anywhere within about a metre below the base (3 in 8), or near the thesis robot's
+    /// workspace, `|x|, |y| < 256`, `z` in `(-556, -300]` (4 in 8), where most TCPs reach.
     pub fn point(&mut self) -> [f64; 3] {
-        if self.byte() % 8 == 0 {
+        let tag = self.byte() % 8;
+        if tag == 0 {
             return [self.f64(), self.f64(), self.f64()];
         }
         let [x, y]: [i16; 2] = [i16::from_le_bytes(self.bytes()), i16::from_le_bytes(self.bytes())];
-        let z = u16::from_le_bytes(self.bytes());
-        [f64::from(x) / 64.0, f64::from(y) / 64.0, -f64::from(z) / 64.0]
+        let z = f64::from(u16::from_le_bytes(self.bytes()));
+        if tag < 4 {
+            [f64::from(x) / 64.0, f64::from(y) / 64.0, -z / 64.0]
+        } else {
+            [f64::from(x) / 128.0, f64::from(y) / 128.0, -300.0 - z / 256.0]
+        }
     }
 }
 

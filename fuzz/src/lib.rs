@@ -22,5 +22,8 @@ pub use c_abi::c_abi;
 pub use cell_toml::cell_toml;
 pub use table_bytes::table_bytes;
 
+/// A fuzz target: panics on a finding.
+pub type Target = fn(&[u8]);
+
 /// The targets by name, as `cargo fuzz` and `fuzz/seeds/` name them.
-pub const TARGETS: [(&str, fn(&[u8])); 3] = [("table_bytes", table_bytes), ("cell_toml", cell_toml), ("c_abi", c_abi)];
+pub const TARGETS: [(&str, Target); 3] = [("table_bytes", table_bytes), ("cell_toml", cell_toml), ("c_abi", c_abi)];
