@@ -75,19 +75,22 @@ fn committed_seeds_replay_without_a_finding() {
 /// every variant, and the corrupted files of `tests/data/`.
 fn table_seeds() -> Vec<(String, Vec<u8>)> {
     let mut out = Vec::new();
-    for (cell_name, variants) in [("t1", &["6d", "5d", "4d_yy", "4d_zz"][..]), ("t3", &["6d"][..])] {
+    for (cell_name, variants) in [("t1", &["6d", "5d", "4d_yy", "4d_zz", "shared"][..]), ("t3", &["6d"][..])] {
         let cell = reference_cell(cell_name).unwrap();
         for &v in variants {
             let variant = match v {
                 "6d" => Variant::D6,
                 "5d" => Variant::D5,
                 "4d_yy" => Variant::D4 { axes: SliceAxes::YY, t: 0 },
+                "shared" => Variant::Shared,
                 _ => Variant::D4 { axes: SliceAxes::ZZ, t: 2 },
             };
             let (header, table, _) =
                 build_table(&cell, 16, &Workspace::THESIS, variant, Labelling::Certified, false).unwrap();
-            out.push((format!("{cell_name}_k16_{v}_cut.dct"), to_bytes(&cut(&table, 24), &header)));
-            if cell_name == "t1" && v == "4d_yy" {
+            if let Some(small) = cut(&table, 24) {
+                out.push((format!("{cell_name}_k16_{v}_cut.dct"), to_bytes(&small, &header)));
+            }
+            if cell_name == "t1" && (v == "4d_yy" || v == "shared") {
                 out.push((format!("{cell_name}_k16_{v}_whole.dct"), to_bytes(&table, &header)));
             }
         }
@@ -100,6 +103,7 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
         ("5d", Table::D5(LinearQuadtree5d::build(&s, false).unwrap())),
         ("4d_yy", Table::D4(LinearQuadtree4d::build(&s, true, SliceAxes::YY, 0).unwrap())),
         ("4d_zz", Table::D4(LinearQuadtree4d::build(&s, false, SliceAxes::ZZ, 3).unwrap())),
+        ("shared", Table::Shared(SharedQuadtree6d::build(&s, true).unwrap())),
     ];
     for (v, t) in synthetic {
         out.push((format!("synthetic_k4_{v}.dct"), to_bytes(&t, &header)));
@@ -113,9 +117,10 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
     out
 }
 
-/// The table's first `n` codes with their data: small, and valid by construction.
-fn cut(table: &Table, n: usize) -> Table {
-    match table {
+/// The table's first `n` codes with their data: small, and valid by construction (`None` for
+/// the shared quadtree, a graph that is small whole).
+fn cut(table: &Table, n: usize) -> Option<Table> {
+    Some(match table {
         Table::D6(q) => {
             let codes = q.codes()[..n.min(q.codes().len())].to_vec();
             Table::D6(LinearQuadtree6d::from_parts(q.levels(), q.symmetric(), codes).unwrap())
@@ -141,7 +146,8 @@ fn cut(table: &Table, n: usize) -> Table {
                 LinearQuadtree4d::from_parts(levels, sym, axes, t, codes[..n].to_vec(), new_slice_of, words).unwrap(),
             )
         }
-    }
+        Table::Shared(_) => return None,
+    })
 }
 
 /// The reference cell files, every key of the schema, and files that must be refused.
