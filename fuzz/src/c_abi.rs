@@ -13,37 +13,39 @@
 //!   FREE only with `DC_STATUS_OK`, STOP on every error, and agree with each other.
 //! - Statuses name the cause: NULL pointers, a wrong TCP count, NaN (the mask names exactly
 //!   the non-finite TCPs), unreachable TCPs (the mask names exactly the TCPs that
-//!   `dc_delta3_inverse_kinematics` rejects).
-//! - `dc_init*` leave `*out_handle` NULL on failure; pair results agree with the report.
+//!   `dc_delta3_inverse_kinematics` rejects), in exact and table mode alike.
+//! - `dc_init*` give exactly the status the Rust API implies (`Cell::new`,
+//!   `TableChecker::new`), leave `*out_handle` NULL on failure, and `dc_last_init_error`
+//!   holds a message exactly when they failed; pair results agree with the report.
 //! - Kinematics: outputs are finite; for the thesis robot FK(IK(p)) = p.
+
+mod init;
 
 use super::input::{Encoder, Input};
 use delta_collide::ffi::*;
-use std::ffi::{c_char, CStr};
-use std::sync::OnceLock;
+use std::ffi::CStr;
 
 /// Calls per input at most.
 pub const MAX_OPS: usize = 64;
 /// Live handles at most; a further init destroys the oldest.
 pub const MAX_HANDLES: usize = 4;
-/// Robots per `dc_init` at most (32 are allowed; more must be refused).
-const MAX_INIT_ROBOTS: u8 = 40;
 /// Number of opcodes.
-const OPS: u8 = 9;
+const OPS: u8 = 11;
 
 /// The opcodes.
 #[derive(Clone, Copy, Debug)]
 #[repr(u8)]
 pub enum Op {
-    /// `dc_init`: n (byte % 41), method (byte), NULL flags (byte: config, robots, out),
-    /// edits (byte % 16) of (robot byte, field byte, value) on thesis robots 450 mm apart.
+    /// `dc_init`: n (byte % 41), method (byte), NULL flags (byte: config, robots), edits
+    /// (byte % 16) of (robot byte, field byte, value) on thesis robots 450 mm apart, NULL out
+    /// flag (byte); then the capacity (byte) for `dc_last_init_error`, as after every init.
     Init = 0,
     /// `dc_query`: handle, count (byte: < 192 the robot count, else byte % 40), points, NULL
     /// flags (byte: tcps, out_verdict, out_report).
     Query = 1,
     /// `dc_pair_results`: handle, capacity (byte * 2), NULL flags (byte: out, out_len).
     PairResults = 2,
-    /// `dc_robot_count` and `dc_pair_count`: handle.
+    /// `dc_robot_count`, `dc_pair_count`, `dc_mode`, `dc_table_fallbacks`: handle.
     Counts = 3,
     /// `dc_delta3_inverse_kinematics`: edits (byte % 4) of the thesis geometry, point, NULL
     /// flags (byte: geometry, out_theta).
@@ -57,6 +59,14 @@ pub enum Op {
     /// `dc_init_from_cell_file`: path kind (byte % 6: NULL, not UTF-8, missing, a directory,
     /// empty, `cells/t1.toml`), NULL out flag (byte).
     InitFromFile = 8,
+    /// `dc_init_with_table`: a config as for `Init` with n = byte % 4, then the table: source
+    /// (byte % 6: four T1 seed tables, or u16 % 512 bytes of the input), up to 7 edits
+    /// (byte % 8 of u16 offset, value), reseal flag (fingerprint of the config's cell,
+    /// checksum), NULL table and NULL out flags.
+    InitWithTable = 9,
+    /// `dc_init_from_files`: cell and table path kinds (as `InitFromFile`; the real table is
+    /// a T1 seed), NULL out flag.
+    InitFromFiles = 10,
 }
 
 /// A live handle and the robots it was made from.
@@ -74,7 +84,7 @@ pub fn c_abi(data: &[u8]) {
             break;
         }
         match input.byte() % OPS {
-            0 => init(&mut input, &mut live),
+            0 => init::init(&mut input, &mut live),
             1 => query(&mut input, &live),
             2 => pair_results(&mut input, &live),
             3 => counts(&mut input, &live),
@@ -82,7 +92,9 @@ pub fn c_abi(data: &[u8]) {
             5 => forward(&mut input),
             6 => status_str(&mut input),
             7 => destroy(&mut input, &mut live),
-            _ => init_from_file(&mut input, &mut live),
+            8 => init::init_from_file(&mut input, &mut live),
+            9 => init::init_with_table(&mut input, &mut live),
+            _ => init::init_from_files(&mut input, &mut live),
         }
     }
     for l in live {
@@ -118,114 +130,6 @@ fn null_if<T>(null: bool, p: *mut T) -> *mut T {
     } else {
         p
     }
-}
-
-/// Sets field `field` of `r` from `input`; fields 0-5 are the geometry.
-fn edit(r: &mut DcRobotConfig, field: u8, input: &mut Input) {
-    let flag = |input: &mut Input| match input.byte() % 3 {
-        0 => 0,
-        1 => 1,
-        _ => input.u32(),
-    };
-    let (g, p, t) = (&mut r.geometry, &mut r.platform, &mut r.tool);
-    let target: &mut f64 = match field % 30 {
-        0 => &mut g.f,
-        1 => &mut g.rf,
-        2 => &mut g.re,
-        3 => &mut g.e,
-        4 => &mut g.theta_min,
-        5 => &mut g.theta_max,
-        6 => &mut r.half_height,
-        7 => &mut r.half_depth,
-        8 => &mut r.margin,
-        9 => &mut r.upper_half_height,
-        10 => &mut r.upper_half_depth,
-        11 => &mut p.offset.x,
-        12 => &mut p.offset.z,
-        13 => &mut p.half.x,
-        14 => &mut p.half.y,
-        15 => &mut p.half.z,
-        16 => &mut t.offset.y,
-        17 => &mut t.offset.z,
-        18 => &mut t.half.x,
-        19 => &mut t.half.y,
-        20 => &mut t.half.z,
-        21 => &mut r.alpha,
-        22 => &mut r.translation.x,
-        23 => &mut r.translation.y,
-        24 => &mut r.translation.z,
-        25 => return r.has_upper_links = flag(input),
-        26 => return r.has_platform = flag(input),
-        27 => return r.has_tool = flag(input),
-        28 => {
-            let [x, y, z] = input.point();
-            return r.translation = DcVec3 { x, y, z: z + 450.0 };
-        }
-        _ => return r.geometry = DcDelta3 { theta_min: input.f64(), theta_max: input.f64(), ..r.geometry },
-    };
-    *target = input.f64();
-}
-
-/// Whether every number `dc_init` reads from `r` is finite.
-fn finite(r: &DcRobotConfig) -> bool {
-    let g = &r.geometry;
-    let b = |on: u32, b: &DcBox| {
-        on == 0 || [b.offset, b.half].iter().all(|v| v.x.is_finite() && v.y.is_finite() && v.z.is_finite())
-    };
-    let upper = r.has_upper_links == 0 || r.upper_half_height.is_finite() && r.upper_half_depth.is_finite();
-    let t = &r.translation;
-    [g.f, g.rf, g.re, g.e, g.theta_min, g.theta_max, r.half_height, r.half_depth, r.margin, r.alpha, t.x, t.y, t.z]
-        .iter()
-        .all(|v| v.is_finite())
-        && upper
-        && b(r.has_platform, &r.platform)
-        && b(r.has_tool, &r.tool)
-}
-
-fn init(input: &mut Input, live: &mut Vec<Live>) {
-    let n = usize::from(input.byte() % (MAX_INIT_ROBOTS + 1));
-    let method = match input.byte() % 4 {
-        0 => DC_METHOD_SAT,
-        1 => DC_METHOD_SAT_CACHE,
-        2 => 2,
-        _ => input.u32(),
-    };
-    let nulls = input.byte();
-    let mut robots: Vec<DcRobotConfig> = (0..n.max(1))
-        .map(|i| DcRobotConfig {
-            translation: DcVec3 { x: 450.0 * i as f64, y: 0.0, z: 0.0 },
-            ..dc_robot_config_thesis()
-        })
-        .collect();
-    for _ in 0..input.byte() % 16 {
-        let i = usize::from(input.byte()) % robots.len();
-        let field = input.byte();
-        edit(&mut robots[i], field, input);
-    }
-    let config = DcCellConfig { robots: null_if(nulls & 2 != 0, robots.as_mut_ptr()), n_robots: n, method };
-    let mut out = sentinel();
-    let config_ptr: *const DcCellConfig = if nulls & 1 != 0 { std::ptr::null() } else { &config };
-    // SAFETY: `config` is NULL or valid with `n_robots <= robots.len()` robots; `out` is NULL
-    // or writable.
-    let status = unsafe { dc_init(config_ptr, null_if(nulls & 4 != 0, &mut out)) };
-    assert_ne!(status, DC_STATUS_PANIC, "dc_init panicked");
-    if nulls & 7 != 0 {
-        assert_eq!(status, DC_STATUS_NULL_POINTER);
-    }
-    if nulls & 4 == 0 {
-        assert!(out != sentinel(), "dc_init did not write *out_handle");
-        assert_eq!(status == DC_STATUS_OK, !out.is_null(), "status {status} with handle {out:?}");
-    }
-    if status != DC_STATUS_OK {
-        return;
-    }
-    assert!((1..=32).contains(&n) && method <= DC_METHOD_SAT_CACHE, "n = {n}, method = {method} accepted");
-    assert!(robots[..n].iter().all(finite), "a non-finite config accepted: {:?}", &robots[..n]);
-    // SAFETY: `out` is a live handle.
-    let (count, pairs) = unsafe { (dc_robot_count(out), dc_pair_count(out)) };
-    assert!(count == n && pairs <= n * (n - 1) / 2, "{count} robots, {pairs} pairs for n = {n}");
-    robots.truncate(n);
-    keep(live, Live { handle: out, robots });
 }
 
 fn query(input: &mut Input, live: &[Live]) {
@@ -362,16 +266,25 @@ fn pair_results(input: &mut Input, live: &[Live]) {
     let n = l.robots.len() as u32;
     for p in pairs {
         assert!(p.robot_a < p.robot_b && p.robot_b < n && p.collides <= 1, "{p:?}");
-        assert_eq!(p.collides == 0, p.box_a == DC_BOX_NONE && p.box_b == DC_BOX_NONE, "{p:?}");
+        // SAFETY: live handle.
+        let exact = unsafe { dc_mode(l.handle) } == DC_MODE_EXACT;
+        let no_boxes = p.box_a == DC_BOX_NONE && p.box_b == DC_BOX_NONE;
+        assert!(if exact { (p.collides == 0) == no_boxes } else { no_boxes }, "{p:?}");
     }
 }
 
 fn counts(input: &mut Input, live: &[Live]) {
     let l = pick(input, live);
     // SAFETY: NULL or live.
-    let (robots, pairs) = unsafe { (dc_robot_count(handle_of(l)), dc_pair_count(handle_of(l))) };
+    let (robots, pairs, mode, fallbacks) = unsafe {
+        let h = handle_of(l);
+        (dc_robot_count(h), dc_pair_count(h), dc_mode(h), dc_table_fallbacks(h))
+    };
     let n = l.map_or(0, |l| l.robots.len());
     assert!(robots == n && pairs <= n * n.saturating_sub(1) / 2, "{robots} robots, {pairs} pairs, n = {n}");
+    let expected_mode = if l.is_none() { DC_MODE_NONE } else { mode.clamp(DC_MODE_EXACT, DC_MODE_TABLE) };
+    assert_eq!(mode, expected_mode, "dc_mode");
+    assert!(mode == DC_MODE_TABLE || fallbacks == 0, "{fallbacks} table fallbacks in mode {mode}");
 }
 
 /// The thesis geometry with up to three edits; also says whether it is unedited.
@@ -380,7 +293,7 @@ fn geometry(input: &mut Input) -> (DcDelta3, bool) {
     let edits = input.byte() % 4;
     for _ in 0..edits {
         let field = input.byte() % 6;
-        edit(&mut r, field, input);
+        init::edit(&mut r, field, input);
     }
     (r.geometry, edits == 0)
 }
@@ -434,7 +347,7 @@ fn status_str(input: &mut Input) {
     // SAFETY: `dc_status_str` returns a static NUL-terminated string.
     let text = unsafe { CStr::from_ptr(dc_status_str(status)) };
     assert!(!text.to_bytes().is_empty() && text.to_str().is_ok(), "status {status}: {text:?}");
-    if status <= DC_STATUS_INVALID_ARGUMENT {
+    if status <= DC_STATUS_TABLE_NOT_TWO_ROBOTS {
         assert_ne!(text.to_bytes(), b"unknown status", "status {status} has no description");
     }
     // SAFETY: `dc_version` returns a static NUL-terminated string.
@@ -448,61 +361,19 @@ fn destroy(input: &mut Input, live: &mut Vec<Live>) {
     unsafe { dc_destroy(h) };
 }
 
-/// `cells/t1.toml`, found from the crate that compiled this file (the fuzz crate or the
-/// main crate's tests).
-fn t1_path() -> &'static CStr {
-    static PATH: OnceLock<std::ffi::CString> = OnceLock::new();
-    PATH.get_or_init(|| {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        let file = [dir.join("cells/t1.toml"), dir.join("../cells/t1.toml")].into_iter().find(|p| p.exists());
-        let file = file.expect("cells/t1.toml next to the crate or one folder up");
-        std::ffi::CString::new(file.to_str().expect("UTF-8 path")).expect("no NUL in the path")
-    })
-}
-
-fn init_from_file(input: &mut Input, live: &mut Vec<Live>) {
-    let kind = input.byte() % 6;
-    let null_out = input.flag();
-    let path: *const c_char = match kind {
-        0 => std::ptr::null(),
-        1 => c"/tmp/\xff\xfe.toml".as_ptr(),
-        2 => c"/nonexistent/delta-collide/cell.toml".as_ptr(),
-        3 => c"/".as_ptr(),
-        4 => c"".as_ptr(),
-        _ => t1_path().as_ptr(),
-    };
-    let mut out = sentinel();
-    // SAFETY: `path` is NULL or NUL-terminated; `out` NULL or writable.
-    let status = unsafe { dc_init_from_cell_file(path, null_if(null_out, &mut out)) };
-    let expected = match (null_out, kind) {
-        (true, _) | (_, 0) => DC_STATUS_NULL_POINTER,
-        (_, 1) => DC_STATUS_INVALID_ARGUMENT,
-        (_, 2..=4) => DC_STATUS_IO,
-        _ => DC_STATUS_OK,
-    };
-    assert_eq!(status, expected, "dc_init_from_cell_file, path kind {kind}");
-    if null_out {
-        return;
-    }
-    assert_eq!(status == DC_STATUS_OK, !out.is_null() && out != sentinel(), "status {status}, handle {out:?}");
-    if status == DC_STATUS_OK {
-        let b = DcRobotConfig { translation: DcVec3 { x: 450.0, y: 0.0, z: 0.0 }, ..dc_robot_config_thesis() };
-        keep(live, Live { handle: out, robots: vec![dc_robot_config_thesis(), b] });
-    }
-}
-
 /// Seed inputs, one per situation, written with the encoding above.
 pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     let home = [0.0, 0.0, -450.0];
-    let init2 = |e: &mut Encoder| {
-        e.byte(Op::Init as u8).byte(2).byte(1).byte(0).byte(0);
+    // Init: n, method, NULL flags, edit count, edits, NULL out flag, init error capacity.
+    let init = |e: &mut Encoder, n: u8, method: u8, nulls: u8| {
+        e.byte(Op::Init as u8).byte(n).byte(method).byte(nulls).byte(0).byte(0).byte(64);
     };
     let query2 = |e: &mut Encoder, a: [f64; 3], b: [f64; 3]| {
         e.byte(Op::Query as u8).byte(0).byte(0).point(a).point(b).byte(0);
     };
     let mut out = Vec::new();
     let mut e = Encoder::default();
-    init2(&mut e);
+    init(&mut e, 2, 1, 0);
     query2(&mut e, home, home);
     query2(&mut e, [225.0, 0.0, -450.0], [-225.0, 0.0, -450.0]);
     query2(&mut e, [f64::NAN, 0.0, -450.0], home);
@@ -511,7 +382,7 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.byte(Op::Counts as u8).byte(0).byte(Op::Destroy as u8).byte(0);
     out.push(("two_robots_query_then_destroy", e.bytes));
     let mut e = Encoder::default();
-    e.byte(Op::Init as u8).byte(32).byte(0).byte(0).byte(0);
+    init(&mut e, 32, 0, 0);
     e.byte(Op::Query as u8).byte(0).byte(0);
     (0..32).for_each(|_| {
         e.point(home);
@@ -523,14 +394,16 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.byte(1).byte(8).f64(5.0); // robot 1: margin 5
     e.byte(1).byte(25).byte(1); // robot 1: upper links on
     e.byte(0).byte(9).f64(f64::NAN); // robot 0: upper half-height NaN (unused: upper links off)
+    e.byte(0).byte(255);
     query2(&mut e, [200.0, 0.0, -400.0], [-200.0, 0.0, -400.0]);
     out.push(("edited_config", e.bytes));
     let mut e = Encoder::default();
-    e.byte(Op::Init as u8).byte(2).byte(0).byte(0).byte(1).byte(0).byte(0).f64(-100.0);
-    e.byte(Op::Init as u8).byte(0).byte(0).byte(0).byte(0);
-    e.byte(Op::Init as u8).byte(33).byte(0).byte(0).byte(0);
-    e.byte(Op::Init as u8).byte(2).byte(3).u32(7).byte(0).byte(0);
-    e.byte(Op::Init as u8).byte(2).byte(0).byte(7).byte(0);
+    e.byte(Op::Init as u8).byte(2).byte(0).byte(0).byte(1).byte(0).byte(0).f64(-100.0).byte(0).byte(8);
+    init(&mut e, 0, 0, 0);
+    init(&mut e, 33, 0, 0);
+    e.byte(Op::Init as u8).byte(2).byte(3).u32(7).byte(0).byte(0).byte(0).byte(0);
+    init(&mut e, 2, 0, 3);
+    e.byte(Op::Init as u8).byte(2).byte(0).byte(0).byte(0).byte(1).byte(1);
     query2(&mut e, home, home);
     out.push(("refused_inits", e.bytes));
     let mut e = Encoder::default();
@@ -540,16 +413,45 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.byte(Op::Forward as u8).byte(0).f64(f64::INFINITY).f64(0.0).f64(0.0).byte(4);
     out.push(("kinematics", e.bytes));
     let mut e = Encoder::default();
-    for s in 0..12 {
+    for s in 0..20 {
         e.byte(Op::StatusStr as u8).byte(1).byte(s);
     }
     e.byte(Op::StatusStr as u8).byte(0).u32(u32::MAX);
     out.push(("status_strings", e.bytes));
     let mut e = Encoder::default();
     for kind in 0..6 {
-        e.byte(Op::InitFromFile as u8).byte(kind).byte(0);
+        e.byte(Op::InitFromFile as u8).byte(kind).byte(0).byte(40);
     }
     query2(&mut e, home, home);
-    out.push(("init_from_file", e.bytes));
+    for (cell, table) in [(5, 5), (5, 2), (2, 5), (0, 5), (5, 1)] {
+        e.byte(Op::InitFromFiles as u8).byte(cell).byte(table).byte(0).byte(40);
+    }
+    e.byte(Op::Counts as u8).byte(0);
+    out.push(("init_from_files", e.bytes));
+    // InitWithTable: config (n, method, NULL flags, edit count), source, edit count, reseal,
+    // NULL table, NULL out, init error capacity.
+    for (name, source) in [("table_6d", 0), ("table_5d", 1), ("table_4d", 2), ("table_shared", 3)] {
+        let mut e = Encoder::default();
+        e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0);
+        e.byte(source).byte(0).byte(0).byte(0).byte(0).byte(100);
+        query2(&mut e, home, home);
+        query2(&mut e, [120.0, 0.0, -420.0], [-120.0, 0.0, -420.0]);
+        query2(&mut e, [0.0, 0.0, -900.0], home);
+        e.byte(Op::PairResults as u8).byte(0).byte(1).byte(0).byte(Op::Counts as u8).byte(0);
+        out.push((name, e.bytes));
+    }
+    let mut e = Encoder::default();
+    e.byte(Op::InitWithTable as u8).byte(3).byte(1).byte(0).byte(0).byte(0).byte(0).byte(0).byte(0).byte(0).byte(9);
+    // Robot 1 with a margin of 1 mm, the table resealed with that cell's fingerprint: loads.
+    e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(1).byte(1).byte(8).f64(1.0);
+    e.byte(0).byte(0).byte(1).byte(0).byte(0).byte(200);
+    // One byte of the table changed (offset 48, r), not resealed: the checksum fails.
+    e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0).byte(0).byte(1).u16(48).byte(0x10);
+    e.byte(0).byte(0).byte(0).byte(200);
+    // A table of 16 bytes from the input: truncated.
+    e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0).byte(4).u16(16);
+    e.bytes.extend_from_slice(b"DCTABLE\0\x04\x03\x02\x01\x01\0\0\0");
+    e.byte(0).byte(0).byte(0).byte(0).byte(200);
+    out.push(("refused_tables", e.bytes));
     out
 }
