@@ -70,12 +70,14 @@ fn committed_seeds_replay_without_a_finding() {
     assert!(findings.is_empty(), "seeds that fail their target:\n{}", findings.join("\n"));
 }
 
-/// T1's and T3's real tables at k = 16 cut down to their first codes (a few hundred bytes that
-/// load and pass `TableChecker::new`), the whole 4D yy' table of T1, synthetic k = 4 tables of
-/// every variant, and the corrupted files of `tests/data/`.
+/// T1's and T3's real tables at k = 16 cut down to their first codes or nodes (a few hundred
+/// bytes that load and pass `TableChecker::new`), the whole 4D yy' table of T1, synthetic
+/// k = 4 tables of every variant, and the corrupted files of `tests/data/`.
 fn table_seeds() -> Vec<(String, Vec<u8>)> {
     let mut out = Vec::new();
-    for (cell_name, variants) in [("t1", &["6d", "5d", "4d_yy", "4d_zz", "shared"][..]), ("t3", &["6d"][..])] {
+    for (cell_name, variants) in
+        [("t1", &["6d", "5d", "4d_yy", "4d_zz", "shared", "shared_sub"][..]), ("t3", &["6d"][..])]
+    {
         let cell = reference_cell(cell_name).unwrap();
         for &v in variants {
             let variant = match v {
@@ -83,6 +85,7 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
                 "5d" => Variant::D5,
                 "4d_yy" => Variant::D4 { axes: SliceAxes::YY, t: 0 },
                 "shared" => Variant::Shared,
+                "shared_sub" => Variant::SharedSubdivided,
                 _ => Variant::D4 { axes: SliceAxes::ZZ, t: 2 },
             };
             let (header, table, _) =
@@ -90,7 +93,7 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
             if let Some(small) = cut(&table, 24) {
                 out.push((format!("{cell_name}_k16_{v}_cut.dct"), to_bytes(&small, &header)));
             }
-            if cell_name == "t1" && (v == "4d_yy" || v == "shared") {
+            if cell_name == "t1" && v == "4d_yy" {
                 out.push((format!("{cell_name}_k16_{v}_whole.dct"), to_bytes(&table, &header)));
             }
         }
@@ -117,8 +120,8 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
     out
 }
 
-/// The table's first `n` codes with their data: small, and valid by construction (`None` for
-/// the shared quadtree, a graph that is small whole).
+/// The table's first `n` codes with their data (the shared quadtree: `n` nodes per depth):
+/// small, and valid by construction.
 fn cut(table: &Table, n: usize) -> Option<Table> {
     Some(match table {
         Table::D6(q) => {
@@ -146,8 +149,58 @@ fn cut(table: &Table, n: usize) -> Option<Table> {
                 LinearQuadtree4d::from_parts(levels, sym, axes, t, codes[..n].to_vec(), new_slice_of, words).unwrap(),
             )
         }
-        Table::Shared(_) => return None,
+        Table::Shared(q) => Table::Shared(prune_shared(q, n)),
     })
+}
+
+/// The shared quadtree with at most `budget` nodes per depth (and leaves): the first ones met
+/// from the root; a child past the budget becomes uniform collision. Valid by construction.
+fn prune_shared(q: &SharedQuadtree6d, budget: usize) -> SharedQuadtree6d {
+    let p = q.parts();
+    let children = p.children.to_u32();
+    let depths = p.depth_start.len() - 1;
+    // kept[d]: old ids (relative to depth d; leaves at d = depths) in the order met.
+    let mut kept: Vec<Vec<u32>> = vec![vec![0]];
+    let (mut masks, mut bases, mut new_children) = (Vec::new(), Vec::new(), Vec::new());
+    let mut depth_start = vec![0u32];
+    for d in 0..depths {
+        let mut next: Vec<u32> = Vec::new();
+        for &old in &kept[d] {
+            let node = p.depth_start[d] as usize + old as usize;
+            let [mut nonuniform, mut collision] = p.masks[node];
+            bases.push(new_children.len() as u32);
+            let mut rank = 0;
+            for bit in (0..64).map(|i| 1u64 << i).filter(|b| p.masks[node][0] & b != 0) {
+                let child = children[p.bases[node] as usize + rank];
+                rank += 1;
+                let id = next.iter().position(|&c| c == child).or_else(|| {
+                    (next.len() < budget).then(|| {
+                        next.push(child);
+                        next.len() - 1
+                    })
+                });
+                match id {
+                    Some(id) => new_children.push(id as u32),
+                    None => (nonuniform, collision) = (nonuniform & !bit, collision | bit),
+                }
+            }
+            masks.push([nonuniform, collision]);
+        }
+        depth_start.push(depth_start[d] + kept[d].len() as u32);
+        kept.push(next);
+    }
+    let leaves = kept[depths].iter().map(|&l| p.leaves[l as usize]).collect();
+    SharedQuadtree6d::from_parts(
+        q.levels(),
+        q.sub_levels(),
+        q.symmetric(),
+        masks,
+        bases,
+        depth_start,
+        new_children,
+        leaves,
+    )
+    .unwrap()
 }
 
 /// The reference cell files, every key of the schema, and files that must be refused.

@@ -60,7 +60,7 @@ pub enum Op {
     /// empty, `cells/t1.toml`), NULL out flag (byte).
     InitFromFile = 8,
     /// `dc_init_with_table`: a config as for `Init` with n = byte % 4, then the table: source
-    /// (byte % 6: four T1 seed tables, or u16 % 512 bytes of the input), up to 7 edits
+    /// (byte % 7: five T1 seed tables, one per variant, or u16 % 512 bytes of the input), up to 7 edits
     /// (byte % 8 of u16 offset, value), reseal flag (fingerprint of the config's cell,
     /// checksum), NULL table and NULL out flags.
     InitWithTable = 9,
@@ -430,7 +430,8 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     out.push(("init_from_files", e.bytes));
     // InitWithTable: config (n, method, NULL flags, edit count), source, edit count, reseal,
     // NULL table, NULL out, init error capacity.
-    for (name, source) in [("table_6d", 0), ("table_5d", 1), ("table_4d", 2), ("table_shared", 3)] {
+    let tables = [("table_6d", 0), ("table_5d", 1), ("table_4d", 2), ("table_shared", 3), ("table_shared_sub", 4)];
+    for (name, source) in tables {
         let mut e = Encoder::default();
         e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0);
         e.byte(source).byte(0).byte(0).byte(0).byte(0).byte(100);
@@ -449,7 +450,7 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0).byte(0).byte(1).u16(48).byte(0x10);
     e.byte(0).byte(0).byte(0).byte(200);
     // A table of 16 bytes from the input: truncated.
-    e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0).byte(4).u16(16);
+    e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0).byte(5).u16(16);
     e.bytes.extend_from_slice(b"DCTABLE\0\x04\x03\x02\x01\x01\0\0\0");
     e.byte(0).byte(0).byte(0).byte(0).byte(200);
     out.push(("refused_tables", e.bytes));

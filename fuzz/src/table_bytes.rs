@@ -76,7 +76,12 @@ fn load_and_probe(bytes: &[u8], rng: &mut Rng) {
 /// Queries corner, random and out-of-range cells.
 fn probe_table(table: &Table, header: &Header, rng: &mut Rng) {
     let _ = (table.name(), table.memory_bytes(), table.symmetric(), header.check_cell(0));
-    let k = 1u32 << table.levels();
+    let grid_k = 1u32 << table.levels();
+    for _ in 0..4 {
+        table.query_grid_cell(std::array::from_fn(|_| rng.below(grid_k) as u16));
+    }
+    // Query indices run to k at the table's resolution (sub-cells included).
+    let k = 1u32 << (table.levels() + table.sub_levels());
     let top = (k - 1) as u16;
     table.query([0; 6]);
     table.query([top; 6]);

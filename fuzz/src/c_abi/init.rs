@@ -16,12 +16,13 @@ use std::sync::OnceLock;
 /// Robots per `dc_init` at most (32 are allowed; more must be refused).
 const MAX_INIT_ROBOTS: u8 = 40;
 
-/// Seed tables of cell T1 (k = 16) that `dc_init_with_table` starts from.
-const TABLES: [&[u8]; 4] = [
+/// Seed tables of cell T1 (k = 16) that `dc_init_with_table` starts from, one per variant.
+const TABLES: [&[u8]; 5] = [
     include_bytes!("../../seeds/table_bytes/t1_k16_6d_cut.dct"),
     include_bytes!("../../seeds/table_bytes/t1_k16_5d_cut.dct"),
     include_bytes!("../../seeds/table_bytes/t1_k16_4d_yy_cut.dct"),
-    include_bytes!("../../seeds/table_bytes/t1_k16_shared_whole.dct"),
+    include_bytes!("../../seeds/table_bytes/t1_k16_shared_cut.dct"),
+    include_bytes!("../../seeds/table_bytes/t1_k16_shared_sub_cut.dct"),
 ];
 
 /// Sets field `field` of `r` from `input`; fields 0-5 are the geometry.
@@ -232,7 +233,7 @@ fn table_status(e: &TableError) -> DcStatus {
 /// optionally resealed (fingerprint of `cell`, checksum) so that edits reach the field checks.
 fn table_bytes(input: &mut Input, cell: Option<&Cell>) -> Vec<u8> {
     let source = input.byte();
-    let mut bytes = match TABLES.get(usize::from(source % 6)) {
+    let mut bytes = match TABLES.get(usize::from(source % 7)) {
         Some(t) => t.to_vec(),
         None => {
             let len = usize::from(u16::from_le_bytes(input.bytes()) % 512);
