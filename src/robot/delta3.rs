@@ -287,8 +287,9 @@ impl Delta3 {
 
     /// The TCP for motor angles `theta`: the lower intersection (smaller z) of the three
     /// spheres of radius `re` around `C_i = G_i - e u_i`. `None` when an angle is not finite,
-    /// the spheres do not meet, their centres are collinear, or the plane of the centres is
-    /// vertical (no lower intersection). Motor limits are not checked.
+    /// the spheres do not meet, their centres are collinear, the plane of the centres is
+    /// vertical (no lower intersection), or the point overflows (a length near `f64::MAX`).
+    /// Motor limits are not checked.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // written so that NaN fails the tests
     pub fn forward_kinematics(&self, theta: &[Real; 3]) -> Option<Vec3> {
         let c: [Vec3; 3] = core::array::from_fn(|i| {
@@ -312,7 +313,8 @@ impl Delta3 {
         }
         let gamma = float::sqrt(h2 / n2);
         let gamma = if n.z > 0.0 { -gamma } else { gamma };
-        Some(c[0] + q0 + n * gamma)
+        let p = c[0] + q0 + n * gamma;
+        p.iter().all(|v| v.is_finite()).then_some(p)
     }
 }
 

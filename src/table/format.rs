@@ -241,7 +241,7 @@ fn read_prefix(r: &mut Reader) -> Result<Shape, TableError> {
             "flags = {flags:#x}: only bit 0 (symmetric) and, for variant 7, bit 1 (sub-cells) are defined"
         )));
     }
-    if (variant == 4) != matches!(axes, 1 | 2) || (variant != 4 && t != 0) {
+    if (variant == 4 && !matches!(axes, 1 | 2)) || (variant != 4 && (axes != 0 || t != 0)) {
         return Err(corrupt(format!("variant {variant} with slice axes = {axes}, t = {t}")));
     }
     Ok(Shape { variant, levels, sub_levels: flags >> 1, symmetric: flags & 1 == 1, axes, t })

@@ -1,0 +1,458 @@
+//! Target `c_abi`: a sequence of up to [`MAX_OPS`] calls of the exported `extern "C"`
+//! functions with arbitrary arguments, within each function's `# Safety` contract (pointers
+//! are NULL or valid; lengths are true).
+//!
+//! # Encoding
+//! Each call is an opcode byte (`byte % OPS`, see [`Op`]) followed by its arguments, read
+//! with [`Input`]; bytes past the end read as zeros. Up to [`MAX_HANDLES`] handles are live;
+//! a handle argument is a byte picking one of them or NULL. [`seeds`] writes example inputs.
+//!
+//! # Properties
+//! - No call returns `DC_STATUS_PANIC` (a panic caught at the boundary is a bug).
+//! - Fail closed: `*out_verdict` and `out_report.verdict` are written on every call, read
+//!   FREE only with `DC_STATUS_OK`, STOP on every error, and agree with each other.
+//! - Statuses name the cause: NULL pointers, a wrong TCP count, NaN (the mask names exactly
+//!   the non-finite TCPs), unreachable TCPs (the mask names exactly the TCPs that
+//!   `dc_delta3_inverse_kinematics` rejects), in exact and table mode alike.
+//! - `dc_init*` give exactly the status the Rust API implies (`Cell::new`,
+//!   `TableChecker::new`), leave `*out_handle` NULL on failure, and `dc_last_init_error`
+//!   holds a message exactly when they failed; pair results agree with the report.
+//! - Kinematics: outputs are finite; for the thesis robot FK(IK(p)) = p.
+
+mod init;
+
+use super::input::{Encoder, Input};
+use delta_collide::ffi::*;
+use std::ffi::CStr;
+
+/// Calls per input at most.
+pub const MAX_OPS: usize = 64;
+/// Live handles at most; a further init destroys the oldest.
+pub const MAX_HANDLES: usize = 4;
+/// Number of opcodes.
+const OPS: u8 = 11;
+
+/// The opcodes.
+#[derive(Clone, Copy, Debug)]
+#[repr(u8)]
+pub enum Op {
+    /// `dc_init`: n (byte % 41), method (byte), NULL flags (byte: config, robots), edits
+    /// (byte % 16) of (robot byte, field byte, value) on thesis robots 450 mm apart, NULL out
+    /// flag (byte); then the capacity (byte) for `dc_last_init_error`, as after every init.
+    Init = 0,
+    /// `dc_query`: handle, count (byte: < 192 the robot count, else byte % 40), points, NULL
+    /// flags (byte: tcps, out_verdict, out_report).
+    Query = 1,
+    /// `dc_pair_results`: handle, capacity (byte * 2), NULL flags (byte: out, out_len).
+    PairResults = 2,
+    /// `dc_robot_count`, `dc_pair_count`, `dc_mode`, `dc_table_fallbacks`: handle.
+    Counts = 3,
+    /// `dc_delta3_inverse_kinematics`: edits (byte % 4) of the thesis geometry, point, NULL
+    /// flags (byte: geometry, out_theta).
+    Inverse = 4,
+    /// `dc_delta3_forward_kinematics`: edits, three numbers, NULL flags (geometry, theta, out).
+    Forward = 5,
+    /// `dc_status_str` of a `u32`, and `dc_version`.
+    StatusStr = 6,
+    /// `dc_destroy`: handle (NULL allowed).
+    Destroy = 7,
+    /// `dc_init_from_cell_file`: path kind (byte % 6: NULL, not UTF-8, missing, a directory,
+    /// empty, `cells/t1.toml`), NULL out flag (byte).
+    InitFromFile = 8,
+    /// `dc_init_with_table`: a config as for `Init` with n = byte % 4, then the table: source
+    /// (byte % 7: five T1 seed tables, one per variant, or u16 % 512 bytes of the input), up to 7 edits
+    /// (byte % 8 of u16 offset, value), reseal flag (fingerprint of the config's cell,
+    /// checksum), NULL table and NULL out flags.
+    InitWithTable = 9,
+    /// `dc_init_from_files`: cell and table path kinds (as `InitFromFile`; the real table is
+    /// a T1 seed), NULL out flag.
+    InitFromFiles = 10,
+}
+
+/// A live handle and the robots it was made from.
+struct Live {
+    handle: *mut DcCollider,
+    robots: Vec<DcRobotConfig>,
+}
+
+/// The target: never panics on any input.
+pub fn c_abi(data: &[u8]) {
+    let mut input = Input::new(data);
+    let mut live: Vec<Live> = Vec::new();
+    for _ in 0..MAX_OPS {
+        if input.is_empty() {
+            break;
+        }
+        match input.byte() % OPS {
+            0 => init::init(&mut input, &mut live),
+            1 => query(&mut input, &live),
+            2 => pair_results(&mut input, &live),
+            3 => counts(&mut input, &live),
+            4 => inverse(&mut input),
+            5 => forward(&mut input),
+            6 => status_str(&mut input),
+            7 => destroy(&mut input, &mut live),
+            8 => init::init_from_file(&mut input, &mut live),
+            9 => init::init_with_table(&mut input, &mut live),
+            _ => init::init_from_files(&mut input, &mut live),
+        }
+    }
+    for l in live {
+        // SAFETY: live handle from dc_init*, destroyed once.
+        unsafe { dc_destroy(l.handle) };
+    }
+}
+
+/// A non-NULL pointer no handle can have: `dc_init*` must overwrite it.
+fn sentinel() -> *mut DcCollider {
+    std::ptr::NonNull::dangling().as_ptr()
+}
+
+fn pick<'a>(input: &mut Input, live: &'a [Live]) -> Option<&'a Live> {
+    live.get(usize::from(input.byte()) % (live.len() + 1))
+}
+
+fn handle_of(l: Option<&Live>) -> *mut DcCollider {
+    l.map_or(std::ptr::null_mut(), |l| l.handle)
+}
+
+fn keep(live: &mut Vec<Live>, l: Live) {
+    if live.len() == MAX_HANDLES {
+        // SAFETY: live handle, destroyed once (removed from the list).
+        unsafe { dc_destroy(live.remove(0).handle) };
+    }
+    live.push(l);
+}
+
+fn null_if<T>(null: bool, p: *mut T) -> *mut T {
+    if null {
+        std::ptr::null_mut()
+    } else {
+        p
+    }
+}
+
+fn query(input: &mut Input, live: &[Live]) {
+    let l = pick(input, live);
+    let n = l.map_or(0, |l| l.robots.len());
+    let count = match input.byte() {
+        b @ 192.. => usize::from(b % 40),
+        _ => n,
+    };
+    let tcps: Vec<DcVec3> = (0..count)
+        .map(|_| {
+            let [x, y, z] = input.point();
+            DcVec3 { x, y, z }
+        })
+        .collect();
+    let nulls = input.byte();
+    let mut verdict = DC_VERDICT_FREE;
+    let mut report = DcQueryReport {
+        verdict: DC_VERDICT_FREE,
+        colliding_pairs: 7,
+        unreachable_mask: 7,
+        first_robot_a: 7,
+        first_robot_b: 7,
+        first_box_a: 7,
+        first_box_b: 7,
+    };
+    let tcps_ptr = if nulls & 1 != 0 { std::ptr::null() } else { tcps.as_ptr() };
+    // SAFETY: the handle is NULL or live; `tcps` holds `count` points; outputs are NULL or
+    // writable.
+    let status = unsafe {
+        dc_query(
+            handle_of(l),
+            tcps_ptr,
+            count,
+            null_if(nulls & 2 != 0, &mut verdict),
+            null_if(nulls & 4 != 0, &mut report),
+        )
+    };
+    assert_ne!(status, DC_STATUS_PANIC, "dc_query panicked");
+    if nulls & 2 == 0 {
+        assert!(verdict <= DC_VERDICT_COLLISION, "verdict {verdict}");
+        assert_eq!(status == DC_STATUS_OK, verdict != DC_VERDICT_STOP, "status {status} with verdict {verdict}");
+    }
+    if nulls & 4 == 0 {
+        assert!(nulls & 2 != 0 || report.verdict == verdict, "report {report:?}, verdict {verdict}");
+        assert_eq!(status == DC_STATUS_OK, report.verdict != DC_VERDICT_STOP, "status {status}, report {report:?}");
+    }
+    let Some(l) = l.filter(|_| nulls & 3 == 0) else {
+        return assert_eq!(status, DC_STATUS_NULL_POINTER);
+    };
+    if count != n {
+        return assert_eq!(status, DC_STATUS_WRONG_ROBOT_COUNT);
+    }
+    let not_finite = |p: &DcVec3| !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite());
+    let mask_of = |bad: &dyn Fn(usize) -> bool| (0..n).fold(0u32, |m, j| m | u32::from(bad(j)) << j);
+    let non_finite = mask_of(&|j| not_finite(&tcps[j]));
+    let unreachable = mask_of(&|j| !reachable(&l.robots[j].geometry, tcps[j]));
+    let expected = match (non_finite, unreachable) {
+        (0, 0) => DC_STATUS_OK,
+        (0, _) => DC_STATUS_UNREACHABLE,
+        _ => DC_STATUS_NON_FINITE,
+    };
+    assert_eq!(status, expected, "TCPs {tcps:?}");
+    if nulls & 4 != 0 {
+        return;
+    }
+    match status {
+        DC_STATUS_NON_FINITE => assert_eq!(report.unreachable_mask, non_finite),
+        DC_STATUS_UNREACHABLE => assert_eq!(report.unreachable_mask, unreachable),
+        _ => check_ok_report(l, &report),
+    }
+}
+
+/// Whether `dc_delta3_inverse_kinematics` accepts `tcp` for `geometry`.
+fn reachable(geometry: &DcDelta3, tcp: DcVec3) -> bool {
+    let mut theta = [0.0; 3];
+    // SAFETY: valid geometry and 3 writable doubles.
+    unsafe { dc_delta3_inverse_kinematics(geometry, tcp, theta.as_mut_ptr()) == DC_STATUS_OK }
+}
+
+/// An OK report agrees with `dc_pair_results`.
+fn check_ok_report(l: &Live, report: &DcQueryReport) {
+    let n = l.robots.len() as u32;
+    assert_eq!(report.unreachable_mask, 0);
+    assert_eq!(report.verdict == DC_VERDICT_COLLISION, report.colliding_pairs > 0, "{report:?}");
+    // SAFETY: live handle.
+    let (pairs, status) = results(l.handle, unsafe { dc_pair_count(l.handle) });
+    assert_eq!(status, DC_STATUS_OK);
+    let colliding: Vec<&DcPairResult> = pairs.iter().filter(|p| p.collides == 1).collect();
+    assert_eq!(colliding.len(), report.colliding_pairs as usize, "{report:?} vs {pairs:?}");
+    if let Some(first) = colliding.first() {
+        let (a, b) = (report.first_robot_a, report.first_robot_b);
+        assert!((a, b) == (first.robot_a, first.robot_b) && a < b && b < n, "{report:?} vs {first:?}");
+        assert!((report.first_box_a, report.first_box_b) == (first.box_a, first.box_b), "{report:?} vs {first:?}");
+    }
+}
+
+/// Calls `dc_pair_results` with room for `capacity` results.
+fn results(h: *mut DcCollider, capacity: usize) -> (Vec<DcPairResult>, DcStatus) {
+    let blank = DcPairResult { robot_a: 7, robot_b: 7, collides: 7, box_a: 7, box_b: 7 };
+    let mut out = vec![blank; capacity];
+    let mut len = usize::MAX;
+    // SAFETY: `h` is NULL or live; `out` holds `capacity` elements; `len` is writable.
+    let status = unsafe { dc_pair_results(h, out.as_mut_ptr(), capacity, &mut len) };
+    assert_ne!(status, DC_STATUS_PANIC, "dc_pair_results panicked");
+    if status == DC_STATUS_OK {
+        out.truncate(len);
+    }
+    (out, status)
+}
+
+fn pair_results(input: &mut Input, live: &[Live]) {
+    let l = pick(input, live);
+    let capacity = usize::from(input.byte()) * 2;
+    let nulls = input.byte();
+    let h = handle_of(l);
+    if nulls & 3 != 0 {
+        let mut out = vec![DcPairResult { robot_a: 0, robot_b: 0, collides: 0, box_a: 0, box_b: 0 }; capacity];
+        let mut len = usize::MAX;
+        // SAFETY: `h` is NULL or live; `out` NULL or `capacity` elements; `len` NULL or writable.
+        let status = unsafe {
+            dc_pair_results(h, null_if(nulls & 1 != 0, out.as_mut_ptr()), capacity, null_if(nulls & 2 != 0, &mut len))
+        };
+        return assert_eq!(status, DC_STATUS_NULL_POINTER);
+    }
+    let (pairs, status) = results(h, capacity);
+    let Some(l) = l else { return assert_eq!(status, DC_STATUS_NULL_POINTER) };
+    // SAFETY: live handle.
+    let count = unsafe { dc_pair_count(l.handle) };
+    if capacity < count {
+        return assert_eq!(status, DC_STATUS_INVALID_ARGUMENT);
+    }
+    assert!(status == DC_STATUS_OK && pairs.len() == count, "status {status}, {} pairs of {count}", pairs.len());
+    let n = l.robots.len() as u32;
+    for p in pairs {
+        assert!(p.robot_a < p.robot_b && p.robot_b < n && p.collides <= 1, "{p:?}");
+        // SAFETY: live handle.
+        let exact = unsafe { dc_mode(l.handle) } == DC_MODE_EXACT;
+        let no_boxes = p.box_a == DC_BOX_NONE && p.box_b == DC_BOX_NONE;
+        assert!(if exact { (p.collides == 0) == no_boxes } else { no_boxes }, "{p:?}");
+    }
+}
+
+fn counts(input: &mut Input, live: &[Live]) {
+    let l = pick(input, live);
+    // SAFETY: NULL or live.
+    let (robots, pairs, mode, fallbacks) = unsafe {
+        let h = handle_of(l);
+        (dc_robot_count(h), dc_pair_count(h), dc_mode(h), dc_table_fallbacks(h))
+    };
+    let n = l.map_or(0, |l| l.robots.len());
+    assert!(robots == n && pairs <= n * n.saturating_sub(1) / 2, "{robots} robots, {pairs} pairs, n = {n}");
+    let expected_mode = if l.is_none() { DC_MODE_NONE } else { mode.clamp(DC_MODE_EXACT, DC_MODE_TABLE) };
+    assert_eq!(mode, expected_mode, "dc_mode");
+    assert!(mode == DC_MODE_TABLE || fallbacks == 0, "{fallbacks} table fallbacks in mode {mode}");
+}
+
+/// The thesis geometry with up to three edits; also says whether it is unedited.
+fn geometry(input: &mut Input) -> (DcDelta3, bool) {
+    let mut r = dc_robot_config_thesis();
+    let edits = input.byte() % 4;
+    for _ in 0..edits {
+        let field = input.byte() % 6;
+        init::edit(&mut r, field, input);
+    }
+    (r.geometry, edits == 0)
+}
+
+fn inverse(input: &mut Input) {
+    let (g, thesis) = geometry(input);
+    let [x, y, z] = input.point();
+    let nulls = input.byte();
+    let mut theta = [f64::NAN; 3];
+    let g_ptr: *const DcDelta3 = if nulls & 1 != 0 { std::ptr::null() } else { &g };
+    // SAFETY: geometry NULL or valid; `theta` NULL or 3 writable doubles.
+    let status =
+        unsafe { dc_delta3_inverse_kinematics(g_ptr, DcVec3 { x, y, z }, null_if(nulls & 2 != 0, theta.as_mut_ptr())) };
+    assert_ne!(status, DC_STATUS_PANIC, "dc_delta3_inverse_kinematics panicked");
+    if nulls & 3 != 0 {
+        return assert_eq!(status, DC_STATUS_NULL_POINTER);
+    }
+    if status != DC_STATUS_OK {
+        return;
+    }
+    assert!(theta.iter().all(|t| t.is_finite()), "IK of {:?} gave {theta:?}", (x, y, z));
+    if thesis {
+        let mut back = DcVec3 { x: f64::NAN, y: 0.0, z: 0.0 };
+        // SAFETY: valid geometry, 3 readable doubles, writable output.
+        assert_eq!(unsafe { dc_delta3_forward_kinematics(&g, theta.as_ptr(), &mut back) }, DC_STATUS_OK);
+        let err = (back.x - x).hypot(back.y - y).hypot(back.z - z);
+        assert!(err < 1e-6, "FK(IK({:?})) = {back:?}, {err} mm off", (x, y, z));
+    }
+}
+
+fn forward(input: &mut Input) {
+    let (g, _) = geometry(input);
+    let theta = [input.f64(), input.f64(), input.f64()];
+    let nulls = input.byte();
+    let mut tcp = DcVec3 { x: f64::NAN, y: f64::NAN, z: f64::NAN };
+    let g_ptr: *const DcDelta3 = if nulls & 1 != 0 { std::ptr::null() } else { &g };
+    let t_ptr = if nulls & 2 != 0 { std::ptr::null() } else { theta.as_ptr() };
+    // SAFETY: each pointer NULL or valid for its use.
+    let status = unsafe { dc_delta3_forward_kinematics(g_ptr, t_ptr, null_if(nulls & 4 != 0, &mut tcp)) };
+    assert_ne!(status, DC_STATUS_PANIC, "dc_delta3_forward_kinematics panicked");
+    if nulls & 7 != 0 {
+        return assert_eq!(status, DC_STATUS_NULL_POINTER);
+    }
+    if status == DC_STATUS_OK {
+        assert!(tcp.x.is_finite() && tcp.y.is_finite() && tcp.z.is_finite(), "FK({theta:?}) = {tcp:?} with {g:?}");
+    }
+}
+
+fn status_str(input: &mut Input) {
+    let status = if input.flag() { u32::from(input.byte()) } else { input.u32() };
+    // SAFETY: `dc_status_str` returns a static NUL-terminated string.
+    let text = unsafe { CStr::from_ptr(dc_status_str(status)) };
+    assert!(!text.to_bytes().is_empty() && text.to_str().is_ok(), "status {status}: {text:?}");
+    if status <= DC_STATUS_TABLE_NOT_TWO_ROBOTS {
+        assert_ne!(text.to_bytes(), b"unknown status", "status {status} has no description");
+    }
+    // SAFETY: `dc_version` returns a static NUL-terminated string.
+    assert!(!unsafe { CStr::from_ptr(dc_version()) }.to_bytes().is_empty());
+}
+
+fn destroy(input: &mut Input, live: &mut Vec<Live>) {
+    let i = usize::from(input.byte()) % (live.len() + 1);
+    let h = if i < live.len() { live.remove(i).handle } else { std::ptr::null_mut() };
+    // SAFETY: NULL or a live handle, now removed from the list.
+    unsafe { dc_destroy(h) };
+}
+
+/// Seed inputs, one per situation, written with the encoding above.
+pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
+    let home = [0.0, 0.0, -450.0];
+    // Init: n, method, NULL flags, edit count, edits, NULL out flag, init error capacity.
+    let init = |e: &mut Encoder, n: u8, method: u8, nulls: u8| {
+        e.byte(Op::Init as u8).byte(n).byte(method).byte(nulls).byte(0).byte(0).byte(64);
+    };
+    let query2 = |e: &mut Encoder, a: [f64; 3], b: [f64; 3]| {
+        e.byte(Op::Query as u8).byte(0).byte(0).point(a).point(b).byte(0);
+    };
+    let mut out = Vec::new();
+    let mut e = Encoder::default();
+    init(&mut e, 2, 1, 0);
+    query2(&mut e, home, home);
+    query2(&mut e, [225.0, 0.0, -450.0], [-225.0, 0.0, -450.0]);
+    query2(&mut e, [f64::NAN, 0.0, -450.0], home);
+    query2(&mut e, [0.0, 0.0, 10.0], home);
+    e.byte(Op::PairResults as u8).byte(0).byte(1).byte(0);
+    e.byte(Op::Counts as u8).byte(0).byte(Op::Destroy as u8).byte(0);
+    out.push(("two_robots_query_then_destroy", e.bytes));
+    let mut e = Encoder::default();
+    init(&mut e, 32, 0, 0);
+    e.byte(Op::Query as u8).byte(0).byte(0);
+    (0..32).for_each(|_| {
+        e.point(home);
+    });
+    e.byte(0).byte(Op::PairResults as u8).byte(0).byte(255).byte(0);
+    out.push(("thirty_two_robots", e.bytes));
+    let mut e = Encoder::default();
+    e.byte(Op::Init as u8).byte(2).byte(0).byte(0).byte(3);
+    e.byte(1).byte(8).f64(5.0); // robot 1: margin 5
+    e.byte(1).byte(25).byte(1); // robot 1: upper links on
+    e.byte(0).byte(9).f64(f64::NAN); // robot 0: upper half-height NaN (unused: upper links off)
+    e.byte(0).byte(255);
+    query2(&mut e, [200.0, 0.0, -400.0], [-200.0, 0.0, -400.0]);
+    out.push(("edited_config", e.bytes));
+    let mut e = Encoder::default();
+    e.byte(Op::Init as u8).byte(2).byte(0).byte(0).byte(1).byte(0).byte(0).f64(-100.0).byte(0).byte(8);
+    init(&mut e, 0, 0, 0);
+    init(&mut e, 33, 0, 0);
+    e.byte(Op::Init as u8).byte(2).byte(3).u32(7).byte(0).byte(0).byte(0).byte(0);
+    init(&mut e, 2, 0, 3);
+    e.byte(Op::Init as u8).byte(2).byte(0).byte(0).byte(0).byte(1).byte(1);
+    query2(&mut e, home, home);
+    out.push(("refused_inits", e.bytes));
+    let mut e = Encoder::default();
+    e.byte(Op::Inverse as u8).byte(0).point([30.0, -40.0, -420.0]).byte(0);
+    e.byte(Op::Inverse as u8).byte(1).byte(2).f64(1e300).point(home).byte(0);
+    e.byte(Op::Forward as u8).byte(0).f64(0.3).f64(0.2).f64(0.1).byte(0);
+    e.byte(Op::Forward as u8).byte(0).f64(f64::INFINITY).f64(0.0).f64(0.0).byte(4);
+    out.push(("kinematics", e.bytes));
+    let mut e = Encoder::default();
+    for s in 0..20 {
+        e.byte(Op::StatusStr as u8).byte(1).byte(s);
+    }
+    e.byte(Op::StatusStr as u8).byte(0).u32(u32::MAX);
+    out.push(("status_strings", e.bytes));
+    let mut e = Encoder::default();
+    for kind in 0..6 {
+        e.byte(Op::InitFromFile as u8).byte(kind).byte(0).byte(40);
+    }
+    query2(&mut e, home, home);
+    for (cell, table) in [(5, 5), (5, 2), (2, 5), (0, 5), (5, 1)] {
+        e.byte(Op::InitFromFiles as u8).byte(cell).byte(table).byte(0).byte(40);
+    }
+    e.byte(Op::Counts as u8).byte(0);
+    out.push(("init_from_files", e.bytes));
+    // InitWithTable: config (n, method, NULL flags, edit count), source, edit count, reseal,
+    // NULL table, NULL out, init error capacity.
+    let tables = [("table_6d", 0), ("table_5d", 1), ("table_4d", 2), ("table_shared", 3), ("table_shared_sub", 4)];
+    for (name, source) in tables {
+        let mut e = Encoder::default();
+        e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0);
+        e.byte(source).byte(0).byte(0).byte(0).byte(0).byte(100);
+        query2(&mut e, home, home);
+        query2(&mut e, [120.0, 0.0, -420.0], [-120.0, 0.0, -420.0]);
+        query2(&mut e, [0.0, 0.0, -900.0], home);
+        e.byte(Op::PairResults as u8).byte(0).byte(1).byte(0).byte(Op::Counts as u8).byte(0);
+        out.push((name, e.bytes));
+    }
+    let mut e = Encoder::default();
+    e.byte(Op::InitWithTable as u8).byte(3).byte(1).byte(0).byte(0).byte(0).byte(0).byte(0).byte(0).byte(0).byte(9);
+    // Robot 1 with a margin of 1 mm, the table resealed with that cell's fingerprint: loads.
+    e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(1).byte(1).byte(8).f64(1.0);
+    e.byte(0).byte(0).byte(1).byte(0).byte(0).byte(200);
+    // One byte of the table changed (offset 48, r), not resealed: the checksum fails.
+    e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0).byte(0).byte(1).u16(48).byte(0x10);
+    e.byte(0).byte(0).byte(0).byte(200);
+    // A table of 16 bytes from the input: truncated.
+    e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0).byte(5).u16(16);
+    e.bytes.extend_from_slice(b"DCTABLE\0\x04\x03\x02\x01\x01\0\0\0");
+    e.byte(0).byte(0).byte(0).byte(0).byte(200);
+    out.push(("refused_tables", e.bytes));
+    out
+}

@@ -1,0 +1,29 @@
+//! The fuzz targets of delta-collide (issue 5 item 2), as plain functions over bytes.
+//!
+//! Each `fuzz_targets/<name>.rs` binary hands libFuzzer's input to one of them; the main
+//! crate's `tests/fuzz_short.rs` compiles this same file (`#[path]`) to replay the committed
+//! seeds in `fuzz/seeds/<name>/` in-process, and runs each binary briefly with `cargo fuzz`.
+//! A target panics (an `assert!`) on a finding; any input at all is valid.
+//!
+//! | target | input | checks |
+//! |---|---|---|
+//! | [`table_bytes`] | a table file | `table::from_bytes`, `TableChecker::new`, queries |
+//! | [`cell_toml`] | a cell file | `cell::parse_cell`, `ExactChecker`, the same cell through `dc_init` |
+//! | [`c_abi`] | a call sequence ([`c_abi::Op`]) | every `extern "C"` function, fail-closed outputs |
+#![deny(unsafe_op_in_unsafe_fn)]
+#![warn(clippy::undocumented_unsafe_blocks)]
+
+pub mod c_abi;
+pub mod cell_toml;
+pub mod input;
+pub mod table_bytes;
+
+pub use c_abi::c_abi;
+pub use cell_toml::cell_toml;
+pub use table_bytes::table_bytes;
+
+/// A fuzz target: panics on a finding.
+pub type Target = fn(&[u8]);
+
+/// The targets by name, as `cargo fuzz` and `fuzz/seeds/` name them.
+pub const TARGETS: [(&str, Target); 3] = [("table_bytes", table_bytes), ("cell_toml", cell_toml), ("c_abi", c_abi)];
