@@ -169,10 +169,9 @@ fn prune_shared(q: &SharedQuadtree6d, budget: usize) -> SharedQuadtree6d {
             let node = p.depth_start[d] as usize + old as usize;
             let [mut nonuniform, mut collision] = p.masks[node];
             bases.push(new_children.len() as u32);
-            let mut rank = 0;
-            for bit in (0..64).map(|i| 1u64 << i).filter(|b| p.masks[node][0] & b != 0) {
+            let bits = (0..64).map(|i| 1u64 << i).filter(|b| p.masks[node][0] & b != 0);
+            for (rank, bit) in bits.enumerate() {
                 let child = children[p.bases[node] as usize + rank];
-                rank += 1;
                 let id = next.iter().position(|&c| c == child).or_else(|| {
                     (next.len() < budget).then(|| {
                         next.push(child);
