@@ -47,53 +47,11 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-#[test]
-fn query_does_not_allocate_over_a_million_ticks() {
-    for method in [DC_METHOD_SAT, DC_METHOD_SAT_CACHE] {
-        let h = two_robot_cell(450.0, method);
-        let mut verdict = DC_VERDICT_STOP;
-        let mut report = zero_report();
-        let ring: Vec<[DcVec3; 2]> = (0..128)
-            .map(|i| {
-                let s = i as f64 / 127.0;
-                [v(-150.0 + 330.0 * s, 30.0, -450.0), v(150.0 - 330.0 * s, -20.0, -430.0)]
-            })
-            .collect();
-        let (mut free, mut hit) = (0, 0);
-        let before = allocations();
-        for i in 0..1_000_000 {
-            let tcps = &ring[i % ring.len()];
-            // SAFETY: live handle, valid slices and outputs.
-            let s = unsafe { dc_query(h, tcps.as_ptr(), 2, &mut verdict, &mut report) };
-            assert_eq!(s, DC_STATUS_OK);
-            if verdict == DC_VERDICT_FREE {
-                free += 1
-            } else {
-                hit += 1
-            }
-        }
-        let after = allocations();
-        assert_eq!(after - before, 0, "dc_query allocated");
-        assert!(free > 0 && hit > 0, "the ring covers both verdicts ({free} free, {hit} collisions)");
-        // SAFETY: live handle, destroyed once.
-        unsafe { dc_destroy(h) };
-    }
-}
-
-#[test]
-fn table_mode_query_does_not_allocate_over_a_million_ticks() {
-    let h = t1_table_handle();
+/// 1,000,000 `dc_query` calls on `h` cycling through `ring`, each asserted OK: (free
+/// verdicts, collision verdicts, allocations made by the calls).
+fn query_million_ticks(h: *mut DcCollider, ring: &[[DcVec3; 2]]) -> (u32, u32, usize) {
     let mut verdict = DC_VERDICT_STOP;
     let mut report = zero_report();
-    // Toward each other through the shared space; every 16th tick robot A is above the
-    // sampled workspace (z = -340, reachable): the exact fallback must not allocate either.
-    let ring: Vec<[DcVec3; 2]> = (0..128)
-        .map(|i| {
-            let s = i as f64 / 127.0;
-            let z = if i % 16 == 0 { -340.0 } else { -450.0 };
-            [v(-150.0 + 330.0 * s, 30.0, z), v(150.0 - 330.0 * s, -20.0, -430.0)]
-        })
-        .collect();
     let (mut free, mut hit) = (0, 0);
     let before = allocations();
     for i in 0..1_000_000 {
@@ -107,8 +65,41 @@ fn table_mode_query_does_not_allocate_over_a_million_ticks() {
             hit += 1
         }
     }
-    let after = allocations();
-    assert_eq!(after - before, 0, "dc_query allocated in table mode");
+    (free, hit, allocations() - before)
+}
+
+#[test]
+fn query_does_not_allocate_over_a_million_ticks() {
+    for method in [DC_METHOD_SAT, DC_METHOD_SAT_CACHE] {
+        let h = two_robot_cell(450.0, method);
+        let ring: Vec<[DcVec3; 2]> = (0..128)
+            .map(|i| {
+                let s = i as f64 / 127.0;
+                [v(-150.0 + 330.0 * s, 30.0, -450.0), v(150.0 - 330.0 * s, -20.0, -430.0)]
+            })
+            .collect();
+        let (free, hit, allocated) = query_million_ticks(h, &ring);
+        assert_eq!(allocated, 0, "dc_query allocated");
+        assert!(free > 0 && hit > 0, "the ring covers both verdicts ({free} free, {hit} collisions)");
+        // SAFETY: live handle, destroyed once.
+        unsafe { dc_destroy(h) };
+    }
+}
+
+#[test]
+fn table_mode_query_does_not_allocate_over_a_million_ticks() {
+    let h = t1_table_handle();
+    // Toward each other through the shared space; every 16th tick robot A is above the
+    // sampled workspace (z = -340, reachable): the exact fallback must not allocate either.
+    let ring: Vec<[DcVec3; 2]> = (0..128)
+        .map(|i| {
+            let s = i as f64 / 127.0;
+            let z = if i % 16 == 0 { -340.0 } else { -450.0 };
+            [v(-150.0 + 330.0 * s, 30.0, z), v(150.0 - 330.0 * s, -20.0, -430.0)]
+        })
+        .collect();
+    let (free, hit, allocated) = query_million_ticks(h, &ring);
+    assert_eq!(allocated, 0, "dc_query allocated in table mode");
     assert!(free > 0 && hit > 0, "the ring covers both verdicts ({free} free, {hit} collisions)");
     // SAFETY: live handle.
     let fallbacks = unsafe { dc_table_fallbacks(h) };
