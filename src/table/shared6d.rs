@@ -554,6 +554,24 @@ mod tests {
     use crate::table::synthetic::{space, Pattern};
     use crate::table::LinearQuadtree6d;
 
+    /// The table rebuilt from its own parts (as a file load does).
+    fn round_trip(t: &SharedQuadtree6d) -> SharedQuadtree6d {
+        let p = t.parts();
+        let (masks, bases, starts, leaves) =
+            (p.masks.to_vec(), p.bases.to_vec(), p.depth_start.to_vec(), p.leaves.to_vec());
+        SharedQuadtree6d::from_parts(
+            t.levels,
+            t.sub_levels,
+            t.symmetric,
+            masks,
+            bases,
+            starts,
+            p.children.to_u32(),
+            leaves,
+        )
+        .unwrap()
+    }
+
     /// Every free and collision sample is answered exactly, as the 6-D linear quadtree does.
     #[test]
     fn answers_every_sample_as_the_labels_and_the_6d_table() {
@@ -583,19 +601,7 @@ mod tests {
                     }
                 }
             }
-            let p = shared.parts();
-            let again = SharedQuadtree6d::from_parts(
-                levels,
-                0,
-                symmetric,
-                p.masks.to_vec(),
-                p.bases.to_vec(),
-                p.depth_start.to_vec(),
-                p.children.to_u32(),
-                p.leaves.to_vec(),
-            )
-            .unwrap();
-            assert_eq!(again, shared);
+            assert_eq!(round_trip(&shared), shared);
         }
     }
 
@@ -671,19 +677,7 @@ mod tests {
             }
             assert!(free > 0 && hit > 0, "{pattern:?}: {checked} checked, {free} free, {hit} collision");
             // The file round trip keeps the sub-level.
-            let p = t.parts();
-            let again = SharedQuadtree6d::from_parts(
-                levels,
-                1,
-                symmetric,
-                p.masks.to_vec(),
-                p.bases.to_vec(),
-                p.depth_start.to_vec(),
-                p.children.to_u32(),
-                p.leaves.to_vec(),
-            )
-            .unwrap();
-            assert_eq!(again, t);
+            assert_eq!(round_trip(&t), t);
         }
     }
 
