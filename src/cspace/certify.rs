@@ -1,29 +1,34 @@
 //! Certified labelling: free labels that are proofs for whole 6-D grid cells (SPEC §6,
-//! thesis 3.2.7; issue 3 item 4).
+//! thesis 3.2.7; issues 3 and 4).
 //!
-//! A pair of samples `(ia, ib)` is free when it is proved free at one of two levels:
-//! 1. the boxes at both cell centres, each enlarged by its own displacement bound over the
-//!    whole cell ([`box_displacement_bounds`]), are disjoint; or, failing that,
-//! 2. (refinement) each robot's cell is cut into its 8 octants, each with its own centre
-//!    boxes and bounds over the octant ([`cube_box_bounds`], about half as large), and for
+//! Each robot's boxes at a cell's reference TCP are swept by their displacement sets over the
+//! cell ([`box_sweeps`], direction-aware, [`crate::cspace::guarantee`]); a box pair is proved
+//! disjoint over a 6-D cell when the swept boxes are ([`crate::geometry::sweep`]). A pair of
+//! samples `(ia, ib)` is free when it is proved free at one of two levels:
+//! 1. every box pair is proved disjoint with the whole cells' sweeps; or, failing that,
+//! 2. (refinement) each robot's cell is cut into its 8 octants, each with its own reference
+//!    boxes and sweeps over the octant ([`cube_box_sweeps`], about half as large), and for
 //!    every pair (octant i of A, octant j of B) each box pair is proved disjoint by one of
-//!    the tests (A cell, B cell), (A octant i, B cell) or (A octant i, B octant j) (a box
-//!    pair proved disjoint by a coarser test is disjoint for every configuration it covers). Octants that hold no reachable TCP are skipped. Pairs
-//!    whose physical boxes collide at the centres skip this level.
+//!    the tests (A cell, B cell), (A octant i, B cell), (A cell, B octant j) or (A octant i,
+//!    B octant j) (a box pair proved disjoint by a coarser test is disjoint for every
+//!    configuration it covers). Octants that hold no reachable TCP are skipped. Pairs whose
+//!    physical boxes collide at the reference TCPs skip this level.
 //!
-//! Either way every configuration of the 6-D cell is covered by a disjoint pair of enlarged
-//! box sets, each of which contains the physical boxes for every TCP of its (sub)cell (see
-//! [`crate::cspace::guarantee`]). Anything not proved is a collision.
+//! Either way every configuration of the 6-D cell is covered by a disjoint pair of swept
+//! box sets, each of which contains the physical boxes for every TCP of its (sub)cell. Anything
+//! not proved is a collision. [`label_space_subdivided`] keeps level 2's answer per octant pair
+//! for the pairs that stay collisions ([`SubCells`]).
 //!
 //! A sample is labelled [`Label::Unreachable`](crate::cspace::Label) ("don't care") only
 //! when no TCP of its whole cell is reachable ([`cube_unreachable`]); a cell whose centre is
-//! unreachable but which holds reachable TCPs has no displacement bound and is a collision.
+//! unreachable but which holds reachable TCPs is measured from a reachable reference point,
+//! or, without one, has no displacement bound and is a collision.
 //!
-//! Bounds are made exactly mirror-symmetric (the larger of an entry's bound and its mirror's,
-//! arms 1 and 2 swapped), so that a symmetric cell gets exactly symmetric labels (thesis 3.2.8).
+//! Sweeps are made mirror-symmetric (every size the larger of an entry's and its mirror's,
+//! arms 1 and 2 swapped), so that a symmetric cell gets symmetric labels (thesis 3.2.8).
 
 use crate::cell::Cell;
-use crate::cspace::guarantee::{box_displacement_bounds, cube_box_bounds, cube_unreachable, reference_point, SPLITS};
+use crate::cspace::guarantee::{box_sweeps, cube_box_sweeps, cube_unreachable, reference_point, SPLITS};
 use crate::cspace::label::{
     aabbs_apart, all_box_pairs, collision_mask, entries_apart, entries_collide, label_pairs, two_robot_grids,
     Inflation, SampleBoxes, Slot,
@@ -32,6 +37,7 @@ use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::symmetry::mirror_cell;
 use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::witness::MAX_BOXES;
+use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use crate::robot::{BoxKind, RobotModel};
 use rayon::prelude::*;
@@ -46,7 +52,8 @@ pub struct CertifiedSpace {
     /// The labels; `space.margin` is the largest whole-cell enlargement used (each box got
     /// its own, never more than this).
     pub space: LabelledSpace,
-    /// Per sample of A, per box: the whole-cell displacement bound its box was enlarged by.
+    /// Per sample of A, per box: the radius of the whole-cell displacement set its box was
+    /// swept by ([`Sweep::radius`]).
     pub bounds_a: Vec<[Real; MAX_BOXES]>,
     /// Per sample of B, per box.
     pub bounds_b: Vec<[Real; MAX_BOXES]>,
@@ -141,20 +148,18 @@ fn label_space_certified_inner(
 ) -> Result<CertifiedSpace, String> {
     let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
     let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
-    let (bounds_a, bounds_b) = (cell_bounds(&ra.model, &grid_a), cell_bounds(&rb.model, &grid_b));
+    let (sweeps_a, sweeps_b) = (cell_sweeps(&ra.model, &grid_a), cell_sweeps(&rb.model, &grid_b));
     let (empty_a, empty_b) = (unreachable_cells(&ra.model, &grid_a), unreachable_cells(&rb.model, &grid_b));
-    let level1 = |b: &[[Real; MAX_BOXES]], empty: &[bool], s: usize| {
+    let level1 = |b: &[[Sweep; MAX_BOXES]], empty: &[bool], s: usize| {
         if empty[s] {
             Inflation::Unreachable
-        } else if b[s].iter().any(|v| v.is_infinite()) {
-            Inflation::Unknown
         } else {
-            Inflation::By(b[s])
+            inflation(b[s])
         }
     };
     let (refs_a, refs_b) = (references(&ra.model, &grid_a), references(&rb.model, &grid_b));
-    let a0 = SampleBoxes::new(&ra.model, &ra.placement, &refs_a, |s| level1(&bounds_a, &empty_a, s));
-    let b0 = SampleBoxes::new(&rb.model, &rb.placement, &refs_b, |s| level1(&bounds_b, &empty_b, s));
+    let a0 = SampleBoxes::new(&ra.model, &ra.placement, &refs_a, |s| level1(&sweeps_a, &empty_a, s));
+    let b0 = SampleBoxes::new(&rb.model, &rb.placement, &refs_b, |s| level1(&sweeps_b, &empty_b, s));
     let labels = if refine {
         let (ca, ea) = octants(&ra.model, &grid_a);
         let (cb, eb) = octants(&rb.model, &grid_b);
@@ -162,7 +167,7 @@ fn label_space_certified_inner(
         let b1 = SampleBoxes::new(&rb.model, &rb.placement, &cb, |s| eb[s]);
         // The physical boxes at the reference points: a pair that collides there is a
         // collision without refinement.
-        let none = |_| Inflation::By([0.0; MAX_BOXES]);
+        let none = |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]);
         let (xa, xb) = (
             SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
             SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
@@ -176,6 +181,8 @@ fn label_space_certified_inner(
         (label_pairs(&a0, &b0, |_, _| true, progress), None)
     };
     let (labels, sub) = labels;
+    let radii = |ss: &[[Sweep; MAX_BOXES]]| ss.iter().map(|s| s.map(|w| w.radius())).collect::<Vec<_>>();
+    let (bounds_a, bounds_b) = (radii(&sweeps_a), radii(&sweeps_b));
     let used = |bs: &[[Real; MAX_BOXES]]| bs.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0, Real::max);
     let margin = used(&bounds_a).max(used(&bounds_b));
     let space = LabelledSpace { grid_a, grid_b, labels, margin };
@@ -196,7 +203,7 @@ fn sub_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBo
                 .enumerate()
                 .filter(|&(_, &l)| l == Label::Collision)
                 .map(|(ib, _)| {
-                    let (care, collision) = octant_pairs(a0, a1, b0, b1, ia, ib);
+                    let (care, collision) = octant_pairs(a0, a1, b0, b1, ia, ib, false);
                     ((ia * nb + ib) as u64, care, collision)
                 })
                 .collect()
@@ -213,7 +220,9 @@ fn sub_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBo
 
 /// `(care, collision)` over the 64 octant pairs of `(ia, ib)`: an octant pair is free when
 /// every box pair is proved disjoint by one of the tests (A cell, B cell), (A octant,
-/// B cell), (A cell, B octant) or (A octant, B octant), each valid for all of it.
+/// B cell), (A cell, B octant) or (A octant, B octant), each valid for all of it. Only the
+/// box pairs a coarser test left open go on to a finer one. With `first_only`, stops at the
+/// first octant pair not proved free.
 fn octant_pairs(
     a0: &SampleBoxes,
     a1: &SampleBoxes,
@@ -221,6 +230,7 @@ fn octant_pairs(
     b1: &SampleBoxes,
     ia: usize,
     ib: usize,
+    first_only: bool,
 ) -> (u64, u64) {
     let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
     let all = all_box_pairs(a0.per_entry, b0.per_entry);
@@ -247,6 +257,9 @@ fn octant_pairs(
             };
             if !proved {
                 collision |= bit;
+                if first_only {
+                    return (care, collision);
+                }
             }
         }
     }
@@ -254,10 +267,8 @@ fn octant_pairs(
 }
 
 /// Level 2 for a pair whose whole-cell test failed or could not run (a sample without a
-/// whole-cell bound, [`Slot::Unknown`]: its centre is unreachable but its cell is not).
-/// Only the box pairs that level 1 left open need a proof (the others are disjoint for every
-/// configuration of the 6-D cell); each octant of A narrows them against B's whole cell, and
-/// what stays open must be proved disjoint against every octant of B.
+/// whole-cell bound, [`Slot::Unknown`]: its centre is unreachable but its cell is not):
+/// every octant pair proved free by [`octant_pairs`] (which stops at the first that is not).
 fn octants_prove_free(
     a0: &SampleBoxes,
     a1: &SampleBoxes,
@@ -266,31 +277,7 @@ fn octants_prove_free(
     ia: usize,
     ib: usize,
 ) -> bool {
-    let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
-    let all = all_box_pairs(a0.per_entry, b0.per_entry);
-    let open = if whole_a && whole_b { collision_mask(a0, ia, b0, ib, all) } else { all };
-    for sa in ia * 8..ia * 8 + 8 {
-        match a1.slot[sa] {
-            Slot::Vacuous => continue,
-            Slot::Boxes => {}
-            Slot::Unreachable | Slot::Unknown => return false,
-        }
-        let open = if whole_b { collision_mask(a1, sa, b0, ib, open) } else { open };
-        if open == 0 {
-            continue;
-        }
-        for sb in ib * 8..ib * 8 + 8 {
-            match b1.slot[sb] {
-                Slot::Vacuous => continue,
-                Slot::Boxes => {}
-                Slot::Unreachable | Slot::Unknown => return false,
-            }
-            if !entries_apart(a1, sa, b1, sb) && collision_mask(a1, sa, b1, sb, open) != 0 {
-                return false;
-            }
-        }
-    }
-    true
+    octant_pairs(a0, a1, b0, b1, ia, ib, true).1 == 0
 }
 
 /// Level 2 for the pairs that [`label_pairs`] made collisions because a sample has no
@@ -369,9 +356,48 @@ fn mirror_box(model: &RobotModel, j: usize) -> usize {
     }
 }
 
-/// The larger of two bounds of mirror entries, `b` given in the mirror's box order.
-fn mirror_max(model: &RobotModel, a: &[Real; MAX_BOXES], b: &[Real; MAX_BOXES]) -> [Real; MAX_BOXES] {
-    std::array::from_fn(|j| if j < model.box_count() { a[j].max(b[mirror_box(model, j)]) } else { a[j] })
+/// A displacement set holding both `a` and its mirror entry's `b` (given in the mirror's box
+/// order): every size the larger of the two. The directions are `a`'s; the mirror's are
+/// their mirror images (the cube's axes map to themselves up to sign, and the elbow arcs of
+/// arms 1 and 2 swap with equal motor angles, up to rounding: the table merges each label
+/// with its mirror's anyway, [`crate::table`]), so each term of `b` lies in the same term of
+/// the result.
+fn mirror_max(model: &RobotModel, a: &[Sweep; MAX_BOXES], b: &[Sweep; MAX_BOXES]) -> [Sweep; MAX_BOXES] {
+    std::array::from_fn(|j| if j < model.box_count() { larger(&a[j], &b[mirror_box(model, j)]) } else { a[j] })
+}
+
+fn larger(a: &Sweep, b: &Sweep) -> Sweep {
+    // The cubes are axis-aligned in the MCS: half-edge `i` is `(amax) e_i`.
+    let cube = std::array::from_fn(|i| {
+        let mut w = Vec3::zeros();
+        w[i] = a.cube[i].amax().max(b.cube[i].amax());
+        w
+    });
+    let arc = std::array::from_fn(|i| {
+        let (la, lb) = (a.arc[i].norm(), b.arc[i].norm());
+        if la > 0.0 && lb > la {
+            a.arc[i] * (lb / la)
+        } else {
+            a.arc[i]
+        }
+    });
+    let ends = std::array::from_fn(|k| (a.ends[k].0.max(b.ends[k].0), a.ends[k].1.max(b.ends[k].1)));
+    Sweep { cube, arc, ends, ball: a.ball.max(b.ball) }
+}
+
+/// The mirror image of `s` under `y -> -y` (the MCS cube maps to itself).
+fn mirrored(s: &Sweep) -> Sweep {
+    let flip = |v: Vec3| Vec3::new(v.x, -v.y, v.z);
+    Sweep { cube: s.cube.map(flip), arc: s.arc.map(flip), ..*s }
+}
+
+/// How to build an entry's boxes from its displacement sets: unknown when one is unbounded.
+fn inflation(s: [Sweep; MAX_BOXES]) -> Inflation {
+    if s.iter().any(|w| !w.radius().is_finite()) {
+        Inflation::Unknown
+    } else {
+        Inflation::Swept(s)
+    }
 }
 
 /// Every sample's reference point ([`reference_point`]; its centre when none).
@@ -386,9 +412,9 @@ fn references(model: &RobotModel, grid: &SampleGrid) -> Vec<Vec3> {
         .collect()
 }
 
-/// Whole-cell bounds of every sample, made mirror-symmetric.
-fn cell_bounds(model: &RobotModel, grid: &SampleGrid) -> Vec<[Real; MAX_BOXES]> {
-    let raw: Vec<_> = (0..grid.cells.len()).into_par_iter().map(|s| box_displacement_bounds(model, grid, s)).collect();
+/// Whole-cell displacement sets of every sample, made mirror-symmetric.
+fn cell_sweeps(model: &RobotModel, grid: &SampleGrid) -> Vec<[Sweep; MAX_BOXES]> {
+    let raw: Vec<_> = (0..grid.cells.len()).into_par_iter().map(|s| box_sweeps(model, grid, s)).collect();
     (0..raw.len())
         .map(|s| match grid.index_of(mirror_cell(grid, grid.cells[s])) {
             Some(m) => mirror_max(model, &raw[s], &raw[m]),
@@ -411,9 +437,9 @@ fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>)
     let cs: Vec<Vec3> = (0..n).map(centre).collect();
     let vacuous = |c: &Vec3| !model.delta.is_reachable(c) && cube_unreachable(&model.delta, c, q);
     let refs: Vec<Vec3> = cs.par_iter().map(|c| reference_point(&model.delta, c, q).unwrap_or(*c)).collect();
-    let raw: Vec<Option<[Real; MAX_BOXES]>> = (0..n)
+    let raw: Vec<Option<[Sweep; MAX_BOXES]>> = (0..n)
         .into_par_iter()
-        .map(|e| if vacuous(&cs[e]) { None } else { cube_box_bounds(model, &cs[e], q, &refs[e], OCTANT_SPLITS) })
+        .map(|e| if vacuous(&cs[e]) { None } else { cube_box_sweeps(model, &cs[e], q, &refs[e], OCTANT_SPLITS) })
         .collect();
     let inflation = (0..n)
         .map(|e| {
@@ -422,15 +448,15 @@ fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>)
                 (None, None) => return Inflation::Vacuous,
                 (Some(a), Some(b)) => mirror_max(model, &a, &b),
                 (Some(a), None) => a,
-                (None, Some(b)) => {
-                    std::array::from_fn(|j| if j < model.box_count() { b[mirror_box(model, j)] } else { 0.0 })
-                }
+                (None, Some(b)) => std::array::from_fn(|j| {
+                    if j < model.box_count() {
+                        mirrored(&b[mirror_box(model, j)])
+                    } else {
+                        Sweep::ZERO
+                    }
+                }),
             };
-            if b.iter().any(|v| v.is_infinite()) {
-                Inflation::Unknown
-            } else {
-                Inflation::By(b)
-            }
+            inflation(b)
         })
         .collect();
     (refs, inflation)

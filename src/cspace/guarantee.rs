@@ -12,6 +12,17 @@
 //! of its points). So if the inflated centre boxes of A and B are disjoint, no configuration
 //! of the 6-D cell collides: a free label is a proof.
 //!
+//! # Direction-aware form (issue 4)
+//! The same derivation gives more than a length: each displacement is a sum of terms whose
+//! directions are known. The TCP's `D` lies in the cube `Z` of half-edges `h_a` (not just in
+//! the ball of radius `dp`); the elbow's `G - G0` lies in the arm's vertical plane (the disc
+//! `D` of radius `dG` orthogonal to `t`); only the turn of the link's `y` and `z` axes stays a
+//! ball. [`cube_box_sweeps`] returns that set as a [`Sweep`] per box, and
+//! [`crate::geometry::sweep`] tests box(p0) plus the set by its support function on the 15
+//! axes of the two boxes. On every axis the support is at most the length `rho` above (its
+//! [`Sweep::radius`]), and on most axes less: a face axis along `t` sees no elbow motion at
+//! all, and a world axis sees `h`, not `h sqrt(3)`, of the TCP's.
+//!
 //! # Reference point
 //! Displacements are measured from a reachable TCP `p0` of the cell: its centre when that is
 //! reachable, else a reachable lattice point near it ([`reference_point`]); the cell's boxes
@@ -49,7 +60,7 @@
 //!
 //! Upper links (`F` to `G`, fixed `F`): `x.t = 0` so `y = t` never turns, `|z - z0| = dG / rf`,
 //! and points move at most `(1 + m/rf) dG + (d_u + m) dG / rf`. Platform and tool boxes
-//! translate with the TCP: `dp`. Unit vectors differ by at most 2, so every `|.|` above is
+//! translate with the TCP: `Z`, at most `dp`. Unit vectors differ by at most 2, so every `|.|` above is
 //! capped at 2.
 //!
 //! # Numerics
@@ -60,6 +71,7 @@
 use crate::cspace::interval::Interval;
 use crate::cspace::sampler::SampleGrid;
 use crate::geometry::witness::MAX_BOXES;
+use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use crate::robot::delta3::{radial, tangent};
 use crate::robot::{BoxKind, Delta3, RobotModel};
@@ -219,28 +231,41 @@ pub fn reference_point(delta: &Delta3, c: &Vec3, h: Real) -> Option<Vec3> {
 
 /// Per box of `model` (in [`RobotModel::boxes`] order), a bound on how far any point of the
 /// box moves when the TCP moves from sample `sample`'s reference point ([`reference_point`]
-/// of its cell) to any reachable point of its closed cell (mm; see the module doc).
-/// `INFINITY` for every box when the cell has no reference point or the motor angles cannot
-/// be enclosed; entries past `model.box_count()` are 0.
+/// of its cell) to any reachable point of its closed cell (mm; the [`Sweep::radius`] of
+/// [`box_sweeps`]). `INFINITY` for every box when the cell has no reference point or the
+/// motor angles cannot be enclosed; entries past `model.box_count()` are 0.
 pub fn box_displacement_bounds(model: &RobotModel, grid: &SampleGrid, sample: usize) -> [Real; MAX_BOXES] {
+    box_sweeps(model, grid, sample).map(|s| s.radius())
+}
+
+/// Per box of `model`, the set of displacements of its points when the TCP moves from sample
+/// `sample`'s reference point to any reachable point of its closed cell, in the MCS (see the
+/// module doc). An infinite ball for every box when nothing can be bounded.
+pub fn box_sweeps(model: &RobotModel, grid: &SampleGrid, sample: usize) -> [Sweep; MAX_BOXES] {
     let (c, h) = (grid.sample_center(sample), 0.5 * grid.r);
     reference_point(&model.delta, &c, h)
-        .and_then(|p0| cube_box_bounds(model, &c, h, &p0, SPLITS))
+        .and_then(|p0| cube_box_sweeps(model, &c, h, &p0, SPLITS))
         .unwrap_or_else(|| unknown(model))
 }
 
-fn unknown(model: &RobotModel) -> [Real; MAX_BOXES] {
-    let mut out = [0.0; MAX_BOXES];
-    out[..model.box_count()].fill(Real::INFINITY);
+fn unknown(model: &RobotModel) -> [Sweep; MAX_BOXES] {
+    let mut out = [Sweep::ZERO; MAX_BOXES];
+    out[..model.box_count()].fill(Sweep { ball: Real::INFINITY, ..Sweep::ZERO });
     out
 }
 
-/// As [`box_displacement_bounds`] for the closed cube of centre `c` and half-side `h`
-/// (widened by a relative 1e-12), measured from the reference TCP `p0` (a reachable point
-/// of the cube), enclosing the motor angles with `splits^3` sub-boxes. `None` when no TCP of
-/// the cube is reachable (nothing to bound: the cube can never be occupied); `INFINITY`
-/// entries when `p0` is unreachable or the angles cannot be enclosed.
-pub fn cube_box_bounds(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, splits: u32) -> Option<[Real; MAX_BOXES]> {
+/// As [`box_sweeps`] for the closed cube of centre `c` and half-side `h` (widened by a
+/// relative 1e-12), measured from the reference TCP `p0` (a reachable point of the cube),
+/// enclosing the motor angles with `splits^3` sub-boxes. `None` when no TCP of the cube is
+/// reachable (nothing to bound: the cube can never be occupied); infinite entries when `p0`
+/// is unreachable or the angles cannot be enclosed.
+///
+/// Per box kind (module doc; `Z` is the cube of half-edges `reach`, `D` the disc orthogonal to
+/// the arm's tangent `t` that the elbow moves in):
+/// - lower link: `hull((1 + mu) dG D + mu Z, mu dG D + (1 + mu) Z) + ball((H + m) dy + (D + m) dz)`;
+/// - upper link: `((1 + m/rf) dG + (d_u + m) dG / rf) D`;
+/// - platform and tool: `Z`.
+pub fn cube_box_sweeps(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, splits: u32) -> Option<[Sweep; MAX_BOXES]> {
     let (d, o) = (&model.delta, &model.options);
     let n = model.box_count();
     let h = h * (1.0 + 1e-12) + 1e-12;
@@ -257,38 +282,53 @@ pub fn cube_box_bounds(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, splits:
     // Per axis, the farthest any TCP of the cube lies from p0 (h at the centre).
     let reach = (p0 - c).abs().add_scalar(h);
     let dp = reach.norm();
-    let dg: [Real; 3] = std::array::from_fn(|arm| {
-        let dth = (th[arm].hi - sol.theta[arm]).max(sol.theta[arm] - th[arm].lo).clamp(0.0, std::f64::consts::PI);
-        2.0 * d.rf * (0.5 * dth).sin()
+    let cube = [Vec3::x() * reach.x, Vec3::y() * reach.y, Vec3::z() * reach.z];
+    let dth: [Real; 3] = std::array::from_fn(|arm| {
+        (th[arm].hi - sol.theta[arm]).max(sol.theta[arm] - th[arm].lo).clamp(0.0, std::f64::consts::PI)
     });
+    let dg = dth.map(|a| 2.0 * d.rf * (0.5 * a).sin());
+    // The elbow's arc: `G - G0 = rf (sin D tau0 + (cos D - 1) nu0)` for `|D| <= dth`.
+    let arc = |arm: usize| {
+        let (s, c) = (sol.theta[arm].sin(), sol.theta[arm].cos());
+        let u = radial(arm);
+        let (nu0, tau0) = (u * c - Vec3::z() * s, -u * s - Vec3::z() * c);
+        let (along, inward) = (dth[arm].min(std::f64::consts::FRAC_PI_2).sin(), 1.0 - dth[arm].cos());
+        (tau0, nu0, along, inward)
+    };
     let m = o.margin;
-    let mut out = [0.0; MAX_BOXES];
+    let mut out = [Sweep::ZERO; MAX_BOXES];
     for (j, slot) in out[..n].iter_mut().enumerate() {
-        let bound = match model.box_kind(j) {
+        let sweep = match model.box_kind(j) {
             BoxKind::LowerLink(arm) => {
                 let (arm, t) = (arm as usize, tangent(arm as usize));
                 let mu = m / d.re;
-                let ax = ((1.0 + mu) * dg[arm] + mu * dp).max(mu * dg[arm] + (1.0 + mu) * dp);
                 let dx = ((dp + dg[arm]) / d.re).min(2.0);
                 let tt = (reach.x * t.x.abs() + reach.y * t.y.abs()) / d.re;
                 let beta = p0.dot(&t).abs() / d.re + tt;
                 if beta >= 1.0 {
-                    Real::INFINITY
+                    Sweep { ball: Real::INFINITY, ..Sweep::ZERO }
                 } else {
                     let w0 = (1.0 - beta * beta).sqrt();
                     let dz = (dx / w0).min(2.0);
                     let dy = ((beta * dx + tt) / w0).min(2.0);
-                    ax + (o.half_height + m) * dy + (o.half_depth + m) * dz
+                    let ball = (o.half_height + m) * dy + (o.half_depth + m) * dz;
+                    let (tau0, nu0, along, inward) = arc(arm);
+                    let arc = [tau0 * (d.rf * along), nu0 * (d.rf * inward)];
+                    Sweep { cube, arc, ends: [(mu, 1.0 + mu), (1.0 + mu, mu)], ball }
                 }
             }
             BoxKind::UpperLink(arm) => {
+                // `lambda (G - G0) + s_z (z - z0)`, `|lambda| <= 1 + m/rf`, `|s_z| <= d_u + m`,
+                // with `z - z0` the link axis's turn: `sin D` along nu0, `1 - cos D` along tau0.
                 let (_, du) = o.upper_links.expect("upper link boxes exist");
-                let g = dg[arm as usize];
-                (1.0 + m / d.rf) * g + (du + m) * (g / d.rf).min(2.0)
+                let (tau0, nu0, along, inward) = arc(arm as usize);
+                let (l, w) = (d.rf + m, du + m);
+                let arc = [tau0 * (l * along + w * inward), nu0 * (l * inward + w * along)];
+                Sweep { cube, arc, ends: [(0.0, 1.0); 2], ball: 0.0 }
             }
-            BoxKind::Platform | BoxKind::Tool => dp,
+            BoxKind::Platform | BoxKind::Tool => Sweep { cube, ends: [(1.0, 0.0); 2], ..Sweep::ZERO },
         };
-        *slot = bound + BOUND_SLACK;
+        *slot = Sweep { ball: sweep.ball + BOUND_SLACK, ..sweep };
     }
     Some(out)
 }
@@ -312,21 +352,28 @@ mod tests {
     use crate::robot::ModelOptions;
     use rand::{rngs::StdRng, RngExt, SeedableRng};
 
-    /// The largest corner displacement of any box between the reference `p0` and `p`.
-    fn measured(model: &RobotModel, p0: &Vec3, p: &Vec3) -> Option<[Real; MAX_BOXES]> {
+    /// Per box, the displacements of its eight corners between the reference `p0` and `p`.
+    fn measured(model: &RobotModel, p0: &Vec3, p: &Vec3) -> Option<Vec<[Vec3; 8]>> {
         let (b0, b1) = (model.boxes(p0).ok()?, model.boxes(p).ok()?);
-        let mut out = [0.0; MAX_BOXES];
-        for (j, slot) in out.iter_mut().enumerate().take(b0.len) {
+        let moved = |j: usize| {
             let (v0, v1) = (b0.boxes[j].vertices(), b1.boxes[j].vertices());
-            *slot = v0.iter().zip(&v1).map(|(a, b)| (a - b).norm()).fold(0.0, Real::max);
-        }
-        Some(out)
+            std::array::from_fn(|i| v1[i] - v0[i])
+        };
+        Some((0..b0.len).map(moved).collect())
     }
 
+    /// Checks every corner displacement `v` against its box's sweep: `|v| <= radius` and
+    /// `v . n <= support(n)` for `n` = `v` itself and the 13 axis, face and corner directions.
+    /// Returns the largest `|v| / radius` seen.
     fn check_bounds_against_brute_force(model: RobotModel, k: u32, cells: usize, points: usize, seed: u64) -> Real {
         let grid = SampleGrid::new(&Workspace::THESIS, k, &model.delta).unwrap();
         let mut rng = StdRng::seed_from_u64(seed);
         let mut worst_ratio: Real = 0.0;
+        let dirs: Vec<Vec3> = (1..27)
+            .map(|i: i32| Vec3::new((i % 3 - 1) as Real, (i / 3 % 3 - 1) as Real, (i / 9 - 1) as Real))
+            .filter(|d| *d != Vec3::zeros())
+            .map(|d| d.normalize())
+            .collect();
         // Half of the cells are drawn from those with an unreachable centre (the boundary of
         // the reachable space), where the bound is measured from an off-centre reference.
         let boundary: Vec<usize> = (0..grid.cells.len()).filter(|&s| !grid.reachable[s]).collect();
@@ -336,7 +383,8 @@ mod tests {
             } else {
                 boundary[rng.random_range(0..boundary.len())]
             };
-            let bounds = box_displacement_bounds(&model, &grid, s);
+            let sweeps = box_sweeps(&model, &grid, s);
+            let bounds = sweeps.map(|w| w.radius());
             let c = grid.sample_center(s);
             let Some(p0) = reference_point(&model.delta, &c, 0.5 * grid.r) else {
                 assert!(bounds[..model.box_count()].iter().all(|b| b.is_infinite()));
@@ -352,9 +400,17 @@ mod tests {
                     Vec3::new(rng.random::<Real>() - 0.5, rng.random::<Real>() - 0.5, rng.random::<Real>() - 0.5)
                 };
                 let Some(m) = measured(&model, &p0, &(c + off * grid.r)) else { continue };
-                for j in 0..model.box_count() {
-                    assert!(m[j] <= bounds[j], "sample {s} box {j}: moved {} > bound {}", m[j], bounds[j]);
-                    worst[j] = Real::max(worst[j], m[j]);
+                for (j, corners) in m.iter().enumerate() {
+                    for v in corners {
+                        let len = v.norm();
+                        assert!(len <= bounds[j], "sample {s} box {j}: moved {len} > bound {}", bounds[j]);
+                        let along = if len > 0.0 { v / len } else { Vec3::z() };
+                        for n in dirs.iter().chain([&along]) {
+                            let h = sweeps[j].support(n);
+                            assert!(v.dot(n) <= h + 1e-9, "sample {s} box {j}: {v:?} . {n:?} > support {h}");
+                        }
+                        worst[j] = Real::max(worst[j], len);
+                    }
                 }
             }
             for j in 0..model.box_count() {

@@ -12,8 +12,8 @@
 //! - [`label_space`]: every box enlarged by one global `margin` (the thesis's blown-up model
 //!   [`label_space_thesis`] with `margin = r / sqrt(2)`, or the exact labelling of the
 //!   centres with 0);
-//! - [`crate::cspace::certify::label_space_certified`]: every box enlarged by its own
-//!   displacement bound, so that a free label holds for the whole 6-D cell.
+//! - [`crate::cspace::certify::label_space_certified`]: every box swept by its own
+//!   displacement set, so that a free label holds for the whole 6-D cell.
 //!
 //! # Numerics
 //! Every pre-test errs toward overlap (slack [`AABB_SLACK`]); only the separating axis test
@@ -24,6 +24,7 @@ use crate::cspace::guarantee::thesis_margin;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::sat::separating_axis;
+use crate::geometry::sweep::{swept_aabb_half, swept_boxes_apart, Sweep};
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{Mat3, Real, Vec3};
@@ -52,8 +53,8 @@ pub enum Slot {
 /// How to enlarge the boxes of one entry when building [`SampleBoxes`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Inflation {
-    /// Box `j` enlarged by `.0[j]` on every half-extent (on top of the model's margin).
-    By([Real; MAX_BOXES]),
+    /// Box `j` swept by the displacement set `.0[j]` (MCS; on top of the model's margin).
+    Swept([Sweep; MAX_BOXES]),
     /// See [`Slot::Vacuous`].
     Vacuous,
     /// Proved: no TCP of the cell is reachable (a [`Slot::Unreachable`] sample).
@@ -70,6 +71,8 @@ pub struct SampleBoxes {
     pub per_entry: usize,
     /// Box `j` of entry `s` at `s * per_entry + j` (meaningful when `slot[s]` is `Boxes`).
     pub boxes: Vec<Obb>,
+    /// Per box: its displacement set in the WCS ([`Sweep::ZERO`] for the exact boxes).
+    pub sweeps: Vec<Sweep>,
     /// Per box: AABB lower corner.
     pub box_lo: Vec<[Real; 3]>,
     /// Per box: AABB upper corner.
@@ -90,7 +93,7 @@ impl SampleBoxes {
         F: Fn(usize) -> Inflation + Sync,
     {
         let nb = model.box_count();
-        let per: Vec<(Slot, Vec<Obb>)> = centres
+        let per: Vec<(Slot, Vec<(Obb, Sweep)>)> = centres
             .par_iter()
             .enumerate()
             .map(|(s, c)| match (inflate(s), model.boxes(c)) {
@@ -98,8 +101,10 @@ impl SampleBoxes {
                 (Inflation::Unreachable, _) => (Slot::Unreachable, vec![]),
                 (Inflation::Unknown, _) => (Slot::Unknown, vec![]),
                 (_, Err(_)) => (Slot::Unreachable, vec![]),
-                (Inflation::By(extra), Ok(boxes)) => {
-                    let b = boxes.as_slice().iter().zip(extra).map(|(b, m)| placement.obb_to_wcs(&b.inflated(m)));
+                (Inflation::Swept(sweeps), Ok(boxes)) => {
+                    let rot = placement.rotation();
+                    let b =
+                        boxes.as_slice().iter().zip(sweeps).map(|(b, s)| (placement.obb_to_wcs(b), s.rotated(&rot)));
                     (Slot::Boxes, b.collect())
                 }
             })
@@ -109,6 +114,7 @@ impl SampleBoxes {
         let mut out = SampleBoxes {
             per_entry: nb,
             boxes: Vec::with_capacity(n * nb),
+            sweeps: Vec::with_capacity(n * nb),
             box_lo: Vec::with_capacity(n * nb),
             box_hi: Vec::with_capacity(n * nb),
             lo: Vec::with_capacity(n),
@@ -118,14 +124,15 @@ impl SampleBoxes {
         for (slot, boxes) in per {
             let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
             for j in 0..nb {
-                let b = boxes.get(j).copied().unwrap_or(empty);
-                let h = b.aabb_half();
+                let (b, sweep) = boxes.get(j).copied().unwrap_or((empty, Sweep::ZERO));
+                let h = swept_aabb_half(&b, &sweep);
                 let (bl, bh) = (b.center - h, b.center + h);
                 for a in 0..3 {
                     lo[a] = lo[a].min(bl[a]);
                     hi[a] = hi[a].max(bh[a]);
                 }
                 out.boxes.push(b);
+                out.sweeps.push(sweep);
                 out.box_lo.push([bl.x, bl.y, bl.z]);
                 out.box_hi.push([bh.x, bh.y, bh.z]);
             }
@@ -159,6 +166,22 @@ pub(crate) fn entries_apart(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usi
     aabbs_apart(&a.lo[ia], &a.hi[ia], &b.lo[ib], &b.hi[ib])
 }
 
+/// Whether box `i` of A (index into `a.boxes`) and box `j` of B may intersect: not proved
+/// apart by their AABBs, nor by the separating axis test (exact boxes) or its swept form
+/// ([`swept_boxes_apart`]).
+#[inline]
+fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usize) -> bool {
+    if aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j]) {
+        return false;
+    }
+    let (sa, sb) = (&a.sweeps[i], &b.sweeps[j]);
+    if sa.is_zero() && sb.is_zero() {
+        separating_axis(&a.boxes[i], &b.boxes[j]).is_none()
+    } else {
+        !swept_boxes_apart(&a.boxes[i], sa, &b.boxes[j], sb)
+    }
+}
+
 /// Whether some box of A's entry `ia` intersects some box of B's entry `ib` (both `Boxes`).
 #[inline]
 pub fn entries_collide(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize) -> bool {
@@ -168,9 +191,7 @@ pub fn entries_collide(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize) -
     let (na, nb) = (a.per_entry, b.per_entry);
     for i in ia * na..(ia + 1) * na {
         for j in ib * nb..(ib + 1) * nb {
-            if !aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j])
-                && separating_axis(&a.boxes[i], &b.boxes[j]).is_none()
-            {
+            if boxes_may_touch(a, i, b, j) {
                 return true;
             }
         }
@@ -191,9 +212,7 @@ pub fn collision_mask(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize, ma
         let bit = rest.trailing_zeros() as usize;
         rest &= rest - 1;
         let (i, j) = (ia * na + bit / 8, ib * nb + bit % 8);
-        if !aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j])
-            && separating_axis(&a.boxes[i], &b.boxes[j]).is_none()
-        {
+        if boxes_may_touch(a, i, b, j) {
             out |= 1 << bit;
         }
     }
@@ -296,8 +315,8 @@ pub fn label_space(cell: &Cell, k: u32, ws: &Workspace, margin: Real, progress: 
     let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
     let (ma, pa) = robot_with_margin(cell, 0, margin);
     let (mb, pb) = robot_with_margin(cell, 1, margin);
-    let a = SampleBoxes::new(&ma, &pa, &centres(&grid_a), |_| Inflation::By([0.0; MAX_BOXES]));
-    let b = SampleBoxes::new(&mb, &pb, &centres(&grid_b), |_| Inflation::By([0.0; MAX_BOXES]));
+    let a = SampleBoxes::new(&ma, &pa, &centres(&grid_a), |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]));
+    let b = SampleBoxes::new(&mb, &pb, &centres(&grid_b), |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]));
     let labels = label_pairs(&a, &b, |_, _| true, progress);
     Ok(LabelledSpace { grid_a, grid_b, labels, margin })
 }

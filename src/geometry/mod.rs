@@ -4,9 +4,11 @@
 pub mod distance;
 pub mod obb;
 pub mod sat;
+pub mod sweep;
 pub mod witness;
 
 pub use distance::obb_distance;
 pub use obb::Obb;
 pub use sat::{obbs_intersect, separating_axis, separating_axis_hinted, Axis};
+pub use sweep::{swept_boxes_apart, Sweep};
 pub use witness::{first_intersecting_pair, WitnessCache};
