@@ -50,7 +50,9 @@ pub enum Slot {
     Unknown,
 }
 
-/// How to enlarge the boxes of one entry when building [`SampleBoxes`].
+/// How to enlarge the boxes of one entry when building [`SampleBoxes`] (a short-lived value,
+/// one per entry while building: its size does not matter).
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Inflation {
     /// Box `j` swept by the displacement set `.0[j]` (MCS; on top of the model's margin).
