@@ -22,7 +22,8 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::symmetry::reflection_y;
 use delta_collide::cspace::{
-    label_space_certified, label_space_subdivided, label_space_thesis, LabelledSpace, SampleGrid, Workspace,
+    label_space_certified, label_space_subdivided, label_space_thesis, subdivided_labels, LabelledSpace, SampleGrid,
+    Workspace,
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
@@ -36,6 +37,7 @@ struct Options {
     random: usize,
     cold: usize,
     cold_shared: usize,
+    sub: bool,
     smoke: bool,
 }
 
@@ -44,7 +46,15 @@ fn options() -> Options {
     let value = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
     let num = |name: &str, default: usize| value(name).map_or(default, |v| v.parse().expect("a number"));
     if !args.iter().any(|a| a == "--bench") {
-        return Options { cells: vec!["T2".into()], k: 16, random: 2000, cold: 200, cold_shared: 200, smoke: true };
+        return Options {
+            cells: vec!["T2".into()],
+            k: 16,
+            random: 2000,
+            cold: 200,
+            cold_shared: 200,
+            sub: true,
+            smoke: true,
+        };
     }
     let cells = value("--cells").unwrap_or("T1,T2,T3".into()).split(',').map(str::to_string).collect();
     Options {
@@ -53,6 +63,7 @@ fn options() -> Options {
         random: num("--random", 1_000_000),
         cold: num("--cold", 100_000),
         cold_shared: num("--cold-shared", 1_000_000),
+        sub: !args.iter().any(|a| a == "--no-sub"),
         smoke: false,
     }
 }
@@ -87,12 +98,10 @@ fn grid_cell(g: &SampleGrid, sampled: &HashSet<[u16; 3]>, p: &Vec3) -> Option<[u
 }
 
 /// The indices `table` is queried with: sub-cells for a subdivided table, else grid cells.
-fn query_cell(table: &Table, fine: [u16; 6]) -> [u16; 6] {
-    if table.sub_levels() == 1 {
-        fine
-    } else {
-        fine.map(|v| v >> 1)
-    }
+/// The cell `table` is queried with for the `fine` cell (at `2^fine_levels` per axis).
+fn query_cell(table: &Table, fine: [u16; 6], fine_levels: u32) -> [u16; 6] {
+    let shift = fine_levels - (table.levels() + table.sub_levels());
+    fine.map(|v| v >> shift)
 }
 
 /// `n` random reachable configurations of both TCPs in the workspace (as `eval` draws them).
@@ -218,9 +227,9 @@ fn main() {
         let certified = label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space;
         let label_secs = start.elapsed().as_secs_f64();
         let start = Instant::now();
-        let subdivided = label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling");
+        let subdivided = opt.sub.then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
         let sub_secs = start.elapsed().as_secs_f64();
-        let sub_cells = subdivided.sub.expect("sub-cells");
+        let expanded = subdivided.as_ref().map(|s| subdivided_labels(&cell, &ws, s).expect("2k labels"));
         let start = Instant::now();
         let thesis = label_space_thesis(&cell, opt.k, &ws, false).expect("labelling");
         let thesis_secs = start.elapsed().as_secs_f64();
@@ -229,7 +238,7 @@ fn main() {
         let outside = configs.len() - fine.len();
         let t_lossy = if opt.k >= 64 { 545 } else { 150 };
         type Build = Box<dyn Fn(&LabelledSpace) -> Result<Table, TableError>>;
-        let variants: Vec<(String, &LabelledSpace, f64, Build)> = vec![
+        let mut variants: Vec<(String, &LabelledSpace, f64, Build)> = vec![
             (
                 "6D".into(),
                 &certified,
@@ -267,18 +276,28 @@ fn main() {
                 Box::new(move |s| SharedQuadtree6d::build(s, symmetric).map(Table::Shared)),
             ),
             (
-                "6D-shared/sub (new)".into(),
-                &subdivided.space,
-                sub_secs,
-                Box::new(move |s| SharedQuadtree6d::build_subdivided(s, &sub_cells, symmetric).map(Table::Shared)),
-            ),
-            (
                 "thesis-style 6D (r/sqrt 2)".into(),
                 &thesis,
                 thesis_secs,
                 Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
             ),
         ];
+        if let (Some(subdivided), Some(expanded)) = (&subdivided, &expanded) {
+            let sub_cells = subdivided.sub.clone().expect("sub-cells");
+            variants.push((
+                "6D-shared/sub (new)".into(),
+                &subdivided.space,
+                sub_secs,
+                Box::new(move |s| SharedQuadtree6d::build_subdivided(s, &sub_cells, symmetric).map(Table::Shared)),
+            ));
+            variants.push((
+                "4D/yy t=0 of the sub-cell labels (2k)".into(),
+                expanded,
+                sub_secs,
+                Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, 0).map(Table::D4)),
+            ));
+        }
+        let fine_levels = opt.k.trailing_zeros() + 1;
         let mut timer = fastest_of_passes(&fine, |c| {
             let start = Instant::now();
             black_box(c);
@@ -286,7 +305,7 @@ fn main() {
         });
         let (m, p, x) = percentiles(&mut timer);
         println!("| {name} | {} | timer (two clock reads) | | | | {m} / {p} / {x} | | | | | | |", opt.k);
-        let mut d6: Option<Table> = None;
+        let (mut d6, mut sub_table): (Option<Table>, Option<Table>) = (None, None);
         for (label, space, secs, build) in &variants {
             let start = Instant::now();
             let table = build(space).expect("build");
@@ -294,7 +313,7 @@ fn main() {
             let (mut tp, mut tn, mut fp, mut fn_) = (0u64, 0u64, 0u64, 0u64);
             for c in &configs {
                 let Some(f) = c.fine else { continue };
-                match (table.query(query_cell(&table, f)), c.collides) {
+                match (table.query(query_cell(&table, f, fine_levels)), c.collides) {
                     (true, true) => tp += 1,
                     (false, false) => tn += 1,
                     (true, false) => fp += 1,
@@ -303,7 +322,7 @@ fn main() {
             }
             let is_shared = matches!(table, Table::Shared(_)) && table.sub_levels() == 0;
             let cold = if is_shared { opt.cold_shared } else { opt.cold };
-            let cells: Vec<[u16; 6]> = fine.iter().map(|&f| query_cell(&table, f)).collect();
+            let cells: Vec<[u16; 6]> = fine.iter().map(|&f| query_cell(&table, f, fine_levels)).collect();
             let (w, f) = time_queries(&table, &cells, cold);
             let flushed = if f.2 == 0 {
                 "n/a".into()
@@ -323,14 +342,26 @@ fn main() {
             if !label.starts_with("thesis") {
                 assert_eq!(fn_, 0, "{name} {label}: a false negative on a certified table");
             }
+            // The plain table of the sub-cell labels answers as the subdivided table does.
+            if let (Some(subdivided), true) = (&sub_table, label.contains("sub-cell labels")) {
+                for &f in &fine {
+                    let want = subdivided.query(query_cell(subdivided, f, fine_levels));
+                    assert_eq!(table.query(query_cell(&table, f, fine_levels)), want, "{name} {label}: {f:?}");
+                }
+            }
+            if table.sub_levels() == 1 {
+                sub_table = Some(table.clone());
+            }
             match (&d6, &table) {
                 (None, Table::D6(_)) => d6 = Some(table),
                 (Some(reference), Table::Shared(_)) => {
                     // The shared table answers as the 6-D table on every configuration drawn;
                     // with sub-cells it only frees configurations the 6-D table calls collision.
                     for &f in &fine {
-                        let (want, got) =
-                            (reference.query(query_cell(reference, f)), table.query(query_cell(&table, f)));
+                        let (want, got) = (
+                            reference.query(query_cell(reference, f, fine_levels)),
+                            table.query(query_cell(&table, f, fine_levels)),
+                        );
                         assert!(got == want || (table.sub_levels() == 1 && want), "{name} {label}: {f:?}");
                     }
                 }

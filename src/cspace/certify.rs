@@ -218,6 +218,61 @@ fn sub_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBo
     out
 }
 
+/// The labels a subdivided labelling ([`label_space_subdivided`]) stands for, on the grid of
+/// `2k` cells per axis (the octants of the `k` grid): a sub-cell takes its pair's label, or,
+/// for a pair with sub-cells, its own ("don't care" outside `care`). A sample of the `2k`
+/// grid whose parent cell is not sampled at `k` is "don't care": queries there never reach
+/// the table. A plain table built from these labels answers as the subdivided one does on
+/// every sub-cell (the baseline for its size).
+///
+/// # Errors
+/// When `certified` has no sub-cells, or as [`crate::cspace::label_space`].
+pub fn subdivided_labels(cell: &Cell, ws: &Workspace, certified: &CertifiedSpace) -> Result<LabelledSpace, String> {
+    let sub = certified.sub.as_ref().ok_or("the labelling has no sub-cells")?;
+    let coarse = &certified.space;
+    let (grid_a, grid_b) = two_robot_grids(cell, 2 * coarse.grid_a.k, ws)?;
+    // Per fine sample: its parent sample and its octant (bits x, y, z = 0, 1, 2).
+    let parents = |fine: &SampleGrid, coarse: &SampleGrid| -> Vec<Option<(usize, usize)>> {
+        let of = |c: &[u16; 3]| {
+            let p = coarse.index_of([c[0] / 2, c[1] / 2, c[2] / 2])?;
+            Some((p, usize::from(c[0] & 1) | usize::from(c[1] & 1) << 1 | usize::from(c[2] & 1) << 2))
+        };
+        fine.cells.iter().map(of).collect()
+    };
+    let (pa, pb) = (parents(&grid_a, &coarse.grid_a), parents(&grid_b, &coarse.grid_b));
+    let (nb, nb0) = (grid_b.cells.len(), coarse.grid_b.cells.len());
+    let mut labels = vec![Label::Unreachable; grid_a.cells.len() * nb];
+    if nb > 0 {
+        labels.par_chunks_mut(nb).zip(&pa).for_each(|(row, parent)| {
+            let Some((ia, i)) = *parent else { return };
+            // The sub-cells of this row's parent pairs, by B's parent sample.
+            let first = sub.pairs.partition_point(|&p| p < (ia * nb0) as u64);
+            let last = sub.pairs.partition_point(|&p| p < ((ia + 1) * nb0) as u64);
+            let mut masks = vec![None; nb0];
+            for e in first..last {
+                masks[sub.pairs[e] as usize - ia * nb0] = Some((sub.care[e], sub.collision[e]));
+            }
+            for (l, parent) in row.iter_mut().zip(&pb) {
+                let Some((ib, j)) = *parent else { continue };
+                *l = match (coarse.label(ia, ib), masks[ib]) {
+                    (Label::Collision, Some((care, collision))) => {
+                        let bit = 1u64 << sub_cell_index(i, j);
+                        if care & bit == 0 {
+                            Label::Unreachable
+                        } else if collision & bit != 0 {
+                            Label::Collision
+                        } else {
+                            Label::Free
+                        }
+                    }
+                    (label, _) => label,
+                };
+            }
+        });
+    }
+    Ok(LabelledSpace { grid_a, grid_b, labels, margin: coarse.margin })
+}
+
 /// `(care, collision)` over the 64 octant pairs of `(ia, ib)`: an octant pair is free when
 /// every box pair is proved disjoint by one of the tests (A cell, B cell), (A octant,
 /// B cell), (A cell, B octant) or (A octant, B octant), each valid for all of it. Only the
@@ -490,5 +545,45 @@ mod tests {
             }
             assert!(freed > 0 && added > 0, "{name}: {freed} freed, {added} added");
         }
+    }
+
+    /// The `2k` labels of a subdivided labelling: every sub-cell of a collision pair as its
+    /// mask says (looked up the plain way), everything else as its parent pair.
+    #[test]
+    fn subdivided_labels_spell_out_the_sub_cells() {
+        let ws = Workspace::THESIS;
+        let cell = reference_cell("T2").unwrap();
+        let c = label_space_subdivided(&cell, 16, &ws, false).unwrap();
+        let fine = subdivided_labels(&cell, &ws, &c).unwrap();
+        let sub = c.sub.as_ref().unwrap();
+        let (coarse, nb0) = (&c.space, c.space.grid_b.cells.len());
+        let (mut seen, mut freed) = (0, 0);
+        for (ja, ca) in fine.grid_a.cells.iter().enumerate() {
+            for (jb, cb) in fine.grid_b.cells.iter().enumerate() {
+                let up = |g: &SampleGrid, x: &[u16; 3]| g.index_of([x[0] / 2, x[1] / 2, x[2] / 2]);
+                let octant =
+                    |x: &[u16; 3]| usize::from(x[0] & 1) | usize::from(x[1] & 1) << 1 | usize::from(x[2] & 1) << 2;
+                let want = match (up(&coarse.grid_a, ca), up(&coarse.grid_b, cb)) {
+                    (Some(ia), Some(ib)) => match sub.get((ia * nb0 + ib) as u64) {
+                        Some((care, collision)) => {
+                            seen += 1;
+                            let bit = 1u64 << sub_cell_index(octant(ca), octant(cb));
+                            match (care & bit != 0, collision & bit != 0) {
+                                (false, _) => Label::Unreachable,
+                                (true, true) => Label::Collision,
+                                (true, false) => {
+                                    freed += 1;
+                                    Label::Free
+                                }
+                            }
+                        }
+                        None => coarse.label(ia, ib),
+                    },
+                    _ => Label::Unreachable,
+                };
+                assert_eq!(fine.label(ja, jb), want, "fine pair ({ja}, {jb})");
+            }
+        }
+        assert!(seen > 0 && freed > 0, "{seen} sub-cells, {freed} freed");
     }
 }

@@ -13,7 +13,8 @@ pub mod sampler;
 pub mod symmetry;
 
 pub use certify::{
-    label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, SubCells,
+    label_space_certified, label_space_certified_with, label_space_subdivided, subdivided_labels, CertifiedSpace,
+    SubCells,
 };
 pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};
 pub use label::{label_space, label_space_thesis};
