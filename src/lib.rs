@@ -30,12 +30,10 @@
 extern crate alloc;
 
 pub mod cell;
-#[cfg(feature = "std")]
 pub mod cspace;
 #[cfg(feature = "std")]
 pub mod ffi;
 pub mod geometry;
 pub mod math;
 pub mod robot;
-#[cfg(feature = "std")]
 pub mod table;

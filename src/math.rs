@@ -53,7 +53,9 @@ pub mod float {
         /// Arc cosine, in [0, pi]; NaN outside [-1, 1].
         acos,
         /// Largest integer not above `x`.
-        floor
+        floor,
+        /// Smallest integer not below `x`.
+        ceil
     );
 
     /// `(sin x, cos x)`.

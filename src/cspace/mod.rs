@@ -4,19 +4,31 @@
 //! A two-robot configuration is `c = (x, y, z, x', y', z')`: robot A's TCP in A's MCS and
 //! robot B's TCP in B's MCS. Each robot's TCP space is cut into cubic grid cells of side `r`
 //! aligned with the quadtree leaves; a sample is a cell centre.
+//!
+//! Without the `std` feature only the workspace, the sampling grid and the label types are
+//! here (a table query needs the grid); labelling, certification and symmetry need `std`.
 
+#[cfg(feature = "std")]
 pub mod certify;
+#[cfg(feature = "std")]
 pub mod guarantee;
+#[cfg(feature = "std")]
 pub mod interval;
+#[cfg(feature = "std")]
 pub mod label;
 pub mod sampler;
+#[cfg(feature = "std")]
 pub mod symmetry;
 
+use alloc::vec::Vec;
+#[cfg(feature = "std")]
 pub use certify::{
     label_space_certified, label_space_certified_with, label_space_subdivided, subdivided_labels, CertifiedSpace,
     SubCells,
 };
+#[cfg(feature = "std")]
 pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};
+#[cfg(feature = "std")]
 pub use label::{label_space, label_space_thesis};
 pub use sampler::{CellIndex, SampleGrid, Workspace};
 

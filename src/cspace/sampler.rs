@@ -21,8 +21,9 @@
 //! `y -> -y` in floating point (thesis 3.2.8 relies on it); membership tests err toward
 //! keeping a cell.
 
-use crate::math::{Real, Vec3};
+use crate::math::{float, Real, Vec3};
 use crate::robot::Delta3;
+use alloc::{format, string::String, vec::Vec};
 
 /// Cylinder + frustum workspace of one robot (thesis 3.2.2, SPEC §4); depth `d = -z`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,7 +82,7 @@ impl Workspace {
     /// Whether the TCP `p` (MCS) lies in the workspace (closed).
     pub fn contains(&self, p: &Vec3) -> bool {
         let d = -p.z;
-        d >= self.zu && d <= self.max_depth() && p.x.hypot(p.y) <= self.radius_at(d)
+        d >= self.zu && d <= self.max_depth() && float::hypot(p.x, p.y) <= self.radius_at(d)
     }
 
     fn validate(&self) -> Result<(), String> {
@@ -134,7 +135,7 @@ impl SampleGrid {
         let half_extent = 0.5 * side;
         if half_extent < ws.max_radius() + r {
             let fix = if half_extent > ws.max_radius() {
-                let k_min = (side / (half_extent - ws.max_radius())).ceil() as u32;
+                let k_min = float::ceil(side / (half_extent - ws.max_radius())) as u32;
                 format!("use k >= {} (a power of two)", k_min.next_power_of_two())
             } else {
                 "no k can: the workspace must be at least twice as deep (Zu + Hcy + Hco) as it is wide (Rcy, Rco)"
@@ -147,7 +148,10 @@ impl SampleGrid {
         }
         let kf = k as Real;
         let origin = Vec3::new(-0.5 * kf * r, -0.5 * kf * r, -kf * r);
-        let reach2 = |c_r: Real| (c_r + r * std::f64::consts::FRAC_1_SQRT_2).powi(2) * (1.0 + 1e-12);
+        let reach2 = |c_r: Real| {
+            let reach = c_r + r * core::f64::consts::FRAC_1_SQRT_2;
+            reach * reach * (1.0 + 1e-12)
+        };
         let mut cells = Vec::new();
         let mut reachable = Vec::new();
         for ix in 0..k {
@@ -186,7 +190,7 @@ impl SampleGrid {
             if !(t >= 0.0 && t <= self.k as Real) {
                 return None;
             }
-            out[a] = (t.floor() as u32).min(self.k - 1) as u16;
+            out[a] = (float::floor(t) as u32).min(self.k - 1) as u16;
         }
         Some(out)
     }

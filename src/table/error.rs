@@ -3,6 +3,8 @@
 //! Every variant names the field it is about and the message says how to fix it, in the
 //! manner of regex-automata's deserialisation errors.
 
+use alloc::string::String;
+
 /// Why a table could not be built from a labelled space, or loaded from bytes.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum TableError {
@@ -48,8 +50,8 @@ pub enum TableError {
     },
 }
 
-impl std::fmt::Display for TableError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl core::fmt::Display for TableError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             TableError::Truncated { what, needed, have } => write!(
                 f,
@@ -84,7 +86,7 @@ impl std::fmt::Display for TableError {
     }
 }
 
-impl std::error::Error for TableError {}
+impl core::error::Error for TableError {}
 
 /// A [`TableError::Corrupt`] naming `what`.
 pub(crate) fn corrupt(what: impl Into<String>) -> TableError {
@@ -92,6 +94,7 @@ pub(crate) fn corrupt(what: impl Into<String>) -> TableError {
 }
 
 /// A [`TableError::BadInput`] naming `what`.
+#[cfg(feature = "std")]
 pub(crate) fn bad_input(what: impl Into<String>) -> TableError {
     TableError::BadInput { what: what.into() }
 }

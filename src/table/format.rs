@@ -36,7 +36,10 @@ use super::quadtree5d::LinearQuadtree5d;
 use super::quadtree6d::LinearQuadtree6d;
 use super::shared6d::SharedQuadtree6d;
 use super::Table;
-use crate::cspace::{LabelledSpace, Workspace};
+#[cfg(feature = "std")]
+use crate::cspace::LabelledSpace;
+use crate::cspace::Workspace;
+use alloc::{format, vec, vec::Vec};
 
 /// The first eight bytes of every table.
 pub const MAGIC: [u8; 8] = *b"DCTABLE\0";
@@ -78,6 +81,7 @@ pub struct Header {
 
 impl Header {
     /// The header of a table built from `space` for the cell with `fingerprint`.
+    #[cfg(feature = "std")]
     pub fn for_space(
         space: &LabelledSpace,
         fingerprint: u64,
@@ -183,7 +187,7 @@ impl<'a> Reader<'a> {
     }
 
     fn u64(&mut self, what: &'static str) -> Result<u64, TableError> {
-        self.take(8, what).map(|b| u64::from_le_bytes(std::array::from_fn(|i| b[i])))
+        self.take(8, what).map(|b| u64::from_le_bytes(core::array::from_fn(|i| b[i])))
     }
 
     fn f64(&mut self, what: &'static str) -> Result<f64, TableError> {
@@ -213,7 +217,7 @@ struct Shape {
 fn read_prefix(r: &mut Reader) -> Result<Shape, TableError> {
     let magic = r.take(8, "magic")?;
     if magic != MAGIC {
-        return Err(TableError::BadMagic { found: std::array::from_fn(|i| magic[i]) });
+        return Err(TableError::BadMagic { found: core::array::from_fn(|i| magic[i]) });
     }
     match r.u32("endianness marker")? {
         ENDIAN_MARK => {}
@@ -277,7 +281,7 @@ fn read_header(r: &mut Reader) -> Result<Header, TableError> {
 }
 
 fn words<const N: usize, T>(bytes: &[u8], f: impl Fn([u8; N]) -> T) -> Vec<T> {
-    bytes.chunks_exact(N).map(|c| f(std::array::from_fn(|i| c[i]))).collect()
+    bytes.chunks_exact(N).map(|c| f(core::array::from_fn(|i| c[i]))).collect()
 }
 
 /// Reads and validates a table (see the module doc); the cell is not checked here, call

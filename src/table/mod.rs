@@ -10,7 +10,13 @@
 //! "don't care": the answer there is whatever compressed best, so the caller must check
 //! reachability and the workspace itself ([`TableChecker`] does). Indices beyond the grid
 //! answer `true`.
+//!
+//! Without the `std` feature this module holds the query side only: loading a table from
+//! bytes ([`from_bytes`], needs `alloc`), the queries of every variant and [`TableChecker`]
+//! (README "Portability and cross-compiling"). The builders ([`build`], `build` of each
+//! variant, [`synthetic`]) need `std`.
 
+#[cfg(feature = "std")]
 pub mod build;
 pub mod code;
 pub mod error;
@@ -21,11 +27,14 @@ pub mod quadtree5d;
 pub mod quadtree6d;
 pub mod shared6d;
 mod space;
+#[cfg(feature = "std")]
 pub mod synthetic;
 
 #[cfg(test)]
 mod agreement_tests;
 
+use alloc::{format, string::String, vec, vec::Vec};
+#[cfg(feature = "std")]
 pub use build::{build_table, build_tables, BuildReport, Labelling, Variant};
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
@@ -68,7 +77,7 @@ impl Table {
     pub fn query_grid_cell(&self, cell: [u16; 6]) -> bool {
         match self.sub_levels() {
             0 => self.query(cell),
-            _ => (0..64u16).any(|c| self.query(std::array::from_fn(|j| 2 * cell[j] + (c >> (5 - j) & 1)))),
+            _ => (0..64u16).any(|c| self.query(core::array::from_fn(|j| 2 * cell[j] + (c >> (5 - j) & 1)))),
         }
     }
 
@@ -115,7 +124,7 @@ impl Table {
     /// flush them from the caches between queries).
     pub fn memory_regions(&self) -> Vec<(usize, usize)> {
         fn region<T>(v: &[T]) -> (usize, usize) {
-            (v.as_ptr() as usize, std::mem::size_of_val(v))
+            (v.as_ptr() as usize, core::mem::size_of_val(v))
         }
         match self {
             Table::D6(t) => vec![region(t.codes())],
@@ -157,6 +166,7 @@ impl Table {
 ///
 /// # Errors
 /// [`TableError::BadInput`] when the space is malformed.
+#[cfg(feature = "std")]
 pub fn symmetry_mismatches(space: &crate::cspace::LabelledSpace) -> Result<usize, TableError> {
     Ok(space::SpaceView::new(space, true)?.asymmetric_pairs())
 }

@@ -19,8 +19,13 @@
 
 use super::code::{encode, MAX_LEVELS};
 use super::error::{corrupt, TableError};
-use super::space::{fold, SpaceView};
+use super::space::fold;
+#[cfg(feature = "std")]
+use super::space::SpaceView;
+#[cfg(feature = "std")]
 use crate::cspace::{Label, LabelledSpace};
+use alloc::{format, vec::Vec};
+#[cfg(feature = "std")]
 use std::collections::BTreeMap;
 
 /// Which two dimensions a slice holds (the two the quadtree ignores).
@@ -63,6 +68,7 @@ fn shape(levels: u32, symmetric: bool, axes: SliceAxes) -> (u32, usize) {
 
 /// `Some(|S \ R|)` when `S` (collision bits, care mask) may join a group with representative
 /// `R` and budgets `g_add`, `g_sub` (see the module doc).
+#[cfg(feature = "std")]
 fn try_join(s: &[u64], care: &[u64], rep: &[u64], g_add: u32, g_sub: u32) -> Option<u32> {
     let (mut add, mut sub) = (0u32, 0u32);
     for ((&s, &c), &r) in s.iter().zip(care).zip(rep) {
@@ -76,6 +82,7 @@ fn try_join(s: &[u64], care: &[u64], rep: &[u64], g_add: u32, g_sub: u32) -> Opt
 }
 
 /// Samples of one robot grouped by its two quadtree coordinates `(ix, second)`.
+#[cfg(feature = "std")]
 fn ranges(cells: &[[u16; 3]], keep: impl Fn(usize) -> bool, second: usize) -> BTreeMap<(u16, u16), Vec<usize>> {
     let mut m: BTreeMap<(u16, u16), Vec<usize>> = BTreeMap::new();
     for (i, c) in cells.iter().enumerate().filter(|(i, _)| keep(*i)) {
@@ -90,6 +97,7 @@ impl LinearQuadtree4d {
     ///
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or the label count is wrong.
+    #[cfg(feature = "std")]
     pub fn build(
         space: &LabelledSpace,
         symmetric: bool,
@@ -146,6 +154,7 @@ impl LinearQuadtree4d {
     }
 
     /// The group `s` joins (its representative updated), or a new one (Algorithm 8 l. 7-19).
+    #[cfg(feature = "std")]
     fn group(&mut self, s: &[u64], care: &[u64], g_add: &mut Vec<u32>, wps: usize) -> u32 {
         for (g, rep) in self.slices.chunks_exact_mut(wps).enumerate() {
             if let Some(add) = try_join(s, care, rep, g_add[g], self.t) {
@@ -246,7 +255,7 @@ impl LinearQuadtree4d {
 
     /// Bytes this table occupies in memory (struct plus its arrays).
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>() + 8 * self.codes.len() + 4 * self.slice_of.len() + 8 * self.slices.len()
+        core::mem::size_of::<Self>() + 8 * self.codes.len() + 4 * self.slice_of.len() + 8 * self.slices.len()
     }
 
     /// The thesis's figure, `8 m + s b^2 / 8 + 8 b + 76` (Observation 3.2.3), for slices of

@@ -9,8 +9,12 @@
 
 use super::code::{encode, MAX_LEVELS};
 use super::error::{corrupt, TableError};
-use super::space::{fold, SpaceView};
+use super::space::fold;
+#[cfg(feature = "std")]
+use super::space::SpaceView;
+#[cfg(feature = "std")]
 use crate::cspace::{Label, LabelledSpace};
+use alloc::{format, vec::Vec};
 
 /// Sorted 5-D codes with the `iz'` collision intervals of each (see the module doc).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -23,6 +27,7 @@ pub struct LinearQuadtree5d {
 }
 
 /// The collision intervals of one column, given `(iz', label)` in increasing `iz'`.
+#[cfg(feature = "std")]
 fn column_intervals(column: impl Iterator<Item = (u16, Label)>, out: &mut Vec<[u8; 2]>) {
     let mut open: Option<[u8; 2]> = None;
     let mut free_since = false;
@@ -51,6 +56,7 @@ impl LinearQuadtree5d {
     ///
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or the label count is wrong.
+    #[cfg(feature = "std")]
     pub fn build(space: &LabelledSpace, symmetric: bool) -> Result<LinearQuadtree5d, TableError> {
         let view = SpaceView::new(space, symmetric)?;
         let cells_b = &space.grid_b.cells;
@@ -158,7 +164,7 @@ impl LinearQuadtree5d {
 
     /// Bytes this table occupies in memory (struct plus its arrays).
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>() + 8 * self.codes.len() + 4 * self.offsets.len() + 2 * self.intervals.len()
+        core::mem::size_of::<Self>() + 8 * self.codes.len() + 4 * self.offsets.len() + 2 * self.intervals.len()
     }
 
     /// The thesis's figure for the same counts, `12 m + 16 i + 64` (Observation 3.2.2).

@@ -17,10 +17,18 @@
 //! after every leaf of its subtree, and stored nodes are disjoint), so one lower-bound search
 //! and one [`covers6`] test replace Algorithm 5's low/high checks.
 
-use super::code::{code6, condensed6, covers6, encode, valid6, MAX_LEVELS};
-use super::error::{bad_input, corrupt, TableError};
-use super::space::{fold, SpaceView};
+use super::code::{code6, covers6, valid6, MAX_LEVELS};
+#[cfg(feature = "std")]
+use super::code::{condensed6, encode};
+#[cfg(feature = "std")]
+use super::error::bad_input;
+use super::error::{corrupt, TableError};
+use super::space::fold;
+#[cfg(feature = "std")]
+use super::space::SpaceView;
+#[cfg(feature = "std")]
 use crate::cspace::{Label, LabelledSpace};
+use alloc::{format, vec::Vec};
 
 /// Sorted stored codes of the collision samples (see the module doc).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -34,6 +42,7 @@ pub struct LinearQuadtree6d {
 pub const MAX_BUILD_LEVELS_6D: u32 = 6;
 
 /// One bit per node of depth `d`, for `d` in `0..levels`: whether it holds a free sample.
+#[cfg(feature = "std")]
 fn free_maps(view: &SpaceView, plain_a: &[u64], plain_b: &[u64], leaves: &mut Vec<u64>) -> Vec<Vec<u64>> {
     let h = view.levels as usize;
     let mut maps: Vec<Vec<u64>> = (0..h).map(|d| vec![0u64; (1usize << (6 * d)).div_ceil(64)]).collect();
@@ -69,6 +78,7 @@ impl LinearQuadtree6d {
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
     /// `levels <= MAX_BUILD_LEVELS_6D`, or the label count is wrong.
+    #[cfg(feature = "std")]
     pub fn build(space: &LabelledSpace, symmetric: bool) -> Result<LinearQuadtree6d, TableError> {
         let view = SpaceView::new(space, symmetric)?;
         if view.levels > MAX_BUILD_LEVELS_6D {
@@ -153,7 +163,7 @@ impl LinearQuadtree6d {
 
     /// Bytes this table occupies in memory (struct plus its array).
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>() + 8 * self.codes.len()
+        core::mem::size_of::<Self>() + 8 * self.codes.len()
     }
 
     /// The thesis's figure for the same code count, `8 m + 64` (Observation 3.2.1).

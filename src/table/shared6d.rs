@@ -27,9 +27,16 @@
 //! allocation. Child indices are `u16` when every index fits, else `u32`.
 
 use super::code::MAX_LEVELS;
-use super::error::{bad_input, corrupt, TableError};
-use super::space::{fold, SpaceView};
+#[cfg(feature = "std")]
+use super::error::bad_input;
+use super::error::{corrupt, TableError};
+use super::space::fold;
+#[cfg(feature = "std")]
+use super::space::SpaceView;
+#[cfg(feature = "std")]
 use crate::cspace::{Label, LabelledSpace, SubCells};
+use alloc::{format, vec::Vec};
+#[cfg(feature = "std")]
 use std::collections::HashMap;
 
 /// Child indices of the pool, as narrow as the table allows.
@@ -131,9 +138,11 @@ fn child_index(c: &[u16; 6], shift: u32) -> u32 {
 }
 
 /// An inner node while building: non-uniform mask, collision mask, child ids.
+#[cfg(feature = "std")]
 type InnerNode = (u64, u64, Vec<u32>);
 
 /// A child while building: don't care, uniform, or a stored node of the next depth.
+#[cfg(feature = "std")]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Part {
     DontCare,
@@ -143,6 +152,7 @@ enum Part {
 }
 
 /// Hash-consing builder over a [`SpaceView`].
+#[cfg(feature = "std")]
 struct Builder<'a> {
     view: SpaceView<'a>,
     /// Sub-cells of the pairs labelled collision, when subdividing.
@@ -161,8 +171,10 @@ struct Builder<'a> {
     leaves: Vec<u64>,
 }
 
+#[cfg(feature = "std")]
 const NONE: u32 = u32::MAX;
 
+#[cfg(feature = "std")]
 fn dense_map(cells: &[[u16; 3]], k: usize, keep: impl Fn(usize) -> bool) -> Vec<u32> {
     let mut dense = vec![NONE; k * k * k];
     for (i, c) in cells.iter().enumerate() {
@@ -174,6 +186,7 @@ fn dense_map(cells: &[[u16; 3]], k: usize, keep: impl Fn(usize) -> bool) -> Vec<
 }
 
 /// `occ[d][block]`: whether the block of side `2^(levels - d)` holds a sample, `d` in `0..=levels`.
+#[cfg(feature = "std")]
 fn occupancy(dense: &[u32], k: usize, levels: u32) -> Vec<Vec<bool>> {
     (0..=levels)
         .map(|d| {
@@ -194,6 +207,7 @@ fn occupancy(dense: &[u32], k: usize, levels: u32) -> Vec<Vec<bool>> {
         .collect()
 }
 
+#[cfg(feature = "std")]
 impl Builder<'_> {
     /// The part for the 6-D block at depth `d` whose per-robot block coordinates are `a`, `b`
     /// (in units of the block side).
@@ -332,6 +346,7 @@ impl Builder<'_> {
 
 /// A sub-cell mask of a pair mapped to its mirror pair's (`y -> -y` flips the y octant bit of
 /// both robots: child index bits 4 and 1).
+#[cfg(feature = "std")]
 fn mirror_sub_cells(mask: u64) -> u64 {
     (0..64).filter(|&c| mask >> c & 1 == 1).fold(0, |m, c| m | 1 << (c ^ 0b01_0010))
 }
@@ -343,6 +358,7 @@ impl SharedQuadtree6d {
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
     /// `2 <= levels <= MAX_LEVELS`, or the label count is wrong.
+    #[cfg(feature = "std")]
     pub fn build(space: &LabelledSpace, symmetric: bool) -> Result<SharedQuadtree6d, TableError> {
         Self::build_with(space, None, symmetric)
     }
@@ -353,6 +369,7 @@ impl SharedQuadtree6d {
     ///
     /// # Errors
     /// As [`build`](Self::build).
+    #[cfg(feature = "std")]
     pub fn build_subdivided(
         space: &LabelledSpace,
         sub: &SubCells,
@@ -361,6 +378,7 @@ impl SharedQuadtree6d {
         Self::build_with(space, Some(sub), symmetric)
     }
 
+    #[cfg(feature = "std")]
     fn build_with(
         space: &LabelledSpace,
         sub: Option<&SubCells>,
@@ -540,7 +558,7 @@ impl SharedQuadtree6d {
 
     /// Bytes this table occupies in memory (struct plus its arrays).
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>()
+        core::mem::size_of::<Self>()
             + 16 * self.masks.len()
             + 4 * (self.bases.len() + self.depth_start.len())
             + self.children.bytes_per_entry() * self.children.len()

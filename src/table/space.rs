@@ -8,14 +8,21 @@
 //! thesis's "y >= 0 and y' >= 0" would lose `y >= 0 > y'`). The stored label of an upper-half
 //! sample merges it with its mirror image (collision wins, then free), so a cell that is not
 //! exactly symmetric still loses no collision.
+//!
+//! Only [`fold`] is on the query side; the rest serves the builders and needs `std`.
 
+#[cfg(feature = "std")]
 use super::code::MAX_LEVELS;
+#[cfg(feature = "std")]
 use super::error::{bad_input, TableError};
+#[cfg(feature = "std")]
 use crate::cspace::{Label, LabelledSpace, SampleGrid};
 
+#[cfg(feature = "std")]
 const NONE: u32 = u32::MAX;
 
 /// A validated labelled space with the symmetry fold (see the module doc).
+#[cfg(feature = "std")]
 pub(crate) struct SpaceView<'a> {
     pub space: &'a LabelledSpace,
     pub k: u32,
@@ -27,6 +34,7 @@ pub(crate) struct SpaceView<'a> {
 }
 
 /// Collision wins over free, free over unreachable.
+#[cfg(feature = "std")]
 pub(crate) fn merge(a: Label, b: Label) -> Label {
     match (a, b) {
         (Label::Collision, _) | (_, Label::Collision) => Label::Collision,
@@ -36,6 +44,7 @@ pub(crate) fn merge(a: Label, b: Label) -> Label {
 }
 
 /// For each sample of `g`, the index of its mirror sample (`iy -> k-1-iy`), or `NONE`.
+#[cfg(feature = "std")]
 fn reflections(g: &SampleGrid) -> Vec<u32> {
     let k = g.k as usize;
     let mut dense = vec![NONE; k * k * k];
@@ -45,6 +54,7 @@ fn reflections(g: &SampleGrid) -> Vec<u32> {
     g.cells.iter().map(|c| dense[(c[0] as usize * k + (k - 1 - c[1] as usize)) * k + c[2] as usize]).collect()
 }
 
+#[cfg(feature = "std")]
 fn check_grid(name: &str, g: &SampleGrid) -> Result<(), TableError> {
     if g.levels == 0 || g.levels > MAX_LEVELS || g.k != 1 << g.levels {
         return Err(bad_input(format!(
@@ -58,6 +68,7 @@ fn check_grid(name: &str, g: &SampleGrid) -> Result<(), TableError> {
     Ok(())
 }
 
+#[cfg(feature = "std")]
 impl<'a> SpaceView<'a> {
     /// Validates `space` (equal k on both grids, indices below k, one label per pair).
     pub fn new(space: &'a LabelledSpace, symmetric: bool) -> Result<SpaceView<'a>, TableError> {
