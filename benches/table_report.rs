@@ -339,11 +339,16 @@ fn slowest_report(clock: Clock, table: &Table, cells: &[[u16; 6]], warm: &[u64],
     let mut order: Vec<usize> = (0..cells.len()).collect();
     order.sort_unstable_by_key(|&i| std::cmp::Reverse(warm[i]));
     let p = shared.parts();
-    let refs: Vec<usize> = p.depth_start.windows(2).map(|w| {
-        p.masks[w[0] as usize..w[1] as usize].iter().map(|m| m[0].count_ones() as usize).sum()
-    }).collect();
+    let refs: Vec<usize> = p
+        .depth_start
+        .windows(2)
+        .map(|w| p.masks[w[0] as usize..w[1] as usize].iter().map(|m| m[0].count_ones() as usize).sum())
+        .collect();
     let mut out = vec![
-        format!("nodes per depth (then leaves): {:?}; child refs out of each depth: {refs:?}", shared.nodes_per_depth()),
+        format!(
+            "nodes per depth (then leaves): {:?}; child refs out of each depth: {refs:?}",
+            shared.nodes_per_depth()
+        ),
         format!("{} slowest warm queries ({}):", n.min(cells.len()), table.name()),
     ];
     for &i in order.iter().take(n) {
@@ -406,17 +411,31 @@ fn main() {
         let (certified, label_secs) =
             timed(&|| label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space);
         let start = Instant::now();
-        let subdivided = wants("shared-sub").then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
+        let subdivided =
+            wants("shared-sub").then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
         let sub_secs = start.elapsed().as_secs_f64();
-        let thesis = wants("thesis").then(|| timed(&|| label_space_thesis(&cell, opt.k, &ws, false).expect("labelling")));
+        let thesis =
+            wants("thesis").then(|| timed(&|| label_space_thesis(&cell, opt.k, &ws, false).expect("labelling")));
         let configs = configurations(&cell, &certified, opt.random, &ws);
         let fine: Vec<[u16; 6]> = configs.iter().filter_map(|c| c.fine).collect();
         let outside = configs.len() - fine.len();
         let t_lossy = if opt.k >= 64 { 545 } else { 150 };
         type Build<'a> = Box<dyn Fn(&LabelledSpace) -> Result<Table, TableError> + 'a>;
         let mut variants: Vec<(&str, String, &LabelledSpace, f64, Build)> = vec![
-            ("6d", "6D".into(), &certified, label_secs, Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6))),
-            ("5d", "5D".into(), &certified, label_secs, Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5))),
+            (
+                "6d",
+                "6D".into(),
+                &certified,
+                label_secs,
+                Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
+            ),
+            (
+                "5d",
+                "5D".into(),
+                &certified,
+                label_secs,
+                Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5)),
+            ),
             (
                 "4d-yy",
                 "4D/yy t=0".into(),
@@ -475,7 +494,7 @@ fn main() {
         for (key, label, space, secs, build) in &variants {
             // The 6-D table is the shared tables' reference: built (not reported) when only they are asked for.
             let report = wants(key);
-            if !report && !(*key == "6d" && shared_wanted) {
+            if !(report || *key == "6d" && shared_wanted) {
                 continue;
             }
             let start = Instant::now();
