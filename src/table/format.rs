@@ -127,8 +127,8 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
         }
         Table::Shared(q) => {
             let p = q.parts();
-            owned = p.masks.iter().flatten().chain(p.leaves).copied().collect();
-            let aux = p.depth_start.iter().chain(p.bases).copied().collect();
+            owned = p.masks.iter().flatten().chain(&p.leaves).copied().collect();
+            let aux = p.depth_start.iter().chain(&p.bases).copied().collect();
             (7, 0, 0, &owned[..], aux, p.children.to_u32().iter().flat_map(|c| c.to_le_bytes()).collect())
         }
     };
