@@ -33,9 +33,16 @@ use delta_collide::cspace::{
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
+#[path = "support/shared_peer.rs"]
+mod shared_peer;
+#[path = "support/timing.rs"]
+mod timing;
+
+use shared_peer::SeparateArrays;
 use std::collections::HashSet;
 use std::hint::black_box;
 use std::time::Instant;
+use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, percentiles, Clock};
 
 /// The tables of the report, by the key `--variants` takes, in report order.
 const VARIANTS: [&str; 8] = ["6d", "5d", "4d-yy", "4d-zz", "4d-yy-lossy", "shared", "shared-sub", "thesis"];
@@ -175,112 +182,6 @@ fn configurations(cell: &Cell, space: &LabelledSpace, n: usize, ws: &Workspace) 
     out
 }
 
-/// Evicts every cache line of `regions` (x86-64 `clflush`), then waits for it.
-#[cfg(target_arch = "x86_64")]
-fn flush(regions: &[(usize, usize)]) {
-    use std::arch::x86_64::{_mm_clflush, _mm_mfence};
-    for &(addr, len) in regions {
-        let mut line = addr & !63;
-        while line < addr + len {
-            // SAFETY: `line` is the start of a cache line that holds bytes of a live array of
-            // the table (`memory_regions`), which outlives this call; clflush reads no data
-            // and changes no value, it only writes the line back and evicts it.
-            unsafe { _mm_clflush(line as *const u8) };
-            line += 64;
-        }
-    }
-    // SAFETY: sse2 is part of the x86-64 baseline; a fence has no other precondition.
-    unsafe { _mm_mfence() };
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-fn flush(_regions: &[(usize, usize)]) {}
-
-/// The time stamp counter between two `lfence`s: no earlier instruction is still running
-/// when it is read, and no later one has started.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn tsc() -> u64 {
-    use std::arch::x86_64::{_mm_lfence, _rdtsc};
-    // SAFETY: rdtsc and lfence (sse2) are part of the x86-64 baseline; they read a counter
-    // and order instructions, touching no memory.
-    unsafe {
-        _mm_lfence();
-        let t = _rdtsc();
-        _mm_lfence();
-        t
-    }
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-fn tsc() -> u64 {
-    0
-}
-
-/// The clock of the query timings.
-#[derive(Clone, Copy, Debug)]
-enum Clock {
-    /// `Instant::now` (on Linux the vDSO `clock_gettime`).
-    Instant,
-    /// [`tsc`] at `ns_per_tick`, calibrated against `Instant`.
-    Tsc { ns_per_tick: f64 },
-}
-
-impl Clock {
-    /// The time stamp counter, calibrated over 200 ms against `Instant` (x86-64 only; the
-    /// invariant TSC of current CPUs runs at a constant rate).
-    fn tsc() -> Option<Clock> {
-        if !cfg!(target_arch = "x86_64") {
-            return None;
-        }
-        let (i0, t0) = (Instant::now(), tsc());
-        while i0.elapsed().as_millis() < 200 {}
-        let (ns, t1) = (i0.elapsed().as_nanos(), tsc());
-        Some(Clock::Tsc { ns_per_tick: ns as f64 / t1.wrapping_sub(t0) as f64 })
-    }
-
-    /// Nanoseconds `f` takes, with the cost of reading the clock twice (the timer row).
-    #[inline(always)]
-    fn time<R>(self, f: impl FnOnce() -> R) -> u64 {
-        match self {
-            Clock::Instant => {
-                let start = Instant::now();
-                black_box(f());
-                start.elapsed().as_nanos() as u64
-            }
-            Clock::Tsc { ns_per_tick } => {
-                let t0 = tsc();
-                black_box(f());
-                let t1 = tsc();
-                (t1.wrapping_sub(t0) as f64 * ns_per_tick).round() as u64
-            }
-        }
-    }
-
-    fn name(self) -> String {
-        match self {
-            Clock::Instant => "Instant".into(),
-            Clock::Tsc { ns_per_tick } => format!("rdtsc+lfence, {:.3} GHz", 1.0 / ns_per_tick),
-        }
-    }
-}
-
-/// Median, p99.9 and maximum of `ns`.
-fn percentiles(ns: &[u64]) -> (u64, u64, u64) {
-    if ns.is_empty() {
-        return (0, 0, 0);
-    }
-    let mut ns = ns.to_vec();
-    ns.sort_unstable();
-    let at = |q: f64| ns[((ns.len() - 1) as f64 * q).round() as usize];
-    (at(0.5), at(0.999), ns[ns.len() - 1])
-}
-
-/// Passes over the queries; each query keeps its fastest pass: the query's own cost without
-/// the interrupts and preemptions of a shared machine (single readings reach milliseconds,
-/// and an interrupt rarely hits the same query in every pass).
-const REPEATS: usize = 3;
-
 fn query_ns(clock: Clock, table: &Table, cell: [u16; 6], regions: Option<&[(usize, usize)]>) -> u64 {
     if let Some(r) = regions {
         flush(r);
@@ -288,15 +189,42 @@ fn query_ns(clock: Clock, table: &Table, cell: [u16; 6], regions: Option<&[(usiz
     clock.time(|| table.query(black_box(cell)))
 }
 
-/// Per query, the fastest of [`REPEATS`] passes over all of `cells`.
-fn fastest_of_passes(cells: &[[u16; 6]], mut time: impl FnMut([u16; 6]) -> u64) -> Vec<u64> {
-    let mut best = vec![u64::MAX; cells.len()];
-    for _ in 0..REPEATS {
-        for (b, &c) in best.iter_mut().zip(cells) {
-            *b = (*b).min(time(c));
-        }
-    }
-    best
+/// As [`time_queries`] for a shared table and its previous layout, taking turns: (warm,
+/// flushed) of the table, then of the peer.
+fn time_with_peer(
+    clock: Clock,
+    table: &Table,
+    peer: &SeparateArrays,
+    cells: &[[u16; 6]],
+    cold: usize,
+) -> [(Vec<u64>, Vec<u64>); 2] {
+    let (warm, warm_peer) = fastest_of_passes_in_turns(
+        cells,
+        |c| query_ns(clock, table, c, None),
+        |c| clock.time(|| peer.query(black_box(c))),
+    );
+    let (regions, peer_regions) = (table.memory_regions(), peer.memory_regions());
+    let cold_cells = &cells[..cold.min(cells.len())];
+    let (flushed, flushed_peer) = if cfg!(target_arch = "x86_64") {
+        fastest_of_passes_in_turns(
+            cold_cells,
+            |c| query_ns(clock, table, c, Some(&regions)),
+            |c| {
+                flush(&peer_regions);
+                clock.time(|| peer.query(black_box(c)))
+            },
+        )
+    } else {
+        (vec![], vec![])
+    };
+    [(warm, flushed), (warm_peer, flushed_peer)]
+}
+
+/// `warm` and `flushed` (of `cold` queries) as the report's two cells.
+fn timing_cells(warm: &[u64], flushed: &[u64], cold: usize) -> (String, String) {
+    let (w, f) = (percentiles(warm), percentiles(flushed));
+    let flushed = if f.2 == 0 { "n/a".into() } else { format!("{} / {} / {} ({cold})", f.0, f.1, f.2) };
+    (format!("{} / {} / {}", w.0, w.1, w.2), flushed)
 }
 
 /// Per query, its fastest time (ns), warm and flushed (the first `cold` queries).
@@ -385,7 +313,7 @@ fn contents(table: &Table) -> String {
         Table::Shared(q) => {
             let per_depth = q.nodes_per_depth();
             let depths: Vec<String> = per_depth.iter().map(|n| n.to_string()).collect();
-            format!("{} nodes ({})", per_depth.iter().sum::<usize>(), depths.join("/"))
+            format!("{} nodes ({}; {}-bit slots)", per_depth.iter().sum::<usize>(), depths.join("/"), q.slot_bits())
         }
     }
 }
@@ -514,23 +442,37 @@ fn main() {
                 let is_shared = matches!(table, Table::Shared(_)) && table.sub_levels() == 0;
                 let cold = if is_shared { opt.cold_shared } else { opt.cold };
                 let cells: Vec<[u16; 6]> = fine.iter().map(|&f| query_cell(&table, f)).collect();
-                let (warm, flushed) = time_queries(clock, &table, &cells, cold);
-                let (w, f) = (percentiles(&warm), percentiles(&flushed));
-                let flushed = if f.2 == 0 {
-                    "n/a".into()
-                } else {
-                    format!("{} / {} / {} ({})", f.0, f.1, f.2, cold.min(cells.len()))
+                let cold = cold.min(cells.len());
+                let peer = match &table {
+                    Table::Shared(t) => Some(SeparateArrays::new(t)),
+                    _ => None,
                 };
+                let [(warm, flushed), peer_times] = match &peer {
+                    Some(peer) => {
+                        // The previous layout answers as the table on every configuration.
+                        for &c in &cells {
+                            assert_eq!(peer.query(c), table.query(c), "{name} {label}: previous layout at {c:?}");
+                        }
+                        time_with_peer(clock, &table, peer, &cells, cold)
+                    }
+                    None => [time_queries(clock, &table, &cells, cold), (vec![], vec![])],
+                };
+                let (w, f) = timing_cells(&warm, &flushed, cold);
                 let accuracy = 100.0 * (tp + tn) as f64 / (tp + tn + fp + fn_).max(1) as f64;
                 println!(
-                    "| {name} | {} | {label} | {} | {} | {build_secs:.2} | {} / {} / {} | {flushed} | {tp} | {tn} | {fp} | {fn_} | {accuracy:.2} % |",
+                    "| {name} | {} | {label} | {} | {} | {build_secs:.2} | {w} | {f} | {tp} | {tn} | {fp} | {fn_} | {accuracy:.2} % |",
                     opt.k,
                     contents(&table),
                     table.memory_bytes(),
-                    w.0,
-                    w.1,
-                    w.2
                 );
+                if let Some(peer) = &peer {
+                    let (w, f) = timing_cells(&peer_times.0, &peer_times.1, cold);
+                    println!(
+                        "| {name} | {} | {label}, previous layout (same run, taking turns) | | {} | | {w} | {f} | | | | | |",
+                        opt.k,
+                        peer.memory_bytes(),
+                    );
+                }
                 if !label.starts_with("thesis") {
                     assert_eq!(fn_, 0, "{name} {label}: a false negative on a certified table");
                 }
