@@ -404,8 +404,10 @@ impl SharedQuadtree6d {
     /// A table from stored parts, validated so that [`query`](Self::query) never reads out of
     /// bounds: `depth_start` has `levels` increasing entries from 0 with one root, masks are
     /// disjoint, every node's children lie in the pool right after the previous node's (bases
-    /// are the running counts, as [`parts`](Self::parts) gives them), and every child index
-    /// names a node of the next depth (or a leaf).
+    /// are the running counts), every child index names a node of the next depth (or a leaf),
+    /// and the nodes of each depth are numbered in the order a depth-first descent first
+    /// reaches them, every one reached (as `build` numbers them and [`parts`](Self::parts)
+    /// gives them back).
     ///
     /// # Errors
     /// [`TableError::Corrupt`] naming the first bad field.
@@ -466,7 +468,9 @@ impl SharedQuadtree6d {
         if children.len() != count {
             return Err(corrupt(format!("{} child indices for {count} non-uniform children", children.len())));
         }
-        Ok(Self::assemble(levels, sub_levels, symmetric, (masks, bases, depth_start, children, leaves)))
+        let arrays = (masks, bases, depth_start, children, leaves);
+        pool::check_order(&arrays, depths).map_err(corrupt)?;
+        Ok(Self::assemble(levels, sub_levels, symmetric, arrays))
     }
 
     /// Whether the 6-D cell is stored as collision, its indices at `2^(levels + sub_levels)`
@@ -531,12 +535,12 @@ impl SharedQuadtree6d {
     /// it from the caches).
     pub fn memory_region(&self) -> (usize, usize) {
         let w = self.pool.words();
-        (w.as_ptr() as usize, std::mem::size_of_val(w))
+        (w.as_ptr() as usize, core::mem::size_of_val(w))
     }
 
     /// Bytes this table occupies in memory (struct plus its array).
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>() + std::mem::size_of_val(self.pool.words())
+        core::mem::size_of::<Self>() + core::mem::size_of_val(self.pool.words())
     }
 }
 
@@ -718,6 +722,19 @@ mod tests {
         assert!(!ok(m.clone(), shifted, ds.clone(), c.clone(), l.clone()), "bases not the running counts");
         let mut longer = c.clone();
         longer.push(0);
-        assert!(!ok(m, b, ds, longer, l), "an unused child index");
+        assert!(!ok(m.clone(), b.clone(), ds.clone(), longer, l.clone()), "an unused child index");
+        // The same table with leaves 0 and 1 numbered the other way round.
+        assert!(l.len() >= 2);
+        let swap = |id: u32| if id < 2 { 1 - id } else { id };
+        let leaf_refs = b[ds[ds.len() - 2] as usize] as usize;
+        let mut renumbered = c.clone();
+        renumbered[leaf_refs..].iter_mut().for_each(|id| *id = swap(*id));
+        let mut swapped = l.clone();
+        swapped.swap(0, 1);
+        let err = SharedQuadtree6d::from_parts(3, 0, false, m.clone(), b.clone(), ds.clone(), renumbered, swapped);
+        assert!(err.unwrap_err().to_string().contains("first reaches"), "leaves out of first-reach order");
+        let mut unreached = l.clone();
+        unreached.push(1);
+        assert!(!ok(m, b, ds, c, unreached), "a leaf never reached");
     }
 }

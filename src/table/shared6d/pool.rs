@@ -1,31 +1,40 @@
 //! The query layout of the shared 6-D quadtree: one array of `u64` words that a query descends
-//! with one cache line per node step (issue 4: "median under 50 ns, maximum within 10x").
+//! with one cache line per node step, each node next to its first parent (issue 4: "median
+//! under 50 ns, maximum within 10x").
 //!
 //! # Layout
 //! ```text
-//! [top table][records of depth 0][depth 1]...[depth depths-1][leaves]
+//! [top table][root record, then every node once, in the order the descent first reaches it]
 //! ```
 //! - *Top table*: the first `top_depths` (2, or 1 for a 2-level grid) inner depths resolved
 //!   at once: one slot per combination of their child indices (`64^top_depths` slots; half
 //!   when symmetric, since a folded query always has A's top `y` bit set). A slot is 0 (free),
-//!   1 (collision), or `2 + r` for the node at pool word `region[top_depths] + r`.
+//!   1 (collision), or the word of the node it reaches (never 0 or 1: the top table comes
+//!   first).
 //! - *Record* of an inner node: `nonuniform`, `collision`, then one slot per non-uniform child
-//!   (`popcount` order), packed into the following words and padded to a word. A child slot
-//!   holds the child's word offset from the start of the next depth's region (inner depths) or
-//!   its leaf index. Records sit depth by depth in the order of [`SharedParts`], so that the
-//!   parts can be read back; the records of the depths under the top table are never read by
-//!   a query.
+//!   (`popcount` order) holding the child's word, packed into the following words and padded
+//!   to a word.
 //! - *Leaf*: one word, bit `i` for child cell `i`.
 //!
-//! Slots are `u16` when every slot value fits, else `u32`, four or two to a word, lowest bits
-//! first. One node step reads the record's masks and then one slot of the same record, 16
-//! to 272 bytes on: the same cache line for a small rank, its neighbour otherwise. The old
-//! layout (masks, bases and child indices in three arrays) read three lines per step.
+//! Nodes are placed depth first (a node, then the subtree of each child not placed yet, in
+//! child order), so that a node that has one parent (all inner nodes but a few, three
+//! quarters of the leaves at k = 32) lies right after its parent's record or its siblings:
+//! the last node step and its leaf share a cache line or its neighbour and one page. The
+//! records above the top table are kept (for [`Pool::arrays`]) but never read by a query.
 //!
-//! [`SharedParts`]: super::SharedParts
+//! Slots are `u16` when every word index fits, else `u32`, four or two to a word, lowest bits
+//! first. A query reads one top slot, then per node step the record's masks and one slot of
+//! the same record, then one leaf. The old layout (masks, bases and child indices in three
+//! arrays, nodes depth by depth) read three lines per step and nine dependent reads at k = 32.
+//!
+//! # Order
+//! [`Pool::arrays`] gives the canonical arrays back by walking the layout, numbering the
+//! nodes of each depth in the order the descent first reaches them: the order `build` gives
+//! them, which [`check_order`] requires of stored parts.
 
 use super::child_index;
 use crate::table::code::MAX_LEVELS;
+use alloc::{format, string::String, vec, vec::Vec};
 
 /// Per-depth arrays hold at most this many entries (inner depths, plus one).
 const DEPTH_SLOTS: usize = MAX_LEVELS as usize + 1;
@@ -33,7 +42,7 @@ const DEPTH_SLOTS: usize = MAX_LEVELS as usize + 1;
 /// The query layout (see the module doc).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(super) struct Pool {
-    /// Top table, records, leaves.
+    /// Top table, then the nodes.
     words: Vec<u64>,
     /// 16 or 32.
     slot_bits: u32,
@@ -42,12 +51,8 @@ pub(super) struct Pool {
     /// Inner depths (`levels + sub_levels - 1`).
     depths: u32,
     symmetric: bool,
-    /// Word where the records of each inner depth start, then the leaves, then the end.
-    region: [u32; DEPTH_SLOTS + 1],
-    /// First node of each inner depth, then the inner node count (as [`SharedParts`] has it).
-    ///
-    /// [`SharedParts`]: super::SharedParts
-    depth_start: [u32; DEPTH_SLOTS],
+    /// Inner nodes per depth, then leaves.
+    counts: [u32; DEPTH_SLOTS],
 }
 
 /// The canonical arrays: masks, bases, depth starts, child indices, leaves.
@@ -60,112 +65,199 @@ fn slot<const BITS: u32>(words: &[u64], word: usize, i: usize) -> usize {
     (words[word + i / per] >> (BITS as usize * (i % per)) & ((1u64 << BITS) - 1)) as usize
 }
 
-/// Packs `values` into words, `bits` each, lowest first.
-fn pack(out: &mut Vec<u64>, values: impl IntoIterator<Item = u64>, bits: u32) {
-    let per = 64 / bits;
+/// Packs `values` into `out` from word 0 on, `bits` each, lowest first.
+fn pack(out: &mut [u64], values: impl IntoIterator<Item = u64>, bits: u32) {
+    let per = (64 / bits) as usize;
     for (i, v) in values.into_iter().enumerate() {
-        if i as u32 % per == 0 {
-            out.push(0);
+        out[i / per] |= v << (bits as usize * (i % per));
+    }
+}
+
+/// Words of a record with `n` child slots.
+fn record_words(n: usize, bits: u32) -> usize {
+    2 + n.div_ceil((64 / bits) as usize)
+}
+
+/// A node of the canonical arrays: inner (depth, global index) or leaf (index).
+#[derive(Clone, Copy)]
+enum Node {
+    Inner(usize, usize),
+    Leaf(usize),
+}
+
+/// Visits the canonical arrays depth first from the root (a node, then each child not yet
+/// visited, in child order), calling `first(node)` at each node's first visit.
+fn depth_first(a: &Arrays, depths: usize, first: &mut impl FnMut(Node)) {
+    let (masks, _, depth_start, _, leaves) = a;
+    let mut seen_inner = vec![false; masks.len()];
+    let mut seen_leaf = vec![false; leaves.len()];
+    visit(a, depths, 0, 0, &mut seen_inner, &mut seen_leaf, first);
+    debug_assert!(depth_start[0] == 0);
+}
+
+fn visit(
+    a: &Arrays,
+    depths: usize,
+    d: usize,
+    node: usize,
+    seen_inner: &mut [bool],
+    seen_leaf: &mut [bool],
+    first: &mut impl FnMut(Node),
+) {
+    let (masks, bases, depth_start, children, _) = a;
+    seen_inner[node] = true;
+    first(Node::Inner(d, node));
+    let n = masks[node][0].count_ones() as usize;
+    for &id in &children[bases[node] as usize..][..n] {
+        if d + 1 < depths {
+            let child = (depth_start[d + 1] + id) as usize;
+            if !seen_inner[child] {
+                visit(a, depths, d + 1, child, seen_inner, seen_leaf, first);
+            }
+        } else if !seen_leaf[id as usize] {
+            seen_leaf[id as usize] = true;
+            first(Node::Leaf(id as usize));
         }
-        *out.last_mut().expect("pushed") |= v << (bits * (i as u32 % per));
+    }
+}
+
+/// Whether bounds-checked canonical arrays number the nodes of each depth in the order the
+/// descent first reaches them, and reach them all (see the module doc).
+///
+/// # Errors
+/// The first node out of order, or the first depth with a node never reached.
+pub(super) fn check_order(a: &Arrays, depths: usize) -> Result<(), String> {
+    let (_, _, depth_start, _, leaves) = a;
+    // Next expected index per depth (global for inner depths), leaves last.
+    let mut next: Vec<usize> = depth_start[..depths].iter().map(|&s| s as usize).collect();
+    next.push(0);
+    let mut bad = None;
+    depth_first(a, depths, &mut |n| {
+        let (d, i) = match n {
+            Node::Inner(d, i) => (d, i),
+            Node::Leaf(i) => (depths, i),
+        };
+        if bad.is_none() && i != next[d] {
+            bad = Some(format!("depth {d}: node {i} is reached first where node {} is due", next[d]));
+        }
+        next[d] += 1;
+    });
+    if let Some(e) = bad {
+        return Err(
+            e + "; nodes must be numbered in the order the descent first reaches them (as `build` numbers them)"
+        );
+    }
+    let ends = depth_start[1..=depths].iter().map(|&s| s as usize).chain([leaves.len()]);
+    match next.iter().zip(ends).position(|(&n, end)| n != end) {
+        Some(d) => Err(format!("depth {d}: some nodes are never reached from the root")),
+        None => Ok(()),
     }
 }
 
 impl Pool {
-    /// The layout of validated canonical arrays (see [`super::SharedQuadtree6d::from_parts`]).
+    /// The layout of canonical arrays that passed [`check_order`] (see
+    /// [`super::SharedQuadtree6d::from_parts`]).
     pub(super) fn new(fine: u32, symmetric: bool, a: &Arrays) -> Pool {
         Self::with_slots(fine, symmetric, a, 16)
             .unwrap_or_else(|| Self::with_slots(fine, symmetric, a, 32).expect("a table of at most 2^32 words"))
     }
 
-    /// The layout with `bits`-bit slots, or `None` when a slot value does not fit.
+    /// The layout with `bits`-bit slots, or `None` when a word index does not fit.
     fn with_slots(fine: u32, symmetric: bool, a: &Arrays, bits: u32) -> Option<Pool> {
         let (masks, bases, depth_start, children, leaves) = a;
         let depths = fine - 1;
-        let per = 64 / bits as usize;
-        let limit = (1u64 << bits) - 1;
-        // Each node's record offset within its depth's region.
-        let mut rel = vec![0u32; masks.len()];
-        let mut region_len = vec![0usize; depths as usize];
-        for d in 0..depths as usize {
-            for node in depth_start[d] as usize..depth_start[d + 1] as usize {
-                rel[node] = u32::try_from(region_len[d]).ok()?;
-                region_len[d] += 2 + (masks[node][0].count_ones() as usize).div_ceil(per);
-            }
-        }
         let top_depths = depths.min(2);
         let top_slots = (64usize << (6 * (top_depths - 1))) >> usize::from(symmetric);
-        let mut region = [0u32; DEPTH_SLOTS + 1];
-        region[0] = u32::try_from(top_slots.div_ceil(per)).ok()?;
-        for d in 0..depths as usize {
-            region[d + 1] = u32::try_from(region[d] as usize + region_len[d]).ok()?;
-        }
-        region[depths as usize + 1] = u32::try_from(region[depths as usize] as usize + leaves.len()).ok()?;
-        // The slot value of child id `id` of a node of depth `d`.
-        let target = |d: usize, id: u32| -> u64 {
-            if d + 1 < depths as usize {
-                u64::from(rel[(depth_start[d + 1] + id) as usize])
-            } else {
-                u64::from(id)
+        let top_words = top_slots.div_ceil((64 / bits) as usize);
+        // Where each node goes: depth first, right after the node placed before it.
+        let (mut inner_at, mut leaf_at) = (vec![0usize; masks.len()], vec![0usize; leaves.len()]);
+        let mut end = top_words;
+        depth_first(a, depths as usize, &mut |n| match n {
+            Node::Inner(_, i) => {
+                inner_at[i] = end;
+                end += record_words(masks[i][0].count_ones() as usize, bits);
             }
-        };
-        let top = top_entries(symmetric, top_depths, a, |d, id| 2 + target(d, id));
-        let mut words = Vec::with_capacity(region[depths as usize + 1] as usize);
-        let fits = |v: &u64| *v <= limit;
-        if !top.iter().all(fits) {
+            Node::Leaf(i) => {
+                leaf_at[i] = end;
+                end += 1;
+            }
+        });
+        if (end as u64) > 1u64 << bits {
             return None;
         }
-        pack(&mut words, top, bits);
+        // The word of child `id` of a node of depth `d`.
+        let target = |d: usize, id: u32| -> u64 {
+            if d + 1 < depths as usize {
+                inner_at[(depth_start[d + 1] + id) as usize] as u64
+            } else {
+                leaf_at[id as usize] as u64
+            }
+        };
+        let mut words = vec![0u64; end];
+        pack(&mut words, top_entries(symmetric, top_depths, a, target), bits);
         for d in 0..depths as usize {
             for node in depth_start[d] as usize..depth_start[d + 1] as usize {
                 let [nonuniform, collision] = masks[node];
-                words.extend([nonuniform, collision]);
+                let at = inner_at[node];
+                words[at] = nonuniform;
+                words[at + 1] = collision;
                 let ids = &children[bases[node] as usize..][..nonuniform.count_ones() as usize];
-                let slots: Vec<u64> = ids.iter().map(|&id| target(d, id)).collect();
-                if !slots.iter().all(fits) {
-                    return None;
-                }
-                pack(&mut words, slots, bits);
+                pack(&mut words[at + 2..], ids.iter().map(|&id| target(d, id)), bits);
             }
         }
-        words.extend_from_slice(leaves);
-        debug_assert_eq!(words.len(), region[depths as usize + 1] as usize);
-        let mut starts = [0u32; DEPTH_SLOTS];
-        starts[..depth_start.len()].copy_from_slice(depth_start);
-        Some(Pool { words, slot_bits: bits, top_depths, depths, symmetric, region, depth_start: starts })
+        for (leaf, &at) in leaves.iter().zip(&leaf_at) {
+            words[at] = *leaf;
+        }
+        let mut counts = [0u32; DEPTH_SLOTS];
+        for d in 0..depths as usize {
+            counts[d] = depth_start[d + 1] - depth_start[d];
+        }
+        counts[depths as usize] = leaves.len() as u32;
+        Some(Pool { words, slot_bits: bits, top_depths, depths, symmetric, counts })
     }
 
-    /// The canonical arrays back (as the file stores them).
+    /// The canonical arrays back (as the file stores them): the layout walked depth first,
+    /// each depth's nodes numbered in the order they are first reached.
     pub(super) fn arrays(&self) -> Arrays {
         let depths = self.depths as usize;
-        let (mut masks, mut bases, mut raw) = (vec![], vec![], vec![]);
-        // Per depth, the record offsets within its region, ascending.
-        let mut offsets: Vec<Vec<u32>> = vec![vec![]; depths];
-        let per = (64 / self.slot_bits) as usize;
-        for (d, offsets) in offsets.iter_mut().enumerate() {
-            let mut w = self.region[d] as usize;
-            for _ in self.depth_start[d]..self.depth_start[d + 1] {
-                let [nonuniform, collision] = [self.words[w], self.words[w + 1]];
-                offsets.push((w - self.region[d] as usize) as u32);
-                masks.push([nonuniform, collision]);
-                bases.push(raw.len() as u32);
-                let n = nonuniform.count_ones() as usize;
-                raw.extend((0..n).map(|i| self.slot_at(w + 2, i) as u32));
-                w += 2 + n.div_ceil(per);
+        let top_words = self.root();
+        // Per depth (leaves last): the words of its nodes in number order; per word, its number.
+        let mut order: Vec<Vec<usize>> = vec![vec![]; depths + 1];
+        let mut number = vec![u32::MAX; self.words.len()];
+        let mut stack = vec![(top_words, 0usize)];
+        // Depth first with an explicit stack: children pushed in reverse to pop in order.
+        while let Some((at, d)) = stack.pop() {
+            if number[at] != u32::MAX {
+                continue;
+            }
+            number[at] = order[d].len() as u32;
+            order[d].push(at);
+            if d < depths {
+                let n = self.words[at].count_ones() as usize;
+                for i in (0..n).rev() {
+                    stack.push((self.slot_at(at + 2, i), d + 1));
+                }
             }
         }
-        // Slots of inner children are record offsets: back to indices within the depth.
-        let raw_len = raw.len();
-        let (mut children, count) = (raw, raw_len);
-        let base = |node: u32| bases.get(node as usize).map_or(count, |&b| b as usize);
-        for d in 0..depths.saturating_sub(1) {
-            let range = base(self.depth_start[d])..base(self.depth_start[d + 1]);
-            for c in &mut children[range] {
-                *c = offsets[d + 1].binary_search(c).expect("a record start") as u32;
+        let (mut masks, mut bases, mut children, mut depth_start) = (vec![], vec![], vec![], vec![]);
+        for level in &order[..depths] {
+            depth_start.push(masks.len() as u32);
+            for &at in level {
+                let nonuniform = self.words[at];
+                masks.push([nonuniform, self.words[at + 1]]);
+                bases.push(children.len() as u32);
+                children.extend((0..nonuniform.count_ones() as usize).map(|i| number[self.slot_at(at + 2, i)]));
             }
         }
-        let leaves = self.words[self.region[depths] as usize..].to_vec();
-        (masks, bases, self.depth_start[..=depths].to_vec(), children, leaves)
+        depth_start.push(masks.len() as u32);
+        let leaves = order[depths].iter().map(|&at| self.words[at]).collect();
+        (masks, bases, depth_start, children, leaves)
+    }
+
+    /// The root record's word (right after the top table).
+    fn root(&self) -> usize {
+        let top_slots = (64usize << (6 * (self.top_depths - 1))) >> usize::from(self.symmetric);
+        top_slots.div_ceil((64 / self.slot_bits) as usize)
     }
 
     /// Slot `i` from word `word` on, at this pool's slot width.
@@ -195,19 +287,17 @@ impl Pool {
     #[inline(always)]
     fn descend<const BITS: u32>(&self, c: &[u16; 6], fine: u32) -> bool {
         let w = &self.words;
-        let entry = slot::<BITS>(w, 0, self.top_index(c, fine));
-        if entry < 2 {
-            return entry == 1;
+        let mut node = slot::<BITS>(w, 0, self.top_index(c, fine));
+        if node < 2 {
+            return node == 1;
         }
-        let mut node = self.region[self.top_depths as usize] as usize + entry - 2;
         for d in self.top_depths..self.depths {
             let bit = 1u64 << child_index(c, fine - 1 - d);
             let (nonuniform, collision) = (w[node], w[node + 1]);
             if nonuniform & bit == 0 {
                 return collision & bit != 0;
             }
-            let rank = (nonuniform & (bit - 1)).count_ones() as usize;
-            node = self.region[d as usize + 1] as usize + slot::<BITS>(w, node + 2, rank);
+            node = slot::<BITS>(w, node + 2, (nonuniform & (bit - 1)).count_ones() as usize);
         }
         w[node] >> child_index(c, 0) & 1 == 1
     }
@@ -221,11 +311,10 @@ impl Pool {
         let slot_addr = |word: usize, i: usize| at(word + i / per) + bytes * (i % per);
         let top = self.top_index(c, fine);
         let mut reads = vec![(slot_addr(0, top), bytes, 0)];
-        let entry = self.slot_at(0, top);
-        if entry < 2 {
-            return (entry == 1, reads);
+        let mut node = self.slot_at(0, top);
+        if node < 2 {
+            return (node == 1, reads);
         }
-        let mut node = self.region[self.top_depths as usize] as usize + entry - 2;
         let mut step = 1;
         for d in self.top_depths..self.depths {
             let bit = 1u64 << child_index(c, fine - 1 - d);
@@ -236,7 +325,7 @@ impl Pool {
             }
             let rank = (nonuniform & (bit - 1)).count_ones() as usize;
             reads.push((slot_addr(node + 2, rank), bytes, step + 1));
-            node = self.region[d as usize + 1] as usize + self.slot_at(node + 2, rank);
+            node = self.slot_at(node + 2, rank);
             step += 2;
         }
         reads.push((at(node), 8, step));
@@ -245,10 +334,7 @@ impl Pool {
 
     /// Inner nodes per depth, then the leaf count.
     pub(super) fn nodes_per_depth(&self) -> Vec<usize> {
-        let d = self.depths as usize;
-        let mut v: Vec<usize> = self.depth_start[..=d].windows(2).map(|w| (w[1] - w[0]) as usize).collect();
-        v.push((self.region[d + 1] - self.region[d]) as usize);
-        v
+        self.counts[..=self.depths as usize].iter().map(|&n| n as usize).collect()
     }
 
     /// The words a query reads.
@@ -341,7 +427,7 @@ mod tests {
                 x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
                 x >> 16
             };
-            std::array::from_fn(|j| (v >> (levels as usize * j) & (k - 1)) as u16)
+            core::array::from_fn(|j| (v >> (levels as usize * j) & (k - 1)) as u16)
         })
     }
 
@@ -386,11 +472,11 @@ mod tests {
 
     #[test]
     fn slots_pack_lowest_first() {
-        let mut w = vec![];
+        let mut w = vec![0; 2];
         pack(&mut w, [1, 2, 3, 4, 5], 16);
         assert_eq!(w, vec![0x0004_0003_0002_0001, 5]);
         assert_eq!((0..5).map(|i| slot::<16>(&w, 0, i)).collect::<Vec<_>>(), [1, 2, 3, 4, 5]);
-        let mut w = vec![];
+        let mut w = vec![0; 2];
         pack(&mut w, [7, u64::from(u32::MAX), 9], 32);
         assert_eq!((0..3).map(|i| slot::<32>(&w, 0, i)).collect::<Vec<_>>(), [7, u32::MAX as usize, 9]);
     }
