@@ -23,10 +23,12 @@
 //!
 //! # Query
 //! The arrays above are what the file stores ([`SharedParts`]); a query reads them laid out
-//! again in one array ([`pool`]): a top table resolves the first two depths in one read, then
-//! each further node step reads one record (masks and child slots together, mostly one cache
-//! line), then one leaf. At k = 32 that is at most 6 dependent reads instead of 9. No search,
-//! no loop whose length depends on the data, no allocation.
+//! again in one array (`shared6d/pool.rs`): a top table resolves the first two depths in one
+//! read, then each further node step reads one record (masks and child slots together), and
+//! nodes sit depth first next to their first parent, so that most leaves share a cache line
+//! or its neighbour with their parent's record. At k = 32 a query makes at most 6 dependent
+//! reads on at most 8 cache lines (the arrays read directly: 9 reads on up to 14 lines). No
+//! search, no loop whose length depends on the data, no allocation.
 
 mod pool;
 
