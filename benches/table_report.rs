@@ -6,7 +6,7 @@
 //!
 //! Run: `cargo bench --bench table_report -- [--cells T1,T2,T3] [--k 32] [--random 1000000]
 //! [--cold 100000] [--cold-shared 1000000] [--variants shared,...] [--timer instant|tsc]
-//! [--slowest 0]` (`--help` lists them). `--cold-shared`: flushed queries of the shared
+//! [--slowest 0] [--passes 3]` (`--help` lists them). `--cold-shared`: flushed queries of the shared
 //! table without sub-cells; `--cold`: of every other table. `--variants`: which tables
 //! (default all; the 6-D table is built anyway when a shared one is, for the agreement check,
 //! and only labellings that a chosen table needs are made). `--timer tsc`: `rdtsc` between
@@ -18,10 +18,12 @@
 //! the 6-D table.
 //!
 //! A query here is the table lookup alone (`Table::query` on a precomputed 6-D cell). All
-//! queries are timed in three passes (flushed before each query for the flushed figures) and
-//! each keeps its fastest pass, so that the maximum is the slowest query and not an
-//! interrupt; timing costs two clock reads, shown as the "timer" rows (the floor of every
-//! figure, measured in the same run for both clocks).
+//! queries are timed in three passes (`--passes`; flushed before each query for the flushed
+//! figures) and each keeps its fastest pass, so that the maximum is the slowest query and not
+//! an interrupt; timing costs two clock reads, shown as the "timer" rows (the floor of every
+//! figure, measured in the same run for both clocks, the same way: when their maximum is
+//! high, the machine was too busy for the maximum of any row to mean more). The shared
+//! table's previous layout (separate arrays) is timed in the same run, the two taking turns.
 //! Configurations whose TCP lies outside the sampled grid (none on the reference cells) would
 //! go to the exact check, as `TableChecker` does, and are counted apart.
 
@@ -55,7 +57,8 @@ const USAGE: &str = "cargo bench --bench table_report -- [options]
   --cold-shared 1000000 flushed queries of the shared table without sub-cells
   --variants LIST       comma list of 6d,5d,4d-yy,4d-zz,4d-yy-lossy,shared,shared-sub,thesis (default all)
   --timer instant|tsc   clock of the query timings (default instant; tsc: rdtsc between lfences)
-  --slowest N           the N slowest warm queries of each shared table, analysed (default 0)";
+  --slowest N           the N slowest warm queries of each shared table, analysed (default 0)
+  --passes 3            passes over the queries; each query keeps its fastest";
 
 struct Options {
     cells: Vec<String>,
@@ -96,6 +99,7 @@ fn options() -> Options {
     if let Some(v) = variants.iter().find(|v| !VARIANTS.contains(&v.as_str())) {
         panic!("--variants: unknown table {v:?}; use {}", VARIANTS.join(","));
     }
+    timing::PASSES.store(num("--passes", 3).max(1), std::sync::atomic::Ordering::Relaxed);
     let tsc = match value("--timer").as_deref() {
         None | Some("instant") => false,
         Some("tsc") => true,

@@ -2,6 +2,7 @@
 //! flushing, and passes that keep each query's fastest time.
 
 use std::hint::black_box;
+use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use std::time::Instant;
 
 /// Evicts every cache line of `regions` (x86-64 `clflush`), then waits for it.
@@ -105,15 +106,16 @@ pub fn percentiles(ns: &[u64]) -> (u64, u64, u64) {
     (at(0.5), at(0.999), ns[ns.len() - 1])
 }
 
-/// Passes over the queries; each query keeps its fastest pass: the query's own cost without
-/// the interrupts and preemptions of a shared machine (single readings reach milliseconds,
-/// and an interrupt rarely hits the same query in every pass).
-pub const REPEATS: usize = 3;
+/// Passes over the queries (3 unless `--passes` says otherwise); each query keeps its fastest
+/// pass: the query's own cost without the interrupts and preemptions of a shared machine
+/// (single readings reach milliseconds, and an interrupt rarely hits the same query in every
+/// pass; on a loaded machine more passes filter more, see the timer rows).
+pub static PASSES: AtomicUsize = AtomicUsize::new(3);
 
-/// Per query, the fastest of [`REPEATS`] passes over all of `cells`.
+/// Per query, the fastest of [`PASSES`] passes over all of `cells`.
 pub fn fastest_of_passes(cells: &[[u16; 6]], mut time: impl FnMut([u16; 6]) -> u64) -> Vec<u64> {
     let mut best = vec![u64::MAX; cells.len()];
-    for _ in 0..REPEATS {
+    for _ in 0..PASSES.load(Relaxed) {
         for (b, &c) in best.iter_mut().zip(cells) {
             *b = (*b).min(time(c));
         }
@@ -124,7 +126,7 @@ pub fn fastest_of_passes(cells: &[[u16; 6]], mut time: impl FnMut([u16; 6]) -> u
 /// Queries per turn when two layouts take turns within a pass.
 pub const TURN: usize = 1 << 20;
 
-/// Per query, the fastest of [`REPEATS`] passes of `a` and of `b`, which take turns every
+/// Per query, the fastest of [`PASSES`] passes of `a` and of `b`, which take turns every
 /// [`TURN`] queries, so that both see the same machine (the load of a shared machine changes
 /// by the second).
 pub fn fastest_of_passes_in_turns(
@@ -133,7 +135,7 @@ pub fn fastest_of_passes_in_turns(
     mut b: impl FnMut([u16; 6]) -> u64,
 ) -> (Vec<u64>, Vec<u64>) {
     let (mut best_a, mut best_b) = (vec![u64::MAX; cells.len()], vec![u64::MAX; cells.len()]);
-    for _ in 0..REPEATS {
+    for _ in 0..PASSES.load(Relaxed) {
         for ((ba, bb), cs) in best_a.chunks_mut(TURN).zip(best_b.chunks_mut(TURN)).zip(cells.chunks(TURN)) {
             for (t, &c) in ba.iter_mut().zip(cs) {
                 *t = (*t).min(a(c));
