@@ -6,9 +6,10 @@
 //! ```text
 //! [top table][root record, then every node once, in the order the descent first reaches it]
 //! ```
-//! - *Top table*: the first `top_depths` (2, or 1 for a 2-level grid) inner depths resolved
-//!   at once: one slot per combination of their child indices (`64^top_depths` slots; half
-//!   when symmetric, since a folded query always has A's top `y` bit set). A slot is 0 (free),
+//! - *Top table*: the first `top_depths` inner depths ([`TOP_DEPTHS`], or 1 for a 2-level
+//!   grid) resolved at once: one slot per combination of their child indices
+//!   (`64^top_depths` slots; half when symmetric, since a folded query always has A's top `y`
+//!   bit set). A slot is 0 (free),
 //!   1 (collision), or the word of the node it reaches (never 0 or 1: the top table comes
 //!   first).
 //! - *Record* of an inner node: `nonuniform`, `collision`, then one slot per non-uniform child
@@ -38,6 +39,12 @@ use alloc::{format, string::String, vec, vec::Vec};
 
 /// Per-depth arrays hold at most this many entries (inner depths, plus one).
 const DEPTH_SLOTS: usize = MAX_LEVELS as usize + 1;
+
+/// Inner depths the top table resolves (fewer when the grid has fewer). Two: 2,048 or 4,096
+/// slots (4 or 8 KiB with 16-bit slots), one dependent read for the two nodes every query
+/// starts with; one would save that much memory and cost one more read (on T1 at k = 32 the
+/// flushed median rose from 160 to 270 ns).
+const TOP_DEPTHS: u32 = 2;
 
 /// The query layout (see the module doc).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -166,7 +173,7 @@ impl Pool {
     fn with_slots(fine: u32, symmetric: bool, a: &Arrays, bits: u32) -> Option<Pool> {
         let (masks, bases, depth_start, children, leaves) = a;
         let depths = fine - 1;
-        let top_depths = depths.min(2);
+        let top_depths = depths.min(TOP_DEPTHS);
         let top_slots = (64usize << (6 * (top_depths - 1))) >> usize::from(symmetric);
         let top_words = top_slots.div_ceil((64 / bits) as usize);
         // Where each node goes: depth first, right after the node placed before it.
