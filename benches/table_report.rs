@@ -5,16 +5,25 @@
 //! warm and with the table flushed from the caches before every query.
 //!
 //! Run: `cargo bench --bench table_report -- [--cells T1,T2,T3] [--k 32] [--random 1000000]
-//! [--cold 100000] [--cold-shared 1000000]` (`--cold-shared`: flushed queries of the
-//! shared table without sub-cells; `--cold`: of every other table). Without `--bench` (as `cargo test` runs it) it
-//! does a small smoke run (T2, k = 16) that still checks FN = 0 and the shared table's
-//! agreement with the 6-D table.
+//! [--cold 100000] [--cold-shared 1000000] [--variants shared,...] [--timer instant|tsc]
+//! [--slowest 0] [--passes 3]` (`--help` lists them). `--cold-shared`: flushed queries of the shared
+//! table without sub-cells; `--cold`: of every other table. `--variants`: which tables
+//! (default all; the 6-D table is built anyway when a shared one is, for the agreement check,
+//! and only labellings that a chosen table needs are made). `--timer tsc`: `rdtsc` between
+//! `lfence`s, converted to ns with a rate calibrated against `Instant` in the same run.
+//! `--slowest N`: for each shared table, the N slowest warm queries with the memory reads of
+//! their descent (dependent steps, cache lines, pages), re-timed one by one, and the warm
+//! times grouped by steps and lines. Without `--bench` (as `cargo test` runs it) it does a
+//! small smoke run (T2, k = 16) that still checks FN = 0 and the shared table's agreement with
+//! the 6-D table.
 //!
 //! A query here is the table lookup alone (`Table::query` on a precomputed 6-D cell). All
-//! queries are timed in three passes (flushed before each query for the flushed figures) and
-//! each keeps its fastest pass, so that the maximum is the slowest query and not an
-//! interrupt; timing costs two clock reads, shown as the "timer" row (the floor of every
-//! figure).
+//! queries are timed in three passes (`--passes`; flushed before each query for the flushed
+//! figures) and each keeps its fastest pass, so that the maximum is the slowest query and not
+//! an interrupt; timing costs two clock reads, shown as the "timer" rows (the floor of every
+//! figure, measured in the same run for both clocks, the same way: when their maximum is
+//! high, the machine was too busy for the maximum of any row to mean more). The shared
+//! table's previous layout (separate arrays) is timed in the same run, the two taking turns.
 //! Configurations whose TCP lies outside the sampled grid (none on the reference cells) would
 //! go to the exact check, as `TableChecker` does, and are counted apart.
 
@@ -27,9 +36,32 @@ use delta_collide::cspace::{
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
+#[path = "support/shared_peer.rs"]
+mod shared_peer;
+#[path = "support/timing.rs"]
+mod timing;
+
+use shared_peer::SeparateArrays;
 use std::collections::HashSet;
 use std::hint::black_box;
 use std::time::Instant;
+use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, percentiles, Clock};
+
+/// The tables of the report, by the key `--variants` takes, in report order.
+const VARIANTS: [&str; 9] =
+    ["6d", "5d", "4d-yy", "4d-zz", "4d-yy-lossy", "shared", "shared-sub", "4d-yy-sub", "thesis"];
+
+const USAGE: &str = "cargo bench --bench table_report -- [options]
+  --cells T1,T2,T3      reference cells (default all three)
+  --k 32                cells per axis
+  --random 1000000      random reachable configurations per cell
+  --cold 100000         flushed queries per table (not the shared one)
+  --cold-shared 1000000 flushed queries of the shared table without sub-cells
+  --variants LIST       comma list of 6d,5d,4d-yy,4d-zz,4d-yy-lossy,shared,shared-sub,4d-yy-sub,
+                        thesis (default all; 4d-yy-sub: the 4D/yy t=0 table of the sub-cell labels)
+  --timer instant|tsc   clock of the query timings (default instant; tsc: rdtsc between lfences)
+  --slowest N           the N slowest warm queries of each shared table, analysed (default 0)
+  --passes 3            passes over the queries; each query keeps its fastest";
 
 struct Options {
     cells: Vec<String>,
@@ -37,14 +69,21 @@ struct Options {
     random: usize,
     cold: usize,
     cold_shared: usize,
-    sub: bool,
+    variants: Vec<String>,
+    tsc: bool,
+    slowest: usize,
     smoke: bool,
 }
 
 fn options() -> Options {
     let args: Vec<String> = std::env::args().collect();
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        println!("{USAGE}");
+        std::process::exit(0);
+    }
     let value = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
     let num = |name: &str, default: usize| value(name).map_or(default, |v| v.parse().expect("a number"));
+    let all = || VARIANTS.iter().map(|v| v.to_string()).collect();
     if !args.iter().any(|a| a == "--bench") {
         return Options {
             cells: vec!["T2".into()],
@@ -52,18 +91,32 @@ fn options() -> Options {
             random: 2000,
             cold: 200,
             cold_shared: 200,
-            sub: true,
+            variants: all(),
+            tsc: false,
+            slowest: 3,
             smoke: true,
         };
     }
-    let cells = value("--cells").unwrap_or("T1,T2,T3".into()).split(',').map(str::to_string).collect();
+    let list = |name: &str| value(name).map(|v| v.split(',').map(str::to_string).collect::<Vec<_>>());
+    let variants = list("--variants").unwrap_or_else(all);
+    if let Some(v) = variants.iter().find(|v| !VARIANTS.contains(&v.as_str())) {
+        panic!("--variants: unknown table {v:?}; use {}", VARIANTS.join(","));
+    }
+    timing::PASSES.store(num("--passes", 3).max(1), std::sync::atomic::Ordering::Relaxed);
+    let tsc = match value("--timer").as_deref() {
+        None | Some("instant") => false,
+        Some("tsc") => true,
+        Some(t) => panic!("--timer: {t:?} is neither instant nor tsc"),
+    };
     Options {
-        cells,
+        cells: list("--cells").unwrap_or_else(|| vec!["T1".into(), "T2".into(), "T3".into()]),
         k: num("--k", 32) as u32,
         random: num("--random", 1_000_000),
         cold: num("--cold", 100_000),
         cold_shared: num("--cold-shared", 1_000_000),
-        sub: !args.iter().any(|a| a == "--no-sub"),
+        variants,
+        tsc,
+        slowest: num("--slowest", 0),
         smoke: false,
     }
 }
@@ -134,73 +187,126 @@ fn configurations(cell: &Cell, space: &LabelledSpace, n: usize, ws: &Workspace) 
     out
 }
 
-/// Evicts every cache line of `regions` (x86-64 `clflush`), then waits for it.
-#[cfg(target_arch = "x86_64")]
-fn flush(regions: &[(usize, usize)]) {
-    use std::arch::x86_64::{_mm_clflush, _mm_mfence};
-    for &(addr, len) in regions {
-        let mut line = addr & !63;
-        while line < addr + len {
-            // SAFETY: `line` is the start of a cache line that holds bytes of a live array of
-            // the table (`memory_regions`), which outlives this call; clflush reads no data
-            // and changes no value, it only writes the line back and evicts it.
-            unsafe { _mm_clflush(line as *const u8) };
-            line += 64;
-        }
-    }
-    // SAFETY: sse2 is part of the x86-64 baseline; a fence has no other precondition.
-    unsafe { _mm_mfence() };
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-fn flush(_regions: &[(usize, usize)]) {}
-
-/// Median, p99.9 and maximum of `ns` (sorted in place).
-fn percentiles(ns: &mut [u64]) -> (u64, u64, u64) {
-    if ns.is_empty() {
-        return (0, 0, 0);
-    }
-    ns.sort_unstable();
-    let at = |q: f64| ns[((ns.len() - 1) as f64 * q).round() as usize];
-    (at(0.5), at(0.999), ns[ns.len() - 1])
-}
-
-/// Passes over the queries; each query keeps its fastest pass: the query's own cost without
-/// the interrupts and preemptions of a shared machine (single readings reach milliseconds,
-/// and an interrupt rarely hits the same query in every pass).
-const REPEATS: usize = 3;
-
-fn query_ns(table: &Table, cell: [u16; 6], regions: Option<&[(usize, usize)]>) -> u64 {
+fn query_ns(clock: Clock, table: &Table, cell: [u16; 6], regions: Option<&[(usize, usize)]>) -> u64 {
     if let Some(r) = regions {
         flush(r);
     }
-    let start = Instant::now();
-    black_box(table.query(black_box(cell)));
-    start.elapsed().as_nanos() as u64
+    clock.time(|| table.query(black_box(cell)))
 }
 
-/// Per query, the fastest of [`REPEATS`] passes over all of `cells`.
-fn fastest_of_passes(cells: &[[u16; 6]], mut time: impl FnMut([u16; 6]) -> u64) -> Vec<u64> {
-    let mut best = vec![u64::MAX; cells.len()];
-    for _ in 0..REPEATS {
-        for (b, &c) in best.iter_mut().zip(cells) {
-            *b = (*b).min(time(c));
-        }
-    }
-    best
+/// As [`time_queries`] for a shared table and its previous layout, taking turns: (warm,
+/// flushed) of the table, then of the peer.
+fn time_with_peer(
+    clock: Clock,
+    table: &Table,
+    peer: &SeparateArrays,
+    cells: &[[u16; 6]],
+    cold: usize,
+) -> [(Vec<u64>, Vec<u64>); 2] {
+    let (warm, warm_peer) = fastest_of_passes_in_turns(
+        cells,
+        |c| query_ns(clock, table, c, None),
+        |c| clock.time(|| peer.query(black_box(c))),
+    );
+    let (regions, peer_regions) = (table.memory_regions(), peer.memory_regions());
+    let cold_cells = &cells[..cold.min(cells.len())];
+    let (flushed, flushed_peer) = if cfg!(target_arch = "x86_64") {
+        fastest_of_passes_in_turns(
+            cold_cells,
+            |c| query_ns(clock, table, c, Some(&regions)),
+            |c| {
+                flush(&peer_regions);
+                clock.time(|| peer.query(black_box(c)))
+            },
+        )
+    } else {
+        (vec![], vec![])
+    };
+    [(warm, flushed), (warm_peer, flushed_peer)]
 }
 
-/// (warm, flushed) median, p99.9 and maximum over the queries.
-fn time_queries(table: &Table, cells: &[[u16; 6]], cold: usize) -> ((u64, u64, u64), (u64, u64, u64)) {
-    let mut warm = fastest_of_passes(cells, |c| query_ns(table, c, None));
+/// `warm` and `flushed` (of `cold` queries) as the report's two cells.
+fn timing_cells(warm: &[u64], flushed: &[u64], cold: usize) -> (String, String) {
+    let (w, f) = (percentiles(warm), percentiles(flushed));
+    let flushed = if f.2 == 0 { "n/a".into() } else { format!("{} / {} / {} ({cold})", f.0, f.1, f.2) };
+    (format!("{} / {} / {}", w.0, w.1, w.2), flushed)
+}
+
+/// Per query, its fastest time (ns), warm and flushed (the first `cold` queries).
+fn time_queries(clock: Clock, table: &Table, cells: &[[u16; 6]], cold: usize) -> (Vec<u64>, Vec<u64>) {
+    let warm = fastest_of_passes(cells, |c| query_ns(clock, table, c, None));
     let regions = table.memory_regions();
     let cold_cells = &cells[..cold.min(cells.len())];
-    let mut flushed = if cfg!(target_arch = "x86_64") {
-        fastest_of_passes(cold_cells, |c| query_ns(table, c, Some(&regions)))
+    let flushed = if cfg!(target_arch = "x86_64") {
+        fastest_of_passes(cold_cells, |c| query_ns(clock, table, c, Some(&regions)))
     } else {
         vec![]
     };
-    (percentiles(&mut warm), percentiles(&mut flushed))
+    (warm, flushed)
+}
+
+/// The reads of one shared-table query: dependent steps, reads, cache lines, 4 KiB pages.
+fn read_counts(reads: &[(usize, usize, u32)]) -> (u32, usize, usize, usize) {
+    let steps = reads.iter().map(|r| r.2 + 1).max().unwrap_or(0);
+    let mut lines: Vec<usize> = reads.iter().flat_map(|&(a, n, _)| [a / 64, (a + n - 1) / 64]).collect();
+    let mut pages: Vec<usize> = reads.iter().map(|&(a, _, _)| a / 4096).collect();
+    for v in [&mut lines, &mut pages] {
+        v.sort_unstable();
+        v.dedup();
+    }
+    (steps, reads.len(), lines.len(), pages.len())
+}
+
+/// Min and median of `n` timings of `f`.
+fn min_median(n: usize, mut f: impl FnMut() -> u64) -> (u64, u64) {
+    let mut t: Vec<u64> = (0..n).map(|_| f()).collect();
+    t.sort_unstable();
+    (t[0], t[n / 2])
+}
+
+/// The slowest warm queries of a shared table, their reads and their times alone; then the
+/// warm times of all queries grouped by dependent steps and by cache lines.
+fn slowest_report(clock: Clock, table: &Table, cells: &[[u16; 6]], warm: &[u64], n: usize) -> Vec<String> {
+    let Table::Shared(shared) = table else { return vec![] };
+    let regions = table.memory_regions();
+    let mut order: Vec<usize> = (0..cells.len()).collect();
+    order.sort_unstable_by_key(|&i| std::cmp::Reverse(warm[i]));
+    let p = shared.parts();
+    let refs: Vec<usize> = p
+        .depth_start
+        .windows(2)
+        .map(|w| p.masks[w[0] as usize..w[1] as usize].iter().map(|m| m[0].count_ones() as usize).sum())
+        .collect();
+    let mut out = vec![
+        format!(
+            "nodes per depth (then leaves): {:?}; child refs out of each depth: {refs:?}",
+            shared.nodes_per_depth()
+        ),
+        format!("{} slowest warm queries ({}):", n.min(cells.len()), table.name()),
+    ];
+    for &i in order.iter().take(n) {
+        let (steps, reads, lines, pages) = read_counts(&shared.query_reads(cells[i]).1);
+        let (hot, hot_med) = min_median(101, || query_ns(clock, table, cells[i], None));
+        let (cold, cold_med) = min_median(11, || query_ns(clock, table, cells[i], Some(&regions)));
+        out.push(format!(
+            "  {:?} warm {} ns: {steps} steps, {reads} reads, {lines} lines, {pages} pages; alone hot min/median {hot} / {hot_med} ns, flushed {cold} / {cold_med} ns",
+            cells[i], warm[i]
+        ));
+    }
+    let mut by: [std::collections::BTreeMap<usize, Vec<u64>>; 2] = Default::default();
+    for (c, &t) in cells.iter().zip(warm) {
+        let (steps, _, lines, _) = read_counts(&shared.query_reads(*c).1);
+        by[0].entry(steps as usize).or_default().push(t);
+        by[1].entry(lines).or_default().push(t);
+    }
+    for (what, groups) in ["dependent steps", "cache lines"].iter().zip(&by) {
+        out.push(format!("warm ns by {what}: value: queries, median / p99.9 / max"));
+        for (v, ts) in groups {
+            let (m, p, x) = percentiles(ts);
+            out.push(format!("  {v}: {}, {m} / {p} / {x}", ts.len()));
+        }
+    }
+    out
 }
 
 /// What a table holds, in the thesis's terms (Tables 3.3-3.5).
@@ -209,13 +315,21 @@ fn contents(table: &Table) -> String {
         Table::D6(q) => format!("{} codes", q.codes().len()),
         Table::D5(q) => format!("{} codes", q.parts().0.len()),
         Table::D4(q) => format!("{} codes / {} slices", q.parts().0.len(), q.slice_count()),
-        Table::Shared(q) => format!("{} nodes", q.nodes_per_depth().iter().sum::<usize>()),
+        Table::Shared(q) => {
+            let per_depth = q.nodes_per_depth();
+            let depths: Vec<String> = per_depth.iter().map(|n| n.to_string()).collect();
+            format!("{} nodes ({}; {}-bit slots)", per_depth.iter().sum::<usize>(), depths.join("/"), q.slot_bits())
+        }
     }
 }
 
 fn main() {
     let opt = options();
+    let wants = |key: &str| opt.variants.iter().any(|v| v == key);
     let ws = Workspace::THESIS;
+    let tsc = Clock::tsc();
+    let clock = if opt.tsc { tsc.expect("--timer tsc needs x86-64") } else { Clock::Instant };
+    println!("(query timings: {})", clock.name());
     println!(
         "| cell | k | table | location codes / slices / nodes | bytes in memory | build s | warm median / p99.9 / max ns | flushed median / p99.9 / max ns (queries) | TP | TN | FP | FN | accuracy |"
     );
@@ -223,74 +337,84 @@ fn main() {
     for name in &opt.cells {
         let cell = reference_cell(name).expect("a reference cell");
         let symmetric = reflection_y(&cell);
+        let timed = |f: &dyn Fn() -> LabelledSpace| {
+            let start = Instant::now();
+            (f(), start.elapsed().as_secs_f64())
+        };
+        let (certified, label_secs) =
+            timed(&|| label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space);
         let start = Instant::now();
-        let certified = label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space;
-        let label_secs = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let subdivided = opt.sub.then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
+        let subdivided = (wants("shared-sub") || wants("4d-yy-sub"))
+            .then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
         let sub_secs = start.elapsed().as_secs_f64();
-        let expanded = subdivided.as_ref().map(|s| subdivided_labels(&cell, &ws, s).expect("2k labels"));
-        let start = Instant::now();
-        let thesis = label_space_thesis(&cell, opt.k, &ws, false).expect("labelling");
-        let thesis_secs = start.elapsed().as_secs_f64();
+        let thesis =
+            wants("thesis").then(|| timed(&|| label_space_thesis(&cell, opt.k, &ws, false).expect("labelling")));
         let configs = configurations(&cell, &certified, opt.random, &ws);
         let fine: Vec<[u16; 6]> = configs.iter().filter_map(|c| c.fine).collect();
         let outside = configs.len() - fine.len();
         let t_lossy = if opt.k >= 64 { 545 } else { 150 };
-        type Build = Box<dyn Fn(&LabelledSpace) -> Result<Table, TableError>>;
-        let mut variants: Vec<(String, &LabelledSpace, f64, Build)> = vec![
+        type Build<'a> = Box<dyn Fn(&LabelledSpace) -> Result<Table, TableError> + 'a>;
+        let mut variants: Vec<(&str, String, &LabelledSpace, f64, Build)> = vec![
             (
+                "6d",
                 "6D".into(),
                 &certified,
                 label_secs,
                 Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
             ),
             (
+                "5d",
                 "5D".into(),
                 &certified,
                 label_secs,
                 Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5)),
             ),
             (
+                "4d-yy",
                 "4D/yy t=0".into(),
                 &certified,
                 label_secs,
                 Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, 0).map(Table::D4)),
             ),
             (
+                "4d-zz",
                 "4D/zz t=0".into(),
                 &certified,
                 label_secs,
                 Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::ZZ, 0).map(Table::D4)),
             ),
             (
+                "4d-yy-lossy",
                 format!("4D/yy t={t_lossy}"),
                 &certified,
                 label_secs,
                 Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, t_lossy).map(Table::D4)),
             ),
             (
+                "shared",
                 "6D-shared (new)".into(),
                 &certified,
                 label_secs,
                 Box::new(move |s| SharedQuadtree6d::build(s, symmetric).map(Table::Shared)),
             ),
-            (
-                "thesis-style 6D (r/sqrt 2)".into(),
-                &thesis,
-                thesis_secs,
-                Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
-            ),
         ];
-        if let (Some(subdivided), Some(expanded)) = (&subdivided, &expanded) {
-            let sub_cells = subdivided.sub.clone().expect("sub-cells");
+        if let Some(sub) = &subdivided {
+            let sub_cells = sub.sub.as_ref().expect("sub-cells");
             variants.push((
+                "shared-sub",
                 "6D-shared/sub (new)".into(),
-                &subdivided.space,
+                &sub.space,
                 sub_secs,
-                Box::new(move |s| SharedQuadtree6d::build_subdivided(s, &sub_cells, symmetric).map(Table::Shared)),
+                Box::new(move |s| SharedQuadtree6d::build_subdivided(s, sub_cells, symmetric).map(Table::Shared)),
             ));
+        }
+        let expanded = subdivided
+            .as_ref()
+            .filter(|_| wants("4d-yy-sub"))
+            .map(|s| subdivided_labels(&cell, &ws, s).expect("2k labels"));
+        if let Some(expanded) = &expanded {
             variants.push((
+                "4d-yy-sub",
                 "4D/yy t=0 of the sub-cell labels (2k)".into(),
                 expanded,
                 sub_secs,
@@ -298,49 +422,82 @@ fn main() {
             ));
         }
         let fine_levels = opt.k.trailing_zeros() + 1;
-        let mut timer = fastest_of_passes(&fine, |c| {
-            let start = Instant::now();
-            black_box(c);
-            start.elapsed().as_nanos() as u64
-        });
-        let (m, p, x) = percentiles(&mut timer);
-        println!("| {name} | {} | timer (two clock reads) | | | | {m} / {p} / {x} | | | | | | |", opt.k);
+        if let Some((thesis, secs)) = &thesis {
+            variants.push((
+                "thesis",
+                "thesis-style 6D (r/sqrt 2)".into(),
+                thesis,
+                *secs,
+                Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
+            ));
+        }
+        for c in [Some(Clock::Instant), tsc].into_iter().flatten() {
+            let (m, p, x) = percentiles(&fastest_of_passes(&fine, |f| c.time(|| f)));
+            println!("| {name} | {} | timer: {} (two reads) | | | | {m} / {p} / {x} | | | | | | |", opt.k, c.name());
+        }
+        let shared_wanted = wants("shared") || wants("shared-sub");
         let (mut d6, mut sub_table): (Option<Table>, Option<Table>) = (None, None);
-        for (label, space, secs, build) in &variants {
+        let mut notes = vec![];
+        for (key, label, space, secs, build) in &variants {
+            // The 6-D table is the shared tables' reference: built (not reported) when only they are asked for.
+            let report = wants(key);
+            if !(report || *key == "6d" && shared_wanted) {
+                continue;
+            }
             let start = Instant::now();
             let table = build(space).expect("build");
             let build_secs = secs + start.elapsed().as_secs_f64();
-            let (mut tp, mut tn, mut fp, mut fn_) = (0u64, 0u64, 0u64, 0u64);
-            for c in &configs {
-                let Some(f) = c.fine else { continue };
-                match (table.query(query_cell(&table, f, fine_levels)), c.collides) {
-                    (true, true) => tp += 1,
-                    (false, false) => tn += 1,
-                    (true, false) => fp += 1,
-                    (false, true) => fn_ += 1,
+            if report {
+                let (mut tp, mut tn, mut fp, mut fn_) = (0u64, 0u64, 0u64, 0u64);
+                for c in &configs {
+                    let Some(f) = c.fine else { continue };
+                    match (table.query(query_cell(&table, f, fine_levels)), c.collides) {
+                        (true, true) => tp += 1,
+                        (false, false) => tn += 1,
+                        (true, false) => fp += 1,
+                        (false, true) => fn_ += 1,
+                    }
                 }
-            }
-            let is_shared = matches!(table, Table::Shared(_)) && table.sub_levels() == 0;
-            let cold = if is_shared { opt.cold_shared } else { opt.cold };
-            let cells: Vec<[u16; 6]> = fine.iter().map(|&f| query_cell(&table, f, fine_levels)).collect();
-            let (w, f) = time_queries(&table, &cells, cold);
-            let flushed = if f.2 == 0 {
-                "n/a".into()
-            } else {
-                format!("{} / {} / {} ({})", f.0, f.1, f.2, cold.min(cells.len()))
-            };
-            let accuracy = 100.0 * (tp + tn) as f64 / (tp + tn + fp + fn_).max(1) as f64;
-            println!(
-                "| {name} | {} | {label} | {} | {} | {build_secs:.2} | {} / {} / {} | {flushed} | {tp} | {tn} | {fp} | {fn_} | {accuracy:.2} % |",
-                opt.k,
-                contents(&table),
-                table.memory_bytes(),
-                w.0,
-                w.1,
-                w.2
-            );
-            if !label.starts_with("thesis") {
-                assert_eq!(fn_, 0, "{name} {label}: a false negative on a certified table");
+                let is_shared = matches!(table, Table::Shared(_)) && table.sub_levels() == 0;
+                let cold = if is_shared { opt.cold_shared } else { opt.cold };
+                let cells: Vec<[u16; 6]> = fine.iter().map(|&f| query_cell(&table, f, fine_levels)).collect();
+                let cold = cold.min(cells.len());
+                let peer = match &table {
+                    Table::Shared(t) => Some(SeparateArrays::new(t)),
+                    _ => None,
+                };
+                let [(warm, flushed), peer_times] = match &peer {
+                    Some(peer) => {
+                        // The previous layout answers as the table on every configuration.
+                        for &c in &cells {
+                            assert_eq!(peer.query(c), table.query(c), "{name} {label}: previous layout at {c:?}");
+                        }
+                        time_with_peer(clock, &table, peer, &cells, cold)
+                    }
+                    None => [time_queries(clock, &table, &cells, cold), (vec![], vec![])],
+                };
+                let (w, f) = timing_cells(&warm, &flushed, cold);
+                let accuracy = 100.0 * (tp + tn) as f64 / (tp + tn + fp + fn_).max(1) as f64;
+                println!(
+                    "| {name} | {} | {label} | {} | {} | {build_secs:.2} | {w} | {f} | {tp} | {tn} | {fp} | {fn_} | {accuracy:.2} % |",
+                    opt.k,
+                    contents(&table),
+                    table.memory_bytes(),
+                );
+                if let Some(peer) = &peer {
+                    let (w, f) = timing_cells(&peer_times.0, &peer_times.1, cold);
+                    println!(
+                        "| {name} | {} | {label}, previous layout (same run, taking turns) | | {} | | {w} | {f} | | | | | |",
+                        opt.k,
+                        peer.memory_bytes(),
+                    );
+                }
+                if !label.starts_with("thesis") {
+                    assert_eq!(fn_, 0, "{name} {label}: a false negative on a certified table");
+                }
+                if opt.slowest > 0 {
+                    notes.extend(slowest_report(clock, &table, &cells, &warm, opt.slowest));
+                }
             }
             // The plain table of the sub-cell labels answers as the subdivided table does.
             if let (Some(subdivided), true) = (&sub_table, label.contains("sub-cell labels")) {
@@ -373,6 +530,9 @@ fn main() {
                 "| {name} | {} | ({outside} configurations outside the sampled grid: exact check) | | | | | | | | |",
                 opt.k
             );
+        }
+        for n in notes {
+            println!("{name}: {n}");
         }
     }
     if opt.smoke {

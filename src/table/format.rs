@@ -23,7 +23,9 @@
 //!              section 2: 5D intervals [begin, end] u8 pairs / 4D slice words u64; 6D none
 //!              variant 7: section 0 = node masks [nonuniform, collision] then leaves (u64);
 //!              section 1 = depth starts (levels entries) then per-node bases (u32);
-//!              section 2 = child indices (u32)
+//!              section 2 = child indices (u32); nodes of each depth numbered in the
+//!              order a depth-first descent first reaches them, bases the running counts
+//!              (as written; loading lays them out again for the query, `shared6d::pool`)
 //!    end-8  8  FNV-1a 64 of every byte before it
 //! ```
 //! Loading checks magic, endianness and version first (so those errors are specific), then
@@ -131,8 +133,8 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
         }
         Table::Shared(q) => {
             let p = q.parts();
-            owned = p.masks.iter().flatten().chain(p.leaves).copied().collect();
-            let aux = p.depth_start.iter().chain(p.bases).copied().collect();
+            owned = p.masks.iter().flatten().chain(&p.leaves).copied().collect();
+            let aux = p.depth_start.iter().chain(&p.bases).copied().collect();
             (7, 0, 0, &owned[..], aux, p.children.to_u32().iter().flat_map(|c| c.to_le_bytes()).collect())
         }
     };

@@ -57,6 +57,11 @@ pub struct TableChecker {
     models: [RobotModel; 2],
     origins: [Vec3; 2],
     sampled: [SampledCells; 2],
+    /// The query resolution, fixed by the table: `2^sub_levels` cells per grid cell and axis,
+    /// cells per axis at it, and their side (mm).
+    sub_levels: u32,
+    query_k: f64,
+    query_r: f64,
     exact: ExactChecker,
     fallbacks: u64,
 }
@@ -87,10 +92,14 @@ impl TableChecker {
                 what: "header r / grid origins disagree with its workspace and k".into(),
             });
         }
+        let sub_levels = table.sub_levels();
         Ok(TableChecker {
             models: [cell.robots[0].model, cell.robots[1].model],
             origins: [grid_a.origin, grid_b.origin],
             sampled: [SampledCells::new(&grid_a), SampledCells::new(&grid_b)],
+            sub_levels,
+            query_k: f64::from(k << sub_levels),
+            query_r: header.r / f64::from(1u32 << sub_levels),
             exact: ExactChecker::new(cell),
             header,
             table,
@@ -116,18 +125,15 @@ impl TableChecker {
     /// The cell of robot `j`'s TCP at the table's query resolution (`2^sub_levels` per grid
     /// cell and axis), or `None` when its grid cell is not sampled.
     fn cell_of(&self, j: usize, tcp: &Vec3) -> Option<[u16; 3]> {
-        let sub = self.table.sub_levels();
-        let kq = f64::from(self.sampled[j].k as u32 * (1 << sub));
-        let rq = self.header.r / f64::from(1u32 << sub);
         let mut c = [0u16; 3];
         for (a, ci) in c.iter_mut().enumerate() {
-            let u = float::floor((tcp[a] - self.origins[j][a]) / rq);
-            if !(u >= 0.0 && u < kq) {
+            let u = float::floor((tcp[a] - self.origins[j][a]) / self.query_r);
+            if !(u >= 0.0 && u < self.query_k) {
                 return None;
             }
             *ci = u as u16;
         }
-        self.sampled[j].contains(c.map(|v| v >> sub)).then_some(c)
+        self.sampled[j].contains(c.map(|v| v >> self.sub_levels)).then_some(c)
     }
 
     /// Answers one tick; `tcps_mcs[j]` is robot j's TCP in its own MCS.

@@ -136,14 +136,7 @@ impl Table {
                 let (codes, slice_of, slices) = t.parts();
                 vec![region(codes), region(slice_of), region(slices)]
             }
-            Table::Shared(t) => {
-                let p = t.parts();
-                let children = match p.children {
-                    shared6d::ChildIndices::Narrow(v) => region(v),
-                    shared6d::ChildIndices::Wide(v) => region(v),
-                };
-                vec![region(p.masks), region(p.bases), region(p.depth_start), children, region(p.leaves)]
-            }
+            Table::Shared(t) => vec![t.memory_region()],
         }
     }
 

@@ -1,0 +1,149 @@
+//! Timing for `table_report`: the clocks (with their floor measured in the same run), cache
+//! flushing, and passes that keep each query's fastest time.
+
+use std::hint::black_box;
+use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+use std::time::Instant;
+
+/// Evicts every cache line of `regions` (x86-64 `clflush`), then waits for it.
+#[cfg(target_arch = "x86_64")]
+pub fn flush(regions: &[(usize, usize)]) {
+    use std::arch::x86_64::{_mm_clflush, _mm_mfence};
+    for &(addr, len) in regions {
+        let mut line = addr & !63;
+        while line < addr + len {
+            // SAFETY: `line` is the start of a cache line that holds bytes of a live array of
+            // the table (`memory_regions`), which outlives this call; clflush reads no data
+            // and changes no value, it only writes the line back and evicts it.
+            unsafe { _mm_clflush(line as *const u8) };
+            line += 64;
+        }
+    }
+    // SAFETY: sse2 is part of the x86-64 baseline; a fence has no other precondition.
+    unsafe { _mm_mfence() };
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+pub fn flush(_regions: &[(usize, usize)]) {}
+
+/// The time stamp counter between two `lfence`s: no earlier instruction is still running
+/// when it is read, and no later one has started.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn tsc() -> u64 {
+    use std::arch::x86_64::{_mm_lfence, _rdtsc};
+    // SAFETY: rdtsc and lfence (sse2) are part of the x86-64 baseline; they read a counter
+    // and order instructions, touching no memory.
+    unsafe {
+        _mm_lfence();
+        let t = _rdtsc();
+        _mm_lfence();
+        t
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+pub fn tsc() -> u64 {
+    0
+}
+
+/// The clock of the query timings.
+#[derive(Clone, Copy, Debug)]
+pub enum Clock {
+    /// `Instant::now` (on Linux the vDSO `clock_gettime`).
+    Instant,
+    /// [`tsc`] at `ns_per_tick`, calibrated against `Instant`.
+    Tsc { ns_per_tick: f64 },
+}
+
+impl Clock {
+    /// The time stamp counter, calibrated over 200 ms against `Instant` (x86-64 only; the
+    /// invariant TSC of current CPUs runs at a constant rate).
+    pub fn tsc() -> Option<Clock> {
+        if !cfg!(target_arch = "x86_64") {
+            return None;
+        }
+        let (i0, t0) = (Instant::now(), tsc());
+        while i0.elapsed().as_millis() < 200 {}
+        let (ns, t1) = (i0.elapsed().as_nanos(), tsc());
+        Some(Clock::Tsc { ns_per_tick: ns as f64 / t1.wrapping_sub(t0) as f64 })
+    }
+
+    /// Nanoseconds `f` takes, with the cost of reading the clock twice (the timer row).
+    #[inline(always)]
+    pub fn time<R>(self, f: impl FnOnce() -> R) -> u64 {
+        match self {
+            Clock::Instant => {
+                let start = Instant::now();
+                black_box(f());
+                start.elapsed().as_nanos() as u64
+            }
+            Clock::Tsc { ns_per_tick } => {
+                let t0 = tsc();
+                black_box(f());
+                let t1 = tsc();
+                (t1.wrapping_sub(t0) as f64 * ns_per_tick).round() as u64
+            }
+        }
+    }
+
+    pub fn name(self) -> String {
+        match self {
+            Clock::Instant => "Instant".into(),
+            Clock::Tsc { ns_per_tick } => format!("rdtsc+lfence, {:.3} GHz", 1.0 / ns_per_tick),
+        }
+    }
+}
+
+/// Median, p99.9 and maximum of `ns`.
+pub fn percentiles(ns: &[u64]) -> (u64, u64, u64) {
+    if ns.is_empty() {
+        return (0, 0, 0);
+    }
+    let mut ns = ns.to_vec();
+    ns.sort_unstable();
+    let at = |q: f64| ns[((ns.len() - 1) as f64 * q).round() as usize];
+    (at(0.5), at(0.999), ns[ns.len() - 1])
+}
+
+/// Passes over the queries (3 unless `--passes` says otherwise); each query keeps its fastest
+/// pass: the query's own cost without the interrupts and preemptions of a shared machine
+/// (single readings reach milliseconds, and an interrupt rarely hits the same query in every
+/// pass; on a loaded machine more passes filter more, see the timer rows).
+pub static PASSES: AtomicUsize = AtomicUsize::new(3);
+
+/// Per query, the fastest of [`PASSES`] passes over all of `cells`.
+pub fn fastest_of_passes(cells: &[[u16; 6]], mut time: impl FnMut([u16; 6]) -> u64) -> Vec<u64> {
+    let mut best = vec![u64::MAX; cells.len()];
+    for _ in 0..PASSES.load(Relaxed) {
+        for (b, &c) in best.iter_mut().zip(cells) {
+            *b = (*b).min(time(c));
+        }
+    }
+    best
+}
+
+/// Queries per turn when two layouts take turns within a pass.
+pub const TURN: usize = 1 << 20;
+
+/// Per query, the fastest of [`PASSES`] passes of `a` and of `b`, which take turns every
+/// [`TURN`] queries, so that both see the same machine (the load of a shared machine changes
+/// by the second).
+pub fn fastest_of_passes_in_turns(
+    cells: &[[u16; 6]],
+    mut a: impl FnMut([u16; 6]) -> u64,
+    mut b: impl FnMut([u16; 6]) -> u64,
+) -> (Vec<u64>, Vec<u64>) {
+    let (mut best_a, mut best_b) = (vec![u64::MAX; cells.len()], vec![u64::MAX; cells.len()]);
+    for _ in 0..PASSES.load(Relaxed) {
+        for ((ba, bb), cs) in best_a.chunks_mut(TURN).zip(best_b.chunks_mut(TURN)).zip(cells.chunks(TURN)) {
+            for (t, &c) in ba.iter_mut().zip(cs) {
+                *t = (*t).min(a(c));
+            }
+            for (t, &c) in bb.iter_mut().zip(cs) {
+                *t = (*t).min(b(c));
+            }
+        }
+    }
+    (best_a, best_b)
+}
