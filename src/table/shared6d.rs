@@ -41,7 +41,7 @@ use super::space::fold;
 use super::space::SpaceView;
 #[cfg(feature = "std")]
 use crate::cspace::{Label, LabelledSpace, SubCells};
-use alloc::{format, vec::Vec};
+use alloc::{format, vec, vec::Vec};
 #[cfg(feature = "std")]
 use std::collections::HashMap;
 
