@@ -322,7 +322,8 @@ fn contents(table: &Table) -> String {
         Table::Shared(q) => {
             let per_depth = q.nodes_per_depth();
             let depths: Vec<String> = per_depth.iter().map(|n| n.to_string()).collect();
-            format!("{} nodes ({}; {}-bit slots)", per_depth.iter().sum::<usize>(), depths.join("/"), q.slot_bits())
+            let bits: Vec<String> = q.slot_bits().iter().map(|b| b.to_string()).collect();
+            format!("{} nodes ({}; slot bits {})", per_depth.iter().sum::<usize>(), depths.join("/"), bits.join("/"))
         }
     }
 }
