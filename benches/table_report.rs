@@ -43,7 +43,6 @@ mod timing;
 
 use shared_peer::SeparateArrays;
 use std::collections::HashSet;
-use std::hint::black_box;
 use std::time::Instant;
 use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, percentiles, Clock};
 
@@ -191,8 +190,12 @@ fn query_ns(clock: Clock, table: &Table, cell: [u16; 6], regions: Option<&[(usiz
     if let Some(r) = regions {
         flush(r);
     }
-    clock.time(|| table.query(black_box(cell)))
+    clock.time(cell, |c| table.query(c))
 }
+
+/// Untimed queries that re-warm a layout at the start of its turn (more than its lines and
+/// pages: a T3 table at k = 32 has about 6,000 lines and 93 pages).
+const WARM_UP: usize = 1 << 16;
 
 /// As [`time_queries`] for a shared table and its previous layout, taking turns: (warm,
 /// flushed) of the table, then of the peer.
@@ -205,18 +208,20 @@ fn time_with_peer(
 ) -> [(Vec<u64>, Vec<u64>); 2] {
     let (warm, warm_peer) = fastest_of_passes_in_turns(
         cells,
+        WARM_UP,
         |c| query_ns(clock, table, c, None),
-        |c| clock.time(|| peer.query(black_box(c))),
+        |c| clock.time(c, |c| peer.query(c)),
     );
     let (regions, peer_regions) = (table.memory_regions(), peer.memory_regions());
     let cold_cells = &cells[..cold.min(cells.len())];
     let (flushed, flushed_peer) = if cfg!(target_arch = "x86_64") {
         fastest_of_passes_in_turns(
             cold_cells,
+            0,
             |c| query_ns(clock, table, c, Some(&regions)),
             |c| {
                 flush(&peer_regions);
-                clock.time(|| peer.query(black_box(c)))
+                clock.time(c, |c| peer.query(c))
             },
         )
     } else {
@@ -289,7 +294,7 @@ fn slowest_report(clock: Clock, table: &Table, cells: &[[u16; 6]], warm: &[u64],
         let (hot, hot_med) = min_median(101, || query_ns(clock, table, cells[i], None));
         let (cold, cold_med) = min_median(11, || query_ns(clock, table, cells[i], Some(&regions)));
         out.push(format!(
-            "  {:?} warm {} ns: {steps} steps, {reads} reads, {lines} lines, {pages} pages; alone hot min/median {hot} / {hot_med} ns, flushed {cold} / {cold_med} ns",
+            "  #{i} {:?} warm {} ns: {steps} steps, {reads} reads, {lines} lines, {pages} pages; alone hot min/median {hot} / {hot_med} ns, flushed {cold} / {cold_med} ns",
             cells[i], warm[i]
         ));
     }
@@ -318,7 +323,8 @@ fn contents(table: &Table) -> String {
         Table::Shared(q) => {
             let per_depth = q.nodes_per_depth();
             let depths: Vec<String> = per_depth.iter().map(|n| n.to_string()).collect();
-            format!("{} nodes ({}; {}-bit slots)", per_depth.iter().sum::<usize>(), depths.join("/"), q.slot_bits())
+            let bits: Vec<String> = q.slot_bits().iter().map(|b| b.to_string()).collect();
+            format!("{} nodes ({}; slot bits {})", per_depth.iter().sum::<usize>(), depths.join("/"), bits.join("/"))
         }
     }
 }
@@ -432,7 +438,7 @@ fn main() {
             ));
         }
         for c in [Some(Clock::Instant), tsc].into_iter().flatten() {
-            let (m, p, x) = percentiles(&fastest_of_passes(&fine, |f| c.time(|| f)));
+            let (m, p, x) = percentiles(&fastest_of_passes(&fine, |f| c.time(f, |f| f)));
             println!("| {name} | {} | timer: {} (two reads) | | | | {m} / {p} / {x} | | | | | | |", opt.k, c.name());
         }
         let shared_wanted = wants("shared") || wants("shared-sub");

@@ -69,18 +69,21 @@ impl Clock {
         Some(Clock::Tsc { ns_per_tick: ns as f64 / t1.wrapping_sub(t0) as f64 })
     }
 
-    /// Nanoseconds `f` takes, with the cost of reading the clock twice (the timer row).
+    /// Nanoseconds `f(input)` takes, with the cost of reading the clock twice (the timer
+    /// row). `input` is in a register before the clock starts: a load of it that misses
+    /// (the first query of each page of a streamed input array) is not timed.
     #[inline(always)]
-    pub fn time<R>(self, f: impl FnOnce() -> R) -> u64 {
+    pub fn time<T, R>(self, input: T, f: impl FnOnce(T) -> R) -> u64 {
+        let input = black_box(input);
         match self {
             Clock::Instant => {
                 let start = Instant::now();
-                black_box(f());
+                black_box(f(input));
                 start.elapsed().as_nanos() as u64
             }
             Clock::Tsc { ns_per_tick } => {
                 let t0 = tsc();
-                black_box(f());
+                black_box(f(input));
                 let t1 = tsc();
                 (t1.wrapping_sub(t0) as f64 * ns_per_tick).round() as u64
             }
@@ -128,18 +131,31 @@ pub const TURN: usize = 1 << 20;
 
 /// Per query, the fastest of [`PASSES`] passes of `a` and of `b`, which take turns every
 /// [`TURN`] queries, so that both see the same machine (the load of a shared machine changes
-/// by the second).
+/// by the second). With `warm_up`, each turn first repeats, untimed, the `warm_up` queries
+/// before it: the other layout's turn evicted this one from the caches and the TLB, which
+/// would otherwise make the first queries of every turn the slowest of the run.
 pub fn fastest_of_passes_in_turns(
     cells: &[[u16; 6]],
+    warm_up: usize,
     mut a: impl FnMut([u16; 6]) -> u64,
     mut b: impl FnMut([u16; 6]) -> u64,
 ) -> (Vec<u64>, Vec<u64>) {
     let (mut best_a, mut best_b) = (vec![u64::MAX; cells.len()], vec![u64::MAX; cells.len()]);
-    for _ in 0..PASSES.load(Relaxed) {
-        for ((ba, bb), cs) in best_a.chunks_mut(TURN).zip(best_b.chunks_mut(TURN)).zip(cells.chunks(TURN)) {
+    for pass in 0..PASSES.load(Relaxed) {
+        for (turn, (ba, bb)) in best_a.chunks_mut(TURN).zip(best_b.chunks_mut(TURN)).enumerate() {
+            let start = turn * TURN;
+            // Before the first turn of a later pass: the end of the pass before.
+            let before = match (start, pass) {
+                (0, 0) => &cells[..0],
+                (0, _) => &cells[cells.len().saturating_sub(warm_up)..],
+                _ => &cells[start.saturating_sub(warm_up)..start],
+            };
+            let cs = &cells[start..start + ba.len()];
+            before.iter().for_each(|&c| _ = black_box(a(c)));
             for (t, &c) in ba.iter_mut().zip(cs) {
                 *t = (*t).min(a(c));
             }
+            before.iter().for_each(|&c| _ = black_box(b(c)));
             for (t, &c) in bb.iter_mut().zip(cs) {
                 *t = (*t).min(b(c));
             }

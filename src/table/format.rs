@@ -23,9 +23,8 @@
 //!              section 2: 5D intervals [begin, end] u8 pairs / 4D slice words u64; 6D none
 //!              variant 7: section 0 = node masks [nonuniform, collision] then leaves (u64);
 //!              section 1 = depth starts (levels entries) then per-node bases (u32);
-//!              section 2 = child indices (u32); nodes of each depth numbered in the
-//!              order a depth-first descent first reaches them, bases the running counts
-//!              (as written; loading lays them out again for the query, `shared6d::pool`)
+//!              section 2 = child indices (u32); bases are the running counts (as
+//!              written; loading lays the nodes out again for the query, `shared6d/pool.rs`)
 //!    end-8  8  FNV-1a 64 of every byte before it
 //! ```
 //! Loading checks magic, endianness and version first (so those errors are specific), then

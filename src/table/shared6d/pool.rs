@@ -1,41 +1,37 @@
 //! The query layout of the shared 6-D quadtree: one array of `u64` words that a query descends
-//! with one cache line per node step, each node next to its first parent (issue 4: "median
-//! under 50 ns, maximum within 10x").
+//! with about one cache line per node step (issue 4: "median under 50 ns, maximum within 10x").
 //!
 //! # Layout
 //! ```text
-//! [top table][root record, then every node once, in the order the descent first reaches it]
+//! [top table][records of depth 0][depth 1]...[depth depths-1][leaves]
 //! ```
 //! - *Top table*: the first `top_depths` inner depths ([`TOP_DEPTHS`], or 1 for a 2-level
 //!   grid) resolved at once: one slot per combination of their child indices
 //!   (`64^top_depths` slots; half when symmetric, since a folded query always has A's top `y`
-//!   bit set). A slot is 0 (free),
-//!   1 (collision), or the word of the node it reaches (never 0 or 1: the top table comes
-//!   first).
+//!   bit set). A slot is 0 (free), 1 (collision), or `2 + r` for the node at word
+//!   `region[top_depths] + r`.
 //! - *Record* of an inner node: `nonuniform`, `collision`, then one slot per non-uniform child
-//!   (`popcount` order) holding the child's word, packed into the following words and padded
-//!   to a word.
+//!   (`popcount` order), packed into the following words and padded to a word. A slot holds
+//!   the child's word offset from the start of the next depth's region (inner depths) or its
+//!   leaf index. Records sit depth by depth in the order of [`SharedParts`] (the order in
+//!   which a depth-first descent first reaches them, as `build` numbers them), so that the
+//!   leaves of one node lie side by side; the records of the depths under the top table are
+//!   kept for [`Pool::arrays`] but never read by a query.
 //! - *Leaf*: one word, bit `i` for child cell `i`.
 //!
-//! Nodes are placed depth first (a node, then the subtree of each child not placed yet, in
-//! child order), so that a node that has one parent (all inner nodes but a few, three
-//! quarters of the leaves at k = 32) lies right after its parent's record or its siblings:
-//! the last node step and its leaf share a cache line or its neighbour and one page. The
-//! records above the top table are kept (for [`Pool::arrays`]) but never read by a query.
+//! The slots of each depth are `u16` when every offset into the next region fits, else
+//! `u32`, four or two to a word, lowest bits first (so a table is as narrow as its stored
+//! child indices were, at the leaves, which hold most slots). One node step reads the
+//! record's masks and then one slot of the same record, 16 to 272 bytes on: the same cache
+//! line for a small rank, its neighbour otherwise. Reading the stored arrays directly (masks,
+//! bases and child indices apart) took three lines per step and, at k = 32, nine dependent
+//! reads instead of six.
 //!
-//! Slots are `u16` when every word index fits, else `u32`, four or two to a word, lowest bits
-//! first. A query reads one top slot, then per node step the record's masks and one slot of
-//! the same record, then one leaf. The old layout (masks, bases and child indices in three
-//! arrays, nodes depth by depth) read three lines per step and nine dependent reads at k = 32.
-//!
-//! # Order
-//! [`Pool::arrays`] gives the canonical arrays back by walking the layout, numbering the
-//! nodes of each depth in the order the descent first reaches them: the order `build` gives
-//! them, which [`check_order`] requires of stored parts.
+//! [`SharedParts`]: super::SharedParts
 
 use super::child_index;
 use crate::table::code::MAX_LEVELS;
-use alloc::{format, string::String, vec, vec::Vec};
+use alloc::{vec, vec::Vec};
 
 /// Per-depth arrays hold at most this many entries (inner depths, plus one).
 const DEPTH_SLOTS: usize = MAX_LEVELS as usize + 1;
@@ -49,17 +45,22 @@ const TOP_DEPTHS: u32 = 2;
 /// The query layout (see the module doc).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(super) struct Pool {
-    /// Top table, then the nodes.
+    /// Top table, records, leaves.
     words: Vec<u64>,
-    /// 16 or 32.
-    slot_bits: u32,
+    /// Bit `d`: the slots of depth `d`'s records (and of the top table, for
+    /// `d = top_depths - 1`) are 32-bit, else 16-bit.
+    wide: u32,
     /// Inner depths resolved by the top table.
     top_depths: u32,
     /// Inner depths (`levels + sub_levels - 1`).
     depths: u32,
     symmetric: bool,
-    /// Inner nodes per depth, then leaves.
-    counts: [u32; DEPTH_SLOTS],
+    /// Word where the records of each inner depth start, then the leaves, then the end.
+    region: [u32; DEPTH_SLOTS + 1],
+    /// First node of each inner depth, then the inner node count (as [`SharedParts`] has it).
+    ///
+    /// [`SharedParts`]: super::SharedParts
+    depth_start: [u32; DEPTH_SLOTS],
 }
 
 /// The canonical arrays: masks, bases, depth starts, child indices, leaves.
@@ -72,207 +73,139 @@ fn slot<const BITS: u32>(words: &[u64], word: usize, i: usize) -> usize {
     (words[word + i / per] >> (BITS as usize * (i % per)) & ((1u64 << BITS) - 1)) as usize
 }
 
-/// Packs `values` into `out` from word 0 on, `bits` each, lowest first.
-fn pack(out: &mut [u64], values: impl IntoIterator<Item = u64>, bits: u32) {
-    let per = (64 / bits) as usize;
-    for (i, v) in values.into_iter().enumerate() {
-        out[i / per] |= v << (bits as usize * (i % per));
+/// Slot `i` from word `word` on, 32-bit when `wide`, else 16-bit.
+#[inline(always)]
+fn slot_of(words: &[u64], wide: bool, word: usize, i: usize) -> usize {
+    if wide {
+        slot::<32>(words, word, i)
+    } else {
+        slot::<16>(words, word, i)
     }
 }
 
-/// Words of a record with `n` child slots.
+/// Packs `values` into words appended to `out`, `bits` each, lowest first.
+fn pack(out: &mut Vec<u64>, values: impl IntoIterator<Item = u64>, bits: u32) {
+    let per = 64 / bits;
+    for (i, v) in values.into_iter().enumerate() {
+        if i as u32 % per == 0 {
+            out.push(0);
+        }
+        *out.last_mut().expect("pushed") |= v << (bits * (i as u32 % per));
+    }
+}
+
+/// Words of a record with `n` child slots of `bits` bits.
 fn record_words(n: usize, bits: u32) -> usize {
     2 + n.div_ceil((64 / bits) as usize)
 }
 
-/// A node of the canonical arrays: inner (depth, global index) or leaf (index).
-#[derive(Clone, Copy)]
-enum Node {
-    Inner(usize, usize),
-    Leaf(usize),
-}
-
-/// Visits the canonical arrays depth first from the root (a node, then each child not yet
-/// visited, in child order), calling `first(node)` at each node's first visit.
-fn depth_first(a: &Arrays, depths: usize, first: &mut impl FnMut(Node)) {
-    let (masks, _, depth_start, _, leaves) = a;
-    let mut seen_inner = vec![false; masks.len()];
-    let mut seen_leaf = vec![false; leaves.len()];
-    visit(a, depths, 0, 0, &mut seen_inner, &mut seen_leaf, first);
-    debug_assert!(depth_start[0] == 0);
-}
-
-fn visit(
-    a: &Arrays,
-    depths: usize,
-    d: usize,
-    node: usize,
-    seen_inner: &mut [bool],
-    seen_leaf: &mut [bool],
-    first: &mut impl FnMut(Node),
-) {
-    let (masks, bases, depth_start, children, _) = a;
-    seen_inner[node] = true;
-    first(Node::Inner(d, node));
-    let n = masks[node][0].count_ones() as usize;
-    for &id in &children[bases[node] as usize..][..n] {
-        if d + 1 < depths {
-            let child = (depth_start[d + 1] + id) as usize;
-            if !seen_inner[child] {
-                visit(a, depths, d + 1, child, seen_inner, seen_leaf, first);
-            }
-        } else if !seen_leaf[id as usize] {
-            seen_leaf[id as usize] = true;
-            first(Node::Leaf(id as usize));
-        }
-    }
-}
-
-/// Whether bounds-checked canonical arrays number the nodes of each depth in the order the
-/// descent first reaches them, and reach them all (see the module doc).
-///
-/// # Errors
-/// The first node out of order, or the first depth with a node never reached.
-pub(super) fn check_order(a: &Arrays, depths: usize) -> Result<(), String> {
-    let (_, _, depth_start, _, leaves) = a;
-    // Next expected index per depth (global for inner depths), leaves last.
-    let mut next: Vec<usize> = depth_start[..depths].iter().map(|&s| s as usize).collect();
-    next.push(0);
-    let mut bad = None;
-    depth_first(a, depths, &mut |n| {
-        let (d, i) = match n {
-            Node::Inner(d, i) => (d, i),
-            Node::Leaf(i) => (depths, i),
-        };
-        if bad.is_none() && i != next[d] {
-            bad = Some(format!("depth {d}: node {i} is reached first where node {} is due", next[d]));
-        }
-        next[d] += 1;
-    });
-    if let Some(e) = bad {
-        return Err(
-            e + "; nodes must be numbered in the order the descent first reaches them (as `build` numbers them)"
-        );
-    }
-    let ends = depth_start[1..=depths].iter().map(|&s| s as usize).chain([leaves.len()]);
-    match next.iter().zip(ends).position(|(&n, end)| n != end) {
-        Some(d) => Err(format!("depth {d}: some nodes are never reached from the root")),
-        None => Ok(()),
-    }
+/// Top-table slots: `64^top_depths`, half when symmetric.
+fn top_slots(top_depths: u32, symmetric: bool) -> usize {
+    (64usize << (6 * (top_depths - 1))) >> usize::from(symmetric)
 }
 
 impl Pool {
-    /// The layout of canonical arrays that passed [`check_order`] (see
-    /// [`super::SharedQuadtree6d::from_parts`]).
+    /// The layout of validated canonical arrays (see [`super::SharedQuadtree6d::from_parts`]).
     pub(super) fn new(fine: u32, symmetric: bool, a: &Arrays) -> Pool {
-        Self::with_slots(fine, symmetric, a, 16)
-            .unwrap_or_else(|| Self::with_slots(fine, symmetric, a, 32).expect("a table of at most 2^32 words"))
+        Self::layout(fine, symmetric, a, false)
     }
 
-    /// The layout with `bits`-bit slots, or `None` when a word index does not fit.
-    fn with_slots(fine: u32, symmetric: bool, a: &Arrays, bits: u32) -> Option<Pool> {
+    /// As [`new`](Self::new) with every slot 32-bit.
+    #[cfg(test)]
+    fn all_wide(fine: u32, symmetric: bool, a: &Arrays) -> Pool {
+        Self::layout(fine, symmetric, a, true)
+    }
+
+    fn layout(fine: u32, symmetric: bool, a: &Arrays, all_wide: bool) -> Pool {
         let (masks, bases, depth_start, children, leaves) = a;
         let depths = fine - 1;
         let top_depths = depths.min(TOP_DEPTHS);
-        let top_slots = (64usize << (6 * (top_depths - 1))) >> usize::from(symmetric);
-        let top_words = top_slots.div_ceil((64 / bits) as usize);
-        // Where each node goes: depth first, right after the node placed before it.
-        let (mut inner_at, mut leaf_at) = (vec![0usize; masks.len()], vec![0usize; leaves.len()]);
-        let mut end = top_words;
-        depth_first(a, depths as usize, &mut |n| match n {
-            Node::Inner(_, i) => {
-                inner_at[i] = end;
-                end += record_words(masks[i][0].count_ones() as usize, bits);
+        // Slot widths, deepest first: a depth's slots are offsets into the next region,
+        // whose size depends on that depth's own width.
+        let (mut wide, mut next_len) = (0u32, leaves.len());
+        let mut rel = vec![0u32; masks.len()];
+        let mut region_len = [0usize; DEPTH_SLOTS];
+        for d in (0..depths as usize).rev() {
+            let top_entry = usize::from(d + 1 == top_depths as usize) * 2;
+            let bits = if !all_wide && next_len + top_entry <= 1 << 16 { 16 } else { 32 };
+            wide |= u32::from(bits == 32) << d;
+            let mut len = 0usize;
+            for node in depth_start[d] as usize..depth_start[d + 1] as usize {
+                rel[node] = u32::try_from(len).expect("a table of at most 2^32 words");
+                len += record_words(masks[node][0].count_ones() as usize, bits);
             }
-            Node::Leaf(i) => {
-                leaf_at[i] = end;
-                end += 1;
-            }
-        });
-        if (end as u64) > 1u64 << bits {
-            return None;
+            region_len[d] = len;
+            next_len = len;
         }
-        // The word of child `id` of a node of depth `d`.
+        let bits_of = |d: usize| if wide >> d & 1 == 1 { 32 } else { 16 };
+        let top_bits = bits_of(top_depths as usize - 1);
+        let mut region = [0u32; DEPTH_SLOTS + 1];
+        region[0] = top_slots(top_depths, symmetric).div_ceil((64 / top_bits) as usize) as u32;
+        for d in 0..depths as usize {
+            region[d + 1] = region[d] + region_len[d] as u32;
+        }
+        region[depths as usize + 1] = region[depths as usize] + leaves.len() as u32;
+        // The slot value of child `id` of a node of depth `d`.
         let target = |d: usize, id: u32| -> u64 {
             if d + 1 < depths as usize {
-                inner_at[(depth_start[d + 1] + id) as usize] as u64
+                u64::from(rel[(depth_start[d + 1] + id) as usize])
             } else {
-                leaf_at[id as usize] as u64
+                u64::from(id)
             }
         };
-        let mut words = vec![0u64; end];
-        pack(&mut words, top_entries(symmetric, top_depths, a, target), bits);
+        let mut words = Vec::with_capacity(region[depths as usize + 1] as usize);
+        pack(&mut words, top_entries(symmetric, top_depths, a, |d, id| 2 + target(d, id)), top_bits);
         for d in 0..depths as usize {
             for node in depth_start[d] as usize..depth_start[d + 1] as usize {
                 let [nonuniform, collision] = masks[node];
-                let at = inner_at[node];
-                words[at] = nonuniform;
-                words[at + 1] = collision;
+                words.extend([nonuniform, collision]);
                 let ids = &children[bases[node] as usize..][..nonuniform.count_ones() as usize];
-                pack(&mut words[at + 2..], ids.iter().map(|&id| target(d, id)), bits);
+                pack(&mut words, ids.iter().map(|&id| target(d, id)), bits_of(d));
             }
         }
-        for (leaf, &at) in leaves.iter().zip(&leaf_at) {
-            words[at] = *leaf;
-        }
-        let mut counts = [0u32; DEPTH_SLOTS];
-        for d in 0..depths as usize {
-            counts[d] = depth_start[d + 1] - depth_start[d];
-        }
-        counts[depths as usize] = leaves.len() as u32;
-        Some(Pool { words, slot_bits: bits, top_depths, depths, symmetric, counts })
+        words.extend_from_slice(leaves);
+        debug_assert_eq!(words.len(), region[depths as usize + 1] as usize);
+        let mut starts = [0u32; DEPTH_SLOTS];
+        starts[..depth_start.len()].copy_from_slice(depth_start);
+        Pool { words, wide, top_depths, depths, symmetric, region, depth_start: starts }
     }
 
-    /// The canonical arrays back (as the file stores them): the layout walked depth first,
-    /// each depth's nodes numbered in the order they are first reached.
+    /// Whether the slots of depth `d`'s records are 32-bit.
+    #[inline(always)]
+    fn is_wide(&self, d: u32) -> bool {
+        self.wide >> d & 1 == 1
+    }
+
+    /// The canonical arrays back (as the file stores them).
     pub(super) fn arrays(&self) -> Arrays {
         let depths = self.depths as usize;
-        let top_words = self.root();
-        // Per depth (leaves last): the words of its nodes in number order; per word, its number.
-        let mut order: Vec<Vec<usize>> = vec![vec![]; depths + 1];
-        let mut number = vec![u32::MAX; self.words.len()];
-        let mut stack = vec![(top_words, 0usize)];
-        // Depth first with an explicit stack: children pushed in reverse to pop in order.
-        while let Some((at, d)) = stack.pop() {
-            if number[at] != u32::MAX {
-                continue;
-            }
-            number[at] = order[d].len() as u32;
-            order[d].push(at);
-            if d < depths {
-                let n = self.words[at].count_ones() as usize;
-                for i in (0..n).rev() {
-                    stack.push((self.slot_at(at + 2, i), d + 1));
-                }
+        let (mut masks, mut bases, mut raw) = (vec![], vec![], vec![]);
+        // Per depth, the record offsets within its region, ascending.
+        let mut offsets: Vec<Vec<u32>> = vec![vec![]; depths];
+        for (d, offsets) in offsets.iter_mut().enumerate() {
+            let (wide, mut w) = (self.is_wide(d as u32), self.region[d] as usize);
+            for _ in self.depth_start[d]..self.depth_start[d + 1] {
+                let [nonuniform, collision] = [self.words[w], self.words[w + 1]];
+                offsets.push((w - self.region[d] as usize) as u32);
+                masks.push([nonuniform, collision]);
+                bases.push(raw.len() as u32);
+                let n = nonuniform.count_ones() as usize;
+                raw.extend((0..n).map(|i| slot_of(&self.words, wide, w + 2, i) as u32));
+                w += record_words(n, if wide { 32 } else { 16 });
             }
         }
-        let (mut masks, mut bases, mut children, mut depth_start) = (vec![], vec![], vec![], vec![]);
-        for level in &order[..depths] {
-            depth_start.push(masks.len() as u32);
-            for &at in level {
-                let nonuniform = self.words[at];
-                masks.push([nonuniform, self.words[at + 1]]);
-                bases.push(children.len() as u32);
-                children.extend((0..nonuniform.count_ones() as usize).map(|i| number[self.slot_at(at + 2, i)]));
+        // Slots of inner children are record offsets: back to indices within the depth.
+        let raw_len = raw.len();
+        let (mut children, count) = (raw, raw_len);
+        let base = |node: u32| bases.get(node as usize).map_or(count, |&b| b as usize);
+        for d in 0..depths.saturating_sub(1) {
+            let range = base(self.depth_start[d])..base(self.depth_start[d + 1]);
+            for c in &mut children[range] {
+                *c = offsets[d + 1].binary_search(c).expect("a record start") as u32;
             }
         }
-        depth_start.push(masks.len() as u32);
-        let leaves = order[depths].iter().map(|&at| self.words[at]).collect();
-        (masks, bases, depth_start, children, leaves)
-    }
-
-    /// The root record's word (right after the top table).
-    fn root(&self) -> usize {
-        let top_slots = (64usize << (6 * (self.top_depths - 1))) >> usize::from(self.symmetric);
-        top_slots.div_ceil((64 / self.slot_bits) as usize)
-    }
-
-    /// Slot `i` from word `word` on, at this pool's slot width.
-    fn slot_at(&self, word: usize, i: usize) -> usize {
-        match self.slot_bits {
-            16 => slot::<16>(&self.words, word, i),
-            _ => slot::<32>(&self.words, word, i),
-        }
+        let leaves = self.words[self.region[depths] as usize..].to_vec();
+        (masks, bases, self.depth_start[..=depths].to_vec(), children, leaves)
     }
 
     /// The top-table slot of the folded cell `c`.
@@ -285,26 +218,20 @@ impl Pool {
     /// Whether the folded cell `c` (indices below `2^fine`) is stored as collision.
     #[inline(always)]
     pub(super) fn query(&self, c: &[u16; 6], fine: u32) -> bool {
-        match self.slot_bits {
-            16 => self.descend::<16>(c, fine),
-            _ => self.descend::<32>(c, fine),
-        }
-    }
-
-    #[inline(always)]
-    fn descend<const BITS: u32>(&self, c: &[u16; 6], fine: u32) -> bool {
         let w = &self.words;
-        let mut node = slot::<BITS>(w, 0, self.top_index(c, fine));
-        if node < 2 {
-            return node == 1;
+        let entry = slot_of(w, self.is_wide(self.top_depths - 1), 0, self.top_index(c, fine));
+        if entry < 2 {
+            return entry == 1;
         }
+        let mut node = self.region[self.top_depths as usize] as usize + entry - 2;
         for d in self.top_depths..self.depths {
             let bit = 1u64 << child_index(c, fine - 1 - d);
             let (nonuniform, collision) = (w[node], w[node + 1]);
             if nonuniform & bit == 0 {
                 return collision & bit != 0;
             }
-            node = slot::<BITS>(w, node + 2, (nonuniform & (bit - 1)).count_ones() as usize);
+            let rank = (nonuniform & (bit - 1)).count_ones() as usize;
+            node = self.region[d as usize + 1] as usize + slot_of(w, self.is_wide(d), node + 2, rank);
         }
         w[node] >> child_index(c, 0) & 1 == 1
     }
@@ -313,15 +240,18 @@ impl Pool {
     pub(super) fn query_reads(&self, c: &[u16; 6], fine: u32) -> (bool, Vec<(usize, usize, u32)>) {
         let w = &self.words;
         let at = |i: usize| w.as_ptr() as usize + 8 * i;
-        let bytes = (self.slot_bits / 8) as usize;
-        let per = (64 / self.slot_bits) as usize;
-        let slot_addr = |word: usize, i: usize| at(word + i / per) + bytes * (i % per);
-        let top = self.top_index(c, fine);
-        let mut reads = vec![(slot_addr(0, top), bytes, 0)];
-        let mut node = self.slot_at(0, top);
-        if node < 2 {
-            return (node == 1, reads);
+        let slot_addr = |wide: bool, word: usize, i: usize| {
+            let (bytes, per) = if wide { (4, 2) } else { (2, 4) };
+            (at(word + i / per) + bytes * (i % per), bytes)
+        };
+        let (top, top_wide) = (self.top_index(c, fine), self.is_wide(self.top_depths - 1));
+        let (addr, bytes) = slot_addr(top_wide, 0, top);
+        let mut reads = vec![(addr, bytes, 0)];
+        let entry = slot_of(w, top_wide, 0, top);
+        if entry < 2 {
+            return (entry == 1, reads);
         }
+        let mut node = self.region[self.top_depths as usize] as usize + entry - 2;
         let mut step = 1;
         for d in self.top_depths..self.depths {
             let bit = 1u64 << child_index(c, fine - 1 - d);
@@ -331,8 +261,9 @@ impl Pool {
                 return (collision & bit != 0, reads);
             }
             let rank = (nonuniform & (bit - 1)).count_ones() as usize;
-            reads.push((slot_addr(node + 2, rank), bytes, step + 1));
-            node = self.slot_at(node + 2, rank);
+            let (addr, bytes) = slot_addr(self.is_wide(d), node + 2, rank);
+            reads.push((addr, bytes, step + 1));
+            node = self.region[d as usize + 1] as usize + slot_of(w, self.is_wide(d), node + 2, rank);
             step += 2;
         }
         reads.push((at(node), 8, step));
@@ -341,7 +272,10 @@ impl Pool {
 
     /// Inner nodes per depth, then the leaf count.
     pub(super) fn nodes_per_depth(&self) -> Vec<usize> {
-        self.counts[..=self.depths as usize].iter().map(|&n| n as usize).collect()
+        let d = self.depths as usize;
+        let mut v: Vec<usize> = self.depth_start[..=d].windows(2).map(|w| (w[1] - w[0]) as usize).collect();
+        v.push((self.region[d + 1] - self.region[d]) as usize);
+        v
     }
 
     /// The words a query reads.
@@ -349,9 +283,9 @@ impl Pool {
         &self.words
     }
 
-    /// Bits per slot (16 or 32).
-    pub(super) fn slot_bits(&self) -> u32 {
-        self.slot_bits
+    /// Bits per slot, per inner depth (16 or 32).
+    pub(super) fn slot_bits(&self) -> Vec<u32> {
+        (0..self.depths).map(|d| if self.is_wide(d) { 32 } else { 16 }).collect()
     }
 }
 
@@ -372,7 +306,7 @@ fn top_entries(symmetric: bool, top_depths: u32, a: &Arrays, node: impl Fn(usize
     let (masks, bases, depth_start, children, _) = a;
     let full_slots = 1usize << (6 * top_depths);
     let ay_bit = 6 * (top_depths as usize - 1) + 4;
-    let mut out = vec![0u64; full_slots >> usize::from(symmetric)];
+    let mut out = vec![0u64; top_slots(top_depths, symmetric)];
     for full in 0..full_slots {
         if symmetric && full >> ay_bit & 1 == 0 {
             continue;
@@ -454,8 +388,12 @@ mod tests {
             let t = SharedQuadtree6d::build(&space(levels, pattern), symmetric).unwrap();
             let p = t.parts();
             let a = (p.masks, p.bases, p.depth_start, p.children.to_u32(), p.leaves);
-            for bits in [16, 32] {
-                let pool = Pool::with_slots(levels, symmetric, &a, bits).unwrap();
+            for wide in [None, Some(u32::MAX)] {
+                let bits = if wide.is_some() { 32 } else { 16 };
+                let pool = match wide {
+                    None => Pool::new(levels, symmetric, &a),
+                    Some(_) => Pool::all_wide(levels, symmetric, &a),
+                };
                 assert_eq!(pool.arrays(), a, "{pattern:?} {levels} {bits}: arrays read back");
                 for cell in cells(levels, 1 << 20) {
                     let c = fold(cell, 1 << levels, symmetric).unwrap();
@@ -479,11 +417,11 @@ mod tests {
 
     #[test]
     fn slots_pack_lowest_first() {
-        let mut w = vec![0; 2];
+        let mut w = vec![];
         pack(&mut w, [1, 2, 3, 4, 5], 16);
         assert_eq!(w, vec![0x0004_0003_0002_0001, 5]);
         assert_eq!((0..5).map(|i| slot::<16>(&w, 0, i)).collect::<Vec<_>>(), [1, 2, 3, 4, 5]);
-        let mut w = vec![0; 2];
+        let mut w = vec![];
         pack(&mut w, [7, u64::from(u32::MAX), 9], 32);
         assert_eq!((0..3).map(|i| slot::<32>(&w, 0, i)).collect::<Vec<_>>(), [7, u32::MAX as usize, 9]);
     }
