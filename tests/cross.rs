@@ -20,7 +20,7 @@ mod native_libs;
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::Workspace;
 use delta_collide::table::{build_tables, to_bytes, Labelling, Variant};
-use native_libs::{CROSS_NATIVE_LIBS, NATIVE_LIBS};
+use native_libs::{native_static_libs, CROSS_NATIVE_LIBS, NATIVE_LIBS};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
@@ -116,15 +116,6 @@ fn requirements_met(test: &str, checks: &[Result<(), String>]) -> bool {
     assert!(!in_ci(), "{test} cannot be skipped on CI: {why} (.ci/run installs them)");
     println!("skipped: {test}: {why}");
     false
-}
-
-/// The libraries rustc names in its `native-static-libs` note.
-fn native_static_libs(log: &str) -> Vec<String> {
-    let line = log.lines().find_map(|l| l.split_once("native-static-libs:")).map(|(_, libs)| libs);
-    line.unwrap_or_else(|| panic!("no native-static-libs note in:\n{log}"))
-        .split_whitespace()
-        .map(str::to_owned)
-        .collect()
 }
 
 /// The e_machine field of an ELF file.

@@ -25,7 +25,7 @@ mod workload;
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::Workspace;
 use delta_collide::table::{build_tables, to_bytes, Labelling, SliceAxes, Variant};
-use native_libs::NATIVE_LIBS;
+use native_libs::{native_static_libs, NATIVE_LIBS};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
@@ -49,15 +49,6 @@ fn cargo_rustc(args: &[&str]) -> Output {
 
 fn text(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout)
-}
-
-/// The libraries rustc names in its `native-static-libs` note.
-fn native_static_libs(log: &str) -> Vec<String> {
-    let line = log.lines().find_map(|l| l.split_once("native-static-libs:")).map(|(_, libs)| libs);
-    line.unwrap_or_else(|| panic!("no native-static-libs note in:\n{log}"))
-        .split_whitespace()
-        .map(str::to_owned)
-        .collect()
 }
 
 #[test]

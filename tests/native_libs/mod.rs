@@ -14,3 +14,12 @@ pub const CROSS_NATIVE_LIBS: &[(&str, &[&str])] = &[
     ("aarch64-unknown-linux-gnu", &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"]),
     ("armv7-unknown-linux-gnueabihf", &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"]),
 ];
+
+/// The libraries rustc names in its `native-static-libs` note.
+pub fn native_static_libs(log: &str) -> Vec<String> {
+    let line = log.lines().find_map(|l| l.split_once("native-static-libs:")).map(|(_, libs)| libs);
+    line.unwrap_or_else(|| panic!("no native-static-libs note in:\n{log}"))
+        .split_whitespace()
+        .map(str::to_owned)
+        .collect()
+}
