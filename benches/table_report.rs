@@ -2,7 +2,8 @@
 //! cell, one certified labelling, then every variant built from it (and the thesis-style
 //! table from the thesis's `r / sqrt 2` labelling), each evaluated on the same random
 //! reachable configurations against the exact model (TP, TN, FP, FN) and timed per query,
-//! warm and with the table flushed from the caches before every query.
+//! in three regimes: hot, streamed and with the table flushed from the caches before every
+//! query.
 //!
 //! Run: `cargo bench --bench table_report -- [--cells T1,T2,T3] [--k 32] [--random 1000000]
 //! [--cold 100000] [--cold-shared 1000000] [--variants shared,...] [--timer instant|tsc]
@@ -11,16 +12,19 @@
 //! (default all; the 6-D table is built anyway when a shared one is, for the agreement check,
 //! and only labellings that a chosen table needs are made). `--timer tsc`: `rdtsc` between
 //! `lfence`s, converted to ns with a rate calibrated against `Instant` in the same run.
-//! `--slowest N`: for each shared table, the N slowest warm queries with the memory reads of
-//! their descent (dependent steps, cache lines, pages), re-timed one by one, and the warm
+//! `--slowest N`: for each shared table, the N slowest streamed queries with the memory reads
+//! of their descent (dependent steps, cache lines, pages), re-timed one by one, and the streamed
 //! times grouped by steps and lines. Without `--bench` (as `cargo test` runs it) it does a
 //! small smoke run (T2, k = 16) that still checks FN = 0 and the shared table's agreement with
 //! the 6-D table.
 //!
 //! A query here is the table lookup alone (`Table::query` on a precomputed 6-D cell). All
-//! queries are timed in three passes (`--passes`; flushed before each query for the flushed
-//! figures) and each keeps its fastest pass, so that the maximum is the slowest query and not
-//! an interrupt; timing costs two clock reads, shown as the "timer" rows (the floor of every
+//! queries are timed in three passes (`--passes`) and each keeps its fastest pass, so that the
+//! maximum is the slowest query and not an interrupt. Three regimes: *hot*, the passes run
+//! back to back over blocks of 4,096 queries, so that every line a query reads is in the
+//! caches; *streamed*, the passes run over all queries, whose own input (12 bytes a query)
+//! evicts the table's rarely read lines between passes, a mix of hot and cold reads; and
+//! *flushed*, every line of the table evicted (`clflush`) before each query. Timing costs two clock reads, shown as the "timer" rows (the floor of every
 //! figure, measured in the same run for both clocks, the same way: when their maximum is
 //! high, the machine was too busy for the maximum of any row to mean more). The shared
 //! table's previous layout (separate arrays) is timed in the same run, the two taking turns.
@@ -44,7 +48,7 @@ mod timing;
 use shared_peer::SeparateArrays;
 use std::collections::HashSet;
 use std::time::Instant;
-use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, percentiles, Clock};
+use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, hottest_of_passes, percentiles, Clock};
 
 /// The tables of the report, by the key `--variants` takes, in report order.
 const VARIANTS: [&str; 9] =
@@ -59,7 +63,7 @@ const USAGE: &str = "cargo bench --bench table_report -- [options]
   --variants LIST       comma list of 6d,5d,4d-yy,4d-zz,4d-yy-lossy,shared,shared-sub,4d-yy-sub,
                         thesis (default all; 4d-yy-sub: the 4D/yy t=0 table of the sub-cell labels)
   --timer instant|tsc   clock of the query timings (default instant; tsc: rdtsc between lfences)
-  --slowest N           the N slowest warm queries of each shared table, analysed (default 0)
+  --slowest N           the N slowest streamed queries of each shared table, analysed (default 0)
   --passes 3            passes over the queries; each query keeps its fastest";
 
 struct Options {
@@ -197,16 +201,22 @@ fn query_ns(clock: Clock, table: &Table, cell: [u16; 6], regions: Option<&[(usiz
 /// pages: a T3 table at k = 32 has about 6,000 lines and 93 pages).
 const WARM_UP: usize = 1 << 16;
 
-/// As [`time_queries`] for a shared table and its previous layout, taking turns: (warm,
-/// flushed) of the table, then of the peer.
-fn time_with_peer(
-    clock: Clock,
-    table: &Table,
-    peer: &SeparateArrays,
-    cells: &[[u16; 6]],
-    cold: usize,
-) -> [(Vec<u64>, Vec<u64>); 2] {
-    let (warm, warm_peer) = fastest_of_passes_in_turns(
+/// Per query, its fastest time (ns) in each regime: hot (its block's passes back to back,
+/// [`hottest_of_passes`]), streamed (passes over all queries, whose input stream evicts
+/// rarely read lines) and flushed (the first `cold` queries, the table flushed before each).
+#[derive(Default)]
+struct Times {
+    hot: Vec<u64>,
+    streamed: Vec<u64>,
+    flushed: Vec<u64>,
+}
+
+/// As [`time_queries`] for a shared table and its previous layout, taking turns: the
+/// table's times, then the peer's.
+fn time_with_peer(clock: Clock, table: &Table, peer: &SeparateArrays, cells: &[[u16; 6]], cold: usize) -> [Times; 2] {
+    let (hot, hot_peer) =
+        hottest_of_passes(cells, |c| query_ns(clock, table, c, None), Some(&mut |c| clock.time(c, |c| peer.query(c))));
+    let (streamed, streamed_peer) = fastest_of_passes_in_turns(
         cells,
         WARM_UP,
         |c| query_ns(clock, table, c, None),
@@ -227,19 +237,25 @@ fn time_with_peer(
     } else {
         (vec![], vec![])
     };
-    [(warm, flushed), (warm_peer, flushed_peer)]
+    [
+        Times { hot, streamed, flushed },
+        Times { hot: hot_peer, streamed: streamed_peer, flushed: flushed_peer },
+    ]
 }
 
-/// `warm` and `flushed` (of `cold` queries) as the report's two cells.
-fn timing_cells(warm: &[u64], flushed: &[u64], cold: usize) -> (String, String) {
-    let (w, f) = (percentiles(warm), percentiles(flushed));
-    let flushed = if f.2 == 0 { "n/a".into() } else { format!("{} / {} / {} ({cold})", f.0, f.1, f.2) };
-    (format!("{} / {} / {}", w.0, w.1, w.2), flushed)
+/// The report's three timing cells: hot, streamed, flushed (of `cold` queries).
+fn timing_cells(t: &Times, cold: usize) -> [String; 3] {
+    let cell = |ns: &[u64]| match percentiles(ns) {
+        (_, _, 0) => "n/a".into(),
+        (m, p, x) => format!("{m} / {p} / {x} ({:.1}x)", x as f64 / m.max(1) as f64),
+    };
+    [cell(&t.hot), cell(&t.streamed), format!("{} ({cold})", cell(&t.flushed))]
 }
 
-/// Per query, its fastest time (ns), warm and flushed (the first `cold` queries).
-fn time_queries(clock: Clock, table: &Table, cells: &[[u16; 6]], cold: usize) -> (Vec<u64>, Vec<u64>) {
-    let warm = fastest_of_passes(cells, |c| query_ns(clock, table, c, None));
+/// Per query, its fastest time (ns) in each regime ([`Times`]).
+fn time_queries(clock: Clock, table: &Table, cells: &[[u16; 6]], cold: usize) -> Times {
+    let (hot, _) = hottest_of_passes(cells, |c| query_ns(clock, table, c, None), None);
+    let streamed = fastest_of_passes(cells, |c| query_ns(clock, table, c, None));
     let regions = table.memory_regions();
     let cold_cells = &cells[..cold.min(cells.len())];
     let flushed = if cfg!(target_arch = "x86_64") {
@@ -247,7 +263,7 @@ fn time_queries(clock: Clock, table: &Table, cells: &[[u16; 6]], cold: usize) ->
     } else {
         vec![]
     };
-    (warm, flushed)
+    Times { hot, streamed, flushed }
 }
 
 /// The reads of one shared-table query: dependent steps, reads, cache lines, 4 KiB pages.
@@ -269,8 +285,8 @@ fn min_median(n: usize, mut f: impl FnMut() -> u64) -> (u64, u64) {
     (t[0], t[n / 2])
 }
 
-/// The slowest warm queries of a shared table, their reads and their times alone; then the
-/// warm times of all queries grouped by dependent steps and by cache lines.
+/// The slowest streamed queries of a shared table, their reads and their times alone; then
+/// the streamed times of all queries grouped by dependent steps and by cache lines.
 fn slowest_report(clock: Clock, table: &Table, cells: &[[u16; 6]], warm: &[u64], n: usize) -> Vec<String> {
     let Table::Shared(shared) = table else { return vec![] };
     let regions = table.memory_regions();
@@ -287,14 +303,14 @@ fn slowest_report(clock: Clock, table: &Table, cells: &[[u16; 6]], warm: &[u64],
             "nodes per depth (then leaves): {:?}; child refs out of each depth: {refs:?}",
             shared.nodes_per_depth()
         ),
-        format!("{} slowest warm queries ({}):", n.min(cells.len()), table.name()),
+        format!("{} slowest streamed queries ({}):", n.min(cells.len()), table.name()),
     ];
     for &i in order.iter().take(n) {
         let (steps, reads, lines, pages) = read_counts(&shared.query_reads(cells[i]).1);
         let (hot, hot_med) = min_median(101, || query_ns(clock, table, cells[i], None));
         let (cold, cold_med) = min_median(11, || query_ns(clock, table, cells[i], Some(&regions)));
         out.push(format!(
-            "  #{i} {:?} warm {} ns: {steps} steps, {reads} reads, {lines} lines, {pages} pages; alone hot min/median {hot} / {hot_med} ns, flushed {cold} / {cold_med} ns",
+            "  #{i} {:?} streamed {} ns: {steps} steps, {reads} reads, {lines} lines, {pages} pages; alone hot min/median {hot} / {hot_med} ns, flushed {cold} / {cold_med} ns",
             cells[i], warm[i]
         ));
     }
@@ -305,7 +321,7 @@ fn slowest_report(clock: Clock, table: &Table, cells: &[[u16; 6]], warm: &[u64],
         by[1].entry(lines).or_default().push(t);
     }
     for (what, groups) in ["dependent steps", "cache lines"].iter().zip(&by) {
-        out.push(format!("warm ns by {what}: value: queries, median / p99.9 / max"));
+        out.push(format!("streamed ns by {what}: value: queries, median / p99.9 / max"));
         for (v, ts) in groups {
             let (m, p, x) = percentiles(ts);
             out.push(format!("  {v}: {}, {m} / {p} / {x}", ts.len()));
@@ -337,9 +353,9 @@ fn main() {
     let clock = if opt.tsc { tsc.expect("--timer tsc needs x86-64") } else { Clock::Instant };
     println!("(query timings: {})", clock.name());
     println!(
-        "| cell | k | table | location codes / slices / nodes | bytes in memory | build s | warm median / p99.9 / max ns | flushed median / p99.9 / max ns (queries) | TP | TN | FP | FN | accuracy |"
+        "| cell | k | table | location codes / slices / nodes | bytes in memory | build s | hot median / p99.9 / max ns (max/median) | streamed median / p99.9 / max ns | flushed median / p99.9 / max ns (queries) | TP | TN | FP | FN | accuracy |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for name in &opt.cells {
         let cell = reference_cell(name).expect("a reference cell");
         let symmetric = reflection_y(&cell);
@@ -438,8 +454,10 @@ fn main() {
             ));
         }
         for c in [Some(Clock::Instant), tsc].into_iter().flatten() {
-            let (m, p, x) = percentiles(&fastest_of_passes(&fine, |f| c.time(f, |f| f)));
-            println!("| {name} | {} | timer: {} (two reads) | | | | {m} / {p} / {x} | | | | | | |", opt.k, c.name());
+            let (hot, _) = hottest_of_passes(&fine, |f| c.time(f, |f| f), None);
+            let streamed = fastest_of_passes(&fine, |f| c.time(f, |f| f));
+            let [h, s, _] = timing_cells(&Times { hot, streamed, flushed: vec![] }, 0);
+            println!("| {name} | {} | timer: {} (two reads) | | | | {h} | {s} | | | | | | |", opt.k, c.name());
         }
         let shared_wanted = wants("shared") || wants("shared-sub");
         let (mut d6, mut sub_table): (Option<Table>, Option<Table>) = (None, None);
@@ -472,7 +490,7 @@ fn main() {
                     Table::Shared(t) => Some(SeparateArrays::new(t)),
                     _ => None,
                 };
-                let [(warm, flushed), peer_times] = match &peer {
+                let [times, peer_times] = match &peer {
                     Some(peer) => {
                         // The previous layout answers as the table on every configuration.
                         for &c in &cells {
@@ -480,20 +498,20 @@ fn main() {
                         }
                         time_with_peer(clock, &table, peer, &cells, cold)
                     }
-                    None => [time_queries(clock, &table, &cells, cold), (vec![], vec![])],
+                    None => [time_queries(clock, &table, &cells, cold), Times::default()],
                 };
-                let (w, f) = timing_cells(&warm, &flushed, cold);
+                let [h, s, f] = timing_cells(&times, cold);
                 let accuracy = 100.0 * (tp + tn) as f64 / (tp + tn + fp + fn_).max(1) as f64;
                 println!(
-                    "| {name} | {} | {label} | {} | {} | {build_secs:.2} | {w} | {f} | {tp} | {tn} | {fp} | {fn_} | {accuracy:.2} % |",
+                    "| {name} | {} | {label} | {} | {} | {build_secs:.2} | {h} | {s} | {f} | {tp} | {tn} | {fp} | {fn_} | {accuracy:.2} % |",
                     opt.k,
                     contents(&table),
                     table.memory_bytes(),
                 );
                 if let Some(peer) = &peer {
-                    let (w, f) = timing_cells(&peer_times.0, &peer_times.1, cold);
+                    let [h, s, f] = timing_cells(&peer_times, cold);
                     println!(
-                        "| {name} | {} | {label}, previous layout (same run, taking turns) | | {} | | {w} | {f} | | | | | |",
+                        "| {name} | {} | {label}, previous layout (same run, taking turns) | | {} | | {h} | {s} | {f} | | | | | |",
                         opt.k,
                         peer.memory_bytes(),
                     );
@@ -502,7 +520,7 @@ fn main() {
                     assert_eq!(fn_, 0, "{name} {label}: a false negative on a certified table");
                 }
                 if opt.slowest > 0 {
-                    notes.extend(slowest_report(clock, &table, &cells, &warm, opt.slowest));
+                    notes.extend(slowest_report(clock, &table, &cells, &times.streamed, opt.slowest));
                 }
             }
             // The plain table of the sub-cell labels answers as the subdivided table does.
@@ -533,7 +551,7 @@ fn main() {
         }
         if outside > 0 {
             println!(
-                "| {name} | {} | ({outside} configurations outside the sampled grid: exact check) | | | | | | | | |",
+                "| {name} | {} | ({outside} configurations outside the sampled grid: exact check) | | | | | | | | | |",
                 opt.k
             );
         }
