@@ -175,7 +175,14 @@ fn label_space_certified_inner(
         let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&a0, &a1, &b0, &b1, ia, ib);
         let mut labels = label_pairs(&a0, &b0, collides, progress);
         refine_unknown_cells(&a0, &a1, &b0, &b1, &mut labels);
-        let sub = subdivide.then(|| sub_cells(&a0, &a1, &b0, &b1, &labels));
+        let sub = subdivide.then(|| {
+            let start = std::time::Instant::now();
+            let sub = sub_cells(&a0, &a1, &b0, &b1, &labels);
+            if progress {
+                eprintln!("sub-cells of {} collision pairs: {:.2} s", sub.pairs.len(), start.elapsed().as_secs_f64());
+            }
+            sub
+        });
         (labels, sub)
     } else {
         (label_pairs(&a0, &b0, |_, _| true, progress), None)
