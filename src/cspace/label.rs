@@ -221,6 +221,24 @@ pub fn collision_mask(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize, ma
     out
 }
 
+/// Whether some box pair among `mask` is not proved disjoint ([`collision_mask`] is not 0),
+/// stopping at the first.
+pub fn any_collision(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize, mask: u64) -> bool {
+    if mask == 0 || aabbs_apart(&a.lo[ia], &a.hi[ia], &b.lo[ib], &b.hi[ib]) {
+        return false;
+    }
+    let (na, nb) = (a.per_entry, b.per_entry);
+    let mut rest = mask;
+    while rest != 0 {
+        let bit = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        if boxes_may_touch(a, ia * na + bit / 8, b, ib * nb + bit % 8) {
+            return true;
+        }
+    }
+    false
+}
+
 /// Every box pair of models with `na` and `nb` boxes, as a [`collision_mask`] mask.
 pub fn all_box_pairs(na: usize, nb: usize) -> u64 {
     (0..na).flat_map(|i| (0..nb).map(move |j| 1u64 << (8 * i + j))).fold(0, |m, b| m | b)
