@@ -36,7 +36,7 @@
 use crate::cell::{Cell, RobotSpec};
 use crate::cspace::guarantee::{box_sweeps, cube_box_sweeps, cube_unreachable, reference_point, SPLITS};
 use crate::cspace::label::{
-    aabbs_apart, all_box_pairs, any_collision, collision_mask, entries_apart, entries_collide, label_pairs,
+    aabbs_apart, all_box_pairs, boxes_may_touch, collision_mask, entries_apart, entries_collide, label_pairs,
     two_robot_grids, Inflation, SampleBoxes, Slot,
 };
 use crate::cspace::sampler::{SampleGrid, Workspace};
@@ -345,17 +345,20 @@ fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize) -> u64 {
 }
 
 /// `(care, collision)` over the 64 octant pairs of `(ia, ib)`, as [`octant_pairs`] gives
-/// them, faster:
+/// them, faster (every change only skips tests whose answers are implied, or reorders tests
+/// whose answers are combined by "and"/"or"):
 /// - an octant pair is a collision as soon as a box pair certainly intersects for every
 ///   configuration of a (sub)cell pair that holds it ([`cores_meet`]): of the whole cells
 ///   (then every octant pair is), of A's octant and B's cell (its row), of A's cell and B's
 ///   octant (its column). Such an octant pair is never proved free by [`octant_pairs`]: its
 ///   octants are [`Slot::Boxes`] only with reachable reference TCPs, a configuration of the
 ///   pair that collides, and its tests are sound; other octants it calls collisions anyway.
-/// - the box pairs left open by (A's octant, B's cell) and by (A's cell, B's octant) are
-///   found once per octant (8 + 8 tests, not 64 + 64) and intersected per pair;
-/// - the last test (A's octant, B's octant) stops at the first box pair it cannot prove
-///   disjoint.
+/// - a box pair of an octant pair is proved disjoint when one of the tests (A octant, B
+///   cell), (A cell, B octant), (A octant, B octant) proves it (after the whole cells left it
+///   open); an octant pair is free when all its box pairs are. The octant-cell tests are
+///   shared by the 8 pairs of a row or column and run only when first needed; the box pairs
+///   are tried from the one that last stopped an octant pair, and an octant pair stops at
+///   its first box pair that no test proves.
 fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize) -> (u64, u64) {
     let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
     let (na, nb) = (a0.per_entry, b0.per_entry);
@@ -366,24 +369,21 @@ fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize) -> (u64, u64) {
     if whole_a && whole_b && cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, open0) {
         return (care, care);
     }
-    // Per octant of A (B): the box pairs left open with B's (A's) whole cell, and whether one
-    // of them certainly intersects there. Only octants with boxes are used.
-    let (mut open_a, mut row_meets) = ([0u64; 8], [false; 8]);
-    for i in 0..8 {
+    let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
+    let row_meets: [bool; 8] = std::array::from_fn(|i| {
         let sa = 8 * ia + i;
-        if a1.slot[sa] == Slot::Boxes {
-            open_a[i] = if whole_b { collision_mask(a1, sa, b0, ib, open0) } else { open0 };
-            row_meets[i] = whole_b && cores_meet(&a.oct_cores, sa, na, &b.whole_cores, ib, nb, open_a[i]);
-        }
-    }
-    let (mut open_b, mut column_meets) = ([0u64; 8], [false; 8]);
-    for j in 0..8 {
+        whole_b && boxes(a1, sa) && cores_meet(&a.oct_cores, sa, na, &b.whole_cores, ib, nb, open0)
+    });
+    let column_meets: [bool; 8] = std::array::from_fn(|j| {
         let sb = 8 * ib + j;
-        if b1.slot[sb] == Slot::Boxes {
-            open_b[j] = if whole_a { collision_mask(a0, ia, b1, sb, open0) } else { open0 };
-            column_meets[j] = whole_a && cores_meet(&a.whole_cores, ia, na, &b.oct_cores, sb, nb, open_b[j]);
-        }
-    }
+        whole_a && boxes(b1, sb) && cores_meet(&a.whole_cores, ia, na, &b.oct_cores, sb, nb, open0)
+    });
+    // Whether box pair `bit` may touch between A's entry `ea` of `x` and B's entry `eb` of `y`.
+    let touch = |x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize| {
+        boxes_may_touch(x, ea * na + bit / 8, y, eb * nb + bit % 8)
+    };
+    let (mut rows, mut columns) = (Memo::default(), Memo::default());
+    let mut hint = open0.trailing_zeros() as usize;
     let mut collision = 0u64;
     for i in 0..8 {
         for j in 0..8 {
@@ -392,17 +392,61 @@ fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize) -> (u64, u64) {
                 continue;
             }
             let (sa, sb) = (8 * ia + i, 8 * ib + j);
-            let proved =
-                a1.slot[sa] == Slot::Boxes && b1.slot[sb] == Slot::Boxes && !row_meets[i] && !column_meets[j] && {
-                    let open = open_a[i] & open_b[j];
-                    open == 0 || !any_collision(a1, sa, b1, sb, open)
-                };
-            if !proved {
-                collision |= bit;
+            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meets[i] || column_meets[j];
+            // Whether box pair `p` stays open: no test of the octant pair proves it.
+            let mut open = |p: usize| {
+                rows.open(i, p, || !whole_b || touch(a1, sa, b0, ib, p))
+                    && columns.open(j, p, || !whole_a || touch(a0, ia, b1, sb, p))
+                    && touch(a1, sa, b1, sb, p)
+            };
+            let stopper = if decided {
+                None
+            } else if entries_apart(a1, sa, b1, sb) {
+                Some(None)
+            } else {
+                Some(hint_first(open0, hint).find(|&p| open(p)))
+            };
+            match stopper {
+                Some(None) => {}
+                Some(Some(p)) => {
+                    hint = p;
+                    collision |= bit;
+                }
+                None => collision |= bit,
             }
         }
     }
     (care, collision)
+}
+
+/// The answers of one kind of coarse test (an octant against the other robot's whole cell),
+/// found when first asked: per octant `o`, bit `p` of `known[o]` says whether box pair `p` was
+/// tested, of `open[o]` whether it stayed open.
+#[derive(Default)]
+struct Memo {
+    known: [u64; 8],
+    open: [u64; 8],
+}
+
+impl Memo {
+    /// Whether box pair `p` of octant `o` stays open; `test` finds it the first time.
+    fn open(&mut self, o: usize, p: usize, test: impl FnOnce() -> bool) -> bool {
+        let bit = 1u64 << p;
+        if self.known[o] & bit == 0 {
+            self.known[o] |= bit;
+            if test() {
+                self.open[o] |= bit;
+            }
+        }
+        self.open[o] & bit != 0
+    }
+}
+
+/// The set bits of `mask` (box pair indices), `hint` first when set, then the others upward.
+fn hint_first(mask: u64, hint: usize) -> impl Iterator<Item = usize> {
+    let first = (hint < 64 && mask >> hint & 1 == 1).then_some(hint);
+    let rest = first.map_or(mask, |h| mask & !(1u64 << h));
+    first.into_iter().chain((0..64).filter(move |&p| rest >> p & 1 == 1))
 }
 
 /// `(care, collision)` over the 64 octant pairs of `(ia, ib)`: an octant pair is free when

@@ -24,7 +24,7 @@ use crate::cspace::guarantee::thesis_margin;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::sat::separating_axis;
-use crate::geometry::sweep::{swept_aabb_half, swept_boxes_apart, Sweep};
+use crate::geometry::sweep::{swept_aabb_half, swept_boxes_apart_with, FaceTerms, Sweep};
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{Mat3, Real, Vec3};
@@ -75,6 +75,8 @@ pub struct SampleBoxes {
     pub boxes: Vec<Obb>,
     /// Per box: its displacement set in the WCS ([`Sweep::ZERO`] for the exact boxes).
     pub sweeps: Vec<Sweep>,
+    /// Per box: its terms of the swept test on its own face axes ([`FaceTerms`]).
+    pub faces: Vec<FaceTerms>,
     /// Per box: AABB lower corner.
     pub box_lo: Vec<[Real; 3]>,
     /// Per box: AABB upper corner.
@@ -117,6 +119,7 @@ impl SampleBoxes {
             per_entry: nb,
             boxes: Vec::with_capacity(n * nb),
             sweeps: Vec::with_capacity(n * nb),
+            faces: Vec::with_capacity(n * nb),
             box_lo: Vec::with_capacity(n * nb),
             box_hi: Vec::with_capacity(n * nb),
             lo: Vec::with_capacity(n),
@@ -135,6 +138,7 @@ impl SampleBoxes {
                 }
                 out.boxes.push(b);
                 out.sweeps.push(sweep);
+                out.faces.push(FaceTerms::new(&b, &sweep));
                 out.box_lo.push([bl.x, bl.y, bl.z]);
                 out.box_hi.push([bh.x, bh.y, bh.z]);
             }
@@ -170,9 +174,9 @@ pub(crate) fn entries_apart(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usi
 
 /// Whether box `i` of A (index into `a.boxes`) and box `j` of B may intersect: not proved
 /// apart by their AABBs, nor by the separating axis test (exact boxes) or its swept form
-/// ([`swept_boxes_apart`]).
+/// ([`crate::geometry::swept_boxes_apart`]).
 #[inline]
-fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usize) -> bool {
+pub(crate) fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usize) -> bool {
     if aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j]) {
         return false;
     }
@@ -180,7 +184,7 @@ fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usize) -> bool
     if sa.is_zero() && sb.is_zero() {
         separating_axis(&a.boxes[i], &b.boxes[j]).is_none()
     } else {
-        !swept_boxes_apart(&a.boxes[i], sa, &b.boxes[j], sb)
+        !swept_boxes_apart_with(&a.boxes[i], sa, &a.faces[i], &b.boxes[j], sb, &b.faces[j])
     }
 }
 
@@ -219,24 +223,6 @@ pub fn collision_mask(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize, ma
         }
     }
     out
-}
-
-/// Whether some box pair among `mask` is not proved disjoint ([`collision_mask`] is not 0),
-/// stopping at the first.
-pub fn any_collision(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize, mask: u64) -> bool {
-    if mask == 0 || aabbs_apart(&a.lo[ia], &a.hi[ia], &b.lo[ib], &b.hi[ib]) {
-        return false;
-    }
-    let (na, nb) = (a.per_entry, b.per_entry);
-    let mut rest = mask;
-    while rest != 0 {
-        let bit = rest.trailing_zeros() as usize;
-        rest &= rest - 1;
-        if boxes_may_touch(a, ia * na + bit / 8, b, ib * nb + bit % 8) {
-            return true;
-        }
-    }
-    false
 }
 
 /// Every box pair of models with `na` and `nb` boxes, as a [`collision_mask`] mask.

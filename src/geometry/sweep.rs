@@ -95,10 +95,17 @@ impl Sweep {
     /// `h_S(n)`, the support function (module doc); `n` need not be unit.
     #[inline]
     pub fn support(&self, n: &Vec3) -> Real {
+        self.support_with_norm(n, float::sqrt(n.norm_squared()))
+    }
+
+    /// [`Sweep::support`] with `norm = float::sqrt(n.norm_squared())` already at hand (the
+    /// same value).
+    #[inline(always)]
+    fn support_with_norm(&self, n: &Vec3, norm: Real) -> Real {
         let z = self.cube[0].dot(n).abs() + self.cube[1].dot(n).abs() + self.cube[2].dot(n).abs();
         let a = self.arc[0].dot(n).abs() + self.arc[1].dot(n).abs();
         let [(e1, d1), (e2, d2)] = self.ends;
-        self.ball * float::sqrt(n.norm_squared()) + (e1 * z + d1 * a).max(e2 * z + d2 * a)
+        self.ball * norm + (e1 * z + d1 * a).max(e2 * z + d2 * a)
     }
 
     /// The largest displacement in the set: `h_S` over unit vectors is at most this.
@@ -126,24 +133,106 @@ pub fn swept_aabb_half(b: &Obb, s: &Sweep) -> Vec3 {
     Vec3::new(e(0), e(1), e(2))
 }
 
+/// The terms of [`swept_boxes_apart`] on a box's own face axes that depend on that box and its
+/// sweep alone: per axis `u_k`, the box's projected radius and the sweep's support. Computed
+/// once per swept box ([`swept_boxes_apart_with`]), with the very operations the test would
+/// use, so that the answers are the same to the bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceTerms {
+    /// The box's axes (columns of `axes`).
+    u: [Vec3; 3],
+    /// `sum_i half_i |u_i . u_k|`, per `k`.
+    radius: [Real; 3],
+    /// `h_S(u_k)`, per `k`.
+    support: [Real; 3],
+    /// `float::sqrt(|u_k|^2)`, per `k`.
+    norm: [Real; 3],
+    /// Whether `|u_k|^2 < 1e-10` (never for a box's unit axes; kept to answer as the test).
+    short: [bool; 3],
+}
+
+impl FaceTerms {
+    /// The face terms of box `b` swept by `s`.
+    pub fn new(b: &Obb, s: &Sweep) -> FaceTerms {
+        let u = axes(b);
+        let norm = u.map(|n| float::sqrt(n.norm_squared()));
+        FaceTerms {
+            short: u.map(|n| n.norm_squared() < 1e-10),
+            u,
+            radius: std::array::from_fn(|k| radius(&u, &b.half, &u[k])),
+            support: std::array::from_fn(|k| s.support_with_norm(&u[k], norm[k])),
+            norm,
+        }
+    }
+}
+
+fn axes(b: &Obb) -> [Vec3; 3] {
+    [b.axes.column(0).into_owned(), b.axes.column(1).into_owned(), b.axes.column(2).into_owned()]
+}
+
+/// The radius of the projection on `n` of the box with axes `u` and half-extents `half`.
+#[inline(always)]
+fn radius(u: &[Vec3; 3], half: &Vec3, n: &Vec3) -> Real {
+    half.x * u[0].dot(n).abs() + half.y * u[1].dot(n).abs() + half.z * u[2].dot(n).abs()
+}
+
 /// Whether `a + sa` and `b + sb` are proved disjoint by one of the 15 axes of `a` and `b`
 /// (see the module doc; `false` means "not proved").
 pub fn swept_boxes_apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
+    swept_boxes_apart_with(a, sa, &FaceTerms::new(a, sa), b, sb, &FaceTerms::new(b, sb))
+}
+
+/// [`swept_boxes_apart`] with the face terms of both swept boxes computed beforehand
+/// (`fa = FaceTerms::new(a, sa)`, `fb = FaceTerms::new(b, sb)`): the same answer, cheaper when
+/// a box meets many others.
+#[inline]
+pub fn swept_boxes_apart_with(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: &Sweep, fb: &FaceTerms) -> bool {
     let d = b.center - a.center;
-    let ua = [a.axes.column(0).into_owned(), a.axes.column(1).into_owned(), a.axes.column(2).into_owned()];
-    let ub = [b.axes.column(0).into_owned(), b.axes.column(1).into_owned(), b.axes.column(2).into_owned()];
-    let radius = |u: &[Vec3; 3], half: &Vec3, n: &Vec3| {
-        half.x * u[0].dot(n).abs() + half.y * u[1].dot(n).abs() + half.z * u[2].dot(n).abs()
+    let (ua, ub) = (&fa.u, &fb.u);
+    // Axis `n` of norm `len` separates when `|n . d|` exceeds the four radii by the gap:
+    // `ra`, `rb` the boxes', `ha`, `hb` the sweeps' supports, `(ra + rb + ha) + hb`. The
+    // supports are never negative (a sweep's sizes are not), so a rounded sum with them is
+    // never below the rounded `ra + rb`: when the boxes alone do not clear the gap (or do not
+    // even come apart, then the norm is not needed either), the swept ones do not, and what
+    // is left is not computed. The same answer, to the bit, as computing everything.
+    #[inline(always)]
+    fn separates(
+        d: &Vec3,
+        n: &Vec3,
+        len: impl Fn() -> Real,
+        ra: Real,
+        rb: Real,
+        ha: impl Fn() -> Real,
+        hb: impl Fn() -> Real,
+    ) -> bool {
+        let (dn, boxes) = (d.dot(n).abs(), ra + rb);
+        if !(dn - boxes > 0.0) {
+            return false;
+        }
+        let gap = SWEEP_GAP * len();
+        dn - boxes > gap && dn - (boxes + ha() + hb()) > gap
+    }
+    let face_a = |k: usize| {
+        let (n, len) = (&ua[k], fa.norm[k]);
+        let rb = radius(ub, &b.half, n);
+        !fa.short[k] && separates(&d, n, || len, fa.radius[k], rb, || fa.support[k], || sb.support_with_norm(n, len))
     };
-    let separates = |n: &Vec3| {
+    let face_b = |k: usize| {
+        let (n, len) = (&ub[k], fb.norm[k]);
+        let ra = radius(ua, &a.half, n);
+        !fb.short[k] && separates(&d, n, || len, ra, fb.radius[k], || sa.support_with_norm(n, len), || fb.support[k])
+    };
+    let edge = |i: usize, j: usize| {
+        let n = ua[i].cross(&ub[j]);
         let len2 = n.norm_squared();
         if len2 < 1e-10 {
             return false;
         }
-        let reach = radius(&ua, &a.half, n) + radius(&ub, &b.half, n) + sa.support(n) + sb.support(n);
-        d.dot(n).abs() - reach > SWEEP_GAP * float::sqrt(len2)
+        let len = || float::sqrt(len2);
+        let (ra, rb) = (radius(ua, &a.half, &n), radius(ub, &b.half, &n));
+        separates(&d, &n, len, ra, rb, || sa.support_with_norm(&n, len()), || sb.support_with_norm(&n, len()))
     };
-    ua.iter().chain(&ub).any(separates) || ua.iter().any(|x| ub.iter().any(|y| separates(&x.cross(y))))
+    (0..3).any(face_a) || (0..3).any(face_b) || (0..3).any(|i| (0..3).any(|j| edge(i, j)))
 }
 
 /// The core of `b` under the displacement set `s` (module doc): the box shrunk along each of
@@ -158,14 +247,11 @@ pub fn core(b: &Obb, s: &Sweep) -> Option<Obb> {
 /// shorter than `1e-5` (module doc, "Numerics").
 pub fn boxes_overlap_deeply(a: &Obb, b: &Obb) -> bool {
     let d = b.center - a.center;
-    let ua = [a.axes.column(0).into_owned(), a.axes.column(1).into_owned(), a.axes.column(2).into_owned()];
-    let ub = [b.axes.column(0).into_owned(), b.axes.column(1).into_owned(), b.axes.column(2).into_owned()];
-    let radius = |u: &[Vec3; 3], half: &Vec3, n: &Vec3| {
-        half.x * u[0].dot(n).abs() + half.y * u[1].dot(n).abs() + half.z * u[2].dot(n).abs()
-    };
+    let (ua, ub) = (axes(a), axes(b));
     let overlaps = |n: &Vec3| {
         let len2 = n.norm_squared();
-        len2 >= 1e-10 && radius(&ua, &a.half, n) + radius(&ub, &b.half, n) - d.dot(n).abs() > MEET_DEPTH * float::sqrt(len2)
+        len2 >= 1e-10
+            && radius(&ua, &a.half, n) + radius(&ub, &b.half, n) - d.dot(n).abs() > MEET_DEPTH * float::sqrt(len2)
     };
     ua.iter().chain(&ub).all(overlaps) && ua.iter().all(|x| ub.iter().all(|y| overlaps(&x.cross(y))))
 }
@@ -230,7 +316,57 @@ mod tests {
         z * e + a * d + ball
     }
 
+    /// The test as first written (one closure for all 15 axes, supports recomputed): the
+    /// prepared form must answer as it does, to the bit.
+    fn swept_boxes_apart_as_written(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
+        let d = b.center - a.center;
+        let ua = [a.axes.column(0).into_owned(), a.axes.column(1).into_owned(), a.axes.column(2).into_owned()];
+        let ub = [b.axes.column(0).into_owned(), b.axes.column(1).into_owned(), b.axes.column(2).into_owned()];
+        let radius = |u: &[Vec3; 3], half: &Vec3, n: &Vec3| {
+            half.x * u[0].dot(n).abs() + half.y * u[1].dot(n).abs() + half.z * u[2].dot(n).abs()
+        };
+        let support = |s: &Sweep, n: &Vec3| {
+            let z = s.cube[0].dot(n).abs() + s.cube[1].dot(n).abs() + s.cube[2].dot(n).abs();
+            let a = s.arc[0].dot(n).abs() + s.arc[1].dot(n).abs();
+            let [(e1, d1), (e2, d2)] = s.ends;
+            s.ball * float::sqrt(n.norm_squared()) + (e1 * z + d1 * a).max(e2 * z + d2 * a)
+        };
+        let separates = |n: &Vec3| {
+            let len2 = n.norm_squared();
+            if len2 < 1e-10 {
+                return false;
+            }
+            let reach = radius(&ua, &a.half, n) + radius(&ub, &b.half, n) + support(sa, n) + support(sb, n);
+            d.dot(n).abs() - reach > SWEEP_GAP * float::sqrt(len2)
+        };
+        ua.iter().chain(&ub).any(separates) || ua.iter().any(|x| ub.iter().any(|y| separates(&x.cross(y))))
+    }
+
     proptest! {
+        /// The test with prepared face terms answers as the test as first written, also right at
+        /// the threshold (B moved along `v` by bisection to where the answer flips, both sides).
+        #[test]
+        fn prepared_swept_test_answers_as_written(a in any_box(), b in any_box(), sa in any_sweep(), sb in any_sweep(),
+                v in prop::array::uniform3(-1.0..1.0f64)) {
+            let v = unit(Vec3::from(v));
+            let at = |t: Real| Obb { center: a.center + v * t, ..b };
+            let same = |t: Real| {
+                let b = at(t);
+                let fast = swept_boxes_apart_with(&a, &sa, &FaceTerms::new(&a, &sa), &b, &sb, &FaceTerms::new(&b, &sb));
+                (fast == swept_boxes_apart_as_written(&a, &sa, &b, &sb), fast)
+            };
+            let (mut lo, mut hi) = (0.0, 2000.0);
+            prop_assert_eq!(same(lo).0 && same(hi).0, true);
+            if !same(lo).1 && same(hi).1 {
+                for _ in 0..80 {
+                    let mid = 0.5 * (lo + hi);
+                    let (ok, apart) = same(mid);
+                    prop_assert!(ok, "differs at {}", mid);
+                    if apart { hi = mid } else { lo = mid }
+                }
+            }
+        }
+
         /// Boxes moved by any displacements of their sets never intersect when the swept boxes
         /// are proved apart; and the proof is symmetric.
         #[test]
@@ -354,7 +490,8 @@ mod tests {
                 Obb::new(c, r, Vec3::new(100.0 + 99.0 * x[i + 3], 40.0 + 30.0 * x[i + 4], 20.0 + 10.0 * x[i + 5]))
             };
             let (a, b) = (rnd_box(Vec3::zeros(), 0), rnd_box(v(6) * 150.0, 9));
-            let motion = |i: usize| (rot((0.05 * x[i], 0.05 * x[i + 1], 0.05 * x[i + 2])), v(i + 3) * 200.0, v(i + 6) * 3.0);
+            let motion =
+                |i: usize| (rot((0.05 * x[i], 0.05 * x[i + 1], 0.05 * x[i + 2])), v(i + 3) * 200.0, v(i + 6) * 3.0);
             let ((fa, sa, _), (fb, sb, _)) = (moved(&a, &motion(15)), moved(&b, &motion(21)));
             let meet = swept_boxes_always_meet(&a, &sa, &b, &sb);
             intersecting += separating_axis(&fa, &fb).is_none() as usize;
