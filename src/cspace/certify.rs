@@ -49,6 +49,10 @@ use crate::math::{Real, Vec3};
 use crate::robot::{BoxKind, RobotModel};
 use rayon::prelude::*;
 
+/// Rows of A whose sub-cells are found together ([`sub_cells`]; a cache blocking, any value
+/// gives the same answers).
+const SUB_CELL_ROWS: usize = 16;
+
 /// Sub-boxes per axis when enclosing the motor angles over an octant (an octant is half as
 /// wide as a cell, so this gives the same sub-box size as [`SPLITS`] on a cell).
 pub const OCTANT_SPLITS: u32 = SPLITS / 2;
@@ -169,12 +173,13 @@ fn label_space_certified_inner(
             SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
             SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
         );
-        let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&a0, &a1, &b0, &b1, ia, ib);
+        let (la, lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+        let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
         let mut labels = label_pairs(&a0, &b0, collides, progress);
-        refine_unknown_cells(&a0, &a1, &b0, &b1, &mut labels);
+        refine_unknown_cells(&la, &lb, &mut labels);
         let sub = subdivide.then(|| {
             let start = std::time::Instant::now();
-            let sub = sub_cells(&a0, &a1, &b0, &b1, &labels);
+            let sub = sub_cells(&la, &lb, &labels);
             if progress {
                 eprintln!("sub-cells of {} collision pairs: {:.2} s", sub.pairs.len(), start.elapsed().as_secs_f64());
             }
@@ -248,24 +253,30 @@ fn cores_meet(a: &[Option<Obb>], ia: usize, na: usize, b: &[Option<Obb>], ib: us
 }
 
 /// The sub-cell labels of every pair labelled collision (see [`SubCells`]).
-fn sub_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBoxes, labels: &[Label]) -> SubCells {
-    let nb = b0.len();
+///
+/// Rows of A are taken [`SUB_CELL_ROWS`] at a time, column by column, so that B's boxes of a
+/// column are used by every row of the block while they are in the cache.
+fn sub_cells(a: &Levels, b: &Levels, labels: &[Label]) -> SubCells {
+    let nb = b.whole.len();
     if nb == 0 {
         return SubCells::default();
     }
-    let (a, b) = (Levels::new(a0, a1), Levels::new(b0, b1));
     let rows: Vec<Vec<(u64, u64, u64)>> = labels
-        .par_chunks(nb)
+        .par_chunks(nb * SUB_CELL_ROWS)
         .enumerate()
-        .map(|(ia, row)| {
-            row.iter()
-                .enumerate()
-                .filter(|&(_, &l)| l == Label::Collision)
-                .map(|(ib, _)| {
-                    let (care, collision) = sub_cell_masks(&a, &b, ia, ib);
-                    ((ia * nb + ib) as u64, care, collision)
-                })
-                .collect()
+        .map(|(block, rows)| {
+            let mut out = vec![];
+            for ib in 0..nb {
+                for (r, row) in rows.chunks(nb).enumerate() {
+                    if row[ib] == Label::Collision {
+                        let ia = block * SUB_CELL_ROWS + r;
+                        let (care, collision) = sub_cell_masks(a, b, ia, ib, false);
+                        out.push(((ia * nb + ib) as u64, care, collision));
+                    }
+                }
+            }
+            out.sort_unstable_by_key(|&(pair, _, _)| pair);
+            out
         })
         .collect();
     let mut out = SubCells::default();
@@ -335,13 +346,11 @@ pub fn subdivided_labels(cell: &Cell, ws: &Workspace, certified: &CertifiedSpace
 /// The sub-cells of `(ia, ib)` that hold reachable TCPs of both robots: neither octant is
 /// [`Slot::Vacuous`].
 fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize) -> u64 {
-    let mut care = 0;
-    for i in (0..8).filter(|&i| a1.slot[8 * ia + i] != Slot::Vacuous) {
-        for j in (0..8).filter(|&j| b1.slot[8 * ib + j] != Slot::Vacuous) {
-            care |= 1u64 << sub_cell_index(i, j);
-        }
-    }
-    care
+    // `sub_cell_index(i, j) = 8 sub_cell_index(i, 0) + sub_cell_index(0, j)`: B's occupied
+    // octants as one byte, shifted to each occupied octant of A's byte.
+    let column =
+        (0..8).filter(|&j| b1.slot[8 * ib + j] != Slot::Vacuous).fold(0u64, |m, j| m | 1 << sub_cell_index(0, j));
+    (0..8).filter(|&i| a1.slot[8 * ia + i] != Slot::Vacuous).fold(0, |m, i| m | column << sub_cell_index(i, 0))
 }
 
 /// `(care, collision)` over the 64 octant pairs of `(ia, ib)`, as [`octant_pairs`] gives
@@ -359,16 +368,20 @@ fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize) -> u64 {
 ///   shared by the 8 pairs of a row or column and run only when first needed; the box pairs
 ///   are tried from the one that last stopped an octant pair, and an octant pair stops at
 ///   its first box pair that no test proves.
-fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize) -> (u64, u64) {
+///
+/// With `first_only`, stops at the first octant pair not proved free.
+fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first_only: bool) -> (u64, u64) {
     let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
     let (na, nb) = (a0.per_entry, b0.per_entry);
     let care = care_mask(a1, ia, b1, ib);
     let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
     let all = all_box_pairs(na, nb);
-    let open0 = if whole_a && whole_b { collision_mask(a0, ia, b0, ib, all) } else { all };
-    if whole_a && whole_b && cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, open0) {
+    // A box pair whose cores meet is never proved disjoint: no need to look for it among
+    // those the whole cells leave open.
+    if whole_a && whole_b && cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) {
         return (care, care);
     }
+    let open0 = if whole_a && whole_b { collision_mask(a0, ia, b0, ib, all) } else { all };
     let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
     let row_meets: [bool; 8] = std::array::from_fn(|i| {
         let sa = 8 * ia + i;
@@ -407,12 +420,13 @@ fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize) -> (u64, u64) {
                 Some(hint_first(open0, hint).find(|&p| open(p)))
             };
             match stopper {
-                Some(None) => {}
-                Some(Some(p)) => {
-                    hint = p;
-                    collision |= bit;
-                }
-                None => collision |= bit,
+                Some(None) => continue,
+                Some(Some(p)) => hint = p,
+                None => {}
+            }
+            collision |= bit;
+            if first_only {
+                return (care, collision);
             }
         }
     }
@@ -445,15 +459,20 @@ impl Memo {
 /// The set bits of `mask` (box pair indices), `hint` first when set, then the others upward.
 fn hint_first(mask: u64, hint: usize) -> impl Iterator<Item = usize> {
     let first = (hint < 64 && mask >> hint & 1 == 1).then_some(hint);
-    let rest = first.map_or(mask, |h| mask & !(1u64 << h));
-    first.into_iter().chain((0..64).filter(move |&p| rest >> p & 1 == 1))
+    let mut rest = first.map_or(mask, |h| mask & !(1u64 << h));
+    first.into_iter().chain(std::iter::from_fn(move || {
+        let p = rest.trailing_zeros() as usize;
+        rest &= rest.wrapping_sub(1);
+        (p < 64).then_some(p)
+    }))
 }
 
 /// `(care, collision)` over the 64 octant pairs of `(ia, ib)`: an octant pair is free when
 /// every box pair is proved disjoint by one of the tests (A cell, B cell), (A octant,
 /// B cell), (A cell, B octant) or (A octant, B octant), each valid for all of it. Only the
 /// box pairs a coarser test left open go on to a finer one. With `first_only`, stops at the
-/// first octant pair not proved free.
+/// first octant pair not proved free. The plain form of [`sub_cell_masks`], kept to test it.
+#[cfg(test)]
 fn octant_pairs(
     a0: &SampleBoxes,
     a1: &SampleBoxes,
@@ -499,21 +518,15 @@ fn octant_pairs(
 
 /// Level 2 for a pair whose whole-cell test failed or could not run (a sample without a
 /// whole-cell bound, [`Slot::Unknown`]: its centre is unreachable but its cell is not):
-/// every octant pair proved free by [`octant_pairs`] (which stops at the first that is not).
-fn octants_prove_free(
-    a0: &SampleBoxes,
-    a1: &SampleBoxes,
-    b0: &SampleBoxes,
-    b1: &SampleBoxes,
-    ia: usize,
-    ib: usize,
-) -> bool {
-    octant_pairs(a0, a1, b0, b1, ia, ib, true).1 == 0
+/// every octant pair proved free ([`sub_cell_masks`], stopping at the first that is not).
+fn octants_prove_free(a: &Levels, b: &Levels, ia: usize, ib: usize) -> bool {
+    sub_cell_masks(a, b, ia, ib, true).1 == 0
 }
 
 /// Level 2 for the pairs that [`label_pairs`] made collisions because a sample has no
 /// whole-cell bound ([`Slot::Unknown`]): each is retried octant by octant.
-fn refine_unknown_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBoxes, labels: &mut [Label]) {
+fn refine_unknown_cells(a: &Levels, b: &Levels, labels: &mut [Label]) {
+    let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
     let unknown_b: Vec<usize> = (0..b0.len()).filter(|&ib| b0.slot[ib] == Slot::Unknown).collect();
     let (cover_a, cover_b) = (octant_covers(a1), octant_covers(b1));
     let nb = b0.len();
@@ -524,7 +537,7 @@ fn refine_unknown_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1
         let mut retry = |ib: usize| {
             if row[ib] == Label::Collision
                 && b0.slot[ib] != Slot::Unreachable
-                && (cover_apart(&cover_a[ia], &cover_b[ib]) || octants_prove_free(a0, a1, b0, b1, ia, ib))
+                && (cover_apart(&cover_a[ia], &cover_b[ib]) || octants_prove_free(a, b, ia, ib))
             {
                 row[ib] = Label::Free;
             }
@@ -752,6 +765,15 @@ mod tests {
             }
             assert!(!want.pairs.is_empty());
             assert!(c.sub.as_ref() == Some(&want), "{name}: the fast sub-cells differ from the plain ones");
+            // The labels' level 2 (first octant pair not proved free) answers as the plain one.
+            let (a, b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+            let unreachable = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Unreachable;
+            for ia in (0..a0.len()).filter(|&ia| !unreachable(&a0, ia)) {
+                for ib in (0..nb).filter(|&ib| !unreachable(&b0, ib)) {
+                    let plain = octant_pairs(&a0, &a1, &b0, &b1, ia, ib, true).1 == 0;
+                    assert_eq!(octants_prove_free(&a, &b, ia, ib), plain, "{name} pair ({ia}, {ib})");
+                }
+            }
         }
     }
 
@@ -775,7 +797,7 @@ mod tests {
                         continue;
                     }
                     tried += 1;
-                    let got = sub_cell_masks(&a, &b, ia, ib);
+                    let got = sub_cell_masks(&a, &b, ia, ib, false);
                     assert_eq!(got, octant_pairs(&a0, &a1, &b0, &b1, ia, ib, false), "{name} pair ({ia}, {ib})");
                     whole += cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) as usize;
                     let octant_meets = |c: &[Option<Obb>], s: usize, d: &[Option<Obb>], e: usize, f: usize| {
