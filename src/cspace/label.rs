@@ -149,6 +149,25 @@ impl SampleBoxes {
         out
     }
 
+    /// The entries `entries` (indices into `self`), in that order.
+    pub fn subset(&self, entries: &[u32]) -> SampleBoxes {
+        let n = self.per_entry;
+        let per_box = |e: &u32| *e as usize * n..(*e as usize + 1) * n;
+        let boxes = |v: &[_]| entries.iter().flat_map(per_box).map(|i| v[i]).collect::<Vec<_>>();
+        let entry = |v: &[_]| entries.iter().map(|&e| v[e as usize]).collect::<Vec<_>>();
+        SampleBoxes {
+            per_entry: n,
+            boxes: entries.iter().flat_map(per_box).map(|i| self.boxes[i]).collect(),
+            sweeps: entries.iter().flat_map(per_box).map(|i| self.sweeps[i]).collect(),
+            faces: entries.iter().flat_map(per_box).map(|i| self.faces[i]).collect(),
+            box_lo: boxes(&self.box_lo),
+            box_hi: boxes(&self.box_hi),
+            lo: entry(&self.lo),
+            hi: entry(&self.hi),
+            slot: entries.iter().map(|&e| self.slot[e as usize]).collect(),
+        }
+    }
+
     /// Entry count.
     pub fn len(&self) -> usize {
         self.slot.len()
@@ -253,6 +272,8 @@ where
     order.sort_by(|&i, &j| b.lo[i as usize][0].total_cmp(&b.lo[j as usize][0]));
     let keys: Vec<Real> = order.iter().map(|&i| b.lo[i as usize][0]).collect();
     let widest = order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
+    // The same entries stored in that order: a row's candidates are read in memory order.
+    let sorted = b.subset(&order);
     let bar = if progress { ProgressBar::new(na as u64) } else { ProgressBar::hidden() };
     if let Ok(style) = ProgressStyle::with_template("labelling {bar:40} {pos}/{len} rows of A, {elapsed} (eta {eta})") {
         bar.set_style(style);
@@ -275,9 +296,9 @@ where
                     let (lo, hi) = (a.lo[ia][0], a.hi[ia][0]);
                     let first = keys.partition_point(|&x| x < lo - widest - AABB_SLACK);
                     let last = keys.partition_point(|&x| x <= hi + AABB_SLACK).max(first);
-                    for &ib in &order[first..last] {
+                    for (k, &ib) in order.iter().enumerate().take(last).skip(first) {
                         let ib = ib as usize;
-                        if entries_collide(a, ia, b, ib) && second_look(ia, ib) {
+                        if entries_collide(a, ia, &sorted, k) && second_look(ia, ib) {
                             row[ib] = Label::Collision;
                         }
                     }
