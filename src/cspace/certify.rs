@@ -231,7 +231,7 @@ fn cores(boxes: &SampleBoxes) -> Vec<Option<Obb>> {
     let n = boxes.per_entry;
     (0..boxes.boxes.len())
         .into_par_iter()
-        .map(|i| if boxes.slot[i / n] == Slot::Boxes { core(&boxes.boxes[i], &boxes.sweeps[i]) } else { None })
+        .map(|i| if boxes.slot[i / n] == Slot::Boxes { core(&boxes.boxes[i].obb, &boxes.boxes[i].sweep) } else { None })
         .collect()
 }
 

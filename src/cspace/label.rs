@@ -65,6 +65,40 @@ pub enum Inflation {
     Unknown,
 }
 
+/// One box of a [`SampleBoxes`] entry with everything the box test reads, side by side (one
+/// stretch of memory per box: the tests read boxes of many entries in turn).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SweptBox {
+    /// AABB of the swept box, lower corner.
+    pub lo: [Real; 3],
+    /// Upper corner.
+    pub hi: [Real; 3],
+    /// The box at the entry's centre.
+    pub obb: Obb,
+    /// Its displacement set in the WCS ([`Sweep::ZERO`] for the exact boxes).
+    pub sweep: Sweep,
+    /// Whether `sweep` is [`Sweep::is_zero`] (an exact box: the separating axis test).
+    pub exact: bool,
+    /// Its terms of the swept test on its own face axes.
+    pub faces: FaceTerms,
+}
+
+impl SweptBox {
+    /// Box `b` swept by `sweep`, with its bounds.
+    pub fn new(b: Obb, sweep: Sweep) -> SweptBox {
+        let h = swept_aabb_half(&b, &sweep);
+        let (lo, hi) = (b.center - h, b.center + h);
+        SweptBox {
+            lo: [lo.x, lo.y, lo.z],
+            hi: [hi.x, hi.y, hi.z],
+            obb: b,
+            sweep,
+            exact: sweep.is_zero(),
+            faces: FaceTerms::new(&b, &sweep),
+        }
+    }
+}
+
 /// One robot's boxes at a list of centres (sample centres, or sub-cell centres), in the WCS,
 /// with their axis-aligned bounds: built once, shared by every pair.
 #[derive(Clone, Debug)]
@@ -72,15 +106,7 @@ pub struct SampleBoxes {
     /// Boxes per entry.
     pub per_entry: usize,
     /// Box `j` of entry `s` at `s * per_entry + j` (meaningful when `slot[s]` is `Boxes`).
-    pub boxes: Vec<Obb>,
-    /// Per box: its displacement set in the WCS ([`Sweep::ZERO`] for the exact boxes).
-    pub sweeps: Vec<Sweep>,
-    /// Per box: its terms of the swept test on its own face axes ([`FaceTerms`]).
-    pub faces: Vec<FaceTerms>,
-    /// Per box: AABB lower corner.
-    pub box_lo: Vec<[Real; 3]>,
-    /// Per box: AABB upper corner.
-    pub box_hi: Vec<[Real; 3]>,
+    pub boxes: Vec<SweptBox>,
     /// Per entry: the AABB of all its boxes, lower corner.
     pub lo: Vec<[Real; 3]>,
     /// Per entry: upper corner.
@@ -118,10 +144,6 @@ impl SampleBoxes {
         let mut out = SampleBoxes {
             per_entry: nb,
             boxes: Vec::with_capacity(n * nb),
-            sweeps: Vec::with_capacity(n * nb),
-            faces: Vec::with_capacity(n * nb),
-            box_lo: Vec::with_capacity(n * nb),
-            box_hi: Vec::with_capacity(n * nb),
             lo: Vec::with_capacity(n),
             hi: Vec::with_capacity(n),
             slot: Vec::with_capacity(n),
@@ -130,17 +152,12 @@ impl SampleBoxes {
             let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
             for j in 0..nb {
                 let (b, sweep) = boxes.get(j).copied().unwrap_or((empty, Sweep::ZERO));
-                let h = swept_aabb_half(&b, &sweep);
-                let (bl, bh) = (b.center - h, b.center + h);
+                let swept = SweptBox::new(b, sweep);
                 for a in 0..3 {
-                    lo[a] = lo[a].min(bl[a]);
-                    hi[a] = hi[a].max(bh[a]);
+                    lo[a] = lo[a].min(swept.lo[a]);
+                    hi[a] = hi[a].max(swept.hi[a]);
                 }
-                out.boxes.push(b);
-                out.sweeps.push(sweep);
-                out.faces.push(FaceTerms::new(&b, &sweep));
-                out.box_lo.push([bl.x, bl.y, bl.z]);
-                out.box_hi.push([bh.x, bh.y, bh.z]);
+                out.boxes.push(swept);
             }
             out.lo.push(lo);
             out.hi.push(hi);
@@ -153,15 +170,10 @@ impl SampleBoxes {
     pub fn subset(&self, entries: &[u32]) -> SampleBoxes {
         let n = self.per_entry;
         let per_box = |e: &u32| *e as usize * n..(*e as usize + 1) * n;
-        let boxes = |v: &[_]| entries.iter().flat_map(per_box).map(|i| v[i]).collect::<Vec<_>>();
         let entry = |v: &[_]| entries.iter().map(|&e| v[e as usize]).collect::<Vec<_>>();
         SampleBoxes {
             per_entry: n,
             boxes: entries.iter().flat_map(per_box).map(|i| self.boxes[i]).collect(),
-            sweeps: entries.iter().flat_map(per_box).map(|i| self.sweeps[i]).collect(),
-            faces: entries.iter().flat_map(per_box).map(|i| self.faces[i]).collect(),
-            box_lo: boxes(&self.box_lo),
-            box_hi: boxes(&self.box_hi),
             lo: entry(&self.lo),
             hi: entry(&self.hi),
             slot: entries.iter().map(|&e| self.slot[e as usize]).collect(),
@@ -196,14 +208,14 @@ pub(crate) fn entries_apart(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usi
 /// ([`crate::geometry::swept_boxes_apart`]).
 #[inline]
 pub(crate) fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usize) -> bool {
-    if aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j]) {
+    let (x, y) = (&a.boxes[i], &b.boxes[j]);
+    if aabbs_apart(&x.lo, &x.hi, &y.lo, &y.hi) {
         return false;
     }
-    let (sa, sb) = (&a.sweeps[i], &b.sweeps[j]);
-    if sa.is_zero() && sb.is_zero() {
-        separating_axis(&a.boxes[i], &b.boxes[j]).is_none()
+    if x.exact && y.exact {
+        separating_axis(&x.obb, &y.obb).is_none()
     } else {
-        !swept_boxes_apart_with(&a.boxes[i], sa, &a.faces[i], &b.boxes[j], sb, &b.faces[j])
+        !swept_boxes_apart_with(&x.obb, &x.sweep, &x.faces, &y.obb, &y.sweep, &y.faces)
     }
 }
 
