@@ -19,6 +19,12 @@
 //! not proved is a collision. [`label_space_subdivided`] keeps level 2's answer per octant pair
 //! for the pairs that stay collisions ([`SubCells`]).
 //!
+//! The sub-cells are found faster than by 64 runs of level 2 ([`sub_cell_masks`], same
+//! answers): an octant pair is a collision without its tests when a box pair certainly
+//! intersects for every configuration of a (sub)cell pair holding it (the boxes' *cores*
+//! overlap, [`crate::geometry::sweep`], "Certain intersection"); whole cells decide all 64
+//! at once, an octant with the other robot's whole cell decides a row or column of 8.
+//!
 //! A sample is labelled [`Label::Unreachable`](crate::cspace::Label) ("don't care") only
 //! when no TCP of its whole cell is reachable ([`cube_unreachable`]); a cell whose centre is
 //! unreachable but which holds reachable TCPs is measured from a reachable reference point,
@@ -27,20 +33,25 @@
 //! Sweeps are made mirror-symmetric (every size the larger of an entry's and its mirror's,
 //! arms 1 and 2 swapped), so that a symmetric cell gets symmetric labels (thesis 3.2.8).
 
-use crate::cell::Cell;
+use crate::cell::{Cell, RobotSpec};
 use crate::cspace::guarantee::{box_sweeps, cube_box_sweeps, cube_unreachable, reference_point, SPLITS};
 use crate::cspace::label::{
-    aabbs_apart, all_box_pairs, collision_mask, entries_apart, entries_collide, label_pairs, two_robot_grids,
-    Inflation, SampleBoxes, Slot,
+    aabbs_apart, all_box_pairs, boxes_may_touch, collision_mask, entries_apart, entries_collide, label_pairs,
+    two_robot_grids, Inflation, SampleBoxes, Slot,
 };
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::symmetry::mirror_cell;
 use crate::cspace::{Label, LabelledSpace};
+use crate::geometry::sweep::{boxes_overlap_deeply, core};
 use crate::geometry::witness::MAX_BOXES;
-use crate::geometry::Sweep;
+use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::{BoxKind, RobotModel};
 use rayon::prelude::*;
+
+/// Rows of A whose sub-cells are found together ([`sub_cells`]; a cache blocking, any value
+/// gives the same answers).
+const SUB_CELL_ROWS: usize = 16;
 
 /// Sub-boxes per axis when enclosing the motor angles over an octant (an octant is half as
 /// wide as a cell, so this gives the same sub-box size as [`SPLITS`] on a cell).
@@ -150,21 +161,11 @@ fn label_space_certified_inner(
     let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
     let (sweeps_a, sweeps_b) = (cell_sweeps(&ra.model, &grid_a), cell_sweeps(&rb.model, &grid_b));
     let (empty_a, empty_b) = (unreachable_cells(&ra.model, &grid_a), unreachable_cells(&rb.model, &grid_b));
-    let level1 = |b: &[[Sweep; MAX_BOXES]], empty: &[bool], s: usize| {
-        if empty[s] {
-            Inflation::Unreachable
-        } else {
-            inflation(b[s])
-        }
-    };
     let (refs_a, refs_b) = (references(&ra.model, &grid_a), references(&rb.model, &grid_b));
-    let a0 = SampleBoxes::new(&ra.model, &ra.placement, &refs_a, |s| level1(&sweeps_a, &empty_a, s));
-    let b0 = SampleBoxes::new(&rb.model, &rb.placement, &refs_b, |s| level1(&sweeps_b, &empty_b, s));
+    let a0 = whole_cell_boxes(ra, &refs_a, &sweeps_a, &empty_a);
+    let b0 = whole_cell_boxes(rb, &refs_b, &sweeps_b, &empty_b);
     let labels = if refine {
-        let (ca, ea) = octants(&ra.model, &grid_a);
-        let (cb, eb) = octants(&rb.model, &grid_b);
-        let a1 = SampleBoxes::new(&ra.model, &ra.placement, &ca, |s| ea[s]);
-        let b1 = SampleBoxes::new(&rb.model, &rb.placement, &cb, |s| eb[s]);
+        let (a1, b1) = (octant_boxes(ra, &grid_a), octant_boxes(rb, &grid_b));
         // The physical boxes at the reference points: a pair that collides there is a
         // collision without refinement.
         let none = |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]);
@@ -172,10 +173,18 @@ fn label_space_certified_inner(
             SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
             SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
         );
-        let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&a0, &a1, &b0, &b1, ia, ib);
+        let (la, lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+        let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
         let mut labels = label_pairs(&a0, &b0, collides, progress);
-        refine_unknown_cells(&a0, &a1, &b0, &b1, &mut labels);
-        let sub = subdivide.then(|| sub_cells(&a0, &a1, &b0, &b1, &labels));
+        refine_unknown_cells(&la, &lb, &mut labels);
+        let sub = subdivide.then(|| {
+            let start = std::time::Instant::now();
+            let sub = sub_cells(&la, &lb, &labels);
+            if progress {
+                eprintln!("sub-cells of {} collision pairs: {:.2} s", sub.pairs.len(), start.elapsed().as_secs_f64());
+            }
+            sub
+        });
         (labels, sub)
     } else {
         (label_pairs(&a0, &b0, |_, _| true, progress), None)
@@ -189,24 +198,85 @@ fn label_space_certified_inner(
     Ok(CertifiedSpace { space, bounds_a, bounds_b, refined: refine, sub })
 }
 
+/// One robot's level-1 boxes: at each sample's reference point `refs[s]`, swept by its
+/// whole-cell displacement sets (`Unreachable` where the whole cell is, `empty[s]`).
+fn whole_cell_boxes(robot: &RobotSpec, refs: &[Vec3], sweeps: &[[Sweep; MAX_BOXES]], empty: &[bool]) -> SampleBoxes {
+    let inflate = |s: usize| if empty[s] { Inflation::Unreachable } else { inflation(sweeps[s]) };
+    SampleBoxes::new(&robot.model, &robot.placement, refs, inflate)
+}
+
+/// One robot's level-2 boxes: entry `8 s + i` for octant `i` of sample `s` ([`octants`]).
+fn octant_boxes(robot: &RobotSpec, grid: &SampleGrid) -> SampleBoxes {
+    let (refs, inflate) = octants(&robot.model, grid);
+    SampleBoxes::new(&robot.model, &robot.placement, &refs, |s| inflate[s])
+}
+
+/// One robot's boxes at both levels with their cores ([`core`]: what every configuration of
+/// the (sub)cell covers; `None` for a box without one or an entry without boxes).
+struct Levels<'a> {
+    whole: &'a SampleBoxes,
+    octs: &'a SampleBoxes,
+    whole_cores: Vec<Option<Obb>>,
+    oct_cores: Vec<Option<Obb>>,
+}
+
+impl<'a> Levels<'a> {
+    fn new(whole: &'a SampleBoxes, octs: &'a SampleBoxes) -> Self {
+        Levels { whole, octs, whole_cores: cores(whole), oct_cores: cores(octs) }
+    }
+}
+
+/// Per box of `boxes`: its core under its sweep, when its entry has boxes and the core exists.
+fn cores(boxes: &SampleBoxes) -> Vec<Option<Obb>> {
+    let n = boxes.per_entry;
+    (0..boxes.boxes.len())
+        .into_par_iter()
+        .map(|i| if boxes.slot[i / n] == Slot::Boxes { core(&boxes.boxes[i].obb, &boxes.boxes[i].sweep) } else { None })
+        .collect()
+}
+
+/// Whether some box pair among `mask` (as [`collision_mask`]) of A's entry `ia` and B's entry
+/// `ib` certainly intersects: their cores overlap deeply ([`boxes_overlap_deeply`]), so the
+/// boxes meet for every configuration of the two (sub)cells.
+fn cores_meet(a: &[Option<Obb>], ia: usize, na: usize, b: &[Option<Obb>], ib: usize, nb: usize, mask: u64) -> bool {
+    let mut rest = mask;
+    while rest != 0 {
+        let bit = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        if let (Some(x), Some(y)) = (&a[ia * na + bit / 8], &b[ib * nb + bit % 8]) {
+            if boxes_overlap_deeply(x, y) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
 /// The sub-cell labels of every pair labelled collision (see [`SubCells`]).
-fn sub_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBoxes, labels: &[Label]) -> SubCells {
-    let nb = b0.len();
+///
+/// Rows of A are taken [`SUB_CELL_ROWS`] at a time, column by column, so that B's boxes of a
+/// column are used by every row of the block while they are in the cache.
+fn sub_cells(a: &Levels, b: &Levels, labels: &[Label]) -> SubCells {
+    let nb = b.whole.len();
     if nb == 0 {
         return SubCells::default();
     }
     let rows: Vec<Vec<(u64, u64, u64)>> = labels
-        .par_chunks(nb)
+        .par_chunks(nb * SUB_CELL_ROWS)
         .enumerate()
-        .map(|(ia, row)| {
-            row.iter()
-                .enumerate()
-                .filter(|&(_, &l)| l == Label::Collision)
-                .map(|(ib, _)| {
-                    let (care, collision) = octant_pairs(a0, a1, b0, b1, ia, ib, false);
-                    ((ia * nb + ib) as u64, care, collision)
-                })
-                .collect()
+        .map(|(block, rows)| {
+            let mut out = vec![];
+            for ib in 0..nb {
+                for (r, row) in rows.chunks(nb).enumerate() {
+                    if row[ib] == Label::Collision {
+                        let ia = block * SUB_CELL_ROWS + r;
+                        let (care, collision) = sub_cell_masks(a, b, ia, ib, false);
+                        out.push(((ia * nb + ib) as u64, care, collision));
+                    }
+                }
+            }
+            out.sort_unstable_by_key(|&(pair, _, _)| pair);
+            out
         })
         .collect();
     let mut out = SubCells::default();
@@ -273,11 +343,136 @@ pub fn subdivided_labels(cell: &Cell, ws: &Workspace, certified: &CertifiedSpace
     Ok(LabelledSpace { grid_a, grid_b, labels, margin: coarse.margin })
 }
 
+/// The sub-cells of `(ia, ib)` that hold reachable TCPs of both robots: neither octant is
+/// [`Slot::Vacuous`].
+fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize) -> u64 {
+    // `sub_cell_index(i, j) = 8 sub_cell_index(i, 0) + sub_cell_index(0, j)`: B's occupied
+    // octants as one byte, shifted to each occupied octant of A's byte.
+    let column =
+        (0..8).filter(|&j| b1.slot[8 * ib + j] != Slot::Vacuous).fold(0u64, |m, j| m | 1 << sub_cell_index(0, j));
+    (0..8).filter(|&i| a1.slot[8 * ia + i] != Slot::Vacuous).fold(0, |m, i| m | column << sub_cell_index(i, 0))
+}
+
+/// `(care, collision)` over the 64 octant pairs of `(ia, ib)`, as [`octant_pairs`] gives
+/// them, faster (every change only skips tests whose answers are implied, or reorders tests
+/// whose answers are combined by "and"/"or"):
+/// - an octant pair is a collision as soon as a box pair certainly intersects for every
+///   configuration of a (sub)cell pair that holds it ([`cores_meet`]): of the whole cells
+///   (then every octant pair is), of A's octant and B's cell (its row), of A's cell and B's
+///   octant (its column). Such an octant pair is never proved free by [`octant_pairs`]: its
+///   octants are [`Slot::Boxes`] only with reachable reference TCPs, a configuration of the
+///   pair that collides, and its tests are sound; other octants it calls collisions anyway.
+/// - a box pair of an octant pair is proved disjoint when one of the tests (A octant, B
+///   cell), (A cell, B octant), (A octant, B octant) proves it (after the whole cells left it
+///   open); an octant pair is free when all its box pairs are. The octant-cell tests are
+///   shared by the 8 pairs of a row or column and run only when first needed; the box pairs
+///   are tried from the one that last stopped an octant pair, and an octant pair stops at
+///   its first box pair that no test proves.
+///
+/// With `first_only`, stops at the first octant pair not proved free.
+fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first_only: bool) -> (u64, u64) {
+    let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
+    let (na, nb) = (a0.per_entry, b0.per_entry);
+    let care = care_mask(a1, ia, b1, ib);
+    let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
+    let all = all_box_pairs(na, nb);
+    // A box pair whose cores meet is never proved disjoint: no need to look for it among
+    // those the whole cells leave open.
+    if whole_a && whole_b && cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) {
+        return (care, care);
+    }
+    let open0 = if whole_a && whole_b { collision_mask(a0, ia, b0, ib, all) } else { all };
+    let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
+    let row_meets: [bool; 8] = std::array::from_fn(|i| {
+        let sa = 8 * ia + i;
+        whole_b && boxes(a1, sa) && cores_meet(&a.oct_cores, sa, na, &b.whole_cores, ib, nb, open0)
+    });
+    let column_meets: [bool; 8] = std::array::from_fn(|j| {
+        let sb = 8 * ib + j;
+        whole_a && boxes(b1, sb) && cores_meet(&a.whole_cores, ia, na, &b.oct_cores, sb, nb, open0)
+    });
+    // Whether box pair `bit` may touch between A's entry `ea` of `x` and B's entry `eb` of `y`.
+    let touch = |x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize| {
+        boxes_may_touch(x, ea * na + bit / 8, y, eb * nb + bit % 8)
+    };
+    let (mut rows, mut columns) = (Memo::default(), Memo::default());
+    let mut hint = open0.trailing_zeros() as usize;
+    let mut collision = 0u64;
+    for i in 0..8 {
+        for j in 0..8 {
+            let bit = 1u64 << sub_cell_index(i, j);
+            if care & bit == 0 {
+                continue;
+            }
+            let (sa, sb) = (8 * ia + i, 8 * ib + j);
+            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meets[i] || column_meets[j];
+            // Whether box pair `p` stays open: no test of the octant pair proves it.
+            let mut open = |p: usize| {
+                rows.open(i, p, || !whole_b || touch(a1, sa, b0, ib, p))
+                    && columns.open(j, p, || !whole_a || touch(a0, ia, b1, sb, p))
+                    && touch(a1, sa, b1, sb, p)
+            };
+            let stopper = if decided {
+                None
+            } else if entries_apart(a1, sa, b1, sb) {
+                Some(None)
+            } else {
+                Some(hint_first(open0, hint).find(|&p| open(p)))
+            };
+            match stopper {
+                Some(None) => continue,
+                Some(Some(p)) => hint = p,
+                None => {}
+            }
+            collision |= bit;
+            if first_only {
+                return (care, collision);
+            }
+        }
+    }
+    (care, collision)
+}
+
+/// The answers of one kind of coarse test (an octant against the other robot's whole cell),
+/// found when first asked: per octant `o`, bit `p` of `known[o]` says whether box pair `p` was
+/// tested, of `open[o]` whether it stayed open.
+#[derive(Default)]
+struct Memo {
+    known: [u64; 8],
+    open: [u64; 8],
+}
+
+impl Memo {
+    /// Whether box pair `p` of octant `o` stays open; `test` finds it the first time.
+    fn open(&mut self, o: usize, p: usize, test: impl FnOnce() -> bool) -> bool {
+        let bit = 1u64 << p;
+        if self.known[o] & bit == 0 {
+            self.known[o] |= bit;
+            if test() {
+                self.open[o] |= bit;
+            }
+        }
+        self.open[o] & bit != 0
+    }
+}
+
+/// The set bits of `mask` (box pair indices), `hint` first when set, then the others upward.
+fn hint_first(mask: u64, hint: usize) -> impl Iterator<Item = usize> {
+    let first = (hint < 64 && mask >> hint & 1 == 1).then_some(hint);
+    let mut rest = first.map_or(mask, |h| mask & !(1u64 << h));
+    first.into_iter().chain(std::iter::from_fn(move || {
+        let p = rest.trailing_zeros() as usize;
+        rest &= rest.wrapping_sub(1);
+        (p < 64).then_some(p)
+    }))
+}
+
 /// `(care, collision)` over the 64 octant pairs of `(ia, ib)`: an octant pair is free when
 /// every box pair is proved disjoint by one of the tests (A cell, B cell), (A octant,
 /// B cell), (A cell, B octant) or (A octant, B octant), each valid for all of it. Only the
 /// box pairs a coarser test left open go on to a finer one. With `first_only`, stops at the
-/// first octant pair not proved free.
+/// first octant pair not proved free. The plain form of [`sub_cell_masks`], kept to test it.
+#[cfg(test)]
 fn octant_pairs(
     a0: &SampleBoxes,
     a1: &SampleBoxes,
@@ -323,21 +518,15 @@ fn octant_pairs(
 
 /// Level 2 for a pair whose whole-cell test failed or could not run (a sample without a
 /// whole-cell bound, [`Slot::Unknown`]: its centre is unreachable but its cell is not):
-/// every octant pair proved free by [`octant_pairs`] (which stops at the first that is not).
-fn octants_prove_free(
-    a0: &SampleBoxes,
-    a1: &SampleBoxes,
-    b0: &SampleBoxes,
-    b1: &SampleBoxes,
-    ia: usize,
-    ib: usize,
-) -> bool {
-    octant_pairs(a0, a1, b0, b1, ia, ib, true).1 == 0
+/// every octant pair proved free ([`sub_cell_masks`], stopping at the first that is not).
+fn octants_prove_free(a: &Levels, b: &Levels, ia: usize, ib: usize) -> bool {
+    sub_cell_masks(a, b, ia, ib, true).1 == 0
 }
 
 /// Level 2 for the pairs that [`label_pairs`] made collisions because a sample has no
 /// whole-cell bound ([`Slot::Unknown`]): each is retried octant by octant.
-fn refine_unknown_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1: &SampleBoxes, labels: &mut [Label]) {
+fn refine_unknown_cells(a: &Levels, b: &Levels, labels: &mut [Label]) {
+    let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
     let unknown_b: Vec<usize> = (0..b0.len()).filter(|&ib| b0.slot[ib] == Slot::Unknown).collect();
     let (cover_a, cover_b) = (octant_covers(a1), octant_covers(b1));
     let nb = b0.len();
@@ -348,7 +537,7 @@ fn refine_unknown_cells(a0: &SampleBoxes, a1: &SampleBoxes, b0: &SampleBoxes, b1
         let mut retry = |ib: usize| {
             if row[ib] == Label::Collision
                 && b0.slot[ib] != Slot::Unreachable
-                && (cover_apart(&cover_a[ia], &cover_b[ib]) || octants_prove_free(a0, a1, b0, b1, ia, ib))
+                && (cover_apart(&cover_a[ia], &cover_b[ib]) || octants_prove_free(a, b, ia, ib))
             {
                 row[ib] = Label::Free;
             }
@@ -544,6 +733,90 @@ mod tests {
                 added += (*e == Label::Free && *f == Label::Collision) as usize;
             }
             assert!(freed > 0 && added > 0, "{name}: {freed} freed, {added} added");
+        }
+    }
+
+    /// Both robots' boxes at both levels, as [`label_space_subdivided`] builds them: `(a0, a1,
+    /// b0, b1)`.
+    fn level_boxes(cell: &Cell, k: u32) -> (SampleBoxes, SampleBoxes, SampleBoxes, SampleBoxes) {
+        let (grid_a, grid_b) = two_robot_grids(cell, k, &Workspace::THESIS).unwrap();
+        let whole = |r: &RobotSpec, g: &SampleGrid| {
+            whole_cell_boxes(r, &references(&r.model, g), &cell_sweeps(&r.model, g), &unreachable_cells(&r.model, g))
+        };
+        let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
+        (whole(ra, &grid_a), octant_boxes(ra, &grid_a), whole(rb, &grid_b), octant_boxes(rb, &grid_b))
+    }
+
+    /// The sub-cells of a subdivided labelling are exactly those of the plain octant tests
+    /// ([`octant_pairs`]), pair by pair, on every collision pair at k = 16.
+    #[test]
+    fn sub_cells_are_those_of_the_plain_octant_tests() {
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let c = label_space_subdivided(&cell, 16, &Workspace::THESIS, false).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let nb = b0.len();
+            let mut want = SubCells::default();
+            for (p, _) in c.space.labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision) {
+                let (care, collision) = octant_pairs(&a0, &a1, &b0, &b1, p / nb, p % nb, false);
+                want.pairs.push(p as u64);
+                want.care.push(care);
+                want.collision.push(collision);
+            }
+            assert!(!want.pairs.is_empty());
+            assert!(c.sub.as_ref() == Some(&want), "{name}: the fast sub-cells differ from the plain ones");
+            // The labels' level 2 (first octant pair not proved free) answers as the plain one.
+            let (a, b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+            let unreachable = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Unreachable;
+            for ia in (0..a0.len()).filter(|&ia| !unreachable(&a0, ia)) {
+                for ib in (0..nb).filter(|&ib| !unreachable(&b0, ib)) {
+                    let plain = octant_pairs(&a0, &a1, &b0, &b1, ia, ib, true).1 == 0;
+                    assert_eq!(octants_prove_free(&a, &b, ia, ib), plain, "{name} pair ({ia}, {ib})");
+                }
+            }
+        }
+    }
+
+    /// At k = 32, where cores exist, the fast masks ([`sub_cell_masks`]) equal the plain ones on
+    /// a spread of pairs whose boxes may meet, among them pairs where each certificate of a
+    /// certain intersection (whole cells, A's octant with B's cell, A's cell with B's octant)
+    /// decides.
+    #[test]
+    fn fast_sub_cell_masks_match_the_plain_ones_where_cores_meet() {
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 32);
+            let (a, b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+            let (na, nb) = (a0.per_entry, b0.per_entry);
+            let all = all_box_pairs(na, nb);
+            let (mut tried, mut whole, mut row, mut column) = (0, 0, 0, 0);
+            for ia in (0..a0.len()).step_by(7) {
+                for ib in (ia % 11..b0.len()).step_by(11) {
+                    let boxes = a0.slot[ia] == Slot::Boxes && b0.slot[ib] == Slot::Boxes;
+                    if !boxes || !entries_collide(&a0, ia, &b0, ib) {
+                        continue;
+                    }
+                    tried += 1;
+                    let got = sub_cell_masks(&a, &b, ia, ib, false);
+                    assert_eq!(got, octant_pairs(&a0, &a1, &b0, &b1, ia, ib, false), "{name} pair ({ia}, {ib})");
+                    whole += cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) as usize;
+                    let octant_meets = |c: &[Option<Obb>], s: usize, d: &[Option<Obb>], e: usize, f: usize| {
+                        (0..8).any(|i| {
+                            if f == 0 {
+                                cores_meet(c, 8 * s + i, na, d, e, nb, all)
+                            } else {
+                                cores_meet(c, s, na, d, 8 * e + i, nb, all)
+                            }
+                        })
+                    };
+                    row += octant_meets(&a.oct_cores, ia, &b.whole_cores, ib, 0) as usize;
+                    column += octant_meets(&a.whole_cores, ia, &b.oct_cores, ib, 1) as usize;
+                }
+            }
+            assert!(
+                whole > 0 && row > whole && column > whole,
+                "{name}: {tried} pairs, cores meet {whole} {row} {column}"
+            );
         }
     }
 

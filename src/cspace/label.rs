@@ -24,7 +24,7 @@ use crate::cspace::guarantee::thesis_margin;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::sat::separating_axis;
-use crate::geometry::sweep::{swept_aabb_half, swept_boxes_apart, Sweep};
+use crate::geometry::sweep::{swept_aabb_half, swept_boxes_apart_with, FaceTerms, Sweep};
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{Mat3, Real, Vec3};
@@ -65,6 +65,40 @@ pub enum Inflation {
     Unknown,
 }
 
+/// One box of a [`SampleBoxes`] entry with everything the box test reads, side by side (one
+/// stretch of memory per box: the tests read boxes of many entries in turn).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SweptBox {
+    /// AABB of the swept box, lower corner.
+    pub lo: [Real; 3],
+    /// Upper corner.
+    pub hi: [Real; 3],
+    /// The box at the entry's centre.
+    pub obb: Obb,
+    /// Its displacement set in the WCS ([`Sweep::ZERO`] for the exact boxes).
+    pub sweep: Sweep,
+    /// Whether `sweep` is [`Sweep::is_zero`] (an exact box: the separating axis test).
+    pub exact: bool,
+    /// Its terms of the swept test on its own face axes.
+    pub faces: FaceTerms,
+}
+
+impl SweptBox {
+    /// Box `b` swept by `sweep`, with its bounds.
+    pub fn new(b: Obb, sweep: Sweep) -> SweptBox {
+        let h = swept_aabb_half(&b, &sweep);
+        let (lo, hi) = (b.center - h, b.center + h);
+        SweptBox {
+            lo: [lo.x, lo.y, lo.z],
+            hi: [hi.x, hi.y, hi.z],
+            obb: b,
+            sweep,
+            exact: sweep.is_zero(),
+            faces: FaceTerms::new(&b, &sweep),
+        }
+    }
+}
+
 /// One robot's boxes at a list of centres (sample centres, or sub-cell centres), in the WCS,
 /// with their axis-aligned bounds: built once, shared by every pair.
 #[derive(Clone, Debug)]
@@ -72,13 +106,7 @@ pub struct SampleBoxes {
     /// Boxes per entry.
     pub per_entry: usize,
     /// Box `j` of entry `s` at `s * per_entry + j` (meaningful when `slot[s]` is `Boxes`).
-    pub boxes: Vec<Obb>,
-    /// Per box: its displacement set in the WCS ([`Sweep::ZERO`] for the exact boxes).
-    pub sweeps: Vec<Sweep>,
-    /// Per box: AABB lower corner.
-    pub box_lo: Vec<[Real; 3]>,
-    /// Per box: AABB upper corner.
-    pub box_hi: Vec<[Real; 3]>,
+    pub boxes: Vec<SweptBox>,
     /// Per entry: the AABB of all its boxes, lower corner.
     pub lo: Vec<[Real; 3]>,
     /// Per entry: upper corner.
@@ -116,9 +144,6 @@ impl SampleBoxes {
         let mut out = SampleBoxes {
             per_entry: nb,
             boxes: Vec::with_capacity(n * nb),
-            sweeps: Vec::with_capacity(n * nb),
-            box_lo: Vec::with_capacity(n * nb),
-            box_hi: Vec::with_capacity(n * nb),
             lo: Vec::with_capacity(n),
             hi: Vec::with_capacity(n),
             slot: Vec::with_capacity(n),
@@ -127,22 +152,32 @@ impl SampleBoxes {
             let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
             for j in 0..nb {
                 let (b, sweep) = boxes.get(j).copied().unwrap_or((empty, Sweep::ZERO));
-                let h = swept_aabb_half(&b, &sweep);
-                let (bl, bh) = (b.center - h, b.center + h);
+                let swept = SweptBox::new(b, sweep);
                 for a in 0..3 {
-                    lo[a] = lo[a].min(bl[a]);
-                    hi[a] = hi[a].max(bh[a]);
+                    lo[a] = lo[a].min(swept.lo[a]);
+                    hi[a] = hi[a].max(swept.hi[a]);
                 }
-                out.boxes.push(b);
-                out.sweeps.push(sweep);
-                out.box_lo.push([bl.x, bl.y, bl.z]);
-                out.box_hi.push([bh.x, bh.y, bh.z]);
+                out.boxes.push(swept);
             }
             out.lo.push(lo);
             out.hi.push(hi);
             out.slot.push(slot);
         }
         out
+    }
+
+    /// The entries `entries` (indices into `self`), in that order.
+    pub fn subset(&self, entries: &[u32]) -> SampleBoxes {
+        let n = self.per_entry;
+        let per_box = |e: &u32| *e as usize * n..(*e as usize + 1) * n;
+        let entry = |v: &[_]| entries.iter().map(|&e| v[e as usize]).collect::<Vec<_>>();
+        SampleBoxes {
+            per_entry: n,
+            boxes: entries.iter().flat_map(per_box).map(|i| self.boxes[i]).collect(),
+            lo: entry(&self.lo),
+            hi: entry(&self.hi),
+            slot: entries.iter().map(|&e| self.slot[e as usize]).collect(),
+        }
     }
 
     /// Entry count.
@@ -170,17 +205,17 @@ pub(crate) fn entries_apart(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usi
 
 /// Whether box `i` of A (index into `a.boxes`) and box `j` of B may intersect: not proved
 /// apart by their AABBs, nor by the separating axis test (exact boxes) or its swept form
-/// ([`swept_boxes_apart`]).
+/// ([`crate::geometry::swept_boxes_apart`]).
 #[inline]
-fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usize) -> bool {
-    if aabbs_apart(&a.box_lo[i], &a.box_hi[i], &b.box_lo[j], &b.box_hi[j]) {
+pub(crate) fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usize) -> bool {
+    let (x, y) = (&a.boxes[i], &b.boxes[j]);
+    if aabbs_apart(&x.lo, &x.hi, &y.lo, &y.hi) {
         return false;
     }
-    let (sa, sb) = (&a.sweeps[i], &b.sweeps[j]);
-    if sa.is_zero() && sb.is_zero() {
-        separating_axis(&a.boxes[i], &b.boxes[j]).is_none()
+    if x.exact && y.exact {
+        separating_axis(&x.obb, &y.obb).is_none()
     } else {
-        !swept_boxes_apart(&a.boxes[i], sa, &b.boxes[j], sb)
+        !swept_boxes_apart_with(&x.obb, &x.sweep, &x.faces, &y.obb, &y.sweep, &y.faces)
     }
 }
 
@@ -249,6 +284,8 @@ where
     order.sort_by(|&i, &j| b.lo[i as usize][0].total_cmp(&b.lo[j as usize][0]));
     let keys: Vec<Real> = order.iter().map(|&i| b.lo[i as usize][0]).collect();
     let widest = order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
+    // The same entries stored in that order: a row's candidates are read in memory order.
+    let sorted = b.subset(&order);
     let bar = if progress { ProgressBar::new(na as u64) } else { ProgressBar::hidden() };
     if let Ok(style) = ProgressStyle::with_template("labelling {bar:40} {pos}/{len} rows of A, {elapsed} (eta {eta})") {
         bar.set_style(style);
@@ -271,9 +308,9 @@ where
                     let (lo, hi) = (a.lo[ia][0], a.hi[ia][0]);
                     let first = keys.partition_point(|&x| x < lo - widest - AABB_SLACK);
                     let last = keys.partition_point(|&x| x <= hi + AABB_SLACK).max(first);
-                    for &ib in &order[first..last] {
+                    for (k, &ib) in order.iter().enumerate().take(last).skip(first) {
                         let ib = ib as usize;
-                        if entries_collide(a, ia, b, ib) && second_look(ia, ib) {
+                        if entries_collide(a, ia, &sorted, k) && second_look(ia, ib) {
                             row[ib] = Label::Collision;
                         }
                     }
