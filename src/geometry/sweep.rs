@@ -159,8 +159,8 @@ impl FaceTerms {
         FaceTerms {
             short: u.map(|n| n.norm_squared() < 1e-10),
             u,
-            radius: std::array::from_fn(|k| radius(&u, &b.half, &u[k])),
-            support: std::array::from_fn(|k| s.support_with_norm(&u[k], norm[k])),
+            radius: core::array::from_fn(|k| radius(&u, &b.half, &u[k])),
+            support: core::array::from_fn(|k| s.support_with_norm(&u[k], norm[k])),
             norm,
         }
     }
