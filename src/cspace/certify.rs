@@ -19,7 +19,7 @@
 //! not proved is a collision. [`label_space_subdivided`] keeps level 2's answer per octant pair
 //! for the pairs that stay collisions ([`SubCells`]).
 //!
-//! The sub-cells are found faster than by 64 runs of level 2 ([`sub_cell_masks`], same
+//! The sub-cells are found faster than by 64 runs of level 2 (`sub_cell_masks`, same
 //! answers): an octant pair is a collision without its tests when a box pair certainly
 //! intersects for every configuration of a (sub)cell pair holding it (the boxes' *cores*
 //! overlap, [`crate::geometry::sweep`], "Certain intersection"); whole cells decide all 64
