@@ -316,13 +316,8 @@ mod tests {
     /// that the unrolled test returns, no earlier axis separates and `k` does.
     #[test]
     fn unrolled_axes_match_the_generic_formula() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
-        };
+        let mut rng = crate::geometry::TestRng(0x9e37_79b9_7f4a_7c15_u64);
+        let mut next = move || rng.unit();
         let mut seen = [0usize; 16];
         for _ in 0..200_000 {
             let rot =

@@ -474,13 +474,8 @@ mod tests {
     /// whose moved boxes intersect.
     #[test]
     fn always_meet_proves_many_intersections() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
-        };
+        let mut rng = crate::geometry::TestRng(0x2545_f491_4f6c_dd1d_u64);
+        let mut next = move || rng.unit();
         let (mut proved, mut intersecting) = (0, 0);
         for _ in 0..20_000 {
             let x: [Real; 30] = std::array::from_fn(|_| next());

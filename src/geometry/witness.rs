@@ -112,22 +112,10 @@ impl WitnessCache {
 mod tests {
     use super::*;
     use crate::geometry::sat::obbs_intersect;
-    use crate::math::{Real, Vec3};
+    use crate::math::Vec3;
     use nalgebra::Rotation3;
 
-    /// A small xorshift generator, enough for unit tests.
-    struct Rng(u64);
-    impl Rng {
-        fn unit(&mut self) -> Real {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
-        }
-        fn vec(&mut self, s: Real) -> Vec3 {
-            Vec3::new(self.unit(), self.unit(), self.unit()) * s
-        }
-    }
+    use crate::geometry::TestRng as Rng;
 
     fn link(center: Vec3, euler: Vec3) -> Obb {
         let rot = *Rotation3::from_euler_angles(euler.x, euler.y, euler.z).matrix();
