@@ -16,6 +16,11 @@
 //! exact matches. `R` becomes `R ∪ S` and `G_add -= |S \ R|`; `G_sub` stays `t`. Don't-care
 //! bits of `S` (unreachable or unsampled) are 0 in `S` and not counted in `|R \ S|`, so
 //! `t = 0` still answers every free and collision sample exactly.
+//!
+//! At `t = 0` a slice joins only a representative that agrees with it on every care bit
+//! (`R ∩ C = S`, with `S ⊆ C`), so `R ∪ S = R`: representatives never change once made.
+//! [`ExactGroups`] uses that to find the first such group without scanning the groups one
+//! by one; the groups, and so the table, are those of the scan.
 
 use super::code::{encode, MAX_LEVELS};
 use super::error::{corrupt, TableError};
@@ -81,6 +86,79 @@ fn try_join(s: &[u64], care: &[u64], rep: &[u64], g_add: u32, g_sub: u32) -> Opt
     Some(add)
 }
 
+/// Algorithm 8's first fit at `t = 0`, bit-sliced: the representatives (fixed once made, see
+/// the module doc) stored transposed, 64 groups to a block, so that word `p` of block `j` has
+/// bit `i` set when group `64 j + i` has slice bit `p`. A query ANDs, block by block, the
+/// words of `S`'s bits and the complements of the words of `C \ S`'s bits, and stops a block
+/// when none of its groups is left: the first block with a group left holds, at its lowest
+/// bit, the first group that the scan in order would join.
+#[cfg(feature = "std")]
+struct ExactGroups {
+    bits: usize,
+    blocks: Vec<u64>,
+    count: usize,
+    /// Per query: the care bits, alternately from `S` and from `C \ S` while both last,
+    /// each with the word to XOR (0 for a bit of `S`, all ones for a bit of `C \ S`).
+    probe: Vec<(u32, u64)>,
+}
+
+#[cfg(feature = "std")]
+impl ExactGroups {
+    fn new(bits: usize) -> ExactGroups {
+        ExactGroups { bits, blocks: Vec::new(), count: 0, probe: Vec::new() }
+    }
+
+    /// The first group whose representative `R` has `R ∩ C = S`, or a new group made of `S`.
+    fn group(&mut self, s: &[u64], care: &[u64]) -> u32 {
+        let set = |w: &[u64]| -> Vec<u32> {
+            let mut v = Vec::new();
+            for (i, &x) in w.iter().enumerate() {
+                let mut x = x;
+                while x != 0 {
+                    v.push((64 * i) as u32 + x.trailing_zeros());
+                    x &= x - 1;
+                }
+            }
+            v
+        };
+        let ones = set(s);
+        let zeros: Vec<u64> = care.iter().zip(s).map(|(&c, &s)| c & !s).collect();
+        let zeros = set(&zeros);
+        self.probe.clear();
+        for i in 0..ones.len().max(zeros.len()) {
+            if let Some(&p) = ones.get(i) {
+                self.probe.push((p, 0));
+            }
+            if let Some(&p) = zeros.get(i) {
+                self.probe.push((p, !0));
+            }
+        }
+        for (j, block) in self.blocks.chunks_exact(self.bits).enumerate() {
+            let n = (self.count - 64 * j).min(64);
+            let mut left = if n == 64 { !0 } else { (1u64 << n) - 1 };
+            for &(p, flip) in &self.probe {
+                left &= block[p as usize] ^ flip;
+                if left == 0 {
+                    break;
+                }
+            }
+            if left != 0 {
+                return (64 * j) as u32 + left.trailing_zeros();
+            }
+        }
+        let g = self.count;
+        if g % 64 == 0 {
+            self.blocks.resize(self.blocks.len() + self.bits, 0);
+        }
+        let block = &mut self.blocks[(g / 64) * self.bits..];
+        for p in ones {
+            block[p as usize] |= 1 << (g % 64);
+        }
+        self.count += 1;
+        g as u32
+    }
+}
+
 /// Samples of one robot grouped by its two quadtree coordinates `(ix, second)`.
 #[cfg(feature = "std")]
 fn ranges(cells: &[[u16; 3]], keep: impl Fn(usize) -> bool, second: usize) -> BTreeMap<(u16, u16), Vec<usize>> {
@@ -115,6 +193,7 @@ impl LinearQuadtree4d {
         let mut g_add: Vec<u32> = Vec::new();
         let mut nodes: Vec<(u64, u32)> = Vec::new();
         let (mut s, mut care) = (vec![0u64; wps], vec![0u64; wps]);
+        let mut exact = (t == 0).then(|| ExactGroups::new(64 * wps));
         // Thesis order x, x', z, z': the A and B maps are sorted by (ix, second).
         let xs_a: Vec<u16> = ra.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
         let xs_b: Vec<u16> = rb.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
@@ -142,7 +221,16 @@ impl LinearQuadtree4d {
                         if !any {
                             continue;
                         }
-                        let group = tree.group(&s, &care, &mut g_add, wps);
+                        let group = match exact.as_mut() {
+                            Some(exact) => {
+                                let g = exact.group(&s, &care);
+                                if g as usize == tree.slices.len() / wps {
+                                    tree.slices.extend_from_slice(&s);
+                                }
+                                g
+                            }
+                            None => tree.group(&s, &care, &mut g_add, wps),
+                        };
                         nodes.push((encode([xa, *za, xb, *zb], 4), group));
                     }
                 }
@@ -280,6 +368,43 @@ mod tests {
         assert_eq!(try_join(&[0b1111], &all, &rep, 2, 2), Some(1));
         assert_eq!(try_join(&[0b0011], &all, &rep, 2, 1), None, "|sub| = 1 is not < 1");
         assert_eq!(try_join(&[0b0011], &[0b1011], &rep, 2, 1), Some(0), "a don't-care bit is not counted");
+    }
+
+    /// Slices made from a few patterns, each seen through one of a few care masks (some with
+    /// a flipped bit), over 3 words so that groups cross block and word boundaries.
+    #[test]
+    fn exact_groups_are_those_of_the_first_fit_scan() {
+        let mut rng = crate::geometry::TestRng(0x9e37_79b9_7f4a_7c15);
+        let mut next = || {
+            rng.unit();
+            rng.0
+        };
+        let wps = 3;
+        let patterns: Vec<Vec<u64>> = (0..200).map(|_| (0..wps).map(|_| next()).collect()).collect();
+        let mut chain = vec![vec![!0u64; wps]];
+        for _ in 0..3 {
+            let wider = chain.last().unwrap().clone();
+            chain.push(wider.iter().map(|&m| m & (next() | next())).collect());
+        }
+        let mut scan =
+            LinearQuadtree4d { levels: 1, symmetric: false, axes: SliceAxes::YY, t: 0, codes: vec![], slice_of: vec![], slices: vec![] };
+        let (mut g_add, mut exact, mut joined) = (Vec::new(), ExactGroups::new(64 * wps), 0);
+        for i in 0..5000 {
+            let pattern = &patterns[(next() % 200) as usize];
+            // One of four nested masks: a slice joins a group made through a wider one.
+            let care: Vec<u64> = (0..wps).map(|w| chain[(next() % 4) as usize][w]).collect();
+            let mut s: Vec<u64> = pattern.iter().zip(&care).map(|(p, c)| p & c).collect();
+            if i % 7 == 0 {
+                let bit = next() % (64 * wps as u64);
+                s[bit as usize / 64] ^= 1 << (bit % 64);
+                s[bit as usize / 64] &= care[bit as usize / 64];
+            }
+            let before = scan.slices.len() / wps;
+            let want = scan.group(&s, &care, &mut g_add, wps);
+            joined += usize::from((want as usize) < before);
+            assert_eq!(exact.group(&s, &care), want, "slice {i}");
+        }
+        assert!(exact.count > 128 && joined > 2500, "{} groups, {joined} joins", exact.count);
     }
 
     #[test]
