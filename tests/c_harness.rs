@@ -17,11 +17,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
 
+mod harness_build;
 mod native_libs;
+use harness_build::{repo_root, run, scratch_dir, text, C_FLAGS};
 use native_libs::NATIVE_LIBS;
-
-/// Strict C flags of the house style (rustls-ffi's CI).
-const C_FLAGS: &[&str] = &["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2"];
 
 /// Sanitizer flags (gcc): every report aborts the run.
 const SANITIZE_FLAGS: &[&str] =
@@ -32,10 +31,6 @@ const TABLE_K: u32 = 32;
 
 /// The reference cells, in the order of the harness's `--table` arguments.
 const CELLS: [&str; 3] = ["T1", "T2", "T3"];
-
-fn repo_root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// The static library built in this cargo run. `cargo test` writes it next to the test
 /// executable (`target/<profile>/deps/libdelta_collide.a`) and does not copy it up to
@@ -52,21 +47,6 @@ fn static_lib() -> PathBuf {
         .clone()
 }
 
-fn scratch_dir(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
-    std::fs::create_dir_all(&dir).expect("create scratch dir");
-    dir
-}
-
-/// Runs a command, returning its output; panics with the command line when it cannot start.
-fn run(cmd: &mut Command) -> Output {
-    cmd.output().unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"))
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
 /// Parses the last `N passed, M failed` line of the harness output.
 fn verdict_line(stdout: &str) -> Option<(u64, u64)> {
     stdout.lines().rev().find_map(|line| {
@@ -76,37 +56,10 @@ fn verdict_line(stdout: &str) -> Option<(u64, u64)> {
     })
 }
 
-/// The C sources of the harness, sorted.
-fn harness_sources() -> Vec<PathBuf> {
-    let mut sources: Vec<PathBuf> = std::fs::read_dir(repo_root().join("c_harness"))
-        .expect("c_harness/ exists")
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "c"))
-        .collect();
-    sources.sort();
-    let names: Vec<_> = sources.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
-    let expected = ["bad_input.c", "harness.c", "main.c", "mock_robotics.c", "pou.c", "table_mode.c"];
-    assert_eq!(names, expected, "c_harness/ sources changed: update this list and the README");
-    sources
-}
-
-/// Compiles the harness with the strict flags plus `extra` into `dir/name`.
+/// Compiles the host harness with the strict flags plus `extra` into the scratch `name`.
 fn compile_harness(name: &str, extra: &[&str]) -> PathBuf {
-    let root = repo_root();
     let exe = scratch_dir("c_harness").join(name);
-    let out = run(Command::new("cc")
-        .args(C_FLAGS)
-        .args(extra)
-        .arg("-I")
-        .arg(root.join("include"))
-        .arg("-I")
-        .arg(root.join("c_harness"))
-        .args(harness_sources())
-        .arg(static_lib())
-        .args(NATIVE_LIBS)
-        .arg("-o")
-        .arg(&exe));
-    assert!(out.status.success(), "cc {extra:?} failed:\n{}{}", text(&out.stdout), text(&out.stderr));
+    harness_build::compile_harness("cc", extra, &static_lib(), NATIVE_LIBS, &exe);
     exe
 }
 

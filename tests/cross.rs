@@ -15,19 +15,18 @@
 //! qemu) skips a test with a note saying what to install, except under `CI` (set and not
 //! "false"), where it fails: `.ci/run` installs them.
 
+mod harness_build;
 mod native_libs;
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::Workspace;
 use delta_collide::table::{build_tables, to_bytes, Labelling, Variant};
+use harness_build::{both, compile_harness, repo_root, run, scratch_dir};
 use native_libs::{native_static_libs, CROSS_NATIVE_LIBS, NATIVE_LIBS};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
 use std::time::Instant;
-
-/// The harness's strict C flags (as `tests/c_harness.rs`).
-const C_FLAGS: &[&str] = &["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2"];
 
 /// Table resolution: k = 16 keeps the labelling (host side) to about a second; the harness's
 /// table mode runs the same code paths as at k = 32.
@@ -60,24 +59,6 @@ const ARMV7: Target = Target {
     elf_machine: 40, // EM_ARM
     packages: "gcc-arm-linux-gnueabihf libc6-dev-armhf-cross qemu-user",
 };
-
-fn repo_root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn scratch_dir(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
-    std::fs::create_dir_all(&dir).expect("create scratch dir");
-    dir
-}
-
-fn run(cmd: &mut Command) -> Output {
-    cmd.output().unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"))
-}
-
-fn text(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr)
-}
 
 /// Whether this run is CI's (`CI` set and not "false"), where nothing may be skipped.
 fn in_ci() -> bool {
@@ -139,7 +120,7 @@ fn cross_library(t: &Target) -> PathBuf {
         .arg("--target-dir")
         .arg(root.join("target/cross"))
         .args(["--", "--print", "native-static-libs"]));
-    let log = text(&out);
+    let log = both(&out);
     assert!(out.status.success(), "cross build for {} failed:\n{log}", t.triple);
     println!("{}: library built in {:.1} s", t.triple, start.elapsed().as_secs_f64());
     let pinned = CROSS_NATIVE_LIBS.iter().find(|(triple, _)| *triple == t.triple).expect("pinned libs").1;
@@ -147,36 +128,6 @@ fn cross_library(t: &Target) -> PathBuf {
     let dir = root.join("target/cross").join(t.triple).join("release");
     assert_eq!(elf_machine(&dir.join("libdelta_collide.so")), t.elf_machine, "{}: cdylib machine", t.triple);
     dir.join("libdelta_collide.a")
-}
-
-/// The C sources of the harness.
-fn harness_sources() -> Vec<PathBuf> {
-    let dir = repo_root().join("c_harness");
-    let mut sources: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("c_harness/ exists")
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "c"))
-        .collect();
-    sources.sort();
-    assert!(sources.len() >= 5, "c_harness/ has only {} C files", sources.len());
-    sources
-}
-
-/// Compiles the harness with `cc` against the generated header, `lib` and `libs`.
-fn compile_harness(cc: &str, lib: &Path, libs: &[&str], exe: &Path) {
-    let root = repo_root();
-    let out = run(Command::new(cc)
-        .args(C_FLAGS)
-        .arg("-I")
-        .arg(root.join("include"))
-        .arg("-I")
-        .arg(root.join("c_harness"))
-        .args(harness_sources())
-        .arg(lib)
-        .args(libs)
-        .arg("-o")
-        .arg(exe));
-    assert!(out.status.success(), "{cc} failed on the harness:\n{}", text(&out));
 }
 
 /// Table files of T1 (6-D), T2 (shared 6-D quadtree), T3 (6-D) at k = [`TABLE_K`], built once
@@ -232,7 +183,7 @@ fn host_harness() -> &'static Path {
     static EXE: OnceLock<PathBuf> = OnceLock::new();
     EXE.get_or_init(|| {
         let exe = scratch_dir("cross_host").join("c_harness");
-        compile_harness("cc", &host_static_lib(), NATIVE_LIBS, &exe);
+        compile_harness("cc", &[], &host_static_lib(), NATIVE_LIBS, &exe);
         exe
     })
 }
@@ -262,7 +213,7 @@ fn harness_runs_under_qemu(t: &Target) {
     let lib = cross_library(t);
     let pinned = CROSS_NATIVE_LIBS.iter().find(|(triple, _)| *triple == t.triple).expect("pinned libs").1;
     let exe = scratch_dir(&format!("cross_{}", t.triple)).join("c_harness");
-    compile_harness(t.cc, &lib, pinned, &exe);
+    compile_harness(t.cc, &[], &lib, pinned, &exe);
     assert_eq!(elf_machine(&exe), t.elf_machine, "{}: harness machine", t.triple);
     let tmp = scratch_dir(&format!("cross_{}_tmp", t.triple));
     let start = Instant::now();
@@ -319,9 +270,9 @@ fn c_harness_runs_on_x86_64_baseline_without_avx() {
     let probe = dir.join("avx_probe");
     std::fs::write(dir.join("avx_probe.c"), AVX_PROBE_C).unwrap();
     let out = run(Command::new("cc").args(["-O1", "-o"]).arg(&probe).arg(dir.join("avx_probe.c")));
-    assert!(out.status.success(), "cc avx_probe:\n{}", text(&out));
+    assert!(out.status.success(), "cc avx_probe:\n{}", both(&out));
     let max = run(Command::new("qemu-x86_64").args(["-cpu", "max"]).arg(&probe));
-    assert!(max.status.success(), "the AVX probe fails on qemu's `max` CPU:\n{}", text(&max));
+    assert!(max.status.success(), "the AVX probe fails on qemu's `max` CPU:\n{}", both(&max));
     let baseline = run(Command::new("qemu-x86_64").args(["-cpu", "qemu64"]).arg(&probe));
     assert!(!baseline.status.success(), "qemu64 ran AVX code, so it cannot show that AVX is not needed");
     let tmp = scratch_dir("cross_x86_64_baseline_tmp");
