@@ -237,10 +237,7 @@ fn time_with_peer(clock: Clock, table: &Table, peer: &SeparateArrays, cells: &[[
     } else {
         (vec![], vec![])
     };
-    [
-        Times { hot, streamed, flushed },
-        Times { hot: hot_peer, streamed: streamed_peer, flushed: flushed_peer },
-    ]
+    [Times { hot, streamed, flushed }, Times { hot: hot_peer, streamed: streamed_peer, flushed: flushed_peer }]
 }
 
 /// The report's three timing cells: hot, streamed, flushed (of `cold` queries).

@@ -17,7 +17,15 @@
 //! Either way every configuration of the 6-D cell is covered by a disjoint pair of swept
 //! box sets, each of which contains the physical boxes for every TCP of its (sub)cell. Anything
 //! not proved is a collision. [`label_space_subdivided`] keeps level 2's answer per octant pair
-//! for the pairs that stay collisions ([`SubCells`]).
+//! for the pairs that stay collisions ([`SubCells`]), with one more level for those:
+//! 3. an octant pair that level 2 leaves a collision, unless some box pair's octant cores
+//!    meet (a certain collision), is cut once more: each octant into its 8 sub-octants
+//!    (half-side `r/8`; boxes and sweeps made when an octant first needs them), and it is
+//!    free when, for every pair of sub-octants, each box pair that level 2 left open is
+//!    proved disjoint by (A sub-octant, B sub-octant), (A sub-octant, B octant) or
+//!    (A octant, B sub-octant). The sub-octants cover their octant, so the proof covers the
+//!    whole sub-cell. These sweeps are not made mirror-symmetric: the tables merge each
+//!    sub-cell with its mirror's, collision winning.
 //!
 //! The sub-cells are found faster than by 64 runs of level 2 (`sub_cell_masks`, same
 //! answers): an octant pair is a collision without its tests when a box pair certainly
@@ -48,6 +56,7 @@ use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::{BoxKind, RobotModel};
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// Rows of A whose sub-cells are found together ([`sub_cells`]; a cache blocking, any value
 /// gives the same answers).
@@ -76,7 +85,8 @@ pub struct CertifiedSpace {
 
 /// Sub-cell labels of the pairs labelled collision: each such 6-D cell cut into its 64
 /// sub-cells (A's octant `i` x B's octant `j`), each proved free or not with the octants'
-/// own bounds (issue 4: adaptive resolution where the labels change).
+/// own bounds and, failing that, the sub-octants' (levels 2 and 3 of the module doc; issue 4:
+/// adaptive resolution where the labels change).
 ///
 /// Bit `c` of a mask is the sub-cell with child index `c = ax << 5 | ay << 4 | az << 3 |
 /// bx << 2 | by << 1 | bz` (octant bits x, y, z of A then B; the order of
@@ -127,7 +137,8 @@ pub fn label_space_certified(cell: &Cell, k: u32, ws: &Workspace, progress: bool
 }
 
 /// As [`label_space_certified`], and every pair labelled collision is subdivided into its 64
-/// sub-cells, each certified with the octants' bounds ([`CertifiedSpace::sub`]).
+/// sub-cells, each certified with the octants' bounds or the sub-octants' (levels 2 and 3,
+/// [`CertifiedSpace::sub`]).
 ///
 /// # Errors
 /// As [`crate::cspace::label_space`].
@@ -173,7 +184,10 @@ fn label_space_certified_inner(
             SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
             SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
         );
-        let (la, lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+        let (mut la, mut lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+        if subdivide {
+            (la.subs, lb.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+        }
         let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
         let mut labels = label_pairs(&a0, &b0, collides, progress);
         refine_unknown_cells(&la, &lb, &mut labels);
@@ -218,12 +232,110 @@ struct Levels<'a> {
     octs: &'a SampleBoxes,
     whole_cores: Vec<Option<Obb>>,
     oct_cores: Vec<Option<Obb>>,
+    /// Level 3, for the sub-cells only.
+    subs: Option<SubOctants<'a>>,
 }
 
 impl<'a> Levels<'a> {
     fn new(whole: &'a SampleBoxes, octs: &'a SampleBoxes) -> Self {
-        Levels { whole, octs, whole_cores: cores(whole), oct_cores: cores(octs) }
+        Levels { whole, octs, whole_cores: cores(whole), oct_cores: cores(octs), subs: None }
     }
+}
+
+/// Level 3 (sub-cells only, module doc): each octant cut into its 8 sub-octants (half-side
+/// `r/8`), their boxes and sweeps made when an octant first needs them.
+struct SubOctants<'a> {
+    robot: &'a RobotSpec,
+    grid: &'a SampleGrid,
+    /// Per octant entry `8 s + i`: its sub-octants, entry `u` offset by `+/- r/8` along x,
+    /// y, z for bits 0, 1, 2 of `u`.
+    boxes: Vec<OnceLock<SampleBoxes>>,
+}
+
+impl<'a> SubOctants<'a> {
+    fn new(robot: &'a RobotSpec, grid: &'a SampleGrid) -> Self {
+        SubOctants { robot, grid, boxes: (0..8 * grid.cells.len()).map(|_| OnceLock::new()).collect() }
+    }
+
+    /// The sub-octants of octant entry `e`.
+    fn of(&self, e: usize) -> &SampleBoxes {
+        self.boxes[e].get_or_init(|| {
+            let (model, r) = (&self.robot.model, self.grid.r);
+            let offset = |o: usize, d: Real| Vec3::from_fn(|a, _| if o >> a & 1 == 1 { d } else { -d });
+            let octant = self.grid.sample_center(e / 8) + offset(e % 8, 0.25 * r);
+            let h = 0.125 * r;
+            let cs: Vec<Vec3> = (0..8).map(|u| octant + offset(u, h)).collect();
+            let refs: Vec<Vec3> = cs.iter().map(|c| reference_point(&model.delta, c, h).unwrap_or(*c)).collect();
+            let inflate = |u: usize| {
+                let vacuous = !model.delta.is_reachable(&cs[u]) && cube_unreachable(&model.delta, &cs[u], h);
+                match (vacuous, cube_box_sweeps(model, &cs[u], h, &refs[u], OCTANT_SPLITS)) {
+                    (false, Some(s)) => inflation(s),
+                    _ => Inflation::Vacuous,
+                }
+            };
+            SampleBoxes::new(model, &self.robot.placement, &refs, inflate)
+        })
+    }
+}
+
+/// Whether level 3 proves octant pair (A's entry `sa`, B's entry `sb`) free: for each pair
+/// of their sub-octants, each box pair of `open` (those the octant pair's tests left open) is
+/// proved disjoint by (A sub-octant, B sub-octant), (A sub-octant, B octant) or (A octant,
+/// B sub-octant). Never when a box pair's octant cores meet (a certain collision). The
+/// sub-octant pair `hint` (`8 u + v`) is tried first; it is set to the one that fails.
+fn sub_octants_prove_free(
+    a: &Levels,
+    b: &Levels,
+    sa: usize,
+    sb: usize,
+    first: usize,
+    open: impl FnOnce() -> u64,
+    hint: &mut usize,
+) -> bool {
+    let (Some(sub_a), Some(sub_b)) = (&a.subs, &b.subs) else { return false };
+    let (a1, b1, na, nb) = (a.octs, b.octs, a.octs.per_entry, b.octs.per_entry);
+    let (x, y) = (sub_a.of(sa), sub_b.of(sb));
+    let usable = |slot: Slot| slot == Slot::Boxes || slot == Slot::Vacuous;
+    if !x.slot[..8].iter().chain(&y.slot[..8]).all(|&s| usable(s)) {
+        return false;
+    }
+    let fine = |u: usize, v: usize, open: u64| {
+        if open == 0 || entries_apart(x, u, y, v) {
+            0
+        } else {
+            collision_mask(x, u, y, v, open)
+        }
+    };
+    // The pair that failed last first, on box pair `first`, finest test first: a collision
+    // usually fails there.
+    let (u0, v0) = (*hint / 8, *hint % 8);
+    let stays = |open: u64| {
+        let left = fine(u0, v0, open);
+        left != 0 && collision_mask(x, u0, b1, sb, left) & collision_mask(a1, sa, y, v0, left) != 0
+    };
+    let hinted = x.slot[u0] == Slot::Boxes && y.slot[v0] == Slot::Boxes;
+    if hinted && stays(1 << first) {
+        return false;
+    }
+    let open = open();
+    if cores_meet(&a.oct_cores, sa, na, &b.oct_cores, sb, nb, open) || hinted && stays(open & !(1 << first)) {
+        return false;
+    }
+    // Then each sub-octant against the other octant, and the finest test for what is left.
+    let (mut rows, mut columns) = ([0u64; 8], [0u64; 8]);
+    for w in 0..8 {
+        rows[w] = if x.slot[w] == Slot::Boxes { collision_mask(x, w, b1, sb, open) } else { 0 };
+        columns[w] = if y.slot[w] == Slot::Boxes { collision_mask(a1, sa, y, w, open) } else { 0 };
+    }
+    for u in (0..8).filter(|&u| x.slot[u] == Slot::Boxes) {
+        for v in (0..8).filter(|&v| y.slot[v] == Slot::Boxes) {
+            if fine(u, v, rows[u] & columns[v]) != 0 {
+                *hint = 8 * u + v;
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// Per box of `boxes`: its core under its sweep, when its entry has boxes and the core exists.
@@ -397,6 +509,7 @@ fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first_only: bool
     };
     let (mut rows, mut columns) = (Memo::default(), Memo::default());
     let mut hint = open0.trailing_zeros() as usize;
+    let mut hint3 = 0;
     let mut collision = 0u64;
     for i in 0..8 {
         for j in 0..8 {
@@ -421,7 +534,15 @@ fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first_only: bool
             };
             match stopper {
                 Some(None) => continue,
-                Some(Some(p)) => hint = p,
+                Some(Some(p)) => {
+                    hint = p;
+                    if !first_only && a.subs.is_some() {
+                        let left = || hint_first(open0, p).filter(|&q| open(q)).fold(0u64, |m, q| m | 1 << q);
+                        if sub_octants_prove_free(a, b, sa, sb, p, left, &mut hint3) {
+                            continue;
+                        }
+                    }
+                }
                 None => {}
             }
             collision |= bit;
@@ -747,8 +868,9 @@ mod tests {
         (whole(ra, &grid_a), octant_boxes(ra, &grid_a), whole(rb, &grid_b), octant_boxes(rb, &grid_b))
     }
 
-    /// The sub-cells of a subdivided labelling are exactly those of the plain octant tests
-    /// ([`octant_pairs`]), pair by pair, on every collision pair at k = 16.
+    /// Without level 3, the sub-cells are exactly those of the plain octant tests
+    /// ([`octant_pairs`]), pair by pair, on every collision pair at k = 16; a subdivided
+    /// labelling has the same pairs and care masks, and level 3 only frees sub-cells.
     #[test]
     fn sub_cells_are_those_of_the_plain_octant_tests() {
         for name in ["T1", "T2", "T3"] {
@@ -764,9 +886,17 @@ mod tests {
                 want.collision.push(collision);
             }
             assert!(!want.pairs.is_empty());
-            assert!(c.sub.as_ref() == Some(&want), "{name}: the fast sub-cells differ from the plain ones");
-            // The labels' level 2 (first octant pair not proved free) answers as the plain one.
             let (a, b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+            assert!(sub_cells(&a, &b, &c.space.labels) == want, "{name}: the fast sub-cells differ from the plain ones");
+            let got = c.sub.as_ref().unwrap();
+            assert_eq!((&got.pairs, &got.care), (&want.pairs, &want.care), "{name}: pairs and care masks");
+            let (mut before, mut after) = (0, 0);
+            for (g, w) in got.collision.iter().zip(&want.collision) {
+                assert_eq!(g & !w, 0, "{name}: level 3 made a sub-cell a collision");
+                (before, after) = (before + w.count_ones(), after + g.count_ones());
+            }
+            assert!(after < before, "{name}: level 3 freed nothing ({before} sub-cells)");
+            // The labels' level 2 (first octant pair not proved free) answers as the plain one.
             let unreachable = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Unreachable;
             for ia in (0..a0.len()).filter(|&ia| !unreachable(&a0, ia)) {
                 for ib in (0..nb).filter(|&ib| !unreachable(&b0, ib)) {
@@ -817,6 +947,53 @@ mod tests {
                 whole > 0 && row > whole && column > whole,
                 "{name}: {tried} pairs, cores meet {whole} {row} {column}"
             );
+        }
+    }
+
+    /// Level 3 is sound: in every sub-cell that it frees (a collision at level 2, on T1, T2
+    /// and T3 at k = 16), 16 random configurations, each TCP uniform in its octant, are free
+    /// for the exact model.
+    #[test]
+    fn sub_cells_freed_by_level_3_hold_no_collision() {
+        use crate::cell::{ExactChecker, SatMethod};
+        use rand::{rngs::StdRng, RngExt, SeedableRng};
+        let ws = Workspace::THESIS;
+        let mut rng = StdRng::seed_from_u64(3);
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let c = label_space_subdivided(&cell, 16, &ws, false).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let plain = sub_cells(&Levels::new(&a0, &a1), &Levels::new(&b0, &b1), &c.space.labels);
+            let got = c.sub.as_ref().unwrap();
+            let (ga, gb, nb) = (&c.space.grid_a, &c.space.grid_b, c.space.grid_b.cells.len());
+            let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
+            let octant = |g: &SampleGrid, s: usize, o: usize| {
+                g.sample_center(s) + Vec3::from_fn(|a, _| if o >> a & 1 == 1 { 0.25 * g.r } else { -0.25 * g.r })
+            };
+            let (mut freed, mut checked) = (0, 0);
+            for (e, &pair) in got.pairs.iter().enumerate() {
+                let (ia, ib) = (pair as usize / nb, pair as usize % nb);
+                for (i, j) in (0..8).flat_map(|i| (0..8).map(move |j| (i, j))) {
+                    let bit = 1u64 << sub_cell_index(i, j);
+                    if plain.collision[e] & bit == 0 || got.collision[e] & bit != 0 {
+                        continue;
+                    }
+                    freed += 1;
+                    let (ca, cb) = (octant(ga, ia, i), octant(gb, ib, j));
+                    for _ in 0..16 {
+                        let mut point = |c: &Vec3, g: &SampleGrid| {
+                            c + Vec3::from_fn(|_, _| (rng.random::<Real>() - 0.5) * 0.5 * g.r)
+                        };
+                        let tcps = [point(&ca, ga), point(&cb, gb)];
+                        let v = exact.check(&tcps).unwrap();
+                        if v.unreachable_mask == 0 {
+                            checked += 1;
+                            assert!(!v.collides(), "{name}: sub-cell ({i}, {j}) of pair ({ia}, {ib}) collides at {tcps:?}");
+                        }
+                    }
+                }
+            }
+            assert!(freed > 1000 && checked > 8 * freed, "{name}: {freed} freed sub-cells, {checked} configurations");
         }
     }
 

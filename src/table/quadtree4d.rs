@@ -386,8 +386,15 @@ mod tests {
             let wider = chain.last().unwrap().clone();
             chain.push(wider.iter().map(|&m| m & (next() | next())).collect());
         }
-        let mut scan =
-            LinearQuadtree4d { levels: 1, symmetric: false, axes: SliceAxes::YY, t: 0, codes: vec![], slice_of: vec![], slices: vec![] };
+        let mut scan = LinearQuadtree4d {
+            levels: 1,
+            symmetric: false,
+            axes: SliceAxes::YY,
+            t: 0,
+            codes: vec![],
+            slice_of: vec![],
+            slices: vec![],
+        };
         let (mut g_add, mut exact, mut joined) = (Vec::new(), ExactGroups::new(64 * wps), 0);
         for i in 0..5000 {
             let pattern = &patterns[(next() % 200) as usize];
