@@ -105,6 +105,21 @@ pub fn query(h: *mut DcCollider, tcps: &[DcVec3]) -> (DcStatus, DcVerdict, DcQue
     (s, verdict, report)
 }
 
+/// `dc_query` on live `h` with NULL `tcps` answers NULL_POINTER with the verdict STOP, and
+/// with NULL `out_verdict` answers NULL_POINTER.
+pub fn assert_null_outputs_rejected(h: *mut DcCollider, home: DcVec3) {
+    let mut verdict = DC_VERDICT_FREE;
+    // SAFETY: h is live; NULL tcps and NULL out_verdict are the inputs under test.
+    unsafe {
+        assert_eq!(dc_query(h, std::ptr::null(), 2, &mut verdict, std::ptr::null_mut()), DC_STATUS_NULL_POINTER);
+        assert_eq!(verdict, DC_VERDICT_STOP);
+        assert_eq!(
+            dc_query(h, [home, home].as_ptr(), 2, std::ptr::null_mut(), std::ptr::null_mut()),
+            DC_STATUS_NULL_POINTER
+        );
+    }
+}
+
 /// A C config of `n` thesis robots `dx` mm apart along x, owning its robots array (keep it
 /// alive while the `DcCellConfig` from [`Config::c`] is used).
 pub struct Config {
