@@ -511,14 +511,14 @@ fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first_only: bool
     let mut hint = open0.trailing_zeros() as usize;
     let mut hint3 = 0;
     let mut collision = 0u64;
-    for i in 0..8 {
-        for j in 0..8 {
+    for (i, &row_meet) in row_meets.iter().enumerate() {
+        for (j, &column_meet) in column_meets.iter().enumerate() {
             let bit = 1u64 << sub_cell_index(i, j);
             if care & bit == 0 {
                 continue;
             }
             let (sa, sb) = (8 * ia + i, 8 * ib + j);
-            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meets[i] || column_meets[j];
+            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meet || column_meet;
             // Whether box pair `p` stays open: no test of the octant pair proves it.
             let mut open = |p: usize| {
                 rows.open(i, p, || !whole_b || touch(a1, sa, b0, ib, p))

@@ -206,7 +206,8 @@ pub fn swept_boxes_apart_with(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: 
         hb: impl Fn() -> Real,
     ) -> bool {
         let (dn, boxes) = (d.dot(n).abs(), ra + rb);
-        if !(dn - boxes > 0.0) {
+        // The boxes alone overlap along `n` (or a value is NaN): not apart.
+        if (dn - boxes).is_nan() || dn - boxes <= 0.0 {
             return false;
         }
         let gap = SWEEP_GAP * len();
