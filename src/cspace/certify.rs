@@ -322,14 +322,15 @@ fn sub_octants_prove_free(
         return false;
     }
     // Then each sub-octant against the other octant, and the finest test for what is left.
-    let (mut rows, mut columns) = ([0u64; 8], [0u64; 8]);
-    for w in 0..8 {
-        rows[w] = if x.slot[w] == Slot::Boxes { collision_mask(x, w, b1, sb, open) } else { 0 };
-        columns[w] = if y.slot[w] == Slot::Boxes { collision_mask(a1, sa, y, w, open) } else { 0 };
-    }
+    let mut columns = [None; 8];
     for u in (0..8).filter(|&u| x.slot[u] == Slot::Boxes) {
+        let row = collision_mask(x, u, b1, sb, open);
+        if row == 0 {
+            continue;
+        }
         for v in (0..8).filter(|&v| y.slot[v] == Slot::Boxes) {
-            if fine(u, v, rows[u] & columns[v]) != 0 {
+            let column = *columns[v].get_or_insert_with(|| collision_mask(a1, sa, y, v, open));
+            if fine(u, v, row & column) != 0 {
                 *hint = 8 * u + v;
                 return false;
             }
