@@ -19,8 +19,8 @@
 //!
 //! At `t = 0` a slice joins only a representative that agrees with it on every care bit
 //! (`R ∩ C = S`, with `S ⊆ C`), so `R ∪ S = R`: representatives never change once made.
-//! [`ExactGroups`] uses that to find the first such group without scanning the groups one
-//! by one; the groups, and so the table, are those of the scan.
+//! `ExactGroups` uses that to find the first such group without scanning the groups one by
+//! one; the groups, and so the table, are those of the scan.
 
 use super::code::{encode, MAX_LEVELS};
 use super::error::{corrupt, TableError};
@@ -97,46 +97,42 @@ struct ExactGroups {
     bits: usize,
     blocks: Vec<u64>,
     count: usize,
-    /// Per query: the care bits, alternately from `S` and from `C \ S` while both last,
-    /// each with the word to XOR (0 for a bit of `S`, all ones for a bit of `C \ S`).
-    probe: Vec<(u32, u64)>,
+}
+
+/// Positions of the set bits of `words` (bit `p % 64` of word `p / 64`), increasing.
+#[cfg(feature = "std")]
+fn set_bits(words: impl Iterator<Item = u64>) -> Vec<u32> {
+    let mut out = Vec::new();
+    for (i, mut w) in words.enumerate() {
+        while w != 0 {
+            out.push(64 * i as u32 + w.trailing_zeros());
+            w &= w - 1;
+        }
+    }
+    out
 }
 
 #[cfg(feature = "std")]
 impl ExactGroups {
     fn new(bits: usize) -> ExactGroups {
-        ExactGroups { bits, blocks: Vec::new(), count: 0, probe: Vec::new() }
+        ExactGroups { bits, blocks: Vec::new(), count: 0 }
     }
 
     /// The first group whose representative `R` has `R ∩ C = S`, or a new group made of `S`.
     fn group(&mut self, s: &[u64], care: &[u64]) -> u32 {
-        let set = |w: &[u64]| -> Vec<u32> {
-            let mut v = Vec::new();
-            for (i, &x) in w.iter().enumerate() {
-                let mut x = x;
-                while x != 0 {
-                    v.push((64 * i) as u32 + x.trailing_zeros());
-                    x &= x - 1;
-                }
-            }
-            v
-        };
-        let ones = set(s);
-        let zeros: Vec<u64> = care.iter().zip(s).map(|(&c, &s)| c & !s).collect();
-        let zeros = set(&zeros);
-        self.probe.clear();
+        let ones = set_bits(s.iter().copied());
+        let zeros = set_bits(care.iter().zip(s).map(|(&c, &s)| c & !s));
+        // The bits to test, alternately from `S` and from `C \ S` while both last, each with
+        // the word to XOR a block's word with (all ones for a bit that must be clear).
+        let mut probe = Vec::with_capacity(ones.len() + zeros.len());
         for i in 0..ones.len().max(zeros.len()) {
-            if let Some(&p) = ones.get(i) {
-                self.probe.push((p, 0));
-            }
-            if let Some(&p) = zeros.get(i) {
-                self.probe.push((p, !0));
-            }
+            probe.extend(ones.get(i).map(|&p| (p, 0u64)));
+            probe.extend(zeros.get(i).map(|&p| (p, !0u64)));
         }
         for (j, block) in self.blocks.chunks_exact(self.bits).enumerate() {
             let n = (self.count - 64 * j).min(64);
             let mut left = if n == 64 { !0 } else { (1u64 << n) - 1 };
-            for &(p, flip) in &self.probe {
+            for &(p, flip) in &probe {
                 left &= block[p as usize] ^ flip;
                 if left == 0 {
                     break;
