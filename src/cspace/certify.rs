@@ -261,17 +261,16 @@ impl<'a> SubOctants<'a> {
     fn of(&self, e: usize) -> &SampleBoxes {
         self.boxes[e].get_or_init(|| {
             let (model, r) = (&self.robot.model, self.grid.r);
-            let offset = |o: usize, d: Real| Vec3::from_fn(|a, _| if o >> a & 1 == 1 { d } else { -d });
-            let octant = self.grid.sample_center(e / 8) + offset(e % 8, 0.25 * r);
+            let octant = octant_centre(&self.grid.sample_center(e / 8), e % 8, 0.25 * r);
             let h = 0.125 * r;
-            let cs: Vec<Vec3> = (0..8).map(|u| octant + offset(u, h)).collect();
+            let cs: Vec<Vec3> = (0..8).map(|u| octant_centre(&octant, u, h)).collect();
             let refs: Vec<Vec3> = cs.iter().map(|c| reference_point(&model.delta, c, h).unwrap_or(*c)).collect();
-            let inflate = |u: usize| {
-                let vacuous = !model.delta.is_reachable(&cs[u]) && cube_unreachable(&model.delta, &cs[u], h);
-                match (vacuous, cube_box_sweeps(model, &cs[u], h, &refs[u], OCTANT_SPLITS)) {
-                    (false, Some(s)) => inflation(s),
-                    _ => Inflation::Vacuous,
-                }
+            let inflate = |u: usize| match (
+                vacuous(model, &cs[u], h),
+                cube_box_sweeps(model, &cs[u], h, &refs[u], OCTANT_SPLITS),
+            ) {
+                (false, Some(s)) => inflation(s),
+                _ => Inflation::Vacuous,
             };
             SampleBoxes::new(model, &self.robot.placement, &refs, inflate)
         })
@@ -537,7 +536,7 @@ fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first_only: bool
                 Some(None) => continue,
                 Some(Some(p)) => {
                     hint = p;
-                    if !first_only && a.subs.is_some() {
+                    if !first_only {
                         let left = || hint_first(open0, p).filter(|&q| open(q)).fold(0u64, |m, q| m | 1 << q);
                         if sub_octants_prove_free(a, b, sa, sb, p, left, &mut hint3) {
                             continue;
@@ -766,6 +765,17 @@ fn inflation(s: [Sweep; MAX_BOXES]) -> Inflation {
     }
 }
 
+/// The centre of octant `o` of a cube of centre `c` and half-side `2 d`: offset by `+/- d`
+/// along x, y, z for bits 0, 1, 2 of `o`.
+fn octant_centre(c: &Vec3, o: usize, d: Real) -> Vec3 {
+    c + Vec3::from_fn(|a, _| if o >> a & 1 == 1 { d } else { -d })
+}
+
+/// Whether the cube of centre `c` and half-side `h` is proved to hold no reachable TCP.
+fn vacuous(model: &RobotModel, c: &Vec3, h: Real) -> bool {
+    !model.delta.is_reachable(c) && cube_unreachable(&model.delta, c, h)
+}
+
 /// Every sample's reference point ([`reference_point`]; its centre when none).
 fn references(model: &RobotModel, grid: &SampleGrid) -> Vec<Vec3> {
     let h = 0.5 * grid.r;
@@ -794,19 +804,20 @@ fn cell_sweeps(model: &RobotModel, grid: &SampleGrid) -> Vec<[Sweep; MAX_BOXES]>
 /// mirror-symmetric.
 fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>) {
     let q = 0.25 * grid.r;
-    let centre = |e: usize| {
-        let (s, i) = (e / 8, e % 8);
-        let sign = |bit: usize| if i >> bit & 1 == 1 { q } else { -q };
-        grid.sample_center(s) + Vec3::new(sign(0), sign(1), sign(2))
-    };
     let n = grid.cells.len() * 8;
-    let cs: Vec<Vec3> = (0..n).map(centre).collect();
-    let vacuous = |c: &Vec3| !model.delta.is_reachable(c) && cube_unreachable(&model.delta, c, q);
+    let cs: Vec<Vec3> = (0..n).map(|e| octant_centre(&grid.sample_center(e / 8), e % 8, q)).collect();
     let refs: Vec<Vec3> = cs.par_iter().map(|c| reference_point(&model.delta, c, q).unwrap_or(*c)).collect();
-    let raw: Vec<Option<[Sweep; MAX_BOXES]>> = (0..n)
-        .into_par_iter()
-        .map(|e| if vacuous(&cs[e]) { None } else { cube_box_sweeps(model, &cs[e], q, &refs[e], OCTANT_SPLITS) })
-        .collect();
+    let raw: Vec<Option<[Sweep; MAX_BOXES]>> =
+        (0..n)
+            .into_par_iter()
+            .map(|e| {
+                if vacuous(model, &cs[e], q) {
+                    None
+                } else {
+                    cube_box_sweeps(model, &cs[e], q, &refs[e], OCTANT_SPLITS)
+                }
+            })
+            .collect();
     let inflation = (0..n)
         .map(|e| {
             let mirror = grid.index_of(mirror_cell(grid, grid.cells[e / 8])).map(|m| 8 * m + ((e % 8) ^ 2));
@@ -888,7 +899,10 @@ mod tests {
             }
             assert!(!want.pairs.is_empty());
             let (a, b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
-            assert!(sub_cells(&a, &b, &c.space.labels) == want, "{name}: the fast sub-cells differ from the plain ones");
+            assert!(
+                sub_cells(&a, &b, &c.space.labels) == want,
+                "{name}: the fast sub-cells differ from the plain ones"
+            );
             let got = c.sub.as_ref().unwrap();
             assert_eq!((&got.pairs, &got.care), (&want.pairs, &want.care), "{name}: pairs and care masks");
             let (mut before, mut after) = (0, 0);
@@ -968,9 +982,7 @@ mod tests {
             let got = c.sub.as_ref().unwrap();
             let (ga, gb, nb) = (&c.space.grid_a, &c.space.grid_b, c.space.grid_b.cells.len());
             let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
-            let octant = |g: &SampleGrid, s: usize, o: usize| {
-                g.sample_center(s) + Vec3::from_fn(|a, _| if o >> a & 1 == 1 { 0.25 * g.r } else { -0.25 * g.r })
-            };
+            let octant = |g: &SampleGrid, s: usize, o: usize| octant_centre(&g.sample_center(s), o, 0.25 * g.r);
             let (mut freed, mut checked) = (0, 0);
             for (e, &pair) in got.pairs.iter().enumerate() {
                 let (ia, ib) = (pair as usize / nb, pair as usize % nb);
@@ -989,7 +1001,10 @@ mod tests {
                         let v = exact.check(&tcps).unwrap();
                         if v.unreachable_mask == 0 {
                             checked += 1;
-                            assert!(!v.collides(), "{name}: sub-cell ({i}, {j}) of pair ({ia}, {ib}) collides at {tcps:?}");
+                            assert!(
+                                !v.collides(),
+                                "{name}: sub-cell ({i}, {j}) of pair ({ia}, {ib}) collides at {tcps:?}"
+                            );
                         }
                     }
                 }
