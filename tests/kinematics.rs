@@ -351,7 +351,16 @@ fn chain_and_direct_models_give_the_same_boxes() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 2_000, failure_persistence: None, ..ProptestConfig::default() })]
+    // About a third of this box lies outside the reachable workspace, so 2,000 accepted cases
+    // take about 1,100 rejects: the default cap of 1,024 made the test fail on about half the
+    // seeds (CI, session 5). The cap is raised to 10 rejects per accepted case: a box that drifted
+    // out of reach would still fail here rather than pass on a few points.
+    #![proptest_config(ProptestConfig {
+        cases: 2_000,
+        max_global_rejects: 20_000,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn ik_fk_round_trip(x in -260.0..260.0f64, y in -260.0..260.0f64, z in -560.0..-300.0f64) {
