@@ -7,14 +7,14 @@
 //!
 //! Run: `cargo bench --bench table_report -- [--cells T1,T2,T3] [--k 32] [--random 1000000]
 //! [--cold 100000] [--cold-shared 1000000] [--variants shared,...] [--timer instant|tsc]
-//! [--slowest 0] [--passes 3]` (`--help` lists them). `--cold-shared`: flushed queries of the shared
+//! [--slowest 0] [--passes 3] [--hot-block 4096]` (`--help` lists them). `--cold-shared`: flushed queries of the shared
 //! table without sub-cells; `--cold`: of every other table. `--variants`: which tables
 //! (default all; the 6-D table is built anyway when a shared one is, for the agreement check,
 //! and only labellings that a chosen table needs are made). `--timer tsc`: `rdtsc` between
 //! `lfence`s, converted to ns with a rate calibrated against `Instant` in the same run.
-//! `--slowest N`: for each shared table, the N slowest streamed queries with the memory reads
-//! of their descent (dependent steps, cache lines, pages), re-timed one by one, and the streamed
-//! times grouped by steps and lines. Without `--bench` (as `cargo test` runs it) it does a
+//! `--slowest N`: for each shared table and for the hot and streamed regimes, the N slowest
+//! queries with the memory reads of their descent (dependent steps, cache lines, pages),
+//! re-timed one by one, and the regime's times grouped by steps and lines. Without `--bench` (as `cargo test` runs it) it does a
 //! small smoke run (T2, k = 16) that still checks FN = 0 and the shared table's agreement with
 //! the 6-D table.
 //!
@@ -63,8 +63,10 @@ const USAGE: &str = "cargo bench --bench table_report -- [options]
   --variants LIST       comma list of 6d,5d,4d-yy,4d-zz,4d-yy-lossy,shared,shared-sub,4d-yy-sub,
                         thesis (default all; 4d-yy-sub: the 4D/yy t=0 table of the sub-cell labels)
   --timer instant|tsc   clock of the query timings (default instant; tsc: rdtsc between lfences)
-  --slowest N           the N slowest streamed queries of each shared table, analysed (default 0)
-  --passes 3            passes over the queries; each query keeps its fastest";
+  --slowest N           the N slowest hot and streamed queries of each shared table, analysed
+                        (default 0)
+  --passes 3            passes over the queries; each query keeps its fastest
+  --hot-block 4096      queries per block of the hot regime";
 
 struct Options {
     cells: Vec<String>,
@@ -106,6 +108,7 @@ fn options() -> Options {
         panic!("--variants: unknown table {v:?}; use {}", VARIANTS.join(","));
     }
     timing::PASSES.store(num("--passes", 3).max(1), std::sync::atomic::Ordering::Relaxed);
+    timing::HOT_BLOCK.store(num("--hot-block", 1 << 12).max(1), std::sync::atomic::Ordering::Relaxed);
     let tsc = match value("--timer").as_deref() {
         None | Some("instant") => false,
         Some("tsc") => true,
@@ -282,9 +285,17 @@ fn min_median(n: usize, mut f: impl FnMut() -> u64) -> (u64, u64) {
     (t[0], t[n / 2])
 }
 
-/// The slowest streamed queries of a shared table, their reads and their times alone; then
-/// the streamed times of all queries grouped by dependent steps and by cache lines.
-fn slowest_report(clock: Clock, table: &Table, cells: &[[u16; 6]], warm: &[u64], n: usize) -> Vec<String> {
+/// The slowest queries of a shared table in one regime (`times`), their reads and their
+/// times alone; then that regime's times of all queries grouped by dependent steps and by
+/// cache lines.
+fn slowest_report(
+    clock: Clock,
+    table: &Table,
+    cells: &[[u16; 6]],
+    warm: &[u64],
+    regime: &str,
+    n: usize,
+) -> Vec<String> {
     let Table::Shared(shared) = table else { return vec![] };
     let regions = table.memory_regions();
     let mut order: Vec<usize> = (0..cells.len()).collect();
@@ -300,14 +311,14 @@ fn slowest_report(clock: Clock, table: &Table, cells: &[[u16; 6]], warm: &[u64],
             "nodes per depth (then leaves): {:?}; child refs out of each depth: {refs:?}",
             shared.nodes_per_depth()
         ),
-        format!("{} slowest streamed queries ({}):", n.min(cells.len()), table.name()),
+        format!("{} slowest {regime} queries ({}):", n.min(cells.len()), table.name()),
     ];
     for &i in order.iter().take(n) {
         let (steps, reads, lines, pages) = read_counts(&shared.query_reads(cells[i]).1);
         let (hot, hot_med) = min_median(101, || query_ns(clock, table, cells[i], None));
         let (cold, cold_med) = min_median(11, || query_ns(clock, table, cells[i], Some(&regions)));
         out.push(format!(
-            "  #{i} {:?} streamed {} ns: {steps} steps, {reads} reads, {lines} lines, {pages} pages; alone hot min/median {hot} / {hot_med} ns, flushed {cold} / {cold_med} ns",
+            "  #{i} {:?} {regime} {} ns: {steps} steps, {reads} reads, {lines} lines, {pages} pages; alone hot min/median {hot} / {hot_med} ns, flushed {cold} / {cold_med} ns",
             cells[i], warm[i]
         ));
     }
@@ -318,7 +329,7 @@ fn slowest_report(clock: Clock, table: &Table, cells: &[[u16; 6]], warm: &[u64],
         by[1].entry(lines).or_default().push(t);
     }
     for (what, groups) in ["dependent steps", "cache lines"].iter().zip(&by) {
-        out.push(format!("streamed ns by {what}: value: queries, median / p99.9 / max"));
+        out.push(format!("{regime} ns by {what}: value: queries, median / p99.9 / max"));
         for (v, ts) in groups {
             let (m, p, x) = percentiles(ts);
             out.push(format!("  {v}: {}, {m} / {p} / {x}", ts.len()));
@@ -517,7 +528,8 @@ fn main() {
                     assert_eq!(fn_, 0, "{name} {label}: a false negative on a certified table");
                 }
                 if opt.slowest > 0 {
-                    notes.extend(slowest_report(clock, &table, &cells, &times.streamed, opt.slowest));
+                    notes.extend(slowest_report(clock, &table, &cells, &times.hot, "hot", opt.slowest));
+                    notes.extend(slowest_report(clock, &table, &cells, &times.streamed, "streamed", opt.slowest));
                 }
             }
             // The plain table of the sub-cell labels answers as the subdivided table does.
