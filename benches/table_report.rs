@@ -7,7 +7,7 @@
 //!
 //! Run: `cargo bench --bench table_report -- [--cells T1,T2,T3] [--k 32] [--random 1000000]
 //! [--cold 100000] [--cold-shared 1000000] [--variants shared,...] [--timer instant|tsc]
-//! [--slowest 0] [--passes 3] [--hot-block 4096]` (`--help` lists them). `--cold-shared`: flushed queries of the shared
+//! [--slowest 0] [--passes 3] [--hot-block 256]` (`--help` lists them). `--cold-shared`: flushed queries of the shared
 //! table without sub-cells; `--cold`: of every other table. `--variants`: which tables
 //! (default all; the 6-D table is built anyway when a shared one is, for the agreement check,
 //! and only labellings that a chosen table needs are made). `--timer tsc`: `rdtsc` between
@@ -21,8 +21,8 @@
 //! A query here is the table lookup alone (`Table::query` on a precomputed 6-D cell). All
 //! queries are timed in three passes (`--passes`) and each keeps its fastest pass, so that the
 //! maximum is the slowest query and not an interrupt. Three regimes: *hot*, the passes run
-//! back to back over blocks of 4,096 queries, so that every line a query reads is in the
-//! caches; *streamed*, the passes run over all queries, whose own input (12 bytes a query)
+//! back to back over blocks of 256 queries, so that every line a query reads is in the
+//! caches (the blocks of the slowest queries then run again, `timing::CONFIRM_ROUNDS`); *streamed*, the passes run over all queries, whose own input (12 bytes a query)
 //! evicts the table's rarely read lines between passes, a mix of hot and cold reads; and
 //! *flushed*, every line of the table evicted (`clflush`) before each query. Timing costs two clock reads, shown as the "timer" rows (the floor of every
 //! figure, measured in the same run for both clocks, the same way: when their maximum is
@@ -66,7 +66,7 @@ const USAGE: &str = "cargo bench --bench table_report -- [options]
   --slowest N           the N slowest hot and streamed queries of each shared table, analysed
                         (default 0)
   --passes 3            passes over the queries; each query keeps its fastest
-  --hot-block 4096      queries per block of the hot regime";
+  --hot-block 256       queries per block of the hot regime";
 
 struct Options {
     cells: Vec<String>,
@@ -108,7 +108,7 @@ fn options() -> Options {
         panic!("--variants: unknown table {v:?}; use {}", VARIANTS.join(","));
     }
     timing::PASSES.store(num("--passes", 3).max(1), std::sync::atomic::Ordering::Relaxed);
-    timing::HOT_BLOCK.store(num("--hot-block", 1 << 12).max(1), std::sync::atomic::Ordering::Relaxed);
+    timing::HOT_BLOCK.store(num("--hot-block", 256).max(1), std::sync::atomic::Ordering::Relaxed);
     let tsc = match value("--timer").as_deref() {
         None | Some("instant") => false,
         Some("tsc") => true,
