@@ -11,7 +11,6 @@
 use delta_collide::cell::{parse_cell, Cell, ExactChecker, SatMethod, MAX_ROBOTS};
 use delta_collide::ffi::*;
 use delta_collide::math::Vec3;
-use delta_collide::robot::ToolBox;
 
 /// The target: never panics on any input.
 pub fn cell_toml(data: &[u8]) {
@@ -67,7 +66,7 @@ struct CHandle(*mut DcCollider);
 
 impl CHandle {
     fn new(cell: &Cell) -> Self {
-        let robots: Vec<DcRobotConfig> = cell.robots.iter().map(robot_config).collect();
+        let robots: Vec<DcRobotConfig> = cell.robots.iter().map(DcRobotConfig::from_spec).collect();
         let method = if cell.method == SatMethod::Sat { DC_METHOD_SAT } else { DC_METHOD_SAT_CACHE };
         let config = DcCellConfig { robots: robots.as_ptr(), n_robots: robots.len(), method };
         let mut h = std::ptr::null_mut();
@@ -78,7 +77,7 @@ impl CHandle {
     }
 
     fn query(&self, tcps: &[Vec3]) -> (DcStatus, DcVerdict) {
-        let tcps: Vec<DcVec3> = tcps.iter().map(dc_vec3).collect();
+        let tcps: Vec<DcVec3> = tcps.iter().map(DcVec3::from_vec3).collect();
         let mut verdict = DC_VERDICT_FREE;
         // SAFETY: live handle; `tcps` holds `len` points; `verdict` is writable.
         let status = unsafe { dc_query(self.0, tcps.as_ptr(), tcps.len(), &mut verdict, std::ptr::null_mut()) };
@@ -90,35 +89,5 @@ impl Drop for CHandle {
     fn drop(&mut self) {
         // SAFETY: live handle from dc_init, destroyed once.
         unsafe { dc_destroy(self.0) }
-    }
-}
-
-fn dc_vec3(v: &Vec3) -> DcVec3 {
-    DcVec3 { x: v.x, y: v.y, z: v.z }
-}
-
-fn dc_box(b: Option<ToolBox>) -> DcBox {
-    let b = b.unwrap_or(ToolBox { offset: Vec3::zeros(), half: Vec3::zeros() });
-    DcBox { offset: dc_vec3(&b.offset), half: dc_vec3(&b.half) }
-}
-
-/// The C description of one robot of a cell.
-fn robot_config(r: &delta_collide::cell::RobotSpec) -> DcRobotConfig {
-    let (d, o) = (&r.model.delta, &r.model.options);
-    let (uh, ud) = o.upper_links.unwrap_or((0.0, 0.0));
-    DcRobotConfig {
-        geometry: DcDelta3 { f: d.f, rf: d.rf, re: d.re, e: d.e, theta_min: d.theta_min, theta_max: d.theta_max },
-        half_height: o.half_height,
-        half_depth: o.half_depth,
-        margin: o.margin,
-        has_upper_links: u32::from(o.upper_links.is_some()),
-        upper_half_height: uh,
-        upper_half_depth: ud,
-        has_platform: u32::from(o.platform.is_some()),
-        platform: dc_box(o.platform),
-        has_tool: u32::from(o.tool.is_some()),
-        tool: dc_box(o.tool),
-        alpha: r.placement.alpha,
-        translation: dc_vec3(&r.placement.t),
     }
 }

@@ -73,25 +73,41 @@ pub(crate) fn cell_from_c(robots: &[DcRobotConfig], method: u32) -> Result<Cell,
     Cell::new("C config".into(), specs, method).map_err(|e| InitError::new(cell_error_status(&e), e.to_string()))
 }
 
+impl DcRobotConfig {
+    /// The C description of `r`, the inverse of [`robot_spec`] (up to the name): what a Rust
+    /// caller of the C ABI (the fuzz targets, for one) passes for a cell it holds.
+    pub fn from_spec(r: &RobotSpec) -> Self {
+        let (d, o) = (&r.model.delta, &r.model.options);
+        let (upper_half_height, upper_half_depth) = o.upper_links.unwrap_or((0.0, 0.0));
+        let dc_box = |b: Option<ToolBox>| {
+            let b = b.unwrap_or(ToolBox { offset: Vec3::zeros(), half: Vec3::zeros() });
+            DcBox { offset: DcVec3::from_vec3(&b.offset), half: DcVec3::from_vec3(&b.half) }
+        };
+        DcRobotConfig {
+            geometry: DcDelta3 { f: d.f, rf: d.rf, re: d.re, e: d.e, theta_min: d.theta_min, theta_max: d.theta_max },
+            half_height: o.half_height,
+            half_depth: o.half_depth,
+            margin: o.margin,
+            has_upper_links: u32::from(o.upper_links.is_some()),
+            upper_half_height,
+            upper_half_depth,
+            has_platform: u32::from(o.platform.is_some()),
+            platform: dc_box(o.platform),
+            has_tool: u32::from(o.tool.is_some()),
+            tool: dc_box(o.tool),
+            alpha: r.placement.alpha,
+            translation: DcVec3::from_vec3(&r.placement.t),
+        }
+    }
+}
+
 /// The thesis robot as a C config, placed at the WCS origin.
 pub(crate) fn thesis_robot_config() -> DcRobotConfig {
-    let (d, o) = (Delta3::THESIS, ModelOptions::THESIS);
-    let zero = DcVec3::from_vec3(&Vec3::zeros());
-    DcRobotConfig {
-        geometry: DcDelta3 { f: d.f, rf: d.rf, re: d.re, e: d.e, theta_min: d.theta_min, theta_max: d.theta_max },
-        half_height: o.half_height,
-        half_depth: o.half_depth,
-        margin: o.margin,
-        has_upper_links: 0,
-        upper_half_height: 0.0,
-        upper_half_depth: 0.0,
-        has_platform: 0,
-        platform: DcBox { offset: zero, half: zero },
-        has_tool: 0,
-        tool: DcBox { offset: zero, half: zero },
-        alpha: 0.0,
-        translation: zero,
-    }
+    DcRobotConfig::from_spec(&RobotSpec {
+        name: String::new(),
+        model: RobotModel { delta: Delta3::THESIS, options: ModelOptions::THESIS },
+        placement: Placement::IDENTITY,
+    })
 }
 
 /// The C geometry as a validated [`Delta3`].
@@ -109,6 +125,24 @@ pub(crate) fn delta3_from_c(g: &DcDelta3) -> Result<Delta3, DcStatus> {
 mod tests {
     use super::*;
     use std::ffi::CStr;
+
+    #[test]
+    fn from_spec_is_the_inverse_of_robot_spec() {
+        let tool = ToolBox { offset: Vec3::new(1.0, -2.0, -30.0), half: Vec3::new(20.0, 25.0, 30.0) };
+        let mut specs: Vec<RobotSpec> = ["T1", "T2", "T3"]
+            .iter()
+            .flat_map(|n| crate::cell::reference::reference_cell(n).unwrap().robots)
+            .collect();
+        let mut full = specs[1].clone();
+        full.model.options.upper_links = Some((12.0, 9.0));
+        full.model.options.platform = Some(ToolBox { offset: Vec3::zeros(), half: Vec3::new(45.0, 45.0, 8.0) });
+        full.model.options.tool = Some(tool);
+        specs.push(full);
+        for (i, r) in specs.iter().enumerate() {
+            let back = robot_spec(i, &DcRobotConfig::from_spec(r));
+            assert_eq!((back.model, back.placement), (r.model, r.placement), "robot {i}");
+        }
+    }
 
     #[test]
     fn each_table_error_has_its_own_status_from_10_with_a_text() {

@@ -86,11 +86,11 @@ pub struct DcVec3 {
 }
 
 impl DcVec3 {
-    pub(crate) fn to_vec3(self) -> Vec3 {
+    pub fn to_vec3(self) -> Vec3 {
         Vec3::new(self.x, self.y, self.z)
     }
 
-    pub(crate) fn from_vec3(v: &Vec3) -> Self {
+    pub fn from_vec3(v: &Vec3) -> Self {
         DcVec3 { x: v.x, y: v.y, z: v.z }
     }
 
