@@ -7,27 +7,30 @@
 //!
 //! Run: `cargo bench --bench table_report -- [--cells T1,T2,T3] [--k 32] [--random 1000000]
 //! [--cold 100000] [--cold-shared 1000000] [--variants shared,...] [--timer instant|tsc]
-//! [--slowest 0] [--passes 3] [--hot-block 256]` (`--help` lists them). `--cold-shared`: flushed queries of the shared
-//! table without sub-cells; `--cold`: of every other table. `--variants`: which tables
-//! (default all; the 6-D table is built anyway when a shared one is, for the agreement check,
-//! and only labellings that a chosen table needs are made). `--timer tsc`: `rdtsc` between
-//! `lfence`s, converted to ns with a rate calibrated against `Instant` in the same run.
+//! [--slowest 0] [--passes 3] [--hot-block 256]` (`--help` lists them). `--cold-shared`:
+//! flushed queries of the shared table without sub-cells; `--cold`: of every other table.
+//! `--variants`: which tables (default all; the 6-D table is built anyway when a shared one
+//! is, for the agreement check, and only labellings that a chosen table needs are made).
+//! `--timer tsc`: `rdtsc` between `lfence`s, converted to ns with a rate calibrated against
+//! `Instant` in the same run.
 //! `--slowest N`: for each shared table and for the hot and streamed regimes, the N slowest
 //! queries with the memory reads of their descent (dependent steps, cache lines, pages),
-//! re-timed one by one, and the regime's times grouped by steps and lines. Without `--bench` (as `cargo test` runs it) it does a
-//! small smoke run (T2, k = 16) that still checks FN = 0 and the shared table's agreement with
-//! the 6-D table.
+//! re-timed one by one, and the regime's times grouped by steps and lines. Without `--bench`
+//! (as `cargo test` runs it) it does a small smoke run (T2, k = 16) that still checks FN = 0
+//! and the shared table's agreement with the 6-D table.
 //!
 //! A query here is the table lookup alone (`Table::query` on a precomputed 6-D cell). All
 //! queries are timed in three passes (`--passes`) and each keeps its fastest pass, so that the
 //! maximum is the slowest query and not an interrupt. Three regimes: *hot*, the passes run
 //! back to back over blocks of 256 queries, so that every line a query reads is in the
-//! caches (the blocks of the slowest queries then run again, `timing::CONFIRM_ROUNDS`); *streamed*, the passes run over all queries, whose own input (12 bytes a query)
-//! evicts the table's rarely read lines between passes, a mix of hot and cold reads; and
-//! *flushed*, every line of the table evicted (`clflush`) before each query. Timing costs two clock reads, shown as the "timer" rows (the floor of every
-//! figure, measured in the same run for both clocks, the same way: when their maximum is
-//! high, the machine was too busy for the maximum of any row to mean more). The shared
-//! table's previous layout (separate arrays) is timed in the same run, the two taking turns.
+//! caches (the blocks of the slowest queries then run again, `timing::CONFIRM_ROUNDS`);
+//! *streamed*, the passes run over all queries, whose own input (12 bytes a query) evicts the
+//! table's rarely read lines between passes, a mix of hot and cold reads; and *flushed*,
+//! every line of the table evicted (`clflush`) before each query. Timing costs two clock
+//! reads, shown as the "timer" rows (the floor of every figure, measured in the same run for
+//! both clocks, the same way: when their maximum is high, the machine was too busy for the
+//! maximum of any row to mean more). The shared table's previous layout (separate arrays) is
+//! timed in the same run, the two taking turns.
 //! Configurations whose TCP lies outside the sampled grid (none on the reference cells) would
 //! go to the exact check, as `TableChecker` does, and are counted apart.
 

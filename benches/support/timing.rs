@@ -126,11 +126,12 @@ pub fn fastest_of_passes(cells: &[[u16; 6]], mut time: impl FnMut([u16; 6]) -> u
     best
 }
 
-/// Queries per block of the hot regime (256 unless `--hot-block` says otherwise): between a
-/// query's untimed and timed run, the lines the block's descents read (at most 13 a query at
-/// k = 64: 3,328 lines, 208 KiB) stay in the 2 MiB L2 and their pages (at most 7 a query:
-/// 1,792) in the 3,072-entry L2 TLB of the EPYC that measures here. (Blocks of 4,096, as
-/// before, fit neither at k = 64: up to 28,672 pages.)
+/// Queries per block of the hot regime (256 unless `--hot-block` says otherwise), so that
+/// between a query's untimed and timed run the block's lines stay in the 2 MiB L2 and its
+/// pages in the 3,072-entry L2 TLB of the EPYC that measures here: a `6D-shared/sub` descent
+/// reads up to 11 lines on 6 pages at k = 32 (T3, `--slowest`), one level more at k = 64.
+/// Blocks of 256 fit both with room to spare; those of 4,096 (before) fit neither in the
+/// worst case.
 pub static HOT_BLOCK: AtomicUsize = AtomicUsize::new(256);
 
 /// After the passes of the hot regime, the blocks holding the [`CONFIRM_SLOWEST`] slowest
