@@ -129,10 +129,8 @@ mod tests {
     #[test]
     fn from_spec_is_the_inverse_of_robot_spec() {
         let tool = ToolBox { offset: Vec3::new(1.0, -2.0, -30.0), half: Vec3::new(20.0, 25.0, 30.0) };
-        let mut specs: Vec<RobotSpec> = ["T1", "T2", "T3"]
-            .iter()
-            .flat_map(|n| crate::cell::reference::reference_cell(n).unwrap().robots)
-            .collect();
+        let mut specs: Vec<RobotSpec> =
+            ["T1", "T2", "T3"].iter().flat_map(|n| crate::cell::reference::reference_cell(n).unwrap().robots).collect();
         let mut full = specs[1].clone();
         full.model.options.upper_links = Some((12.0, 9.0));
         full.model.options.platform = Some(ToolBox { offset: Vec3::zeros(), half: Vec3::new(45.0, 45.0, 8.0) });
