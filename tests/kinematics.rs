@@ -351,11 +351,11 @@ fn chain_and_direct_models_give_the_same_boxes() {
 }
 
 proptest! {
-    // About 35 % of this box lies outside the reachable workspace (CI, session 5: 1,024
-    // rejects for 1,906 accepted), so 2,000 accepted cases take about 1,080 rejects on average
-    // and the default cap of 1,024 failed the test on most seeds. The cap is raised to 10
-    // rejects per accepted case: a box that drifted out of reach would still fail here rather
-    // than pass on a few points.
+    // About a third of this box lies outside the reachable workspace (CI, session 5: 1,024
+    // rejects for 1,906 accepted, 35 %), so 2,000 accepted cases take about 1,000 rejects on
+    // average, as many as proptest's default cap of 1,024: the test failed on some seeds. The
+    // cap is raised to 10 rejects per accepted case: a box that drifted out of reach would
+    // still fail here rather than pass on a few points.
     #![proptest_config(ProptestConfig {
         cases: 2_000,
         max_global_rejects: 20_000,
