@@ -295,14 +295,14 @@ fn slowest_report(
     clock: Clock,
     table: &Table,
     cells: &[[u16; 6]],
-    warm: &[u64],
+    times: &[u64],
     regime: &str,
     n: usize,
 ) -> Vec<String> {
     let Table::Shared(shared) = table else { return vec![] };
     let regions = table.memory_regions();
     let mut order: Vec<usize> = (0..cells.len()).collect();
-    order.sort_unstable_by_key(|&i| std::cmp::Reverse(warm[i]));
+    order.sort_unstable_by_key(|&i| std::cmp::Reverse(times[i]));
     let p = shared.parts();
     let refs: Vec<usize> = p
         .depth_start
@@ -322,11 +322,11 @@ fn slowest_report(
         let (cold, cold_med) = min_median(11, || query_ns(clock, table, cells[i], Some(&regions)));
         out.push(format!(
             "  #{i} {:?} {regime} {} ns: {steps} steps, {reads} reads, {lines} lines, {pages} pages; alone hot min/median {hot} / {hot_med} ns, flushed {cold} / {cold_med} ns",
-            cells[i], warm[i]
+            cells[i], times[i]
         ));
     }
     let mut by: [std::collections::BTreeMap<usize, Vec<u64>>; 2] = Default::default();
-    for (c, &t) in cells.iter().zip(warm) {
+    for (c, &t) in cells.iter().zip(times) {
         let (steps, _, lines, _) = read_counts(&shared.query_reads(*c).1);
         by[0].entry(steps as usize).or_default().push(t);
         by[1].entry(lines).or_default().push(t);

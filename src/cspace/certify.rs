@@ -265,13 +265,7 @@ impl<'a> SubOctants<'a> {
             let h = 0.125 * r;
             let cs: Vec<Vec3> = (0..8).map(|u| octant_centre(&octant, u, h)).collect();
             let refs: Vec<Vec3> = cs.iter().map(|c| reference_point(&model.delta, c, h).unwrap_or(*c)).collect();
-            let inflate = |u: usize| match (
-                vacuous(model, &cs[u], h),
-                cube_box_sweeps(model, &cs[u], h, &refs[u], OCTANT_SPLITS),
-            ) {
-                (false, Some(s)) => inflation(s),
-                _ => Inflation::Vacuous,
-            };
+            let inflate = |u: usize| octant_sweeps(model, &cs[u], h, &refs[u]).map_or(Inflation::Vacuous, inflation);
             SampleBoxes::new(model, &self.robot.placement, &refs, inflate)
         })
     }
@@ -771,9 +765,15 @@ fn octant_centre(c: &Vec3, o: usize, d: Real) -> Vec3 {
     c + Vec3::from_fn(|a, _| if o >> a & 1 == 1 { d } else { -d })
 }
 
-/// Whether the cube of centre `c` and half-side `h` is proved to hold no reachable TCP.
-fn vacuous(model: &RobotModel, c: &Vec3, h: Real) -> bool {
-    !model.delta.is_reachable(c) && cube_unreachable(&model.delta, c, h)
+/// The box sweeps over the cube of centre `c` and half-side `h` (about `reference`, with
+/// [`OCTANT_SPLITS`]), or `None` when the cube is proved to hold no reachable TCP or has no
+/// bound: the octants and sub-octants of levels 2 and 3.
+fn octant_sweeps(model: &RobotModel, c: &Vec3, h: Real, reference: &Vec3) -> Option<[Sweep; MAX_BOXES]> {
+    let vacuous = !model.delta.is_reachable(c) && cube_unreachable(&model.delta, c, h);
+    if vacuous {
+        return None;
+    }
+    cube_box_sweeps(model, c, h, reference, OCTANT_SPLITS)
 }
 
 /// Every sample's reference point ([`reference_point`]; its centre when none).
@@ -808,16 +808,7 @@ fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>)
     let cs: Vec<Vec3> = (0..n).map(|e| octant_centre(&grid.sample_center(e / 8), e % 8, q)).collect();
     let refs: Vec<Vec3> = cs.par_iter().map(|c| reference_point(&model.delta, c, q).unwrap_or(*c)).collect();
     let raw: Vec<Option<[Sweep; MAX_BOXES]>> =
-        (0..n)
-            .into_par_iter()
-            .map(|e| {
-                if vacuous(model, &cs[e], q) {
-                    None
-                } else {
-                    cube_box_sweeps(model, &cs[e], q, &refs[e], OCTANT_SPLITS)
-                }
-            })
-            .collect();
+        (0..n).into_par_iter().map(|e| octant_sweeps(model, &cs[e], q, &refs[e])).collect();
     let inflation = (0..n)
         .map(|e| {
             let mirror = grid.index_of(mirror_cell(grid, grid.cells[e / 8])).map(|m| 8 * m + ((e % 8) ^ 2));

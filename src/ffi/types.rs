@@ -86,10 +86,12 @@ pub struct DcVec3 {
 }
 
 impl DcVec3 {
+    /// As the crate's vector type.
     pub fn to_vec3(self) -> Vec3 {
         Vec3::new(self.x, self.y, self.z)
     }
 
+    /// From the crate's vector type.
     pub fn from_vec3(v: &Vec3) -> Self {
         DcVec3 { x: v.x, y: v.y, z: v.z }
     }
