@@ -38,7 +38,7 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::symmetry::reflection_y;
 use delta_collide::cspace::{
-    label_space_certified, label_space_subdivided, label_space_thesis, subdivided_labels, LabelledSpace, SampleGrid,
+    label_space_certified, label_space_subdivided, label_space_thesis, LabelledSpace, SampleGrid, SubdividedLabels,
     Workspace,
 };
 use delta_collide::math::Vec3;
@@ -54,8 +54,8 @@ use std::time::Instant;
 use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, hottest_of_passes, percentiles, Clock};
 
 /// The tables of the report, by the key `--variants` takes, in report order.
-const VARIANTS: [&str; 9] =
-    ["6d", "5d", "4d-yy", "4d-zz", "4d-yy-lossy", "shared", "shared-sub", "4d-yy-sub", "thesis"];
+const VARIANTS: [&str; 10] =
+    ["6d", "5d", "4d-yy", "4d-zz", "4d-yy-lossy", "shared", "shared-sub", "4d-yy-sub", "4d-zz-sub", "thesis"];
 
 const USAGE: &str = "cargo bench --bench table_report -- [options]
   --cells T1,T2,T3      reference cells (default all three)
@@ -64,7 +64,8 @@ const USAGE: &str = "cargo bench --bench table_report -- [options]
   --cold 100000         flushed queries per table (not the shared one)
   --cold-shared 1000000 flushed queries of the shared table without sub-cells
   --variants LIST       comma list of 6d,5d,4d-yy,4d-zz,4d-yy-lossy,shared,shared-sub,4d-yy-sub,
-                        thesis (default all; 4d-yy-sub: the 4D/yy t=0 table of the sub-cell labels)
+                        4d-zz-sub,thesis (default all; 4d-yy-sub, 4d-zz-sub: the 4D t=0 tables
+                        of the sub-cell labels at 2k)
   --timer instant|tsc   clock of the query timings (default instant; tsc: rdtsc between lfences)
   --slowest N           the N slowest hot and streamed queries of each shared table, analysed
                         (default 0)
@@ -377,9 +378,17 @@ fn main() {
         let (certified, label_secs) =
             timed(&|| label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space);
         let start = Instant::now();
-        let subdivided = (wants("shared-sub") || wants("4d-yy-sub"))
+        let subdivided = (wants("shared-sub") || wants("4d-yy-sub") || wants("4d-zz-sub"))
             .then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
         let sub_secs = start.elapsed().as_secs_f64();
+        // The thesis's 4-D tables of the sub-cell labels at `2 k`, read pair by pair (their
+        // dense labels take 64 times the bytes of the labels at `k`).
+        let start = Instant::now();
+        let fine_labels = subdivided
+            .as_ref()
+            .filter(|_| wants("4d-yy-sub") || wants("4d-zz-sub"))
+            .map(|s| SubdividedLabels::new(&cell, &ws, s).expect("2k grids"));
+        let fine_secs = sub_secs + start.elapsed().as_secs_f64();
         let thesis =
             wants("thesis").then(|| timed(&|| label_space_thesis(&cell, opt.k, &ws, false).expect("labelling")));
         let configs = configurations(&cell, &certified, opt.random, &ws);
@@ -441,18 +450,18 @@ fn main() {
                 Box::new(move |s| SharedQuadtree6d::build_subdivided(s, sub_cells, symmetric).map(Table::Shared)),
             ));
         }
-        let expanded = subdivided
-            .as_ref()
-            .filter(|_| wants("4d-yy-sub"))
-            .map(|s| subdivided_labels(&cell, &ws, s).expect("2k labels"));
-        if let Some(expanded) = &expanded {
-            variants.push((
-                "4d-yy-sub",
-                "4D/yy t=0 of the sub-cell labels (2k)".into(),
-                expanded,
-                sub_secs,
-                Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, 0).map(Table::D4)),
-            ));
+        if let (Some(sub), Some(fine_labels)) = (&subdivided, &fine_labels) {
+            for (key, axes, name) in [("4d-yy-sub", SliceAxes::YY, "yy"), ("4d-zz-sub", SliceAxes::ZZ, "zz")] {
+                variants.push((
+                    key,
+                    format!("4D/{name} t=0 of the sub-cell labels (2k)"),
+                    &sub.space,
+                    fine_secs,
+                    Box::new(move |_| {
+                        LinearQuadtree4d::build_subdivided(fine_labels, symmetric, axes, 0).map(Table::D4)
+                    }),
+                ));
+            }
         }
         let fine_levels = opt.k.trailing_zeros() + 1;
         if let Some((thesis, secs)) = &thesis {

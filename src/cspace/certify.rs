@@ -395,58 +395,105 @@ fn sub_cells(a: &Levels, b: &Levels, labels: &[Label]) -> SubCells {
 }
 
 /// The labels a subdivided labelling ([`label_space_subdivided`]) stands for, on the grid of
-/// `2k` cells per axis (the octants of the `k` grid): a sub-cell takes its pair's label, or,
-/// for a pair with sub-cells, its own ("don't care" outside `care`). A sample of the `2k`
-/// grid whose parent cell is not sampled at `k` is "don't care": queries there never reach
-/// the table. A plain table built from these labels answers as the subdivided one does on
-/// every sub-cell (the baseline for its size).
-///
-/// # Errors
-/// When `certified` has no sub-cells, or as [`crate::cspace::label_space`].
-pub fn subdivided_labels(cell: &Cell, ws: &Workspace, certified: &CertifiedSpace) -> Result<LabelledSpace, String> {
-    let sub = certified.sub.as_ref().ok_or("the labelling has no sub-cells")?;
-    let coarse = &certified.space;
-    let (grid_a, grid_b) = two_robot_grids(cell, 2 * coarse.grid_a.k, ws)?;
-    // Per fine sample: its parent sample and its octant (bits x, y, z = 0, 1, 2).
-    let parents = |fine: &SampleGrid, coarse: &SampleGrid| -> Vec<Option<(usize, usize)>> {
-        let of = |c: &[u16; 3]| {
-            let p = coarse.index_of([c[0] / 2, c[1] / 2, c[2] / 2])?;
-            Some((p, usize::from(c[0] & 1) | usize::from(c[1] & 1) << 1 | usize::from(c[2] & 1) << 2))
+/// `2k` cells per axis (the octants of the `k` grid), found pair by pair: a sub-cell takes
+/// its pair's label, or, for a pair with sub-cells, its own ("don't care" outside `care`). A
+/// sample of the `2k` grid whose parent cell is not sampled at `k` is "don't care": queries
+/// there never reach the table. A plain table built from these labels answers as the
+/// subdivided one does on every sub-cell (the baseline for its size); at `k = 64` the dense
+/// labels ([`subdivided_labels`]) would not fit in memory, so the 4-D builder reads them
+/// here ([`crate::table::LinearQuadtree4d::build_subdivided`]).
+pub struct SubdividedLabels<'a> {
+    coarse: &'a LabelledSpace,
+    sub: &'a SubCells,
+    /// A's samples at `2k`.
+    pub grid_a: SampleGrid,
+    /// B's samples at `2k`.
+    pub grid_b: SampleGrid,
+    /// Per sample at `2k`: its parent sample at `k` and its octant (bits x, y, z = 0, 1, 2).
+    parent_a: Vec<Option<(u32, u8)>>,
+    parent_b: Vec<Option<(u32, u8)>>,
+    /// `sub.pairs[row_start[ia]..row_start[ia + 1]]` are the pairs of A's sample `ia` at `k`.
+    row_start: Vec<usize>,
+}
+
+impl<'a> SubdividedLabels<'a> {
+    /// The `2k` grids of `cell` and the parents of their samples in `certified`'s grids.
+    ///
+    /// # Errors
+    /// When `certified` has no sub-cells, or as [`crate::cspace::label_space`].
+    pub fn new(cell: &Cell, ws: &Workspace, certified: &'a CertifiedSpace) -> Result<SubdividedLabels<'a>, String> {
+        let sub = certified.sub.as_ref().ok_or("the labelling has no sub-cells")?;
+        let coarse = &certified.space;
+        let (grid_a, grid_b) = two_robot_grids(cell, 2 * coarse.grid_a.k, ws)?;
+        let parents = |fine: &SampleGrid, coarse: &SampleGrid| -> Vec<Option<(u32, u8)>> {
+            let of = |c: &[u16; 3]| {
+                let p = coarse.index_of([c[0] / 2, c[1] / 2, c[2] / 2])?;
+                Some((p as u32, (c[0] & 1) as u8 | ((c[1] & 1) as u8) << 1 | ((c[2] & 1) as u8) << 2))
+            };
+            fine.cells.iter().map(of).collect()
         };
-        fine.cells.iter().map(of).collect()
-    };
-    let (pa, pb) = (parents(&grid_a, &coarse.grid_a), parents(&grid_b, &coarse.grid_b));
-    let (nb, nb0) = (grid_b.cells.len(), coarse.grid_b.cells.len());
-    let mut labels = vec![Label::Unreachable; grid_a.cells.len() * nb];
-    if nb > 0 {
-        labels.par_chunks_mut(nb).zip(&pa).for_each(|(row, parent)| {
-            let Some((ia, i)) = *parent else { return };
-            // The sub-cells of this row's parent pairs, by B's parent sample.
-            let first = sub.pairs.partition_point(|&p| p < (ia * nb0) as u64);
-            let last = sub.pairs.partition_point(|&p| p < ((ia + 1) * nb0) as u64);
-            let mut masks = vec![None; nb0];
-            for e in first..last {
-                masks[sub.pairs[e] as usize - ia * nb0] = Some((sub.care[e], sub.collision[e]));
-            }
-            for (l, parent) in row.iter_mut().zip(&pb) {
-                let Some((ib, j)) = *parent else { continue };
-                *l = match (coarse.label(ia, ib), masks[ib]) {
-                    (Label::Collision, Some((care, collision))) => {
-                        let bit = 1u64 << sub_cell_index(i, j);
-                        if care & bit == 0 {
+        let (parent_a, parent_b) = (parents(&grid_a, &coarse.grid_a), parents(&grid_b, &coarse.grid_b));
+        let nb0 = coarse.grid_b.cells.len() as u64;
+        let row_start =
+            (0..=coarse.grid_a.cells.len() as u64).map(|ia| sub.pairs.partition_point(|&p| p < ia * nb0)).collect();
+        Ok(SubdividedLabels { coarse, sub, grid_a, grid_b, parent_a, parent_b, row_start })
+    }
+
+    /// The labels at `k` the sub-cells refine.
+    pub fn coarse(&self) -> &LabelledSpace {
+        self.coarse
+    }
+
+    /// The labels of A's sample `ia` with each of B's samples `ibs` (`u32::MAX`, or `ia =
+    /// None`: no sample, "don't care"), into `out`.
+    pub fn row(&self, ia: Option<usize>, ibs: &[u32], out: &mut [Label]) {
+        let Some((pa, i)) = ia.and_then(|ia| self.parent_a[ia]) else {
+            out.fill(Label::Unreachable);
+            return;
+        };
+        let (pa, nb0) = (pa as usize, self.coarse.grid_b.cells.len());
+        let labels = &self.coarse.labels[pa * nb0..(pa + 1) * nb0];
+        let (first, last) = (self.row_start[pa], self.row_start[pa + 1]);
+        let row = &self.sub.pairs[first..last];
+        for (l, &ib) in out.iter_mut().zip(ibs) {
+            let Some(&Some((pb, j))) = self.parent_b.get(ib as usize) else {
+                *l = Label::Unreachable;
+                continue;
+            };
+            *l = match labels[pb as usize] {
+                Label::Collision => match row.binary_search(&((pa * nb0) as u64 + u64::from(pb))) {
+                    Ok(e) => {
+                        let bit = 1u64 << sub_cell_index(usize::from(i), usize::from(j));
+                        if self.sub.care[first + e] & bit == 0 {
                             Label::Unreachable
-                        } else if collision & bit != 0 {
+                        } else if self.sub.collision[first + e] & bit != 0 {
                             Label::Collision
                         } else {
                             Label::Free
                         }
                     }
-                    (label, _) => label,
-                };
-            }
-        });
+                    Err(_) => Label::Collision,
+                },
+                label => label,
+            };
+        }
     }
-    Ok(LabelledSpace { grid_a, grid_b, labels, margin: coarse.margin })
+}
+
+/// The labels of [`SubdividedLabels`] as one array (they take `8^2` times the bytes of the
+/// labels at `k`).
+///
+/// # Errors
+/// As [`SubdividedLabels::new`].
+pub fn subdivided_labels(cell: &Cell, ws: &Workspace, certified: &CertifiedSpace) -> Result<LabelledSpace, String> {
+    let fine = SubdividedLabels::new(cell, ws, certified)?;
+    let nb = fine.grid_b.cells.len();
+    let ibs: Vec<u32> = (0..nb as u32).collect();
+    let mut labels = vec![Label::Unreachable; fine.grid_a.cells.len() * nb];
+    if nb > 0 {
+        labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| fine.row(Some(ia), &ibs, row));
+    }
+    Ok(LabelledSpace { grid_a: fine.grid_a, grid_b: fine.grid_b, labels, margin: certified.space.margin })
 }
 
 /// The sub-cells of `(ia, ib)` that hold reachable TCPs of both robots: neither octant is

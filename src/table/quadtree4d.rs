@@ -26,10 +26,12 @@ use super::code::{encode, MAX_LEVELS};
 use super::error::{corrupt, TableError};
 use super::space::fold;
 #[cfg(feature = "std")]
-use super::space::SpaceView;
+use super::space::{check_grids, merge, reflections, SpaceView, NONE};
 #[cfg(feature = "std")]
-use crate::cspace::{Label, LabelledSpace};
+use crate::cspace::{Label, LabelledSpace, SubdividedLabels};
 use alloc::{format, vec::Vec};
+#[cfg(feature = "std")]
+use rayon::prelude::*;
 #[cfg(feature = "std")]
 use std::collections::BTreeMap;
 
@@ -165,6 +167,61 @@ fn ranges(cells: &[[u16; 3]], keep: impl Fn(usize) -> bool, second: usize) -> BT
     m
 }
 
+/// Algorithm 8's grouping, fed the ranges' slices in the thesis's order (x, x', then the
+/// second dimension of each).
+#[cfg(feature = "std")]
+struct Grouping {
+    tree: LinearQuadtree4d,
+    wps: usize,
+    g_add: Vec<u32>,
+    exact: Option<ExactGroups>,
+    nodes: Vec<(u64, u32)>,
+}
+
+#[cfg(feature = "std")]
+impl Grouping {
+    fn new(levels: u32, symmetric: bool, axes: SliceAxes, t: u32) -> Grouping {
+        let wps = shape(levels, symmetric, axes).1;
+        let tree = LinearQuadtree4d { levels, symmetric, axes, t, codes: vec![], slice_of: vec![], slices: vec![] };
+        let exact = (t == 0).then(|| ExactGroups::new(64 * wps));
+        Grouping { tree, wps, g_add: Vec::new(), exact, nodes: Vec::new() }
+    }
+
+    /// Range `[x, second, x', second']` with slice `s` (collision bits) and `care`.
+    fn add(&mut self, range: [u16; 4], s: &[u64], care: &[u64]) {
+        let group = match self.exact.as_mut() {
+            Some(exact) => {
+                let g = exact.group(s, care);
+                if g as usize == self.tree.slices.len() / self.wps {
+                    self.tree.slices.extend_from_slice(s);
+                }
+                g
+            }
+            None => self.tree.group(s, care, &mut self.g_add, self.wps),
+        };
+        self.nodes.push((encode(range, 4), group));
+    }
+
+    fn finish(mut self) -> LinearQuadtree4d {
+        self.nodes.sort_unstable_by_key(|n| n.0);
+        (self.tree.codes, self.tree.slice_of) = self.nodes.into_iter().unzip();
+        self.tree
+    }
+}
+
+/// Puts `label` at slice bit `bit`; whether it is a collision.
+#[cfg(feature = "std")]
+fn put(s: &mut [u64], care: &mut [u64], bit: usize, label: Label) -> bool {
+    if label != Label::Unreachable {
+        care[bit / 64] |= 1 << (bit % 64);
+    }
+    let collision = label == Label::Collision;
+    if collision {
+        s[bit / 64] |= 1 << (bit % 64);
+    }
+    collision
+}
+
 impl LinearQuadtree4d {
     /// Builds the table of `space` with threshold `t` (thesis Algorithm 8); with
     /// `symmetric`, only A's upper half `iy >= k/2` is stored.
@@ -185,11 +242,8 @@ impl LinearQuadtree4d {
         let (ca, cb) = (&space.grid_a.cells, &space.grid_b.cells);
         let ra = ranges(ca, |i| view.stored(i), second);
         let rb = ranges(cb, |_| true, second);
-        let mut tree = LinearQuadtree4d { levels, symmetric, axes, t, codes: vec![], slice_of: vec![], slices: vec![] };
-        let mut g_add: Vec<u32> = Vec::new();
-        let mut nodes: Vec<(u64, u32)> = Vec::new();
+        let mut grouping = Grouping::new(levels, symmetric, axes, t);
         let (mut s, mut care) = (vec![0u64; wps], vec![0u64; wps]);
-        let mut exact = (t == 0).then(|| ExactGroups::new(64 * wps));
         // Thesis order x, x', z, z': the A and B maps are sorted by (ix, second).
         let xs_a: Vec<u16> = ra.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
         let xs_b: Vec<u16> = rb.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
@@ -204,37 +258,103 @@ impl LinearQuadtree4d {
                             let row = (u32::from(ca[ia][ignored]) - a0) * k;
                             for &ib in ibs {
                                 let bit = (row + u32::from(cb[ib][ignored])) as usize;
-                                let label = view.label(ia, ib);
-                                if label != Label::Unreachable {
-                                    care[bit / 64] |= 1 << (bit % 64);
-                                }
-                                if label == Label::Collision {
-                                    s[bit / 64] |= 1 << (bit % 64);
-                                    any = true;
-                                }
+                                any |= put(&mut s, &mut care, bit, view.label(ia, ib));
                             }
                         }
-                        if !any {
-                            continue;
+                        if any {
+                            grouping.add([xa, *za, xb, *zb], &s, &care);
                         }
-                        let group = match exact.as_mut() {
-                            Some(exact) => {
-                                let g = exact.group(&s, &care);
-                                if g as usize == tree.slices.len() / wps {
-                                    tree.slices.extend_from_slice(&s);
-                                }
-                                g
-                            }
-                            None => tree.group(&s, &care, &mut g_add, wps),
-                        };
-                        nodes.push((encode([xa, *za, xb, *zb], 4), group));
                     }
                 }
             }
         }
-        nodes.sort_unstable_by_key(|n| n.0);
-        (tree.codes, tree.slice_of) = nodes.into_iter().unzip();
-        Ok(tree)
+        Ok(grouping.finish())
+    }
+
+    /// The table [`build`](Self::build) makes from [`crate::cspace::subdivided_labels`]
+    /// (the same table, tested), without those dense labels: only the ranges inside a coarse
+    /// range that holds a collision, itself or by its mirror, can hold one, so only they are
+    /// visited, their pairs' labels read from `labels` and their slices made in parallel,
+    /// a block of ranges at a time; the grouping runs in order.
+    ///
+    /// # Errors
+    /// [`TableError::BadInput`] when the grids differ.
+    #[cfg(feature = "std")]
+    pub fn build_subdivided(
+        labels: &SubdividedLabels,
+        symmetric: bool,
+        axes: SliceAxes,
+        t: u32,
+    ) -> Result<LinearQuadtree4d, TableError> {
+        let (ga, gb) = (&labels.grid_a, &labels.grid_b);
+        check_grids(ga, gb)?;
+        let (k, levels) = (ga.k, ga.levels);
+        let (second, ignored) = axes.dims();
+        let (a0, wps) = shape(levels, symmetric, axes);
+        let ra = ranges(&ga.cells, |i| !symmetric || u32::from(ga.cells[i][1]) >= k / 2, second);
+        let rb = ranges(&gb.cells, |_| true, second);
+        let (refl_a, refl_b) = if symmetric { (reflections(ga), reflections(gb)) } else { (vec![], vec![]) };
+        let coarse = labels.coarse();
+        let (ca0, cb0, k0) = (&coarse.grid_a.cells, &coarse.grid_b.cells, coarse.grid_a.k as u16);
+        let nb0 = cb0.len().max(1);
+        let mut coarse_ranges: Vec<[u16; 4]> = coarse
+            .labels
+            .par_chunks(nb0)
+            .enumerate()
+            .flat_map_iter(|(pa, row)| {
+                let (a, mut out) = (ca0[pa], Vec::new());
+                for (pb, _) in row.iter().enumerate().filter(|(_, &l)| l == Label::Collision) {
+                    let b = cb0[pb];
+                    out.push([a[0], a[second], b[0], b[second]]);
+                    if symmetric && second == 1 {
+                        out.push([a[0], k0 - 1 - a[1], b[0], k0 - 1 - b[1]]);
+                    }
+                }
+                out.sort_unstable();
+                out.dedup();
+                out
+            })
+            .collect();
+        coarse_ranges.par_sort_unstable();
+        coarse_ranges.dedup();
+        let mut fine: Vec<[u16; 4]> = coarse_ranges
+            .iter()
+            .flat_map(|c| (0..16u16).map(move |o| core::array::from_fn(|d| 2 * c[d] + (o >> d & 1))))
+            .filter(|f: &[u16; 4]| ra.contains_key(&(f[0], f[1])) && rb.contains_key(&(f[2], f[3])))
+            .collect();
+        // The thesis order (x, x', then the second dimension of each).
+        fine.par_sort_unstable_by_key(|f| (f[0], f[2], f[1], f[3]));
+        let slice = |f: &[u16; 4]| -> Option<(Vec<u64>, Vec<u64>)> {
+            let (ias, ibs) = (&ra[&(f[0], f[1])], &rb[&(f[2], f[3])]);
+            let own_b: Vec<u32> = ibs.iter().map(|&ib| ib as u32).collect();
+            let mirror_b: Vec<u32> = if symmetric { ibs.iter().map(|&ib| refl_b[ib]).collect() } else { vec![] };
+            let (mut own, mut mirror) = (vec![Label::Unreachable; ibs.len()], vec![Label::Unreachable; ibs.len()]);
+            let (mut s, mut care, mut any) = (vec![0u64; wps], vec![0u64; wps], false);
+            for &ia in ias {
+                labels.row(Some(ia), &own_b, &mut own);
+                if symmetric {
+                    let m = refl_a[ia];
+                    labels.row((m != NONE).then_some(m as usize), &mirror_b, &mut mirror);
+                }
+                let row = (u32::from(ga.cells[ia][ignored]) - a0) * k;
+                for (n, &ib) in ibs.iter().enumerate() {
+                    let bit = (row + u32::from(gb.cells[ib][ignored])) as usize;
+                    // A missing mirror reads "don't care", which `merge` leaves as `own`.
+                    any |= put(&mut s, &mut care, bit, merge(own[n], mirror[n]));
+                }
+            }
+            any.then_some((s, care))
+        };
+        let mut grouping = Grouping::new(levels, symmetric, axes, t);
+        for block in fine.chunks(4096) {
+            let slices: Vec<_> = block.par_iter().map(slice).collect();
+            for (f, s) in block.iter().zip(slices) {
+                if let Some((s, care)) = s {
+                    grouping.add(*f, &s, &care);
+                }
+            }
+        }
+        Ok(grouping.finish())
     }
 
     /// The group `s` joins (its representative updated), or a new one (Algorithm 8 l. 7-19).
@@ -408,6 +528,35 @@ mod tests {
             assert_eq!(exact.group(&s, &care), want, "slice {i}");
         }
         assert!(exact.count > 128 && joined > 2500, "{} groups, {joined} joins", exact.count);
+    }
+
+    /// The builder without dense labels makes the table the dense builder makes from the
+    /// sub-cell labels: the same ranges, slices and groups (so the same order), on T1 and T2
+    /// (symmetric) and T3 (not), for both slice axes, exact and lossy.
+    #[test]
+    fn subdivided_build_is_the_dense_build_of_the_sub_cell_labels() {
+        use crate::cell::reference::reference_cell;
+        use crate::cspace::symmetry::reflection_y;
+        use crate::cspace::{label_space_subdivided, subdivided_labels, SubdividedLabels, Workspace};
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let mut certified = label_space_subdivided(&cell, 16, &Workspace::THESIS, false).unwrap();
+            // Every fifth pair's sub-cells all collisions: labels no longer mirror-symmetric,
+            // so the symmetric tables must merge each pair with its mirror as the dense one does.
+            let sub = certified.sub.as_mut().unwrap();
+            sub.collision.iter_mut().zip(&sub.care).step_by(5).for_each(|(c, &care)| *c = care);
+            let dense = subdivided_labels(&cell, &Workspace::THESIS, &certified).unwrap();
+            let sparse = SubdividedLabels::new(&cell, &Workspace::THESIS, &certified).unwrap();
+            let symmetric = reflection_y(&cell);
+            for axes in [SliceAxes::YY, SliceAxes::ZZ] {
+                for t in [0, 40] {
+                    let want = LinearQuadtree4d::build(&dense, symmetric, axes, t).unwrap();
+                    let got = LinearQuadtree4d::build_subdivided(&sparse, symmetric, axes, t).unwrap();
+                    assert!(want.codes.len() > 100 && want.slice_count() > 10, "{name} {axes:?} t={t}: too small");
+                    assert!(got == want, "{name} {axes:?} t={t}: the tables differ");
+                }
+            }
+        }
     }
 
     #[test]

@@ -19,7 +19,7 @@ use super::error::{bad_input, TableError};
 use crate::cspace::{Label, LabelledSpace, SampleGrid};
 
 #[cfg(feature = "std")]
-const NONE: u32 = u32::MAX;
+pub(crate) const NONE: u32 = u32::MAX;
 
 /// A validated labelled space with the symmetry fold (see the module doc).
 #[cfg(feature = "std")]
@@ -45,13 +45,24 @@ pub(crate) fn merge(a: Label, b: Label) -> Label {
 
 /// For each sample of `g`, the index of its mirror sample (`iy -> k-1-iy`), or `NONE`.
 #[cfg(feature = "std")]
-fn reflections(g: &SampleGrid) -> Vec<u32> {
+pub(crate) fn reflections(g: &SampleGrid) -> Vec<u32> {
     let k = g.k as usize;
     let mut dense = vec![NONE; k * k * k];
     for (i, c) in g.cells.iter().enumerate() {
         dense[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] = i as u32;
     }
     g.cells.iter().map(|c| dense[(c[0] as usize * k + (k - 1 - c[1] as usize)) * k + c[2] as usize]).collect()
+}
+
+/// Both grids valid (`k = 2^levels`, indices below `k`) and of equal `k`.
+#[cfg(feature = "std")]
+pub(crate) fn check_grids(ga: &SampleGrid, gb: &SampleGrid) -> Result<(), TableError> {
+    check_grid("grid_a", ga)?;
+    check_grid("grid_b", gb)?;
+    if ga.k != gb.k {
+        return Err(bad_input(format!("grid_a.k = {} differs from grid_b.k = {}", ga.k, gb.k)));
+    }
+    Ok(())
 }
 
 #[cfg(feature = "std")]
@@ -72,12 +83,8 @@ fn check_grid(name: &str, g: &SampleGrid) -> Result<(), TableError> {
 impl<'a> SpaceView<'a> {
     /// Validates `space` (equal k on both grids, indices below k, one label per pair).
     pub fn new(space: &'a LabelledSpace, symmetric: bool) -> Result<SpaceView<'a>, TableError> {
-        check_grid("grid_a", &space.grid_a)?;
-        check_grid("grid_b", &space.grid_b)?;
         let (ga, gb) = (&space.grid_a, &space.grid_b);
-        if ga.k != gb.k {
-            return Err(bad_input(format!("grid_a.k = {} differs from grid_b.k = {}", ga.k, gb.k)));
-        }
+        check_grids(ga, gb)?;
         let nb = gb.cells.len();
         if space.labels.len() != ga.cells.len() * nb {
             return Err(bad_input(format!(
