@@ -9,8 +9,10 @@
 //! [--cold 100000] [--cold-shared 1000000] [--variants shared,...] [--timer instant|tsc]
 //! [--slowest 0] [--passes 3] [--hot-block 256]` (`--help` lists them). `--cold-shared`:
 //! flushed queries of the shared table without sub-cells; `--cold`: of every other table.
-//! `--variants`: which tables (default all; the 6-D table is built anyway when a shared one
-//! is, for the agreement check, and only labellings that a chosen table needs are made).
+//! `--variants`: which tables (default all). Only the labellings a chosen table needs are
+//! made: the plain certified one for the first six, and with it the 6-D table whenever a
+//! shared table is asked for, for the agreement check; so `shared-sub`, `4d-yy-sub` and
+//! `4d-zz-sub` alone skip the plain labels and that check.
 //! `--timer tsc`: `rdtsc` between `lfence`s, converted to ns with a rate calibrated against
 //! `Instant` in the same run.
 //! `--slowest N`: for each shared table and for the hot and streamed regimes, the N slowest
@@ -375,8 +377,12 @@ fn main() {
             let start = Instant::now();
             (f(), start.elapsed().as_secs_f64())
         };
-        let (certified, label_secs) =
-            timed(&|| label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space);
+        // The plain certified labels: for the plain tables and the 6-D table the shared ones
+        // are checked against (not made when only subdivided or thesis-style tables are asked
+        // for: the largest runs need its memory).
+        let plain = VARIANTS[..6].iter().any(|v| wants(v));
+        let certified =
+            plain.then(|| timed(&|| label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space));
         let start = Instant::now();
         let subdivided = (wants("shared-sub") || wants("4d-yy-sub") || wants("4d-zz-sub"))
             .then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
@@ -391,55 +397,62 @@ fn main() {
         let fine_secs = sub_secs + start.elapsed().as_secs_f64();
         let thesis =
             wants("thesis").then(|| timed(&|| label_space_thesis(&cell, opt.k, &ws, false).expect("labelling")));
-        let configs = configurations(&cell, &certified, opt.random, &ws);
+        let grids = (certified.as_ref().map(|c| &c.0))
+            .or(subdivided.as_ref().map(|s| &s.space))
+            .or(thesis.as_ref().map(|t| &t.0))
+            .expect("a table to report");
+        let configs = configurations(&cell, grids, opt.random, &ws);
         let fine: Vec<[u16; 6]> = configs.iter().filter_map(|c| c.fine).collect();
         let outside = configs.len() - fine.len();
         let t_lossy = if opt.k >= 64 { 545 } else { 150 };
         type Build<'a> = Box<dyn Fn(&LabelledSpace) -> Result<Table, TableError> + 'a>;
-        let mut variants: Vec<(&str, String, &LabelledSpace, f64, Build)> = vec![
-            (
-                "6d",
-                "6D".into(),
-                &certified,
-                label_secs,
-                Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
-            ),
-            (
-                "5d",
-                "5D".into(),
-                &certified,
-                label_secs,
-                Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5)),
-            ),
-            (
-                "4d-yy",
-                "4D/yy t=0".into(),
-                &certified,
-                label_secs,
-                Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, 0).map(Table::D4)),
-            ),
-            (
-                "4d-zz",
-                "4D/zz t=0".into(),
-                &certified,
-                label_secs,
-                Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::ZZ, 0).map(Table::D4)),
-            ),
-            (
-                "4d-yy-lossy",
-                format!("4D/yy t={t_lossy}"),
-                &certified,
-                label_secs,
-                Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, t_lossy).map(Table::D4)),
-            ),
-            (
-                "shared",
-                "6D-shared (new)".into(),
-                &certified,
-                label_secs,
-                Box::new(move |s| SharedQuadtree6d::build(s, symmetric).map(Table::Shared)),
-            ),
-        ];
+        let mut variants: Vec<(&str, String, &LabelledSpace, f64, Build)> = vec![];
+        if let Some((certified, label_secs)) = &certified {
+            variants.extend::<[(&str, String, &LabelledSpace, f64, Build); 6]>([
+                (
+                    "6d",
+                    "6D".into(),
+                    certified,
+                    *label_secs,
+                    Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
+                ),
+                (
+                    "5d",
+                    "5D".into(),
+                    certified,
+                    *label_secs,
+                    Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5)),
+                ),
+                (
+                    "4d-yy",
+                    "4D/yy t=0".into(),
+                    certified,
+                    *label_secs,
+                    Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, 0).map(Table::D4)),
+                ),
+                (
+                    "4d-zz",
+                    "4D/zz t=0".into(),
+                    certified,
+                    *label_secs,
+                    Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::ZZ, 0).map(Table::D4)),
+                ),
+                (
+                    "4d-yy-lossy",
+                    format!("4D/yy t={t_lossy}"),
+                    certified,
+                    *label_secs,
+                    Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, t_lossy).map(Table::D4)),
+                ),
+                (
+                    "shared",
+                    "6D-shared (new)".into(),
+                    certified,
+                    *label_secs,
+                    Box::new(move |s| SharedQuadtree6d::build(s, symmetric).map(Table::Shared)),
+                ),
+            ]);
+        }
         if let Some(sub) = &subdivided {
             let sub_cells = sub.sub.as_ref().expect("sub-cells");
             variants.push((
