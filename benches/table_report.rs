@@ -65,6 +65,8 @@ const USAGE: &str = "cargo bench --bench table_report -- [options]
   --random 1000000      random reachable configurations per cell
   --cold 100000         flushed queries per table (not the shared one)
   --cold-shared 1000000 flushed queries of the shared table without sub-cells
+  --cold-own 1000000    flushed queries of each shared table with only their own lines
+                        evicted (a note under the table)
   --variants LIST       comma list of 6d,5d,4d-yy,4d-zz,4d-yy-lossy,shared,shared-sub,4d-yy-sub,
                         4d-zz-sub,thesis (default all; 4d-yy-sub, 4d-zz-sub: the 4D t=0 tables
                         of the sub-cell labels at 2k)
@@ -80,6 +82,7 @@ struct Options {
     random: usize,
     cold: usize,
     cold_shared: usize,
+    cold_own: usize,
     variants: Vec<String>,
     tsc: bool,
     slowest: usize,
@@ -102,6 +105,7 @@ fn options() -> Options {
             random: 2000,
             cold: 200,
             cold_shared: 200,
+            cold_own: 2000,
             variants: all(),
             tsc: false,
             slowest: 3,
@@ -126,6 +130,7 @@ fn options() -> Options {
         random: num("--random", 1_000_000),
         cold: num("--cold", 100_000),
         cold_shared: num("--cold-shared", 1_000_000),
+        cold_own: num("--cold-own", 1_000_000),
         variants,
         tsc,
         slowest: num("--slowest", 0),
@@ -270,6 +275,21 @@ fn time_queries(clock: Clock, table: &Table, cells: &[[u16; 6]], cold: usize) ->
         vec![]
     };
     Times { hot, streamed, flushed }
+}
+
+/// Per query of a shared table, its fastest time with only the lines it reads evicted before
+/// it (`SharedQuadtree6d::query_reads`): the flushed regime at a few `clflush`es a query
+/// instead of the whole table's, so that a million queries of a 90 MB table take seconds.
+/// The lines are listed before the flush; the query then reads every one of them from memory.
+fn own_lines_flushed(clock: Clock, table: &Table, cells: &[[u16; 6]]) -> Vec<u64> {
+    let Table::Shared(shared) = table else { return vec![] };
+    if !cfg!(target_arch = "x86_64") {
+        return vec![];
+    }
+    fastest_of_passes(cells, |c| {
+        let lines: Vec<(usize, usize)> = shared.query_reads(c).1.iter().map(|&(a, n, _)| (a, n)).collect();
+        query_ns(clock, table, c, Some(&lines))
+    })
 }
 
 /// The reads of one shared-table query: dependent steps, reads, cache lines, 4 KiB pages.
@@ -551,6 +571,16 @@ fn main() {
                 }
                 if !label.starts_with("thesis") {
                     assert_eq!(fn_, 0, "{name} {label}: a false negative on a certified table");
+                }
+                let own = own_lines_flushed(clock, &table, &cells[..opt.cold_own.min(cells.len())]);
+                if !own.is_empty() {
+                    let n = own.len().min(cold);
+                    let [_, _, all] = timing_cells(&Times { flushed: own.clone(), ..Times::default() }, own.len());
+                    let [_, _, first] = timing_cells(&Times { flushed: own[..n].to_vec(), ..Times::default() }, n);
+                    notes.push(format!(
+                        "{label}: flushed with only its own lines evicted: {all}; its first {n} queries: {first} \
+                         (the whole table evicted: {f})"
+                    ));
                 }
                 if opt.slowest > 0 {
                     notes.extend(slowest_report(clock, &table, &cells, &times.hot, "hot", opt.slowest));
