@@ -56,8 +56,20 @@ use std::time::Instant;
 use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, hottest_of_passes, percentiles, Clock};
 
 /// The tables of the report, by the key `--variants` takes, in report order.
-const VARIANTS: [&str; 10] =
-    ["6d", "5d", "4d-yy", "4d-zz", "4d-yy-lossy", "shared", "shared-sub", "4d-yy-sub", "4d-zz-sub", "thesis"];
+const VARIANTS: [&str; 12] = [
+    "6d",
+    "5d",
+    "4d-yy",
+    "4d-zz",
+    "4d-yy-lossy",
+    "shared",
+    "shared-sub",
+    "4d-yy-sub",
+    "4d-zz-sub",
+    "4d-yy-sub-bound",
+    "4d-zz-sub-bound",
+    "thesis",
+];
 
 const USAGE: &str = "cargo bench --bench table_report -- [options]
   --cells T1,T2,T3      reference cells (default all three)
@@ -68,8 +80,9 @@ const USAGE: &str = "cargo bench --bench table_report -- [options]
   --cold-own 1000000    flushed queries of each shared table with only their own lines
                         evicted (a note under the table)
   --variants LIST       comma list of 6d,5d,4d-yy,4d-zz,4d-yy-lossy,shared,shared-sub,4d-yy-sub,
-                        4d-zz-sub,thesis (default all; 4d-yy-sub, 4d-zz-sub: the 4D t=0 tables
-                        of the sub-cell labels at 2k)
+                        4d-zz-sub,4d-yy-sub-bound,4d-zz-sub-bound,thesis (default all;
+                        4d-yy-sub, 4d-zz-sub: the 4D t=0 tables of the sub-cell labels at 2k;
+                        4d-yy-sub-bound, 4d-zz-sub-bound: a lower bound on their bytes, a note)
   --timer instant|tsc   clock of the query timings (default instant; tsc: rdtsc between lfences)
   --slowest N           the N slowest hot and streamed queries of each shared table, analysed
                         (default 0)
@@ -404,7 +417,8 @@ fn main() {
         let certified =
             plain.then(|| timed(&|| label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space));
         let start = Instant::now();
-        let subdivided = (wants("shared-sub") || wants("4d-yy-sub") || wants("4d-zz-sub"))
+        let fine_wanted = VARIANTS[7..11].iter().any(|v| wants(v));
+        let subdivided = (wants("shared-sub") || fine_wanted)
             .then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
         let sub_secs = start.elapsed().as_secs_f64();
         // The thesis's 4-D tables of the sub-cell labels at `2 k`, read pair by pair (their
@@ -412,7 +426,7 @@ fn main() {
         let start = Instant::now();
         let fine_labels = subdivided
             .as_ref()
-            .filter(|_| wants("4d-yy-sub") || wants("4d-zz-sub"))
+            .filter(|_| fine_wanted)
             .map(|s| SubdividedLabels::new(&cell, &ws, s).expect("2k grids"));
         let fine_secs = sub_secs + start.elapsed().as_secs_f64();
         let thesis =
@@ -618,6 +632,26 @@ fn main() {
                 "| {name} | {} | ({outside} configurations outside the sampled grid: exact check) | | | | | | | | | |",
                 opt.k
             );
+        }
+        // Lower bounds on the 4-D tables of the sub-cell labels, for when building them would
+        // take hours (`SliceBound`).
+        let bounds = [("4d-yy-sub-bound", SliceAxes::YY, "yy"), ("4d-zz-sub-bound", SliceAxes::ZZ, "zz")];
+        for (_, axes, axes_name) in bounds.into_iter().filter(|b| wants(b.0)) {
+            let fine_labels = fine_labels.as_ref().expect("sub-cell labels");
+            let start = Instant::now();
+            let mut bound = SliceBound::new(fine_labels.grid_a.levels, symmetric, axes);
+            subdivided_slices(fine_labels, symmetric, axes, |_, s, care| bound.add(s, care)).expect("slices");
+            let ((groups, (r0, c0, side)), bytes) = (bound.groups_at_least(), bound.bytes_at_least());
+            let ratio = sub_table.as_ref().map_or(String::new(), |t| {
+                let b = t.memory_bytes();
+                format!("; `6D-shared/sub` ({b} bytes) is {:.1} % of that", 100.0 * b as f64 / bytes as f64)
+            });
+            notes.push(format!(
+                "4D/{axes_name} t=0 of the sub-cell labels (2k), bounded in {:.0} s: {} codes, at least {groups} \
+                 slices (patterns in the {side} x {side} window at row {r0}, column {c0}), at least {bytes} bytes{ratio}",
+                start.elapsed().as_secs_f64(),
+                bound.codes,
+            ));
         }
         for n in notes {
             println!("{name}: {n}");
