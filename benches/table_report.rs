@@ -40,8 +40,8 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::symmetry::reflection_y;
 use delta_collide::cspace::{
-    label_space_certified, label_space_subdivided, label_space_thesis, LabelledSpace, SampleGrid, SubdividedLabels,
-    Workspace,
+    label_space_certified, label_space_subdivided, label_space_thesis, subdivided_labels, LabelledSpace, SampleGrid,
+    SubdividedLabels, Workspace,
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
@@ -56,7 +56,7 @@ use std::time::Instant;
 use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, hottest_of_passes, percentiles, Clock};
 
 /// The tables of the report, by the key `--variants` takes, in report order.
-const VARIANTS: [&str; 12] = [
+const VARIANTS: [&str; 14] = [
     "6d",
     "5d",
     "4d-yy",
@@ -68,6 +68,8 @@ const VARIANTS: [&str; 12] = [
     "4d-zz-sub",
     "4d-yy-sub-bound",
     "4d-zz-sub-bound",
+    "6d-sub",
+    "5d-sub",
     "thesis",
 ];
 
@@ -80,9 +82,10 @@ const USAGE: &str = "cargo bench --bench table_report -- [options]
   --cold-own 1000000    flushed queries of each shared table with only their own lines
                         evicted (a note under the table)
   --variants LIST       comma list of 6d,5d,4d-yy,4d-zz,4d-yy-lossy,shared,shared-sub,4d-yy-sub,
-                        4d-zz-sub,4d-yy-sub-bound,4d-zz-sub-bound,thesis (default all;
-                        4d-yy-sub, 4d-zz-sub: the 4D t=0 tables of the sub-cell labels at 2k;
-                        4d-yy-sub-bound, 4d-zz-sub-bound: a lower bound on their bytes, a note)
+                        4d-zz-sub,4d-yy-sub-bound,4d-zz-sub-bound,6d-sub,5d-sub,thesis (default
+                        all; 4d-yy-sub, 4d-zz-sub: the 4D t=0 tables of the sub-cell labels at
+                        2k; 4d-yy-sub-bound, 4d-zz-sub-bound: a lower bound on their bytes, a
+                        note; 6d-sub, 5d-sub: from those labels made dense, up to k = 32)
   --timer instant|tsc   clock of the query timings (default instant; tsc: rdtsc between lfences)
   --slowest N           the N slowest hot and streamed queries of each shared table, analysed
                         (default 0)
@@ -417,7 +420,7 @@ fn main() {
         let certified =
             plain.then(|| timed(&|| label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space));
         let start = Instant::now();
-        let fine_wanted = VARIANTS[7..11].iter().any(|v| wants(v));
+        let fine_wanted = VARIANTS[7..13].iter().any(|v| wants(v));
         let subdivided = (wants("shared-sub") || fine_wanted)
             .then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
         let sub_secs = start.elapsed().as_secs_f64();
@@ -429,6 +432,13 @@ fn main() {
             .filter(|_| fine_wanted)
             .map(|s| SubdividedLabels::new(&cell, &ws, s).expect("2k grids"));
         let fine_secs = sub_secs + start.elapsed().as_secs_f64();
+        // The same labels as one array, for the 6-D and 5-D builders (64 times the bytes of
+        // the labels at `k`).
+        let start = Instant::now();
+        let dense = (subdivided.as_ref())
+            .filter(|_| wants("6d-sub") || wants("5d-sub"))
+            .map(|s| subdivided_labels(&cell, &ws, s).expect("2k labels"));
+        let dense_secs = fine_secs + start.elapsed().as_secs_f64();
         let thesis =
             wants("thesis").then(|| timed(&|| label_space_thesis(&cell, opt.k, &ws, false).expect("labelling")));
         let grids = (certified.as_ref().map(|c| &c.0))
@@ -509,6 +519,22 @@ fn main() {
                     }),
                 ));
             }
+        }
+        if let Some(dense) = &dense {
+            variants.push((
+                "6d-sub",
+                "6D of the sub-cell labels (2k)".into(),
+                dense,
+                dense_secs,
+                Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
+            ));
+            variants.push((
+                "5d-sub",
+                "5D of the sub-cell labels (2k)".into(),
+                dense,
+                dense_secs,
+                Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5)),
+            ));
         }
         let fine_levels = opt.k.trailing_zeros() + 1;
         if let Some((thesis, secs)) = &thesis {
