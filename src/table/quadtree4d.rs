@@ -494,9 +494,9 @@ pub fn subdivided_slices(
 /// (module doc), so two slices of one group agree on every bit both care for. So for any
 /// window `W` of slice bits, slices that care for all of `W` and differ on it are in
 /// different groups: the number of their distinct patterns on `W` is at most the number of
-/// groups. The bound is the largest such number over the square windows that tile the slice
-/// in sides of a quarter, half and all of its rows (4 to 64; patterns are counted by a 64-bit
-/// hash: a collision only lowers the count).
+/// groups. The bound is the largest such number over square windows of sides from a
+/// sixteenth to all of the slice's rows (4 to 64), each side's windows overlapping by half
+/// (patterns are counted by a 64-bit hash: a collision only lowers the count).
 #[cfg(feature = "std")]
 pub struct SliceBound {
     k: usize,
@@ -515,7 +515,7 @@ impl SliceBound {
         let k = 1usize << levels;
         let rows = k - a0 as usize;
         let mut windows = Vec::new();
-        for side in [rows / 4, rows / 2, rows].into_iter().filter(|w| (4..=64).contains(w)) {
+        for side in [rows / 16, rows / 8, rows / 4, rows / 2, rows].into_iter().filter(|w| (4..=64).contains(w)) {
             for r0 in (0..=rows - side).step_by(side / 2) {
                 for c0 in (0..=k - side).step_by(side / 2) {
                     windows.push(((r0, c0, side), Default::default()));
