@@ -11,8 +11,8 @@
 //! flushed queries of the shared table without sub-cells; `--cold`: of every other table.
 //! `--variants`: which tables (default all). Only the labellings a chosen table needs are
 //! made: the plain certified one for the first six, and with it the 6-D table whenever a
-//! shared table is asked for, for the agreement check; so `shared-sub`, `4d-yy-sub` and
-//! `4d-zz-sub` alone skip the plain labels and that check.
+//! shared table is asked for, for the agreement check; so the subdivided table and the
+//! baselines of its sub-cell labels alone skip the plain labels and that check.
 //! `--timer tsc`: `rdtsc` between `lfence`s, converted to ns with a rate calibrated against
 //! `Instant` in the same run.
 //! `--slowest N`: for each shared table and for the hot and streamed regimes, the N slowest
@@ -55,7 +55,9 @@ use std::collections::HashSet;
 use std::time::Instant;
 use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, hottest_of_passes, percentiles, Clock};
 
-/// The tables of the report, by the key `--variants` takes, in report order.
+/// The tables of the report, by the key `--variants` takes, in report order: the first six
+/// from the plain certified labels, then `shared-sub`, then (`[7..13]`) the thesis's tables
+/// of its sub-cell labels, then the thesis-style table.
 const VARIANTS: [&str; 14] = [
     "6d",
     "5d",
