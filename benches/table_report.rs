@@ -40,8 +40,8 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::symmetry::reflection_y;
 use delta_collide::cspace::{
-    label_space_certified, label_space_subdivided, label_space_thesis, subdivided_labels, LabelledSpace, SampleGrid,
-    SubdividedLabels, Workspace,
+    label_space_certified, label_space_subdivided, label_space_thesis, LabelledSpace, SampleGrid, SubdividedLabels,
+    Workspace,
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
@@ -437,9 +437,7 @@ fn main() {
         // The same labels as one array, for the 6-D and 5-D builders (64 times the bytes of
         // the labels at `k`).
         let start = Instant::now();
-        let dense = (subdivided.as_ref())
-            .filter(|_| wants("6d-sub") || wants("5d-sub"))
-            .map(|s| subdivided_labels(&cell, &ws, s).expect("2k labels"));
+        let dense = (fine_labels.as_ref()).filter(|_| wants("6d-sub") || wants("5d-sub")).map(|f| f.to_dense());
         let dense_secs = fine_secs + start.elapsed().as_secs_f64();
         let thesis =
             wants("thesis").then(|| timed(&|| label_space_thesis(&cell, opt.k, &ws, false).expect("labelling")));

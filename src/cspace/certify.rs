@@ -400,7 +400,7 @@ fn sub_cells(a: &Levels, b: &Levels, labels: &[Label]) -> SubCells {
 /// sample of the `2k` grid whose parent cell is not sampled at `k` is "don't care": queries
 /// there never reach the table. A plain table built from these labels answers as the
 /// subdivided one does on every sub-cell (the baseline for its size); at `k = 64` the dense
-/// labels ([`subdivided_labels`]) would not fit in memory, so the 4-D builder reads them
+/// labels ([`SubdividedLabels::to_dense`]) would not fit in memory, so the 4-D builder reads them
 /// here ([`crate::table::LinearQuadtree4d::build_subdivided`]).
 pub struct SubdividedLabels<'a> {
     coarse: &'a LabelledSpace,
@@ -437,6 +437,18 @@ impl<'a> SubdividedLabels<'a> {
         let row_start =
             (0..=coarse.grid_a.cells.len() as u64).map(|ia| sub.pairs.partition_point(|&p| p < ia * nb0)).collect();
         Ok(SubdividedLabels { coarse, sub, grid_a, grid_b, parent_a, parent_b, row_start })
+    }
+
+    /// These labels as one array (`8^2` times the bytes of the labels at `k`).
+    pub fn to_dense(&self) -> LabelledSpace {
+        let nb = self.grid_b.cells.len();
+        let ibs: Vec<u32> = (0..nb as u32).collect();
+        let mut labels = vec![Label::Unreachable; self.grid_a.cells.len() * nb];
+        if nb > 0 {
+            labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| self.row(Some(ia), &ibs, row));
+        }
+        let (grid_a, grid_b) = (self.grid_a.clone(), self.grid_b.clone());
+        LabelledSpace { grid_a, grid_b, labels, margin: self.coarse.margin }
     }
 
     /// The labels at `k` the sub-cells refine.
@@ -478,22 +490,6 @@ impl<'a> SubdividedLabels<'a> {
             };
         }
     }
-}
-
-/// The labels of [`SubdividedLabels`] as one array (they take `8^2` times the bytes of the
-/// labels at `k`).
-///
-/// # Errors
-/// As [`SubdividedLabels::new`].
-pub fn subdivided_labels(cell: &Cell, ws: &Workspace, certified: &CertifiedSpace) -> Result<LabelledSpace, String> {
-    let fine = SubdividedLabels::new(cell, ws, certified)?;
-    let nb = fine.grid_b.cells.len();
-    let ibs: Vec<u32> = (0..nb as u32).collect();
-    let mut labels = vec![Label::Unreachable; fine.grid_a.cells.len() * nb];
-    if nb > 0 {
-        labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| fine.row(Some(ia), &ibs, row));
-    }
-    Ok(LabelledSpace { grid_a: fine.grid_a, grid_b: fine.grid_b, labels, margin: certified.space.margin })
 }
 
 /// The sub-cells of `(ia, ib)` that hold reachable TCPs of both robots: neither octant is
@@ -1058,7 +1054,7 @@ mod tests {
         let ws = Workspace::THESIS;
         let cell = reference_cell("T2").unwrap();
         let c = label_space_subdivided(&cell, 16, &ws, false).unwrap();
-        let fine = subdivided_labels(&cell, &ws, &c).unwrap();
+        let fine = SubdividedLabels::new(&cell, &ws, &c).unwrap().to_dense();
         let sub = c.sub.as_ref().unwrap();
         let (coarse, nb0) = (&c.space, c.space.grid_b.cells.len());
         let (mut seen, mut freed) = (0, 0);

@@ -23,8 +23,8 @@ pub mod symmetry;
 use alloc::vec::Vec;
 #[cfg(feature = "std")]
 pub use certify::{
-    label_space_certified, label_space_certified_with, label_space_subdivided, subdivided_labels, CertifiedSpace,
-    SubCells, SubdividedLabels,
+    label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, SubCells,
+    SubdividedLabels,
 };
 #[cfg(feature = "std")]
 pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};

@@ -39,9 +39,9 @@ pub use build::{build_table, build_tables, BuildReport, Labelling, Variant};
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
 pub use lookup::{TableAnswer, TableChecker};
-pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
 #[cfg(feature = "std")]
 pub use quadtree4d::{subdivided_slices, SliceBound};
+pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
 pub use quadtree5d::LinearQuadtree5d;
 pub use quadtree6d::LinearQuadtree6d;
 pub use shared6d::{SharedParts, SharedQuadtree6d};

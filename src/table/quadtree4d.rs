@@ -271,7 +271,7 @@ impl LinearQuadtree4d {
         Ok(grouping.finish())
     }
 
-    /// The table [`build`](Self::build) makes from [`crate::cspace::subdivided_labels`]
+    /// The table [`build`](Self::build) makes from [`SubdividedLabels::to_dense`]
     /// (the same table, tested), without those dense labels ([`subdivided_slices`]).
     ///
     /// # Errors
@@ -636,7 +636,7 @@ mod tests {
     fn subdivided_build_is_the_dense_build_of_the_sub_cell_labels() {
         use crate::cell::reference::reference_cell;
         use crate::cspace::symmetry::reflection_y;
-        use crate::cspace::{label_space_subdivided, subdivided_labels, SubdividedLabels, Workspace};
+        use crate::cspace::{label_space_subdivided, SubdividedLabels, Workspace};
         for name in ["T1", "T2", "T3"] {
             let cell = reference_cell(name).unwrap();
             let mut certified = label_space_subdivided(&cell, 16, &Workspace::THESIS, false).unwrap();
@@ -644,8 +644,8 @@ mod tests {
             // so the symmetric tables must merge each pair with its mirror as the dense one does.
             let sub = certified.sub.as_mut().unwrap();
             sub.collision.iter_mut().zip(&sub.care).step_by(5).for_each(|(c, &care)| *c = care);
-            let dense = subdivided_labels(&cell, &Workspace::THESIS, &certified).unwrap();
             let sparse = SubdividedLabels::new(&cell, &Workspace::THESIS, &certified).unwrap();
+            let dense = sparse.to_dense();
             let symmetric = reflection_y(&cell);
             for axes in [SliceAxes::YY, SliceAxes::ZZ] {
                 for t in [0, 40] {
