@@ -235,6 +235,7 @@ impl ExactGroups {
 
     /// The first group whose representative `R` has `R ∩ C = S`, or a new group made of `S`.
     fn group(&mut self, s: &[u64], care: &[u64]) -> u32 {
+        debug_assert!(s.iter().zip(care).all(|(&s, &c)| s & !c == 0), "a collision bit outside the care mask");
         let found = match self.rarest_tile(s, care) {
             Some(None) => None,
             Some(Some(groups)) => groups.iter().copied().find(|&g| self.fits(g, s, care)),
