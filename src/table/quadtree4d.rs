@@ -163,7 +163,7 @@ impl ExactGroups {
             });
             (t as u32, bits)
         });
-        (tiles, if side == 8 { !0 } else { (1 << (side * side)) - 1 })
+        (tiles, u64::MAX >> (64 - side * side))
     }
 
     /// Over the mixed tiles of `s` that `care` covers whole, of the first side with one:
@@ -290,10 +290,10 @@ struct Grouping {
 #[cfg(feature = "std")]
 impl Grouping {
     fn new(levels: u32, symmetric: bool, axes: SliceAxes, t: u32) -> Grouping {
-        let wps = shape(levels, symmetric, axes).1;
+        let (a0, wps) = shape(levels, symmetric, axes);
         let tree = LinearQuadtree4d { levels, symmetric, axes, t, codes: vec![], slice_of: vec![], slices: vec![] };
-        let (a0, k) = (shape(levels, symmetric, axes).0 as usize, 1usize << levels);
-        let exact = (t == 0).then(|| ExactGroups::new(wps, k - a0, k));
+        let k = 1usize << levels;
+        let exact = (t == 0).then(|| ExactGroups::new(wps, k - a0 as usize, k));
         Grouping { tree, wps, g_add: Vec::new(), exact, nodes: Vec::new() }
     }
 
