@@ -23,6 +23,13 @@ pub const SAT_EPSILON: Real = 1e-12;
 /// lost in rounding) report a collision.
 pub const SAT_TOUCH_TOLERANCE: Real = 1e-9;
 
+/// The largest length, margin, box offset or placement coordinate a cell accepts (mm): 1 km.
+///
+/// Far beyond any robot cell, and far below overflow: sums and squares of such values (the
+/// AABB of a robot, the loop equations, `|t|^2`) stay finite, where `1e308` would turn a
+/// bounding-box centre into NaN.
+pub const MAX_LENGTH: Real = 1e6;
+
 /// The float functions the per-tick code needs that `core` lacks (SPEC §1 units: rad).
 ///
 /// With the `std` feature they are `f64`'s own methods, so results are exactly those of
@@ -102,6 +109,30 @@ pub mod float {
     }
 }
 
+/// The smaller of `a` and `b`, NaN when either is NaN.
+///
+/// `f64::min` returns the other operand when one is NaN, so a bounding box folded with it
+/// silently drops a NaN box, and a pair whose boxes were never tested is reported free. Every
+/// bound that decides "free" is folded with this and [`max_or_nan`] instead.
+#[inline]
+pub fn min_or_nan(a: Real, b: Real) -> Real {
+    if a.is_nan() || b.is_nan() {
+        Real::NAN
+    } else {
+        a.min(b)
+    }
+}
+
+/// The larger of `a` and `b`, NaN when either is NaN (see [`min_or_nan`]).
+#[inline]
+pub fn max_or_nan(a: Real, b: Real) -> Real {
+    if a.is_nan() || b.is_nan() {
+        Real::NAN
+    } else {
+        a.max(b)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::float;
@@ -115,6 +146,15 @@ mod tests {
     /// The `no_std` build takes libm's functions: on the arguments the kinematics see they
     /// agree with std's to within 1 ulp (sqrt and floor exactly), and with `std` the shim
     /// is std's methods themselves.
+    #[test]
+    fn nan_propagating_min_and_max() {
+        use super::{max_or_nan, min_or_nan};
+        assert_eq!((min_or_nan(1.0, 2.0), max_or_nan(1.0, 2.0)), (1.0, 2.0));
+        for (a, b) in [(f64::NAN, 1.0), (1.0, f64::NAN), (f64::NAN, f64::NAN)] {
+            assert!(min_or_nan(a, b).is_nan() && max_or_nan(a, b).is_nan());
+        }
+    }
+
     #[test]
     fn libm_agrees_with_std_within_one_ulp() {
         let mut x = 0x2545_f491_4f6c_dd1d_u64;

@@ -6,8 +6,8 @@
 //! boxes before the box-pair tests. All buffers live in the checker: a check never allocates.
 
 use crate::cell::{Cell, SatMethod};
-use crate::geometry::{first_intersecting_pair, WitnessCache};
-use crate::math::Vec3;
+use crate::geometry::{first_intersecting_pair, Obb, WitnessCache};
+use crate::math::{max_or_nan, min_or_nan, Vec3};
 use crate::robot::{RobotBoxes, Unreachable};
 use alloc::{vec, vec::Vec};
 
@@ -179,38 +179,77 @@ impl ExactChecker {
             let (a, b) = (pair.a, pair.b);
             pair.state = if self.verdict.unreachable_mask & (1 << a | 1 << b) != 0 {
                 PairState::Undecided
-            } else if !aabbs_overlap(&self.aabb[a], &self.aabb[b]) {
-                PairState::Free
             } else {
-                let (ba, bb) = (self.boxes[a].as_slice(), self.boxes[b].as_slice());
-                let hit = match self.cell.method {
-                    SatMethod::Sat => first_intersecting_pair(ba, bb),
-                    SatMethod::SatCache => self.caches[k].first_intersecting_pair(ba, bb),
+                let robot = |j: usize| RobotInWcs { boxes: self.boxes[j].as_slice(), aabb: &self.aabb[j] };
+                let cache = match self.cell.method {
+                    SatMethod::Sat => None,
+                    SatMethod::SatCache => Some(&mut self.caches[k]),
                 };
-                hit.map_or(PairState::Free, |(i, j)| PairState::Collides(i, j))
+                pair_state(&robot(a), &robot(b), cache)
             };
         }
         Ok(&self.verdict)
     }
 }
 
-/// Centre and half-extents of the axis-aligned box around all of a robot's boxes.
-fn aabb_of(boxes: &RobotBoxes) -> (Vec3, Vec3) {
+/// One robot's boxes in the WCS and the AABB around them, as the pair test reads them.
+#[derive(Clone, Copy, Debug)]
+pub struct RobotInWcs<'a> {
+    /// The boxes.
+    pub boxes: &'a [Obb],
+    /// Centre and half-extents of the AABB of all of them (from [`aabb_of`]: NaN-propagating).
+    pub aabb: &'a (Vec3, Vec3),
+}
+
+/// The exact state of one robot pair: the AABB test, then the box tests (plain, or through the
+/// witness `cache`).
+///
+/// Fails closed: a non-finite value in any box (a degenerate frame, an overflow) makes the
+/// robot's AABB non-finite, and the pair is then reported colliding at its first non-finite
+/// boxes without any test, since no comparison with a NaN can be trusted to say "apart".
+pub fn pair_state(a: &RobotInWcs, b: &RobotInWcs, cache: Option<&mut WitnessCache>) -> PairState {
+    let finite = |r: &RobotInWcs| r.aabb.0.iter().chain(r.aabb.1.iter()).all(|v| v.is_finite());
+    if !(finite(a) && finite(b)) {
+        return PairState::Collides(first_non_finite(a.boxes), first_non_finite(b.boxes));
+    }
+    if aabbs_apart(a.aabb, b.aabb) {
+        return PairState::Free;
+    }
+    let hit = match cache {
+        None => first_intersecting_pair(a.boxes, b.boxes),
+        Some(cache) => cache.first_intersecting_pair(a.boxes, b.boxes),
+    };
+    hit.map_or(PairState::Free, |(i, j)| PairState::Collides(i, j))
+}
+
+/// The index of the first box holding a non-finite value (0 when all are finite).
+fn first_non_finite(boxes: &[Obb]) -> usize {
+    let finite = |b: &Obb| b.center.iter().chain(b.axes.iter()).chain(b.half.iter()).all(|v| v.is_finite());
+    boxes.iter().position(|b| !finite(b)).unwrap_or(0)
+}
+
+/// Centre and half-extents of the axis-aligned box around all of a robot's boxes; NaN
+/// when any box holds a NaN (see [`min_or_nan`]).
+pub fn aabb_of(boxes: &RobotBoxes) -> (Vec3, Vec3) {
     let mut lo = Vec3::repeat(f64::INFINITY);
     let mut hi = Vec3::repeat(f64::NEG_INFINITY);
     for b in boxes.as_slice() {
         let h = b.aabb_half();
-        lo = lo.inf(&(b.center - h));
-        hi = hi.sup(&(b.center + h));
+        lo = lo.zip_map(&(b.center - h), min_or_nan);
+        hi = hi.zip_map(&(b.center + h), max_or_nan);
     }
     ((lo + hi) * 0.5, (hi - lo) * 0.5)
 }
 
-/// Closed overlap of two AABBs given as (centre, half-extents); errs toward overlap.
-fn aabbs_overlap(a: &(Vec3, Vec3), b: &(Vec3, Vec3)) -> bool {
+/// Whether two AABBs given as (centre, half-extents) are apart on some world axis by more
+/// than the rounding slack: only then is the pair free without its box tests.
+///
+/// Written as "some gap exceeds", so that a NaN anywhere (the comparison is then false) leaves
+/// the pair to the box tests, which answer NaN as intersecting.
+fn aabbs_apart(a: &(Vec3, Vec3), b: &(Vec3, Vec3)) -> bool {
     let d = (a.0 - b.0).abs();
     let r = a.1 + b.1;
-    d.x <= r.x * (1.0 + 1e-12) + 1e-9 && d.y <= r.y * (1.0 + 1e-12) + 1e-9 && d.z <= r.z * (1.0 + 1e-12) + 1e-9
+    (0..3).any(|k| d[k] > r[k] * (1.0 + 1e-12) + 1e-9)
 }
 
 #[cfg(test)]
@@ -250,6 +289,80 @@ mod tests {
         assert_eq!(v.unreachable_mask, 0b010);
         assert!(v.pairs.iter().filter(|p| p.a == 1 || p.b == 1).all(|p| p.state == PairState::Undecided));
         assert_eq!(checker.check(&[home]).unwrap_err(), QueryError::WrongRobotCount { expected: 3, found: 1 });
+    }
+
+    /// A NaN in any quantity between the TCP and the verdict (a motor cosine or sine, any
+    /// scalar of any box, any AABB bound) never yields "free", with or without the cache.
+    #[test]
+    fn a_nan_anywhere_never_yields_free() {
+        use crate::cell::reference::reference_cell;
+        use crate::robot::{MotorCosSin, RobotModel};
+        type BoxEdit<'a> = &'a dyn Fn(&mut [RobotBoxes; 2]);
+        type AabbEdit<'a> = &'a dyn Fn(&mut [(Vec3, Vec3); 2]);
+        let cell = reference_cell("T1").unwrap();
+        let model = RobotModel::THESIS;
+        let (rot, t) = (cell.robots[1].placement.rotation(), cell.robots[1].placement.t);
+        // Far apart (free by the AABBs), close (free by the box tests) and colliding.
+        let configs = [
+            (Vec3::new(-150.0, 0.0, -450.0), Vec3::new(150.0, 0.0, -450.0)),
+            (Vec3::new(60.0, 30.0, -420.0), Vec3::new(-60.0, -30.0, -430.0)),
+            (Vec3::new(180.0, 0.0, -450.0), Vec3::new(-180.0, 0.0, -450.0)),
+        ];
+        let mut injected = 0;
+        for (ta, tb) in configs {
+            let ik = |p: &Vec3| model.delta.inverse_kinematics_cos_sin(p).unwrap();
+            let sol = [ik(&ta), ik(&tb)];
+            let mut check = |sol: &[MotorCosSin; 2], edit_boxes: BoxEdit, edit_aabb: AabbEdit, what: &str| {
+                let mut boxes = [model.boxes_from_cos_sin(&ta, &sol[0]), model.boxes_from_cos_sin(&tb, &sol[1])];
+                for b in &mut boxes[1].boxes[..3] {
+                    *b = b.transformed(&rot, &t);
+                }
+                edit_boxes(&mut boxes);
+                let mut aabb = [aabb_of(&boxes[0]), aabb_of(&boxes[1])];
+                edit_aabb(&mut aabb);
+                let robot = |j: usize| RobotInWcs { boxes: boxes[j].as_slice(), aabb: &aabb[j] };
+                let mut cache = WitnessCache::new();
+                for state in
+                    [pair_state(&robot(0), &robot(1), None), pair_state(&robot(0), &robot(1), Some(&mut cache))]
+                {
+                    assert_ne!(state, PairState::Free, "NaN in {what} at {ta:?} {tb:?}");
+                }
+                injected += 1;
+            };
+            for robot in 0..2 {
+                for arm in 0..3 {
+                    let (mut c, mut s) = (sol, sol);
+                    c[robot].cos[arm] = f64::NAN;
+                    s[robot].sin[arm] = f64::NAN;
+                    check(&c, &|_| {}, &|_| {}, &format!("cos of robot {robot} motor {arm}"));
+                    check(&s, &|_| {}, &|_| {}, &format!("sin of robot {robot} motor {arm}"));
+                }
+                for bi in 0..3 {
+                    for k in 0..15 {
+                        let edit = |boxes: &mut [RobotBoxes; 2]| {
+                            let b = &mut boxes[robot].boxes[bi];
+                            match k {
+                                0..=2 => b.center[k] = f64::NAN,
+                                3..=11 => b.axes[k - 3] = f64::NAN,
+                                _ => b.half[k - 12] = f64::NAN,
+                            }
+                        };
+                        check(&sol, &edit, &|_| {}, &format!("scalar {k} of box {bi} of robot {robot}"));
+                    }
+                }
+                for k in 0..6 {
+                    let edit = |aabb: &mut [(Vec3, Vec3); 2]| {
+                        if k < 3 {
+                            aabb[robot].0[k] = f64::NAN
+                        } else {
+                            aabb[robot].1[k - 3] = f64::NAN
+                        }
+                    };
+                    check(&sol, &|_| {}, &edit, &format!("AABB bound {k} of robot {robot}"));
+                }
+            }
+        }
+        assert_eq!(injected, 3 * 2 * (6 + 45 + 6));
     }
 
     #[test]

@@ -17,7 +17,7 @@ pub use config::parse_cell;
 pub use exact::{CellVerdict, ExactChecker, PairVerdict, QueryError};
 pub use placement::Placement;
 
-use crate::math::{float, Real};
+use crate::math::{float, Real, MAX_LENGTH};
 use crate::robot::RobotModel;
 use alloc::{format, string::String, vec::Vec};
 
@@ -79,11 +79,19 @@ impl core::fmt::Display for CellError {
 impl core::error::Error for CellError {}
 
 fn check_length(what: &str, v: Real, allow_zero: bool) -> Result<(), CellError> {
-    if v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0)) {
+    if v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0)) && v <= MAX_LENGTH {
         Ok(())
     } else {
         let need = if allow_zero { ">= 0" } else { "> 0" };
-        Err(CellError::Invalid(format!("{what} = {v} must be finite and {need} (mm)")))
+        Err(CellError::Invalid(format!("{what} = {v} must be finite, {need} and <= {MAX_LENGTH:e} (mm)")))
+    }
+}
+
+fn check_coordinate(what: &str, v: Real) -> Result<(), CellError> {
+    if v.is_finite() && v.abs() <= MAX_LENGTH {
+        Ok(())
+    } else {
+        Err(CellError::Invalid(format!("{what} = {v} must be finite with |value| <= {MAX_LENGTH:e} (mm)")))
     }
 }
 
@@ -102,15 +110,16 @@ fn validate_robot(i: usize, r: &RobotSpec) -> Result<(), CellError> {
         if let Some(b) = b {
             for k in 0..3 {
                 check_length(&format!("{name}: model.{what}.half[{k}]"), b.half[k], true)?;
-                if !b.offset[k].is_finite() {
-                    return Err(CellError::Invalid(format!("{name}: model.{what}.offset[{k}] is not finite")));
-                }
+                check_coordinate(&format!("{name}: model.{what}.offset[{k}]"), b.offset[k])?;
             }
         }
     }
     let p = &r.placement;
-    if !(p.alpha.is_finite() && p.t.iter().all(|v| v.is_finite())) {
-        return Err(CellError::Invalid(format!("{name}: placement has a NaN or infinite value")));
+    if !p.alpha.is_finite() {
+        return Err(CellError::Invalid(format!("{name}: placement.alpha = {} rad must be finite", p.alpha)));
+    }
+    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+        check_coordinate(&format!("{name}: placement.translation.{axis}"), p.t[k])?;
     }
     Ok(())
 }

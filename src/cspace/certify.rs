@@ -53,7 +53,7 @@ use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::sweep::{boxes_overlap_deeply, core};
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::{Obb, Sweep};
-use crate::math::{Real, Vec3};
+use crate::math::{max_or_nan, min_or_nan, Real, Vec3};
 use crate::robot::{BoxKind, RobotModel};
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -388,7 +388,8 @@ fn sub_cells(a: &Levels, b: &Levels, labels: &[Label]) -> SubCells {
     // Each block's rows are freed as they are copied, and the copies never reallocate: the
     // peak stays near one copy of the sub-cells (at k = 64 on T2, gigabytes).
     let n = rows.iter().map(Vec::len).sum();
-    let mut out = SubCells { pairs: Vec::with_capacity(n), care: Vec::with_capacity(n), collision: Vec::with_capacity(n) };
+    let mut out =
+        SubCells { pairs: Vec::with_capacity(n), care: Vec::with_capacity(n), collision: Vec::with_capacity(n) };
     for (pair, care, collision) in rows.into_iter().flatten() {
         out.pairs.push(pair);
         out.care.push(care);
@@ -724,8 +725,8 @@ fn octant_covers(octs: &SampleBoxes) -> Vec<Option<([Real; 3], [Real; 3])>> {
                     Slot::Unreachable | Slot::Unknown => return None,
                 }
                 for a in 0..3 {
-                    lo[a] = lo[a].min(octs.lo[e][a]);
-                    hi[a] = hi[a].max(octs.hi[e][a]);
+                    lo[a] = min_or_nan(lo[a], octs.lo[e][a]);
+                    hi[a] = max_or_nan(hi[a], octs.hi[e][a]);
                 }
             }
             Some((lo, hi))

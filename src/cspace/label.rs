@@ -27,7 +27,7 @@ use crate::geometry::sat::separating_axis;
 use crate::geometry::sweep::{swept_aabb_half, swept_boxes_apart_with, FaceTerms, Sweep};
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
-use crate::math::{Mat3, Real, Vec3};
+use crate::math::{max_or_nan, min_or_nan, Mat3, Real, Vec3};
 use crate::robot::{ModelOptions, RobotModel};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -148,16 +148,20 @@ impl SampleBoxes {
             hi: Vec::with_capacity(n),
             slot: Vec::with_capacity(n),
         };
-        for (slot, boxes) in per {
+        for (mut slot, boxes) in per {
             let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
             for j in 0..nb {
                 let (b, sweep) = boxes.get(j).copied().unwrap_or((empty, Sweep::ZERO));
                 let swept = SweptBox::new(b, sweep);
                 for a in 0..3 {
-                    lo[a] = lo[a].min(swept.lo[a]);
-                    hi[a] = hi[a].max(swept.hi[a]);
+                    lo[a] = min_or_nan(lo[a], swept.lo[a]);
+                    hi[a] = max_or_nan(hi[a], swept.hi[a]);
                 }
                 out.boxes.push(swept);
+            }
+            // A non-finite box or sweep proves nothing: every pair of the entry is a collision.
+            if slot == Slot::Boxes && !lo.iter().chain(&hi).all(|v| v.is_finite()) {
+                slot = Slot::Unknown;
             }
             out.lo.push(lo);
             out.hi.push(hi);

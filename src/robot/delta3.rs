@@ -20,7 +20,7 @@
 //! limit is the exact `atan2` taken. [`Delta3::inverse_kinematics_cos_sin`] stops there;
 //! [`Delta3::inverse_kinematics`] adds one `atan2` per arm for the angles themselves.
 
-use crate::math::{float, Real, Vec3};
+use crate::math::{float, Real, Vec3, MAX_LENGTH};
 use alloc::{format, string::String};
 use core::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
@@ -170,8 +170,8 @@ impl Delta3 {
     /// A sentence naming the bad parameter.
     pub fn validate(&self) -> Result<(), String> {
         for (name, v) in [("f", self.f), ("rf", self.rf), ("re", self.re), ("e", self.e)] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("Delta3 parameter {name} = {v} must be a positive finite length in mm"));
+            if !(v.is_finite() && v > 0.0 && v <= MAX_LENGTH) {
+                return Err(format!("Delta3 parameter {name} = {v} must be a length in (0, {MAX_LENGTH:e}] mm"));
             }
         }
         let span = self.theta_max - self.theta_min;

@@ -18,7 +18,7 @@
 
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
-use crate::math::{float, Mat3, Real, Vec3};
+use crate::math::{float, Mat3, Real, Vec3, MAX_LENGTH};
 use crate::robot::delta3::{radial, tangent, ArmSolution, Delta3, MotorCosSin, Unreachable};
 use alloc::{format, string::String};
 use core::f64::consts::PI;
@@ -67,16 +67,16 @@ impl ModelOptions {
     /// A sentence naming the bad option.
     pub fn validate(&self) -> Result<(), String> {
         let positive = |name: &str, v: Real| {
-            if v.is_finite() && v > 0.0 {
+            if v.is_finite() && v > 0.0 && v <= MAX_LENGTH {
                 Ok(())
             } else {
-                Err(format!("model option {name} = {v} must be a positive finite length in mm"))
+                Err(format!("model option {name} = {v} must be a length in (0, {MAX_LENGTH:e}] mm"))
             }
         };
         positive("half_height", self.half_height)?;
         positive("half_depth", self.half_depth)?;
-        if !(self.margin.is_finite() && self.margin >= 0.0) {
-            return Err(format!("safety margin {} must be a finite length >= 0 mm", self.margin));
+        if !(self.margin.is_finite() && self.margin >= 0.0 && self.margin <= MAX_LENGTH) {
+            return Err(format!("safety margin {} must be a length in [0, {MAX_LENGTH:e}] mm", self.margin));
         }
         if let Some((h, d)) = self.upper_links {
             positive("upper link half height", h)?;
@@ -84,8 +84,11 @@ impl ModelOptions {
         }
         for (name, b) in [("platform", self.platform), ("tool", self.tool)] {
             if let Some(b) = b {
-                if !(b.offset.iter().all(|v| v.is_finite())) {
-                    return Err(format!("{name} box offset {:?} must be finite", b.offset));
+                if !(b.offset.iter().all(|v| v.is_finite() && v.abs() <= MAX_LENGTH)) {
+                    return Err(format!(
+                        "{name} box offset {:?} must be finite, each |value| <= {MAX_LENGTH:e} mm",
+                        b.offset
+                    ));
                 }
                 for v in b.half.iter() {
                     positive(&format!("{name} box half-extent"), *v)?;
@@ -303,12 +306,33 @@ fn pose_box(m: &Mat4, half: Vec3) -> Obb {
     Obb::new(center, m.fixed_view::<3, 3>(0, 0).into_owned(), half)
 }
 
+/// Below this `|x cross t|` the link runs (nearly) along its motor axis and `x cross t` no
+/// longer fixes the box's roll about x: it is taken from the vertical instead.
+///
+/// At 1e-6 the cross product still has about ten exact digits (its rounding is ~1e-16), so
+/// the axes stay orthonormal to ~1e-10 and a box of 200 mm half-extent keeps its extent to
+/// ~1e-8 mm, below the SAT's touch tolerance.
+const PARALLEL_TO_MOTOR_AXIS: Real = 1e-6;
+
 /// The box around the segment `p -> q` of length `1 / inv_len`: x along it,
 /// z = normalize(x cross t), y = z cross x (SPEC §3).
+///
+/// When the link is parallel to `t` (a TCP at `|b| = re`, on the reach boundary: lower link
+/// along the motor axis), `x cross t` vanishes and SPEC §3's frame is undefined. Any roll of
+/// the box about x then models the link equally well; z is taken as the unit vector across
+/// x in the plane of x and the vertical, so that the axes stay an orthonormal frame and the
+/// box keeps its extent (a NaN frame would make the box vanish from every test).
 fn link_box(p: &Vec3, q: &Vec3, inv_len: Real, t: &Vec3, half: Vec3) -> Obb {
     let x = (q - p) * inv_len;
     let xt = x.cross(t);
-    let z = xt * (1.0 / xt.norm());
+    let n = xt.norm();
+    let z = if n > PARALLEL_TO_MOTOR_AXIS {
+        xt * (1.0 / n)
+    } else {
+        // x is within 1e-6 rad of t, which is horizontal, so x cross z_world has norm ~1.
+        let xv = x.cross(&Vec3::z());
+        xv * (1.0 / xv.norm())
+    };
     let y = z.cross(&x);
     Obb::new((p + q) * 0.5, Mat3::from_columns(&[x, y, z]), half)
 }
@@ -333,6 +357,24 @@ mod tests {
             assert!((b.axes.transpose() * b.axes - Mat3::identity()).norm() < 1e-12);
             assert!(b.axes.column(1).dot(&tangent(arm)) > 0.9, "y stays close to t_i");
         }
+    }
+
+    /// At `y = re`, `(60, 400, -150)` puts lower link 0 exactly along its motor axis: its
+    /// frame falls back to the vertical and stays orthonormal, and near it the usual frame
+    /// is used without a jump in extent.
+    #[test]
+    fn link_along_its_motor_axis_keeps_an_orthonormal_frame() {
+        let model = RobotModel::THESIS;
+        for tcp in [Vec3::new(60.0, 400.0, -150.0), Vec3::new(60.0, 400.0 - 1e-7, -150.0)] {
+            let Ok(sol) = model.delta.inverse_kinematics(&tcp) else { continue };
+            let boxes = model.boxes(&tcp).unwrap();
+            let b = &boxes.boxes[0];
+            assert!((b.axes.transpose() * b.axes - Mat3::identity()).norm() < 1e-9, "{tcp:?}: {b:?}");
+            let g = model.delta.elbow(0, sol.cos[0], sol.sin[0]);
+            assert!((b.center - b.axes.column(0) * b.half.x - g).norm() < 1e-9);
+            assert!(b.axes.column(0).cross(&tangent(0)).norm() < 1e-3, "{tcp:?}: link 0 runs along t_0");
+        }
+        assert!(model.delta.inverse_kinematics(&Vec3::new(60.0, 400.0, -150.0)).is_ok(), "the exact pose is reachable");
     }
 
     fn full_options(margin: Real) -> RobotModel {
