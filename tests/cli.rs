@@ -1,16 +1,56 @@
-//! The command line as a user runs it: `demo` and `check` on real files.
+//! The command line as a user runs it: `demo` and `check` on real files, the help, the
+//! version, completions and man page, usage errors (exit code 2) and failures (exit code 1),
+//! and outputs that are never left looking complete when they are not.
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::ExactChecker;
 use delta_collide::math::Vec3;
-use std::process::Command;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+const BIN: &str = env!("CARGO_BIN_EXE_delta-collide");
 
 fn cli(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_delta-collide"))
+    Command::new(BIN).args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+}
+
+/// `cli` with `input` on stdin.
+fn cli_stdin(args: &[&str], input: &str) -> Output {
+    let mut child = Command::new(BIN)
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap()
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(input.as_bytes()).unwrap();
+    child.wait_with_output().unwrap()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// A new empty directory of this test process.
+fn fresh_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("dc-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The names of the files in `dir`, sorted.
+fn names_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
 }
 
 #[test]
@@ -87,7 +127,7 @@ fn bad_arguments_and_rows_fail_with_a_message() {
     let input = dir.join("bad.csv");
     std::fs::write(&input, "1,2,3,4,5,6\n1,2,three,4,5,6\n").unwrap();
     let out = cli(&["check", "--cell", "T1", "--input", input.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.status.code(), Some(1), "a bad row is a failure, not a usage error");
     assert!(String::from_utf8_lossy(&out.stderr).contains("line 2"));
 }
 
@@ -111,11 +151,320 @@ fn build_inspect_eval_and_check_with_a_table() {
         text.lines().filter_map(|l| l.split("FN").nth(1)).map(|r| r.split_whitespace().next().unwrap()).collect();
     assert_eq!(fns, vec!["0", "0", "0"], "practical, collision and random: no false negative");
     let out = cli(&["eval", "--cell", "T1", "--table", table, "--random", "10"]);
-    assert_eq!(out.status.code(), Some(2), "a T3 table is refused for T1");
+    assert_eq!(out.status.code(), Some(1), "a T3 table is refused for T1");
     assert!(String::from_utf8_lossy(&out.stderr).contains("rebuild"));
     let input = dir.join("in.csv");
     // Robots reaching toward each other (B's MCS is turned by 30 degrees), apart, unreachable.
     std::fs::write(&input, "190,70,-450,-200,-20,-450\n-150,0,-450,150,0,-450\n0,0,-900,0,0,-450\n").unwrap();
     let out = cli(&["check", "--cell", "T3", "--table", table, "--input", input.to_str().unwrap()]);
     assert_eq!(String::from_utf8(out.stdout).unwrap(), "reachable,collide\n1,1\n1,0\n0,NA\n");
+}
+
+/// The fenced block after "delta-collide --help" in the README's "Command line" section.
+fn readme_help_block() -> String {
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let section = readme.split("\n## Command line\n").nth(1).expect("a \"Command line\" section");
+    let section = section.split("\n## ").next().unwrap();
+    let block = section.split("```text\n").nth(1).expect("a ```text block in \"Command line\"");
+    block.split("\n```").next().unwrap().to_string()
+}
+
+fn trim_lines(s: &str) -> String {
+    s.trim_end().lines().map(str::trim_end).collect::<Vec<_>>().join("\n")
+}
+
+#[test]
+fn help_lists_every_command_and_the_readme_shows_it() {
+    let out = cli(&["--help"]);
+    assert_eq!(out.status.code(), Some(0));
+    let help = stdout(&out);
+    for command in ["demo", "check", "build", "inspect", "eval", "render", "quilt", "completions", "man", "--quiet"] {
+        assert!(help.contains(command), "{command} in\n{help}");
+    }
+    assert_eq!(
+        trim_lines(&readme_help_block()),
+        trim_lines(&help),
+        "README.md \"Command line\" shows an outdated `delta-collide --help`; paste the new one in"
+    );
+    // No command at all: the help, as a usage error.
+    let out = cli(&[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("Usage:"));
+}
+
+#[test]
+fn each_command_explains_its_flags_units_and_defaults() {
+    let help = |cmd: &str| {
+        let out = cli(&[cmd, "--help"]);
+        assert_eq!(out.status.code(), Some(0), "{cmd}");
+        stdout(&out)
+    };
+    for cmd in ["check", "build", "eval", "render", "quilt"] {
+        assert!(help(cmd).contains("T1, T2, T3 or a .toml file"), "{cmd} names the built-in cells");
+    }
+    assert!(help("demo").contains("T1, T2, T3, all"));
+    let build = help("build");
+    for part in ["[default: 32]", "power of two from 2 to 256", "[default: 6d]", "4d-yy", "shared-sub", "[default: 0]"]
+    {
+        assert!(build.contains(part), "build --help: {part}\n{build}");
+    }
+    assert!(help("render").contains("own MCS (mm)") && help("render").contains("[default: render.png]"));
+    assert!(help("eval").contains("[default: 1000000]") && help("eval").contains("pixels"));
+    assert!(help("quilt").contains("[default: yy]") && help("quilt").contains("[default: 1200]"));
+}
+
+#[test]
+fn version_names_the_table_format_it_writes() {
+    let out = cli(&["--version"]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = stdout(&out);
+    assert!(text.contains(env!("CARGO_PKG_VERSION")), "{text}");
+    let format = format!("table format version {}", delta_collide::table::format::VERSION);
+    assert!(text.contains(&format), "{text}");
+}
+
+/// Each usage error: exit code 2 and a message with `what` in it.
+#[test]
+fn usage_errors_exit_with_2_and_say_what_is_wrong() {
+    let dir = fresh_dir("usage");
+    let table = dir.join("t.dct");
+    let table = table.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["frobnicate"], "unrecognized subcommand"),
+        (&["demo", "--cel", "T1"], "unexpected argument '--cel'"),
+        (&["check"], "--cell <CELL>"),
+        (&["build", "--cell", "T1", "--output", table, "--k", "16", "--k", "32"], "cannot be used multiple times"),
+        (&["build", "--cell", "T1", "--output", table, "--k", "512"], "power of two from 2 to 256"),
+        (&["build", "--cell", "T1", "--output", table, "--k", "48"], "power of two"),
+        (&["build", "--cell", "T1", "--output", table, "--k", "lots"], "power of two"),
+        (
+            &["build", "--cell", "T1", "--output", table, "--variant", "7d"],
+            "use 6d, 5d, 4d-yy, 4d-zz, shared or shared-sub",
+        ),
+        (
+            &["build", "--cell", "T1", "--output", table, "--variant", "6d", "--t", "5"],
+            "--t 5 applies to --variant 4d-yy",
+        ),
+        (&["build", "--cell", "T1", "--output", table, "--t", "5"], "not to --variant 6d"),
+        (
+            &["build", "--cell", "T1", "--output", table, "--variant", "shared-sub", "--labelling", "thesis"],
+            "certified",
+        ),
+        (&["build", "--cell", "T9", "--output", table], "T1, T2, T3"),
+        (&["build", "--cell", "cells/nope.toml", "--output", table], "nope.toml"),
+        (&["inspect", "A", "B"], "unexpected argument 'B'"),
+        (&["inspect"], "<FILE.dct>"),
+        (&["eval", "--cell", "T1", "--table", table, "--width", "900"], "--plot"),
+        (&["eval", "--cell", "T1", "--table", table, "--seed", "0"], "must not be 0"),
+        (&["eval", "--cell", "T1", "--table", table, "--random", "-3"], "'-3'"),
+        (&["render", "--cell", "T1", "--tcp", "1,2", "--tcp", "0,0,-450"], "three numbers"),
+        (&["render", "--cell", "T1", "--tcp", "0,0,-450"], "one --tcp x,y,z per robot"),
+        (&["quilt", "--cell", "T1", "--table", table, "--a", "1,2,3", "--axes", "zz"], "cannot be used with"),
+        (&["quilt", "--cell", "T1", "--table", table, "--a", "1,2,3", "--fix", "1,2"], "cannot be used with"),
+        (&["completions", "tcsh"], "use bash"),
+    ];
+    for (args, what) in cases {
+        let out = cli(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(what), "{args:?}: `{what}` in\n{}", stderr(&out));
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+    assert!(names_in(&dir).is_empty(), "no usage error writes a file");
+}
+
+#[test]
+fn the_unknown_cell_error_names_the_built_in_cells() {
+    let out = cli(&["check", "--cell", "T9"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(err.contains("'T9'") && err.contains("T1, T2, T3") && err.contains(".toml"), "{err}");
+    let out = cli(&["demo", "--cell", "T9"]);
+    assert!(stderr(&out).contains("T1, T2, T3") && stderr(&out).contains("all"), "{}", stderr(&out));
+}
+
+/// Failures (a file that cannot be read, a table that is not one): exit code 1.
+#[test]
+fn failures_exit_with_1() {
+    let dir = fresh_dir("failures");
+    let missing = dir.join("missing.dct");
+    let missing = missing.to_str().unwrap();
+    let out = cli(&["inspect", missing]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("missing.dct"));
+    let out = cli_stdin(&["check", "--cell", "T1", "--table", missing], "");
+    assert_eq!(out.status.code(), Some(1));
+    let not_a_table = dir.join("not.dct");
+    std::fs::write(&not_a_table, "hello").unwrap();
+    let out = cli(&["inspect", not_a_table.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let out = cli(&["check", "--cell", "T1", "--input", dir.join("missing.csv").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn completions_and_man_pages_are_generated_from_the_definition() {
+    for shell in ["bash", "zsh", "fish", "elvish", "powershell"] {
+        let out = cli(&["completions", shell]);
+        assert_eq!(out.status.code(), Some(0), "{shell}: {}", stderr(&out));
+        let script = stdout(&out);
+        for word in ["delta-collide", "build", "quilt", "--variant"] {
+            assert!(script.contains(word), "{shell} completion: {word}");
+        }
+        if ["bash", "zsh", "fish"].contains(&shell) {
+            assert!(script.contains("shared-sub"), "{shell} completes the variants");
+        }
+    }
+    let out = cli(&["man"]);
+    assert_eq!(out.status.code(), Some(0));
+    let page = stdout(&out);
+    assert!(page.starts_with(".ie") && page.contains(".TH delta-collide 1"), "{}", &page[..page.len().min(300)]);
+    for word in ["build", "check", "quilt", "completions", "quiet"] {
+        assert!(page.contains(word), "man page: {word}");
+    }
+    let dir = fresh_dir("man");
+    let out = cli(&["man", "--output", dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let names = names_in(&dir);
+    for name in ["delta-collide.1", "delta-collide-build.1", "delta-collide-check.1", "delta-collide-quilt.1"] {
+        assert!(names.contains(&name.to_string()), "{name} in {names:?}");
+    }
+    let build = std::fs::read_to_string(dir.join("delta-collide-build.1")).unwrap();
+    assert!(build.contains("\\-\\-variant") && build.contains("shared\\-sub"), "{build}");
+}
+
+/// Issue: `printf '150,0,-450,-150,0,-450,\n' | delta-collide check --cell T1` took the
+/// malformed row for a header and printed only the header, exit 0.
+#[test]
+fn a_malformed_first_row_is_an_error_not_a_header() {
+    let out = cli_stdin(&["check", "--cell", "T1"], "150,0,-450,-150,0,-450,\n");
+    assert_eq!(out.status.code(), Some(1), "{}", stdout(&out));
+    assert!(stderr(&out).contains("line 1"), "{}", stderr(&out));
+    let out = cli_stdin(&["check", "--cell", "T1"], "150,0,-450,-150,0\n");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("line 1: expected 6 numbers"), "{}", stderr(&out));
+    // A header (no number in it) is skipped; a first row of numbers is answered.
+    let out = cli_stdin(&["check", "--cell", "T1"], "x,y,z,x2,y2,z2\n-150,0,-450,150,0,-450\n");
+    assert_eq!((out.status.code(), stdout(&out).as_str()), (Some(0), "reachable,collide\n1,0\n"));
+    let out = cli_stdin(&["check", "--cell", "T1"], "\n-150,0,-450,150,0,-450\n");
+    assert_eq!((out.status.code(), stdout(&out).as_str()), (Some(0), "reachable,collide\n1,0\n"));
+    // Only the first line can be a header.
+    let out = cli_stdin(&["check", "--cell", "T1"], "x,y,z,x2,y2,z2\nx,y,z,x2,y2,z2\n");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("line 2"));
+}
+
+/// Issue: an error that echoed a bad CSV line or value echoed all of it.
+#[test]
+fn errors_echo_at_most_a_few_dozen_characters_of_the_input() {
+    let long = format!("1,2,{}", "9".repeat(5000)) + ",x";
+    let out = cli_stdin(&["check", "--cell", "T1"], &format!("{long}\n"));
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("line 1") && err.contains("...") && err.len() < 200, "{err}");
+    let out = cli(&["render", "--cell", "T1", "--tcp", &long, "--tcp", "0,0,-450"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("...") && stderr(&out).len() < 300, "{}", stderr(&out));
+    let out = cli(&["build", "--cell", "T1", "--output", "x.dct", "--k", &long]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("...") && stderr(&out).len() < 300, "{}", stderr(&out));
+    let out = cli(&["build", "--cell", "T1", "--output", "x.dct", "--variant", &long]);
+    assert!(stderr(&out).contains("...") && stderr(&out).len() < 300, "{}", stderr(&out));
+}
+
+/// Issue: `check --output` wrote in place, so a bad row left a shorter file that looked
+/// complete (and the file it replaced was gone).
+#[test]
+fn check_output_is_untouched_when_a_row_fails() {
+    let dir = fresh_dir("check-output");
+    let (input, output) = (dir.join("in.csv"), dir.join("out.csv"));
+    std::fs::write(&input, "-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n1,2,three,4,5,6\n").unwrap();
+    std::fs::write(&output, "the previous answers\n").unwrap();
+    let args = ["check", "--cell", "T1", "--input", input.to_str().unwrap(), "--output", output.to_str().unwrap()];
+    let out = cli(&args);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("line 3"));
+    assert_eq!(std::fs::read_to_string(&output).unwrap(), "the previous answers\n");
+    assert_eq!(names_in(&dir), ["in.csv", "out.csv"], "no temporary file is left");
+    // Once the input is good the file is replaced whole.
+    std::fs::write(&input, "-150,0,-450,150,0,-450\n").unwrap();
+    assert_eq!(cli(&args).status.code(), Some(0));
+    assert_eq!(std::fs::read_to_string(&output).unwrap(), "reachable,collide\n1,0\n");
+    assert_eq!(names_in(&dir), ["in.csv", "out.csv"]);
+}
+
+/// Runs the CLI under a file-size limit of `blocks` (as `ulimit -f` counts them): a write
+/// past it kills the process, as a full disk or a crash would stop it mid-file.
+#[cfg(unix)]
+fn cli_with_file_limit(blocks: u32, args: &[&str]) -> Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -f {blocks} && exec \"$0\" \"$@\""))
+        .arg(BIN)
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+/// Issue: `build --output` wrote the table in place, so a rebuild stopped mid-write
+/// destroyed the good table it was replacing.
+#[cfg(unix)]
+#[test]
+fn a_build_stopped_mid_write_leaves_the_old_table_intact() {
+    let dir = fresh_dir("build-output");
+    let table = dir.join("t1.dct");
+    let t = table.to_str().unwrap();
+    let out = cli(&["build", "--quiet", "--cell", "T1", "--k", "16", "--variant", "5d", "--output", t]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(out.stderr.is_empty(), "--quiet: {}", stderr(&out));
+    let good = std::fs::read(&table).unwrap();
+    assert!(good.len() > 8 * 1024, "the table is bigger than the limit below");
+    let out = cli_with_file_limit(8, &["build", "--cell", "T1", "--k", "16", "--variant", "6d", "--output", t]);
+    assert!(!out.status.success(), "the limit stops the write");
+    assert_eq!(std::fs::read(&table).unwrap(), good, "the old table is intact");
+    assert!(cli(&["inspect", t]).status.success());
+    // A picture stopped mid-write: the old file stays as it was, too.
+    let picture = dir.join("render.png");
+    std::fs::write(&picture, "the previous picture").unwrap();
+    let p = picture.to_str().unwrap();
+    let out =
+        cli_with_file_limit(8, &["render", "--cell", "T1", "--tcp", "0,0,-450", "--tcp", "0,0,-450", "--output", p]);
+    assert!(!out.status.success());
+    assert_eq!(std::fs::read_to_string(&picture).unwrap(), "the previous picture");
+}
+
+/// Issue: `build --k 512` aborted after trying to allocate 29 GB, and `--k 1024` ran away.
+#[test]
+fn a_k_beyond_the_format_or_the_memory_is_refused_before_allocating() {
+    let dir = fresh_dir("big-k");
+    let table = dir.join("t.dct");
+    let t = table.to_str().unwrap();
+    for k in ["512", "1024"] {
+        let out = cli(&["build", "--cell", "T1", "--k", k, "--output", t]);
+        assert_eq!(out.status.code(), Some(2), "k = {k} is not a k of the format");
+        assert!(stderr(&out).contains("at most 8 levels"), "{}", stderr(&out));
+    }
+    if cfg!(target_os = "linux") {
+        // k = 256: about 9 TB of labels, far beyond any machine this runs on.
+        let start = std::time::Instant::now();
+        let out = cli(&["build", "--cell", "T1", "--k", "256", "--output", t]);
+        assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+        let err = stderr(&out);
+        assert!(err.contains("needs about") && err.contains("GB of memory") && err.contains("smaller k"), "{err}");
+        assert!(!err.contains("panicked") && !err.contains("backtrace"), "{err}");
+        assert!(start.elapsed().as_secs() < 60, "refused before labelling");
+    }
+    assert!(names_in(&dir).is_empty(), "nothing written");
+}
+
+#[test]
+fn progress_never_goes_into_the_data() {
+    let dir = fresh_dir("progress");
+    let table = dir.join("t.dct");
+    let out = cli(&["build", "--cell", "T1", "--k", "16", "--variant", "5d", "--output", table.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = stdout(&out);
+    assert!(!text.contains("rows of A") && !text.contains('\r') && !text.contains('\u{1b}'), "{text}");
+    let out = cli_stdin(&["check", "--quiet", "--cell", "T1"], "-150,0,-450,150,0,-450\n");
+    assert_eq!((stdout(&out).as_str(), stderr(&out).as_str()), ("reachable,collide\n1,0\n", ""));
 }

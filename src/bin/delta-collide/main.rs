@@ -1,116 +1,117 @@
 //! The delta-collide command line: runs the thesis's scenarios, checks CSV files of
 //! configurations, and (with tables) builds, inspects and evaluates precomputed tables.
 //!
-//! ```text
-//! delta-collide demo  [--cell T1|T2|T3|all|FILE.toml]
-//! delta-collide check --cell T1|FILE.toml [--table FILE.dct] [--input FILE.csv] [--output FILE.csv]
-//! delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz|shared|shared-sub] [--t 0] [--labelling certified|thesis]
-//! delta-collide inspect FILE.dct
-//! delta-collide eval  --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S] [--plot FILE.png]
-//! delta-collide render --cell T1|FILE.toml --tcp x,y,z --tcp x,y,z [--output FILE.png]
-//! delta-collide quilt --cell T1|FILE.toml --table FILE.dct [--axes yy|zz|xx] [--fix i,j] [--a ix,iy,iz] [--output FILE.png]
-//! ```
+//! The commands and flags are defined in [`args`] (clap); `delta-collide --help` lists them,
+//! `delta-collide completions SHELL` and `delta-collide man` generate the completions and the
+//! man page from the same definition. Exit codes: 0 done, 1 failed (an unreadable or bad
+//! input, a table for another cell, a k too big for the memory), 2 usage error.
 //!
-//! The pictures (`render`, `quilt`, `eval --plot`) are PNG files drawn in-process (modules
-//! [`render`], [`quilt`], [`plot`]; shared parts in [`picture`]).
+//! Output files are replaced only once complete ([`files`]). The pictures (`render`, `quilt`,
+//! `eval --plot`) are PNG files drawn in-process (modules [`render`], [`quilt`], [`plot`];
+//! shared parts in [`picture`]).
 
+mod args;
+mod files;
 mod picture;
 mod plot;
 mod quilt;
 mod render;
 
-use delta_collide::cell::reference::reference_cell;
+use args::{clip, BuildArgs, CheckArgs, Cli, Command, DemoArgs, EvalArgs, InspectArgs};
+use clap::CommandFactory;
 use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
-use delta_collide::cspace::Workspace;
+use delta_collide::cspace::{Label, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
-use delta_collide::table::{
-    build_table, from_bytes, to_bytes, Labelling, SliceAxes, Table, TableAnswer, TableChecker, Variant,
-};
-use std::io::{BufRead, BufWriter, Write};
+use delta_collide::table::{build_table, from_bytes, to_bytes, Labelling, Table, TableAnswer, TableChecker};
+use std::io::{BufRead, Write};
+use std::path::Path;
 use std::time::Instant;
 
 /// The scenario file shared with the C harness.
 const SCENARIOS: &str = include_str!("../../../c_harness/scenarios.txt");
 
-const USAGE: &str = "usage:
-  delta-collide demo  [--cell T1|T2|T3|all|FILE.toml]
-      runs the practical and collision scenarios (c_harness/scenarios.txt) with SAT and
-      SAT-cache; prints the first collision tick and per-tick query times
-  delta-collide check --cell T1|T2|T3|FILE.toml [--table FILE.dct] [--input FILE.csv] [--output FILE.csv]
-      reads rows x,y,z,x2,y2,z2 (one TCP per robot, each in its own MCS; stdin by default),
-      writes one line `reachable,collide` per row (stdout by default); collide is NA when a
-      TCP is unreachable; with --table the answers come from the table
-  delta-collide build --cell T1|FILE.toml --output FILE.dct [--k 32] [--variant 6d|5d|4d-yy|4d-zz|shared|shared-sub]
-                      [--t 0] [--labelling certified|thesis]
-      samples, labels (certified per-cell bounds by default) and builds a table file
-  delta-collide inspect FILE.dct
-      prints what a table file holds
-  delta-collide eval --cell T1|FILE.toml --table FILE.dct [--random N] [--seed S] [--plot FILE.png]
-                     [--width W] [--height H]
-      compares the table with the exact physical model (margin 0) on the cell's scenarios and
-      on N random reachable configurations: TP, TN, FP, FN, accuracy, query times; --plot
-      draws, per scenario and tick, the distance between the robots' boxes and the labels
-      reported by the table and by the exact model
-  delta-collide render --cell T1|FILE.toml --tcp x,y,z --tcp x,y,z [--output render.png]
-                       [--width 1400] [--height 700]
-      draws the cell at one configuration (one --tcp per robot, each in its own MCS) in top
-      and side view: every box of the model, the colliding ones in red
-  delta-collide quilt --cell T1|FILE.toml --table FILE.dct [--axes yy|zz|xx] [--fix i,j]
-                      [--output quilt.png] [--width 1200] [--height 1200]
-  delta-collide quilt --cell T1|FILE.toml --table FILE.dct --a ix,iy,iz [--output quilt.png]
-      draws the table's 2-D slices as in the thesis's Figures 3.16-3.17: --axes yy puts
-      yy'-slices in a quilt over (z, z'), zz puts zz'-slices in a quilt over (y, y'), xx puts
-      xx'-slices over (z, z'); --fix gives the grid indices of the remaining pair (default: half
-      the workspace radius toward the other robot). With --a, A's grid cell is fixed and each
-      panel is an x'y'-slice of B's grid at one depth z'. Black: collision, white: free, orange:
-      a cell proved unreachable (don't care), grey: outside the sampled grid";
+/// Why a command did not finish.
+pub enum Failure {
+    /// Arguments that turned out wrong only once files were read (exit code 2).
+    Usage(clap::Error),
+    /// Anything else (exit code 1).
+    Failed(String),
+}
+
+impl From<String> for Failure {
+    fn from(m: String) -> Failure {
+        Failure::Failed(m)
+    }
+}
+
+impl From<&str> for Failure {
+    fn from(m: &str) -> Failure {
+        Failure::Failed(m.to_string())
+    }
+}
+
+impl From<clap::Error> for Failure {
+    fn from(e: clap::Error) -> Failure {
+        Failure::Usage(e)
+    }
+}
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let result = match args.first().map(String::as_str) {
-        Some("demo") => demo(&args[1..]),
-        Some("check") => check(&args[1..]),
-        Some("build") => build(&args[1..]),
-        Some("inspect") => inspect(&args[1..]),
-        Some("eval") => eval(&args[1..]),
-        Some("render") => render::render(&args[1..]),
-        Some("quilt") => quilt::quilt(&args[1..]),
-        Some("-h" | "--help" | "help") => {
-            println!("{USAGE}");
-            Ok(())
-        }
-        _ => Err(format!("unknown or missing command\n{USAGE}")),
+    let cli = Cli::parse_checked();
+    let progress = !cli.quiet;
+    let result = match &cli.command {
+        Command::Demo(a) => demo(a),
+        Command::Check(a) => check(a),
+        Command::Build(a) => build(a, progress),
+        Command::Inspect(a) => inspect(a),
+        Command::Eval(a) => eval(a),
+        Command::Render(a) => render::render(a),
+        Command::Quilt(a) => quilt::quilt(a),
+        Command::Completions { shell } => completions(*shell),
+        Command::Man { output } => man(output.as_deref()),
     };
-    if let Err(e) = result {
-        eprintln!("error: {e}");
-        std::process::exit(2);
-    }
-}
-
-/// The value of `--name` in `args`, if given.
-fn option<'a>(args: &'a [String], name: &str) -> Result<Option<&'a str>, String> {
-    match args.iter().position(|a| a == name) {
-        Some(i) => args.get(i + 1).map(|v| Some(v.as_str())).ok_or(format!("{name} needs a value")),
-        None => Ok(None),
-    }
-}
-
-/// Refuses options the command does not know (a typo never passes silently).
-fn known_options(args: &[String], known: &[&str]) -> Result<(), String> {
-    let mut i = 0;
-    while i < args.len() {
-        if !known.contains(&args[i].as_str()) {
-            return Err(format!("unknown argument `{}`\n{USAGE}", args[i]));
+    match result {
+        Ok(()) => {}
+        Err(Failure::Usage(e)) => e.exit(),
+        Err(Failure::Failed(m)) => {
+            eprintln!("error: {m}");
+            std::process::exit(1);
         }
-        i += 2;
     }
+}
+
+/// `completions SHELL`: the completion script on stdout.
+fn completions(shell: clap_complete::Shell) -> Result<(), Failure> {
+    let mut script = Vec::new();
+    clap_complete::generate(shell, &mut Cli::command(), "delta-collide", &mut script);
+    std::io::stdout().lock().write_all(&script).map_err(|e| format!("stdout: {e}"))?;
     Ok(())
 }
 
-/// A reference cell by name, or a cell file.
-fn load_cell(spec: &str) -> Result<Cell, String> {
-    reference_cell(spec).map_or_else(|| Cell::from_file(std::path::Path::new(spec)).map_err(|e| e.to_string()), Ok)
+/// `man [--output DIR]`: the man page on stdout, or one page per command into `DIR`.
+fn man(dir: Option<&Path>) -> Result<(), Failure> {
+    let mut cmd = Cli::command();
+    cmd.build();
+    let page = |c: clap::Command| -> Result<Vec<u8>, String> {
+        let mut bytes = Vec::new();
+        clap_mangen::Man::new(c).render(&mut bytes).map_err(|e| format!("man page: {e}"))?;
+        Ok(bytes)
+    };
+    let Some(dir) = dir else {
+        std::io::stdout().lock().write_all(&page(cmd)?).map_err(|e| format!("stdout: {e}"))?;
+        return Ok(());
+    };
+    let mut pages = vec![("delta-collide.1".to_string(), page(cmd.clone())?)];
+    for sub in cmd.get_subcommands() {
+        let name = format!("delta-collide-{}", sub.get_name());
+        pages.push((format!("{name}.1"), page(sub.clone().name(name))?));
+    }
+    for (file, bytes) in &pages {
+        files::write_file(&dir.join(file), |w| w.write_all(bytes).map_err(|e| format!("{file}: {e}")))?;
+    }
+    println!("{}: {} man pages", dir.display(), pages.len());
+    Ok(())
 }
 
 fn with_method(cell: &Cell, method: SatMethod) -> Cell {
@@ -150,15 +151,9 @@ fn percentile(sorted: &[u64], p: f64) -> u64 {
     sorted[((sorted.len() - 1) as f64 * p).round() as usize]
 }
 
-fn demo(args: &[String]) -> Result<(), String> {
-    known_options(args, &["--cell"])?;
-    let which = option(args, "--cell")?.unwrap_or("T1");
+fn demo(args: &DemoArgs) -> Result<(), Failure> {
     let scenarios = parse_scenarios(SCENARIOS)?;
-    let cells: Vec<Cell> = if which.eq_ignore_ascii_case("all") {
-        ["T1", "T2", "T3"].iter().filter_map(|n| reference_cell(n)).collect()
-    } else {
-        vec![load_cell(which)?]
-    };
+    let cells = &args.cell.0;
     println!(
         "delta-collide {} demo: exact check (SAT on the box model), {RUN_TICKS} ticks of 1 ms per run",
         env!("CARGO_PKG_VERSION")
@@ -170,20 +165,20 @@ fn demo(args: &[String]) -> Result<(), String> {
         "{:<4} {:<10} {:<9} {:>15} {:>15} {:>10} {:>10} {:>10}",
         "cell", "case", "method", "first collision", "collision ticks", "median ns", "p99 ns", "max ns"
     );
-    for cell in &cells {
+    for cell in cells {
         let cases: Vec<&Scenario> = scenarios.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)).collect();
         if cases.is_empty() {
-            return Err(format!("no scenario for cell {} in c_harness/scenarios.txt", cell.name));
+            return Err(format!("no scenario for cell {} in c_harness/scenarios.txt", cell.name).into());
         }
         for scenario in cases {
             if scenario.robots.len() != cell.robots.len() {
-                return Err(format!(
+                return Err(Failure::Failed(format!(
                     "scenario {} {} has {} robots, the cell {}",
                     scenario.cell,
                     scenario.case,
                     scenario.robots.len(),
                     cell.robots.len()
-                ));
+                )));
             }
             for (name, method) in [("SAT", SatMethod::Sat), ("SAT-cache", SatMethod::SatCache)] {
                 let r = run(&with_method(cell, method), scenario)?;
@@ -205,55 +200,82 @@ fn demo(args: &[String]) -> Result<(), String> {
     Ok(())
 }
 
-fn check(args: &[String]) -> Result<(), String> {
-    known_options(args, &["--cell", "--table", "--input", "--output"])?;
-    let cell = load_cell(option(args, "--cell")?.ok_or("check needs --cell")?)?;
-    let mut table = option(args, "--table")?.map(|p| load_table(&cell, p)).transpose()?;
-    let n = cell.robots.len();
-    let input: Box<dyn BufRead> = match option(args, "--input")? {
-        Some(p) => Box::new(std::io::BufReader::new(std::fs::File::open(p).map_err(|e| format!("{p}: {e}"))?)),
+fn check(args: &CheckArgs) -> Result<(), Failure> {
+    let cell = &args.cell;
+    let mut table = args.table.as_deref().map(|p| load_table(cell, p)).transpose()?;
+    let mut input: Box<dyn BufRead> = match &args.input {
+        Some(p) => {
+            let file = std::fs::File::open(p).map_err(|e| format!("{}: {e}", p.display()))?;
+            Box::new(std::io::BufReader::new(file))
+        }
         None => Box::new(std::io::stdin().lock()),
     };
-    let output: Box<dyn Write> = match option(args, "--output")? {
-        Some(p) => Box::new(std::fs::File::create(p).map_err(|e| format!("{p}: {e}"))?),
-        None => Box::new(std::io::stdout().lock()),
-    };
-    let mut out = BufWriter::with_capacity(1 << 16, output);
-    let mut checker = ExactChecker::new(cell);
+    let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut());
+    match &args.output {
+        Some(path) => files::write_file(path, |w| rows(w))?,
+        None => {
+            let mut out = std::io::BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
+            rows(&mut out)?;
+            out.flush().map_err(|e| format!("stdout: {e}"))?;
+        }
+    }
+    Ok(())
+}
+
+/// Answers every row of `input` on `out`, after the line `reachable,collide`.
+///
+/// # Errors
+/// A row that is not `3 n` numbers (naming its line; the first line may be a header, a line
+/// with no number in it), the table's error, or a read or write error.
+fn check_rows(
+    input: &mut dyn BufRead,
+    out: &mut dyn Write,
+    cell: &Cell,
+    mut table: Option<&mut TableChecker>,
+) -> Result<(), String> {
+    let n = cell.robots.len();
+    let mut checker = ExactChecker::new(cell.clone());
     let mut tcps = vec![Vec3::zeros(); n];
     let mut values = Vec::with_capacity(3 * n);
-    let write_err = |e: std::io::Error| e.to_string();
+    let write_err = |e: std::io::Error| format!("writing the answers: {e}");
     writeln!(out, "reachable,collide").map_err(write_err)?;
+    let mut first = true;
     for (line_no, line) in input.lines().enumerate() {
-        let line = line.map_err(|e| e.to_string())?;
+        let line = line.map_err(|e| format!("line {}: {e}", line_no + 1))?;
         let line = line.trim();
         if line.is_empty() {
             continue;
         }
-        values.clear();
-        let parsed: Result<(), ()> =
-            line.split(',').try_for_each(|f| f.trim().parse::<f64>().map(|v| values.push(v)).map_err(|_| ()));
-        if parsed.is_err() && line_no == 0 {
-            continue; // a header row
+        let header = first && line.split(',').all(|f| f.trim().parse::<f64>().is_err());
+        first = false;
+        if header {
+            continue;
         }
+        values.clear();
+        let parsed = line.split(',').try_for_each(|f| f.trim().parse::<f64>().map(|v| values.push(v)));
         if parsed.is_err() || values.len() != 3 * n {
-            return Err(format!("line {}: expected {} numbers (x,y,z per robot), got `{line}`", line_no + 1, 3 * n));
+            return Err(format!(
+                "line {}: expected {} numbers (x,y,z per robot) separated by commas, got `{}`",
+                line_no + 1,
+                3 * n,
+                clip(line)
+            ));
         }
         for (j, t) in tcps.iter_mut().enumerate() {
             *t = Vec3::new(values[3 * j], values[3 * j + 1], values[3 * j + 2]);
         }
-        let answer = match table.as_mut() {
+        let answer = match table.as_deref_mut() {
             Some(t) => t.check(&tcps),
             None => checker.check(&tcps).map(exact_answer),
         };
-        let row = match answer.map_err(|e| e.to_string())? {
+        let row = match answer.map_err(|e| format!("line {}: {e}", line_no + 1))? {
             TableAnswer::Unreachable(_) => "0,NA\n",
             TableAnswer::Collision => "1,1\n",
             TableAnswer::Free => "1,0\n",
         };
         out.write_all(row.as_bytes()).map_err(write_err)?;
     }
-    out.flush().map_err(write_err)
+    Ok(())
 }
 
 /// The exact verdict in the table's terms.
@@ -265,38 +287,19 @@ fn exact_answer(v: &delta_collide::cell::CellVerdict) -> TableAnswer {
     }
 }
 
-fn load_table(cell: &Cell, path: &str) -> Result<TableChecker, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{path}: {e}"))?;
-    TableChecker::new(cell.clone(), &bytes).map_err(|e| format!("{path}: {e}"))
+fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    TableChecker::new(cell.clone(), &bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-fn parse_num<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> Result<T, String> {
-    option(args, name)?.map_or(Ok(default), |v| v.parse().map_err(|_| format!("{name} {v}: not a number")))
-}
-
-fn build(args: &[String]) -> Result<(), String> {
-    known_options(args, &["--cell", "--output", "--k", "--variant", "--t", "--labelling"])?;
-    let cell = load_cell(option(args, "--cell")?.ok_or("build needs --cell")?)?;
-    let output = option(args, "--output")?.ok_or("build needs --output FILE.dct")?;
-    let k: u32 = parse_num(args, "--k", 32)?;
-    let t: u32 = parse_num(args, "--t", 0)?;
-    let variant = match option(args, "--variant")?.unwrap_or("6d") {
-        "6d" => Variant::D6,
-        "5d" => Variant::D5,
-        "4d-yy" => Variant::D4 { axes: SliceAxes::YY, t },
-        "4d-zz" => Variant::D4 { axes: SliceAxes::ZZ, t },
-        "shared" => Variant::Shared,
-        "shared-sub" => Variant::SharedSubdivided,
-        v => return Err(format!("--variant {v}: use 6d, 5d, 4d-yy, 4d-zz, shared or shared-sub")),
-    };
-    let labelling = match option(args, "--labelling")?.unwrap_or("certified") {
-        "certified" => Labelling::Certified,
-        "thesis" => Labelling::ThesisMargin,
-        v => return Err(format!("--labelling {v}: use certified or thesis")),
-    };
-    let (header, table, r) = build_table(&cell, k, &Workspace::THESIS, variant, labelling, true)?;
+fn build(args: &BuildArgs, progress: bool) -> Result<(), Failure> {
+    let (cell, k, output) = (&args.cell, args.k, &args.output);
+    let variant = args.variant.variant(args.t.unwrap_or(0));
+    let labelling = Labelling::from(args.labelling);
+    check_memory(cell, k, &Workspace::THESIS)?;
+    let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
     let bytes = to_bytes(&table, &header);
-    std::fs::write(output, &bytes).map_err(|e| format!("{output}: {e}"))?;
+    files::write_file(output, |w| w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display())))?;
     println!("cell {} k {k}: {} x {} samples, {} pairs", cell.name, r.samples.0, r.samples.1, r.pairs);
     let unreachable = match labelling {
         Labelling::Certified => "cell proved unreachable (don't care)",
@@ -308,12 +311,54 @@ fn build(args: &[String]) -> Result<(), String> {
     );
     println!("labelling {:.2} s, building {:.2} s", r.label_secs, r.build_secs);
     println!(
-        "{output}: {} ({} bytes in memory, {} bytes on disk)",
+        "{}: {} ({} bytes in memory, {} bytes on disk)",
+        output.display(),
         describe(&table),
         table.memory_bytes(),
         bytes.len()
     );
     Ok(())
+}
+
+/// Refuses, before anything big is allocated, a `k` whose label array (one byte per pair of
+/// sampled grid cells, about `(0.2 k^3)^2`) needs more memory than the machine has.
+///
+/// # Errors
+/// The bytes needed and the bytes the machine has; or the grid's error for a bad `k`.
+fn check_memory(cell: &Cell, k: u32, ws: &Workspace) -> Result<(), String> {
+    let (Some(total), [a, b]) = (total_memory(), &cell.robots[..]) else {
+        return Ok(()); // unknown memory, or not a two-robot cell (the build says so)
+    };
+    // Sample counts from a grid of at most 64 cells per axis, scaled by the cell volume.
+    let k0 = k.min(64);
+    let scale = u64::from(k / k0).pow(3);
+    let samples = |delta| SampleGrid::new(ws, k0, delta).map(|g| g.cells.len() as u64 * scale);
+    let (na, nb) = (samples(&a.model.delta)?, samples(&b.model.delta)?);
+    let needed = na.saturating_mul(nb).saturating_mul(std::mem::size_of::<Label>() as u64);
+    if needed > total {
+        return Err(format!(
+            "k = {k}: labelling cell {} needs about {} of memory for its labels alone ({na} x {nb} \
+             sample pairs, {} byte each), more than this machine's {}; use a smaller k (each \
+             halving needs 64 times less)",
+            cell.name,
+            gigabytes(needed),
+            std::mem::size_of::<Label>(),
+            gigabytes(total)
+        ));
+    }
+    Ok(())
+}
+
+fn gigabytes(bytes: u64) -> String {
+    format!("{:.1} GB", bytes as f64 / 1e9)
+}
+
+/// The machine's memory in bytes (`MemTotal` of `/proc/meminfo`), where known.
+fn total_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kb: u64 = line.trim_start_matches("MemTotal:").trim().trim_end_matches("kB").trim().parse().ok()?;
+    kb.checked_mul(1024)
 }
 
 /// Variant, sizes and thesis-formula bytes of a table.
@@ -328,9 +373,9 @@ fn describe(table: &Table) -> String {
     }
 }
 
-fn inspect(args: &[String]) -> Result<(), String> {
-    let path = args.first().ok_or("inspect needs a table file")?;
-    let bytes = std::fs::read(path).map_err(|e| format!("{path}: {e}"))?;
+fn inspect(args: &InspectArgs) -> Result<(), Failure> {
+    let path = args.table.display();
+    let bytes = std::fs::read(&args.table).map_err(|e| format!("{path}: {e}"))?;
     let (h, table) = from_bytes(&bytes).map_err(|e| format!("{path}: {e}"))?;
     println!("{path}: {} bytes", bytes.len());
     println!("table: {}", describe(&table));
@@ -370,15 +415,12 @@ impl Confusion {
     }
 }
 
-fn eval(args: &[String]) -> Result<(), String> {
-    known_options(args, &["--cell", "--table", "--random", "--seed", "--plot", "--width", "--height"])?;
-    let cell = load_cell(option(args, "--cell")?.ok_or("eval needs --cell")?)?;
-    let table_path = option(args, "--table")?.ok_or("eval needs --table FILE.dct")?;
-    let mut table = load_table(&cell, table_path)?;
-    let n: u64 = parse_num(args, "--random", 1_000_000)?;
-    let mut seed: u64 = parse_num(args, "--seed", 1)?;
-    let plot = option(args, "--plot")?;
-    let plot_size = picture::size_option(args, (1400, 900), (500, 400))?;
+fn eval(args: &EvalArgs) -> Result<(), Failure> {
+    let cell = &args.cell;
+    let mut table = load_table(cell, &args.table)?;
+    let (n, mut seed) = (args.random, args.seed);
+    let plot = args.plot.as_deref();
+    let plot_size = (args.width, args.height);
     let table_name = format!("{} k = {}", table.table().name(), 1u32 << table.table().levels());
     let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
     let mut ns = Vec::new();
@@ -397,7 +439,7 @@ fn eval(args: &[String]) -> Result<(), String> {
     let mut traces = Vec::new();
     for scenario in parse_scenarios(SCENARIOS)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)) {
         let mut c = Confusion::default();
-        let mut trace = plot.map(|_| plot::Trace::new(&cell, format!("{} {}", scenario.cell, scenario.case)));
+        let mut trace = plot.map(|_| plot::Trace::new(cell, format!("{} {}", scenario.cell, scenario.case)));
         for tick in 0..RUN_TICKS {
             scenario.tcps_at(tick, &mut tcps);
             let answer = compare(&tcps, &mut c, &mut ns)?;
@@ -409,9 +451,13 @@ fn eval(args: &[String]) -> Result<(), String> {
         traces.extend(trace);
     }
     if let Some(path) = plot {
-        let title = format!("cell {}, table {table_path} ({table_name}): box distance and labels per tick", cell.name);
+        let title = format!(
+            "cell {}, table {} ({table_name}): box distance and labels per tick",
+            cell.name,
+            args.table.display()
+        );
         plot::draw_plot(path, plot_size, &title, &traces)?;
-        println!("{path}: {} x {} pixels, {} scenarios", plot_size.0, plot_size.1, traces.len());
+        println!("{}: {} x {} pixels, {} scenarios", path.display(), plot_size.0, plot_size.1, traces.len());
     }
     // Random reachable configurations, uniform in the workspace box (xorshift64*, seeded).
     let mut next = move || {

@@ -1,13 +1,14 @@
 //! What the three pictures share: an RGB canvas that plotters draws into, the font compiled
-//! into the binary, PNG output, `--width`/`--height`, colours and a 2-D convex hull.
+//! into the binary, PNG output, colours and a 2-D convex hull.
 //!
 //! No system font or external program is used: text is drawn with DejaVu Sans (a subset, see
 //! `font/LICENSE`) through plotters' `ab_glyph` backend, and the PNG is encoded by the `png`
 //! crate.
 
-use crate::{option, parse_num};
+use crate::files::write_file;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use std::path::Path;
 use std::sync::Once;
 
 /// DejaVu Sans, printable ASCII and a few symbols (`font/LICENSE` says how it was cut).
@@ -27,9 +28,6 @@ pub const OUTSIDE: RGBColor = RGBColor(200, 200, 200);
 pub const ROBOT: [RGBColor; 4] =
     [RGBColor(40, 90, 200), RGBColor(20, 150, 80), RGBColor(150, 60, 170), RGBColor(180, 120, 20)];
 
-/// The largest width or height accepted (pixels).
-const MAX_SIDE: u32 = 8192;
-
 /// Makes the compiled-in font the `sans-serif` family of plotters (once per process).
 fn register_font() {
     static ONCE: Once = Once::new();
@@ -45,30 +43,13 @@ pub fn plot_err<E: std::fmt::Debug>(e: E) -> String {
     format!("drawing failed: {e:?}")
 }
 
-/// `--width` and `--height` (pixels), with defaults and bounds.
-pub fn size_option(args: &[String], default: (u32, u32), min: (u32, u32)) -> Result<(u32, u32), String> {
-    let w: u32 = parse_num(args, "--width", default.0)?;
-    let h: u32 = parse_num(args, "--height", default.1)?;
-    if !(min.0..=MAX_SIDE).contains(&w) || !(min.1..=MAX_SIDE).contains(&h) {
-        return Err(format!(
-            "--width {w} --height {h}: this picture needs at least {} x {} and at most {MAX_SIDE} x {MAX_SIDE} pixels",
-            min.0, min.1
-        ));
-    }
-    Ok((w, h))
-}
-
-/// `--output`, or `default` when not given.
-pub fn output_option<'a>(args: &'a [String], default: &'a str) -> Result<&'a str, String> {
-    Ok(option(args, "--output")?.unwrap_or(default))
-}
-
-/// Draws with `draw` on a white `width` x `height` RGB canvas and writes it to `path` as PNG.
+/// Draws with `draw` on a white `width` x `height` RGB canvas and writes it to `path` as PNG
+/// (replacing `path` only once the file is complete).
 ///
 /// # Errors
 /// The drawing's error, or the file's.
 pub fn draw_png(
-    path: &str,
+    path: &Path,
     (width, height): (u32, u32),
     draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<(), String>,
 ) -> Result<(), String> {
@@ -83,15 +64,17 @@ pub fn draw_png(
 }
 
 /// Encodes an 8-bit RGB buffer as a PNG file.
-fn write_png(path: &str, rgb: &[u8], width: u32, height: u32) -> Result<(), String> {
-    let file = std::fs::File::create(path).map_err(|e| format!("{path}: {e}"))?;
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    encoder.set_compression(png::Compression::High);
-    let mut writer = encoder.write_header().map_err(|e| format!("{path}: {e}"))?;
-    writer.write_image_data(rgb).map_err(|e| format!("{path}: {e}"))?;
-    writer.finish().map_err(|e| format!("{path}: {e}"))
+fn write_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<(), String> {
+    let shown = path.display();
+    write_file(path, |out| {
+        let mut encoder = png::Encoder::new(out, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_compression(png::Compression::High);
+        let mut writer = encoder.write_header().map_err(|e| format!("{shown}: {e}"))?;
+        writer.write_image_data(rgb).map_err(|e| format!("{shown}: {e}"))?;
+        writer.finish().map_err(|e| format!("{shown}: {e}"))
+    })
 }
 
 /// A text style of the compiled-in font.

@@ -69,7 +69,7 @@ impl Trace {
 }
 
 /// Draws one panel per trace into a PNG.
-pub fn draw_plot(path: &str, size: (u32, u32), title: &str, traces: &[Trace]) -> Result<(), String> {
+pub fn draw_plot(path: &std::path::Path, size: (u32, u32), title: &str, traces: &[Trace]) -> Result<(), String> {
     if traces.is_empty() {
         return Err("the cell has no scenario in c_harness/scenarios.txt to plot".into());
     }

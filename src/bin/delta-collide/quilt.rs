@@ -15,10 +15,10 @@
 //! grid (no table entry: queries there fall back to the exact check). A cell whose centre is
 //! unreachable but which may hold reachable TCPs shows the table's answer.
 
-use crate::picture::{
-    draw_png, legend, output_option, plot_err, size_option, text, Swatch, COLLISION, FREE, OUTSIDE, UNREACHABLE,
-};
-use crate::{known_options, load_cell, load_table, option};
+use crate::args::{usage_error, QuiltArgs, QuiltAxes};
+use crate::picture::{draw_png, legend, plot_err, text, Swatch, COLLISION, FREE, OUTSIDE, UNREACHABLE};
+use crate::{load_table, Failure};
+use clap::error::ErrorKind;
 use delta_collide::cell::Cell;
 use delta_collide::cspace::guarantee::cube_unreachable;
 use delta_collide::cspace::{SampleGrid, Workspace};
@@ -94,12 +94,10 @@ struct Quilt {
     title: String,
 }
 
-/// `quilt --cell C --table F.dct [--axes yy|zz|xx] [--fix i,j] [--a ix,iy,iz] [--output F.png]`.
-pub fn quilt(args: &[String]) -> Result<(), String> {
-    known_options(args, &["--cell", "--table", "--axes", "--fix", "--a", "--output", "--width", "--height"])?;
-    let cell = load_cell(option(args, "--cell")?.ok_or("quilt needs --cell")?)?;
-    let path = option(args, "--table")?.ok_or("quilt needs --table FILE.dct")?;
-    let checker = load_table(&cell, path)?;
+/// `quilt`: draws the slices `args` asks for.
+pub fn quilt(args: &QuiltArgs) -> Result<(), Failure> {
+    let cell = &args.cell;
+    let checker = load_table(cell, &args.table)?;
     let (header, table) = (checker.header(), checker.table());
     let k = 1u32 << table.levels();
     let grid = |j: usize| {
@@ -107,25 +105,22 @@ pub fn quilt(args: &[String]) -> Result<(), String> {
         SampleGrid::new(&header.workspace, k, delta).map(|g| GridMap::new(g, delta))
     };
     let maps = [grid(0)?, grid(1)?];
+    let path = args.table.display();
     let what = format!("cell {}, table {} ({}, k = {k}, r = {:.2} mm)", cell.name, path, table.name(), header.r);
-    let quilt = match option(args, "--a")? {
-        Some(a) => {
-            if option(args, "--axes")?.is_some() || option(args, "--fix")?.is_some() {
-                return Err("--a fixes A's cell and shows B's x'y'-slices: give it without --axes and --fix".into());
-            }
-            b_slices(&maps, parse_indices::<3>("--a", a, k)?, &what)
-        }
+    let quilt = match args.a {
+        Some(a) => b_slices(&maps, within_grid("--a", a, k)?, &what),
         None => {
-            let axes = option(args, "--axes")?.unwrap_or("yy");
-            thesis_quilt(&cell, &maps, &header.workspace, axes, option(args, "--fix")?, &what)?
+            let fix = args.fix.map(|f| within_grid("--fix", f, k)).transpose()?;
+            thesis_quilt(cell, &maps, &header.workspace, args.axes, fix, &what)
         }
     };
-    let output = output_option(args, "quilt.png")?;
-    let size = size_option(args, (1200, 1200), (200, 200))?;
+    let (output, size) = (&args.output, (args.width, args.height));
+    layout(&quilt, &maps, size).map_err(|m| usage_error("quilt", ErrorKind::ValueValidation, m))?;
     let counts = count(&quilt, &maps, table);
     draw_png(output, size, |root| draw(root, &quilt, &maps, table))?;
     println!(
-        "{output}: {} x {} pixels, {} slices of {} x {} cells: {} collision, {} free, {} unreachable, {} outside the grid",
+        "{}: {} x {} pixels, {} slices of {} x {} cells: {} collision, {} free, {} unreachable, {} outside the grid",
+        output.display(),
         size.0,
         size.1,
         quilt.panels.len(),
@@ -139,13 +134,50 @@ pub fn quilt(args: &[String]) -> Result<(), String> {
     Ok(())
 }
 
-/// `N` comma-separated grid indices, each below `k`.
-fn parse_indices<const N: usize>(name: &str, v: &str, k: u32) -> Result<[u16; N], String> {
-    let parsed: Vec<u16> = v.split(',').map(|f| f.trim().parse::<u16>()).collect::<Result<_, _>>().unwrap_or_default();
-    if parsed.len() != N || parsed.iter().any(|&i| i as u32 >= k) {
-        return Err(format!("{name} {v}: expected {N} grid indices between 0 and {} separated by commas", k - 1));
+/// Where the panels go: cells per panel, caption and gap heights, pixels per grid cell.
+struct Layout {
+    nh: usize,
+    nv: usize,
+    caption: u32,
+    gap: u32,
+    s: f64,
+}
+
+/// The layout of `q` on a `w` x `h` picture.
+///
+/// # Errors
+/// When a grid cell would get less than one pixel, with the size that would do.
+fn layout(q: &Quilt, maps: &[GridMap; 2], (w, h): (u32, u32)) -> Result<Layout, String> {
+    let (nh, nv) = (span(maps, q.inner[0]).len(), span(maps, q.inner[1]).len());
+    let caption = if q.panels.iter().any(|p| p.caption.is_some()) { 18 } else { 0 };
+    let gap = 3;
+    let avail_w = w.saturating_sub(LEFT + PAD + gap * q.cols as u32) as f64;
+    let avail_h = h.saturating_sub(TITLE + BOTTOM + PAD + (gap + caption) * q.rows as u32) as f64;
+    // Pixels per grid cell: fractional, so that the quilt fills the picture.
+    let s = (avail_w / (q.cols * nh) as f64).min(avail_h / (q.rows * nv) as f64);
+    if s < 1.0 {
+        return Err(format!(
+            "the picture is too small for {} x {} slices of {nh} x {nv} cells: give at least --width {} --height {}",
+            q.cols,
+            q.rows,
+            LEFT + PAD + (gap + (nh as u32)) * q.cols as u32,
+            TITLE + BOTTOM + PAD + (gap + caption + nv as u32) * q.rows as u32
+        ));
     }
-    Ok(std::array::from_fn(|i| parsed[i]))
+    Ok(Layout { nh, nv, caption, gap, s })
+}
+
+/// `indices`, when each is below the table's `k` (a usage error otherwise).
+fn within_grid<const N: usize>(name: &str, indices: [u16; N], k: u32) -> Result<[u16; N], clap::Error> {
+    if indices.iter().all(|&i| u32::from(i) < k) {
+        return Ok(indices);
+    }
+    let shown: Vec<String> = indices.iter().map(u16::to_string).collect();
+    Err(usage_error(
+        "quilt",
+        ErrorKind::ValueValidation,
+        format!("{name} {}: the table has k = {k}, so each grid index must be from 0 to {}", shown.join(","), k - 1),
+    ))
 }
 
 /// The sampled index range of 6-D dimension `d`.
@@ -167,21 +199,16 @@ fn thesis_quilt(
     cell: &Cell,
     maps: &[GridMap; 2],
     ws: &Workspace,
-    axes: &str,
-    fix: Option<&str>,
+    axes: QuiltAxes,
+    fix: Option<[u16; 2]>,
     what: &str,
-) -> Result<Quilt, String> {
+) -> Quilt {
     let (inner, outer, fixed) = match axes {
-        "yy" => (1, 2, 0),
-        "zz" => (2, 1, 0),
-        "xx" => (0, 2, 1),
-        _ => return Err(format!("--axes {axes}: use yy (Figure 3.16), zz (Figure 3.17) or xx")),
+        QuiltAxes::Yy => (1, 2, 0),
+        QuiltAxes::Zz => (2, 1, 0),
+        QuiltAxes::Xx => (0, 2, 1),
     };
-    let k = maps[0].grid.k;
-    let fixed_idx = match fix {
-        Some(v) => parse_indices::<2>("--fix", v, k)?,
-        None => default_fix(cell, maps, ws, fixed),
-    };
+    let fixed_idx = fix.unwrap_or_else(|| default_fix(cell, maps, ws, fixed));
     let (cols, rows) = (span(maps, outer), span(maps, outer + 3));
     let mut panels = Vec::new();
     for (row, iv) in rows.clone().enumerate() {
@@ -198,7 +225,7 @@ fn thesis_quilt(
         (format!("{} (mm)", NAMES[d]), r.map(|i| format!("{:.0}", coordinate(maps, d, i))).collect())
     };
     let (a, b) = (fixed_idx[0], fixed_idx[1]);
-    Ok(Quilt {
+    Quilt {
         inner: [inner, inner + 3],
         cols: cols.len(),
         rows: rows.len(),
@@ -214,7 +241,7 @@ fn thesis_quilt(
             o = NAMES[outer],
             f = NAMES[fixed],
         ),
-    })
+    }
 }
 
 /// The fixed pair's default indices: half the workspace radius from each robot's axis toward
@@ -313,22 +340,7 @@ fn draw(root: &DrawingArea<BitMapBackend, Shift>, q: &Quilt, maps: &[GridMap; 2]
         (Swatch::Square(OUTSIDE), "outside the sampled grid"),
     ];
     legend(root, (PAD as i32, TITLE as i32 - 20), &entries)?;
-    let (nh, nv) = (span(maps, q.inner[0]).len(), span(maps, q.inner[1]).len());
-    let caption = if q.panels.iter().any(|p| p.caption.is_some()) { 18 } else { 0 };
-    let gap = 3;
-    let avail_w = w.saturating_sub(LEFT + PAD + gap * q.cols as u32) as f64;
-    let avail_h = h.saturating_sub(TITLE + BOTTOM + PAD + (gap + caption) * q.rows as u32) as f64;
-    // Pixels per grid cell: fractional, so that the quilt fills the picture.
-    let s = (avail_w / (q.cols * nh) as f64).min(avail_h / (q.rows * nv) as f64);
-    if s < 1.0 {
-        return Err(format!(
-            "the picture is too small for {} x {} slices of {nh} x {nv} cells: give at least --width {} --height {}",
-            q.cols,
-            q.rows,
-            LEFT + PAD + (gap + (nh as u32)) * q.cols as u32,
-            TITLE + BOTTOM + PAD + (gap + caption + nv as u32) * q.rows as u32
-        ));
-    }
+    let Layout { nh, nv, caption, gap, s } = layout(q, maps, (w, h))?;
     let (pw, ph) = (nh as f64 * s, nv as f64 * s);
     let (gap, caption) = (gap as f64, caption as f64);
     let panel_origin = |p: &Panel| {

@@ -7,8 +7,9 @@
 //! thesis workspace's outline (SPEC §4) are drawn thinly; they take no part in the verdict
 //! unless the cell file switches on boxes for them.
 
-use crate::picture::{convex_hull, draw_png, legend, output_option, plot_err, size_option, text, Swatch, HIT, ROBOT};
-use crate::{known_options, load_cell};
+use crate::args::RenderArgs;
+use crate::picture::{convex_hull, draw_png, legend, plot_err, text, Swatch, HIT, ROBOT};
+use crate::Failure;
 use delta_collide::cell::exact::PairState;
 use delta_collide::cell::{Cell, CellVerdict, ExactChecker};
 use delta_collide::cspace::Workspace;
@@ -39,47 +40,17 @@ struct RobotPicture {
     base_radius: f64,
 }
 
-/// `render --cell C --tcp x,y,z --tcp x,y,z [--output F.png] [--width W] [--height H]`.
-pub fn render(args: &[String]) -> Result<(), String> {
-    known_options(args, &["--cell", "--tcp", "--output", "--width", "--height"])?;
-    let cell = load_cell(crate::option(args, "--cell")?.ok_or("render needs --cell")?)?;
-    let tcps = tcp_options(args)?;
-    if tcps.len() != cell.robots.len() {
-        return Err(format!(
-            "cell {} has {} robots: give one --tcp x,y,z per robot (each in its own MCS, mm), got {}",
-            cell.name,
-            cell.robots.len(),
-            tcps.len()
-        ));
-    }
-    let output = output_option(args, "render.png")?;
-    let size = size_option(args, (1400, 700), (700, 350))?;
+/// `render`: draws `args.cell` at the TCPs `args.tcp` (one per robot, checked when parsed).
+pub fn render(args: &RenderArgs) -> Result<(), Failure> {
+    let (cell, tcps, output) = (&args.cell, &args.tcp, &args.output);
+    let size = (args.width, args.height);
     let mut checker = ExactChecker::new(cell.clone());
-    let verdict = checker.check(&tcps).map_err(|e| e.to_string())?.clone();
-    let robots = pictures_of(&cell, &checker, &verdict, &tcps);
-    let title = describe(&cell, &verdict, &robots, &tcps);
+    let verdict = checker.check(tcps).map_err(|e| e.to_string())?.clone();
+    let robots = pictures_of(cell, &checker, &verdict, tcps);
+    let title = describe(cell, &verdict, &robots, tcps);
     draw_png(output, size, |root| draw(root, &robots, &title))?;
-    println!("{output}: {} x {} pixels; {title}", size.0, size.1);
+    println!("{}: {} x {} pixels; {title}", output.display(), size.0, size.1);
     Ok(())
-}
-
-/// Every `--tcp x,y,z` in order.
-fn tcp_options(args: &[String]) -> Result<Vec<Vec3>, String> {
-    let mut out = Vec::new();
-    for (i, a) in args.iter().enumerate() {
-        if a == "--tcp" && i % 2 == 0 {
-            let v = args.get(i + 1).ok_or("--tcp needs a value x,y,z")?;
-            let xyz: Vec<f64> =
-                v.split(',').map(|f| f.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| {
-                    format!("--tcp {v}: expected three numbers x,y,z (mm, the robot's own MCS), e.g. 150,0,-450")
-                })?;
-            if xyz.len() != 3 {
-                return Err(format!("--tcp {v}: expected three numbers x,y,z, got {}", xyz.len()));
-            }
-            out.push(Vec3::new(xyz[0], xyz[1], xyz[2]));
-        }
-    }
-    Ok(out)
 }
 
 /// The drawable state of every robot after the check.

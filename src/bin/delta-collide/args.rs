@@ -1,0 +1,537 @@
+//! The command line's definition (clap derive): every command and flag with its meaning,
+//! unit and default, and the parsers that check values when the arguments are read. The
+//! help, the shell completions and the man page are all generated from it.
+//!
+//! A value that is wrong on its own (a k the table format cannot hold, a coordinate that is
+//! not three numbers, an unknown cell) is refused here with exit code 2; flags that
+//! contradict each other are refused by [`Cli::parse_checked`], also with 2.
+
+use clap::builder::{PossibleValue, TypedValueParser};
+use clap::error::{ContextKind, ContextValue, ErrorKind};
+use clap::{Args, CommandFactory, Parser, Subcommand, ValueEnum};
+use delta_collide::cell::reference::{reference_cell, REFERENCE_CELL_FILES};
+use delta_collide::cell::Cell;
+use delta_collide::math::Vec3;
+use delta_collide::table::code::MAX_LEVELS;
+use delta_collide::table::{Labelling, SliceAxes, Variant};
+use std::path::PathBuf;
+use std::sync::LazyLock;
+
+/// `--version`: the crate's version and the table format version that `build` writes.
+static VERSION_TEXT: LazyLock<String> = LazyLock::new(|| {
+    format!("{} (writes table format version {})", env!("CARGO_PKG_VERSION"), delta_collide::table::format::VERSION)
+});
+
+/// The largest width or height of a picture (pixels).
+const MAX_SIDE: u32 = 8192;
+
+/// Longest piece of a user's input that an error message echoes.
+pub const ECHO_CHARS: usize = 40;
+
+/// `s` cut to [`ECHO_CHARS`] characters, with "..." when it was longer.
+pub fn clip(s: &str) -> String {
+    match s.char_indices().nth(ECHO_CHARS) {
+        Some((i, _)) => format!("{}...", &s[..i]),
+        None => s.to_string(),
+    }
+}
+
+/// Collision detection for Delta robots: exact checks, precomputed tables and their pictures.
+#[derive(Parser, Debug)]
+#[command(name = "delta-collide", version = VERSION_TEXT.as_str(), subcommand_required = true)]
+#[command(arg_required_else_help = true, disable_help_subcommand = true)]
+pub struct Cli {
+    /// Draw no progress bars (they go to stderr only, and only when it is a terminal)
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Run the practical and collision scenarios with SAT and SAT-cache
+    ///
+    /// Runs the scenarios of c_harness/scenarios.txt for the chosen cells and prints the
+    /// first collision tick and the per-tick query times of the exact check.
+    Demo(DemoArgs),
+    /// Check configurations from a CSV file, exactly or with a table
+    ///
+    /// Reads rows x,y,z,x2,y2,z2 (one TCP per robot, each in its own MCS, mm; a first line
+    /// with no number in it is a header) and writes one line `reachable,collide` per row;
+    /// collide is NA when a TCP is unreachable. A malformed row is an error naming its line.
+    Check(CheckArgs),
+    /// Sample, label and build a table file
+    ///
+    /// Samples both robots' workspaces on a k x k x k grid, labels every pair of grid cells
+    /// (certified per-cell bounds by default) and writes the table. Memory grows as k^6: a k
+    /// whose labels do not fit in the machine's memory is refused before anything is
+    /// allocated.
+    Build(BuildArgs),
+    /// Print what a table file holds
+    Inspect(InspectArgs),
+    /// Compare a table with the exact model
+    ///
+    /// Compares the table with the exact physical model (margin 0) on the cell's scenarios and
+    /// on N random reachable configurations: TP, TN, FP, FN, accuracy, query times. --plot
+    /// draws, per scenario and tick, the distance between the robots' boxes and the labels
+    /// reported by the table and by the exact model.
+    Eval(EvalArgs),
+    /// Draw the cell at one configuration (PNG)
+    ///
+    /// Top and side view of the cell at one configuration: every box of the model, the
+    /// colliding ones in red.
+    Render(RenderArgs),
+    /// Draw a table's 2-D slices (PNG)
+    ///
+    /// The table's 2-D slices as in the thesis's Figures 3.16-3.17: --axes yy puts yy'-slices
+    /// in a quilt over (z, z'), zz puts zz'-slices in a quilt over (y, y'), xx puts xx'-slices
+    /// over (z, z'). With --a, A's grid cell is fixed and each panel is an x'y'-slice of B's
+    /// grid at one depth z'. Black: collision, white: free, orange: a cell proved unreachable
+    /// (don't care), grey: outside the sampled grid.
+    Quilt(QuiltArgs),
+    /// Print a shell completion script
+    Completions {
+        /// The shell
+        #[arg(value_parser = choice::<clap_complete::Shell>())]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page, or write one page per command into a directory
+    Man {
+        /// Write delta-collide.1 and delta-collide-COMMAND.1 into this directory instead
+        #[arg(long, value_name = "DIR")]
+        output: Option<PathBuf>,
+    },
+}
+
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// The cell: T1, T2, T3, all (the three) or a .toml file
+    #[arg(long, value_name = "CELL", default_value = "T1", value_parser = clipped(parse_cells))]
+    pub cell: Cells,
+}
+
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    /// The cell: T1, T2, T3 or a .toml file
+    #[arg(long, value_name = "CELL", value_parser = clipped(parse_cell))]
+    pub cell: Cell,
+    /// Answer from this table (built for the same cell) instead of the exact check
+    #[arg(long, value_name = "FILE.dct")]
+    pub table: Option<PathBuf>,
+    /// Read the rows from this file [default: stdin]
+    #[arg(long, value_name = "FILE.csv")]
+    pub input: Option<PathBuf>,
+    /// Write the answers to this file, replaced only once complete [default: stdout]
+    #[arg(long, value_name = "FILE.csv")]
+    pub output: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub struct BuildArgs {
+    /// The cell: T1, T2, T3 or a .toml file
+    #[arg(long, value_name = "CELL", value_parser = clipped(parse_cell))]
+    pub cell: Cell,
+    /// The table file to write, replaced only once complete
+    #[arg(long, value_name = "FILE.dct")]
+    pub output: PathBuf,
+    /// Grid cells per axis and robot: a power of two from 2 to 256 (the table format's limit)
+    #[arg(long, value_name = "K", default_value_t = 32, value_parser = clipped(parse_k))]
+    pub k: u32,
+    /// The table's kind
+    #[arg(long, value_name = "VARIANT", default_value = "6d")]
+    #[arg(value_parser = choice::<VariantArg>())]
+    pub variant: VariantArg,
+    /// Similarity threshold of the 4-D table's slice groups, in differing grid cells
+    /// (0: lossless; only with --variant 4d-yy or 4d-zz) [default: 0]
+    #[arg(long, value_name = "T", value_parser = clipped(parse_number::<u32>))]
+    pub t: Option<u32>,
+    /// How the samples are labelled
+    #[arg(long, value_name = "LABELLING", default_value = "certified")]
+    #[arg(value_parser = choice::<LabellingArg>())]
+    pub labelling: LabellingArg,
+}
+
+#[derive(Args, Debug)]
+pub struct InspectArgs {
+    /// The table file
+    #[arg(value_name = "FILE.dct")]
+    pub table: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// The cell: T1, T2, T3 or a .toml file
+    #[arg(long, value_name = "CELL", value_parser = clipped(parse_cell))]
+    pub cell: Cell,
+    /// The table file, built for the same cell
+    #[arg(long, value_name = "FILE.dct")]
+    pub table: PathBuf,
+    /// Random reachable configurations to compare
+    #[arg(long, value_name = "N", default_value_t = 1_000_000, value_parser = clipped(parse_number::<u64>))]
+    pub random: u64,
+    /// Seed of the random configurations (xorshift64*; not 0)
+    #[arg(long, value_name = "S", default_value_t = 1, value_parser = clipped(parse_seed))]
+    pub seed: u64,
+    /// Draw the scenarios' box distances and labels into this PNG file
+    #[arg(long, value_name = "FILE.png")]
+    pub plot: Option<PathBuf>,
+    /// Width of the plot in pixels, 500 to 8192 (only with --plot)
+    #[arg(long, value_name = "W", default_value_t = 1400, requires = "plot")]
+    #[arg(value_parser = clipped(pixels(500)))]
+    pub width: u32,
+    /// Height of the plot in pixels, 400 to 8192 (only with --plot)
+    #[arg(long, value_name = "H", default_value_t = 900, requires = "plot")]
+    #[arg(value_parser = clipped(pixels(400)))]
+    pub height: u32,
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// The cell: T1, T2, T3 or a .toml file
+    #[arg(long, value_name = "CELL", value_parser = clipped(parse_cell))]
+    pub cell: Cell,
+    /// A robot's TCP as x,y,z in its own MCS (mm), e.g. 150,0,-450; once per robot, in order
+    #[arg(long, value_name = "X,Y,Z", required = true, allow_hyphen_values = true)]
+    #[arg(value_parser = clipped(parse_xyz))]
+    pub tcp: Vec<Vec3>,
+    /// The PNG file to write, replaced only once complete
+    #[arg(long, value_name = "FILE.png", default_value = "render.png")]
+    pub output: PathBuf,
+    /// Width of the picture in pixels, 700 to 8192
+    #[arg(long, value_name = "W", default_value_t = 1400, value_parser = clipped(pixels(700)))]
+    pub width: u32,
+    /// Height of the picture in pixels, 350 to 8192
+    #[arg(long, value_name = "H", default_value_t = 700, value_parser = clipped(pixels(350)))]
+    pub height: u32,
+}
+
+#[derive(Args, Debug)]
+pub struct QuiltArgs {
+    /// The cell: T1, T2, T3 or a .toml file
+    #[arg(long, value_name = "CELL", value_parser = clipped(parse_cell))]
+    pub cell: Cell,
+    /// The table file, built for the same cell
+    #[arg(long, value_name = "FILE.dct")]
+    pub table: PathBuf,
+    /// Which slices: yy (thesis Figure 3.16), zz (Figure 3.17) or xx
+    #[arg(long, value_name = "AXES", default_value = "yy", conflicts_with = "a")]
+    #[arg(value_parser = choice::<QuiltAxes>())]
+    pub axes: QuiltAxes,
+    /// Grid indices i,j of the remaining dimension pair (e.g. x and x' with --axes yy)
+    /// [default: half the workspace radius toward the other robot]
+    #[arg(long, value_name = "I,J", conflicts_with = "a", value_parser = clipped(parse_indices::<2>))]
+    pub fix: Option<[u16; 2]>,
+    /// Fix A's grid cell ix,iy,iz and show B's x'y'-slices, one per depth z'
+    #[arg(long, value_name = "IX,IY,IZ", value_parser = clipped(parse_indices::<3>))]
+    pub a: Option<[u16; 3]>,
+    /// The PNG file to write, replaced only once complete
+    #[arg(long, value_name = "FILE.png", default_value = "quilt.png")]
+    pub output: PathBuf,
+    /// Width of the picture in pixels, 200 to 8192
+    #[arg(long, value_name = "W", default_value_t = 1200, value_parser = clipped(pixels(200)))]
+    pub width: u32,
+    /// Height of the picture in pixels, 200 to 8192
+    #[arg(long, value_name = "H", default_value_t = 1200, value_parser = clipped(pixels(200)))]
+    pub height: u32,
+}
+
+/// The table kinds `build` writes (the library's [`Variant`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VariantArg {
+    /// Condensed 6-D linear quadtree (thesis 3.2.4)
+    #[value(name = "6d")]
+    D6,
+    /// 5-D quadtree with z' collision intervals (thesis 3.2.5)
+    #[value(name = "5d")]
+    D5,
+    /// 4-D quadtree of yy'-slices grouped by similarity (thesis 3.2.6)
+    #[value(name = "4d-yy")]
+    D4yy,
+    /// 4-D quadtree of zz'-slices grouped by similarity (thesis 3.2.6)
+    #[value(name = "4d-zz")]
+    D4zz,
+    /// 6-D quadtree with shared subtrees
+    Shared,
+    /// As shared, collision cells cut into 64 sub-cells (certified labelling only)
+    SharedSub,
+}
+
+impl VariantArg {
+    /// The library's variant, with threshold `t` for the 4-D kinds.
+    pub fn variant(self, t: u32) -> Variant {
+        match self {
+            VariantArg::D6 => Variant::D6,
+            VariantArg::D5 => Variant::D5,
+            VariantArg::D4yy => Variant::D4 { axes: SliceAxes::YY, t },
+            VariantArg::D4zz => Variant::D4 { axes: SliceAxes::ZZ, t },
+            VariantArg::Shared => Variant::Shared,
+            VariantArg::SharedSub => Variant::SharedSubdivided,
+        }
+    }
+}
+
+/// How `build` labels the samples (the library's [`Labelling`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LabellingArg {
+    /// Per-cell proved displacement bounds: no false negative in a free cell
+    Certified,
+    /// The thesis's margin at the cell centre
+    Thesis,
+}
+
+impl From<LabellingArg> for Labelling {
+    fn from(l: LabellingArg) -> Labelling {
+        match l {
+            LabellingArg::Certified => Labelling::Certified,
+            LabellingArg::Thesis => Labelling::ThesisMargin,
+        }
+    }
+}
+
+/// The slice pairs of `quilt`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum QuiltAxes {
+    /// yy'-slices in a quilt over (z, z'), x and x' fixed (Figure 3.16)
+    Yy,
+    /// zz'-slices in a quilt over (y, y'), x and x' fixed (Figure 3.17)
+    Zz,
+    /// xx'-slices in a quilt over (z, z'), y and y' fixed
+    Xx,
+}
+
+/// The cells of `demo`.
+#[derive(Clone, Debug)]
+pub struct Cells(pub Vec<Cell>);
+
+impl Cli {
+    /// The parsed command line; on a usage error (unknown, repeated, contradictory or badly
+    /// typed flags) prints clap's message and exits with 2, on `--help`/`--version` exits 0.
+    pub fn parse_checked() -> Cli {
+        let cli = Cli::try_parse().unwrap_or_else(|e| e.exit());
+        if let Err(e) = cli.check() {
+            e.exit();
+        }
+        cli
+    }
+
+    /// Refuses flags that contradict each other or the cell.
+    fn check(&self) -> Result<(), clap::Error> {
+        match &self.command {
+            Command::Build(b) => {
+                let four_d = matches!(b.variant, VariantArg::D4yy | VariantArg::D4zz);
+                if let (Some(t), false) = (b.t, four_d) {
+                    let v = b.variant.to_possible_value().map(|p| p.get_name().to_string()).unwrap_or_default();
+                    return Err(usage_error(
+                        "build",
+                        ErrorKind::ArgumentConflict,
+                        format!("--t {t} applies to --variant 4d-yy and 4d-zz only, not to --variant {v}"),
+                    ));
+                }
+                if b.variant == VariantArg::SharedSub && b.labelling == LabellingArg::Thesis {
+                    return Err(usage_error(
+                        "build",
+                        ErrorKind::ArgumentConflict,
+                        "--variant shared-sub certifies sub-cells: it needs --labelling certified".into(),
+                    ));
+                }
+            }
+            Command::Render(r) if r.tcp.len() != r.cell.robots.len() => {
+                return Err(usage_error(
+                    "render",
+                    ErrorKind::WrongNumberOfValues,
+                    format!(
+                        "cell {} has {} robots: give one --tcp x,y,z per robot (each in its own MCS, mm), got {}",
+                        r.cell.name,
+                        r.cell.robots.len(),
+                        r.tcp.len()
+                    ),
+                ));
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// A usage error of subcommand `name`, formatted by clap (with that command's usage line);
+/// it exits with 2.
+pub fn usage_error(name: &str, kind: ErrorKind, message: String) -> clap::Error {
+    let mut cmd = Cli::command();
+    cmd.build();
+    match cmd.find_subcommand_mut(name) {
+        Some(sub) => sub.error(kind, message),
+        None => cmd.error(kind, message),
+    }
+}
+
+/// Wraps a value parser so that its errors echo at most [`ECHO_CHARS`] characters of the value.
+pub fn clipped<P: TypedValueParser>(inner: P) -> Clipped<P> {
+    Clipped(inner)
+}
+
+#[derive(Clone)]
+pub struct Clipped<P>(P);
+
+impl<P: TypedValueParser> TypedValueParser for Clipped<P> {
+    type Value = P::Value;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<Self::Value, clap::Error> {
+        let mut err = match self.0.parse_ref(cmd, arg, value) {
+            Ok(v) => return Ok(v),
+            Err(e) => e,
+        };
+        let text = value.to_string_lossy();
+        if text.chars().count() > ECHO_CHARS {
+            // The error's context names the value in full; put the clipped one in its place.
+            err.insert(ContextKind::InvalidValue, ContextValue::String(clip(&text)));
+        }
+        Err(err)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        self.0.possible_values()
+    }
+}
+
+/// A value of `E`, refused with the list of its values ("use a, b or c").
+pub fn choice<E: ValueEnum + Clone + Send + Sync + 'static>() -> Choice<E> {
+    Choice(std::marker::PhantomData)
+}
+
+#[derive(Clone)]
+pub struct Choice<E>(std::marker::PhantomData<E>);
+
+impl<E: ValueEnum + Clone + Send + Sync + 'static> TypedValueParser for Choice<E> {
+    type Value = E;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<E, clap::Error> {
+        if let Some(v) = value.to_str().and_then(|s| E::from_str(s, false).ok()) {
+            return Ok(v);
+        }
+        let names: Vec<String> = E::value_variants()
+            .iter()
+            .filter_map(ValueEnum::to_possible_value)
+            .map(|p| p.get_name().to_string())
+            .collect();
+        let list = match names.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+            _ => names.concat(),
+        };
+        let arg = arg.map_or_else(|| "the value".to_string(), |a| format!("'{a}'"));
+        let message = format!("invalid value '{}' for {arg}: use {list}\n", clip(&value.to_string_lossy()));
+        Err(clap::Error::raw(ErrorKind::InvalidValue, message).with_cmd(cmd))
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new(E::value_variants().iter().filter_map(ValueEnum::to_possible_value)))
+    }
+}
+
+/// The built-in cell names, for messages.
+fn builtin_names() -> String {
+    let names: Vec<&str> = REFERENCE_CELL_FILES.iter().map(|(n, _)| *n).collect();
+    names.join(", ")
+}
+
+/// A built-in cell by name (any case), or a cell file ending in `.toml`.
+fn parse_cell(s: &str) -> Result<Cell, String> {
+    if let Some(cell) = reference_cell(s) {
+        return Ok(cell);
+    }
+    if !s.to_ascii_lowercase().ends_with(".toml") {
+        return Err(format!("not a built-in cell ({}) nor a .toml cell file", builtin_names()));
+    }
+    Cell::from_file(std::path::Path::new(s)).map_err(|e| e.to_string())
+}
+
+/// As [`parse_cell`], or `all` for the three built-in cells.
+fn parse_cells(s: &str) -> Result<Cells, String> {
+    if s.eq_ignore_ascii_case("all") {
+        return Ok(Cells(REFERENCE_CELL_FILES.iter().filter_map(|(n, _)| reference_cell(n)).collect()));
+    }
+    parse_cell(s).map(|c| Cells(vec![c])).map_err(|e| format!("{e}; or all"))
+}
+
+/// A number of type `T`.
+fn parse_number<T: std::str::FromStr>(s: &str) -> Result<T, String>
+where
+    T::Err: std::fmt::Display,
+{
+    s.trim().parse().map_err(|e| format!("not a number of the expected kind ({e})"))
+}
+
+/// The seed of xorshift64*, which stays at 0 forever from 0.
+fn parse_seed(s: &str) -> Result<u64, String> {
+    match parse_number::<u64>(s)? {
+        0 => Err("the seed must not be 0 (the generator would stay at 0)".into()),
+        v => Ok(v),
+    }
+}
+
+/// A k that the table format holds: a power of two from 2 to `2^MAX_LEVELS`.
+fn parse_k(s: &str) -> Result<u32, String> {
+    let max = 1u32 << MAX_LEVELS;
+    let fix = format!("k must be a power of two from 2 to {max} (the table format holds at most {MAX_LEVELS} levels)");
+    match s.trim().parse::<u32>() {
+        Ok(k) if k >= 2 && k <= max && k.is_power_of_two() => Ok(k),
+        _ => Err(fix),
+    }
+}
+
+/// A side of a picture in pixels, from `min` to 8192.
+fn pixels(min: u32) -> impl TypedValueParser<Value = u32> {
+    move |s: &str| -> Result<u32, String> {
+        match parse_number::<u32>(s)? {
+            v if (min..=MAX_SIDE).contains(&v) => Ok(v),
+            _ => Err(format!("this picture needs at least {min} and at most {MAX_SIDE} pixels")),
+        }
+    }
+}
+
+/// Three comma-separated numbers `x,y,z`.
+fn parse_xyz(s: &str) -> Result<Vec3, String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|f| f.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| "expected three numbers x,y,z (mm, the robot's own MCS), e.g. 150,0,-450".to_string())?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
+        [_, _, _] => Err("the coordinates must be finite".into()),
+        _ => Err(format!("expected three numbers x,y,z, got {}", v.len())),
+    }
+}
+
+/// `N` comma-separated grid indices.
+fn parse_indices<const N: usize>(s: &str) -> Result<[u16; N], String> {
+    let v: Vec<u16> = s.split(',').map(|f| f.trim().parse::<u16>()).collect::<Result<_, _>>().unwrap_or_default();
+    <[u16; N]>::try_from(v).map_err(|_| format!("expected {N} grid indices (whole numbers from 0) separated by commas"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn clip_cuts_long_input_on_a_char_boundary() {
+        assert_eq!(clip("1,2,3"), "1,2,3");
+        let long = "é".repeat(100);
+        assert_eq!(clip(&long), format!("{}...", "é".repeat(ECHO_CHARS)));
+    }
+}
