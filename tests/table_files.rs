@@ -104,7 +104,7 @@ fn magic_endianness_version_and_cell_give_their_errors() {
     b[12..16].copy_from_slice(&2u32.to_le_bytes());
     assert_eq!(from_bytes(&b).unwrap_err(), TableError::UnsupportedVersion { found: 2, supported: format::VERSION });
     let e = from_bytes_for_cell(&good, 42).unwrap_err();
-    assert_eq!(e, TableError::WrongCell { expected: 42, found: FINGERPRINT });
+    assert_eq!(e, TableError::WrongCell { expected: 42, found: FINGERPRINT, differs: None });
     let msg = e.to_string();
     assert!(msg.contains("0x0123456789abcdef") && msg.contains("delta-collide build --cell"), "{msg}");
     let mut b = good.clone();

@@ -147,10 +147,19 @@ impl Cell {
     /// Reads and validates a TOML cell file.
     ///
     /// # Errors
-    /// [`CellError::Io`] when the file cannot be read, else as [`parse_cell`].
+    /// [`CellError::Io`] when the file cannot be read, [`CellError::Parse`] when it is not
+    /// UTF-8 text, else as [`parse_cell`].
     #[cfg(feature = "std")]
     pub fn from_file(path: &std::path::Path) -> Result<Cell, CellError> {
-        let text = std::fs::read_to_string(path).map_err(|e| CellError::Io(format!("{}: {e}", path.display())))?;
+        let bytes = std::fs::read(path).map_err(|e| CellError::Io(format!("{}: {e}", path.display())))?;
+        // A file that was read but is not text is a parse error (not TOML), not an I/O error.
+        let text = String::from_utf8(bytes).map_err(|e| {
+            CellError::Parse(format!(
+                "{}: not UTF-8 text (byte {} is invalid), so not TOML",
+                path.display(),
+                e.utf8_error().valid_up_to()
+            ))
+        })?;
         parse_cell(&text)
     }
 
@@ -185,32 +194,61 @@ impl Cell {
         pairs
     }
 
-    /// A 64-bit FNV-1a hash of everything that decides a collision (geometry, boxes,
-    /// margins, placements; not names or the SAT method): tables record it to refuse being
-    /// used with another cell.
-    pub fn fingerprint(&self) -> u64 {
-        let mut bytes = Vec::new();
-        let mut eat = |v: Real| bytes.extend_from_slice(&v.to_le_bytes());
-        eat(self.robots.len() as Real);
-        for r in &self.robots {
+    /// Every value that decides a collision (geometry, boxes, margins, placements; not names
+    /// or the SAT method), named as a cell file names it, in a fixed order. An absent optional
+    /// box is the single value -1. `-0.0` is written as `0.0`: the two describe the same cell,
+    /// and their bits differ.
+    ///
+    /// Tables store these values, so that a table refused for another cell can name the field
+    /// that differs.
+    pub fn parameters(&self) -> Vec<(String, Real)> {
+        let mut out = Vec::new();
+        let mut put = |name: String, v: Real| out.push((name, v + 0.0));
+        put("robots".into(), self.robots.len() as Real);
+        for (i, r) in self.robots.iter().enumerate() {
             let (d, o, p) = (&r.model.delta, &r.model.options, &r.placement);
-            for v in [d.f, d.rf, d.re, d.e, d.theta_min, d.theta_max, o.half_height, o.half_depth, o.margin] {
-                eat(v);
+            let geometry = [("f", d.f), ("rf", d.rf), ("re", d.re), ("e", d.e)];
+            for (key, v) in geometry.into_iter().chain([("theta_min", d.theta_min), ("theta_max", d.theta_max)]) {
+                put(format!("robot {i}: geometry.{key}"), v);
+            }
+            for (key, v) in [("half_height", o.half_height), ("half_depth", o.half_depth), ("margin", o.margin)] {
+                put(format!("robot {i}: model.{key}"), v);
             }
             let (uh, ud) = o.upper_links.unwrap_or((-1.0, -1.0));
-            eat(uh);
-            eat(ud);
-            for b in [o.platform, o.tool] {
+            put(format!("robot {i}: model.upper_links.half_height"), uh);
+            put(format!("robot {i}: model.upper_links.half_depth"), ud);
+            for (key, b) in [("platform", o.platform), ("tool", o.tool)] {
                 match b {
-                    Some(b) => b.offset.iter().chain(b.half.iter()).for_each(|&v| eat(v)),
-                    None => eat(-1.0),
+                    Some(b) => {
+                        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                            put(format!("robot {i}: model.{key}.offset.{axis}"), b.offset[k]);
+                        }
+                        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                            put(format!("robot {i}: model.{key}.half.{axis}"), b.half[k]);
+                        }
+                    }
+                    None => put(format!("robot {i}: model.{key} (absent)"), -1.0),
                 }
             }
-            eat(p.alpha);
-            p.t.iter().for_each(|&v| eat(v));
+            put(format!("robot {i}: placement.alpha"), p.alpha);
+            for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                put(format!("robot {i}: placement.translation.{axis}"), p.t[k]);
+            }
         }
-        fnv1a64(&bytes)
+        out
     }
+
+    /// A 64-bit FNV-1a hash of [`Cell::parameters`]' values: tables record it to refuse
+    /// being used with another cell.
+    pub fn fingerprint(&self) -> u64 {
+        fingerprint_of(self.parameters().iter().map(|(_, v)| *v))
+    }
+}
+
+/// The fingerprint of a list of cell parameter values (see [`Cell::fingerprint`]).
+pub fn fingerprint_of(values: impl Iterator<Item = Real>) -> u64 {
+    let bytes: Vec<u8> = values.flat_map(|v| (v + 0.0).to_le_bytes()).collect();
+    fnv1a64(&bytes)
 }
 
 /// FNV-1a 64 of `bytes` (cell fingerprints, table checksums).

@@ -5,8 +5,8 @@
 //! robot B's TCP in B's MCS. Each robot's TCP space is cut into cubic grid cells of side `r`
 //! aligned with the quadtree leaves; a sample is a cell centre.
 //!
-//! Without the `std` feature only the workspace, the sampling grid and the label types are
-//! here (a table query needs the grid); labelling, certification and symmetry need `std`.
+//! Without the `std` feature only the workspace, the sampling grid, the symmetry test and the
+//! label types are here (loading a table needs them); labelling and certification need `std`.
 
 #[cfg(feature = "std")]
 pub mod certify;
@@ -17,7 +17,6 @@ pub mod interval;
 #[cfg(feature = "std")]
 pub mod label;
 pub mod sampler;
-#[cfg(feature = "std")]
 pub mod symmetry;
 
 use alloc::vec::Vec;

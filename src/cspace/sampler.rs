@@ -44,6 +44,14 @@ impl Workspace {
     /// The thesis's values: Zu 365, Hcy 135, Rcy 225, Hco 30, Rco 173.
     pub const THESIS: Workspace = Workspace { zu: 365.0, hcy: 135.0, rcy: 225.0, hco: 30.0, rco: 173.0 };
 
+    /// The workspace the tables of `cell` sample: thesis 3.2.2's, for every cell. The CLI
+    /// builds with it and [`crate::table::TableChecker`] refuses a table that records another,
+    /// since a wider workspace in a header would make cells that the table never labelled
+    /// look sampled.
+    pub fn for_cell(_cell: &crate::cell::Cell) -> Workspace {
+        Workspace::THESIS
+    }
+
     /// The deepest depth of the workspace, `Zu + Hcy + Hco`.
     pub fn max_depth(&self) -> Real {
         self.zu + self.hcy + self.hco

@@ -18,8 +18,8 @@
 
 use crate::cell::Cell;
 use crate::cspace::sampler::{CellIndex, SampleGrid};
-use crate::math::Real;
-use std::f64::consts::PI;
+use crate::math::{float, Real};
+use core::f64::consts::PI;
 
 /// How far `alpha` may be from 0 or pi (rad) and still count as symmetric.
 pub const ALPHA_TOLERANCE: Real = 1e-12;
@@ -29,8 +29,8 @@ pub const ALPHA_TOLERANCE: Real = 1e-12;
 pub fn reflection_y(cell: &Cell) -> bool {
     cell.robots.iter().all(|r| {
         let p = &r.placement;
-        let a = p.alpha.rem_euclid(2.0 * PI);
-        let alpha_ok = a.min(2.0 * PI - a) <= ALPHA_TOLERANCE || (a - PI).abs() <= ALPHA_TOLERANCE;
+        let a = float::rem_euclid(p.alpha, 2.0 * PI);
+        let alpha_ok = a.min(2.0 * PI - a) <= ALPHA_TOLERANCE || (a - PI).max(PI - a) <= ALPHA_TOLERANCE;
         let extras_ok = [r.model.options.platform, r.model.options.tool].iter().flatten().all(|b| b.offset.y == 0.0);
         p.t.y == 0.0 && alpha_ok && extras_ok
     })

@@ -150,7 +150,7 @@ mod tests {
             TableError::UnsupportedVersion { found: 2, supported: 1 },
             TableError::WrongEndianness,
             TableError::Corrupt { what: "checksum".into() },
-            TableError::WrongCell { expected: 1, found: 2 },
+            TableError::WrongCell { expected: 1, found: 2, differs: None },
             TableError::BadInput { what: "three robots".into() },
         ];
         let statuses: Vec<DcStatus> = errors.iter().map(table_error_status).collect();

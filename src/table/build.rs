@@ -152,5 +152,5 @@ pub fn build_tables(
         })
         .collect::<Result<Vec<_>, _>>()?;
     report.build_secs = start.elapsed().as_secs_f64();
-    Ok((Header::for_space(&space, cell.fingerprint(), *ws, certification), tables, report))
+    Ok((Header::for_cell(&space, cell, *ws, certification), tables, report))
 }

@@ -42,6 +42,8 @@ pub enum TableError {
         expected: u64,
         /// The fingerprint recorded in the table.
         found: u64,
+        /// The first parameter that differs, when the table recorded its cell's parameters.
+        differs: Option<String>,
     },
     /// The labelled space or the parameters given to a builder are not usable.
     BadInput {
@@ -76,11 +78,16 @@ impl core::fmt::Display for TableError {
             TableError::Corrupt { what } => {
                 write!(f, "table is corrupt: {what}; rebuild it with `delta-collide build` or copy it again")
             }
-            TableError::WrongCell { expected, found } => write!(
-                f,
-                "table was built for cell {found:#018x}, this controller is configured for \
-                 {expected:#018x}; rebuild with `delta-collide build --cell ...` for this cell"
-            ),
+            TableError::WrongCell { expected, found, differs } => {
+                write!(
+                    f,
+                    "table was built for cell {found:#018x}, this controller is configured for {expected:#018x}"
+                )?;
+                if let Some(d) = differs {
+                    write!(f, " ({d})")?;
+                }
+                write!(f, "; rebuild with `delta-collide build --cell ...` for this cell")
+            }
             TableError::BadInput { what } => write!(f, "cannot build a table: {what}"),
         }
     }

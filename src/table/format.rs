@@ -18,7 +18,10 @@
 //!    104   40  workspace Zu, Hcy, Rcy, Hco, Rco (mm)
 //!    144    8  margin (mm)  152  4  certification kind       156  4  reserved, 0
 //!    160   24  element counts of sections 0, 1, 2 (u64 each)
-//!    184       section 0: codes, u64 each
+//!    184    8  n, the number of cell parameters
+//!    192   8n  the cell's parameter values (`Cell::parameters`, f64 each), so that a table
+//!              refused for another cell names the field that differs
+//!              section 0: codes, u64 each
 //!              section 1: 5D offsets (m + 1) / 4D slice index per code, u32 each; 6D none
 //!              section 2: 5D intervals [begin, end] u8 pairs / 4D slice words u64; 6D none
 //!              variant 7: section 0 = node masks [nonuniform, collision] then leaves (u64);
@@ -45,7 +48,7 @@ use alloc::{format, vec, vec::Vec};
 /// The first eight bytes of every table.
 pub const MAGIC: [u8; 8] = *b"DCTABLE\0";
 /// The format version written and read.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 const ENDIAN_MARK: u32 = 0x0102_0304;
 const HEADER_LEN: usize = 184;
 
@@ -78,6 +81,9 @@ pub struct Header {
     pub margin: f64,
     /// How the margin was obtained.
     pub certification: Certification,
+    /// The values of `Cell::parameters` of the cell the table was built for (their hash is
+    /// `cell_fingerprint`); empty when the builder did not record them.
+    pub cell_parameters: Vec<f64>,
 }
 
 impl Header {
@@ -98,6 +104,21 @@ impl Header {
             workspace,
             margin: space.margin,
             certification,
+            cell_parameters: Vec::new(),
+        }
+    }
+
+    /// The header for `cell`: its fingerprint and parameter values recorded.
+    #[cfg(feature = "std")]
+    pub fn for_cell(
+        space: &LabelledSpace,
+        cell: &crate::cell::Cell,
+        workspace: Workspace,
+        certification: Certification,
+    ) -> Header {
+        Header {
+            cell_parameters: cell.parameters().into_iter().map(|(_, v)| v).collect(),
+            ..Header::for_space(space, cell.fingerprint(), workspace, certification)
         }
     }
 
@@ -109,8 +130,30 @@ impl Header {
         if self.cell_fingerprint == expected {
             Ok(())
         } else {
-            Err(TableError::WrongCell { expected, found: self.cell_fingerprint })
+            Err(TableError::WrongCell { expected, found: self.cell_fingerprint, differs: None })
         }
+    }
+
+    /// Checks that the table was built for `cell`, naming the first parameter that differs
+    /// when the table recorded its cell's parameters.
+    ///
+    /// # Errors
+    /// [`TableError::WrongCell`] when the fingerprints differ.
+    pub fn check_cell_parameters(&self, cell: &crate::cell::Cell) -> Result<(), TableError> {
+        let expected = cell.fingerprint();
+        if self.cell_fingerprint == expected {
+            return Ok(());
+        }
+        let ours = cell.parameters();
+        let stored = &self.cell_parameters;
+        let differs = if stored.is_empty() {
+            None
+        } else if let Some(((name, v), t)) = ours.iter().zip(stored).find(|((_, v), t)| v.to_bits() != t.to_bits()) {
+            Some(format!("{name} is {t} in the table's cell and {v} in this one"))
+        } else {
+            Some(format!("the table's cell has {} parameters, this one {}", stored.len(), ours.len()))
+        };
+        Err(TableError::WrongCell { expected, found: self.cell_fingerprint, differs })
     }
 }
 
@@ -157,9 +200,10 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
     }
     out.extend_from_slice(&(header.certification as u32).to_le_bytes());
     out.extend_from_slice(&0u32.to_le_bytes());
-    for n in [s0.len(), s1.len(), n2] {
+    for n in [s0.len(), s1.len(), n2, header.cell_parameters.len()] {
         out.extend_from_slice(&(n as u64).to_le_bytes());
     }
+    header.cell_parameters.iter().for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
     s0.iter().for_each(|c| out.extend_from_slice(&c.to_le_bytes()));
     s1.iter().for_each(|c| out.extend_from_slice(&c.to_le_bytes()));
     out.extend_from_slice(&s2);
@@ -278,7 +322,55 @@ fn read_header(r: &mut Reader) -> Result<Header, TableError> {
         return Err(corrupt(format!("r = {grid_r} must be > 0 and margin = {margin} >= 0")));
     }
     let workspace = Workspace { zu: ws[0], hcy: ws[1], rcy: ws[2], hco: ws[3], rco: ws[4] };
-    Ok(Header { cell_fingerprint, r: grid_r, origin_a, origin_b, workspace, margin, certification })
+    let cell_parameters = Vec::new();
+    Ok(Header { cell_fingerprint, r: grid_r, origin_a, origin_b, workspace, margin, certification, cell_parameters })
+}
+
+/// A symmetric table stores only A's half `iy >= k/2` (thesis 3.2.8) and folds every query
+/// into it. A code (or a root child of the shared tree) wholly in the other half is never
+/// read, so a file that holds one was not written by a symmetric build: refuse it.
+///
+/// Codes put dimension 1 (`iy`) in the top level's group at index bit `D - 2` (`code.rs`);
+/// a 6-D group that is the bare mark (the root, condensed) spans both halves. 4D/yy' tables
+/// have no `iy` in their codes: their slices start at row `k/2` by construction.
+fn check_unstored_half(shape: &Shape, words: &[u64]) -> Result<(), TableError> {
+    let top = |stride: u32, c: u64| (c >> (stride * (shape.levels - 1))) & ((1 << stride) - 1);
+    let lower = |i: usize| corrupt(format!("symmetric table has codes[{i}] in the half it does not store (iy < k/2)"));
+    match shape.variant {
+        6 => match words.iter().position(|&c| top(7, c) != super::code::MARK && top(7, c) & 1 << 4 == 0) {
+            Some(i) => Err(lower(i)),
+            None => Ok(()),
+        },
+        5 => words.iter().position(|&c| top(5, c) & 1 << 3 == 0).map_or(Ok(()), |i| Err(lower(i))),
+        4 if shape.axes == 2 => words.iter().position(|&c| top(4, c) & 1 << 2 == 0).map_or(Ok(()), |i| Err(lower(i))),
+        7 => {
+            // The root's 64 children, child index `bx << 5 | by << 4 | ...`: those with by = 0.
+            let lower_children = (0..64u64).filter(|c| c >> 4 & 1 == 0).fold(0u64, |m, c| m | 1 << c);
+            match words.get(..2) {
+                Some(&[nonuniform, collision]) if (nonuniform | collision) & lower_children != 0 => {
+                    Err(corrupt("symmetric shared table has root children in the half it does not store (iy < k/2)"))
+                }
+                _ => Ok(()),
+            }
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Most cell parameters a table records: 32 robots of at most 30 values, with room to spare.
+const MAX_CELL_PARAMETERS: u64 = 4096;
+
+/// The cell parameter values; when present, their fingerprint must be the recorded one.
+fn read_cell_parameters(r: &mut Reader, fingerprint: u64) -> Result<Vec<f64>, TableError> {
+    let n = r.u64("cell parameter count")?;
+    if n > MAX_CELL_PARAMETERS {
+        return Err(corrupt(format!("cell parameter count = {n} exceeds {MAX_CELL_PARAMETERS}")));
+    }
+    let values = (0..n).map(|_| r.f64("cell parameter")).collect::<Result<Vec<_>, _>>()?;
+    if !values.is_empty() && crate::cell::fingerprint_of(values.iter().copied()) != fingerprint {
+        return Err(corrupt("cell parameters do not give the recorded cell fingerprint"));
+    }
+    Ok(values)
 }
 
 fn words<const N: usize, T>(bytes: &[u8], f: impl Fn([u8; N]) -> T) -> Vec<T> {
@@ -294,8 +386,9 @@ fn words<const N: usize, T>(bytes: &[u8], f: impl Fn([u8; N]) -> T) -> Vec<T> {
 pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
     let mut r = Reader { buf: bytes, pos: 0 };
     let shape = read_prefix(&mut r)?;
-    let header = read_header(&mut r)?;
+    let mut header = read_header(&mut r)?;
     let counts = [r.u64("section 0 count")?, r.u64("section 1 count")?, r.u64("section 2 count")?];
+    header.cell_parameters = read_cell_parameters(&mut r, header.cell_fingerprint)?;
     let sizes: [usize; 3] = match shape.variant {
         6 => [8, 4, 0],
         5 => [8, 4, 2],
@@ -323,6 +416,9 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
     }
     let codes = words(sections[0], u64::from_le_bytes);
     let aux = words(sections[1], u32::from_le_bytes);
+    if shape.symmetric {
+        check_unstored_half(&shape, &codes)?;
+    }
     let table = match shape.variant {
         6 => Table::D6(LinearQuadtree6d::from_parts(shape.levels, shape.symmetric, codes)?),
         5 => {

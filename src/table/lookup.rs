@@ -7,10 +7,12 @@
 //! [`TableChecker::fallbacks`]), so the answer is never a guess. Nothing allocates per tick.
 
 use crate::cell::{Cell, ExactChecker, QueryError};
+use crate::cspace::symmetry::reflection_y;
 use crate::cspace::SampleGrid;
+use crate::cspace::Workspace;
 use crate::math::{float, Vec3};
 use crate::robot::RobotModel;
-use crate::table::format::from_bytes_for_cell;
+use crate::table::format::from_bytes;
 use crate::table::{Header, Table, TableError};
 use alloc::{format, vec, vec::Vec};
 
@@ -23,6 +25,32 @@ pub enum TableAnswer {
     Collision,
     /// Bit j set: robot j's TCP is unreachable or not finite.
     Unreachable(u32),
+}
+
+/// Refuses a table whose header disagrees with what the cell determines: the workspace its
+/// grids sample and whether only the mirror-symmetric half is stored. Both change answers, and
+/// a header edited with its checksum recomputed passes every other check.
+fn check_determined_by_cell(header: &Header, table: &Table, cell: &Cell) -> Result<(), TableError> {
+    let fingerprint = cell.fingerprint();
+    let wrong =
+        |differs: String| TableError::WrongCell { expected: fingerprint, found: fingerprint, differs: Some(differs) };
+    let (w, ours) = (&header.workspace, Workspace::for_cell(cell));
+    let fields = [("zu", w.zu, ours.zu), ("hcy", w.hcy, ours.hcy), ("rcy", w.rcy, ours.rcy), ("hco", w.hco, ours.hco)];
+    for (name, theirs, ours) in fields.into_iter().chain([("rco", w.rco, ours.rco)]) {
+        if theirs.to_bits() != ours.to_bits() {
+            return Err(wrong(format!("workspace.{name} is {theirs} mm in the table and {ours} mm for this cell")));
+        }
+    }
+    let symmetric = reflection_y(cell);
+    if table.symmetric() != symmetric {
+        let says = |s: bool| if s { "mirror-symmetric" } else { "not mirror-symmetric" };
+        return Err(wrong(format!(
+            "the table is stored as {} and the cell is {}",
+            says(table.symmetric()),
+            says(symmetric)
+        )));
+    }
+    Ok(())
 }
 
 /// Which cells of one robot's grid were sampled: a dense bitmap over the `k^3` cells.
@@ -79,7 +107,9 @@ impl TableChecker {
                 what: format!("tables serve two-robot cells; this one has {}", cell.robots.len()),
             });
         }
-        let (header, table) = from_bytes_for_cell(bytes, cell.fingerprint())?;
+        let (header, table) = from_bytes(bytes)?;
+        header.check_cell_parameters(&cell)?;
+        check_determined_by_cell(&header, &table, &cell)?;
         let k = 1u32 << table.levels();
         let grid = |j: usize| {
             SampleGrid::new(&header.workspace, k, &cell.robots[j].model.delta)
