@@ -42,6 +42,10 @@ fn header(s: &LabelledSpace) -> Header {
     Header::for_space(s, FINGERPRINT, Workspace::THESIS, Certification::SweptBound)
 }
 
+/// Where the sections start in these files: after the 184-byte header and the parameter
+/// count, with no cell parameters recorded (`src/table/format.rs`).
+const SECTIONS: usize = 192;
+
 /// Recomputes the checksum after a deliberate edit, so that only the field check can object.
 fn reseal(bytes: &mut [u8]) {
     let n = bytes.len() - 8;
@@ -101,8 +105,8 @@ fn magic_endianness_version_and_cell_give_their_errors() {
     b[8..12].copy_from_slice(&0x0102_0304u32.to_be_bytes());
     assert_eq!(from_bytes(&b).unwrap_err(), TableError::WrongEndianness);
     let mut b = good.clone();
-    b[12..16].copy_from_slice(&2u32.to_le_bytes());
-    assert_eq!(from_bytes(&b).unwrap_err(), TableError::UnsupportedVersion { found: 2, supported: format::VERSION });
+    b[12..16].copy_from_slice(&1u32.to_le_bytes());
+    assert_eq!(from_bytes(&b).unwrap_err(), TableError::UnsupportedVersion { found: 1, supported: format::VERSION });
     let e = from_bytes_for_cell(&good, 42).unwrap_err();
     assert_eq!(e, TableError::WrongCell { expected: 42, found: FINGERPRINT, differs: None });
     let msg = e.to_string();
@@ -119,7 +123,7 @@ fn corrupted_files(s: &LabelledSpace) -> Vec<(&'static str, Vec<u8>, &'static st
     let mut out = Vec::new();
     // 6D: the first two codes swapped.
     let mut b = to_bytes(&ts[0], &header(s));
-    let (a, c) = (184, 192);
+    let (a, c) = (SECTIONS, SECTIONS + 8);
     let first: [u8; 8] = b[a..a + 8].try_into().unwrap();
     b.copy_within(c..c + 8, a);
     b[c..c + 8].copy_from_slice(&first);
@@ -128,21 +132,21 @@ fn corrupted_files(s: &LabelledSpace) -> Vec<(&'static str, Vec<u8>, &'static st
     // 4D: the first slice index set past the slice count.
     let mut b = to_bytes(&ts[3], &header(s));
     let m = u64::from_le_bytes(b[160..168].try_into().unwrap()) as usize;
-    let at = 184 + 8 * m;
+    let at = SECTIONS + 8 * m;
     b[at..at + 4].copy_from_slice(&1000u32.to_le_bytes());
     reseal(&mut b);
     out.push(("slice_index_out_of_range_4d.dctable", b, "slice_of[0]"));
     // 5D: the first interval's end set to k.
     let mut b = to_bytes(&ts[2], &header(s));
     let m = u64::from_le_bytes(b[160..168].try_into().unwrap()) as usize;
-    let at = 184 + 8 * m + 4 * (m + 1);
+    let at = SECTIONS + 8 * m + 4 * (m + 1);
     b[at + 1] = 4;
     reseal(&mut b);
     out.push(("interval_beyond_k_5d.dctable", b, "intervals[0]"));
     // Shared 6-D: the first child index set past the nodes of its depth.
     let mut b = to_bytes(&ts[5], &header(s));
     let count = |i: usize| u64::from_le_bytes(b[160 + 8 * i..168 + 8 * i].try_into().unwrap()) as usize;
-    let at = 184 + 8 * count(0) + 4 * count(1);
+    let at = SECTIONS + 8 * count(0) + 4 * count(1);
     b[at..at + 4].copy_from_slice(&60_000u32.to_le_bytes());
     reseal(&mut b);
     out.push(("child_index_out_of_range_shared.dctable", b, "child index"));
