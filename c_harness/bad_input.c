@@ -377,6 +377,98 @@ static void bad_tables(const HarnessOptions *options, const DcCellConfig *t1_con
     }
 }
 
+/* Expects dc_init to refuse `config` with INVALID_CONFIG and a message naming `field`. */
+static void expect_init_naming(const char *what, const DcCellConfig *config, const char *field)
+{
+    char message[512];
+    expect_init(what, config, DC_STATUS_INVALID_CONFIG);
+    check(dc_last_init_error(message, sizeof message) > 0 && strstr(message, field) != NULL,
+          "fail closed, %s: message \"%s\" does not name %s", what, message, field);
+}
+
+/* One query that must answer OK and COLLISION. */
+static void expect_collision(const char *what, DcCollider *h, const DcVec3 *tcps)
+{
+    DcVerdict v = DC_VERDICT_FREE;
+    DcStatus s = dc_query(h, tcps, 2, &v, NULL);
+    check(s == DC_STATUS_OK && v == DC_VERDICT_COLLISION, "fail closed, %s: status %u (%s), verdict %u, expected OK and "
+          "COLLISION", what, (unsigned)s, dc_status_str(s), (unsigned)v);
+}
+
+/* The cases of an adversarial review that answered FREE, or took a bad input, where they must
+ * not: a singular pose (lower link 0 along its motor axis), huge finite configuration values,
+ * -0.0 as another cell, and a binary file given as a cell file. */
+static void fail_closed(const HarnessOptions *options, const DcCellConfig *config, const DcRobotConfig *robots)
+{
+    DcRobotConfig r[MR_MAX_ROBOTS];
+    DcCellConfig c = *config;
+    DcCollider *h = NULL;
+    DcStatus s;
+    DcVec3 t[2];
+    char path[512];
+    FILE *f;
+    static const unsigned char binary[] = { 0x7f, 'E', 'L', 'F', 0xff, 0xfe, 0x00, 0x01, 0xc3, 0x28 };
+
+    /* (60, 400, -150): y = re exactly and hypot(a, c) = rf, reachable with link 0 along t_0. */
+    t[0] = vec3(60.0, 400.0, -150.0);
+    t[1] = vec3(-258.41263562619667, 256.22158467793497, -152.07408585805371);
+    s = dc_init(config, &h);
+    check(s == DC_STATUS_OK, "fail closed: dc_init T1: %s", dc_status_str(s));
+    if (h != NULL) {
+        expect_collision("singular pose, exact mode", h, t);
+        t[0].z = -150.000001;
+        expect_collision("next to the singular pose, exact mode", h, t);
+        t[0].z = -150.0;
+        dc_destroy(h);
+        h = NULL;
+    }
+    if (options->tables[0].bytes != NULL) {
+        s = dc_init_with_table(config, options->tables[0].bytes, options->tables[0].len, &h);
+        check(s == DC_STATUS_OK, "fail closed: dc_init_with_table T1: %s", dc_status_str(s));
+        if (h != NULL) {
+            /* Outside the table's grid: the exact fallback answers. */
+            expect_collision("singular pose, table mode", h, t);
+            dc_destroy(h);
+            h = NULL;
+        }
+        /* -0.0 is the same cell as 0.0. */
+        memcpy(r, robots, sizeof r);
+        r[1].translation.y = -0.0;
+        r[0].translation.x = -0.0;
+        c.robots = r;
+        s = dc_init_with_table(&c, options->tables[0].bytes, options->tables[0].len, &h);
+        check(s == DC_STATUS_OK, "fail closed: T1 with translation.y = -0.0 refused its table: %s",
+              dc_status_str(s));
+        dc_destroy(h);
+        h = NULL;
+    }
+
+    /* Huge finite values overflowed the bounding boxes into NaN: refused, the field named. */
+    memcpy(r, robots, sizeof r);
+    c.robots = r;
+    r[0].translation.x = 1e308;
+    r[1].translation.x = 1e308;
+    expect_init_naming("translation.x = 1e308", &c, "translation.x");
+    memcpy(r, robots, sizeof r);
+    r[0].margin = 1.5e308;
+    expect_init_naming("margin = 1.5e308", &c, "margin");
+    memcpy(r, robots, sizeof r);
+    r[1].geometry.re = 1e300;
+    expect_init_naming("re = 1e300", &c, "parameter re = ");
+    memcpy(r, robots, sizeof r);
+    r[1].half_height = 2e6;
+    expect_init_naming("half_height = 2e6", &c, "half_height");
+
+    /* A file that is not text is not TOML: DC_STATUS_PARSE, as documented, not DC_STATUS_IO. */
+    sprintf(path, "%.400s/c_harness_binary_cell.toml", options->tmp_dir);
+    f = fopen(path, "wb");
+    check(f != NULL && fwrite(binary, 1, sizeof binary, f) == sizeof binary && fclose(f) == 0, "cannot write %s",
+          path);
+    expect_init_file("binary cell file", path, DC_STATUS_PARSE);
+    remove(path);
+    printf("fail closed: done\n");
+}
+
 void bad_input(const HarnessOptions *options)
 {
     MrCell cell;
@@ -404,6 +496,7 @@ void bad_input(const HarnessOptions *options)
               && dc_table_fallbacks(NULL) == 0,
           "bad input: counts and mode of a NULL handle are not 0 / DC_MODE_NONE");
     bad_configs(options, &config, robots);
+    fail_closed(options, &config, robots);
     if (options->tables[0].bytes != NULL) {
         bad_tables(options, &config);
     } else {

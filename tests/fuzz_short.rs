@@ -238,6 +238,7 @@ fn generated_seeds(target: &str) -> Vec<(String, Vec<u8>)> {
     match target {
         "table_bytes" => table_seeds(),
         "cell_toml" => cell_seeds(),
+        "exact_oracle" => targets::exact_oracle::seeds(),
         _ => targets::c_abi::seeds().into_iter().map(|(n, b)| (format!("{n}.bin"), b)).collect(),
     }
 }

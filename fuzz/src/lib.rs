@@ -10,20 +10,24 @@
 //! | [`table_bytes`] | a table file | `table::from_bytes`, `TableChecker::new`, queries |
 //! | [`cell_toml`] | a cell file | `cell::parse_cell`, `ExactChecker`, the same cell through `dc_init` |
 //! | [`c_abi`] | a call sequence ([`c_abi::Op`]) | every `extern "C"` function, fail-closed outputs |
+//! | [`exact_oracle`] | two TCPs, plain or on a singular family | `ExactChecker` against a frame-free brute force |
 #![deny(unsafe_op_in_unsafe_fn)]
 #![warn(clippy::undocumented_unsafe_blocks)]
 
 pub mod c_abi;
 pub mod cell_toml;
+pub mod exact_oracle;
 pub mod input;
 pub mod table_bytes;
 
 pub use c_abi::c_abi;
 pub use cell_toml::cell_toml;
+pub use exact_oracle::exact_oracle;
 pub use table_bytes::table_bytes;
 
 /// A fuzz target: panics on a finding.
 pub type Target = fn(&[u8]);
 
 /// The targets by name, as `cargo fuzz` and `fuzz/seeds/` name them.
-pub const TARGETS: [(&str, Target); 3] = [("table_bytes", table_bytes), ("cell_toml", cell_toml), ("c_abi", c_abi)];
+pub const TARGETS: [(&str, Target); 4] =
+    [("table_bytes", table_bytes), ("cell_toml", cell_toml), ("c_abi", c_abi), ("exact_oracle", exact_oracle)];
