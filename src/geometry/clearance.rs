@@ -1,0 +1,451 @@
+//! Signed clearance of two oriented boxes, and a certified lower bound on it that costs about
+//! one separating axis test (SPEC §8 "Clearance", §3 boxes).
+//!
+//! # Conventions
+//! Clearance is positive when the boxes are apart (the Euclidean gap), negative when they
+//! intersect (minus the penetration depth: the smallest overlap of the two boxes' projections
+//! over the 15 SAT axes, each normalised, cross products shorter than
+//! [`CROSS_AXIS_MIN_NORM`] left out) and 0 when they touch. The witness points satisfy
+//! `point_b - point_a = distance * n`, with `n` the unit direction from A toward B: the
+//! closest points when apart; when intersecting, a deepest vertex of A along the axis of
+//! least overlap and that vertex moved back by the overlap.
+//!
+//! # Method
+//! Apart: for disjoint convex polytopes the vector `d` between closest points is unique, and
+//! the closest pairs are the intersection of A's supporting face in direction `d` with B's
+//! supporting face in `-d` (moved by `d`). A vertex of that polygon is a vertex of A or of B
+//! (the 16 vertex-to-box distances find it), or the crossing of an edge of A along `A_i` with
+//! an edge of B along `B_j`, both perpendicular to `d`, so `d` is parallel to `A_i x B_j` and
+//! the two edges are the supporting edges of that direction. Hence the 16 vertex distances
+//! and one supporting edge pair per cross axis (9 line-line solves) give the exact distance;
+//! where a sign of the supporting direction is within rounding of 0 (parallel faces), every
+//! edge pair of that axis is tried. Each candidate is a distance between two points of the
+//! boxes, so extra candidates can only leave the minimum unchanged.
+//!
+//! # Numerics
+//! Whether the boxes are apart is decided by the separating axis test's own inequalities
+//! (`sat.rs`, with [`SAT_EPSILON`] and [`SAT_TOUCH_TOLERANCE`]), so "apart" here is exactly
+//! [`separating_axis`](crate::geometry::separating_axis)`.is_some()`; a gap inside that
+//! tolerance reports 0 (touching). The lower bound subtracts the same guards before
+//! normalising, which keeps it below the exact value and makes `bound > 0` imply that the
+//! SAT separates. Any NaN or infinite input gives a NaN distance.
+
+use crate::geometry::obb::Obb;
+use crate::math::{float, Real, Vec3, CROSS_AXIS_MIN_NORM, SAT_EPSILON, SAT_TOUCH_TOLERANCE};
+
+/// Signed clearance of two boxes, with witness points (world frame, mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clearance {
+    /// Gap when positive, minus the penetration depth when negative, 0 when touching.
+    pub distance: Real,
+    /// Witness point on (or, penetrating, of) box A.
+    pub point_a: Vec3,
+    /// Witness point of box B: `point_a + distance * n`, `n` the unit direction A -> B.
+    pub point_b: Vec3,
+}
+
+/// Signed clearance of two robots: the minimum over their box pairs, and which pair.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairClearance {
+    /// The smallest signed clearance over all box pairs (`+inf` when a slice is empty).
+    pub distance: Real,
+    /// Index of the box of the first robot.
+    pub box_a: usize,
+    /// Index of the box of the second robot.
+    pub box_b: usize,
+    /// Witness point on box `a[box_a]`.
+    pub point_a: Vec3,
+    /// Witness point on box `b[box_b]`.
+    pub point_b: Vec3,
+}
+
+/// Relative error allowed for in the lower bound on top of the SAT guards: a few units in
+/// the last place of the largest term of an axis inequality.
+const BOUND_REL_SLACK: Real = 1e-14;
+
+/// A component of a supporting direction this close to 0 (relative to unit axes) may have
+/// the wrong sign after rounding (about 1e-16 here): both signs are then tried.
+const SIGN_TIE: Real = 1e-9;
+
+/// Cross products shorter than this (squared) are parallel edges for the closest-point
+/// solve: the vertex distances cover them (the error is below `|edge| * 1e-10`).
+const PARALLEL_NORM2: Real = 1e-20;
+
+/// B relative to A: `r[i][j] = A_i . B_j`, `t` = `c_B - c_A` in A's frame, `tb` in B's frame.
+/// Computed with the same expressions, in the same order, as `sat.rs`.
+struct Rel {
+    r: [[Real; 3]; 3],
+    t: [Real; 3],
+    tb: [Real; 3],
+    a: [Real; 3],
+    b: [Real; 3],
+}
+
+#[inline(always)]
+fn dot(u: &[Real; 3], v: &[Real; 3]) -> Real {
+    u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+}
+
+#[inline(always)]
+fn rel(a: &Obb, b: &Obb) -> Rel {
+    let (ma, mb) = (&a.axes, &b.axes);
+    let ua: [[Real; 3]; 3] = core::array::from_fn(|i| [ma[(0, i)], ma[(1, i)], ma[(2, i)]]);
+    let ub: [[Real; 3]; 3] = core::array::from_fn(|j| [mb[(0, j)], mb[(1, j)], mb[(2, j)]]);
+    let r: [[Real; 3]; 3] = core::array::from_fn(|i| core::array::from_fn(|j| dot(&ua[i], &ub[j])));
+    let d = [b.center.x - a.center.x, b.center.y - a.center.y, b.center.z - a.center.z];
+    let t = [dot(&ua[0], &d), dot(&ua[1], &d), dot(&ua[2], &d)];
+    let tb = core::array::from_fn(|j| t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j]);
+    Rel { r, t, tb, a: [a.half.x, a.half.y, a.half.z], b: [b.half.x, b.half.y, b.half.z] }
+}
+
+/// Whether every input number is finite (a NaN or an infinity anywhere gives `false`).
+#[inline(always)]
+fn finite(a: &Obb, b: &Obb) -> bool {
+    let s = a.center.sum() + a.axes.sum() + a.half.sum() + b.center.sum() + b.axes.sum() + b.half.sum();
+    (s * 0.0) == 0.0
+}
+
+/// One of the 15 axes as the SAT writes it: `|lhs|` against `rhs`, `norm` its length.
+/// `lhs` is signed (positive when B lies on the axis' positive side).
+#[derive(Clone, Copy)]
+struct AxisTerms {
+    lhs: Real,
+    rhs: Real,
+    rhs_guarded: Real,
+    norm2: Real,
+}
+
+/// The terms of axis `k` (numbered as [`Axis`](crate::geometry::Axis)); `rhs_guarded` is
+/// `sat.rs`'s right-hand side to the last rounding (|R| + SAT_EPSILON, + touch tolerance).
+#[inline(always)]
+fn axis_terms(rel: &Rel, k: usize) -> AxisTerms {
+    let (r, t, a, b) = (&rel.r, &rel.t, &rel.a, &rel.b);
+    let g = |x: Real| x.abs() + SAT_EPSILON;
+    match k {
+        0..=2 => {
+            let i = k;
+            AxisTerms {
+                lhs: t[i],
+                rhs: a[i] + b[0] * r[i][0].abs() + b[1] * r[i][1].abs() + b[2] * r[i][2].abs(),
+                rhs_guarded: a[i] + b[0] * g(r[i][0]) + b[1] * g(r[i][1]) + b[2] * g(r[i][2]) + SAT_TOUCH_TOLERANCE,
+                norm2: 1.0,
+            }
+        }
+        3..=5 => {
+            let j = k - 3;
+            AxisTerms {
+                lhs: rel.tb[j],
+                rhs: a[0] * r[0][j].abs() + a[1] * r[1][j].abs() + a[2] * r[2][j].abs() + b[j],
+                rhs_guarded: a[0] * g(r[0][j]) + a[1] * g(r[1][j]) + a[2] * g(r[2][j]) + b[j] + SAT_TOUCH_TOLERANCE,
+                norm2: 1.0,
+            }
+        }
+        _ => {
+            let (i, j) = ((k - 6) / 3, (k - 6) % 3);
+            let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
+            AxisTerms {
+                lhs: t[i2] * r[i1][j] - t[i1] * r[i2][j],
+                rhs: a[i1] * r[i2][j].abs() + a[i2] * r[i1][j].abs() + b[j1] * r[i][j2].abs() + b[j2] * r[i][j1].abs(),
+                rhs_guarded: a[i1] * g(r[i2][j]) + a[i2] * g(r[i1][j]) + b[j1] * g(r[i][j2]) + b[j2] * g(r[i][j1])
+                    + SAT_TOUCH_TOLERANCE,
+                norm2: r[i1][j] * r[i1][j] + r[i2][j] * r[i2][j],
+            }
+        }
+    }
+}
+
+/// Whether axis `k` takes part in the normalised gaps (face axes always; cross axes when
+/// the cross product is at least [`CROSS_AXIS_MIN_NORM`] long).
+#[inline(always)]
+fn included(k: usize, norm2: Real) -> bool {
+    k < 6 || norm2 >= CROSS_AXIS_MIN_NORM * CROSS_AXIS_MIN_NORM
+}
+
+/// A lower bound on the signed clearance (mm) at about the cost of one separating axis test.
+///
+/// The largest gap between the two boxes' projections over the 15 axes (each normalised;
+/// cross products shorter than [`CROSS_AXIS_MIN_NORM`] left out); when no axis separates,
+/// this is minus the smallest overlap, the exact penetration clearance. It is rounded down
+/// by the SAT's guards, so it never exceeds [`obb_clearance`], and when it is positive
+/// [`separating_axis`](crate::geometry::separating_axis) finds a separating axis. NaN or
+/// infinite input gives NaN.
+#[inline]
+pub fn obb_clearance_lower_bound(a: &Obb, b: &Obb) -> Real {
+    if !finite(a, b) {
+        return Real::NAN;
+    }
+    let rel = rel(a, b);
+    let mut best = Real::NEG_INFINITY;
+    for k in 0..15 {
+        let ax = axis_terms(&rel, k);
+        if !included(k, ax.norm2) {
+            continue;
+        }
+        let diff = ax.lhs.abs() - ax.rhs_guarded;
+        let slack = BOUND_REL_SLACK * (ax.lhs.abs() + ax.rhs_guarded);
+        let gap = if k < 6 { diff - slack } else { (diff - slack) / float::sqrt(ax.norm2) };
+        if gap > best {
+            best = gap;
+        }
+    }
+    best
+}
+
+/// The smallest [`obb_clearance_lower_bound`] over all pairs of a box of `a` and a box of
+/// `b` (`+inf` when either is empty; NaN when any box holds a NaN).
+pub fn boxes_clearance_lower_bound(a: &[Obb], b: &[Obb]) -> Real {
+    let mut best = Real::INFINITY;
+    for x in a {
+        for y in b {
+            let d = obb_clearance_lower_bound(x, y);
+            if d.is_nan() {
+                return d;
+            }
+            best = best.min(d);
+        }
+    }
+    best
+}
+
+/// The signed clearance of two closed boxes (mm), with witness points in the world frame.
+///
+/// Apart (the separating axis test finds an axis): the Euclidean distance and the closest
+/// points. Otherwise minus the smallest normalised overlap over the 15 axes, capped at 0
+/// (a gap within the SAT's touch tolerance reads as touching). NaN or infinite input gives
+/// a NaN distance.
+pub fn obb_clearance(a: &Obb, b: &Obb) -> Clearance {
+    if !finite(a, b) {
+        return Clearance { distance: Real::NAN, point_a: a.center, point_b: b.center };
+    }
+    let rel = rel(a, b);
+    let mut apart = false;
+    for k in 0..15 {
+        let ax = axis_terms(&rel, k);
+        apart |= ax.lhs.abs() > ax.rhs_guarded;
+    }
+    if apart {
+        separated(a, &rel)
+    } else {
+        penetrating(a, &rel)
+    }
+}
+
+/// Local point `p` of box `o` in the world frame.
+#[inline(always)]
+fn to_world(o: &Obb, p: &[Real; 3]) -> Vec3 {
+    o.center + o.axes * Vec3::new(p[0], p[1], p[2])
+}
+
+/// `+1` or `-1` by the sign of `x` (`+1` for 0).
+#[inline(always)]
+fn sign(x: Real) -> Real {
+    if x < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
+/// Penetrating or touching: minus the smallest normalised overlap, capped at 0.
+fn penetrating(a: &Obb, rel: &Rel) -> Clearance {
+    let (mut best, mut axis, mut lhs) = (Real::INFINITY, 0, 0.0);
+    for k in 0..15 {
+        let ax = axis_terms(rel, k);
+        if !included(k, ax.norm2) {
+            continue;
+        }
+        let n = if k < 6 { 1.0 } else { float::sqrt(ax.norm2) };
+        let overlap = (ax.rhs - ax.lhs.abs()) / n;
+        if overlap < best {
+            (best, axis, lhs) = (overlap, k, ax.lhs / n);
+        }
+    }
+    // The unit axis toward B, in A's frame.
+    let (r, s) = (&rel.r, sign(lhs));
+    let dir: [Real; 3] = match axis {
+        0..=2 => core::array::from_fn(|m| if m == axis { s } else { 0.0 }),
+        3..=5 => core::array::from_fn(|m| s * r[m][axis - 3]),
+        _ => {
+            let (i, j) = ((axis - 6) / 3, (axis - 6) % 3);
+            let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+            let n = float::sqrt(r[i1][j] * r[i1][j] + r[i2][j] * r[i2][j]);
+            let mut v = [0.0; 3];
+            (v[i1], v[i2]) = (-s * r[i2][j] / n, s * r[i1][j] / n);
+            v
+        }
+    };
+    let distance = if best > 0.0 { -best } else { 0.0 };
+    // A's deepest vertex along the axis, and that vertex moved back by the overlap.
+    let pa: [Real; 3] = core::array::from_fn(|m| sign(dir[m]) * rel.a[m]);
+    let pb: [Real; 3] = core::array::from_fn(|m| pa[m] + distance * dir[m]);
+    Clearance { distance, point_a: to_world(a, &pa), point_b: to_world(a, &pb) }
+}
+
+/// The closest pair found so far, in A's frame.
+struct Best {
+    d2: Real,
+    p: [Real; 3],
+    q: [Real; 3],
+}
+
+/// Apart: the exact distance, from the 16 vertex-to-box distances and the supporting edge
+/// pairs of the nine cross axes (module doc).
+fn separated(a: &Obb, rel: &Rel) -> Clearance {
+    let mut best = vertices(rel);
+    for i in 0..3 {
+        for j in 0..3 {
+            edge_axis(rel, i, j, &mut best);
+        }
+    }
+    Clearance { distance: float::sqrt(best.d2), point_a: to_world(a, &best.p), point_b: to_world(a, &best.q) }
+}
+
+/// The vertex of the 16 that is closest to the other box, with its closest point.
+#[inline(always)]
+fn vertices(rel: &Rel) -> Best {
+    let (r, t, tb, a, b) = (&rel.r, &rel.t, &rel.tb, &rel.a, &rel.b);
+    // B's vertices in A's frame, t + sum_l +-b_l R_.l, against A.
+    let mut d2b = [0.0; 8];
+    for (v, d2) in d2b.iter_mut().enumerate() {
+        let mut s = 0.0;
+        for k in 0..3 {
+            let x = t[k] + (0..3).map(|l| if v >> l & 1 == 0 { -b[l] } else { b[l] } * r[k][l]).sum::<Real>();
+            let o = (x.abs() - a[k]).max(0.0);
+            s += o * o;
+        }
+        *d2 = s;
+    }
+    // A's vertices in B's frame, -tb + sum_k +-a_k R_k., against B.
+    let mut d2a = [0.0; 8];
+    for (v, d2) in d2a.iter_mut().enumerate() {
+        let mut s = 0.0;
+        for l in 0..3 {
+            let x = -tb[l] + (0..3).map(|k| if v >> k & 1 == 0 { -a[k] } else { a[k] } * r[k][l]).sum::<Real>();
+            let o = (x.abs() - b[l]).max(0.0);
+            s += o * o;
+        }
+        *d2 = s;
+    }
+    let (mut vb, mut va) = (0, 0);
+    for v in 1..8 {
+        if d2b[v] < d2b[vb] {
+            vb = v;
+        }
+        if d2a[v] < d2a[va] {
+            va = v;
+        }
+    }
+    let sgn = |v: usize, m: usize| if v >> m & 1 == 0 { -1.0 } else { 1.0 };
+    if d2b[vb] <= d2a[va] {
+        let q: [Real; 3] = core::array::from_fn(|k| t[k] + (0..3).map(|l| sgn(vb, l) * b[l] * r[k][l]).sum::<Real>());
+        let p = core::array::from_fn(|k| q[k].clamp(-a[k], a[k]));
+        Best { d2: d2b[vb], p, q }
+    } else {
+        // A's vertex in A's frame, and its closest point of B (clamped in B's frame) back in A's.
+        let p: [Real; 3] = core::array::from_fn(|k| sgn(va, k) * a[k]);
+        let xb: [Real; 3] =
+            core::array::from_fn(|l| (-tb[l] + (0..3).map(|k| p[k] * r[k][l]).sum::<Real>()).clamp(-b[l], b[l]));
+        let q = core::array::from_fn(|k| t[k] + (0..3).map(|l| r[k][l] * xb[l]).sum::<Real>());
+        Best { d2: d2a[va], p, q }
+    }
+}
+
+/// The supporting edge pair(s) of cross axis `A_i x B_j`, solved as lines and clamped to the
+/// edges (a true distance between points of the boxes, exact when the edges cross).
+#[inline(always)]
+fn edge_axis(rel: &Rel, i: usize, j: usize, best: &mut Best) {
+    let (r, t) = (&rel.r, &rel.t);
+    let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
+    let n2 = r[i1][j] * r[i1][j] + r[i2][j] * r[i2][j];
+    if !(n2 >= PARALLEL_NORM2) {
+        return;
+    }
+    let nt = t[i2] * r[i1][j] - t[i1] * r[i2][j];
+    // The gap along this axis bounds every pair of it from below: skip when it cannot win.
+    let ax = axis_terms(rel, 6 + 3 * i + j);
+    let gap = nt.abs() - ax.rhs;
+    if gap > 0.0 && gap * gap >= best.d2 * n2 {
+        return;
+    }
+    // Signs of the supporting edges: A's in direction s n, B's in -s n, n = A_i x B_j with
+    // n . A_i1 = -R_i2j, n . A_i2 = R_i1j, n . B_j1 = R_ij2, n . B_j2 = -R_ij1.
+    let comps = [-r[i2][j], r[i1][j], r[i][j2], -r[i][j1]];
+    let tie_t = 1e-12 * (t[0].abs() + t[1].abs() + t[2].abs());
+    if nt.abs() > tie_t && comps.iter().all(|c| c.abs() > SIGN_TIE) {
+        let s = sign(nt);
+        let sg = [s * sign(comps[0]), s * sign(comps[1]), -s * sign(comps[2]), -s * sign(comps[3])];
+        edge_pair(rel, i, j, n2, sg, best);
+    } else {
+        for m in 0..16 {
+            let sg = core::array::from_fn(|q| if m >> q & 1 == 0 { -1.0 } else { 1.0 });
+            edge_pair(rel, i, j, n2, sg, best);
+        }
+    }
+}
+
+/// The edge of A along `A_i` at signs `(sg0, sg1)` on `(A_i1, A_i2)` against the edge of B
+/// along `B_j` at signs `(sg2, sg3)` on `(B_j1, B_j2)`; keeps the pair if closer.
+#[inline(always)]
+fn edge_pair(rel: &Rel, i: usize, j: usize, n2: Real, sg: [Real; 4], best: &mut Best) {
+    let (r, t, a, b) = (&rel.r, &rel.t, &rel.a, &rel.b);
+    let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
+    let mut p = [0.0; 3];
+    (p[i1], p[i2]) = (sg[0] * a[i1], sg[1] * a[i2]);
+    let (bj1, bj2) = (sg[2] * b[j1], sg[3] * b[j2]);
+    let q0: [Real; 3] = core::array::from_fn(|k| t[k] + bj1 * r[k][j1] + bj2 * r[k][j2]);
+    let w: [Real; 3] = core::array::from_fn(|k| p[k] - q0[k]);
+    // Minimise |w + s e_i - u B_j|^2: s = (c w.B_j - w_i) / (1 - c^2), then u given s.
+    let c = r[i][j];
+    let wr = w[0] * r[0][j] + w[1] * r[1][j] + w[2] * r[2][j];
+    let s = ((c * wr - w[i]) / n2).clamp(-a[i], a[i]);
+    let u = (wr + c * s).clamp(-b[j], b[j]);
+    p[i] = s;
+    let q: [Real; 3] = core::array::from_fn(|k| q0[k] + u * r[k][j]);
+    let d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
+    if d2 < best.d2 {
+        *best = Best { d2, p, q };
+    }
+}
+
+/// The smallest signed clearance between a box of `a` and a box of `b`, and which pair.
+///
+/// Pairs whose [`obb_clearance_lower_bound`] is not below the best clearance found so far
+/// are skipped (their clearance cannot be smaller). `+inf` with indices 0 when either slice
+/// is empty; a NaN distance when any box holds a NaN. No allocation.
+pub fn boxes_clearance(a: &[Obb], b: &[Obb]) -> PairClearance {
+    const MAX_PAIRS: usize = 64;
+    let mut out = PairClearance {
+        distance: Real::INFINITY,
+        box_a: 0,
+        box_b: 0,
+        point_a: Vec3::zeros(),
+        point_b: Vec3::zeros(),
+    };
+    let n = a.len().saturating_mul(b.len());
+    let mut bound = [Real::NEG_INFINITY; MAX_PAIRS];
+    let m = b.len().max(1);
+    let mut first = 0;
+    if n <= MAX_PAIRS {
+        // Start from the pair with the smallest bound: usually the closest pair, so that
+        // the others are skipped.
+        for k in 0..n {
+            bound[k] = obb_clearance_lower_bound(&a[k / m], &b[k % m]);
+            if !(bound[k] >= bound[first]) {
+                first = k;
+            }
+        }
+    }
+    for k in (0..n).map(|k| (k + first) % n) {
+        if n <= MAX_PAIRS && bound[k] >= out.distance {
+            continue;
+        }
+        let c = obb_clearance(&a[k / m], &b[k % m]);
+        if !(c.distance >= out.distance) {
+            out = PairClearance { distance: c.distance, box_a: k / m, box_b: k % m, point_a: c.point_a, point_b: c.point_b };
+            if c.distance.is_nan() {
+                break;
+            }
+        }
+    }
+    out
+}
