@@ -154,6 +154,29 @@ fn axis_terms(rel: &Rel, k: usize) -> AxisTerms {
     }
 }
 
+/// The 15 axes' terms; `axis_terms` is inlined with a constant `k` each time, so the
+/// index arithmetic folds away.
+#[inline(always)]
+fn all_axes(rel: &Rel) -> [AxisTerms; 15] {
+    [
+        axis_terms(rel, 0),
+        axis_terms(rel, 1),
+        axis_terms(rel, 2),
+        axis_terms(rel, 3),
+        axis_terms(rel, 4),
+        axis_terms(rel, 5),
+        axis_terms(rel, 6),
+        axis_terms(rel, 7),
+        axis_terms(rel, 8),
+        axis_terms(rel, 9),
+        axis_terms(rel, 10),
+        axis_terms(rel, 11),
+        axis_terms(rel, 12),
+        axis_terms(rel, 13),
+        axis_terms(rel, 14),
+    ]
+}
+
 /// Whether axis `k` takes part in the normalised gaps (face axes always; cross axes when
 /// the cross product is at least [`CROSS_AXIS_MIN_NORM`] long).
 #[inline(always)]
@@ -174,18 +197,22 @@ pub fn obb_clearance_lower_bound(a: &Obb, b: &Obb) -> Real {
     if !finite(a, b) {
         return Real::NAN;
     }
-    let rel = rel(a, b);
-    let mut best = Real::NEG_INFINITY;
-    for k in 0..15 {
-        let ax = axis_terms(&rel, k);
-        if !included(k, ax.norm2) {
-            continue;
-        }
+    let axes = all_axes(&rel(a, b));
+    let gap: [Real; 15] = core::array::from_fn(|k| {
+        let ax = &axes[k];
         let diff = ax.lhs.abs() - ax.rhs_guarded;
-        let slack = BOUND_REL_SLACK * (ax.lhs.abs() + ax.rhs_guarded);
-        let gap = if k < 6 { diff - slack } else { (diff - slack) / float::sqrt(ax.norm2) };
-        if gap > best {
-            best = gap;
+        diff - BOUND_REL_SLACK * (ax.lhs.abs() + ax.rhs_guarded)
+    });
+    let mut best = gap[0].max(gap[1]).max(gap[2]).max(gap[3]).max(gap[4]).max(gap[5]);
+    for k in 6..15 {
+        // Normalising costs a square root: only for axes that could beat the best, that
+        // is `gap / |n| > best` with `|n| <= 1`, compared in squares when both are positive.
+        let n2 = axes[k].norm2;
+        if included(k, n2) && (best < 0.0 || (gap[k] > 0.0 && gap[k] * gap[k] > best * best * n2)) {
+            let g = gap[k] / float::sqrt(n2);
+            if g > best {
+                best = g;
+            }
         }
     }
     best
@@ -218,15 +245,11 @@ pub fn obb_clearance(a: &Obb, b: &Obb) -> Clearance {
         return Clearance { distance: Real::NAN, point_a: a.center, point_b: b.center };
     }
     let rel = rel(a, b);
-    let mut apart = false;
-    for k in 0..15 {
-        let ax = axis_terms(&rel, k);
-        apart |= ax.lhs.abs() > ax.rhs_guarded;
-    }
-    if apart {
+    let axes = all_axes(&rel);
+    if axes.iter().any(|ax| ax.lhs.abs() > ax.rhs_guarded) {
         separated(a, &rel)
     } else {
-        penetrating(a, &rel)
+        penetrating(a, &rel, &axes)
     }
 }
 
@@ -247,10 +270,9 @@ fn sign(x: Real) -> Real {
 }
 
 /// Penetrating or touching: minus the smallest normalised overlap, capped at 0.
-fn penetrating(a: &Obb, rel: &Rel) -> Clearance {
+fn penetrating(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
     let (mut best, mut axis, mut lhs) = (Real::INFINITY, 0, 0.0);
-    for k in 0..15 {
-        let ax = axis_terms(rel, k);
+    for (k, ax) in axes.iter().enumerate() {
         if !included(k, ax.norm2) {
             continue;
         }
@@ -292,11 +314,16 @@ struct Best {
 /// pairs of the nine cross axes (module doc).
 fn separated(a: &Obb, rel: &Rel) -> Clearance {
     let mut best = vertices(rel);
-    for i in 0..3 {
-        for j in 0..3 {
-            edge_axis(rel, i, j, &mut best);
-        }
-    }
+    // Written out so that each call is inlined with constant indices.
+    edge_axis(rel, 0, 0, &mut best);
+    edge_axis(rel, 0, 1, &mut best);
+    edge_axis(rel, 0, 2, &mut best);
+    edge_axis(rel, 1, 0, &mut best);
+    edge_axis(rel, 1, 1, &mut best);
+    edge_axis(rel, 1, 2, &mut best);
+    edge_axis(rel, 2, 0, &mut best);
+    edge_axis(rel, 2, 1, &mut best);
+    edge_axis(rel, 2, 2, &mut best);
     Clearance { distance: float::sqrt(best.d2), point_a: to_world(a, &best.p), point_b: to_world(a, &best.q) }
 }
 
@@ -305,27 +332,25 @@ fn separated(a: &Obb, rel: &Rel) -> Clearance {
 fn vertices(rel: &Rel) -> Best {
     let (r, t, tb, a, b) = (&rel.r, &rel.t, &rel.tb, &rel.a, &rel.b);
     // B's vertices in A's frame, t + sum_l +-b_l R_.l, against A.
-    let mut d2b = [0.0; 8];
-    for (v, d2) in d2b.iter_mut().enumerate() {
-        let mut s = 0.0;
-        for k in 0..3 {
-            let x = t[k] + (0..3).map(|l| if v >> l & 1 == 0 { -b[l] } else { b[l] } * r[k][l]).sum::<Real>();
-            let o = (x.abs() - a[k]).max(0.0);
-            s += o * o;
-        }
-        *d2 = s;
-    }
+    let cb: [[Real; 3]; 3] = core::array::from_fn(|k| core::array::from_fn(|l| b[l] * r[k][l]));
+    let d2b: [Real; 8] = core::array::from_fn(|v| {
+        let sg = |l: usize| if v >> l & 1 == 0 { -1.0 } else { 1.0 };
+        let o: [Real; 3] = core::array::from_fn(|k| {
+            let x = t[k] + sg(0) * cb[k][0] + sg(1) * cb[k][1] + sg(2) * cb[k][2];
+            (x.abs() - a[k]).max(0.0)
+        });
+        o[0] * o[0] + o[1] * o[1] + o[2] * o[2]
+    });
     // A's vertices in B's frame, -tb + sum_k +-a_k R_k., against B.
-    let mut d2a = [0.0; 8];
-    for (v, d2) in d2a.iter_mut().enumerate() {
-        let mut s = 0.0;
-        for l in 0..3 {
-            let x = -tb[l] + (0..3).map(|k| if v >> k & 1 == 0 { -a[k] } else { a[k] } * r[k][l]).sum::<Real>();
-            let o = (x.abs() - b[l]).max(0.0);
-            s += o * o;
-        }
-        *d2 = s;
-    }
+    let ca: [[Real; 3]; 3] = core::array::from_fn(|l| core::array::from_fn(|k| a[k] * r[k][l]));
+    let d2a: [Real; 8] = core::array::from_fn(|v| {
+        let sg = |k: usize| if v >> k & 1 == 0 { -1.0 } else { 1.0 };
+        let o: [Real; 3] = core::array::from_fn(|l| {
+            let x = -tb[l] + sg(0) * ca[l][0] + sg(1) * ca[l][1] + sg(2) * ca[l][2];
+            (x.abs() - b[l]).max(0.0)
+        });
+        o[0] * o[0] + o[1] * o[1] + o[2] * o[2]
+    });
     let (mut vb, mut va) = (0, 0);
     for v in 1..8 {
         if d2b[v] < d2b[vb] {
