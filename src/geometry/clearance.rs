@@ -198,11 +198,7 @@ pub fn obb_clearance_lower_bound(a: &Obb, b: &Obb) -> Real {
         return Real::NAN;
     }
     let axes = all_axes(&rel(a, b));
-    let gap: [Real; 15] = core::array::from_fn(|k| {
-        let ax = &axes[k];
-        let diff = ax.lhs.abs() - ax.rhs_guarded;
-        diff - BOUND_REL_SLACK * (ax.lhs.abs() + ax.rhs_guarded)
-    });
+    let gap: [Real; 15] = core::array::from_fn(|k| guarded_gap(&axes[k]));
     let mut best = gap[0].max(gap[1]).max(gap[2]).max(gap[3]).max(gap[4]).max(gap[5]);
     for k in 6..15 {
         // Normalising costs a square root: only for axes that could beat the best, that
@@ -218,19 +214,64 @@ pub fn obb_clearance_lower_bound(a: &Obb, b: &Obb) -> Real {
     best
 }
 
-/// The smallest [`obb_clearance_lower_bound`] over all pairs of a box of `a` and a box of
-/// `b` (`+inf` when either is empty; NaN when any box holds a NaN).
-pub fn boxes_clearance_lower_bound(a: &[Obb], b: &[Obb]) -> Real {
-    let mut best = Real::INFINITY;
-    for x in a {
-        for y in b {
-            let d = obb_clearance_lower_bound(x, y);
-            if d.is_nan() {
-                return d;
+/// The gap of one axis before normalising, less the SAT's guards and the rounding slack:
+/// positive only when `sat.rs` finds that axis separating.
+#[inline(always)]
+fn guarded_gap(ax: &AxisTerms) -> Real {
+    let diff = ax.lhs.abs() - ax.rhs_guarded;
+    diff - BOUND_REL_SLACK * (ax.lhs.abs() + ax.rhs_guarded)
+}
+
+/// The face-axis part of [`obb_clearance_lower_bound`] (so never above it), at about a
+/// third of its cost: the bound by which robot-level searches skip pairs.
+#[inline]
+fn face_bound(a: &Obb, b: &Obb) -> Real {
+    if !finite(a, b) {
+        return Real::NAN;
+    }
+    let rel = rel(a, b);
+    let g = |k: usize| guarded_gap(&axis_terms(&rel, k));
+    g(0).max(g(1)).max(g(2)).max(g(3)).max(g(4)).max(g(5))
+}
+
+/// Most box pairs whose cheap bounds [`pairs_by_bound`] keeps on the stack.
+const MAX_PAIRS: usize = 64;
+
+/// Calls `visit(k, bound_k)` for every pair `k = i * b.len() + j` of `a[i]`, `b[j]`, the pair
+/// with the smallest [`face_bound`] first (usually the closest pair, so that the others can
+/// be skipped by their bound). Beyond [`MAX_PAIRS`] pairs, in order with bound `-inf`.
+#[inline(always)]
+fn pairs_by_bound(a: &[Obb], b: &[Obb], mut visit: impl FnMut(usize, Real)) {
+    let n = a.len().saturating_mul(b.len());
+    let m = b.len().max(1);
+    let mut bound = [Real::NEG_INFINITY; MAX_PAIRS];
+    let mut first = 0;
+    if n <= MAX_PAIRS {
+        for k in 0..n {
+            bound[k] = face_bound(&a[k / m], &b[k % m]);
+            if !(bound[k] >= bound[first]) {
+                first = k;
             }
-            best = best.min(d);
         }
     }
+    for k in (0..n).map(|k| (k + first) % n) {
+        visit(k, if n <= MAX_PAIRS { bound[k] } else { Real::NEG_INFINITY });
+    }
+}
+
+/// The smallest [`obb_clearance_lower_bound`] over all pairs of a box of `a` and a box of
+/// `b` (`+inf` when either is empty; NaN when any box holds a NaN). Pairs whose face-axis
+/// bound already reaches the smallest so far are skipped: their bound cannot be smaller.
+pub fn boxes_clearance_lower_bound(a: &[Obb], b: &[Obb]) -> Real {
+    let (mut best, m) = (Real::INFINITY, b.len().max(1));
+    pairs_by_bound(a, b, |k, cheap| {
+        if !(cheap >= best) && !best.is_nan() {
+            let d = obb_clearance_lower_bound(&a[k / m], &b[k % m]);
+            if !(d >= best) {
+                best = d;
+            }
+        }
+    });
     best
 }
 
@@ -247,7 +288,7 @@ pub fn obb_clearance(a: &Obb, b: &Obb) -> Clearance {
     let rel = rel(a, b);
     let axes = all_axes(&rel);
     if axes.iter().any(|ax| ax.lhs.abs() > ax.rhs_guarded) {
-        separated(a, &rel)
+        separated(a, &rel, &axes)
     } else {
         penetrating(a, &rel, &axes)
     }
@@ -312,18 +353,70 @@ struct Best {
 
 /// Apart: the exact distance, from the 16 vertex-to-box distances and the supporting edge
 /// pairs of the nine cross axes (module doc).
-fn separated(a: &Obb, rel: &Rel) -> Clearance {
+///
+/// The gap along any unit axis is at most the distance, and along the direction of a
+/// crossing edge pair of cross axis `k` it equals the distance: so only the cross axes whose
+/// normalised gap reaches the largest gap `g` over the 15 axes (to rounding) need their edge
+/// pair, and none does when a vertex is already at distance `g`.
+fn separated(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
     let mut best = vertices(rel);
-    // Written out so that each call is inlined with constant indices.
-    edge_axis(rel, 0, 0, &mut best);
-    edge_axis(rel, 0, 1, &mut best);
-    edge_axis(rel, 0, 2, &mut best);
-    edge_axis(rel, 1, 0, &mut best);
-    edge_axis(rel, 1, 1, &mut best);
-    edge_axis(rel, 1, 2, &mut best);
-    edge_axis(rel, 2, 0, &mut best);
-    edge_axis(rel, 2, 1, &mut best);
-    edge_axis(rel, 2, 2, &mut best);
+    // Rounding of a normalised gap: about 1e-16 * size / |n|, |n| >= CROSS_AXIS_MIN_NORM.
+    // Generous for choosing edge pairs (an extra pair costs time only), tight for stopping
+    // at a vertex (a vertex above the true distance by the tolerance would be kept).
+    let size = rel.t.iter().chain(&rel.a).chain(&rel.b).map(|x| x.abs()).sum::<Real>();
+    let tol = 1e-8 * size + 1e-12;
+    let mut g = Real::NEG_INFINITY;
+    for ax in &axes[..6] {
+        g = g.max(ax.lhs.abs() - ax.rhs);
+    }
+    let mut gap = [Real::NEG_INFINITY; 9];
+    for (m, ax) in axes[6..].iter().enumerate() {
+        let raw = ax.lhs.abs() - ax.rhs;
+        if ax.norm2 >= CROSS_AXIS_MIN_NORM * CROSS_AXIS_MIN_NORM {
+            // `raw / |n| > g - tol` (|n| <= 1), tested in squares to spare most square
+            // roots; `g` only grows, so an axis left out stays below the final `g - tol`.
+            let low = g - tol;
+            if raw > 0.0 && (low < 0.0 || raw * raw > low * low * ax.norm2) {
+                gap[m] = raw / float::sqrt(ax.norm2);
+                g = g.max(gap[m]);
+            }
+        } else {
+            // Too short to normalise accurately: always tried.
+            gap[m] = Real::INFINITY;
+        }
+    }
+    let reach = (g + 1e-13 * size).max(0.0);
+    if best.d2 > reach * reach {
+        let near = |m: usize| gap[m] >= g - tol;
+        // Written out so that each call is inlined with constant indices.
+        if near(0) {
+            edge_axis(rel, 0, 0, &mut best);
+        }
+        if near(1) {
+            edge_axis(rel, 0, 1, &mut best);
+        }
+        if near(2) {
+            edge_axis(rel, 0, 2, &mut best);
+        }
+        if near(3) {
+            edge_axis(rel, 1, 0, &mut best);
+        }
+        if near(4) {
+            edge_axis(rel, 1, 1, &mut best);
+        }
+        if near(5) {
+            edge_axis(rel, 1, 2, &mut best);
+        }
+        if near(6) {
+            edge_axis(rel, 2, 0, &mut best);
+        }
+        if near(7) {
+            edge_axis(rel, 2, 1, &mut best);
+        }
+        if near(8) {
+            edge_axis(rel, 2, 2, &mut best);
+        }
+    }
     Clearance { distance: float::sqrt(best.d2), point_a: to_world(a, &best.p), point_b: to_world(a, &best.q) }
 }
 
@@ -386,12 +479,6 @@ fn edge_axis(rel: &Rel, i: usize, j: usize, best: &mut Best) {
         return;
     }
     let nt = t[i2] * r[i1][j] - t[i1] * r[i2][j];
-    // The gap along this axis bounds every pair of it from below: skip when it cannot win.
-    let ax = axis_terms(rel, 6 + 3 * i + j);
-    let gap = nt.abs() - ax.rhs;
-    if gap > 0.0 && gap * gap >= best.d2 * n2 {
-        return;
-    }
     // Signs of the supporting edges: A's in direction s n, B's in -s n, n = A_i x B_j with
     // n . A_i1 = -R_i2j, n . A_i2 = R_i1j, n . B_j1 = R_ij2, n . B_j2 = -R_ij1.
     let comps = [-r[i2][j], r[i1][j], r[i][j2], -r[i][j1]];
@@ -434,11 +521,12 @@ fn edge_pair(rel: &Rel, i: usize, j: usize, n2: Real, sg: [Real; 4], best: &mut 
 
 /// The smallest signed clearance between a box of `a` and a box of `b`, and which pair.
 ///
-/// Pairs whose [`obb_clearance_lower_bound`] is not below the best clearance found so far
-/// are skipped (their clearance cannot be smaller). `+inf` with indices 0 when either slice
-/// is empty; a NaN distance when any box holds a NaN. No allocation.
+/// Pairs whose face-axis lower bound (part of [`obb_clearance_lower_bound`]) is not below
+/// the best clearance found so far are skipped: their clearance cannot be smaller. `+inf`
+/// with indices 0 when either slice is empty; a NaN distance when any box holds a NaN. No
+/// allocation.
 pub fn boxes_clearance(a: &[Obb], b: &[Obb]) -> PairClearance {
-    const MAX_PAIRS: usize = 64;
+    let m = b.len().max(1);
     let mut out = PairClearance {
         distance: Real::INFINITY,
         box_a: 0,
@@ -446,31 +534,13 @@ pub fn boxes_clearance(a: &[Obb], b: &[Obb]) -> PairClearance {
         point_a: Vec3::zeros(),
         point_b: Vec3::zeros(),
     };
-    let n = a.len().saturating_mul(b.len());
-    let mut bound = [Real::NEG_INFINITY; MAX_PAIRS];
-    let m = b.len().max(1);
-    let mut first = 0;
-    if n <= MAX_PAIRS {
-        // Start from the pair with the smallest bound: usually the closest pair, so that
-        // the others are skipped.
-        for k in 0..n {
-            bound[k] = obb_clearance_lower_bound(&a[k / m], &b[k % m]);
-            if !(bound[k] >= bound[first]) {
-                first = k;
+    pairs_by_bound(a, b, |k, cheap| {
+        if !(cheap >= out.distance) && !out.distance.is_nan() {
+            let c = obb_clearance(&a[k / m], &b[k % m]);
+            if !(c.distance >= out.distance) {
+                out = PairClearance { distance: c.distance, box_a: k / m, box_b: k % m, point_a: c.point_a, point_b: c.point_b };
             }
         }
-    }
-    for k in (0..n).map(|k| (k + first) % n) {
-        if n <= MAX_PAIRS && bound[k] >= out.distance {
-            continue;
-        }
-        let c = obb_clearance(&a[k / m], &b[k % m]);
-        if !(c.distance >= out.distance) {
-            out = PairClearance { distance: c.distance, box_a: k / m, box_b: k % m, point_a: c.point_a, point_b: c.point_b };
-            if c.distance.is_nan() {
-                break;
-            }
-        }
-    }
+    });
     out
 }
