@@ -9,6 +9,10 @@
 //! common perpendicular). Otherwise minus the smallest projection overlap over the 15 axes
 //! (cross products shorter than `CROSS_AXIS_MIN_NORM` left out). Agreement: `TOL` mm.
 
+// `!(x >= y)` is deliberate: it is true when either side is NaN, which sends NaN to the
+// "check it" or "colliding" side.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use delta_collide::geometry::{
     boxes_clearance, boxes_clearance_lower_bound, obb_clearance, obb_clearance_lower_bound, separating_axis, Obb,
 };

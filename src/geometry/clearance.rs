@@ -30,6 +30,10 @@
 //! normalising, which keeps it below the exact value and makes `bound > 0` imply that the
 //! SAT separates. Any NaN or infinite input gives a NaN distance.
 
+// `!(x >= y)` is deliberate: it is true when either side is NaN, which sends NaN to the
+// "check it" or "colliding" side.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use crate::geometry::obb::Obb;
 use crate::math::{float, Real, Vec3, CROSS_AXIS_MIN_NORM, SAT_EPSILON, SAT_TOUCH_TOLERANCE};
 
@@ -543,4 +547,75 @@ pub fn boxes_clearance(a: &[Obb], b: &[Obb]) -> PairClearance {
         }
     });
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Mat3;
+
+    fn cube(center: Vec3, half: Real) -> Obb {
+        Obb::new(center, Mat3::identity(), Vec3::repeat(half))
+    }
+
+    #[test]
+    fn face_corner_touching_and_penetrating_cubes() {
+        let a = cube(Vec3::zeros(), 1.0);
+        let c = obb_clearance(&a, &cube(Vec3::new(5.0, 0.3, -0.2), 1.0));
+        assert_eq!(c.distance, 3.0, "face to face");
+        assert!((c.point_b - c.point_a - Vec3::new(3.0, 0.0, 0.0)).norm() < 1e-12, "{c:?}");
+        let c = obb_clearance(&a, &cube(Vec3::new(4.0, 4.0, 4.0), 1.0));
+        assert!((c.distance - 12f64.sqrt()).abs() < 1e-12, "corner to corner {c:?}");
+        assert!((c.point_a - Vec3::repeat(1.0)).norm() < 1e-12 && (c.point_b - Vec3::repeat(3.0)).norm() < 1e-12);
+        assert_eq!(obb_clearance(&a, &cube(Vec3::new(2.0, 0.0, 0.0), 1.0)).distance, 0.0, "touching");
+        // Overlapping by 0.5 along x and 1.5 along y: the depth is the smaller overlap.
+        let b = cube(Vec3::new(1.5, 0.5, 0.0), 1.0);
+        let c = obb_clearance(&a, &b);
+        assert_eq!(c.distance, -0.5);
+        assert!((c.point_b - c.point_a - Vec3::new(-0.5, 0.0, 0.0)).norm() < 1e-12, "{c:?}");
+        let lb = obb_clearance_lower_bound(&a, &b);
+        assert!(lb <= -0.5 && lb > -0.5 - 1e-8, "the SAT guards, about 1e-9 below: {lb}");
+    }
+
+    #[test]
+    fn crossing_edges_of_two_turned_cubes() {
+        // A turned 45 degrees about y has a top edge along y at z = sqrt 2; B turned 45 degrees
+        // about x has a bottom edge along x: the closest features are these two edges.
+        let s = core::f64::consts::FRAC_1_SQRT_2;
+        let about_y = Mat3::new(s, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, s);
+        let about_x = Mat3::new(1.0, 0.0, 0.0, 0.0, s, -s, 0.0, s, s);
+        let a = Obb::new(Vec3::zeros(), about_y, Vec3::repeat(1.0));
+        let b = Obb::new(Vec3::new(0.0, 0.0, 2.0 * 2f64.sqrt() + 0.5), about_x, Vec3::repeat(1.0));
+        let c = obb_clearance(&a, &b);
+        assert!((c.distance - 0.5).abs() < 1e-12, "{c:?}");
+        assert!((c.point_a - Vec3::new(0.0, 0.0, 2f64.sqrt())).norm() < 1e-12, "{c:?}");
+        let lb = obb_clearance_lower_bound(&a, &b);
+        assert!(lb <= 0.5 && lb > 0.5 - 1e-8, "the edge axis gives the bound, less the SAT guards: {lb}");
+    }
+
+    #[test]
+    fn robot_level_picks_the_closest_pair_and_skips_nothing_it_needs() {
+        let a = [cube(Vec3::zeros(), 1.0), cube(Vec3::new(0.0, 10.0, 0.0), 1.0)];
+        let b = [cube(Vec3::new(0.0, 30.0, 0.0), 1.0), cube(Vec3::new(0.0, 13.5, 0.0), 1.0)];
+        let c = boxes_clearance(&a, &b);
+        assert_eq!((c.distance, c.box_a, c.box_b), (1.5, 1, 1));
+        assert!(boxes_clearance_lower_bound(&a, &b) <= 1.5);
+        assert_eq!(boxes_clearance(&a, &[]).distance, Real::INFINITY);
+        assert_eq!(boxes_clearance_lower_bound(&[], &b), Real::INFINITY);
+    }
+
+    #[test]
+    fn random_pairs_agree_with_obb_distance_when_apart() {
+        let mut rng = crate::geometry::TestRng(0x5eed_c1ea);
+        for _ in 0..20_000 {
+            let rot = |r: &mut crate::geometry::TestRng| {
+                *nalgebra::Rotation3::from_euler_angles(r.unit() * 3.2, r.unit() * 3.2, r.unit() * 3.2).matrix()
+            };
+            let a = Obb::new(rng.vec(5.0), rot(&mut rng), rng.vec(2.0).abs().add_scalar(0.1));
+            let b = Obb::new(rng.vec(5.0), rot(&mut rng), rng.vec(2.0).abs().add_scalar(0.1));
+            let (c, d) = (obb_clearance(&a, &b), crate::geometry::obb_distance(&a, &b));
+            assert!((c.distance.max(0.0) - d).abs() < 1e-9, "{a:?} {b:?}: {c:?} vs {d}");
+            assert!(obb_clearance_lower_bound(&a, &b) <= c.distance);
+        }
+    }
 }
