@@ -38,7 +38,8 @@ struct Config {
 
 fn parry_parts(o: &Obb) -> (Pose, Cuboid) {
     let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(o.axes));
-    let pose = Pose::from_parts(Vector::new(o.center.x, o.center.y, o.center.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w));
+    let pose =
+        Pose::from_parts(Vector::new(o.center.x, o.center.y, o.center.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w));
     (pose, Cuboid::new(Vector::new(o.half.x, o.half.y, o.half.z)))
 }
 
@@ -136,9 +137,8 @@ fn clearance(c: &mut Criterion) {
         let nine: Vec<Real> = ring.iter().map(all_nine).collect();
         let parry: Vec<Real> = ring.iter().map(parry_nine).collect();
         let worst = ours.iter().zip(&parry).map(|(o, p)| (o.distance.max(0.0) - p).abs()).fold(0.0, Real::max);
-        let (lo, hi) = ours.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(l, h), o| {
-            (l.min(o.distance), h.max(o.distance))
-        });
+        let (lo, hi) =
+            ours.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(l, h), o| (l.min(o.distance), h.max(o.distance)));
         println!("{band}: clearance {lo:.6} .. {hi:.6} mm; largest |ours (0 if < 0) - parry| {worst:e} mm");
 
         let mut g = c.benchmark_group(format!("clearance/{band}"));

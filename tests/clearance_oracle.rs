@@ -494,7 +494,8 @@ fn axis_gap_only(a: &Obb, b: &Obb) -> Real {
 
 fn parry_parts(o: &Obb) -> (Pose, Cuboid) {
     let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(o.axes));
-    let pose = Pose::from_parts(Vector::new(o.center.x, o.center.y, o.center.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w));
+    let pose =
+        Pose::from_parts(Vector::new(o.center.x, o.center.y, o.center.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w));
     (pose, Cuboid::new(Vector::new(o.half.x, o.half.y, o.half.z)))
 }
 
@@ -527,7 +528,9 @@ fn parry_distance_against_the_oracle() {
             worst = worst.max(parry - truth.distance);
         }
     }
-    println!("{apart} separated pairs; parry above the oracle by more than {TOL} mm on {parry_above} (worst {worst:e} mm)");
+    println!(
+        "{apart} separated pairs; parry above the oracle by more than {TOL} mm on {parry_above} (worst {worst:e} mm)"
+    );
     assert!(parry_above * 100 < apart, "parry disagrees on {parry_above} of {apart}");
 }
 
@@ -535,11 +538,7 @@ fn parry_distance_against_the_oracle() {
 // Properties.
 
 fn obb() -> impl Strategy<Value = Obb> {
-    (
-        prop::array::uniform3(-300.0..300.0f64),
-        prop::array::uniform4(-1.0..1.0f64),
-        prop::array::uniform3(0.5..250.0f64),
-    )
+    (prop::array::uniform3(-300.0..300.0f64), prop::array::uniform4(-1.0..1.0f64), prop::array::uniform3(0.5..250.0f64))
         .prop_filter_map("degenerate rotation", |(c, q, h)| {
             let q = nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]);
             (q.norm() > 1e-3).then(|| {

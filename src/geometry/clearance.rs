@@ -150,7 +150,10 @@ fn axis_terms(rel: &Rel, k: usize) -> AxisTerms {
             AxisTerms {
                 lhs: t[i2] * r[i1][j] - t[i1] * r[i2][j],
                 rhs: a[i1] * r[i2][j].abs() + a[i2] * r[i1][j].abs() + b[j1] * r[i][j2].abs() + b[j2] * r[i][j1].abs(),
-                rhs_guarded: a[i1] * g(r[i2][j]) + a[i2] * g(r[i1][j]) + b[j1] * g(r[i][j2]) + b[j2] * g(r[i][j1])
+                rhs_guarded: a[i1] * g(r[i2][j])
+                    + a[i2] * g(r[i1][j])
+                    + b[j1] * g(r[i][j2])
+                    + b[j2] * g(r[i][j1])
                     + SAT_TOUCH_TOLERANCE,
                 norm2: r[i1][j] * r[i1][j] + r[i2][j] * r[i2][j],
             }
@@ -531,18 +534,19 @@ fn edge_pair(rel: &Rel, i: usize, j: usize, n2: Real, sg: [Real; 4], best: &mut 
 /// allocation.
 pub fn boxes_clearance(a: &[Obb], b: &[Obb]) -> PairClearance {
     let m = b.len().max(1);
-    let mut out = PairClearance {
-        distance: Real::INFINITY,
-        box_a: 0,
-        box_b: 0,
-        point_a: Vec3::zeros(),
-        point_b: Vec3::zeros(),
-    };
+    let mut out =
+        PairClearance { distance: Real::INFINITY, box_a: 0, box_b: 0, point_a: Vec3::zeros(), point_b: Vec3::zeros() };
     pairs_by_bound(a, b, |k, cheap| {
         if !(cheap >= out.distance) && !out.distance.is_nan() {
             let c = obb_clearance(&a[k / m], &b[k % m]);
             if !(c.distance >= out.distance) {
-                out = PairClearance { distance: c.distance, box_a: k / m, box_b: k % m, point_a: c.point_a, point_b: c.point_b };
+                out = PairClearance {
+                    distance: c.distance,
+                    box_a: k / m,
+                    box_b: k % m,
+                    point_a: c.point_a,
+                    point_b: c.point_b,
+                };
             }
         }
     });
