@@ -30,6 +30,12 @@ pub const SAT_TOUCH_TOLERANCE: Real = 1e-9;
 /// bounding-box centre into NaN.
 pub const MAX_LENGTH: Real = 1e6;
 
+/// Cross products `A_i x B_j` shorter than this are left out of the normalised axes of the
+/// clearance (`geometry::clearance`): their edges are parallel to 1e-6 rad, the face axes
+/// then stand for them, and normalising would divide rounding errors of about 1e-16 mm per
+/// mm of size by this length.
+pub const CROSS_AXIS_MIN_NORM: Real = 1e-6;
+
 /// The float functions the per-tick code needs that `core` lacks (SPEC §1 units: rad).
 ///
 /// With the `std` feature they are `f64`'s own methods, so results are exactly those of

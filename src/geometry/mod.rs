@@ -1,12 +1,16 @@
-//! Oriented boxes, the exact test between two of them (thesis 2.4 and 3.1, SPEC §3), and their
-//! distance (for reports and pictures).
+//! Oriented boxes, the exact test between two of them (thesis 2.4 and 3.1, SPEC §3), their
+//! distance (for reports and pictures) and their signed clearance (SPEC §8).
 
+pub mod clearance;
 pub mod distance;
 pub mod obb;
 pub mod sat;
 pub mod sweep;
 pub mod witness;
 
+pub use clearance::{
+    boxes_clearance, boxes_clearance_lower_bound, obb_clearance, obb_clearance_lower_bound, Clearance, PairClearance,
+};
 pub use distance::obb_distance;
 pub use obb::Obb;
 pub use sat::{obbs_intersect, separating_axis, separating_axis_hinted, Axis};
