@@ -12,7 +12,7 @@
 //! verdict is a collision; when its enclosing capsules (radius `hypot(H, D)`) are apart it is
 //! free.
 
-use crate::input::{Encoder, Input};
+use super::input::{Encoder, Input};
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::ExactChecker;
 use delta_collide::math::Vec3;
