@@ -1,4 +1,4 @@
-//! Labelling all k = 16 sample pairs of reference cell T1 (thesis 3.2.3; issue 3 item 2):
+//! Labelling all k = 16 sample pairs of reference cell T1 (thesis 3.2.3):
 //! ours (each robot's boxes built once per sample, x-sorted pruning, rayon) next to the naive
 //! per-pair [`ExactChecker`] (IK and boxes of both robots for every pair, rayon too), and the
 //! certified labelling (SPEC §6) for scale. Both exact labellings are checked to agree on

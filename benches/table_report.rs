@@ -1,4 +1,4 @@
-//! The tables side by side on the reference cells (issue 3 item 8, issue 4 item 4): for each
+//! The tables side by side on the reference cells: for each
 //! cell, one certified labelling, then every variant built from it (and the thesis-style
 //! table from the thesis's `r / sqrt 2` labelling), each evaluated on the same random
 //! reachable configurations against the exact model (TP, TN, FP, FN) and timed per query,
@@ -31,7 +31,7 @@
 //! every line of the table evicted (`clflush`) before each query. Timing costs two clock
 //! reads, shown as the "timer" rows (the floor of every figure, measured in the same run for
 //! both clocks, the same way: when their maximum is high, the machine was too busy for the
-//! maximum of any row to mean more). The shared table's previous layout (separate arrays) is
+//! maximum of any row to mean more). The shared table's separate-arrays layout (its peer) is
 //! timed in the same run, the two taking turns.
 //! Configurations whose TCP lies outside the sampled grid (none on the reference cells) would
 //! go to the exact check, as `TableChecker` does, and are counted apart.
@@ -243,7 +243,7 @@ struct Times {
     flushed: Vec<u64>,
 }
 
-/// As [`time_queries`] for a shared table and its previous layout, taking turns: the
+/// As [`time_queries`] for a shared table and its separate-arrays peer, taking turns: the
 /// table's times, then the peer's.
 fn time_with_peer(clock: Clock, table: &Table, peer: &SeparateArrays, cells: &[[u16; 6]], cold: usize) -> [Times; 2] {
     let (hot, hot_peer) =
@@ -585,9 +585,9 @@ fn main() {
                 };
                 let [times, peer_times] = match &peer {
                     Some(peer) => {
-                        // The previous layout answers as the table on every configuration.
+                        // The separate-arrays peer answers as the table on every configuration.
                         for &c in &cells {
-                            assert_eq!(peer.query(c), table.query(c), "{name} {label}: previous layout at {c:?}");
+                            assert_eq!(peer.query(c), table.query(c), "{name} {label}: separate-arrays peer at {c:?}");
                         }
                         time_with_peer(clock, &table, peer, &cells, cold)
                     }
@@ -604,7 +604,7 @@ fn main() {
                 if let Some(peer) = &peer {
                     let [h, s, f] = timing_cells(&peer_times, cold);
                     println!(
-                        "| {name} | {} | {label}, previous layout (same run, taking turns) | | {} | | {h} | {s} | {f} | | | | | |",
+                        "| {name} | {} | {label}, separate arrays (same run, taking turns) | | {} | | {h} | {s} | {f} | | | | | |",
                         opt.k,
                         peer.memory_bytes(),
                     );

@@ -1,5 +1,5 @@
 /*
- * bad_input.c: the C harness's bad-input scenarios (issue 5 item 3): every documented error
+ * bad_input.c: the C harness's bad-input scenarios: every documented error
  * status of the C ABI, in exact and in table mode, and the fail-closed outputs: a query that
  * fails never reads FREE, a failed init leaves a NULL handle, which then queries as
  * DC_STATUS_NULL_POINTER with DC_VERDICT_STOP.

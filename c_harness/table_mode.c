@@ -1,5 +1,5 @@
 /*
- * table_mode.c: one trajectory scenario with the POU in table mode (issue 3 item 6; thesis
+ * table_mode.c: one trajectory scenario with the POU in table mode (thesis
  * 3.2 query phase, SPEC section 6).
  *
  * Start-up reads the cell's table file into memory, initialises the POU with

@@ -1,4 +1,4 @@
-//! The C harness (thesis appendix A.1, SPEC §5; issue 3 item 6, issue 5 item 3): builds
+//! The C harness (thesis appendix A.1, SPEC §5): builds
 //! `c_harness/*.c` with the system C compiler against the generated header
 //! `include/delta_collide.h` and the static library, builds the table files of T1, T2 and T3
 //! (k = 32, 6-D, certified labels), runs the harness from the repository root in exact and
@@ -70,7 +70,7 @@ fn plain_harness() -> &'static Path {
 }
 
 /// The table kinds the harness runs on: the thesis's 6-D linear quadtree and the shared 6-D
-/// quadtree (issue 4), both built from one certified labelling.
+/// quadtree, both built from one certified labelling.
 const KINDS: [(&str, Variant); 2] = [("6d", Variant::D6), ("shared", Variant::Shared)];
 
 /// The table files of `CELLS[c]`, one per [`KINDS`] (the pipeline of `delta-collide build
@@ -162,7 +162,7 @@ fn c_harness_passes_in_exact_and_table_mode() {
     harness_passes_with_tables(0);
 }
 
-/// The same scenarios on the shared 6-D quadtree (issue 4 item 3).
+/// The same scenarios on the shared 6-D quadtree.
 #[test]
 fn c_harness_passes_on_the_shared_table() {
     harness_passes_with_tables(1);

@@ -1,4 +1,4 @@
-//! Cross builds for the controller, run (issue 5, portability; README "Portability and
+//! Cross builds for the controller, run (README "Portability and
 //! cross-compiling"):
 //! - 64-bit ARM (`aarch64-unknown-linux-gnu`) and 32-bit ARM with hard float
 //!   (`armv7-unknown-linux-gnueabihf`): the controller's library

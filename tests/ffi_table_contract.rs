@@ -1,4 +1,4 @@
-//! The C ABI's table mode (issue 3 item 6), exercised from Rust through the exported
+//! The C ABI's table mode, exercised from Rust through the exported
 //! functions: every table error's own status and message with no handle, fail-closed
 //! reports and pair results, no FREE where the exact model collides, files like buffers.
 //! Tables of T1 and T2 are built here at k = 16.

@@ -351,7 +351,7 @@ fn chain_and_direct_models_give_the_same_boxes() {
 }
 
 proptest! {
-    // About a third of this box lies outside the reachable workspace (CI, session 5: 1,024
+    // About a third of this box lies outside the reachable workspace (a CI run: 1,024
     // rejects for 1,906 accepted, 35 %), so 2,000 accepted cases take about 1,000 rejects on
     // average, as many as proptest's default cap of 1,024: the test failed on some seeds. The
     // cap is raised to 10 rejects per accepted case: a box that drifted out of reach would

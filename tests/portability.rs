@@ -1,4 +1,4 @@
-//! Portability to the controller (issue 5 item 5): the link line of the static library is
+//! Portability to the controller: the link line of the static library is
 //! pinned, the per-tick code builds without std, and there is no SIMD path that would need
 //! a CPU feature beyond the target's baseline. The cross builds for ARM Linux and the run on
 //! an x86-64 CPU without AVX are in `tests/cross.rs`.

@@ -1,4 +1,4 @@
-//! The table file format (issue 3 item 5): round trips, and every kind of damage gives its
+//! The table file format: round trips, and every kind of damage gives its
 //! specific `TableError`, never a panic nor a table that loads. Corrupted files kept in
 //! `tests/data/` are described in `tests/data/README.md`.
 

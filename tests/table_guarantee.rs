@@ -1,4 +1,4 @@
-//! The safety guarantee of a labelled configuration space (SPEC §6, issue 3 item 4): over at
+//! The safety guarantee of a labelled configuration space (SPEC §6): over at
 //! least a million random off-grid configurations per reference cell, the certified labels
 //! never report free where the exact physical model (margin 0) collides. The thesis's global
 //! blow-up `r / sqrt(2)` is measured the same way and its false negatives are printed, not

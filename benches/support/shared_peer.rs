@@ -1,5 +1,5 @@
-//! The shared table's previous query layout, the peer of `table_report`'s shared rows (issue
-//! 4): masks, bases and child indices in separate arrays, nodes depth by depth; a query reads
+//! The shared table's query layout with separate arrays, the peer of `table_report`'s shared
+//! rows: masks, bases and child indices in separate arrays, nodes depth by depth; a query reads
 //! per node step the mask pair and the base, then the child index, and at the end one leaf
 //! (at most `levels + sub_levels - 1` steps). Built from [`SharedQuadtree6d::parts`], so it
 //! holds the same nodes, and timed in the same run as the table's own layout.
@@ -7,7 +7,7 @@
 use delta_collide::table::shared6d::ChildIndices;
 use delta_collide::table::SharedQuadtree6d;
 
-/// The previous layout (see the module doc).
+/// The separate-arrays layout (see the module doc).
 pub struct SeparateArrays {
     fine: u32,
     symmetric: bool,

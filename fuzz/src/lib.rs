@@ -1,4 +1,4 @@
-//! The fuzz targets of delta-collide (issue 5 item 2), as plain functions over bytes.
+//! The fuzz targets of delta-collide, as plain functions over bytes.
 //!
 //! Each `fuzz_targets/<name>.rs` binary hands libFuzzer's input to one of them; the main
 //! crate's `tests/fuzz_short.rs` compiles this same file (`#[path]`) to replay the committed

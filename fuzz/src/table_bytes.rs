@@ -1,5 +1,5 @@
 //! Target `table_bytes`: a table file's bytes, loaded with `table::from_bytes` and with
-//! `TableChecker::new`, then queried (issue 3 item 5: "a loaded table never panics nor reads
+//! `TableChecker::new`, then queried ("a loaded table never panics nor reads
 //! out of bounds").
 //!
 //! The input is loaded twice: as it is, and *sealed*: its fingerprint field set to the

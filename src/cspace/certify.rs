@@ -85,7 +85,7 @@ pub struct CertifiedSpace {
 
 /// Sub-cell labels of the pairs labelled collision: each such 6-D cell cut into its 64
 /// sub-cells (A's octant `i` x B's octant `j`), each proved free or not with the octants'
-/// own bounds and, failing that, the sub-octants' (levels 2 and 3 of the module doc; issue 4:
+/// own bounds and, failing that, the sub-octants' (levels 2 and 3 of the module doc;
 /// adaptive resolution where the labels change).
 ///
 /// Bit `c` of a mask is the sub-cell with child index `c = ax << 5 | ay << 4 | az << 3 |

@@ -1,5 +1,5 @@
 //! The safety guarantee of a table: how far any point of any box of a robot can move while
-//! its TCP stays inside one grid cell (thesis 3.2.7, SPEC §6; issue 3 item 4).
+//! its TCP stays inside one grid cell (thesis 3.2.7, SPEC §6).
 //!
 //! The thesis blows the model up by `r / sqrt(2)`, the TCP's worst displacement in a 2-D
 //! square. That is not a proof: the cube's half-diagonal is `r sqrt(3) / 2`, and a link point
@@ -12,7 +12,7 @@
 //! of its points). So if the inflated centre boxes of A and B are disjoint, no configuration
 //! of the 6-D cell collides: a free label is a proof.
 //!
-//! # Direction-aware form (issue 4)
+//! # Direction-aware form
 //! The same derivation gives more than a length: each displacement is a sum of terms whose
 //! directions are known. The TCP's `D` lies in the cube `Z` of half-edges `h_a` (not just in
 //! the ball of radius `dp`); the elbow's `G - G0` lies in the arm's vertical plane (the disc

@@ -1,5 +1,5 @@
 //! Labelling every two-robot sample with the exact box test, in parallel (thesis 3.2.3,
-//! 3.2.7; SPEC §6; issue 3 items 2 and 4).
+//! 3.2.7; SPEC §6).
 //!
 //! The product structure is used twice: each robot's boxes are built once per sample (IK,
 //! boxes, placement, inflation, axis-aligned bounds), never once per pair; and for one sample

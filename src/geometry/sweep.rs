@@ -1,5 +1,5 @@
 //! Swept boxes: an oriented box with a convex set of displacements of its points, and a
-//! separating-axis test between two of them (issue 4: certified labelling with a
+//! separating-axis test between two of them (certified labelling with a
 //! direction-aware bound, beyond the thesis's uniform blow-up of 3.2.7).
 //!
 //! # The displacement set

@@ -1,5 +1,5 @@
 //! Every variant against the raw labels and against the 6-D table, on every sample of
-//! several synthetic spaces (issue 3 item 3: "the variants with t = 0 answer exactly as the
+//! several synthetic spaces ("the variants with t = 0 answer exactly as the
 //! 6D table does on every sample").
 
 use super::synthetic::{space, Pattern};

@@ -35,9 +35,9 @@ pub enum Variant {
         /// Similarity threshold (0: lossless).
         t: u32,
     },
-    /// Issue 4: the 6-D quadtree with shared subtrees ([`SharedQuadtree6d`]).
+    /// The 6-D quadtree with shared subtrees ([`SharedQuadtree6d`]).
     Shared,
-    /// Issue 4: as `Shared`, with every certified collision cell cut into 64 sub-cells
+    /// As `Shared`, with every certified collision cell cut into 64 sub-cells
     /// certified on their own ([`crate::cspace::label_space_subdivided`]; certified labelling
     /// only).
     SharedSubdivided,

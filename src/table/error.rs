@@ -1,4 +1,4 @@
-//! Why a table cannot be built or loaded (issue 3 item 5; SPEC §6).
+//! Why a table cannot be built or loaded (SPEC §6).
 //!
 //! Every variant names the field it is about and the message says how to fix it, in the
 //! manner of regex-automata's deserialisation errors.

@@ -1,5 +1,5 @@
 //! The table file format: a fixed little-endian header, up to three sections and a checksum,
-//! validated once when loaded from a memory buffer (issue 3 item 5; SPEC §6).
+//! validated once when loaded from a memory buffer (SPEC §6).
 //!
 //! # Layout (all integers and floats little-endian)
 //! ```text

@@ -1,5 +1,5 @@
 //! Precomputed tables of the configuration space: the three linear quadtrees of the thesis,
-//! the shared 6-D quadtree (issue 4), their file format, and one [`Table`] enum to query them
+//! the shared 6-D quadtree, their file format, and one [`Table`] enum to query them
 //! (thesis 3.2.4-3.2.6 and 3.2.8; SPEC §6; issues 3 and 4).
 //!
 //! A table answers "is the 6-D grid cell `(ix, iy, iz, ix', iy', iz')` a collision" without
@@ -47,7 +47,7 @@ pub use quadtree6d::LinearQuadtree6d;
 pub use shared6d::{SharedParts, SharedQuadtree6d};
 
 /// One of the three table variants of the thesis (3.2.4, 3.2.5, 3.2.6) or the shared 6-D
-/// quadtree (issue 4).
+/// quadtree.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Table {
     /// Linear 6-D quadtree, condensed.
@@ -56,7 +56,7 @@ pub enum Table {
     D5(LinearQuadtree5d),
     /// Linear 4-D quadtree with grouped 2-D slices.
     D4(LinearQuadtree4d),
-    /// 6-D quadtree with shared subtrees (issue 4; beyond the thesis).
+    /// 6-D quadtree with shared subtrees (beyond the thesis).
     Shared(SharedQuadtree6d),
 }
 

@@ -1,6 +1,6 @@
 //! The shared 6-D quadtree: the 6-D quadtree of the labels with identical subtrees stored
-//! once (a directed acyclic graph), queried by a descent of at most `levels` nodes (issue 4;
-//! beyond the thesis: its chapter 4 and 3.2.3 suggest exploiting repetition and hashing
+//! once (a directed acyclic graph), queried by a descent of at most `levels` nodes (beyond
+//! the thesis: its chapter 4 and 3.2.3 suggest exploiting repetition and hashing
 //! similar slices; this hashes whole subtrees).
 //!
 //! # Structure

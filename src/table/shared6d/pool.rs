@@ -1,5 +1,5 @@
 //! The query layout of the shared 6-D quadtree: one array of `u64` words that a query descends
-//! with about one cache line per node step (issue 4: "median under 50 ns, maximum within 10x").
+//! with about one cache line per node step (its targets: median under 50 ns, maximum within 10x).
 //!
 //! # Layout
 //! ```text
