@@ -14,9 +14,10 @@ fn data(target: &str, name: &str) -> Vec<u8> {
     std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz").join(target).join(name)).unwrap()
 }
 
-/// c_abi, `fk_huge_re_nan_tcp.bin`: with `re = f64::MAX` (valid: finite and positive),
-/// `dc_delta3_forward_kinematics` returned `DC_STATUS_OK` with the TCP (NaN, NaN, -inf):
-/// `re * re` overflowed. Forward kinematics now reports an overflowing point as no solution.
+/// c_abi, `fk_huge_re_nan_tcp.bin`: with `re = f64::MAX` (then accepted: finite and
+/// positive), `dc_delta3_forward_kinematics` returned `DC_STATUS_OK` with the TCP (NaN, NaN,
+/// -inf): `re * re` overflowed. Forward kinematics reports an overflowing point as no solution,
+/// and the C ABI refuses a length above `math::MAX_LENGTH` (1e6 mm) as an invalid geometry.
 #[test]
 fn forward_kinematics_with_a_huge_lower_link_is_unreachable_not_nan() {
     let d = Delta3 { re: f64::MAX, ..Delta3::THESIS };
@@ -25,7 +26,7 @@ fn forward_kinematics_with_a_huge_lower_link_is_unreachable_not_nan() {
     let mut tcp = DcVec3 { x: 1.0, y: 2.0, z: 3.0 };
     // SAFETY: valid geometry, 3 readable doubles, writable output.
     let status = unsafe { dc_delta3_forward_kinematics(&g, [0.0; 3].as_ptr(), &mut tcp) };
-    assert_eq!(status, DC_STATUS_UNREACHABLE);
+    assert_eq!(status, DC_STATUS_INVALID_CONFIG);
     assert_eq!(tcp, DcVec3 { x: 1.0, y: 2.0, z: 3.0 }, "nothing written on failure");
 }
 

@@ -14,7 +14,7 @@ use crate::math::{float, Vec3};
 use crate::robot::RobotModel;
 use crate::table::format::from_bytes;
 use crate::table::{Header, Table, TableError};
-use alloc::{format, vec, vec::Vec};
+use alloc::{format, string::String, vec, vec::Vec};
 
 /// The answer of one table-backed query.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
