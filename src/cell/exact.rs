@@ -137,11 +137,6 @@ impl ExactChecker {
         &self.verdict
     }
 
-    /// Forgets the witness cache (answers never depend on it; only speed does).
-    pub fn reset_cache(&mut self) {
-        self.caches.iter_mut().for_each(|c| *c = WitnessCache::new());
-    }
-
     /// Checks one configuration: `tcps_mcs[j]` is robot `j`'s TCP in its own MCS.
     ///
     /// Unreachable or non-finite TCPs are reported in the verdict (their pairs are

@@ -115,18 +115,6 @@ pub fn sub_cell_index(i: usize, j: usize) -> u32 {
     b(i, 0) << 5 | b(i, 1) << 4 | b(i, 2) << 3 | b(j, 0) << 2 | b(j, 1) << 1 | b(j, 2)
 }
 
-impl CertifiedSpace {
-    /// The largest whole-cell displacement bound of A's sample `ia` (`reach_a[ia]`, mm).
-    pub fn reach_a(&self, ia: usize) -> Real {
-        self.bounds_a[ia].iter().copied().fold(0.0, Real::max)
-    }
-
-    /// The largest whole-cell displacement bound of B's sample `ib`.
-    pub fn reach_b(&self, ib: usize) -> Real {
-        self.bounds_b[ib].iter().copied().fold(0.0, Real::max)
-    }
-}
-
 /// Certified labels of every sample pair of the two-robot `cell` at `k` cells per axis, with
 /// octant refinement (see the module doc).
 ///

@@ -19,7 +19,7 @@
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{float, Mat3, Real, Vec3, MAX_LENGTH};
-use crate::robot::delta3::{radial, tangent, ArmSolution, Delta3, MotorCosSin, Unreachable};
+use crate::robot::delta3::{radial, tangent, Delta3, MotorCosSin, Unreachable};
 use alloc::{format, string::String};
 use core::f64::consts::PI;
 
@@ -187,11 +187,6 @@ impl RobotModel {
         let sol = self.delta.inverse_kinematics_cos_sin(tcp)?;
         self.write_boxes(tcp, &sol, out);
         Ok(())
-    }
-
-    /// The boxes for a TCP and its already solved motor angles (direct vector form).
-    pub fn boxes_from_solution(&self, tcp: &Vec3, sol: &ArmSolution) -> RobotBoxes {
-        self.boxes_from_cos_sin(tcp, &MotorCosSin { cos: sol.cos, sin: sol.sin })
     }
 
     /// The boxes for a TCP and the cosines and sines of its motor angles (direct vector form,
