@@ -9,6 +9,8 @@ pub mod config;
 pub mod exact;
 pub mod placement;
 #[cfg(feature = "std")]
+pub mod protective;
+#[cfg(feature = "std")]
 pub mod reference;
 pub mod trajectory;
 

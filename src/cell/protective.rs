@@ -1,0 +1,449 @@
+//! The protective verdict (SPEC §8): can both robots still stop, from this tick on, without
+//! any box of one touching any box of the other? FREE only when that is proved.
+//!
+//! # The bound
+//! 1. **Speed now.** The controller gives TCPs, not speeds. With `v_fd = |p - p_prev| / T`
+//!    (`T = tick_ms`) the average velocity over the last tick, the true speed now differs from
+//!    `|v_fd|` by at most `a_max T` (`|v(t) - v(s)| <= a_max |t - s|` for `s` in the tick), so
+//!    `v <= v_b := min(|v_fd| + a_max T, v_max)`. Without a previous TCP (first tick, after
+//!    any error) `v_b = v_max`. A step longer than `v_max T`, or a change of `v_fd` between
+//!    two ticks larger than `a_max T` (two consecutive averages differ by at most that), is
+//!    impossible under the model: [`ProtectiveStatus::ImplausibleMotion`], STOP.
+//! 2. **Latency of the verdict itself.** A FREE at tick `k` must cover a STOP issued at tick
+//!    `k + 1`: the robot then moves one more tick before its reaction starts. The reaction
+//!    time used is therefore `T_r = reaction_ms + tick_ms`.
+//! 3. **Where the TCP can be.** Along its path the TCP travels at most
+//!    `min(v_b T_r + a_max T_r^2 / 2, v_max T_r)` while reacting, then, braking from
+//!    `v_r = min(v_b + a_max T_r, v_max)` at `>= decel`, at most `v_r^2 / (2 decel)`: in all
+//!    `S` ([`StopModel::stopping_distance`]). The path is unknown, so every TCP of the whole
+//!    stop lies in the ball of radius `S` around the TCP now, hence in the cube of half-side
+//!    `S` around it (and in the robot's reachable space).
+//! 4. **Where the boxes can be.** [`cube_box_sweeps`] bounds, per box, the displacement of
+//!    every box point for every reachable TCP of that cube, measured from the TCP now (interval
+//!    inverse kinematics: elbows may swing far more than the TCP moves, SPEC §8); the
+//!    displacement set is a [`Sweep`] (MCS, rotated to the WCS with the robot's placement).
+//! 5. **Apart.** Box `i` of robot `a` over the stop lies in `box_i(now) + sweep_i`, and
+//!    likewise for `b`; [`swept_boxes_apart`] proves the two sums disjoint on one of the 15
+//!    axes (with a positive gap). All box pairs of all pairs that can meet proved: FREE.
+//!    Proved again with `warn_mm` added to one sweep's ball: else WARN. Any unproved pair,
+//!    unreachable TCP, unbounded sweep or status other than OK: STOP.
+//!
+//! The **speed limit** of a robot is the largest measured speed `|v_fd|` in `[0, v_max]` at
+//! which every pair involving it is still proved, the other robots as they are: bisection
+//! (at most [`LIMIT_STEPS`] + 2 evaluations) that keeps the last speed proved. 0 when not
+//! even standing still is proved; `v_max` when full speed is.
+//!
+//! Nothing here allocates after [`ProtectiveChecker::new`].
+
+use crate::cell::exact::PairVerdict;
+use crate::cell::{Cell, CellError, ExactChecker, QueryError};
+use crate::cspace::guarantee::{cube_box_sweeps, SPLITS};
+use crate::geometry::distance::obb_distance;
+use crate::geometry::witness::MAX_BOXES;
+use crate::geometry::{swept_boxes_apart, Obb, Sweep};
+use crate::math::{Real, Vec3};
+use crate::robot::RobotModel;
+#[cfg(doc)]
+use crate::robot::StopModel;
+
+/// Bisection steps of a speed limit (after the checks at 0 and at `v_max`).
+pub const LIMIT_STEPS: u32 = 8;
+
+/// Relative and absolute slack of the plausibility checks: rounding of the caller's own
+/// trajectory arithmetic must not read as an impossible motion.
+const PLAUSIBLE_SLACK: Real = 1e-9;
+
+/// The protective verdict of one tick.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Protective {
+    /// Proved: a stop started now ends with every box apart.
+    Free,
+    /// Proved, but with less than `warn_mm` to spare.
+    Warn,
+    /// Not proved (or a status other than OK): stop now.
+    Stop,
+}
+
+/// Why a tick has no proof to offer at all (the verdict is then STOP).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProtectiveStatus {
+    /// The inputs were usable.
+    Ok,
+    /// Robot `.0`'s TCP (or given speed) is NaN or infinite.
+    NonFinite(usize),
+    /// Robot `.0`'s TCP moved further, or changed its velocity more, in one tick than its
+    /// stopping model allows.
+    ImplausibleMotion(usize),
+    /// Robot `.0`'s TCP is outside its reach or motor limits.
+    Unreachable(usize),
+}
+
+/// Box `box_a` of robot `a` and box `box_b` of robot `b`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BoxPair {
+    /// First robot (`a < b`).
+    pub a: usize,
+    /// Second robot.
+    pub b: usize,
+    /// Box of `a` ([`RobotModel::boxes`] order).
+    pub box_a: usize,
+    /// Box of `b`.
+    pub box_b: usize,
+}
+
+/// What the verdict assumed and found for one robot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RobotProtection {
+    /// The measured speed `|v_fd|` (mm/s); `INFINITY` when there was no previous TCP.
+    pub speed_mm_s: Real,
+    /// The speed bound used, `v_b` (mm/s).
+    pub speed_bound_mm_s: Real,
+    /// `S`: how far the TCP may travel until it stands still (mm).
+    pub protective_mm: Real,
+    /// The largest measured speed at which FREE would still hold (mm/s; module doc).
+    pub speed_limit_mm_s: Real,
+}
+
+impl RobotProtection {
+    const UNKNOWN: RobotProtection =
+        RobotProtection { speed_mm_s: Real::INFINITY, speed_bound_mm_s: 0.0, protective_mm: 0.0, speed_limit_mm_s: 0.0 };
+}
+
+/// The result of one protective check.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProtectiveReport {
+    /// FREE, WARN or STOP.
+    pub verdict: Protective,
+    /// OK, or why there is no proof.
+    pub status: ProtectiveStatus,
+    /// The clearance of the cell now (mm, SPEC §8; 0 when boxes touch or intersect,
+    /// `INFINITY` when no pair can meet, NaN when not computed).
+    pub clearance_mm: Real,
+    /// The box pair of the smallest clearance now.
+    pub closest: Option<BoxPair>,
+    /// The first box pair not proved apart (STOP) or not with `warn_mm` to spare (WARN).
+    pub limiting: Option<BoxPair>,
+    /// One entry per robot.
+    pub robots: alloc::vec::Vec<RobotProtection>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct History {
+    tcp: Option<Vec3>,
+    /// The last finite-difference velocity (mm/s).
+    velocity: Option<Vec3>,
+}
+
+const NO_HISTORY: History = History { tcp: None, velocity: None };
+
+/// The protective check of one cell; keeps each robot's previous TCP between ticks.
+#[derive(Clone, Debug)]
+pub struct ProtectiveChecker {
+    exact: ExactChecker,
+    warn_mm: Real,
+    history: alloc::vec::Vec<History>,
+    /// Per robot, the WCS displacement sets of its boxes over the stop.
+    sweeps: alloc::vec::Vec<[Sweep; MAX_BOXES]>,
+    report: ProtectiveReport,
+}
+
+impl ProtectiveChecker {
+    /// A checker for `cell` (its `tick_ms` and stopping models) that warns with less than
+    /// `warn_mm` to spare.
+    ///
+    /// # Errors
+    /// [`CellError::Invalid`] when `warn_mm` is NaN, infinite or negative.
+    pub fn new(cell: Cell, warn_mm: Real) -> Result<Self, CellError> {
+        if !(warn_mm.is_finite() && warn_mm >= 0.0) {
+            return Err(CellError::Invalid(alloc::format!("warn_mm = {warn_mm} must be finite and >= 0")));
+        }
+        let n = cell.robots.len();
+        Ok(ProtectiveChecker {
+            exact: ExactChecker::new(cell),
+            warn_mm,
+            history: alloc::vec![NO_HISTORY; n],
+            sweeps: alloc::vec![[Sweep::ZERO; MAX_BOXES]; n],
+            report: ProtectiveReport {
+                verdict: Protective::Stop,
+                status: ProtectiveStatus::Ok,
+                clearance_mm: Real::NAN,
+                closest: None,
+                limiting: None,
+                robots: alloc::vec![RobotProtection::UNKNOWN; n],
+            },
+        })
+    }
+
+    /// The cell being checked.
+    pub fn cell(&self) -> &Cell {
+        self.exact.cell()
+    }
+
+    /// The WARN threshold (mm).
+    pub fn warn_mm(&self) -> Real {
+        self.warn_mm
+    }
+
+    /// The exact checker underneath (its boxes are those of the last check).
+    pub fn exact(&self) -> &ExactChecker {
+        &self.exact
+    }
+
+    /// The report of the last check.
+    pub fn report(&self) -> &ProtectiveReport {
+        &self.report
+    }
+
+    /// Forgets every previous TCP: the next tick assumes full speed (module doc, step 1).
+    pub fn reset(&mut self) {
+        self.history.fill(NO_HISTORY);
+    }
+
+    /// One tick: `tcps_mcs[j]` is robot `j`'s TCP now, in its own MCS; the speeds come from
+    /// the TCPs of the previous call (module doc).
+    ///
+    /// # Errors
+    /// [`QueryError::WrongRobotCount`] (the history is then left as it was).
+    pub fn check(&mut self, tcps_mcs: &[Vec3]) -> Result<&ProtectiveReport, QueryError> {
+        let n = self.cell().robots.len();
+        if tcps_mcs.len() != n {
+            return Err(QueryError::WrongRobotCount { expected: n, found: tcps_mcs.len() });
+        }
+        let tick_s = self.cell().tick_ms * 1e-3;
+        let mut status = ProtectiveStatus::Ok;
+        for (j, tcp) in tcps_mcs.iter().enumerate() {
+            let stop = self.exact.cell().stops[j];
+            let slot = &mut self.report.robots[j];
+            *slot = RobotProtection::UNKNOWN;
+            if !tcp.iter().all(|v| v.is_finite()) {
+                status = worse(status, ProtectiveStatus::NonFinite(j));
+                continue;
+            }
+            let Some(prev) = self.history[j].tcp else { continue };
+            let velocity = (tcp - prev) / tick_s;
+            let plausible = |x: Real, limit: Real| x <= limit * (1.0 + PLAUSIBLE_SLACK) + PLAUSIBLE_SLACK;
+            let accel_ok = self.history[j]
+                .velocity
+                .is_none_or(|v| plausible((velocity - v).norm(), stop.max_accel_mm_s2 * tick_s));
+            if !plausible(velocity.norm(), stop.max_speed_mm_s) || !accel_ok {
+                status = worse(status, ProtectiveStatus::ImplausibleMotion(j));
+            }
+            slot.speed_mm_s = velocity.norm();
+            self.history[j].velocity = Some(velocity);
+        }
+        if status == ProtectiveStatus::Ok {
+            for (h, tcp) in self.history.iter_mut().zip(tcps_mcs) {
+                h.tcp = Some(*tcp);
+            }
+        } else {
+            self.reset();
+        }
+        self.evaluate(tcps_mcs, status);
+        Ok(&self.report)
+    }
+
+    /// The verdict for TCPs `tcps_mcs` moving at measured speeds `speeds_mm_s` (`INFINITY`:
+    /// unknown, full speed), without reading or changing the history: for a controller that
+    /// knows its speeds, and to check a reported speed limit.
+    ///
+    /// # Errors
+    /// [`QueryError::WrongRobotCount`] when either slice's length differs from the robot count.
+    pub fn check_at_speeds(&mut self, tcps_mcs: &[Vec3], speeds_mm_s: &[Real]) -> Result<&ProtectiveReport, QueryError> {
+        let n = self.cell().robots.len();
+        for len in [tcps_mcs.len(), speeds_mm_s.len()] {
+            if len != n {
+                return Err(QueryError::WrongRobotCount { expected: n, found: len });
+            }
+        }
+        let mut status = ProtectiveStatus::Ok;
+        for (j, (tcp, &v)) in tcps_mcs.iter().zip(speeds_mm_s).enumerate() {
+            self.report.robots[j] = RobotProtection { speed_mm_s: v, ..RobotProtection::UNKNOWN };
+            if !tcp.iter().all(|x| x.is_finite()) || v.is_nan() || v < 0.0 {
+                status = worse(status, ProtectiveStatus::NonFinite(j));
+            }
+        }
+        self.evaluate(tcps_mcs, status);
+        Ok(&self.report)
+    }
+
+    /// Fills the report from the TCPs and the measured speeds already in `report.robots`.
+    fn evaluate(&mut self, tcps_mcs: &[Vec3], status: ProtectiveStatus) {
+        let report = &mut self.report;
+        (report.verdict, report.status, report.clearance_mm) = (Protective::Stop, status, Real::NAN);
+        (report.closest, report.limiting) = (None, None);
+        if status != ProtectiveStatus::Ok {
+            return;
+        }
+        let Ok(exact) = self.exact.check(tcps_mcs) else { return };
+        if let Some((j, _)) = exact.first_unreachable {
+            self.report.status = ProtectiveStatus::Unreachable(j);
+            return;
+        }
+        let (clearance, closest) = clearance_now(&self.exact);
+        (self.report.clearance_mm, self.report.closest) = (clearance, closest);
+        for (j, tcp) in tcps_mcs.iter().enumerate() {
+            let v = self.report.robots[j].speed_mm_s;
+            let (s, sweeps) = self.stop_sweeps(j, tcp, v);
+            let bound = self.speed_bound(j, v);
+            let r = &mut self.report.robots[j];
+            (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
+            self.sweeps[j] = sweeps;
+        }
+        let pairs = &self.exact.verdict().pairs;
+        let boxes = |j: usize| self.exact.boxes(j).as_slice();
+        self.report.limiting = first_unproved(pairs, &boxes, &self.sweeps, None, 0.0);
+        self.report.verdict = if self.report.limiting.is_some() {
+            Protective::Stop
+        } else if self.warn_mm > 0.0 {
+            self.report.limiting = first_unproved(pairs, &boxes, &self.sweeps, None, self.warn_mm);
+            if self.report.limiting.is_some() { Protective::Warn } else { Protective::Free }
+        } else {
+            Protective::Free
+        };
+        for j in 0..tcps_mcs.len() {
+            self.report.robots[j].speed_limit_mm_s = self.speed_limit(j, &tcps_mcs[j]);
+        }
+    }
+
+    /// `v_b` of robot `j` for measured speed `v` (module doc, step 1).
+    fn speed_bound(&self, j: usize, v: Real) -> Real {
+        let stop = &self.cell().stops[j];
+        let bound = v + stop.max_accel_mm_s2 * self.cell().tick_ms * 1e-3;
+        if bound.is_finite() { bound.min(stop.max_speed_mm_s) } else { stop.max_speed_mm_s }
+    }
+
+    /// `S` and the WCS box sweeps of robot `j` at `tcp_mcs` for measured speed `v`.
+    fn stop_sweeps(&self, j: usize, tcp_mcs: &Vec3, v: Real) -> (Real, [Sweep; MAX_BOXES]) {
+        let cell = self.cell();
+        let reaction_s = (cell.stops[j].reaction_ms + cell.tick_ms) * 1e-3;
+        let s = cell.stops[j].stopping_distance(self.speed_bound(j, v), reaction_s);
+        let robot = &cell.robots[j];
+        (s, stop_sweeps_wcs(&robot.model, &robot.placement.rotation(), tcp_mcs, s))
+    }
+
+    /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are.
+    fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3) -> Real {
+        let saved = self.sweeps[j];
+        let proved = |me: &mut Self, v: Real| {
+            me.sweeps[j] = me.stop_sweeps(j, tcp_mcs, v).1;
+            let boxes = |i: usize| me.exact.boxes(i).as_slice();
+            first_unproved(&me.exact.verdict().pairs, &boxes, &me.sweeps, Some(j), 0.0).is_none()
+        };
+        let vmax = self.cell().stops[j].max_speed_mm_s;
+        let limit = if proved(self, vmax) {
+            vmax
+        } else if !proved(self, 0.0) {
+            0.0
+        } else {
+            let (mut lo, mut hi) = (0.0, vmax);
+            for _ in 0..LIMIT_STEPS {
+                let mid = 0.5 * (lo + hi);
+                if proved(self, mid) { lo = mid } else { hi = mid }
+            }
+            lo
+        };
+        self.sweeps[j] = saved;
+        limit
+    }
+}
+
+/// The status that wins when several robots fail: non-finite, then implausible, then
+/// unreachable; the lowest robot index first within one kind.
+fn worse(a: ProtectiveStatus, b: ProtectiveStatus) -> ProtectiveStatus {
+    let rank = |s: &ProtectiveStatus| match s {
+        ProtectiveStatus::Ok => 0,
+        ProtectiveStatus::Unreachable(_) => 1,
+        ProtectiveStatus::ImplausibleMotion(_) => 2,
+        ProtectiveStatus::NonFinite(_) => 3,
+    };
+    if rank(&b) > rank(&a) { b } else { a }
+}
+
+/// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
+/// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded.
+pub fn stop_sweeps_wcs(model: &RobotModel, rot_wcs: &crate::math::Mat3, tcp_mcs: &Vec3, s: Real) -> [Sweep; MAX_BOXES] {
+    match cube_box_sweeps(model, tcp_mcs, s, tcp_mcs, SPLITS) {
+        Some(sweeps) => sweeps.map(|w| w.rotated(rot_wcs)),
+        None => [Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES],
+    }
+}
+
+/// The first box pair (of the pairs involving `only`, or of all pairs) not proved apart
+/// with `extra` mm added to the first robot's sweep.
+fn first_unproved<'a>(
+    pairs: &[PairVerdict],
+    boxes: &impl Fn(usize) -> &'a [Obb],
+    sweeps: &[[Sweep; MAX_BOXES]],
+    only: Option<usize>,
+    extra: Real,
+) -> Option<BoxPair> {
+    for p in pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
+        for (i, box_a) in boxes(p.a).iter().enumerate() {
+            let sa = Sweep { ball: sweeps[p.a][i].ball + extra, ..sweeps[p.a][i] };
+            for (k, box_b) in boxes(p.b).iter().enumerate() {
+                if !swept_boxes_apart(box_a, &sa, box_b, &sweeps[p.b][k]) {
+                    return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
+                }
+            }
+        }
+    }
+    None
+}
+
+/// The clearance of the cell as of the exact checker's last check and its closest box pair:
+/// the one place that computes it (mm; 0 when boxes touch or intersect).
+pub fn clearance_now(exact: &ExactChecker) -> (Real, Option<BoxPair>) {
+    let mut best = (Real::INFINITY, None);
+    for p in &exact.verdict().pairs {
+        for (i, box_a) in exact.boxes(p.a).as_slice().iter().enumerate() {
+            for (k, box_b) in exact.boxes(p.b).as_slice().iter().enumerate() {
+                let d = obb_distance(box_a, box_b);
+                if !(d >= best.0) {
+                    best = (d, Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k }));
+                }
+            }
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::reference::reference_cell;
+
+    fn checker(name: &str) -> ProtectiveChecker {
+        ProtectiveChecker::new(reference_cell(name).unwrap(), 10.0).unwrap()
+    }
+
+    #[test]
+    fn far_apart_and_still_is_free_and_close_at_speed_is_stop() {
+        let mut c = checker("T1");
+        let (a, b) = (Vec3::new(-150.0, 0.0, -450.0), Vec3::new(150.0, 0.0, -450.0));
+        // First tick: full speed assumed.
+        let r = c.check(&[a, b]).unwrap().clone();
+        assert_eq!(r.status, ProtectiveStatus::Ok);
+        assert_eq!(r.robots[0].speed_bound_mm_s, 4_600.0);
+        // Standing still: the bound is the reaction only.
+        let r = c.check(&[a, b]).unwrap().clone();
+        assert_eq!(r.verdict, Protective::Free, "{r:?}");
+        assert!(r.clearance_mm > 100.0);
+        assert!(r.robots.iter().all(|x| x.speed_limit_mm_s > 0.0));
+        let close = [Vec3::new(60.0, 30.0, -420.0), Vec3::new(-60.0, -30.0, -430.0)];
+        let r = c.check_at_speeds(&close, &[4_000.0, 4_000.0]).unwrap();
+        assert_eq!(r.verdict, Protective::Stop);
+    }
+
+    #[test]
+    fn jumps_and_unreachable_tcps_are_statuses_with_stop() {
+        let mut c = checker("T1");
+        let (a, b) = (Vec3::new(-150.0, 0.0, -450.0), Vec3::new(150.0, 0.0, -450.0));
+        c.check(&[a, b]).unwrap();
+        let r = c.check(&[a + Vec3::new(10.0, 0.0, 0.0), b]).unwrap();
+        assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::ImplausibleMotion(0)));
+        let r = c.check(&[a, Vec3::new(0.0, 0.0, 100.0)]).unwrap();
+        assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Unreachable(1)));
+        let r = c.check(&[a, Vec3::new(Real::NAN, 0.0, -450.0)]).unwrap();
+        assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::NonFinite(1)));
+    }
+}
