@@ -285,6 +285,9 @@ fn implausible_jumps_unreachable_and_non_finite_tcps_stop() {
     c.reset();
     let r = c.check(&[a, Vec3::new(0.0, 0.0, -700.0)]).unwrap();
     assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Unreachable(1)));
+    // An unreachable TCP is no history either.
+    let r = c.check(&[a, b]).unwrap();
+    assert_eq!((r.status, r.robots[1].speed_bound_mm_s), (ProtectiveStatus::Ok, 4_600.0));
     let r = c.check(&[Vec3::new(0.0, Real::INFINITY, -450.0), b]).unwrap();
     assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::NonFinite(0)));
     assert!(c.check(&[a]).is_err());

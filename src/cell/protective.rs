@@ -52,6 +52,10 @@ use crate::robot::StopModel;
 /// to `2 + LIMIT_STEPS + 1` sweep sets per robot.
 pub const SPLITS: u32 = 2;
 
+/// The WARN threshold of the C ABI until `dc_set_stop_model` sets one (mm): the 10 mm by which
+/// the practical scenarios clear the robots (SPEC §5).
+pub const DEFAULT_WARN_MM: Real = 10.0;
+
 /// Bisection steps of a speed limit (after the checks at 0 and at `v_max`).
 pub const LIMIT_STEPS: u32 = 8;
 
@@ -237,14 +241,15 @@ impl ProtectiveChecker {
             slot.speed_mm_s = velocity.norm();
             self.history[j].velocity = Some(velocity);
         }
-        if status == ProtectiveStatus::Ok {
+        self.evaluate(tcps_mcs, status);
+        // Only a tick without error (unreachable included) becomes the next one's history.
+        if self.report.status == ProtectiveStatus::Ok {
             for (h, tcp) in self.history.iter_mut().zip(tcps_mcs) {
                 h.tcp = Some(*tcp);
             }
         } else {
             self.reset();
         }
-        self.evaluate(tcps_mcs, status);
         Ok(&self.report)
     }
 
