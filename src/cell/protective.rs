@@ -311,8 +311,8 @@ impl ProtectiveChecker {
         } else {
             Protective::Free
         };
-        for j in 0..tcps_mcs.len() {
-            self.report.robots[j].speed_limit_mm_s = self.speed_limit(j, &tcps_mcs[j]);
+        for (j, tcp) in tcps_mcs.iter().enumerate() {
+            self.report.robots[j].speed_limit_mm_s = self.speed_limit(j, tcp);
         }
     }
 
@@ -409,7 +409,8 @@ pub fn clearance_now(exact: &ExactChecker) -> (Real, Option<BoxPair>) {
         for (i, box_a) in exact.boxes(p.a).as_slice().iter().enumerate() {
             for (k, box_b) in exact.boxes(p.b).as_slice().iter().enumerate() {
                 let d = obb_distance(box_a, box_b);
-                if !(d >= best.0) {
+                // A NaN distance (a non-finite box) wins, so it shows in the report.
+                if d.is_nan() || d < best.0 {
                     best = (d, Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k }));
                 }
             }

@@ -32,7 +32,7 @@ impl InitError {
 /// How a collider answers.
 enum Checker {
     /// Every box pair with the separating axis test (thesis 3.1).
-    Exact(ExactChecker),
+    Exact(Box<ExactChecker>),
     /// One lookup in a table built offline for a two-robot cell (thesis 3.2).
     Table(Box<TableChecker>),
 }
@@ -58,7 +58,7 @@ impl Collider {
         let n = cell.robots.len();
         Collider {
             protective: protective_for(&cell),
-            checker: Checker::Exact(ExactChecker::new(cell)),
+            checker: Checker::Exact(Box::new(ExactChecker::new(cell))),
             tcps: vec![Vec3::zeros(); n],
             table_collides: false,
         }
