@@ -22,6 +22,10 @@
 //!    every box point for every reachable TCP of that cube, measured from the TCP now (interval
 //!    inverse kinematics: elbows may swing far more than the TCP moves, SPEC §8); the
 //!    displacement set is a [`Sweep`] (MCS, rotated to the WCS with the robot's placement).
+//!    Its TCP term (the cube of half-side `S`, weighted `e_k`) may equally be replaced by the
+//!    ball of radius `S` that holds the TCP (weight `max e_k`): two sound forms of one bound
+//!    ([`SweepForms`]); a box pair is proved apart when any combination of forms proves it
+//!    (the cube is tighter where the separating axis is a world axis, the ball elsewhere).
 //! 5. **Apart.** Box `i` of robot `a` over the stop lies in `box_i(now) + sweep_i`, and
 //!    likewise for `b`; [`swept_boxes_apart`] proves the two sums disjoint on one of the 15
 //!    axes (with a positive gap). All box pairs of all pairs that can meet proved: FREE.
@@ -153,7 +157,7 @@ pub struct ProtectiveChecker {
     warn_mm: Real,
     history: alloc::vec::Vec<History>,
     /// Per robot, the WCS displacement sets of its boxes over the stop.
-    sweeps: alloc::vec::Vec<[Sweep; MAX_BOXES]>,
+    sweeps: alloc::vec::Vec<SweepForms>,
     report: ProtectiveReport,
 }
 
@@ -172,7 +176,7 @@ impl ProtectiveChecker {
             exact: ExactChecker::new(cell),
             warn_mm,
             history: alloc::vec![NO_HISTORY; n],
-            sweeps: alloc::vec![[Sweep::ZERO; MAX_BOXES]; n],
+            sweeps: alloc::vec![[[Sweep::ZERO; MAX_BOXES]; 2]; n],
             report: ProtectiveReport {
                 verdict: Protective::Stop,
                 status: ProtectiveStatus::Ok,
@@ -324,7 +328,7 @@ impl ProtectiveChecker {
     }
 
     /// `S` and the WCS box sweeps of robot `j` at `tcp_mcs` for measured speed `v`.
-    fn stop_sweeps(&self, j: usize, tcp_mcs: &Vec3, v: Real) -> (Real, [Sweep; MAX_BOXES]) {
+    fn stop_sweeps(&self, j: usize, tcp_mcs: &Vec3, v: Real) -> (Real, SweepForms) {
         let cell = self.cell();
         let reaction_s = (cell.stops[j].reaction_ms + cell.tick_ms) * 1e-3;
         let s = cell.stops[j].stopping_distance(self.speed_bound(j, v), reaction_s);
@@ -372,27 +376,45 @@ fn worse(a: ProtectiveStatus, b: ProtectiveStatus) -> ProtectiveStatus {
 
 /// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
 /// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded.
-pub fn stop_sweeps_wcs(model: &RobotModel, rot_wcs: &crate::math::Mat3, tcp_mcs: &Vec3, s: Real) -> [Sweep; MAX_BOXES] {
+pub fn stop_sweeps_wcs(model: &RobotModel, rot_wcs: &crate::math::Mat3, tcp_mcs: &Vec3, s: Real) -> SweepForms {
     match cube_box_sweeps(model, tcp_mcs, s, tcp_mcs, SPLITS) {
-        Some(sweeps) => sweeps.map(|w| w.rotated(rot_wcs)),
-        None => [Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES],
+        Some(sweeps) => {
+            // The TCP's own displacement lies in the ball of radius `s` (widened as the cube
+            // is in `cube_box_sweeps`), so its cube term may be traded for that ball.
+            let reach = s * (1.0 + 1e-12) + 1e-12;
+            let ball_form = |w: &Sweep| {
+                let [(e1, d1), (e2, d2)] = w.ends;
+                Sweep { cube: [Vec3::zeros(); 3], ends: [(0.0, d1), (0.0, d2)], ball: w.ball + e1.max(e2) * reach, ..*w }
+            };
+            [sweeps.map(|w| w.rotated(rot_wcs)), sweeps.map(|w| ball_form(&w).rotated(rot_wcs))]
+        }
+        None => [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2],
     }
 }
+
+/// Two forms of the same bound on each box's displacements (module doc, step 4): `[0]` with
+/// the TCP's motion as a cube, `[1]` as a ball; either alone is sound.
+pub type SweepForms = [[Sweep; MAX_BOXES]; 2];
 
 /// The first box pair (of the pairs involving `only`, or of all pairs) not proved apart
 /// with `extra` mm added to the first robot's sweep.
 fn first_unproved<'a>(
     pairs: &[PairVerdict],
     boxes: &impl Fn(usize) -> &'a [Obb],
-    sweeps: &[[Sweep; MAX_BOXES]],
+    sweeps: &[SweepForms],
     only: Option<usize>,
     extra: Real,
 ) -> Option<BoxPair> {
+    const FORMS: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
     for p in pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
         for (i, box_a) in boxes(p.a).iter().enumerate() {
-            let sa = Sweep { ball: sweeps[p.a][i].ball + extra, ..sweeps[p.a][i] };
             for (k, box_b) in boxes(p.b).iter().enumerate() {
-                if !swept_boxes_apart(box_a, &sa, box_b, &sweeps[p.b][k]) {
+                let apart = |&(fa, fb): &(usize, usize)| {
+                    let sa = &sweeps[p.a][fa][i];
+                    let sa = Sweep { ball: sa.ball + extra, ..*sa };
+                    swept_boxes_apart(box_a, &sa, box_b, &sweeps[p.b][fb][k])
+                };
+                if !FORMS.iter().any(apart) {
                     return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
                 }
             }
