@@ -450,3 +450,36 @@ fn scenario_counts_with_the_default_and_a_stiff_model() {
     scenario_counts(StopModel::DEFAULT, "default");
     scenario_counts(STIFF, "stiff");
 }
+
+/// `dc_protective_query` through the C ABI: no allocation per call, FREE for robots standing
+/// apart, and the report's per-robot fields filled.
+#[test]
+fn the_c_entry_point_never_allocates_and_fills_the_report() {
+    use delta_collide::ffi::*;
+    let mut robots = [dc_robot_config_thesis(); 2];
+    robots[1].translation = DcVec3 { x: 450.0, y: 0.0, z: 0.0 };
+    let config = DcCellConfig { robots: robots.as_ptr(), n_robots: 2, method: DC_METHOD_SAT_CACHE };
+    let mut h = std::ptr::null_mut();
+    // SAFETY: valid config and out pointer.
+    assert_eq!(unsafe { dc_init(&config, &mut h) }, DC_STATUS_OK);
+    let stops = [dc_stop_config_default(); 2];
+    // SAFETY: live handle, two readable configs.
+    assert_eq!(unsafe { dc_set_stop_model(h, 1.0, 10.0, stops.as_ptr(), 2) }, DC_STATUS_OK);
+    let tcps = [DcVec3 { x: -150.0, y: 0.0, z: -450.0 }, DcVec3 { x: 150.0, y: 0.0, z: -450.0 }];
+    let mut verdict = DC_VERDICT_STOP;
+    let mut report = std::mem::MaybeUninit::<DcProtectiveReport>::zeroed();
+    let before = allocations();
+    for _ in 0..1_000 {
+        // SAFETY: live handle, two readable TCPs, writable outputs.
+        let s = unsafe { dc_protective_query(h, tcps.as_ptr(), 2, &mut verdict, report.as_mut_ptr()) };
+        assert_eq!(s, DC_STATUS_OK);
+    }
+    assert_eq!(allocations(), before);
+    // SAFETY: written by every call above.
+    let report = unsafe { report.assume_init() };
+    assert_eq!((verdict, report.verdict, report.n_robots), (DC_VERDICT_FREE, DC_VERDICT_FREE, 2));
+    assert!(report.clearance_mm > 100.0 && report.protective_mm[0] > 0.0 && report.speed_limit_mm_s[1] > 0.0);
+    assert_eq!((report.closest_robot_a, report.closest_robot_b, report.limiting_robot_a), (0, 1, DC_BOX_NONE));
+    // SAFETY: live handle, destroyed once.
+    unsafe { dc_destroy(h) };
+}
