@@ -17,9 +17,14 @@
 //!    `v_r = min(v_b + a_max T_r, v_max)` at `>= decel`, at most `v_r^2 / (2 decel)`: in all
 //!    `S` ([`StopModel::stopping_distance`]). The path is unknown, so every TCP of the whole
 //!    stop lies in the ball of radius `S` around the TCP now, hence in the cube of half-side
-//!    `S` around it (and in the robot's reachable space).
+//!    `S` around it (and in the robot's reachable space). With a measured velocity `v_fd`
+//!    the direction is known during the reaction: the TCP is within `a_max T t + a_max t^2/2`
+//!    of `p + v_fd t`, so the whole stop lies in the capsule around `p .. p + v_fd T_r` of
+//!    radius `S - |v_fd| T_r`, and in the ball around its middle of radius
+//!    `S - |v_fd| T_r / 2` ([`capsule_ball`]); that ball is used, with the boxes built at its
+//!    centre, when the centre is reachable.
 //! 4. **Where the boxes can be.** [`cube_box_sweeps`] bounds, per box, the displacement of
-//!    every box point for every reachable TCP of that cube, measured from the TCP now (interval
+//!    every box point for every reachable TCP of that cube, measured from its centre (interval
 //!    inverse kinematics: elbows may swing far more than the TCP moves, SPEC §8); the
 //!    displacement set is a [`Sweep`] (MCS, rotated to the WCS with the robot's placement).
 //!    Its TCP term (the cube of half-side `S`, weighted `e_k`) may equally be replaced by the
@@ -46,9 +51,7 @@ use crate::geometry::distance::obb_distance;
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::{swept_boxes_apart, Obb, Sweep};
 use crate::math::{Real, Vec3};
-use crate::robot::RobotModel;
-#[cfg(doc)]
-use crate::robot::StopModel;
+use crate::robot::{RobotBoxes, RobotModel, StopModel};
 
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`SPLITS^3` per
 /// arm). The cubes here are tens to hundreds of mm, where finer splits shrink the sweeps by
@@ -158,6 +161,10 @@ pub struct ProtectiveChecker {
     history: alloc::vec::Vec<History>,
     /// Per robot, the WCS displacement sets of its boxes over the stop.
     sweeps: alloc::vec::Vec<SweepForms>,
+    /// Per robot, the measured velocity of this tick (MCS, mm/s; zero when unknown).
+    velocity: alloc::vec::Vec<Vec3>,
+    /// Per robot, its boxes (WCS) at the reference TCP its sweeps are measured from.
+    ref_boxes: alloc::vec::Vec<RobotBoxes>,
     report: ProtectiveReport,
 }
 
@@ -177,6 +184,8 @@ impl ProtectiveChecker {
             warn_mm,
             history: alloc::vec![NO_HISTORY; n],
             sweeps: alloc::vec![[[Sweep::ZERO; MAX_BOXES]; 2]; n],
+            velocity: alloc::vec![Vec3::zeros(); n],
+            ref_boxes: alloc::vec![RobotBoxes::empty(); n],
             report: ProtectiveReport {
                 verdict: Protective::Stop,
                 status: ProtectiveStatus::Ok,
@@ -229,6 +238,7 @@ impl ProtectiveChecker {
             let stop = self.exact.cell().stops[j];
             let slot = &mut self.report.robots[j];
             *slot = RobotProtection::UNKNOWN;
+            self.velocity[j] = Vec3::zeros();
             if !tcp.iter().all(|v| v.is_finite()) {
                 status = worse(status, ProtectiveStatus::NonFinite(j));
                 continue;
@@ -243,6 +253,7 @@ impl ProtectiveChecker {
                 status = worse(status, ProtectiveStatus::ImplausibleMotion(j));
             }
             slot.speed_mm_s = velocity.norm();
+            self.velocity[j] = velocity;
             self.history[j].velocity = Some(velocity);
         }
         self.evaluate(tcps_mcs, status);
@@ -273,6 +284,7 @@ impl ProtectiveChecker {
         let mut status = ProtectiveStatus::Ok;
         for (j, (tcp, &v)) in tcps_mcs.iter().zip(speeds_mm_s).enumerate() {
             self.report.robots[j] = RobotProtection { speed_mm_s: v, ..RobotProtection::UNKNOWN };
+            self.velocity[j] = Vec3::zeros();
             if !tcp.iter().all(|x| x.is_finite()) || v.is_nan() || v < 0.0 {
                 status = worse(status, ProtectiveStatus::NonFinite(j));
             }
@@ -298,14 +310,13 @@ impl ProtectiveChecker {
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let v = self.report.robots[j].speed_mm_s;
-            let (s, sweeps) = self.stop_sweeps(j, tcp, v);
+            let s = self.stop_sweeps(j, tcp, v);
             let bound = self.speed_bound(j, v);
             let r = &mut self.report.robots[j];
             (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
-            self.sweeps[j] = sweeps;
         }
         let pairs = &self.exact.verdict().pairs;
-        let boxes = |j: usize| self.exact.boxes(j).as_slice();
+        let boxes = |j: usize| self.ref_boxes[j].as_slice();
         self.report.limiting = first_unproved(pairs, &boxes, &self.sweeps, None, 0.0);
         self.report.verdict = if self.report.limiting.is_some() {
             Protective::Stop
@@ -327,21 +338,39 @@ impl ProtectiveChecker {
         if bound.is_finite() { bound.min(stop.max_speed_mm_s) } else { stop.max_speed_mm_s }
     }
 
-    /// `S` and the WCS box sweeps of robot `j` at `tcp_mcs` for measured speed `v`.
-    fn stop_sweeps(&self, j: usize, tcp_mcs: &Vec3, v: Real) -> (Real, SweepForms) {
-        let cell = self.cell();
-        let reaction_s = (cell.stops[j].reaction_ms + cell.tick_ms) * 1e-3;
-        let s = cell.stops[j].stopping_distance(self.speed_bound(j, v), reaction_s);
+    /// Sets robot `j`'s reference boxes and sweeps for TCP `tcp_mcs` at measured speed `v`
+    /// (along the measured velocity's direction, when known); returns `S`.
+    fn stop_sweeps(&mut self, j: usize, tcp_mcs: &Vec3, v: Real) -> Real {
+        let cell = self.exact.cell();
+        let stop = cell.stops[j];
+        let reaction_s = (stop.reaction_ms + cell.tick_ms) * 1e-3;
+        let s = stop.stopping_distance(self.speed_bound(j, v), reaction_s);
+        let (centre, radius) = capsule_ball(&stop, cell.tick_ms * 1e-3, reaction_s, tcp_mcs, &self.velocity[j], v, s);
         let robot = &cell.robots[j];
-        (s, stop_sweeps_wcs(&robot.model, &robot.placement.rotation(), tcp_mcs, s))
+        let (rot, t) = (robot.placement.rotation(), robot.placement.t);
+        let (centre, radius) = match robot.model.boxes_into(&centre, &mut self.ref_boxes[j]) {
+            Ok(()) if centre != *tcp_mcs => (centre, radius),
+            _ => {
+                self.ref_boxes[j] = *self.exact.boxes(j);
+                (*tcp_mcs, s)
+            }
+        };
+        if centre != *tcp_mcs {
+            let boxes = &mut self.ref_boxes[j];
+            for b in &mut boxes.boxes[..boxes.len] {
+                *b = b.transformed(&rot, &t);
+            }
+        }
+        self.sweeps[j] = stop_sweeps_wcs(&robot.model, &rot, &centre, radius);
+        s
     }
 
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are.
     fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3) -> Real {
-        let saved = self.sweeps[j];
+        let saved = (self.sweeps[j], self.ref_boxes[j]);
         let proved = |me: &mut Self, v: Real| {
-            me.sweeps[j] = me.stop_sweeps(j, tcp_mcs, v).1;
-            let boxes = |i: usize| me.exact.boxes(i).as_slice();
+            me.stop_sweeps(j, tcp_mcs, v);
+            let boxes = |i: usize| me.ref_boxes[i].as_slice();
             first_unproved(&me.exact.verdict().pairs, &boxes, &me.sweeps, Some(j), 0.0).is_none()
         };
         let vmax = self.cell().stops[j].max_speed_mm_s;
@@ -357,9 +386,29 @@ impl ProtectiveChecker {
             }
             lo
         };
-        self.sweeps[j] = saved;
+        (self.sweeps[j], self.ref_boxes[j]) = saved;
         limit
     }
+}
+
+/// A ball holding every TCP of the stop when the measured velocity `velocity` is known
+/// (module doc, step 3, direction-aware): while reacting the TCP is within
+/// `a_max T t + a_max t^2 / 2` of `p + v_fd t` (`v_fd` scaled to speed `v`), then travels at
+/// most `L_b` more; all of it lies in the capsule around the segment from `p` to
+/// `p + v_fd T_r` of radius `R = a_max T T_r + a_max T_r^2 / 2 + L_b`, and so in the ball
+/// around the segment's middle of radius `R + v T_r / 2`. Returns that ball when it is
+/// smaller than the ball of radius `s` around `p`, else `(p, s)`.
+fn capsule_ball(stop: &StopModel, tick_s: Real, reaction_s: Real, p: &Vec3, velocity: &Vec3, v: Real, s: Real) -> (Vec3, Real) {
+    let norm = velocity.norm();
+    if !(norm > 0.0 && v.is_finite()) {
+        return (*p, s);
+    }
+    let (a, vmax, t) = (stop.max_accel_mm_s2, stop.max_speed_mm_s, reaction_s);
+    let delta = a * tick_s;
+    let v_r = (v + delta + a * t).min(vmax);
+    let r = delta * t + 0.5 * a * t * t + v_r * v_r / (2.0 * stop.decel_mm_s2);
+    let radius = r + 0.5 * v * t;
+    if radius < s { (p + velocity * (v / norm * 0.5 * t), radius) } else { (*p, s) }
 }
 
 /// The status that wins when several robots fail: non-finite, then implausible, then
