@@ -1,6 +1,7 @@
 //! The protective verdict (SPEC §8) next to the plain exact query it builds on, on T1's
 //! practical trajectory: one `check_at_speeds` (sweeps of both robots, the swept-box proofs
-//! and both speed limits) against one `ExactChecker::check` of the same TCPs.
+//! and both speed limits; and the verdict alone) against one `ExactChecker::check` of the
+//! same TCPs.
 //!
 //! Inputs: 128 ticks of the run sampled every 47 ticks, with the speeds of the trajectory
 //! there; every iteration asserts the verdict computed before timing.
@@ -45,6 +46,15 @@ fn protective_query(c: &mut Criterion) {
             let (tcps, speeds, verdict, _) = &inputs[i % inputs.len()];
             i += 1;
             assert_eq!(protective.check_at_speeds(black_box(tcps), speeds).unwrap().verdict, *verdict);
+        })
+    });
+    let mut verdict_only = ProtectiveChecker::new(reference_cell("T1").unwrap(), 10.0).unwrap().with_speed_limits(false);
+    let mut i = 0;
+    group.bench_function(BenchmarkId::new("protective", "verdict only"), |b| {
+        b.iter(|| {
+            let (tcps, speeds, verdict, _) = &inputs[i % inputs.len()];
+            i += 1;
+            assert_eq!(verdict_only.check_at_speeds(black_box(tcps), speeds).unwrap().verdict, *verdict);
         })
     });
     let mut i = 0;

@@ -397,6 +397,14 @@ fn a_tick_never_allocates() {
         c.check_at_speeds(s, &[100.0, 300.0]).unwrap();
     }
     assert_eq!(allocations(), before);
+    // Without the speed limits: the same verdicts, NaN limits.
+    let mut fast = ProtectiveChecker::new(cell, 5.0).unwrap().with_speed_limits(false);
+    for s in &states {
+        let full = c.check_at_speeds(s, &[100.0, 300.0]).unwrap().clone();
+        let r = fast.check_at_speeds(s, &[100.0, 300.0]).unwrap();
+        assert_eq!(r.verdict, full.verdict);
+        assert!(r.robots.iter().all(|x| x.speed_limit_mm_s.is_nan()));
+    }
 }
 
 /// Per scenario of `c_harness/scenarios.txt`: ticks with WARN and STOP, the first of each,

@@ -117,7 +117,8 @@ pub struct RobotProtection {
     pub speed_bound_mm_s: Real,
     /// `S`: how far the TCP may travel until it stands still (mm).
     pub protective_mm: Real,
-    /// The largest measured speed at which FREE would still hold (mm/s; module doc).
+    /// The largest measured speed at which FREE would still hold (mm/s; module doc); NaN when
+    /// not computed ([`ProtectiveChecker::with_speed_limits`]).
     pub speed_limit_mm_s: Real,
 }
 
@@ -165,6 +166,8 @@ pub struct ProtectiveChecker {
     velocity: alloc::vec::Vec<Vec3>,
     /// Per robot, its boxes (WCS) at the reference TCP its sweeps are measured from.
     ref_boxes: alloc::vec::Vec<RobotBoxes>,
+    /// Whether each tick also finds the speed limits (most of its time).
+    speed_limits: bool,
     report: ProtectiveReport,
 }
 
@@ -186,6 +189,7 @@ impl ProtectiveChecker {
             sweeps: alloc::vec![[[Sweep::ZERO; MAX_BOXES]; 2]; n],
             velocity: alloc::vec![Vec3::zeros(); n],
             ref_boxes: alloc::vec![RobotBoxes::empty(); n],
+            speed_limits: true,
             report: ProtectiveReport {
                 verdict: Protective::Stop,
                 status: ProtectiveStatus::Ok,
@@ -200,6 +204,13 @@ impl ProtectiveChecker {
     /// The cell being checked.
     pub fn cell(&self) -> &Cell {
         self.exact.cell()
+    }
+
+    /// This checker finding the speed limits on every tick (the default), or not: the verdict
+    /// alone takes under a third of the time (`benches/protective.rs`), and the limits then
+    /// read NaN.
+    pub fn with_speed_limits(self, on: bool) -> Self {
+        ProtectiveChecker { speed_limits: on, ..self }
     }
 
     /// The WARN threshold (mm).
@@ -327,7 +338,7 @@ impl ProtectiveChecker {
             Protective::Free
         };
         for (j, tcp) in tcps_mcs.iter().enumerate() {
-            self.report.robots[j].speed_limit_mm_s = self.speed_limit(j, tcp);
+            self.report.robots[j].speed_limit_mm_s = if self.speed_limits { self.speed_limit(j, tcp) } else { Real::NAN };
         }
     }
 
