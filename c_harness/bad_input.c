@@ -467,6 +467,94 @@ static void fail_closed(const HarnessOptions *options, const DcCellConfig *confi
     expect_init_file("binary cell file", path, DC_STATUS_PARSE);
     remove(path);
     printf("fail closed: done\n");
+/* A protective query that must fail: the status, a STOP verdict over the pre-set FREE, and the report. */
+static void expect_protective(const char *what, DcCollider *h, const DcVec3 *tcps, size_t n, DcStatus expected,
+                              uint32_t mask)
+{
+    DcVerdict v = DC_VERDICT_FREE;
+    DcProtectiveReport rep;
+    DcStatus s;
+    memset(&rep, 0, sizeof rep);
+    rep.verdict = DC_VERDICT_FREE;
+    s = dc_protective_query(h, tcps, n, &v, &rep);
+    check(s == expected, "bad input (protective), %s: status %u (%s), expected %u", what, (unsigned)s,
+          dc_status_str(s), (unsigned)expected);
+    check(v == DC_VERDICT_STOP && rep.verdict == DC_VERDICT_STOP, "bad input (protective), %s: verdict %u / %u", what,
+          (unsigned)v, (unsigned)rep.verdict);
+    check(rep.unreachable_mask == mask, "bad input (protective), %s: unreachable_mask %u, expected %u", what,
+          (unsigned)rep.unreachable_mask, (unsigned)mask);
+}
+
+/* dc_protective_query and dc_set_stop_model: every documented status, fail-closed outputs. */
+static void bad_protective(DcCollider *h)
+{
+    DcVec3 tcps[2];
+    DcStopConfig stops[2];
+    DcVerdict v = DC_VERDICT_FREE;
+    DcStatus s;
+    char message[256];
+    const double qnan = NAN;
+
+    tcps[0] = vec3(-150.0, 0.0, -450.0);
+    tcps[1] = vec3(150.0, 0.0, -450.0);
+    stops[0] = dc_stop_config_default();
+    stops[1] = dc_stop_config_default();
+    check(stops[0].struct_size == sizeof(DcStopConfig) && stops[0].reaction_ms == 4.0
+              && stops[0].decel_mm_s2 == 40000.0 && stops[0].max_accel_mm_s2 == 130000.0
+              && stops[0].max_speed_mm_s == 4600.0,
+          "bad input (protective): dc_stop_config_default is not the documented default");
+    /* First query: no previous TCP, full speed assumed; standing still afterwards: FREE. */
+    s = dc_protective_query(h, tcps, 2, &v, NULL);
+    check(s == DC_STATUS_OK, "bad input (protective): first query status %u", (unsigned)s);
+    s = dc_protective_query(h, tcps, 2, &v, NULL);
+    check(s == DC_STATUS_OK && v == DC_VERDICT_FREE, "bad input (protective): still robots apart: status %u verdict %u",
+          (unsigned)s, (unsigned)v);
+    expect_protective("NULL handle", NULL, tcps, 2, DC_STATUS_NULL_POINTER, 0);
+    expect_protective("NULL tcps", h, NULL, 2, DC_STATUS_NULL_POINTER, 0);
+    expect_protective("one TCP for two robots", h, tcps, 1, DC_STATUS_WRONG_ROBOT_COUNT, 0);
+    s = dc_protective_query(h, tcps, 2, NULL, NULL);
+    check(s == DC_STATUS_NULL_POINTER, "bad input (protective), NULL out_verdict: %u", (unsigned)s);
+    tcps[1].y = qnan;
+    expect_protective("NaN TCP", h, tcps, 2, DC_STATUS_NON_FINITE, 2u);
+    tcps[1] = vec3(0.0, 0.0, -900.0);
+    expect_protective("unreachable TCP", h, tcps, 2, DC_STATUS_UNREACHABLE, 2u);
+    tcps[1] = vec3(150.0, 0.0, -450.0);
+    dc_protective_query(h, tcps, 2, &v, NULL);
+    tcps[0].x += 10.0; /* 10 mm in 1 ms: 10 m/s */
+    expect_protective("a 10 mm jump", h, tcps, 2, DC_STATUS_IMPLAUSIBLE_MOTION, 1u);
+
+    s = dc_set_stop_model(NULL, 1.0, 10.0, stops, 2);
+    check(s == DC_STATUS_NULL_POINTER, "bad input, dc_set_stop_model NULL handle: %u", (unsigned)s);
+    s = dc_set_stop_model(h, 1.0, 10.0, NULL, 2);
+    check(s == DC_STATUS_NULL_POINTER, "bad input, dc_set_stop_model NULL stops: %u", (unsigned)s);
+    s = dc_set_stop_model(h, 1.0, 10.0, stops, 1);
+    check(s == DC_STATUS_WRONG_ROBOT_COUNT, "bad input, dc_set_stop_model one model: %u", (unsigned)s);
+    s = dc_set_stop_model(h, 0.0, 10.0, stops, 2);
+    dc_last_init_error(message, sizeof message);
+    check(s == DC_STATUS_INVALID_CONFIG && strstr(message, "tick_ms") != NULL,
+          "bad input, dc_set_stop_model tick 0: %u (%s)", (unsigned)s, message);
+    s = dc_set_stop_model(h, 1.0, -1.0, stops, 2);
+    check(s == DC_STATUS_INVALID_CONFIG, "bad input, dc_set_stop_model warn -1: %u", (unsigned)s);
+    stops[1].struct_size = 8;
+    s = dc_set_stop_model(h, 1.0, 10.0, stops, 2);
+    dc_last_init_error(message, sizeof message);
+    check(s == DC_STATUS_INVALID_ARGUMENT && strstr(message, "struct_size") != NULL,
+          "bad input, dc_set_stop_model struct_size 8: %u (%s)", (unsigned)s, message);
+    stops[1] = dc_stop_config_default();
+    stops[1].decel_mm_s2 = 200000.0;
+    s = dc_set_stop_model(h, 1.0, 10.0, stops, 2);
+    dc_last_init_error(message, sizeof message);
+    check(s == DC_STATUS_INVALID_CONFIG && strstr(message, "decel_mm_s2") != NULL,
+          "bad input, dc_set_stop_model decel above max accel: %u (%s)", (unsigned)s, message);
+    stops[1] = dc_stop_config_default();
+    stops[1].max_speed_mm_s = qnan;
+    s = dc_set_stop_model(h, 1.0, 10.0, stops, 2);
+    check(s == DC_STATUS_INVALID_CONFIG, "bad input, dc_set_stop_model NaN speed: %u", (unsigned)s);
+    stops[1] = dc_stop_config_default();
+    s = dc_set_stop_model(h, 1.0, 10.0, stops, 2);
+    check(s == DC_STATUS_OK, "bad input, dc_set_stop_model defaults: %u", (unsigned)s);
+    dc_protective_reset(NULL); /* a no-op */
+    dc_protective_reset(h);
 }
 
 void bad_input(const HarnessOptions *options)
@@ -489,6 +577,7 @@ void bad_input(const HarnessOptions *options)
           dc_status_str(s));
     if (h != NULL) {
         bad_queries("exact mode", h);
+        bad_protective(h);
         dc_destroy(h);
         h = NULL;
     }
@@ -505,7 +594,7 @@ void bad_input(const HarnessOptions *options)
 
     /* Teardown and strings. */
     dc_destroy(NULL); /* a no-op: reaching the next line is the test */
-    for (code = 0; code <= DC_STATUS_TABLE_NOT_TWO_ROBOTS; ++code) {
+    for (code = 0; code <= DC_STATUS_IMPLAUSIBLE_MOTION; ++code) {
         const char *text = dc_status_str(code);
         check(text != NULL && text[0] != '\0' && strcmp(text, dc_status_str(12345u)) != 0,
               "dc_status_str(%u) is empty or unknown", code);

@@ -79,4 +79,9 @@ int run_table_scenario(const char *cell_name, const char *case_name, const Harne
  * table-mode ones when T1's table is loaded. */
 void bad_input(const HarnessOptions *options);
 
+/* The trajectory scenarios with the protective verdict (protective.c): at the first STOP the
+ * robots stop as their stopping models say, and every 0.1 ms of the stop is checked for
+ * contact with the exact model. --quick runs T1 collision only. */
+void protective_scenarios(const HarnessOptions *options);
+
 #endif /* HARNESS_H */

@@ -14,6 +14,11 @@
 #include <stdint.h>
 
 /*
+ Most robots of a cell; the size of the per-robot arrays of `DcProtectiveReport`.
+ */
+#define DC_MAX_ROBOTS 32
+
+/*
  Plain separating axis test.
  */
 #define DC_METHOD_SAT 0
@@ -216,6 +221,99 @@ typedef struct DcQueryReport {
 } DcQueryReport;
 
 /*
+ One robot's stopping model (SPEC section 8) for `dc_set_stop_model`; start from
+ `dc_stop_config_default()`, which also sets `struct_size`.
+ */
+typedef struct DcStopConfig {
+  /*
+   `sizeof(DcStopConfig)` as the caller compiled it: lets later versions add fields.
+   */
+  size_t struct_size;
+  /*
+   Time from a STOP until braking starts (ms); the TCP may do anything within the
+   limits meanwhile. Default 4.
+   */
+  double reaction_ms;
+  /*
+   Least deceleration along the path while braking (mm/s^2). Default 40000.
+   */
+  double decel_mm_s2;
+  /*
+   Largest TCP acceleration at any time (mm/s^2); at least `decel_mm_s2`. Default 130000.
+   */
+  double max_accel_mm_s2;
+  /*
+   Largest TCP speed at any time (mm/s). Default 4600.
+   */
+  double max_speed_mm_s;
+} DcStopConfig;
+
+/*
+ Summary of one protective query, written on every call when the pointer is not NULL.
+ */
+typedef struct DcProtectiveReport {
+  /*
+   Same value as `*out_verdict`: `DC_VERDICT_FREE`, `DC_VERDICT_WARN` or `DC_VERDICT_STOP`.
+   */
+  DcVerdict verdict;
+  /*
+   Bit j set: robot j's TCP is not finite, unreachable or moved implausibly.
+   */
+  uint32_t unreachable_mask;
+  /*
+   Clearance of the cell now (mm): the smallest distance between boxes of robots that
+   can meet, 0 when touching or intersecting; NaN when not computed (status not OK).
+   */
+  double clearance_mm;
+  /*
+   Closest box pair now: robots and boxes, or `DC_BOX_NONE`.
+   */
+  uint32_t closest_robot_a;
+  /*
+   See `closest_robot_a`.
+   */
+  uint32_t closest_robot_b;
+  /*
+   See `closest_robot_a`.
+   */
+  uint32_t closest_box_a;
+  /*
+   See `closest_robot_a`.
+   */
+  uint32_t closest_box_b;
+  /*
+   The first box pair not proved apart over a stop (STOP) or not with `warn_mm` to spare
+   (WARN): robots and boxes, or `DC_BOX_NONE`.
+   */
+  uint32_t limiting_robot_a;
+  /*
+   See `limiting_robot_a`.
+   */
+  uint32_t limiting_robot_b;
+  /*
+   See `limiting_robot_a`.
+   */
+  uint32_t limiting_box_a;
+  /*
+   See `limiting_robot_a`.
+   */
+  uint32_t limiting_box_b;
+  /*
+   Number of entries used in the arrays below (the cell's robots).
+   */
+  uint32_t n_robots;
+  /*
+   Per robot: how far its TCP may travel until it stands still after a stop now (mm).
+   */
+  double protective_mm[32];
+  /*
+   Per robot: the largest measured TCP speed (mm/s) at which FREE would still hold, the
+   other robots as they are; 0 when not even standing still is proved.
+   */
+  double speed_limit_mm_s[32];
+} DcProtectiveReport;
+
+/*
  One robot pair's result of the last query.
  */
 typedef struct DcPairResult {
@@ -336,6 +434,13 @@ typedef uint32_t DcMode;
 #define DC_STATUS_TABLE_NOT_TWO_ROBOTS 16
 
 /*
+ Protective query: a TCP moved further, or changed its velocity more, in one tick than its
+ robot's stopping model allows (`max_speed_mm_s`, `max_accel_mm_s2`); the report's
+ `unreachable_mask` names the robot. The next query has no previous TCP.
+ */
+#define DC_STATUS_IMPLAUSIBLE_MOTION 17
+
+/*
  Could not decide (any error): stop the robots.
  */
 #define DC_VERDICT_STOP 0
@@ -349,6 +454,12 @@ typedef uint32_t DcMode;
  At least one pair of robots collides.
  */
 #define DC_VERDICT_COLLISION 2
+
+/*
+ Protective query: a stop started now is proved to keep every box apart, but with less
+ than `warn_mm` to spare. Only ever written together with `DC_STATUS_OK`.
+ */
+#define DC_VERDICT_WARN 3
 
 /*
  No handle (`dc_mode(NULL)`).
@@ -472,6 +583,66 @@ size_t dc_last_init_error(char *buf, size_t capacity);
  NULL or writable.
  */
 DcStatus dc_query(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, DcVerdict *out_verdict, struct DcQueryReport *out_report);
+
+/*
+ The default stopping model (SPEC section 8: reaction 4 ms, decel 40000 mm/s^2, max accel
+ 130000 mm/s^2, max speed 4600 mm/s) with `struct_size` set: start from it and change
+ the fields that differ.
+ */
+struct DcStopConfig dc_stop_config_default(void);
+
+/*
+ Sets the protective verdict's controller tick (ms), WARN threshold (mm) and one stopping
+ model per robot (`n_stops` = the cell's robots), and forgets the previous TCPs. Until it
+ is called a handle uses the cell file's `tick_ms` and `stop` keys, or for `dc_init` the
+ defaults (tick 1 ms, `dc_stop_config_default()`), and `warn_mm` = 10. Setup only: it
+ allocates; call it before the tick loop. On failure the handle keeps its previous models
+ and `dc_last_init_error` names the field at fault.
+
+ Statuses: `DC_STATUS_NULL_POINTER` (handle or stops NULL), `DC_STATUS_WRONG_ROBOT_COUNT`,
+ `DC_STATUS_INVALID_ARGUMENT` (a `struct_size` that is not this header's
+ `sizeof(DcStopConfig)`), `DC_STATUS_INVALID_CONFIG` (a value NaN, infinite or not > 0,
+ `decel_mm_s2` above `max_accel_mm_s2`, `warn_mm` negative), `DC_STATUS_PANIC`.
+
+ # Safety
+ `handle` must be NULL or a live handle not used by another thread; `stops` must be NULL
+ or point to `n_stops` readable `DcStopConfig`.
+ */
+DcStatus dc_set_stop_model(struct DcCollider *handle, double tick_ms, double warn_mm, const struct DcStopConfig *stops, size_t n_stops);
+
+/*
+ Forgets the previous TCPs of the protective verdict (e.g. after the robots were moved by
+ hand): the next `dc_protective_query` assumes every robot at full speed. NULL is a no-op.
+
+ # Safety
+ `handle` must be NULL or a live handle not used by another thread.
+ */
+void dc_protective_reset(struct DcCollider *handle);
+
+/*
+ The per-tick protective query (SPEC section 8): can every robot still stop, from now on,
+ without any box touching a box of another robot? Robot j's TCP is `tcps_mcs[j]` (its
+ MCS); its speed is estimated from the TCP of the previous call, so call it once per tick
+ with the tick of `dc_set_stop_model` (works in exact and table mode: it reads the exact
+ boxes).
+
+ Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
+ `DC_VERDICT_FREE` (proved: every stop the models allow keeps the boxes apart),
+ `DC_VERDICT_WARN` (proved, with less than `warn_mm` to spare) or `DC_VERDICT_STOP` (not
+ proved, or any status other than OK). The first call, and the first after any error or
+ `dc_protective_reset`, has no previous TCP and assumes full speed. Statuses:
+ `DC_STATUS_NULL_POINTER` (handle, tcps_mcs or out_verdict NULL),
+ `DC_STATUS_WRONG_ROBOT_COUNT`, `DC_STATUS_NON_FINITE`, `DC_STATUS_UNREACHABLE`,
+ `DC_STATUS_IMPLAUSIBLE_MOTION` (the report's `unreachable_mask` names the robot),
+ `DC_STATUS_PANIC` (destroy the handle). Never allocates, locks or does I/O; it takes a
+ few hundred microseconds (the speed limits are most of it).
+
+ # Safety
+ `handle` must be NULL or a live handle from `dc_init*` not used by another thread;
+ `tcps_mcs` must be NULL or point to `n_tcps` readable `DcVec3`; the out pointers must be
+ NULL or writable.
+ */
+DcStatus dc_protective_query(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, DcVerdict *out_verdict, struct DcProtectiveReport *out_report);
 
 /*
  Copies the per-pair results of the last query into `out[0..]` and their number into

@@ -468,3 +468,21 @@ fn progress_never_goes_into_the_data() {
     let out = cli_stdin(&["check", "--quiet", "--cell", "T1"], "-150,0,-450,150,0,-450\n");
     assert_eq!((stdout(&out).as_str(), stderr(&out).as_str()), ("reachable,collide\n1,0\n", ""));
 }
+
+/// `replay`: one line per tick, the first tick STOP (no previous TCP), robots standing apart
+/// FREE afterwards, a malformed row an error naming its line.
+#[test]
+fn replay_writes_one_verdict_per_tick() {
+    let rows = "x,y,z,x2,y2,z2\n-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n";
+    let out = cli_stdin(&["replay", "--cell", "T1"], rows);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = stdout(&out);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4, "{text}");
+    assert!(lines[0].starts_with("tick,verdict,status,clearance_mm,protective_mm_A,protective_mm_B,speed_limit_mm_s_A"));
+    assert!(lines[1].starts_with("0,STOP,ok,"), "{text}");
+    assert!(lines[2].starts_with("1,FREE,ok,") && lines[3].starts_with("2,FREE,ok,"), "{text}");
+    let out = cli_stdin(&["replay", "--cell", "T1"], "1,2,3\n");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("line 1"), "{}", stderr(&out));
+}

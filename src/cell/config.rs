@@ -14,12 +14,16 @@
 //! name = "B"
 //! placement = { alpha_deg = 0.0, t = [450.0, 0.0, 0.0] }
 //! model = { margin = 5.0, upper_links = { half_height = 30.0, half_depth = 15.0 } }
+//! stop = { reaction_ms = 4.0, decel_mm_s2 = 40000.0, max_accel_mm_s2 = 130000.0, max_speed_mm_s = 4600.0 }
 //! ```
+//!
+//! The top-level `tick_ms` (default 1) and each robot's `stop` (SPEC §8; defaults in
+//! [`StopModel::DEFAULT`]) serve the protective verdict only.
 
 use crate::cell::placement::Placement;
 use crate::cell::{Cell, CellError, RobotSpec, SatMethod};
 use crate::math::{Real, Vec3};
-use crate::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
+use crate::robot::{Delta3, ModelOptions, RobotModel, StopModel, ToolBox, DEFAULT_TICK_MS};
 use serde::Deserialize;
 
 #[derive(Deserialize)]
@@ -29,6 +33,8 @@ struct CellFile {
     name: Option<String>,
     #[serde(default)]
     method: Option<String>,
+    #[serde(default)]
+    tick_ms: Option<Real>,
     #[serde(rename = "robot")]
     robots: Vec<RobotFile>,
 }
@@ -44,6 +50,30 @@ struct RobotFile {
     model: ModelFile,
     #[serde(default)]
     placement: PlacementFile,
+    #[serde(default)]
+    stop: StopFile,
+}
+
+/// A robot's `stop = { ... }`: every key defaults to [`StopModel::DEFAULT`] (its doc says why).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct StopFile {
+    reaction_ms: Real,
+    decel_mm_s2: Real,
+    max_accel_mm_s2: Real,
+    max_speed_mm_s: Real,
+}
+
+impl Default for StopFile {
+    fn default() -> Self {
+        let s = StopModel::DEFAULT;
+        StopFile {
+            reaction_ms: s.reaction_ms,
+            decel_mm_s2: s.decel_mm_s2,
+            max_accel_mm_s2: s.max_accel_mm_s2,
+            max_speed_mm_s: s.max_speed_mm_s,
+        }
+    }
 }
 
 #[derive(Deserialize)]
@@ -163,7 +193,18 @@ pub fn parse_cell(text: &str) -> Result<Cell, CellError> {
             placement: Placement { alpha: r.placement.alpha_deg.to_radians(), t: Vec3::from(r.placement.t) },
         })
         .collect();
-    Cell::new(file.name.unwrap_or_else(|| "unnamed".into()), robots, method)
+    let stops = file
+        .robots
+        .iter()
+        .map(|r| StopModel {
+            reaction_ms: r.stop.reaction_ms,
+            decel_mm_s2: r.stop.decel_mm_s2,
+            max_accel_mm_s2: r.stop.max_accel_mm_s2,
+            max_speed_mm_s: r.stop.max_speed_mm_s,
+        })
+        .collect();
+    Cell::new(file.name.unwrap_or_else(|| "unnamed".into()), robots, method)?
+        .with_stopping(file.tick_ms.unwrap_or(DEFAULT_TICK_MS), stops)
 }
 
 #[cfg(test)]
@@ -187,5 +228,19 @@ mod tests {
         assert!(err.contains("margin"), "{err}");
         let err = parse_cell("method = \"gjk\"\n[[robot]]\n").unwrap_err().to_string();
         assert!(err.contains("gjk"), "{err}");
+    }
+
+    #[test]
+    fn stop_models_and_tick_are_read_defaulted_and_checked() {
+        let cell = parse_cell("tick_ms = 2.0\n[[robot]]\nstop = { reaction_ms = 6.0 }\n[[robot]]\n").unwrap();
+        assert_eq!(cell.tick_ms, 2.0);
+        assert_eq!(cell.stops[0], StopModel { reaction_ms: 6.0, ..StopModel::DEFAULT });
+        assert_eq!(cell.stops[1], StopModel::DEFAULT);
+        let err = |text: &str| parse_cell(text).unwrap_err().to_string();
+        assert!(err("[[robot]]\nstop = { reaction = 6.0 }\n").contains("reaction"));
+        assert!(err("[[robot]]\nstop = { decel_mm_s2 = -1.0 }\n").contains("decel_mm_s2"));
+        assert!(err("[[robot]]\nstop = { max_speed_mm_s = nan }\n").contains("max_speed_mm_s"));
+        assert!(err("[[robot]]\nstop = { decel_mm_s2 = 200000.0 }\n").contains("max_accel_mm_s2"));
+        assert!(err("tick_ms = 0.0\n[[robot]]\n").contains("tick_ms"));
     }
 }

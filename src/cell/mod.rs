@@ -9,6 +9,8 @@ pub mod config;
 pub mod exact;
 pub mod placement;
 #[cfg(feature = "std")]
+pub mod protective;
+#[cfg(feature = "std")]
 pub mod reference;
 pub mod trajectory;
 
@@ -18,7 +20,7 @@ pub use exact::{CellVerdict, ExactChecker, PairVerdict, QueryError};
 pub use placement::Placement;
 
 use crate::math::{float, Real, MAX_LENGTH};
-use crate::robot::RobotModel;
+use crate::robot::{RobotModel, StopModel, DEFAULT_TICK_MS};
 use alloc::{format, string::String, vec::Vec};
 
 /// Most robots in one cell (the unreachable mask of a report is a `u32`).
@@ -53,6 +55,10 @@ pub struct Cell {
     pub robots: Vec<RobotSpec>,
     /// Plain SAT or SAT with witness cache.
     pub method: SatMethod,
+    /// The controller's cycle (ms; SPEC §8): the protective verdict's speed estimate.
+    pub tick_ms: Real,
+    /// One stopping model per robot (SPEC §8); [`StopModel::DEFAULT`] unless set.
+    pub stops: Vec<StopModel>,
 }
 
 /// Why a cell cannot be built.
@@ -141,7 +147,29 @@ impl Cell {
         for (i, r) in robots.iter().enumerate() {
             validate_robot(i, r)?;
         }
-        Ok(Cell { name, robots, method })
+        let stops = alloc::vec![StopModel::DEFAULT; robots.len()];
+        Ok(Cell { name, robots, method, tick_ms: DEFAULT_TICK_MS, stops })
+    }
+
+    /// This cell with the controller's tick and one stopping model per robot (SPEC §8).
+    ///
+    /// # Errors
+    /// [`CellError::Invalid`] naming the field: a count other than one model per robot, a
+    /// `tick_ms` or stop field that is NaN, infinite or not > 0, or a `decel_mm_s2` above
+    /// `max_accel_mm_s2`.
+    pub fn with_stopping(self, tick_ms: Real, stops: Vec<StopModel>) -> Result<Cell, CellError> {
+        crate::robot::stopping::validate_tick_ms(tick_ms).map_err(CellError::Invalid)?;
+        if stops.len() != self.robots.len() {
+            return Err(CellError::Invalid(format!(
+                "{} stopping models given for {} robots: give one per robot",
+                stops.len(),
+                self.robots.len()
+            )));
+        }
+        for (i, (s, r)) in stops.iter().zip(&self.robots).enumerate() {
+            s.validate(&format!("robot {i} ({}): stop", r.name)).map_err(CellError::Invalid)?;
+        }
+        Ok(Cell { tick_ms, stops, ..self })
     }
 
     /// Reads and validates a TOML cell file.

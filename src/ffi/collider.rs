@@ -6,6 +6,8 @@
 //! allocates nothing in either mode.
 
 use crate::cell::exact::PairState;
+use crate::cell::protective::{BoxPair, Protective, ProtectiveChecker, ProtectiveStatus, DEFAULT_WARN_MM};
+use crate::robot::StopModel;
 use crate::cell::{Cell, ExactChecker};
 use crate::ffi::convert::{cell_error_status, table_error_status};
 use crate::ffi::types::*;
@@ -30,7 +32,7 @@ impl InitError {
 /// How a collider answers.
 enum Checker {
     /// Every box pair with the separating axis test (thesis 3.1).
-    Exact(ExactChecker),
+    Exact(Box<ExactChecker>),
     /// One lookup in a table built offline for a two-robot cell (thesis 3.2).
     Table(Box<TableChecker>),
 }
@@ -42,6 +44,12 @@ pub(crate) struct Collider {
     tcps: Vec<Vec3>,
     /// Table mode: whether the last query answered COLLISION (for `dc_pair_results`).
     table_collides: bool,
+    /// The protective verdict (either mode: it reads the exact boxes).
+    protective: ProtectiveChecker,
+}
+
+fn protective_for(cell: &Cell) -> ProtectiveChecker {
+    ProtectiveChecker::new(cell.clone(), DEFAULT_WARN_MM).expect("the default warn_mm is valid")
 }
 
 impl Collider {
@@ -49,7 +57,8 @@ impl Collider {
     pub(crate) fn exact(cell: Cell) -> Collider {
         let n = cell.robots.len();
         Collider {
-            checker: Checker::Exact(ExactChecker::new(cell)),
+            protective: protective_for(&cell),
+            checker: Checker::Exact(Box::new(ExactChecker::new(cell))),
             tcps: vec![Vec3::zeros(); n],
             table_collides: false,
         }
@@ -67,9 +76,15 @@ impl Collider {
                 ),
             ));
         }
+        let protective = protective_for(&cell);
         let checker =
             TableChecker::new(cell, bytes).map_err(|e| InitError::new(table_error_status(&e), e.to_string()))?;
-        Ok(Collider { checker: Checker::Table(Box::new(checker)), tcps: vec![Vec3::zeros(); 2], table_collides: false })
+        Ok(Collider {
+            checker: Checker::Table(Box::new(checker)),
+            tcps: vec![Vec3::zeros(); 2],
+            table_collides: false,
+            protective,
+        })
     }
 
     /// A table-mode collider from a TOML cell file and a table file, each read once, here.
@@ -136,6 +151,76 @@ impl Collider {
                 status
             }
         }
+    }
+
+    /// Replaces the tick, WARN threshold and stopping models of the protective verdict (and
+    /// forgets the previous TCPs).
+    pub(crate) fn set_stopping(&mut self, tick_ms: f64, warn_mm: f64, stops: &[DcStopConfig]) -> Result<(), InitError> {
+        let invalid = |m: String| InitError::new(DC_STATUS_INVALID_CONFIG, m);
+        if let Some((i, c)) = stops.iter().enumerate().find(|(_, c)| c.struct_size != size_of::<DcStopConfig>()) {
+            return Err(InitError::new(
+                DC_STATUS_INVALID_ARGUMENT,
+                format!(
+                    "stops[{i}].struct_size = {}, this library's DcStopConfig has {} bytes: start from \
+                     dc_stop_config_default() and compile against this header",
+                    c.struct_size,
+                    size_of::<DcStopConfig>()
+                ),
+            ));
+        }
+        let models = stops
+            .iter()
+            .map(|c| StopModel {
+                reaction_ms: c.reaction_ms,
+                decel_mm_s2: c.decel_mm_s2,
+                max_accel_mm_s2: c.max_accel_mm_s2,
+                max_speed_mm_s: c.max_speed_mm_s,
+            })
+            .collect();
+        let cell = self.protective.cell().clone().with_stopping(tick_ms, models).map_err(|e| invalid(e.to_string()))?;
+        self.protective = ProtectiveChecker::new(cell, warn_mm).map_err(|e| invalid(e.to_string()))?;
+        Ok(())
+    }
+
+    /// Forgets the previous TCPs of the protective verdict.
+    pub(crate) fn reset_protective(&mut self) {
+        self.protective.reset();
+    }
+
+    /// The protective query: fills `report` (which starts as [`DcProtectiveReport::STOP`])
+    /// and returns the status; the verdict is FREE or WARN only with `DC_STATUS_OK`.
+    pub(crate) fn protective_query(&mut self, tcps: &[DcVec3], report: &mut DcProtectiveReport) -> DcStatus {
+        if tcps.len() != self.tcps.len() {
+            return DC_STATUS_WRONG_ROBOT_COUNT;
+        }
+        for (dst, src) in self.tcps.iter_mut().zip(tcps) {
+            *dst = src.to_vec3();
+        }
+        let Ok(r) = self.protective.check(&self.tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };
+        report.n_robots = r.robots.len() as u32;
+        report.clearance_mm = r.clearance_mm;
+        for (j, robot) in r.robots.iter().enumerate() {
+            (report.protective_mm[j], report.speed_limit_mm_s[j]) = (robot.protective_mm, robot.speed_limit_mm_s);
+        }
+        let ids = |p: Option<BoxPair>| {
+            p.map_or([DC_BOX_NONE; 4], |p| [p.a as u32, p.b as u32, p.box_a as u32, p.box_b as u32])
+        };
+        [report.closest_robot_a, report.closest_robot_b, report.closest_box_a, report.closest_box_b] = ids(r.closest);
+        [report.limiting_robot_a, report.limiting_robot_b, report.limiting_box_a, report.limiting_box_b] =
+            ids(r.limiting);
+        let (status, robot) = match r.status {
+            ProtectiveStatus::Ok => (DC_STATUS_OK, None),
+            ProtectiveStatus::NonFinite(j) => (DC_STATUS_NON_FINITE, Some(j)),
+            ProtectiveStatus::Unreachable(j) => (DC_STATUS_UNREACHABLE, Some(j)),
+            ProtectiveStatus::ImplausibleMotion(j) => (DC_STATUS_IMPLAUSIBLE_MOTION, Some(j)),
+        };
+        report.unreachable_mask = robot.map_or(0, |j| 1 << j);
+        report.verdict = match r.verdict {
+            Protective::Free => DC_VERDICT_FREE,
+            Protective::Warn => DC_VERDICT_WARN,
+            Protective::Stop => DC_VERDICT_STOP,
+        };
+        status
     }
 
     /// Writes the per-pair results of the last query into `out[..pair_count()]`, which the

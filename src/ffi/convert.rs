@@ -7,6 +7,18 @@ use crate::math::Vec3;
 use crate::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
 use crate::table::TableError;
 
+/// [`crate::robot::StopModel::DEFAULT`] as a C struct, `struct_size` set.
+pub(crate) fn stop_config_default() -> DcStopConfig {
+    let s = crate::robot::StopModel::DEFAULT;
+    DcStopConfig {
+        struct_size: size_of::<DcStopConfig>(),
+        reaction_ms: s.reaction_ms,
+        decel_mm_s2: s.decel_mm_s2,
+        max_accel_mm_s2: s.max_accel_mm_s2,
+        max_speed_mm_s: s.max_speed_mm_s,
+    }
+}
+
 /// The status a cell error maps to.
 pub(crate) fn cell_error_status(e: &CellError) -> DcStatus {
     match e {

@@ -317,6 +317,134 @@ pub unsafe extern "C" fn dc_query(
     status
 }
 
+/// The default stopping model (SPEC section 8: reaction 4 ms, decel 40000 mm/s^2, max accel
+/// 130000 mm/s^2, max speed 4600 mm/s) with `struct_size` set: start from it and change
+/// the fields that differ.
+#[no_mangle]
+pub extern "C" fn dc_stop_config_default() -> DcStopConfig {
+    convert::stop_config_default()
+}
+
+/// Sets the protective verdict's controller tick (ms), WARN threshold (mm) and one stopping
+/// model per robot (`n_stops` = the cell's robots), and forgets the previous TCPs. Until it
+/// is called a handle uses the cell file's `tick_ms` and `stop` keys, or for `dc_init` the
+/// defaults (tick 1 ms, `dc_stop_config_default()`), and `warn_mm` = 10. Setup only: it
+/// allocates; call it before the tick loop. On failure the handle keeps its previous models
+/// and `dc_last_init_error` names the field at fault.
+///
+/// Statuses: `DC_STATUS_NULL_POINTER` (handle or stops NULL), `DC_STATUS_WRONG_ROBOT_COUNT`,
+/// `DC_STATUS_INVALID_ARGUMENT` (a `struct_size` that is not this header's
+/// `sizeof(DcStopConfig)`), `DC_STATUS_INVALID_CONFIG` (a value NaN, infinite or not > 0,
+/// `decel_mm_s2` above `max_accel_mm_s2`, `warn_mm` negative), `DC_STATUS_PANIC`.
+///
+/// # Safety
+/// `handle` must be NULL or a live handle not used by another thread; `stops` must be NULL
+/// or point to `n_stops` readable `DcStopConfig`.
+#[no_mangle]
+pub unsafe extern "C" fn dc_set_stop_model(
+    handle: *mut DcCollider,
+    tick_ms: f64,
+    warn_mm: f64,
+    stops: *const DcStopConfig,
+    n_stops: usize,
+) -> DcStatus {
+    boundary(|| {
+        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
+        if stops.is_null() {
+            return DC_STATUS_NULL_POINTER;
+        }
+        if h.poisoned {
+            return DC_STATUS_PANIC;
+        }
+        if n_stops != h.inner.robot_count() {
+            return DC_STATUS_WRONG_ROBOT_COUNT;
+        }
+        // SAFETY: non-null, and the caller guarantees `n_stops` readable elements.
+        let stops = unsafe { std::slice::from_raw_parts(stops, n_stops) };
+        let (status, message) = match h.inner.set_stopping(tick_ms, warn_mm, stops) {
+            Ok(()) => (DC_STATUS_OK, String::new()),
+            Err(e) => (e.status, e.message),
+        };
+        let _ = LAST_INIT_ERROR.try_with(|m| *m.borrow_mut() = message);
+        status
+    })
+}
+
+/// Forgets the previous TCPs of the protective verdict (e.g. after the robots were moved by
+/// hand): the next `dc_protective_query` assumes every robot at full speed. NULL is a no-op.
+///
+/// # Safety
+/// `handle` must be NULL or a live handle not used by another thread.
+#[no_mangle]
+pub unsafe extern "C" fn dc_protective_reset(handle: *mut DcCollider) {
+    // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+    if let Some(h) = unsafe { handle.as_mut() } {
+        let _ = catch_unwind(AssertUnwindSafe(|| h.inner.reset_protective()));
+    }
+}
+
+/// The per-tick protective query (SPEC section 8): can every robot still stop, from now on,
+/// without any box touching a box of another robot? Robot j's TCP is `tcps_mcs[j]` (its
+/// MCS); its speed is estimated from the TCP of the previous call, so call it once per tick
+/// with the tick of `dc_set_stop_model` (works in exact and table mode: it reads the exact
+/// boxes).
+///
+/// Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
+/// `DC_VERDICT_FREE` (proved: every stop the models allow keeps the boxes apart),
+/// `DC_VERDICT_WARN` (proved, with less than `warn_mm` to spare) or `DC_VERDICT_STOP` (not
+/// proved, or any status other than OK). The first call, and the first after any error or
+/// `dc_protective_reset`, has no previous TCP and assumes full speed. Statuses:
+/// `DC_STATUS_NULL_POINTER` (handle, tcps_mcs or out_verdict NULL),
+/// `DC_STATUS_WRONG_ROBOT_COUNT`, `DC_STATUS_NON_FINITE`, `DC_STATUS_UNREACHABLE`,
+/// `DC_STATUS_IMPLAUSIBLE_MOTION` (the report's `unreachable_mask` names the robot),
+/// `DC_STATUS_PANIC` (destroy the handle). Never allocates, locks or does I/O; it takes a
+/// few hundred microseconds (the speed limits are most of it).
+///
+/// # Safety
+/// `handle` must be NULL or a live handle from `dc_init*` not used by another thread;
+/// `tcps_mcs` must be NULL or point to `n_tcps` readable `DcVec3`; the out pointers must be
+/// NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn dc_protective_query(
+    handle: *mut DcCollider,
+    tcps_mcs: *const DcVec3,
+    n_tcps: usize,
+    out_verdict: *mut DcVerdict,
+    out_report: *mut DcProtectiveReport,
+) -> DcStatus {
+    let mut report = DcProtectiveReport::STOP;
+    let status = boundary(|| {
+        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
+        if out_verdict.is_null() || tcps_mcs.is_null() {
+            return DC_STATUS_NULL_POINTER;
+        }
+        if h.poisoned {
+            return DC_STATUS_PANIC;
+        }
+        // SAFETY: non-null, and the caller guarantees `n_tcps` readable elements.
+        let tcps = unsafe { std::slice::from_raw_parts(tcps_mcs, n_tcps) };
+        let status = catch_unwind(AssertUnwindSafe(|| h.inner.protective_query(tcps, &mut report)));
+        status.unwrap_or_else(|_| {
+            h.poisoned = true;
+            DC_STATUS_PANIC
+        })
+    });
+    if status != DC_STATUS_OK {
+        report.verdict = DC_VERDICT_STOP;
+    }
+    if !out_verdict.is_null() {
+        // SAFETY: non-null; the caller guarantees it is writable.
+        unsafe { *out_verdict = report.verdict };
+    }
+    if !out_report.is_null() {
+        // SAFETY: non-null; the caller guarantees it is writable.
+        unsafe { *out_report = report };
+    }
+    status
+}
+
 /// Copies the per-pair results of the last query into `out[0..]` and their number into
 /// `*out_len`. Exact mode: the pairs whose reach can overlap (`dc_pair_count`), with the
 /// colliding boxes. Table mode: one pair (robots 0 and 1), `collides` as the last verdict,
@@ -438,6 +566,9 @@ pub extern "C" fn dc_status_str(status: DcStatus) -> *const c_char {
             c"the table was built for another cell: rebuild it with `delta-collide build --cell ...` for this cell"
         }
         DC_STATUS_TABLE_NOT_TWO_ROBOTS => c"tables serve two-robot cells only: use dc_init (exact mode) for this cell",
+        DC_STATUS_IMPLAUSIBLE_MOTION => {
+            c"a TCP moved further or changed its velocity more in one tick than its stopping model allows"
+        }
         _ => c"unknown status",
     };
     s.as_ptr()

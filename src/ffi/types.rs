@@ -45,6 +45,10 @@ pub const DC_STATUS_TABLE_CORRUPT: DcStatus = 14;
 pub const DC_STATUS_TABLE_WRONG_CELL: DcStatus = 15;
 /// Table mode: tables serve two-robot cells only; use `dc_init` (exact mode) for this cell.
 pub const DC_STATUS_TABLE_NOT_TWO_ROBOTS: DcStatus = 16;
+/// Protective query: a TCP moved further, or changed its velocity more, in one tick than its
+/// robot's stopping model allows (`max_speed_mm_s`, `max_accel_mm_s2`); the report's
+/// `unreachable_mask` names the robot. The next query has no previous TCP.
+pub const DC_STATUS_IMPLAUSIBLE_MOTION: DcStatus = 17;
 
 /// What the controller should do; 0 is STOP so that zeroed memory fails closed.
 pub type DcVerdict = u32;
@@ -54,6 +58,12 @@ pub const DC_VERDICT_STOP: DcVerdict = 0;
 pub const DC_VERDICT_FREE: DcVerdict = 1;
 /// At least one pair of robots collides.
 pub const DC_VERDICT_COLLISION: DcVerdict = 2;
+/// Protective query: a stop started now is proved to keep every box apart, but with less
+/// than `warn_mm` to spare. Only ever written together with `DC_STATUS_OK`.
+pub const DC_VERDICT_WARN: DcVerdict = 3;
+
+/// Most robots of a cell; the size of the per-robot arrays of `DcProtectiveReport`.
+pub const DC_MAX_ROBOTS: usize = 32;
 
 /// How a handle answers (`dc_mode`).
 pub type DcMode = u32;
@@ -219,4 +229,78 @@ pub struct DcPairResult {
     pub box_a: u32,
     /// Colliding box of `robot_b`, or `DC_BOX_NONE`.
     pub box_b: u32,
+}
+
+/// One robot's stopping model (SPEC section 8) for `dc_set_stop_model`; start from
+/// `dc_stop_config_default()`, which also sets `struct_size`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DcStopConfig {
+    /// `sizeof(DcStopConfig)` as the caller compiled it: lets later versions add fields.
+    pub struct_size: usize,
+    /// Time from a STOP until braking starts (ms); the TCP may do anything within the
+    /// limits meanwhile. Default 4.
+    pub reaction_ms: f64,
+    /// Least deceleration along the path while braking (mm/s^2). Default 40000.
+    pub decel_mm_s2: f64,
+    /// Largest TCP acceleration at any time (mm/s^2); at least `decel_mm_s2`. Default 130000.
+    pub max_accel_mm_s2: f64,
+    /// Largest TCP speed at any time (mm/s). Default 4600.
+    pub max_speed_mm_s: f64,
+}
+
+/// Summary of one protective query, written on every call when the pointer is not NULL.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DcProtectiveReport {
+    /// Same value as `*out_verdict`: `DC_VERDICT_FREE`, `DC_VERDICT_WARN` or `DC_VERDICT_STOP`.
+    pub verdict: DcVerdict,
+    /// Bit j set: robot j's TCP is not finite, unreachable or moved implausibly.
+    pub unreachable_mask: u32,
+    /// Clearance of the cell now (mm): the smallest distance between boxes of robots that
+    /// can meet, 0 when touching or intersecting; NaN when not computed (status not OK).
+    pub clearance_mm: f64,
+    /// Closest box pair now: robots and boxes, or `DC_BOX_NONE`.
+    pub closest_robot_a: u32,
+    /// See `closest_robot_a`.
+    pub closest_robot_b: u32,
+    /// See `closest_robot_a`.
+    pub closest_box_a: u32,
+    /// See `closest_robot_a`.
+    pub closest_box_b: u32,
+    /// The first box pair not proved apart over a stop (STOP) or not with `warn_mm` to spare
+    /// (WARN): robots and boxes, or `DC_BOX_NONE`.
+    pub limiting_robot_a: u32,
+    /// See `limiting_robot_a`.
+    pub limiting_robot_b: u32,
+    /// See `limiting_robot_a`.
+    pub limiting_box_a: u32,
+    /// See `limiting_robot_a`.
+    pub limiting_box_b: u32,
+    /// Number of entries used in the arrays below (the cell's robots).
+    pub n_robots: u32,
+    /// Per robot: how far its TCP may travel until it stands still after a stop now (mm).
+    pub protective_mm: [f64; 32],
+    /// Per robot: the largest measured TCP speed (mm/s) at which FREE would still hold, the
+    /// other robots as they are; 0 when not even standing still is proved.
+    pub speed_limit_mm_s: [f64; 32],
+}
+
+impl DcProtectiveReport {
+    pub(crate) const STOP: DcProtectiveReport = DcProtectiveReport {
+        verdict: DC_VERDICT_STOP,
+        unreachable_mask: 0,
+        clearance_mm: f64::NAN,
+        closest_robot_a: DC_BOX_NONE,
+        closest_robot_b: DC_BOX_NONE,
+        closest_box_a: DC_BOX_NONE,
+        closest_box_b: DC_BOX_NONE,
+        limiting_robot_a: DC_BOX_NONE,
+        limiting_robot_b: DC_BOX_NONE,
+        limiting_box_a: DC_BOX_NONE,
+        limiting_box_b: DC_BOX_NONE,
+        n_robots: 0,
+        protective_mm: [0.0; 32],
+        speed_limit_mm_s: [0.0; 32],
+    };
 }

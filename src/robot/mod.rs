@@ -2,6 +2,8 @@
 
 pub mod delta3;
 pub mod model;
+pub mod stopping;
 
 pub use delta3::{ArmSolution, Delta3, MotorCosSin, Unreachable};
 pub use model::{BoxKind, ModelOptions, RobotBoxes, RobotModel, ToolBox};
+pub use stopping::{StopModel, DEFAULT_TICK_MS};

@@ -61,6 +61,14 @@ pub enum Command {
     /// with no number in it is a header) and writes one line `reachable,collide` per row;
     /// collide is NA when a TCP is unreachable. A malformed row is an error naming its line.
     Check(CheckArgs),
+    /// Replay a trajectory through the protective verdict
+    ///
+    /// Reads one row x,y,z,x2,y2,z2 per controller tick (one TCP per robot, each in its own
+    /// MCS, mm; a first line with no number in it is a header), with the cell's tick_ms and
+    /// stopping models, and writes per tick
+    /// `tick,verdict,status,clearance_mm,protective_mm_<robot>...,speed_limit_mm_s_<robot>...`
+    /// (verdict FREE, WARN or STOP; SPEC section 8).
+    Replay(ReplayArgs),
     /// Sample, label and build a table file
     ///
     /// Samples both robots' workspaces on a k x k x k grid, labels every pair of grid cells
@@ -125,6 +133,22 @@ pub struct CheckArgs {
     /// Write the answers to this file, replaced only once complete [default: stdout]
     #[arg(long, value_name = "FILE.csv")]
     pub output: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub struct ReplayArgs {
+    /// The cell: T1, T2, T3 or a .toml file (its tick_ms and stop keys apply)
+    #[arg(long, value_name = "CELL", value_parser = clipped(parse_cell))]
+    pub cell: Cell,
+    /// Read the rows, one per tick, from this file [default: stdin]
+    #[arg(long, value_name = "FILE.csv")]
+    pub input: Option<PathBuf>,
+    /// Write the verdicts to this file, replaced only once complete [default: stdout]
+    #[arg(long, value_name = "FILE.csv")]
+    pub output: Option<PathBuf>,
+    /// WARN when a stop is proved with less than this to spare (mm)
+    #[arg(long, value_name = "MM", default_value_t = 10.0)]
+    pub warn_mm: f64,
 }
 
 #[derive(Args, Debug)]

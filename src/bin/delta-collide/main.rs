@@ -16,6 +16,7 @@ mod picture;
 mod plot;
 mod quilt;
 mod render;
+mod replay;
 
 use args::{clip, BuildArgs, CheckArgs, Cli, Command, DemoArgs, EvalArgs, InspectArgs};
 use clap::CommandFactory;
@@ -63,6 +64,7 @@ fn main() {
     let result = match &cli.command {
         Command::Demo(a) => demo(a),
         Command::Check(a) => check(a),
+        Command::Replay(a) => replay::replay(a),
         Command::Build(a) => build(a, progress),
         Command::Inspect(a) => inspect(a),
         Command::Eval(a) => eval(a),
@@ -203,13 +205,7 @@ fn demo(args: &DemoArgs) -> Result<(), Failure> {
 fn check(args: &CheckArgs) -> Result<(), Failure> {
     let cell = &args.cell;
     let mut table = args.table.as_deref().map(|p| load_table(cell, p)).transpose()?;
-    let mut input: Box<dyn BufRead> = match &args.input {
-        Some(p) => {
-            let file = std::fs::File::open(p).map_err(|e| format!("{}: {e}", p.display()))?;
-            Box::new(std::io::BufReader::new(file))
-        }
-        None => Box::new(std::io::stdin().lock()),
-    };
+    let mut input = open_input(args.input.as_deref())?;
     let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut());
     match &args.output {
         Some(path) => files::write_file(path, |w| rows(w))?,
@@ -220,6 +216,29 @@ fn check(args: &CheckArgs) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// The rows' source: the file, or stdin.
+pub(crate) fn open_input(path: Option<&Path>) -> Result<Box<dyn BufRead>, String> {
+    Ok(match path {
+        Some(p) => {
+            let file = std::fs::File::open(p).map_err(|e| format!("{}: {e}", p.display()))?;
+            Box::new(std::io::BufReader::new(file))
+        }
+        None => Box::new(std::io::stdin().lock()),
+    })
+}
+
+/// Writes through `rows` to the output file (replaced once complete) or to stdout.
+pub(crate) fn write_output(output: Option<&Path>, mut rows: impl FnMut(&mut dyn Write) -> Result<(), String>) -> Result<(), String> {
+    match output {
+        Some(path) => files::write_file(path, |w| rows(w)),
+        None => {
+            let mut out = std::io::BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
+            rows(&mut out)?;
+            out.flush().map_err(|e| format!("stdout: {e}"))
+        }
+    }
 }
 
 /// Answers every row of `input` on `out`, after the line `reachable,collide`.

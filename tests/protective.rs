@@ -1,0 +1,493 @@
+//! The protective verdict (SPEC §8) against brute force, independent of its construction:
+//! whenever it says FREE, many stopping motions that the model allows are simulated at
+//! 0.1 ms steps with the exact checker and none may bring two boxes into contact. Also the
+//! fail-closed rules (first tick, implausible jumps, unreachable TCPs), the WARN threshold's
+//! monotonicity, the speed limit, no allocation per tick, and the counts on the scenarios.
+
+use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveReport, ProtectiveStatus};
+use delta_collide::cell::reference::reference_cell;
+use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
+use delta_collide::cell::{Cell, ExactChecker};
+use delta_collide::math::{Real, Vec3};
+use delta_collide::robot::StopModel;
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+use std::alloc::{GlobalAlloc, Layout, System};
+
+/// Counts allocations per thread (tests run in parallel threads of one process).
+struct Counting;
+thread_local! {
+    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+// SAFETY: forwards to the system allocator unchanged; only counts calls.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// A stiffer robot than the default (short reaction, hard braking): FREE then happens with
+/// the robots close, where a wrong bound would show.
+const STIFF: StopModel =
+    StopModel { reaction_ms: 2.0, decel_mm_s2: 120_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 };
+
+fn cell(name: &str, stop: StopModel) -> Cell {
+    let c = reference_cell(name).unwrap();
+    let n = c.robots.len();
+    c.with_stopping(1.0, vec![stop; n]).unwrap()
+}
+
+fn unit(rng: &mut StdRng) -> Vec3 {
+    loop {
+        let v = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let n = v.norm();
+        if n > 1e-3 && n <= 1.0 {
+            return v / n;
+        }
+    }
+}
+
+/// A reachable TCP of robot `j` (MCS) out toward the other robot, at a random depth.
+fn tcp_toward_other(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
+    let other = cell.robots[1 - j].placement.t - cell.robots[j].placement.t;
+    let alpha = cell.robots[j].placement.alpha;
+    let (s, c) = alpha.sin_cos();
+    // The direction to the other base in robot j's MCS: Rz(-alpha) applied.
+    let d = Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize();
+    let side = Vec3::new(-d.y, d.x, 0.0);
+    loop {
+        let p = d * rng.random_range(-60.0..230.0) + side * rng.random_range(-140.0..140.0)
+            + Vec3::z() * rng.random_range(-530.0..-370.0);
+        if cell.robots[j].model.delta.is_reachable(&p) {
+            return p;
+        }
+    }
+}
+
+/// One robot's stopping motion, sampled every `DT`: reaction with random accelerations,
+/// then braking along a straight or curved path.
+struct Motion {
+    p: Vec3,
+    v: Vec3,
+    accel: Vec3,
+    braking: bool,
+    /// Braking: deceleration along the path and turn rate of the path (rad/s about `axis`).
+    decel: Real,
+    turn: Real,
+    axis: Vec3,
+    done: bool,
+}
+
+const DT: Real = 1e-4;
+
+impl Motion {
+    fn step(&mut self, t: Real, reaction_s: Real, model: &StopModel, rng: &mut StdRng, kind: usize, toward: &Vec3) {
+        if self.done {
+            return;
+        }
+        if t < reaction_s {
+            // New random acceleration every 0.5 ms (kind 0: always the hardest push toward the
+            // other robot).
+            if kind == 0 {
+                self.accel = toward * model.max_accel_mm_s2;
+            } else if (t / 5e-4).fract() < DT / 5e-4 + 1e-12 {
+                self.accel = unit(rng) * model.max_accel_mm_s2 * rng.random_range(0.0..1.0f64).sqrt();
+            }
+            self.v += self.accel * DT;
+            let speed = self.v.norm();
+            if speed > model.max_speed_mm_s {
+                self.v *= model.max_speed_mm_s / speed;
+            }
+            self.p += self.v * DT;
+            return;
+        }
+        if !self.braking {
+            self.braking = true;
+            let speed = self.v.norm();
+            // The path's direction at the start of braking: kind 0 toward the other robot,
+            // 1 straight on, 2 a random direction, 3 random and curving.
+            let dir = match kind {
+                0 => *toward,
+                1 if speed > 0.0 => self.v / speed,
+                _ => unit(rng),
+            };
+            self.v = dir * speed;
+            self.decel = if kind == 0 { model.decel_mm_s2 } else { model.decel_mm_s2 * rng.random_range(1.0..1.5) };
+            self.turn = if kind == 3 { rng.random_range(-40.0..40.0) } else { 0.0 };
+            self.axis = unit(rng);
+        }
+        let speed = self.v.norm();
+        let new_speed = (speed - self.decel * DT).max(0.0);
+        if new_speed == 0.0 || speed == 0.0 {
+            self.done = true;
+            return;
+        }
+        let mut dir = self.v / speed;
+        if self.turn != 0.0 {
+            let rot = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(self.axis), self.turn * DT);
+            dir = rot * dir;
+        }
+        self.v = dir * new_speed;
+        self.p += dir * (0.5 * (speed + new_speed) * DT);
+    }
+}
+
+/// Simulates `motions` random stops of both robots from TCPs `tcps` with true velocities
+/// `vel`; panics at the first contact.
+fn assert_stops_never_touch(cell: &Cell, tcps: &[Vec3; 2], vel: &[Vec3; 2], motions: usize, rng: &mut StdRng) -> usize {
+    let mut exact = ExactChecker::new(cell.clone());
+    let mut steps = 0;
+    for m in 0..motions {
+        let kind = m % 4;
+        let toward = |j: usize| {
+            // The other robot's TCP in robot j's MCS, roughly: its base direction.
+            let other = cell.robots[1 - j].placement.t - cell.robots[j].placement.t;
+            let (s, c) = cell.robots[j].placement.alpha.sin_cos();
+            Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize()
+        };
+        let mut robots: Vec<Motion> = (0..2)
+            .map(|j| Motion {
+                p: tcps[j],
+                v: vel[j],
+                accel: Vec3::zeros(),
+                braking: false,
+                decel: 0.0,
+                turn: 0.0,
+                axis: Vec3::z(),
+                done: false,
+            })
+            .collect();
+        let mut t = 0.0;
+        while !robots.iter().all(|r| r.done) {
+            for (j, r) in robots.iter_mut().enumerate() {
+                let stop = cell.stops[j];
+                r.step(t, (stop.reaction_ms + cell.tick_ms) * 1e-3, &stop, rng, kind, &toward(j));
+            }
+            t += DT;
+            let v = exact.check(&[robots[0].p, robots[1].p]).unwrap();
+            if !v.all_reachable() {
+                break; // the robot cannot go there: this motion is not physical
+            }
+            steps += 1;
+            assert!(!v.collides(), "contact at t = {t:.4} s in motion {m} from {tcps:?} with {vel:?}");
+            assert!(t < 1.0, "a stop lasted a second");
+        }
+    }
+    steps
+}
+
+/// Random states near each other; for each FREE one, random stops are simulated.
+fn brute_force(name: &str, stop: StopModel, states: usize, seed: u64) -> (usize, usize) {
+    let cell = cell(name, stop);
+    let mut checker = ProtectiveChecker::new(cell.clone(), 5.0).unwrap();
+    let mut rng = StdRng::seed_from_u64(seed);
+    let (mut free, mut steps) = (0, 0);
+    let tick = cell.tick_ms * 1e-3;
+    for _ in 0..states {
+        let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
+        // Speeds mostly low (else nothing near is FREE), directions random.
+        let v_fd: [Vec3; 2] = std::array::from_fn(|_| unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3));
+        let prev = [tcps[0] - v_fd[0] * tick, tcps[1] - v_fd[1] * tick];
+        checker.reset();
+        checker.check(&prev).unwrap();
+        let r = checker.check(&tcps).unwrap().clone();
+        if r.status != ProtectiveStatus::Ok || r.verdict == Protective::Stop {
+            continue;
+        }
+        free += 1;
+        // The true velocity now: within a_max * tick of the finite difference, under v_max.
+        let vel = v_fd.map(|v| {
+            let w = v + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
+            if w.norm() > stop.max_speed_mm_s { w * (stop.max_speed_mm_s / w.norm()) } else { w }
+        });
+        steps += assert_stops_never_touch(&cell, &tcps, &vel, 8, &mut rng);
+    }
+    (free, steps)
+}
+
+#[test]
+fn free_verdicts_survive_simulated_stops() {
+    let mut total = 0;
+    for (i, name) in ["T1", "T2", "T3"].iter().enumerate() {
+        for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
+            let (free, steps) = brute_force(name, stop, 150, 100 + 10 * i as u64 + k as u64);
+            println!("{name} model {k}: {free} FREE/WARN states of 150, {steps} exact checks of simulated stops");
+            total += free;
+        }
+    }
+    assert!(total >= 60, "too few FREE states to test: {total}");
+}
+
+fn verdict_rank(v: Protective) -> u8 {
+    match v {
+        Protective::Free => 0,
+        Protective::Warn => 1,
+        Protective::Stop => 2,
+    }
+}
+
+#[test]
+fn first_tick_assumes_full_speed_and_close_robots_are_never_free() {
+    let mut rng = StdRng::seed_from_u64(7);
+    for name in ["T1", "T2", "T3"] {
+        let cell = cell(name, StopModel::DEFAULT);
+        let mut c = ProtectiveChecker::new(cell.clone(), 0.0).unwrap();
+        for _ in 0..100 {
+            let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
+            c.reset();
+            let first = c.check(&tcps).unwrap().clone();
+            assert!(first.robots.iter().all(|r| r.speed_bound_mm_s == 4_600.0 && r.speed_mm_s.is_infinite()));
+            let full = c.check_at_speeds(&tcps, &[Real::INFINITY; 2]).unwrap().clone();
+            assert_eq!(first.verdict, full.verdict);
+            if first.clearance_mm < 100.0 {
+                assert_eq!(first.verdict, Protective::Stop, "{name} {tcps:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn implausible_jumps_unreachable_and_non_finite_tcps_stop() {
+    let cell = cell("T1", STIFF);
+    let mut c = ProtectiveChecker::new(cell, 5.0).unwrap();
+    let (a, b) = (Vec3::new(-150.0, 0.0, -450.0), Vec3::new(150.0, 0.0, -450.0));
+    c.check(&[a, b]).unwrap();
+    assert_eq!(c.check(&[a, b]).unwrap().verdict, Protective::Free);
+    // 4.6 m/s is 4.6 mm per tick: 5 mm is too far.
+    let r = c.check(&[a + Vec3::new(0.0, 5.0, 0.0), b]).unwrap();
+    assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::ImplausibleMotion(0)));
+    // After an error there is no previous TCP: full speed assumed.
+    let r = c.check(&[a, b]).unwrap();
+    assert_eq!(r.robots[0].speed_bound_mm_s, 4_600.0);
+    c.check(&[a, b]).unwrap();
+    // Within the speed limit but a velocity change of 2 m/s in one tick: over 130 m/s^2.
+    let r = c.check(&[a, b + Vec3::new(2.0, 0.0, 0.0)]).unwrap();
+    assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::ImplausibleMotion(1)));
+    c.reset();
+    let r = c.check(&[a, Vec3::new(0.0, 0.0, -700.0)]).unwrap();
+    assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Unreachable(1)));
+    // An unreachable TCP is no history either.
+    let r = c.check(&[a, b]).unwrap();
+    assert_eq!((r.status, r.robots[1].speed_bound_mm_s), (ProtectiveStatus::Ok, 4_600.0));
+    let r = c.check(&[Vec3::new(0.0, Real::INFINITY, -450.0), b]).unwrap();
+    assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::NonFinite(0)));
+    assert!(c.check(&[a]).is_err());
+}
+
+#[test]
+fn a_larger_warn_threshold_never_warns_less() {
+    let mut rng = StdRng::seed_from_u64(11);
+    for name in ["T1", "T2", "T3"] {
+        let cell = cell(name, STIFF);
+        let mut checkers: Vec<ProtectiveChecker> =
+            [0.0, 2.0, 10.0, 40.0].iter().map(|&w| ProtectiveChecker::new(cell.clone(), w).unwrap()).collect();
+        let mut counts = [0usize; 4];
+        for _ in 0..150 {
+            let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
+            let speeds = [rng.random_range(0.0..1_500.0), rng.random_range(0.0..1_500.0)];
+            let ranks: Vec<u8> =
+                checkers.iter_mut().map(|c| verdict_rank(c.check_at_speeds(&tcps, &speeds).unwrap().verdict)).collect();
+            assert!(ranks.windows(2).all(|w| w[0] <= w[1]), "{name} {tcps:?} {speeds:?}: {ranks:?}");
+            for (k, r) in ranks.iter().enumerate() {
+                counts[k] += (*r > 0) as usize;
+            }
+        }
+        println!("{name}: WARN+STOP of 150 for warn 0, 2, 10, 40 mm: {counts:?}");
+    }
+}
+
+#[test]
+fn at_the_speed_limit_the_verdict_holds_and_ten_percent_above_it_does_not() {
+    let mut rng = StdRng::seed_from_u64(13);
+    let mut checked = 0;
+    for name in ["T1", "T2", "T3"] {
+        for stop in [STIFF, StopModel::DEFAULT] {
+            let cell = cell(name, stop);
+            let mut c = ProtectiveChecker::new(cell.clone(), 0.0).unwrap();
+            let resolution = stop.max_speed_mm_s / 256.0;
+            for _ in 0..40 {
+                let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
+                let speeds = [rng.random_range(0.0..800.0), rng.random_range(0.0..800.0)];
+                let r: ProtectiveReport = c.check_at_speeds(&tcps, &speeds).unwrap().clone();
+                for j in 0..2 {
+                    let limit = r.robots[j].speed_limit_mm_s;
+                    let mut at = speeds;
+                    at[j] = limit;
+                    if limit > 0.0 {
+                        assert_ne!(c.check_at_speeds(&tcps, &at).unwrap().verdict, Protective::Stop, "{name} {tcps:?} {at:?}");
+                        checked += 1;
+                    }
+                    if limit < stop.max_speed_mm_s {
+                        at[j] = (1.1 * limit).max(limit + resolution);
+                        assert_eq!(c.check_at_speeds(&tcps, &at).unwrap().verdict, Protective::Stop, "{name} {tcps:?} {at:?}");
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 40, "{checked}");
+}
+
+#[test]
+fn the_speed_limit_through_the_tick_history_gives_a_proof() {
+    let cell = cell("T1", STIFF);
+    let mut c = ProtectiveChecker::new(cell, 0.0).unwrap();
+    let (a, b) = (Vec3::new(60.0, 0.0, -450.0), Vec3::new(-80.0, 0.0, -450.0));
+    let r = c.check_at_speeds(&[a, b], &[0.0, 0.0]).unwrap().clone();
+    let limit = r.robots[0].speed_limit_mm_s;
+    assert!(limit > 0.0 && limit < 4_600.0, "{r:?}");
+    // Robot A moving toward B at its limit, measured from the previous TCP.
+    let step = Vec3::x() * (limit * 1e-3 * (1.0 - 1e-9));
+    c.reset();
+    c.check(&[a - step * 2.0, b]).unwrap();
+    c.check(&[a - step, b]).unwrap();
+    let r = c.check(&[a, b]).unwrap();
+    assert_eq!(r.status, ProtectiveStatus::Ok);
+    assert_ne!(r.verdict, Protective::Stop, "{r:?}");
+}
+
+#[test]
+fn timing_of_one_sweep_set() {
+    use delta_collide::cell::protective::stop_sweeps_wcs;
+    use delta_collide::cspace::guarantee::cube_box_sweeps;
+    let model = delta_collide::robot::RobotModel::THESIS;
+    let p = Vec3::new(100.0, 20.0, -450.0);
+    for splits in [1, 2, 3, 4] {
+        let t = std::time::Instant::now();
+        let mut r = 0.0;
+        for i in 0..2000 {
+            let s = cube_box_sweeps(&model, &p, 50.0 + (i % 7) as Real * 30.0, &p, splits).unwrap();
+            r += s[0].radius();
+        }
+        println!("splits {splits}: {:.1} us per sweep set ({r:.0})", t.elapsed().as_secs_f64() * 1e6 / 2000.0);
+    }
+    let _ = stop_sweeps_wcs;
+}
+
+#[test]
+fn a_tick_never_allocates() {
+    let cell = cell("T2", STIFF);
+    let mut c = ProtectiveChecker::new(cell.clone(), 5.0).unwrap();
+    let mut rng = StdRng::seed_from_u64(17);
+    let states: Vec<[Vec3; 2]> =
+        (0..64).map(|_| [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)]).collect();
+    let before = allocations();
+    for k in 0..2_000 {
+        let s = &states[k % states.len()];
+        c.check(s).unwrap();
+        c.check_at_speeds(s, &[100.0, 300.0]).unwrap();
+    }
+    assert_eq!(allocations(), before);
+    // Without the speed limits: the same verdicts, NaN limits.
+    let mut fast = ProtectiveChecker::new(cell, 5.0).unwrap().with_speed_limits(false);
+    for s in &states {
+        let full = c.check_at_speeds(s, &[100.0, 300.0]).unwrap().clone();
+        let r = fast.check_at_speeds(s, &[100.0, 300.0]).unwrap();
+        assert_eq!(r.verdict, full.verdict);
+        assert!(r.robots.iter().all(|x| x.speed_limit_mm_s.is_nan()));
+    }
+}
+
+/// Per scenario of `c_harness/scenarios.txt`: ticks with WARN and STOP, the first of each,
+/// the smallest clearance, and that the first STOP comes before the first contact.
+fn scenario_counts(stop: StopModel, label: &str) {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    for s in parse_scenarios(&text).unwrap() {
+        let cell = cell(&s.cell, stop);
+        let mut c = ProtectiveChecker::new(cell.clone(), 10.0).unwrap();
+        let mut exact = ExactChecker::new(cell);
+        let mut tcps = vec![Vec3::zeros(); s.robots.len()];
+        let (mut warn, mut stops, mut implausible) = (0, 0, 0);
+        let (mut first_warn, mut first_stop, mut first_contact) = (None, None, None);
+        let mut min_clear = Real::INFINITY;
+        let started = std::time::Instant::now();
+        for tick in 0..RUN_TICKS {
+            s.tcps_at(tick, &mut tcps);
+            let r = c.check(&tcps).unwrap();
+            min_clear = min_clear.min(r.clearance_mm);
+            implausible += matches!(r.status, ProtectiveStatus::ImplausibleMotion(_)) as u32;
+            match r.verdict {
+                Protective::Warn => {
+                    warn += 1;
+                    first_warn.get_or_insert(tick);
+                }
+                Protective::Stop => {
+                    stops += 1;
+                    first_stop.get_or_insert(tick);
+                }
+                Protective::Free => {}
+            }
+            if first_contact.is_none() && exact.check(&tcps).unwrap().collides() {
+                first_contact = Some(tick);
+            }
+        }
+        let us = started.elapsed().as_secs_f64() * 1e6 / RUN_TICKS as f64;
+        println!(
+            "{label} {} {}: STOP {stops} WARN {warn} ticks of {RUN_TICKS}, first WARN {first_warn:?} first STOP \
+             {first_stop:?} first contact {first_contact:?}, min clearance {min_clear:.1} mm, implausible {implausible}, {us:.0} us/tick",
+            s.cell, s.case
+        );
+        assert_eq!(implausible, 0, "the scenarios respect the stopping model's limits");
+        if let Some(contact) = first_contact {
+            assert!(first_stop.is_some_and(|t| t < contact), "STOP must come before contact");
+        }
+    }
+}
+
+#[test]
+fn scenario_counts_with_the_default_and_a_stiff_model() {
+    scenario_counts(StopModel::DEFAULT, "default");
+    scenario_counts(STIFF, "stiff");
+}
+
+/// `dc_protective_query` through the C ABI: no allocation per call, FREE for robots standing
+/// apart, and the report's per-robot fields filled.
+#[test]
+fn the_c_entry_point_never_allocates_and_fills_the_report() {
+    use delta_collide::ffi::*;
+    let mut robots = [dc_robot_config_thesis(); 2];
+    robots[1].translation = DcVec3 { x: 450.0, y: 0.0, z: 0.0 };
+    let config = DcCellConfig { robots: robots.as_ptr(), n_robots: 2, method: DC_METHOD_SAT_CACHE };
+    let mut h = std::ptr::null_mut();
+    // SAFETY: valid config and out pointer.
+    assert_eq!(unsafe { dc_init(&config, &mut h) }, DC_STATUS_OK);
+    let stops = [dc_stop_config_default(); 2];
+    // SAFETY: live handle, two readable configs.
+    assert_eq!(unsafe { dc_set_stop_model(h, 1.0, 10.0, stops.as_ptr(), 2) }, DC_STATUS_OK);
+    let tcps = [DcVec3 { x: -150.0, y: 0.0, z: -450.0 }, DcVec3 { x: 150.0, y: 0.0, z: -450.0 }];
+    let mut verdict = DC_VERDICT_STOP;
+    let mut report = std::mem::MaybeUninit::<DcProtectiveReport>::zeroed();
+    let before = allocations();
+    for _ in 0..1_000 {
+        // SAFETY: live handle, two readable TCPs, writable outputs.
+        let s = unsafe { dc_protective_query(h, tcps.as_ptr(), 2, &mut verdict, report.as_mut_ptr()) };
+        assert_eq!(s, DC_STATUS_OK);
+    }
+    assert_eq!(allocations(), before);
+    // SAFETY: written by every call above.
+    let report = unsafe { report.assume_init() };
+    assert_eq!((verdict, report.verdict, report.n_robots), (DC_VERDICT_FREE, DC_VERDICT_FREE, 2));
+    assert!(report.clearance_mm > 100.0 && report.protective_mm[0] > 0.0 && report.speed_limit_mm_s[1] > 0.0);
+    assert_eq!((report.closest_robot_a, report.closest_robot_b, report.limiting_robot_a), (0, 1, DC_BOX_NONE));
+    // SAFETY: live handle, destroyed once.
+    unsafe { dc_destroy(h) };
+}
