@@ -467,6 +467,8 @@ static void fail_closed(const HarnessOptions *options, const DcCellConfig *confi
     expect_init_file("binary cell file", path, DC_STATUS_PARSE);
     remove(path);
     printf("fail closed: done\n");
+}
+
 /* A protective query that must fail: the status, a STOP verdict over the pre-set FREE, and the report. */
 static void expect_protective(const char *what, DcCollider *h, const DcVec3 *tcps, size_t n, DcStatus expected,
                               uint32_t mask)
