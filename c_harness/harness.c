@@ -127,6 +127,10 @@ int parse_options(int argc, char **argv, HarnessOptions *out)
     memset(out, 0, sizeof *out);
     out->tmp_dir = ".";
     for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--protective-quick") == 0) {
+            out->protective_quick = 1;
+            continue;
+        }
         if (strcmp(argv[i], "--quick") == 0) {
             out->quick = 1;
         } else if (strcmp(argv[i], "--tmp") == 0 && i + 1 < argc) {

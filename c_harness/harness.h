@@ -25,10 +25,13 @@ typedef struct HarnessTable {
 /* The command line: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]...
  *   --quick  runs the T1 collision scenario only (exact and table mode), for valgrind;
  *            the kinematics grid and every bad-input scenario still run;
+ *   --protective-quick  the protective scenarios on T1 collision only (under qemu, where the
+ *            interval arithmetic of every scenario would take many minutes);
  *   --tmp    a directory for scratch files (default ".");
  *   --table  the table file of reference cell CELL (T1, T2 or T3): enables table mode. */
 typedef struct HarnessOptions {
     int quick;
+    int protective_quick; /* --protective-quick: the protective verdict on T1 collision only */
     const char *tmp_dir;
     HarnessTable tables[HARNESS_N_CELLS]; /* T1, T2, T3 */
 } HarnessOptions;

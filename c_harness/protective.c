@@ -255,7 +255,7 @@ void protective_scenarios(const HarnessOptions *options)
     size_t c, k;
     stiff.reaction_ms = 2.0;
     stiff.decel_mm_s2 = 120000.0;
-    if (options->quick) {
+    if (options->quick || options->protective_quick) {
         /* Valgrind: the default model stops at about tick 60 and stands still by tick 100. */
         run_protective("T1", "collision", "default", &standard, 200);
         return;
