@@ -48,7 +48,8 @@ fn protective_query(c: &mut Criterion) {
             assert_eq!(protective.check_at_speeds(black_box(tcps), speeds).unwrap().verdict, *verdict);
         })
     });
-    let mut verdict_only = ProtectiveChecker::new(reference_cell("T1").unwrap(), 10.0).unwrap().with_speed_limits(false);
+    let mut verdict_only =
+        ProtectiveChecker::new(reference_cell("T1").unwrap(), 10.0).unwrap().with_speed_limits(false);
     let mut i = 0;
     group.bench_function(BenchmarkId::new("protective", "verdict only"), |b| {
         b.iter(|| {

@@ -75,7 +75,8 @@ fn tcp_toward_other(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
     let d = Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize();
     let side = Vec3::new(-d.y, d.x, 0.0);
     loop {
-        let p = d * rng.random_range(-60.0..230.0) + side * rng.random_range(-140.0..140.0)
+        let p = d * rng.random_range(-60.0..230.0)
+            + side * rng.random_range(-140.0..140.0)
             + Vec3::z() * rng.random_range(-530.0..-370.0);
         if cell.robots[j].model.delta.is_reachable(&p) {
             return p;
@@ -205,7 +206,8 @@ fn brute_force(name: &str, stop: StopModel, states: usize, seed: u64) -> (usize,
     for _ in 0..states {
         let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
         // Speeds mostly low (else nothing near is FREE), directions random.
-        let v_fd: [Vec3; 2] = std::array::from_fn(|_| unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3));
+        let v_fd: [Vec3; 2] =
+            std::array::from_fn(|_| unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3));
         let prev = [tcps[0] - v_fd[0] * tick, tcps[1] - v_fd[1] * tick];
         checker.reset();
         checker.check(&prev).unwrap();
@@ -217,7 +219,11 @@ fn brute_force(name: &str, stop: StopModel, states: usize, seed: u64) -> (usize,
         // The true velocity now: within a_max * tick of the finite difference, under v_max.
         let vel = v_fd.map(|v| {
             let w = v + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
-            if w.norm() > stop.max_speed_mm_s { w * (stop.max_speed_mm_s / w.norm()) } else { w }
+            if w.norm() > stop.max_speed_mm_s {
+                w * (stop.max_speed_mm_s / w.norm())
+            } else {
+                w
+            }
         });
         steps += assert_stops_never_touch(&cell, &tcps, &vel, 8, &mut rng);
     }
@@ -333,12 +339,20 @@ fn at_the_speed_limit_the_verdict_holds_and_ten_percent_above_it_does_not() {
                     let mut at = speeds;
                     at[j] = limit;
                     if limit > 0.0 {
-                        assert_ne!(c.check_at_speeds(&tcps, &at).unwrap().verdict, Protective::Stop, "{name} {tcps:?} {at:?}");
+                        assert_ne!(
+                            c.check_at_speeds(&tcps, &at).unwrap().verdict,
+                            Protective::Stop,
+                            "{name} {tcps:?} {at:?}"
+                        );
                         checked += 1;
                     }
                     if limit < stop.max_speed_mm_s {
                         at[j] = (1.1 * limit).max(limit + resolution);
-                        assert_eq!(c.check_at_speeds(&tcps, &at).unwrap().verdict, Protective::Stop, "{name} {tcps:?} {at:?}");
+                        assert_eq!(
+                            c.check_at_speeds(&tcps, &at).unwrap().verdict,
+                            Protective::Stop,
+                            "{name} {tcps:?} {at:?}"
+                        );
                     }
                 }
             }

@@ -123,8 +123,12 @@ pub struct RobotProtection {
 }
 
 impl RobotProtection {
-    const UNKNOWN: RobotProtection =
-        RobotProtection { speed_mm_s: Real::INFINITY, speed_bound_mm_s: 0.0, protective_mm: 0.0, speed_limit_mm_s: 0.0 };
+    const UNKNOWN: RobotProtection = RobotProtection {
+        speed_mm_s: Real::INFINITY,
+        speed_bound_mm_s: 0.0,
+        protective_mm: 0.0,
+        speed_limit_mm_s: 0.0,
+    };
 }
 
 /// The result of one protective check.
@@ -285,7 +289,11 @@ impl ProtectiveChecker {
     ///
     /// # Errors
     /// [`QueryError::WrongRobotCount`] when either slice's length differs from the robot count.
-    pub fn check_at_speeds(&mut self, tcps_mcs: &[Vec3], speeds_mm_s: &[Real]) -> Result<&ProtectiveReport, QueryError> {
+    pub fn check_at_speeds(
+        &mut self,
+        tcps_mcs: &[Vec3],
+        speeds_mm_s: &[Real],
+    ) -> Result<&ProtectiveReport, QueryError> {
         let n = self.cell().robots.len();
         for len in [tcps_mcs.len(), speeds_mm_s.len()] {
             if len != n {
@@ -333,12 +341,17 @@ impl ProtectiveChecker {
             Protective::Stop
         } else if self.warn_mm > 0.0 {
             self.report.limiting = first_unproved(pairs, &boxes, &self.sweeps, None, self.warn_mm);
-            if self.report.limiting.is_some() { Protective::Warn } else { Protective::Free }
+            if self.report.limiting.is_some() {
+                Protective::Warn
+            } else {
+                Protective::Free
+            }
         } else {
             Protective::Free
         };
         for (j, tcp) in tcps_mcs.iter().enumerate() {
-            self.report.robots[j].speed_limit_mm_s = if self.speed_limits { self.speed_limit(j, tcp) } else { Real::NAN };
+            self.report.robots[j].speed_limit_mm_s =
+                if self.speed_limits { self.speed_limit(j, tcp) } else { Real::NAN };
         }
     }
 
@@ -346,7 +359,11 @@ impl ProtectiveChecker {
     fn speed_bound(&self, j: usize, v: Real) -> Real {
         let stop = &self.cell().stops[j];
         let bound = v + stop.max_accel_mm_s2 * self.cell().tick_ms * 1e-3;
-        if bound.is_finite() { bound.min(stop.max_speed_mm_s) } else { stop.max_speed_mm_s }
+        if bound.is_finite() {
+            bound.min(stop.max_speed_mm_s)
+        } else {
+            stop.max_speed_mm_s
+        }
     }
 
     /// Sets robot `j`'s reference boxes and sweeps for TCP `tcp_mcs` at measured speed `v`
@@ -393,7 +410,11 @@ impl ProtectiveChecker {
             let (mut lo, mut hi) = (0.0, vmax);
             for _ in 0..LIMIT_STEPS {
                 let mid = 0.5 * (lo + hi);
-                if proved(self, mid) { lo = mid } else { hi = mid }
+                if proved(self, mid) {
+                    lo = mid
+                } else {
+                    hi = mid
+                }
             }
             lo
         };
@@ -409,7 +430,15 @@ impl ProtectiveChecker {
 /// `p + v_fd T_r` of radius `R = a_max T T_r + a_max T_r^2 / 2 + L_b`, and so in the ball
 /// around the segment's middle of radius `R + v T_r / 2`. Returns that ball when it is
 /// smaller than the ball of radius `s` around `p`, else `(p, s)`.
-fn capsule_ball(stop: &StopModel, tick_s: Real, reaction_s: Real, p: &Vec3, velocity: &Vec3, v: Real, s: Real) -> (Vec3, Real) {
+fn capsule_ball(
+    stop: &StopModel,
+    tick_s: Real,
+    reaction_s: Real,
+    p: &Vec3,
+    velocity: &Vec3,
+    v: Real,
+    s: Real,
+) -> (Vec3, Real) {
     let norm = velocity.norm();
     if !(norm > 0.0 && v.is_finite()) {
         return (*p, s);
@@ -419,7 +448,11 @@ fn capsule_ball(stop: &StopModel, tick_s: Real, reaction_s: Real, p: &Vec3, velo
     let v_r = (v + delta + a * t).min(vmax);
     let r = delta * t + 0.5 * a * t * t + v_r * v_r / (2.0 * stop.decel_mm_s2);
     let radius = r + 0.5 * v * t;
-    if radius < s { (p + velocity * (v / norm * 0.5 * t), radius) } else { (*p, s) }
+    if radius < s {
+        (p + velocity * (v / norm * 0.5 * t), radius)
+    } else {
+        (*p, s)
+    }
 }
 
 /// The status that wins when several robots fail: non-finite, then implausible, then
@@ -431,7 +464,11 @@ fn worse(a: ProtectiveStatus, b: ProtectiveStatus) -> ProtectiveStatus {
         ProtectiveStatus::ImplausibleMotion(_) => 2,
         ProtectiveStatus::NonFinite(_) => 3,
     };
-    if rank(&b) > rank(&a) { b } else { a }
+    if rank(&b) > rank(&a) {
+        b
+    } else {
+        a
+    }
 }
 
 /// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
@@ -444,7 +481,12 @@ pub fn stop_sweeps_wcs(model: &RobotModel, rot_wcs: &crate::math::Mat3, tcp_mcs:
             let reach = s * (1.0 + 1e-12) + 1e-12;
             let ball_form = |w: &Sweep| {
                 let [(e1, d1), (e2, d2)] = w.ends;
-                Sweep { cube: [Vec3::zeros(); 3], ends: [(0.0, d1), (0.0, d2)], ball: w.ball + e1.max(e2) * reach, ..*w }
+                Sweep {
+                    cube: [Vec3::zeros(); 3],
+                    ends: [(0.0, d1), (0.0, d2)],
+                    ball: w.ball + e1.max(e2) * reach,
+                    ..*w
+                }
             };
             [sweeps.map(|w| w.rotated(rot_wcs)), sweeps.map(|w| ball_form(&w).rotated(rot_wcs))]
         }

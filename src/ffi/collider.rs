@@ -7,11 +7,11 @@
 
 use crate::cell::exact::PairState;
 use crate::cell::protective::{BoxPair, Protective, ProtectiveChecker, ProtectiveStatus, DEFAULT_WARN_MM};
-use crate::robot::StopModel;
 use crate::cell::{Cell, ExactChecker};
 use crate::ffi::convert::{cell_error_status, table_error_status};
 use crate::ffi::types::*;
 use crate::math::Vec3;
+use crate::robot::StopModel;
 use crate::table::{TableAnswer, TableChecker};
 use std::path::Path;
 

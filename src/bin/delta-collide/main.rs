@@ -17,8 +17,9 @@ mod plot;
 mod quilt;
 mod render;
 mod replay;
+mod rows;
 
-use args::{clip, BuildArgs, CheckArgs, Cli, Command, DemoArgs, EvalArgs, InspectArgs};
+use args::{BuildArgs, CheckArgs, Cli, Command, DemoArgs, EvalArgs, InspectArgs};
 use clap::CommandFactory;
 use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
@@ -230,7 +231,10 @@ pub(crate) fn open_input(path: Option<&Path>) -> Result<Box<dyn BufRead>, String
 }
 
 /// Writes through `rows` to the output file (replaced once complete) or to stdout.
-pub(crate) fn write_output(output: Option<&Path>, mut rows: impl FnMut(&mut dyn Write) -> Result<(), String>) -> Result<(), String> {
+pub(crate) fn write_output(
+    output: Option<&Path>,
+    mut rows: impl FnMut(&mut dyn Write) -> Result<(), String>,
+) -> Result<(), String> {
     match output {
         Some(path) => files::write_file(path, |w| rows(w)),
         None => {
@@ -252,49 +256,21 @@ fn check_rows(
     cell: &Cell,
     mut table: Option<&mut TableChecker>,
 ) -> Result<(), String> {
-    let n = cell.robots.len();
     let mut checker = ExactChecker::new(cell.clone());
-    let mut tcps = vec![Vec3::zeros(); n];
-    let mut values = Vec::with_capacity(3 * n);
     let write_err = |e: std::io::Error| format!("writing the answers: {e}");
     writeln!(out, "reachable,collide").map_err(write_err)?;
-    let mut first = true;
-    for (line_no, line) in input.lines().enumerate() {
-        let line = line.map_err(|e| format!("line {}: {e}", line_no + 1))?;
-        let line = line.trim();
-        if line.is_empty() {
-            continue;
-        }
-        let header = first && line.split(',').all(|f| f.trim().parse::<f64>().is_err());
-        first = false;
-        if header {
-            continue;
-        }
-        values.clear();
-        let parsed = line.split(',').try_for_each(|f| f.trim().parse::<f64>().map(|v| values.push(v)));
-        if parsed.is_err() || values.len() != 3 * n {
-            return Err(format!(
-                "line {}: expected {} numbers (x,y,z per robot) separated by commas, got `{}`",
-                line_no + 1,
-                3 * n,
-                clip(line)
-            ));
-        }
-        for (j, t) in tcps.iter_mut().enumerate() {
-            *t = Vec3::new(values[3 * j], values[3 * j + 1], values[3 * j + 2]);
-        }
+    rows::for_each_row(input, cell.robots.len(), |line_no, tcps| {
         let answer = match table.as_deref_mut() {
-            Some(t) => t.check(&tcps),
-            None => checker.check(&tcps).map(exact_answer),
+            Some(t) => t.check(tcps),
+            None => checker.check(tcps).map(exact_answer),
         };
-        let row = match answer.map_err(|e| format!("line {}: {e}", line_no + 1))? {
+        let row = match answer.map_err(|e| format!("line {line_no}: {e}"))? {
             TableAnswer::Unreachable(_) => "0,NA\n",
             TableAnswer::Collision => "1,1\n",
             TableAnswer::Free => "1,0\n",
         };
-        out.write_all(row.as_bytes()).map_err(write_err)?;
-    }
-    Ok(())
+        out.write_all(row.as_bytes()).map_err(write_err)
+    })
 }
 
 /// The exact verdict in the table's terms.

@@ -1,10 +1,9 @@
 //! `replay`: a recorded trajectory, one row per controller tick, through the protective
 //! verdict (SPEC §8), one output line per tick.
 
-use crate::args::{clip, ReplayArgs};
+use crate::args::ReplayArgs;
 use crate::{open_input, write_output, Failure};
 use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveStatus};
-use delta_collide::math::Vec3;
 use std::io::{BufRead, Write};
 
 pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
@@ -26,32 +25,9 @@ fn replay_rows(input: &mut dyn BufRead, out: &mut dyn Write, checker: &mut Prote
     let columns = |prefix: &str| names.iter().map(|r| format!(",{prefix}_{r}")).collect::<String>();
     writeln!(out, "tick,verdict,status,clearance_mm{}{}", columns("protective_mm"), columns("speed_limit_mm_s"))
         .map_err(write_err)?;
-    let (mut tcps, mut values, mut tick, mut first) = (vec![Vec3::zeros(); n], Vec::with_capacity(3 * n), 0u64, true);
-    for (line_no, line) in input.lines().enumerate() {
-        let line = line.map_err(|e| format!("line {}: {e}", line_no + 1))?;
-        let line = line.trim();
-        if line.is_empty() {
-            continue;
-        }
-        let header = first && line.split(',').all(|f| f.trim().parse::<f64>().is_err());
-        first = false;
-        if header {
-            continue;
-        }
-        values.clear();
-        let parsed = line.split(',').try_for_each(|f| f.trim().parse::<f64>().map(|v| values.push(v)));
-        if parsed.is_err() || values.len() != 3 * n {
-            return Err(format!(
-                "line {}: expected {} numbers (x,y,z per robot) separated by commas, got `{}`",
-                line_no + 1,
-                3 * n,
-                clip(line)
-            ));
-        }
-        for (j, t) in tcps.iter_mut().enumerate() {
-            *t = Vec3::new(values[3 * j], values[3 * j + 1], values[3 * j + 2]);
-        }
-        let r = checker.check(&tcps).map_err(|e| format!("line {}: {e}", line_no + 1))?;
+    let mut tick = 0u64;
+    crate::rows::for_each_row(input, n, |line_no, tcps| {
+        let r = checker.check(tcps).map_err(|e| format!("line {line_no}: {e}"))?;
         let verdict = match r.verdict {
             Protective::Free => "FREE",
             Protective::Warn => "WARN",
@@ -68,6 +44,6 @@ fn replay_rows(input: &mut dyn BufRead, out: &mut dyn Write, checker: &mut Prote
         r.robots.iter().for_each(|x| row += &format!(",{:.1}", x.speed_limit_mm_s));
         writeln!(out, "{row}").map_err(write_err)?;
         tick += 1;
-    }
-    Ok(())
+        Ok(())
+    })
 }
