@@ -158,6 +158,107 @@ fn build_inspect_eval_and_check_with_a_table() {
     std::fs::write(&input, "190,70,-450,-200,-20,-450\n-150,0,-450,150,0,-450\n0,0,-900,0,0,-450\n").unwrap();
     let out = cli(&["check", "--cell", "T3", "--table", table, "--input", input.to_str().unwrap()]);
     assert_eq!(String::from_utf8(out.stdout).unwrap(), "reachable,collide\n1,1\n1,0\n0,NA\n");
+    // --clearance in table mode: the exact signed clearance beside the table's answer.
+    let out = cli(&["check", "--cell", "T3", "--table", table, "--clearance", "--input", input.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let rows: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(text.lines().next(), Some("reachable,collide,clearance_mm"));
+    let tcps = [
+        [Vec3::new(190.0, 70.0, -450.0), Vec3::new(-200.0, -20.0, -450.0)],
+        [Vec3::new(-150.0, 0.0, -450.0), Vec3::new(150.0, 0.0, -450.0)],
+    ];
+    for (row, t) in rows.iter().zip(&tcps) {
+        let truth = oracle_clearance("T3", t).unwrap();
+        let got: f64 = row[2].parse().unwrap();
+        assert!((got - truth).abs() < 2e-3, "T3 {t:?}: printed {got}, oracle {truth}");
+    }
+    assert!(rows[0][2].starts_with('-') && !rows[1][2].starts_with('-'), "{text}");
+    assert_eq!(rows[2], ["0", "NA", "NA"]);
+}
+
+/// Signed clearance of the cell `cell` at `tcps` computed here, apart from
+/// `geometry::clearance`: apart, the smallest box distance of `geometry::distance` (vertex and
+/// edge distances); intersecting, minus the smallest overlap (the shift that separates them)
+/// of the 8-vertex projections of two boxes over their 15 normalised axes. `None` when a TCP is unreachable.
+fn oracle_clearance(cell: &str, tcps: &[Vec3]) -> Option<f64> {
+    use delta_collide::geometry::{obb_distance, Obb};
+    let mut exact = ExactChecker::new(reference_cell(cell).unwrap());
+    if !exact.check(tcps).unwrap().all_reachable() {
+        return None;
+    }
+    let overlap = |a: &Obb, b: &Obb| -> f64 {
+        let mut axes: Vec<Vec3> = (0..3).flat_map(|i| [a.axes.column(i).into(), b.axes.column(i).into()]).collect();
+        for i in 0..3 {
+            for j in 0..3 {
+                let c: Vec3 = a.axes.column(i).cross(&b.axes.column(j));
+                if c.norm() >= delta_collide::math::CROSS_AXIS_MIN_NORM {
+                    axes.push(c.normalize());
+                }
+            }
+        }
+        let range = |o: &Obb, n: &Vec3| {
+            o.vertices().iter().map(|v| v.dot(n)).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
+        };
+        axes.iter()
+            .map(|n| {
+                let ((a0, a1), (b0, b1)) = (range(a, n), range(b, n));
+                // How far one must move along n to separate them (containment included).
+                (a1 - b0).min(b1 - a0)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut best = f64::INFINITY;
+    for p in &exact.verdict().pairs {
+        for a in exact.boxes(p.a).as_slice() {
+            for b in exact.boxes(p.b).as_slice() {
+                let o = overlap(a, b);
+                best = best.min(if o > 0.0 { -o } else { obb_distance(a, b) });
+            }
+        }
+    }
+    Some(best)
+}
+
+/// `check --clearance` along T1's collision scenario (far apart at first, intersecting at the
+/// end) and one unreachable row: every printed clearance matches the oracle.
+#[test]
+fn check_clearance_matches_an_independent_signed_distance() {
+    let dir = fresh_dir("clearance");
+    let input = dir.join("in.csv");
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt")).unwrap();
+    let scenarios = delta_collide::cell::trajectory::parse_scenarios(&text).unwrap();
+    let s = scenarios.iter().find(|s| s.cell == "T1" && s.case == "collision").unwrap();
+    let mut configs = Vec::new();
+    for tick in (0..6000).step_by(25) {
+        let mut t = vec![Vec3::zeros(); 2];
+        s.tcps_at(tick, &mut t);
+        configs.push(t);
+    }
+    configs.push(vec![Vec3::new(0.0, 0.0, 100.0), Vec3::new(150.0, 0.0, -450.0)]);
+    let rows: Vec<String> =
+        configs.iter().map(|t| format!("{},{},{},{},{},{}", t[0].x, t[0].y, t[0].z, t[1].x, t[1].y, t[1].z)).collect();
+    std::fs::write(&input, rows.join("\n")).unwrap();
+    let out = cli(&["check", "--cell", "T1", "--clearance", "--input", input.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("reachable,collide,clearance_mm"));
+    let (mut negative, mut far) = (0, 0);
+    for (line, t) in lines.zip(&configs) {
+        let f: Vec<&str> = line.split(',').collect();
+        let Some(truth) = oracle_clearance("T1", t) else {
+            assert_eq!(f, ["0", "NA", "NA"], "{t:?}");
+            continue;
+        };
+        let got: f64 = f[2].parse().unwrap();
+        assert!((got - truth).abs() < 2e-3, "{t:?}: printed {got}, oracle {truth}");
+        assert_eq!(f[1] == "1", got <= 0.0, "{t:?}: collide and the sign agree: {line}");
+        negative += (got < -1.0) as u32;
+        far += (got > 100.0) as u32;
+    }
+    assert!(negative > 0 && far > 0, "the run covers intersecting and far configurations:\n{text}");
+    assert_eq!(text.lines().count(), configs.len() + 1);
 }
 
 /// The fenced block after "delta-collide --help" in the README's "Command line" section.

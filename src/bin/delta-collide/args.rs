@@ -60,6 +60,8 @@ pub enum Command {
     /// Reads rows x,y,z,x2,y2,z2 (one TCP per robot, each in its own MCS, mm; a first line
     /// with no number in it is a header) and writes one line `reachable,collide` per row;
     /// collide is NA when a TCP is unreachable. A malformed row is an error naming its line.
+    /// --clearance adds the column clearance_mm: the exact signed clearance of the cell (mm;
+    /// the gap when apart, minus the penetration depth when intersecting; SPEC section 8).
     Check(CheckArgs),
     /// Replay a trajectory through the protective verdict
     ///
@@ -133,6 +135,10 @@ pub struct CheckArgs {
     /// Write the answers to this file, replaced only once complete [default: stdout]
     #[arg(long, value_name = "FILE.csv")]
     pub output: Option<PathBuf>,
+    /// Add the column clearance_mm: the exact signed clearance (mm, negative when the boxes
+    /// intersect; NA when a TCP is unreachable), also with --table
+    #[arg(long)]
+    pub clearance: bool,
 }
 
 #[derive(Args, Debug)]

@@ -11,6 +11,7 @@
 //! shared parts in [`picture`]).
 
 mod args;
+mod clearance;
 mod files;
 mod picture;
 mod plot;
@@ -207,7 +208,8 @@ fn check(args: &CheckArgs) -> Result<(), Failure> {
     let cell = &args.cell;
     let mut table = args.table.as_deref().map(|p| load_table(cell, p)).transpose()?;
     let mut input = open_input(args.input.as_deref())?;
-    let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut());
+    let clearance = args.clearance;
+    let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut(), clearance);
     match &args.output {
         Some(path) => files::write_file(path, |w| rows(w))?,
         None => {
@@ -245,7 +247,9 @@ pub(crate) fn write_output(
     }
 }
 
-/// Answers every row of `input` on `out`, after the line `reachable,collide`.
+/// Answers every row of `input` on `out`, after the line `reachable,collide` (with
+/// `,clearance_mm` when `clearance`: the exact signed clearance, NA when a TCP is unreachable,
+/// computed by the exact model also in table mode).
 ///
 /// # Errors
 /// A row that is not `3 n` numbers (naming its line; the first line may be a header, a line
@@ -255,21 +259,35 @@ fn check_rows(
     out: &mut dyn Write,
     cell: &Cell,
     mut table: Option<&mut TableChecker>,
+    clearance: bool,
 ) -> Result<(), String> {
     let mut checker = ExactChecker::new(cell.clone());
     let write_err = |e: std::io::Error| format!("writing the answers: {e}");
-    writeln!(out, "reachable,collide").map_err(write_err)?;
+    writeln!(out, "reachable,collide{}", if clearance { ",clearance_mm" } else { "" }).map_err(write_err)?;
     rows::for_each_row(input, cell.robots.len(), |line_no, tcps| {
+        let at_line = |e: delta_collide::cell::QueryError| format!("line {line_no}: {e}");
         let answer = match table.as_deref_mut() {
-            Some(t) => t.check(tcps),
-            None => checker.check(tcps).map(exact_answer),
+            Some(t) => t.check(tcps).map_err(at_line)?,
+            None => exact_answer(checker.check(tcps).map_err(at_line)?),
         };
-        let row = match answer.map_err(|e| format!("line {line_no}: {e}"))? {
-            TableAnswer::Unreachable(_) => "0,NA\n",
-            TableAnswer::Collision => "1,1\n",
-            TableAnswer::Free => "1,0\n",
+        let row = match answer {
+            TableAnswer::Unreachable(_) => "0,NA",
+            TableAnswer::Collision => "1,1",
+            TableAnswer::Free => "1,0",
         };
-        out.write_all(row.as_bytes()).map_err(write_err)
+        out.write_all(row.as_bytes()).map_err(write_err)?;
+        if clearance {
+            if table.is_some() {
+                checker.check(tcps).map_err(at_line)?;
+            }
+            // NA also where the table's reachability and the exact model's differ.
+            match clearance::signed_clearance(&checker).filter(|_| !matches!(answer, TableAnswer::Unreachable(_))) {
+                Some(d) => write!(out, ",{d:.3}"),
+                None => write!(out, ",NA"),
+            }
+            .map_err(write_err)?;
+        }
+        out.write_all(b"\n").map_err(write_err)
     })
 }
 
