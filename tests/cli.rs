@@ -198,7 +198,10 @@ fn oracle_clearance(cell: &str, tcps: &[Vec3]) -> Option<f64> {
             }
         }
         let range = |o: &Obb, n: &Vec3| {
-            o.vertices().iter().map(|v| v.dot(n)).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
+            o.vertices()
+                .iter()
+                .map(|v| v.dot(n))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
         };
         axes.iter()
             .map(|n| {
