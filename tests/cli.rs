@@ -54,14 +54,15 @@ fn names_in(dir: &Path) -> Vec<String> {
 }
 
 #[test]
-fn demo_reports_no_collision_when_practical_and_the_same_first_tick_for_both_methods() {
+fn demo_reports_no_collision_when_practical_the_same_first_tick_for_both_methods_and_a_clear_stop() {
     let out = cli(&["demo", "--cell", "all"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8(out.stdout).unwrap();
     println!("{text}");
     for cell in ["T1", "T2", "T3"] {
-        let rows: Vec<Vec<&str>> =
+        let all: Vec<Vec<&str>> =
             text.lines().filter(|l| l.starts_with(cell)).map(|l| l.split_whitespace().collect()).collect();
+        let rows: Vec<&Vec<&str>> = all.iter().filter(|r| r[2].starts_with("SAT")).collect();
         assert_eq!(rows.len(), 4, "{cell}: practical and collision, SAT and SAT-cache");
         for r in rows.iter().filter(|r| r[1] == "practical") {
             assert_eq!((r[3], r[4]), ("none", "0"), "{cell} practical never collides");
@@ -70,6 +71,17 @@ fn demo_reports_no_collision_when_practical_and_the_same_first_tick_for_both_met
         assert_eq!(ticks.len(), 2);
         assert_eq!(ticks[0], ticks[1], "{cell}: SAT and SAT-cache stop at the same tick");
         assert!(ticks[0] > 3000 && ticks[0] < 6000, "{cell}: the last part of the run collides");
+        // The protective rows: cell case firstWARN firstSTOP WARN STOP stop stop_ms closest median_us.
+        let protective: Vec<&Vec<&str>> = all.iter().filter(|r| r.len() == 10).collect();
+        assert_eq!(protective.len(), 2, "{cell}: one protective row per scenario");
+        for r in protective {
+            let first_stop: u32 = r[3].parse().expect("the scenarios come close enough to need a STOP");
+            assert!(first_stop < ticks[0], "{cell} {}: STOP at {first_stop}, before the contact at {}", r[1], ticks[0]);
+            let (warn, stop): (u32, u32) = (r[4].parse().unwrap(), r[5].parse().unwrap());
+            assert!(stop > 0 && warn + stop <= 6000, "{r:?}");
+            assert_eq!(r[6], "clear", "{cell} {}: the simulated stop never touches", r[1]);
+            assert!(r[7].parse::<f64>().unwrap() > 0.0 && r[8].parse::<f64>().unwrap() > 0.0, "{r:?}");
+        }
     }
 }
 

@@ -12,6 +12,7 @@
 
 mod args;
 mod clearance;
+mod demo;
 mod files;
 mod picture;
 mod plot;
@@ -19,10 +20,11 @@ mod quilt;
 mod render;
 mod replay;
 mod rows;
+mod stop;
 
-use args::{BuildArgs, CheckArgs, Cli, Command, DemoArgs, EvalArgs, InspectArgs};
+use args::{BuildArgs, CheckArgs, Cli, Command, EvalArgs, InspectArgs};
 use clap::CommandFactory;
-use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
+use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::{Label, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
@@ -32,7 +34,7 @@ use std::path::Path;
 use std::time::Instant;
 
 /// The scenario file shared with the C harness.
-const SCENARIOS: &str = include_str!("../../../c_harness/scenarios.txt");
+pub(crate) const SCENARIOS: &str = include_str!("../../../c_harness/scenarios.txt");
 
 /// Why a command did not finish.
 pub enum Failure {
@@ -64,7 +66,7 @@ fn main() {
     let cli = Cli::parse_checked();
     let progress = !cli.quiet;
     let result = match &cli.command {
-        Command::Demo(a) => demo(a),
+        Command::Demo(a) => demo::demo(a),
         Command::Check(a) => check(a),
         Command::Replay(a) => replay::replay(a),
         Command::Build(a) => build(a, progress),
@@ -118,90 +120,8 @@ fn man(dir: Option<&Path>) -> Result<(), Failure> {
     Ok(())
 }
 
-fn with_method(cell: &Cell, method: SatMethod) -> Cell {
-    Cell { method, ..cell.clone() }
-}
-
-/// Per-tick timings of one run: nanoseconds, sorted.
-struct RunResult {
-    first_collision: Option<u32>,
-    collision_ticks: u32,
-    ns: Vec<u64>,
-}
-
-fn run(cell: &Cell, scenario: &Scenario) -> Result<RunResult, String> {
-    let mut checker = ExactChecker::new(cell.clone());
-    let mut tcps = vec![Vec3::zeros(); cell.robots.len()];
-    let mut r = RunResult { first_collision: None, collision_ticks: 0, ns: Vec::with_capacity(RUN_TICKS as usize) };
-    for tick in 0..RUN_TICKS {
-        scenario.tcps_at(tick, &mut tcps);
-        let start = Instant::now();
-        let v = checker.check(&tcps).map_err(|e| e.to_string())?;
-        let (reachable, collides) = (v.all_reachable(), v.collides());
-        r.ns.push(start.elapsed().as_nanos() as u64);
-        if !reachable {
-            return Err(format!("{} {}: a TCP is unreachable at tick {tick}", scenario.cell, scenario.case));
-        }
-        if collides {
-            r.collision_ticks += 1;
-            r.first_collision.get_or_insert(tick);
-        }
-    }
-    r.ns.sort_unstable();
-    Ok(r)
-}
-
-fn percentile(sorted: &[u64], p: f64) -> u64 {
+pub(crate) fn percentile(sorted: &[u64], p: f64) -> u64 {
     sorted[((sorted.len() - 1) as f64 * p).round() as usize]
-}
-
-fn demo(args: &DemoArgs) -> Result<(), Failure> {
-    let scenarios = parse_scenarios(SCENARIOS)?;
-    let cells = &args.cell.0;
-    println!(
-        "delta-collide {} demo: exact check (SAT on the box model), {RUN_TICKS} ticks of 1 ms per run",
-        env!("CARGO_PKG_VERSION")
-    );
-    println!(
-        "per-tick query time = 2 IK + box models + pair tests, measured with Instant (includes ~20 ns timer overhead)"
-    );
-    println!(
-        "{:<4} {:<10} {:<9} {:>15} {:>15} {:>10} {:>10} {:>10}",
-        "cell", "case", "method", "first collision", "collision ticks", "median ns", "p99 ns", "max ns"
-    );
-    for cell in cells {
-        let cases: Vec<&Scenario> = scenarios.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)).collect();
-        if cases.is_empty() {
-            return Err(format!("no scenario for cell {} in c_harness/scenarios.txt", cell.name).into());
-        }
-        for scenario in cases {
-            if scenario.robots.len() != cell.robots.len() {
-                return Err(Failure::Failed(format!(
-                    "scenario {} {} has {} robots, the cell {}",
-                    scenario.cell,
-                    scenario.case,
-                    scenario.robots.len(),
-                    cell.robots.len()
-                )));
-            }
-            for (name, method) in [("SAT", SatMethod::Sat), ("SAT-cache", SatMethod::SatCache)] {
-                let r = run(&with_method(cell, method), scenario)?;
-                let first = r.first_collision.map_or("none".to_string(), |t| format!("tick {t}"));
-                println!(
-                    "{:<4} {:<10} {:<9} {:>15} {:>15} {:>10} {:>10} {:>10}",
-                    cell.name,
-                    scenario.case,
-                    name,
-                    first,
-                    r.collision_ticks,
-                    percentile(&r.ns, 0.5),
-                    percentile(&r.ns, 0.99),
-                    r.ns[r.ns.len() - 1]
-                );
-            }
-        }
-    }
-    Ok(())
 }
 
 fn check(args: &CheckArgs) -> Result<(), Failure> {
