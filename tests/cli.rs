@@ -602,3 +602,83 @@ fn replay_writes_one_verdict_per_tick() {
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("line 1"), "{}", stderr(&out));
 }
+
+/// The rows of a scenario of `c_harness/scenarios.txt` for its first `ticks` ticks, as CSV.
+fn scenario_rows(cell: &str, case: &str, ticks: u32) -> String {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt")).unwrap();
+    let scenarios = delta_collide::cell::trajectory::parse_scenarios(&text).unwrap();
+    let s = scenarios.iter().find(|s| s.cell == cell && s.case == case).unwrap();
+    let mut rows = String::from("x,y,z,x2,y2,z2\n");
+    let mut t = vec![Vec3::zeros(); 2];
+    for tick in 0..ticks {
+        s.tcps_at(tick, &mut t);
+        rows += &format!("{},{},{},{},{},{}\n", t[0].x, t[0].y, t[0].z, t[1].x, t[1].y, t[1].z);
+    }
+    rows
+}
+
+/// An 8-bit RGB PNG file's width, height and pixels.
+fn read_png(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut rgb = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut rgb).unwrap();
+    assert_eq!((info.color_type, info.bit_depth), (png::ColorType::Rgb, png::BitDepth::Eight));
+    rgb.truncate(info.buffer_size());
+    (info.width, info.height, rgb.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect())
+}
+
+/// `replay --plot`: the verdicts as without it, and a PNG of the requested size whose
+/// verdict band holds FREE, WARN and STOP ticks (T1's collision run has all three).
+#[test]
+fn replay_plot_writes_a_png_of_the_requested_size() {
+    let dir = fresh_dir("replay-plot");
+    let (input, output, plot) = (dir.join("run.csv"), dir.join("verdicts.csv"), dir.join("run.png"));
+    std::fs::write(&input, scenario_rows("T1", "collision", 4000)).unwrap();
+    let args = ["replay", "--cell", "T1", "--input", input.to_str().unwrap(), "--output", output.to_str().unwrap()];
+    let out = cli(&[&args[..], &["--plot", plot.to_str().unwrap(), "--width", "900", "--height", "450"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("900 x 450 pixels, 4000 ticks"), "{}", stderr(&out));
+    let verdicts = std::fs::read_to_string(&output).unwrap();
+    assert_eq!(verdicts.lines().count(), 4001);
+    let (w, h, pixels) = read_png(&plot);
+    assert_eq!((w, h), (900, 450));
+    for (name, colour) in [("FREE", [120, 200, 120]), ("WARN", [240, 170, 60]), ("STOP", [220, 30, 30])] {
+        assert!(verdicts.contains(&format!(",{name},")), "the run has {name} ticks");
+        assert!(pixels.iter().filter(|&&p| p == colour).count() > 20, "{name} band missing");
+    }
+    // Without --plot the verdicts are the same.
+    let out = cli(&args);
+    assert!(out.status.success());
+    assert_eq!(std::fs::read_to_string(&output).unwrap(), verdicts);
+}
+
+#[test]
+fn replay_plot_refuses_bad_arguments_with_a_clear_message() {
+    let dir = fresh_dir("replay-plot-bad");
+    let input = dir.join("run.csv");
+    std::fs::write(&input, scenario_rows("T1", "practical", 5)).unwrap();
+    let input = input.to_str().unwrap();
+    let plot = dir.join("p.png");
+    let plot = plot.to_str().unwrap();
+    let usage: [(&[&str], &str); 5] = [
+        (&["--plot", plot, "--width", "100"], "at least 500"),
+        (&["--plot", plot, "--height", "x"], "--height"),
+        (&["--width", "900"], "--plot"),
+        (&["--plot", "run.csv"], "ending in .png"),
+        (&["--plot", plot, "--output", plot], "same file"),
+    ];
+    for (extra, message) in usage {
+        let out = cli(&[&["replay", "--cell", "T1", "--input", input][..], extra].concat());
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(message), "{extra:?}: {}", stderr(&out));
+    }
+    let missing = dir.join("no-such-dir").join("p.png");
+    let out = cli(&["replay", "--cell", "T1", "--input", input, "--plot", missing.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("no-such-dir"), "{}", stderr(&out));
+    let out = cli_stdin(&["replay", "--cell", "T1", "--plot", plot], "x,y,z,x2,y2,z2\n");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("no rows"), "{}", stderr(&out));
+    assert_eq!(names_in(&dir), ["run.csv"], "no picture is left behind by a failure");
+}

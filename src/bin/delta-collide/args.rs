@@ -69,7 +69,8 @@ pub enum Command {
     /// MCS, mm; a first line with no number in it is a header), with the cell's tick_ms and
     /// stopping models, and writes per tick
     /// `tick,verdict,status,clearance_mm,protective_mm_<robot>...,speed_limit_mm_s_<robot>...`
-    /// (verdict FREE, WARN or STOP; SPEC section 8).
+    /// (verdict FREE, WARN or STOP; SPEC section 8). --plot draws the clearance, the protective
+    /// distances and the verdict along the run.
     Replay(ReplayArgs),
     /// Sample, label and build a table file
     ///
@@ -155,6 +156,18 @@ pub struct ReplayArgs {
     /// WARN when a stop is proved with less than this to spare (mm)
     #[arg(long, value_name = "MM", default_value_t = 10.0)]
     pub warn_mm: f64,
+    /// Also draw the clearance, each robot's protective distance and the verdict per tick
+    /// into this PNG file
+    #[arg(long, value_name = "FILE.png")]
+    pub plot: Option<PathBuf>,
+    /// Width of the plot in pixels, 500 to 8192 (only with --plot)
+    #[arg(long, value_name = "W", default_value_t = 1400, requires = "plot")]
+    #[arg(value_parser = clipped(pixels(500)))]
+    pub width: u32,
+    /// Height of the plot in pixels, 300 to 8192 (only with --plot)
+    #[arg(long, value_name = "H", default_value_t = 600, requires = "plot")]
+    #[arg(value_parser = clipped(pixels(300)))]
+    pub height: u32,
 }
 
 #[derive(Args, Debug)]
@@ -364,6 +377,28 @@ impl Cli {
                         ErrorKind::ArgumentConflict,
                         "--variant shared-sub certifies sub-cells: it needs --labelling certified".into(),
                     ));
+                }
+            }
+            Command::Replay(r) => {
+                if let Some(plot) = &r.plot {
+                    if !plot.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
+                        return Err(usage_error(
+                            "replay",
+                            ErrorKind::InvalidValue,
+                            format!(
+                                "--plot {} : the plot is a PNG file, give a name ending in .png",
+                                clip(&plot.display().to_string())
+                            ),
+                        ));
+                    }
+                    if r.output.as_ref() == Some(plot) {
+                        return Err(usage_error(
+                            "replay",
+                            ErrorKind::ArgumentConflict,
+                            "--plot and --output name the same file: the verdicts (CSV) and the plot (PNG) need two"
+                                .into(),
+                        ));
+                    }
                 }
             }
             Command::Render(r) if r.tcp.len() != r.cell.robots.len() => {

@@ -19,6 +19,7 @@ mod plot;
 mod quilt;
 mod render;
 mod replay;
+mod replay_plot;
 mod rows;
 mod stop;
 

@@ -121,6 +121,35 @@ pub fn legend(
     Ok(x)
 }
 
+/// A strip of one colour per tick, `height` pixels tall (2 of them left as a gap) from `y`,
+/// over `(left, width)` pixels of `area` (the x range of a chart's plotting area), with
+/// `label` right-aligned before it.
+pub fn colour_strip(
+    area: &DrawingArea<BitMapBackend, Shift>,
+    label: &str,
+    (left, width): (i32, f64),
+    y: i32,
+    height: i32,
+    colours: &[RGBColor],
+) -> Result<(), String> {
+    use plotters::style::text_anchor::{HPos, Pos, VPos};
+    let n = colours.len().max(1);
+    let label_pos = (left - 6, y + height / 2);
+    area.draw(&Text::new(label.to_string(), label_pos, text(12, BLACK).pos(Pos::new(HPos::Right, VPos::Center))))
+        .map_err(plot_err)?;
+    // One run of equal colour at a time.
+    let mut start = 0;
+    for t in 1..=colours.len() {
+        if t == colours.len() || colours[t] != colours[start] {
+            let px = |tick: usize| left + (tick as f64 / n as f64 * width).round() as i32;
+            let (a, b) = (px(start), px(t).max(px(start) + 1));
+            area.draw(&Rectangle::new([(a, y), (b, y + height - 2)], colours[start].filled())).map_err(plot_err)?;
+            start = t;
+        }
+    }
+    Ok(())
+}
+
 /// The convex hull of 2-D points, counter-clockwise, without repeated points (Andrew's
 /// monotone chain).
 pub fn convex_hull(points: &[(f64, f64)]) -> Vec<(f64, f64)> {

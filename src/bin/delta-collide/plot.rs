@@ -7,7 +7,7 @@
 //! table tick labelled collision over a positive distance is a false positive; a tick labelled
 //! free at distance 0 would be a false negative.
 
-use crate::picture::{draw_png, legend, plot_err, text, Swatch, HIT, OUTSIDE, ROBOT};
+use crate::picture::{colour_strip, draw_png, legend, plot_err, text, Swatch, HIT, OUTSIDE, ROBOT};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::geometry::obb_distance;
 use delta_collide::math::Vec3;
@@ -147,19 +147,7 @@ fn draw_trace(area: &DrawingArea<BitMapBackend, Shift>, trace: &Trace) -> Result
         ("exact", trace.exact.iter().map(|e| exact_colour(*e)).collect()),
     ];
     for (r, (label, colours)) in rows.iter().enumerate() {
-        let y = top + r as i32 * STRIP;
-        let label_pos = (left - 6, y + STRIP / 2);
-        area.draw(&Text::new(*label, label_pos, text(12, BLACK).pos(right_centre()))).map_err(plot_err)?;
-        // One run of equal colour at a time.
-        let mut start = 0;
-        for t in 1..=colours.len() {
-            if t == colours.len() || colours[t] != colours[start] {
-                let px = |tick: usize| left + (tick as f64 / n as f64 * width).round() as i32;
-                let (a, b) = (px(start), px(t).max(px(start) + 1));
-                area.draw(&Rectangle::new([(a, y), (b, y + STRIP - 2)], colours[start].filled())).map_err(plot_err)?;
-                start = t;
-            }
-        }
+        colour_strip(area, label, (left, width), top + r as i32 * STRIP, STRIP, colours)?;
     }
     Ok(())
 }
@@ -178,9 +166,4 @@ fn exact_colour(e: Option<bool>) -> RGBColor {
         Some(false) => FREE_TICK,
         None => OUTSIDE,
     }
-}
-
-fn right_centre() -> plotters::style::text_anchor::Pos {
-    use plotters::style::text_anchor::{HPos, Pos, VPos};
-    Pos::new(HPos::Right, VPos::Center)
 }
