@@ -386,7 +386,7 @@ impl Cli {
                             "replay",
                             ErrorKind::InvalidValue,
                             format!(
-                                "--plot {} : the plot is a PNG file, give a name ending in .png",
+                                "--plot {}: the plot is a PNG file; give a name ending in .png",
                                 clip(&plot.display().to_string())
                             ),
                         ));
