@@ -87,4 +87,9 @@ void bad_input(const HarnessOptions *options);
  * contact with the exact model. --quick runs T1 collision only. */
 void protective_scenarios(const HarnessOptions *options);
 
+/* The practical scenarios with the speed limits of the protective verdict applied as a speed
+ * override (speed_override.c): cycle time against the unscaled cycle, STOP ticks, contacts.
+ * Skipped with --quick and --protective-quick. */
+void speed_override_scenarios(const HarnessOptions *options);
+
 #endif /* HARNESS_H */

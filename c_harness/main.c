@@ -10,7 +10,9 @@
  *     trajectory) collides.
  * On every tick the mock's own C kinematics is cross-checked against the library's. When a
  * table file is given for the cell, each scenario runs once more with the POU in table mode
- * (table_mode.c), and once with the protective verdict and a simulated stop (protective.c). Then the bad-input scenarios (bad_input.c) check every documented error
+ * (table_mode.c), and once with the protective verdict and a simulated stop (protective.c);
+ * the practical ones once more with the speed limits applied as a speed override
+ * (speed_override.c). Then the bad-input scenarios (bad_input.c) check every documented error
  * status and the fail-closed outputs, in both modes.
  *
  * Usage (from the repository root):
@@ -359,6 +361,7 @@ int main(int argc, char **argv)
         }
     }
     protective_scenarios(&options);
+    speed_override_scenarios(&options);
     bad_input(&options);
     for (c = 0; c < 3; ++c) {
         for (k = 0; k < 2; ++k) {

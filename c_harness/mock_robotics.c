@@ -262,6 +262,93 @@ void mr_trajectory_tcp(const MrTrajectory *traj, long tick, double out[3])
     }
 }
 
+void mr_trajectory_tcp_at(const MrTrajectory *traj, double tick, double out[3])
+{
+    size_t i;
+    int k;
+    if (traj->n_waypoints == 0) {
+        out[0] = out[1] = out[2] = 0.0;
+        return;
+    }
+    for (i = 0; i + 1 < traj->n_waypoints && tick > (double)traj->tick[i]; ++i) {
+        if (tick <= (double)traj->tick[i + 1]) {
+            double t0 = (double)traj->tick[i], t1 = (double)traj->tick[i + 1];
+            double s = mr_min_jerk((tick - t0) / (t1 - t0));
+            for (k = 0; k < 3; ++k) {
+                out[k] = traj->tcp[i][k] + s * (traj->tcp[i + 1][k] - traj->tcp[i][k]);
+            }
+            return;
+        }
+    }
+    /* Before the first waypoint's tick the robot holds it; after the last, the last. */
+    memcpy(out, traj->tcp[tick <= (double)traj->tick[0] ? 0 : traj->n_waypoints - 1], 3 * sizeof(double));
+}
+
+static double distance3(const double a[3], const double b[3])
+{
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+double mr_trajectory_advance(const MrTrajectory *traj, double tick, double distance_mm)
+{
+    size_t i;
+    for (i = 0; i + 1 < traj->n_waypoints; ++i) {
+        double t0 = (double)traj->tick[i], t1 = (double)traj->tick[i + 1];
+        if (tick >= t0 && tick < t1) {
+            double length = distance3(traj->tcp[i], traj->tcp[i + 1]);
+            double lo = (tick - t0) / (t1 - t0), hi = 1.0, target;
+            int n;
+            if (length <= 0.0 || !(distance_mm > 0.0)) {
+                return tick;
+            }
+            /* The segment is straight: the distance along it is length * s(tau). */
+            target = mr_min_jerk(lo) + distance_mm / length;
+            if (target >= 1.0) {
+                return t1;
+            }
+            for (n = 0; n < 60; ++n) { /* s is increasing: bisect for s(tau) = target */
+                double mid = 0.5 * (lo + hi);
+                if (mr_min_jerk(mid) < target) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            return t0 + lo * (t1 - t0);
+        }
+    }
+    return tick;
+}
+
+void mr_override_start(const MrTrajectory *traj, MrOverride *o)
+{
+    o->path_tick = traj->n_waypoints > 0 ? (double)traj->tick[0] : 0.0;
+    o->speed = o->cap = 0.0;
+    mr_trajectory_tcp_at(traj, o->path_tick, o->tcp);
+}
+
+void mr_override_request(MrOverride *o, double wanted_mm_s, double ramp_mm_s2, double dt_s)
+{
+    double lo = o->speed - ramp_mm_s2 * dt_s, hi = o->speed + ramp_mm_s2 * dt_s;
+    double cap = wanted_mm_s < lo ? lo : (wanted_mm_s > hi ? hi : wanted_mm_s);
+    o->cap = cap > 0.0 ? cap : 0.0;
+}
+
+void mr_override_step(const MrTrajectory *traj, MrOverride *o, double dt_ticks, double dt_s)
+{
+    double programmed[3], before[3];
+    memcpy(before, o->tcp, sizeof before);
+    mr_trajectory_tcp_at(traj, o->path_tick + dt_ticks, programmed);
+    if (distance3(before, programmed) <= o->cap * dt_s) {
+        o->path_tick += dt_ticks;
+        memcpy(o->tcp, programmed, sizeof programmed);
+    } else {
+        o->path_tick = mr_trajectory_advance(traj, o->path_tick, o->cap * dt_s);
+        mr_trajectory_tcp_at(traj, o->path_tick, o->tcp);
+    }
+    o->speed = distance3(before, o->tcp) / dt_s;
+}
+
 MrStatus mr_load_scenario(const char *path, const char *cell, const char *name, size_t n_robots,
                           MrScenario *out)
 {

@@ -105,6 +105,38 @@ double mr_min_jerk(double tau);
  * linearly (min-jerk in time) between consecutive waypoints, holds the last one after it. */
 void mr_trajectory_tcp(const MrTrajectory *traj, long tick, double out[3]);
 
+/* The commanded TCP at a fractional tick: mr_trajectory_tcp's profile in continuous time. */
+void mr_trajectory_tcp_at(const MrTrajectory *traj, double tick, double out[3]);
+
+/* The tick `tick` moved forward by `distance_mm` along the straight segment it lies on, never
+ * past the segment's end (the next waypoint); unchanged where the robot holds a waypoint. */
+double mr_trajectory_advance(const MrTrajectory *traj, double tick, double distance_mm);
+
+/* Speed override of one robot (SPEC section 8, "What physics allows"): the robot follows its
+ * programmed path, but its progress along it is a parameter of its own (path_tick, in
+ * programmed ticks) that advances at the programmed speed or at the override's speed cap,
+ * whichever is lower. The cap moves toward the speed the controller asks for by at most
+ * `ramp_mm_s2` per second, so slowing down and speeding up stay within the robot's
+ * acceleration limit. */
+typedef struct MrOverride {
+    double path_tick; /* progress along the programmed path (programmed ticks) */
+    double speed;     /* TCP speed over the last step (mm/s) */
+    double cap;       /* speed cap of the next step (mm/s) */
+    double tcp[3];    /* TCP now (MCS, mm) */
+} MrOverride;
+
+/* A robot standing at its first waypoint, its cap at 0. */
+void mr_override_start(const MrTrajectory *traj, MrOverride *o);
+
+/* Sets the cap of the next step toward `wanted_mm_s` (>= 0), at most `ramp_mm_s2 * dt_s`
+ * away from the current speed. */
+void mr_override_request(MrOverride *o, double wanted_mm_s, double ramp_mm_s2, double dt_s);
+
+/* One step of `dt_ticks` programmed ticks (`dt_s` seconds): the programmed motion when its
+ * displacement is within `cap * dt_s`, else `cap * dt_s` along the path (never past the
+ * segment's end). */
+void mr_override_step(const MrTrajectory *traj, MrOverride *o, double dt_ticks, double dt_s);
+
 /* Reads the scenario (cell, case) from a scenarios file (format at the top of the file).
  * Every robot 0..n_robots-1 must have at least one waypoint. */
 MrStatus mr_load_scenario(const char *path, const char *cell, const char *name, size_t n_robots,

@@ -18,30 +18,6 @@
 #define SUBSTEPS 10          /* 0.1 ms steps per 1 ms tick */
 #define PATH_STEP_MS 0.01    /* resolution of the walk along a path while braking */
 
-/* The commanded TCP at a fractional tick (mr_trajectory_tcp's profile, continuous time). */
-static void path_at(const MrTrajectory *t, double tick, double out[3])
-{
-    size_t i, k;
-    if (t->n_waypoints == 0) {
-        out[0] = out[1] = out[2] = 0.0;
-        return;
-    }
-    if (tick <= (double)t->tick[0]) {
-        memcpy(out, t->tcp[0], 3 * sizeof(double));
-        return;
-    }
-    for (i = 0; i + 1 < t->n_waypoints; ++i) {
-        if (tick <= (double)t->tick[i + 1]) {
-            double s = mr_min_jerk((tick - (double)t->tick[i]) / (double)(t->tick[i + 1] - t->tick[i]));
-            for (k = 0; k < 3; ++k) {
-                out[k] = t->tcp[i][k] + s * (t->tcp[i + 1][k] - t->tcp[i][k]);
-            }
-            return;
-        }
-    }
-    memcpy(out, t->tcp[t->n_waypoints - 1], 3 * sizeof(double));
-}
-
 /* The tick of the first waypoint after `tick` (the end of the current straight segment). */
 static double segment_end(const MrTrajectory *t, double tick)
 {
@@ -78,13 +54,13 @@ static void stop_step(const MrTrajectory *t, const DcStopConfig *m, double dt_ms
     s->elapsed_ms += dt_ms;
     if (s->elapsed_ms <= m->reaction_ms) {
         s->path_tick += dt_ms; /* keeps its commanded motion */
-        path_at(t, s->path_tick, s->tcp);
+        mr_trajectory_tcp_at(t, s->path_tick, s->tcp);
         return;
     }
     if (!s->braking) {
         double a[3], b[3];
-        path_at(t, s->path_tick - 0.05, a);
-        path_at(t, s->path_tick, b);
+        mr_trajectory_tcp_at(t, s->path_tick - 0.05, a);
+        mr_trajectory_tcp_at(t, s->path_tick, b);
         s->speed = dist3(a, b) / 0.05e-3;
         s->end_tick = segment_end(t, s->path_tick);
         s->braking = 1;
@@ -106,7 +82,7 @@ static void stop_step(const MrTrajectory *t, const DcStopConfig *m, double dt_ms
             if (tick > s->end_tick) {
                 tick = s->end_tick;
             }
-            path_at(t, tick, p);
+            mr_trajectory_tcp_at(t, tick, p);
             step = dist3(here, p);
             if (step > dist) {
                 /* Part of this small step, on the chord (the path is straight). */
@@ -170,7 +146,7 @@ static void run_protective(const char *cell_name, const char *case_name, const c
     }
     memset(st, 0, sizeof st);
     for (j = 0; j < cell.n_robots; ++j) {
-        path_at(&scenario.robots[j], 0.0, st[j].tcp);
+        mr_trajectory_tcp_at(&scenario.robots[j], 0.0, st[j].tcp);
     }
     {
         /* Start-up: the robots stand at their first waypoint; this primes the speeds. */
@@ -189,7 +165,7 @@ static void run_protective(const char *cell_name, const char *case_name, const c
         if (!stopping) {
             for (j = 0; j < cell.n_robots; ++j) {
                 st[j].path_tick = (double)tick;
-                path_at(&scenario.robots[j], (double)tick, st[j].tcp);
+                mr_trajectory_tcp_at(&scenario.robots[j], (double)tick, st[j].tcp);
             }
         } else {
             /* The stop in 0.1 ms steps, each checked with the exact model. */

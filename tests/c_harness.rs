@@ -143,6 +143,29 @@ fn assert_harness_passed(what: &str, out: &Output) -> String {
     stdout
 }
 
+/// The speed-override lines (`c_harness/speed_override.c`), one per practical scenario: the
+/// boxes never touch (every tick, and every 0.1 ms of each stop simulated at a STOP), the
+/// scaled run completes its cycle, no sooner than the unscaled one, with fewer STOP ticks.
+fn assert_speed_override(stdout: &str) {
+    let number = |line: &str, before: &str| -> f64 {
+        let rest = line.split(before).nth(1).unwrap_or_else(|| panic!("no `{before}` in: {line}"));
+        let field = rest.split(|c: char| c == ' ' || c == ',' || c == ')').find(|f| !f.is_empty()).unwrap();
+        field.parse().unwrap_or_else(|_| panic!("`{before}` is not followed by a number in: {line}"))
+    };
+    for cell in ["T1", "T2", "T3"] {
+        let prefix = format!("speed override {cell} practical: ");
+        let line = stdout.lines().find(|l| l.starts_with(&prefix)).unwrap_or_else(|| panic!("no `{prefix}` line"));
+        assert!(!line.contains("NOT COMPLETED"), "{line}");
+        let (cycle, unscaled) = (number(line, "cycle "), number(line, "unscaled "));
+        assert!(cycle >= unscaled && unscaled > 1000.0, "{line}");
+        assert_eq!(number(line, "ticks touching "), 0.0, "{line}");
+        assert_eq!(number(line, "contacts "), 0.0, "{line}");
+        let (stops, unscaled_stops) = (number(line, "STOP "), number(line, "(unscaled "));
+        assert!(stops < unscaled_stops, "the override needs fewer stops than the unscaled run: {line}");
+        assert_eq!(number(line, "stops simulated "), stops, "a stop is simulated at every STOP: {line}");
+    }
+}
+
 /// The harness's `summary` lines: (cell, case, table stop tick, first exact collision tick).
 fn summaries(stdout: &str) -> Vec<(String, String, Option<u64>, Option<u64>)> {
     let tick = |s: &str| s.trim_end_matches(',').parse().ok();
@@ -175,6 +198,7 @@ fn harness_passes_with_tables(kind: usize) {
         run(Command::new(exe).arg("--tmp").arg(&tmp).args(table_args_of(&[0, 1, 2], kind)).current_dir(repo_root()));
     let stdout = assert_harness_passed(&format!("c_harness (exact and {} table mode, T1 T2 T3)", KINDS[kind].0), &out);
     assert!(stdout.contains("bad input: done (exact and table mode)"), "table-mode bad inputs did not run");
+    assert_speed_override(&stdout);
     let runs = summaries(&stdout);
     assert_eq!(runs.len(), 6, "one table-mode summary per cell and case: {runs:?}");
     for (cell, case, table_stop, exact_first) in &runs {

@@ -44,7 +44,16 @@ pub fn harness_sources() -> Vec<PathBuf> {
         .collect();
     sources.sort();
     let names: Vec<_> = sources.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
-    let expected = ["bad_input.c", "harness.c", "main.c", "mock_robotics.c", "pou.c", "protective.c", "table_mode.c"];
+    let expected = [
+        "bad_input.c",
+        "harness.c",
+        "main.c",
+        "mock_robotics.c",
+        "pou.c",
+        "protective.c",
+        "speed_override.c",
+        "table_mode.c",
+    ];
     assert_eq!(names, expected, "c_harness/ sources changed: update this list and the README");
     sources
 }
