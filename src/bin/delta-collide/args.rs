@@ -50,10 +50,14 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Run the practical and collision scenarios with SAT and SAT-cache
+    /// Run the practical and collision scenarios: exact check and protective verdict
     ///
     /// Runs the scenarios of c_harness/scenarios.txt for the chosen cells and prints the
-    /// first collision tick and the per-tick query times of the exact check.
+    /// first collision tick and the per-tick query times of the exact check (SAT and
+    /// SAT-cache); then, along the same runs, the protective verdict with the cell's stopping
+    /// models: first WARN and STOP tick, WARN and STOP counts, and whether a stop simulated
+    /// from the first STOP (reaction, then braking along the path) stays clear, checked with
+    /// the exact model every 0.1 ms.
     Demo(DemoArgs),
     /// Check configurations from a CSV file, exactly or with a table
     ///
