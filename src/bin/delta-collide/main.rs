@@ -7,8 +7,8 @@
 //! input, a table for another cell, a k too big for the memory), 2 usage error.
 //!
 //! Output files are replaced only once complete ([`files`]). The pictures (`render`, `quilt`,
-//! `eval --plot`) are PNG files drawn in-process (modules [`render`], [`quilt`], [`plot`];
-//! shared parts in [`picture`]).
+//! `eval --plot`, `replay --plot`) are PNG files drawn in-process (modules [`render`],
+//! [`quilt`], [`plot`], [`replay_plot`]; shared parts in [`picture`]).
 
 mod args;
 mod clearance;
