@@ -149,7 +149,7 @@ fn assert_harness_passed(what: &str, out: &Output) -> String {
 fn assert_speed_override(stdout: &str) {
     let number = |line: &str, before: &str| -> f64 {
         let rest = line.split(before).nth(1).unwrap_or_else(|| panic!("no `{before}` in: {line}"));
-        let field = rest.split(|c: char| c == ' ' || c == ',' || c == ')').find(|f| !f.is_empty()).unwrap();
+        let field = rest.split([' ', ',', ')']).find(|f| !f.is_empty()).unwrap();
         field.parse().unwrap_or_else(|_| panic!("`{before}` is not followed by a number in: {line}"))
     };
     for cell in ["T1", "T2", "T3"] {
