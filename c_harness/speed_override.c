@@ -108,7 +108,12 @@ static void simulate_stop(DcCollider *exact, const MrScenario *s, const DcStopCo
             if (elapsed_ms <= stops[j].reaction_ms) {
                 mr_override_step(t, &o[j], dt_ms, dt_ms * 1e-3);
                 moving = 1;
-            } else if (o[j].cap > 0.0) {
+                continue;
+            }
+            if (elapsed_ms - dt_ms <= stops[j].reaction_ms) {
+                o[j].cap = o[j].speed; /* braking starts from the speed the reaction ended at */
+            }
+            if (o[j].cap > 0.0) {
                 double next = o[j].cap - stops[j].decel_mm_s2 * dt_ms * 1e-3;
                 double end_tick;
                 next = next > 0.0 ? next : 0.0;
