@@ -368,13 +368,24 @@ fn at_the_speed_limit_the_verdict_holds_and_ten_percent_above_it_does_not() {
     for name in ["T1", "T2", "T3"] {
         for stop in [STIFF, StopModel::DEFAULT] {
             let cell = cell(name, stop);
-            let mut c = ProtectiveChecker::new(cell.clone(), 0.0).unwrap();
+            let mut c = ProtectiveChecker::new(cell.clone(), 0.0).unwrap().with_precise_limits(true);
+            let mut cheap = ProtectiveChecker::new(cell.clone(), 0.0).unwrap();
             let resolution = stop.max_speed_mm_s / 256.0;
             for _ in 0..40 {
                 let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
                 let speeds = [rng.random_range(0.0..800.0), rng.random_range(0.0..800.0)];
                 let r: ProtectiveReport = c.check_at_speeds(&tcps, &speeds).unwrap().clone();
+                let fast = cheap.check_at_speeds(&tcps, &speeds).unwrap().clone();
+                assert_eq!(fast.verdict, r.verdict);
                 for j in 0..2 {
+                    // The table tier's limit: never above the precise one, and FREE at it.
+                    let low = fast.robots[j].speed_limit_mm_s;
+                    assert!(low <= r.robots[j].speed_limit_mm_s, "{name} {tcps:?} {speeds:?}: {low} > {r:?}");
+                    if low > 0.0 {
+                        let mut at = speeds;
+                        at[j] = low;
+                        assert_ne!(cheap.check_at_speeds(&tcps, &at).unwrap().verdict, Protective::Stop);
+                    }
                     let limit = r.robots[j].speed_limit_mm_s;
                     let mut at = speeds;
                     at[j] = limit;
@@ -469,6 +480,8 @@ fn scenario_counts(stop: StopModel, label: &str) {
         let cell = cell(&s.cell, stop);
         let mut c = ProtectiveChecker::new(cell.clone(), 10.0).unwrap();
         let mut verdict_only = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+        let mut precise = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_precise_limits(true);
+        let (mut limit_ratio, mut limited) = (0.0, 0);
         let mut exact = ExactChecker::new(cell);
         let mut tcps = vec![Vec3::zeros(); s.robots.len()];
         let (mut t_full, mut t_verdict, mut t_exact) =
@@ -486,6 +499,14 @@ fn scenario_counts(stop: StopModel, label: &str) {
             let t2 = std::time::Instant::now();
             let r = c.check(&tcps).unwrap();
             t_full.push(t2.elapsed().as_secs_f64() * 1e6);
+            let p = precise.check(&tcps).unwrap();
+            assert_eq!(p.verdict, r.verdict);
+            for (fast, slow) in r.robots.iter().zip(&p.robots) {
+                assert!(fast.speed_limit_mm_s <= slow.speed_limit_mm_s, "tick {tick}: {fast:?} {slow:?}");
+                if slow.speed_limit_mm_s > 0.0 {
+                    (limit_ratio, limited) = (limit_ratio + fast.speed_limit_mm_s / slow.speed_limit_mm_s, limited + 1);
+                }
+            }
             (t_verdict.push((t1 - t0).as_secs_f64() * 1e6), t_exact.push((t2 - t1).as_secs_f64() * 1e6));
             assert_eq!(v, r.verdict, "tick {tick}: the verdict does not depend on the speed limits");
             min_clear = min_clear.min(r.clearance_mm);
@@ -516,8 +537,8 @@ fn scenario_counts(stop: StopModel, label: &str) {
             "{label} {} {}: STOP {stops} WARN {warn} ticks of {RUN_TICKS}, first WARN {first_warn:?} first STOP \
              {first_stop:?} first contact {first_contact:?}, min clearance {min_clear:.1} mm, implausible {implausible}, \
              {us:.0} us/tick in all; median (p99) us per tick: with limits {full:.1} ({full99:.1}), verdict {verdict:.2} \
-             ({verdict99:.1}), exact {plain:.2}",
-            s.cell, s.case
+             ({verdict99:.1}), exact {plain:.2}; table-tier speed limit / precise: {:.3} on average",
+            s.cell, s.case, limit_ratio / limited.max(1) as f64
         );
         assert_eq!(implausible, 0, "the scenarios respect the stopping model's limits");
         if let Some(contact) = first_contact {

@@ -31,16 +31,37 @@
 //!    ball of radius `S` that holds the TCP (weight `max e_k`): two sound forms of one bound
 //!    ([`SweepForms`]); a box pair is proved apart when any combination of forms proves it
 //!    (the cube is tighter where the separating axis is a world axis, the ball elsewhere).
+//!    The motor angles over the cube come in **tiers**, each a sound enclosure of the angle
+//!    of every reachable TCP of the cube (the only input of the bound that needs inverse
+//!    kinematics): tier 1 reads them from the robot's [`MotorTable`] (certified interval
+//!    inverse kinematics per 16 mm cell, computed in [`ProtectiveChecker::new`]; its module
+//!    doc proves the cover), 8 reads per arm; tier 2, only where tier 1 leaves the tick
+//!    unproved (STOP or WARN), intersects that with the direct enclosure over the cube in
+//!    [`PRECISE_SPLITS`]`^3` sub-boxes (two sound enclosures: so is their intersection, and
+//!    a narrower angle range gives a smaller sweep on every axis, so tier 2 proves whatever
+//!    the direct enclosure alone proved before the table existed).
 //! 5. **Apart.** Box `i` of robot `a` over the stop lies in `box_i(now) + sweep_i`, and
 //!    likewise for `b`; [`swept_boxes_apart`] proves the two sums disjoint on one of the 15
 //!    axes (with a positive gap). All box pairs of all pairs that can meet proved: FREE.
 //!    Proved again with `warn_mm` added to one sweep's ball: else WARN. Any unproved pair,
 //!    unreachable TCP, unbounded sweep or status other than OK: STOP.
+//! 6. **Certain STOP, before any sweep.** Every sweep of a lower-link, platform or tool box
+//!    holds the ball of radius `S'` (the radius of step 3's ball): form 0's support on any `n`
+//!    is at least `(1 + mu) sum_a S' |w_a . n| >= S' |n|` (the cube term with weight
+//!    `max e_k >= 1`, the arc and ball terms are `>= 0`), form 1's at least
+//!    `(1 + mu) S' |n|`. So on every axis the swept box's projection holds that of the box
+//!    swept by the ball `S'` alone (upper links: by nothing). When [`swept_boxes_apart`] does
+//!    not separate the boxes swept by those balls (radii shrunk by a relative 1e-9, far above
+//!    rounding), it cannot separate them with the real sweeps of any tier: STOP at once,
+//!    without inverse kinematics.
 //!
 //! The **speed limit** of a robot is the largest measured speed `|v_fd|` in `[0, v_max]` at
-//! which every pair involving it is still proved, the other robots as they are: bisection
-//! (at most [`LIMIT_STEPS`] + 2 evaluations) that keeps the last speed proved. 0 when not
-//! even standing still is proved; `v_max` when full speed is.
+//! which every pair involving it is still proved, the other robots as they are: bisection to
+//! `v_max / 2^LIMIT_STEPS` ([`LIMIT_STEPS`]) that keeps the last speed proved. 0 when not
+//! even standing still is proved; `v_max` when full speed is. By default the bisection uses
+//! tier 1 alone (a few us per robot): that limit is proved, and never above the limit of
+//! both tiers ([`ProtectiveChecker::with_precise_limits`] for that one: both tiers, the
+//! second only above the first's limit and below the speed where step 6 already fails).
 //!
 //! Nothing here allocates after [`ProtectiveChecker::new`].
 
@@ -187,6 +208,8 @@ pub struct ProtectiveChecker {
     speed_limits: bool,
     /// Sub-boxes per axis of the second tier's direct enclosure (0: no second tier).
     precise_splits: u32,
+    /// Whether the speed limits use the second tier too (else the table's alone).
+    precise_limits: bool,
     /// Per robot, the centre (MCS) and radius of the ball holding its TCP over the stop.
     centres: alloc::vec::Vec<Vec3>,
     reach: alloc::vec::Vec<Real>,
@@ -224,6 +247,7 @@ impl ProtectiveChecker {
             ref_boxes: alloc::vec![RobotBoxes::empty(); n],
             speed_limits: true,
             precise_splits: PRECISE_SPLITS,
+            precise_limits: false,
             centres: alloc::vec![Vec3::zeros(); n],
             reach: alloc::vec![0.0; n],
             sweep_tier: alloc::vec![None; n],
@@ -254,6 +278,14 @@ impl ProtectiveChecker {
     /// default; 0: the table alone, faster, more STOPs).
     pub fn with_precise_splits(self, splits: u32) -> Self {
         ProtectiveChecker { precise_splits: splits, ..self }
+    }
+
+    /// This checker finding the speed limits with both tiers (`true`: the largest speed at
+    /// which the verdict itself proves FREE, to [`LIMIT_STEPS`] bisection steps; about 100 us
+    /// per robot) or with the table's tier alone (`false`, the default: a few us per robot,
+    /// never above the precise limit, so FREE holds at it too).
+    pub fn with_precise_limits(self, on: bool) -> Self {
+        ProtectiveChecker { precise_limits: on, ..self }
     }
 
     /// The WARN threshold (mm).
@@ -489,19 +521,23 @@ impl ProtectiveChecker {
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are.
     fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3) -> Real {
         let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]);
-        let proved = |me: &mut Self, v: Real, tier: u32| {
+        // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
+        let proved = |me: &mut Self, v: Real, tier: Option<u32>| {
             me.stop_reference(j, tcp_mcs, v);
             if me.certain_stop(Some(j)).is_some() {
                 return false;
             }
+            let Some(tier) = tier else { return true };
             // The other robots as they are, with the motor angles of the same tier.
             (0..me.centres.len()).for_each(|i| me.sweeps_at(i, tier));
             let boxes = |i: usize| me.ref_boxes[i].as_slice();
             first_unproved(&me.exact.verdict().pairs, &boxes, &me.sweeps, &me.faces, Some(j), 0.0).is_none()
         };
-        // The last speed proved and the first not, between `lo` (proved) and `hi` (not).
-        let bisect = |me: &mut Self, (mut lo, mut hi): (Real, Real), tier: u32| {
-            for _ in 0..LIMIT_STEPS {
+        let vmax = self.cell().stops[j].max_speed_mm_s;
+        let resolution = vmax / (1u32 << LIMIT_STEPS) as Real;
+        // From `lo` (proved) and `hi` (not), halves until they are `resolution` apart.
+        let bisect = |me: &mut Self, (mut lo, mut hi): (Real, Real), tier: Option<u32>| {
+            while hi - lo > resolution {
                 let mid = 0.5 * (lo + hi);
                 if proved(me, mid, tier) {
                     lo = mid
@@ -511,31 +547,32 @@ impl ProtectiveChecker {
             }
             (lo, hi)
         };
-        // The limit of one tier alone: the bracket it ends in.
-        let limit_of = |me: &mut Self, tier: u32| {
-            let vmax = me.cell().stops[j].max_speed_mm_s;
-            if proved(me, vmax, tier) {
+        // The bracket of one test alone below `top` (not proved there, unless `top = vmax`).
+        let limit_of = |me: &mut Self, tier: Option<u32>, top: Real| {
+            if top == vmax && proved(me, vmax, tier) {
                 (vmax, vmax)
             } else if !proved(me, 0.0, tier) {
                 (0.0, 0.0)
             } else {
-                bisect(me, (0.0, vmax), tier)
+                bisect(me, (0.0, top), tier)
             }
         };
-        let vmax = self.cell().stops[j].max_speed_mm_s;
-        let tier = self.precise_splits;
-        let (lo, hi) = limit_of(self, 0);
-        let limit = if tier == 0 || lo == vmax {
+        let tier = if self.precise_limits { self.precise_splits } else { 0 };
+        // Above `top` no tier proves anything: the certain-STOP test fails there (found
+        // first only for the second tier, whose bisection it shortens).
+        let top = if tier == 0 { vmax } else { limit_of(self, None, vmax).1 };
+        let (lo, hi) = if top == 0.0 { (0.0, 0.0) } else { limit_of(self, Some(0), top) };
+        let limit = if tier == 0 || lo == vmax || top == 0.0 {
             lo
         } else if hi == 0.0 {
             // The table proves not even standing still: the second tier alone.
-            limit_of(self, tier).0
-        } else if !proved(self, hi, tier) {
+            limit_of(self, Some(tier), top).0
+        } else if !proved(self, hi, Some(tier)) {
             lo
-        } else if proved(self, vmax, tier) {
+        } else if top == vmax && proved(self, vmax, Some(tier)) {
             vmax
         } else {
-            bisect(self, (hi, vmax), tier).0
+            bisect(self, (hi, top), Some(tier)).0
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
         limit
