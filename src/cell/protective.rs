@@ -214,7 +214,7 @@ pub struct ProtectiveChecker {
     centres: alloc::vec::Vec<Vec3>,
     reach: alloc::vec::Vec<Real>,
     /// Per robot, the tier its sweeps were computed with (`None`: not for this reference).
-    sweep_tier: alloc::vec::Vec<Option<u32>>,
+    sweep_tier: alloc::vec::Vec<Option<(u32, u8)>>,
     report: ProtectiveReport,
 }
 
@@ -409,10 +409,23 @@ impl ProtectiveChecker {
         if let Some(pair) = self.certain_stop(None) {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
         } else {
-            (0..n).for_each(|j| self.sweeps_at(j, 0));
+            (0..n).for_each(|j| self.sweeps_at(j, 0, 0));
             (self.report.verdict, self.report.limiting) = self.prove();
-            if self.report.verdict != Protective::Free && self.precise_splits > 0 {
-                (0..n).for_each(|j| self.sweeps_at(j, self.precise_splits));
+            // Tier 2, arm by arm: a box's sweep depends on its own arm's angles only, so the
+            // arms of the limiting pair are refined until it is proved or both are refined
+            // (then the full tier 2 fails on it too: the same verdict and limiting pair, as a
+            // pair proved with fewer arms refined stays proved with more).
+            let splits = self.precise_splits;
+            while let (Some(p), true) = (self.report.limiting, splits > 0) {
+                let (arms_a, arms_b) = (self.arm_bit(p.a, p.box_a), self.arm_bit(p.b, p.box_b));
+                let refined = |me: &Self, j: usize| me.sweep_tier[j].filter(|t| t.0 == splits).map_or(0, |t| t.1);
+                let (ra, rb) = (refined(self, p.a), refined(self, p.b));
+                if ra & arms_a == arms_a && rb & arms_b == arms_b {
+                    break;
+                }
+                self.sweeps_at(p.a, splits, ra | arms_a);
+                let rb = refined(self, p.b);
+                self.sweeps_at(p.b, splits, rb | arms_b);
                 (self.report.verdict, self.report.limiting) = self.prove();
             }
         }
@@ -478,23 +491,34 @@ impl ProtectiveChecker {
         s
     }
 
+    /// The arm whose motor angle box `k` of robot `j` moves with, as a bit (0 for platform
+    /// and tool boxes, which move with the TCP alone).
+    fn arm_bit(&self, j: usize, k: usize) -> u8 {
+        match self.exact.cell().robots[j].model.box_kind(k) {
+            BoxKind::LowerLink(arm) | BoxKind::UpperLink(arm) => 1 << arm,
+            BoxKind::Platform | BoxKind::Tool => 0,
+        }
+    }
+
     /// Computes robot `j`'s sweeps (and their face terms) about its reference ball, with the
-    /// motor angles of `tier` (0: the table alone; else also `tier^3` direct sub-boxes).
-    fn sweeps_at(&mut self, j: usize, tier: u32) {
-        if self.sweep_tier[j] == Some(tier) {
+    /// motor angles of `tier` (0: the table alone; else also `tier^3` direct sub-boxes for the
+    /// arms in the bit mask `arms`).
+    fn sweeps_at(&mut self, j: usize, tier: u32, arms: u8) {
+        let arms = if tier == 0 { 0 } else { arms };
+        if self.sweep_tier[j] == Some((tier, arms)) {
             return;
         }
         let robot = &self.exact.cell().robots[j];
         let rot = robot.placement.rotation();
         let (centre, radius) = (self.centres[j], self.reach[j]);
-        self.sweeps[j] = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, Some(&self.tables[j]), tier);
+        self.sweeps[j] = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, Some(&self.tables[j]), tier, arms);
         let boxes = &self.ref_boxes[j];
         for (form, faces) in self.faces[j].iter_mut().enumerate() {
             for (k, b) in boxes.as_slice().iter().enumerate() {
                 faces[k] = FaceTerms::new(b, &self.sweeps[j][form][k]);
             }
         }
-        self.sweep_tier[j] = Some(tier);
+        self.sweep_tier[j] = Some((tier, arms));
     }
 
     /// A box pair (of the pairs involving `only`, or of all) that no sweeps of any tier can
@@ -529,7 +553,7 @@ impl ProtectiveChecker {
             }
             let Some(tier) = tier else { return true };
             // The other robots as they are, with the motor angles of the same tier.
-            (0..me.centres.len()).for_each(|i| me.sweeps_at(i, tier));
+            (0..me.centres.len()).for_each(|i| me.sweeps_at(i, tier, 0b111));
             let boxes = |i: usize| me.ref_boxes[i].as_slice();
             first_unproved(&me.exact.verdict().pairs, &boxes, &me.sweeps, &me.faces, Some(j), 0.0).is_none()
         };
@@ -558,21 +582,26 @@ impl ProtectiveChecker {
             }
         };
         let tier = if self.precise_limits { self.precise_splits } else { 0 };
-        // Above `top` no tier proves anything: the certain-STOP test fails there (found
-        // first only for the second tier, whose bisection it shortens).
-        let top = if tier == 0 { vmax } else { limit_of(self, None, vmax).1 };
-        let (lo, hi) = if top == 0.0 { (0.0, 0.0) } else { limit_of(self, Some(0), top) };
-        let limit = if tier == 0 || lo == vmax || top == 0.0 {
+        // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit, and the floor
+        // of the precise one.
+        let (lo, hi) = limit_of(self, Some(0), vmax);
+        let limit = if tier == 0 || lo == vmax {
             lo
-        } else if hi == 0.0 {
-            // The table proves not even standing still: the second tier alone.
-            limit_of(self, Some(tier), top).0
-        } else if !proved(self, hi, Some(tier)) {
-            lo
-        } else if top == vmax && proved(self, vmax, Some(tier)) {
-            vmax
         } else {
-            bisect(self, (hi, top), Some(tier)).0
+            // Above `top` no tier proves anything: the certain-STOP test fails there.
+            let top = limit_of(self, None, vmax).1;
+            if top == 0.0 {
+                0.0
+            } else if hi == 0.0 {
+                // The table proves not even standing still: the second tier alone.
+                limit_of(self, Some(tier), top).0
+            } else if hi >= top || !proved(self, hi, Some(tier)) {
+                lo
+            } else if top == vmax && proved(self, vmax, Some(tier)) {
+                vmax
+            } else {
+                bisect(self, (hi, top), Some(tier)).0
+            }
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
         limit
@@ -629,8 +658,10 @@ fn worse(a: ProtectiveStatus, b: ProtectiveStatus) -> ProtectiveStatus {
 
 /// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
 /// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded. The motor
-/// angles come from `table` (built for `model.delta`) where it covers the cube, else from the
-/// interval inverse kinematics with [`SPLITS`].
+/// angles come from `table` (built for `model.delta`) where it covers the cube, intersected,
+/// for the arms in the bit mask `arms`, with the interval inverse kinematics in `precise^3`
+/// sub-boxes (none when `precise` is 0); without the table, from the interval inverse
+/// kinematics with [`SPLITS`].
 pub fn stop_sweeps_wcs(
     model: &RobotModel,
     rot_wcs: &crate::math::Mat3,
@@ -638,6 +669,7 @@ pub fn stop_sweeps_wcs(
     s: Real,
     table: Option<&MotorTable>,
     precise: u32,
+    arms: u8,
 ) -> SweepForms {
     let d = &model.delta;
     let direct = |lo: &Vec3, hi: &Vec3, splits: u32| -> [Enclosure; 3] {
@@ -646,8 +678,14 @@ pub fn stop_sweeps_wcs(
     let sweeps = match table.filter(|t| t.delta() == d) {
         Some(t) => cube_box_sweeps_with(model, tcp_mcs, s, tcp_mcs, |lo, hi| match t.enclose(lo, hi) {
             Some(th) if precise > 0 => {
-                let more = direct(lo, hi, precise);
-                core::array::from_fn(|arm| intersect(th[arm], more[arm]))
+                let refine = |arm: usize| arms >> arm & 1 == 1;
+                core::array::from_fn(|arm| {
+                    if refine(arm) {
+                        intersect(th[arm], theta_range(d, arm, lo, hi, precise))
+                    } else {
+                        th[arm]
+                    }
+                })
             }
             Some(th) => th,
             None => direct(lo, hi, SPLITS),
