@@ -729,16 +729,22 @@ fn first_unproved<'a>(
 ) -> Option<BoxPair> {
     const FORMS: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
     for p in pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
+        // With `extra`, robot `a`'s face terms under its widened sweeps, once per pair.
+        let mut widened = [faces[p.a][0], faces[p.a][1]];
+        if extra != 0.0 {
+            for (form, terms) in widened.iter_mut().enumerate() {
+                for (i, box_a) in boxes(p.a).iter().enumerate() {
+                    let sa = &sweeps[p.a][form][i];
+                    terms[i] = FaceTerms::new(box_a, &Sweep { ball: sa.ball + extra, ..*sa });
+                }
+            }
+        }
         for (i, box_a) in boxes(p.a).iter().enumerate() {
             for (k, box_b) in boxes(p.b).iter().enumerate() {
                 let apart = |&(fa, fb): &(usize, usize)| {
                     let (sa, sb) = (&sweeps[p.a][fa][i], &sweeps[p.b][fb][k]);
-                    if extra == 0.0 {
-                        let (ta, tb) = (&faces[p.a][fa][i], &faces[p.b][fb][k]);
-                        return swept_boxes_apart_with(box_a, sa, ta, box_b, sb, tb);
-                    }
                     let sa = Sweep { ball: sa.ball + extra, ..*sa };
-                    swept_boxes_apart(box_a, &sa, box_b, sb)
+                    swept_boxes_apart_with(box_a, &sa, &widened[fa][i], box_b, sb, &faces[p.b][fb][k])
                 };
                 if !FORMS.iter().any(apart) {
                     return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
