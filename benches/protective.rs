@@ -5,6 +5,11 @@
 //!
 //! Inputs: 128 ticks of the run sampled every 47 ticks, with the speeds of the trajectory
 //! there; every iteration asserts the verdict computed before timing.
+//!
+//! The realistic mix (`protective_T1_practical_replay`): the 6,000 ticks of the run replayed in
+//! order through `check` (speeds from the tick history, as in operation), so the share of ticks
+//! that reach the slower tiers is the scenario's own; the exact query on the same ticks is the
+//! peer. The verdict of every tick is computed before timing and asserted.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use delta_collide::cell::protective::{Protective, ProtectiveChecker};
@@ -69,5 +74,49 @@ fn protective_query(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, protective_query);
+/// The run's TCPs, tick by tick.
+fn run_ticks() -> Vec<[Vec3; 2]> {
+    let s = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    (0..RUN_TICKS)
+        .map(|tick| {
+            let mut now = [Vec3::zeros(); 2];
+            s.tcps_at(tick, &mut now);
+            now
+        })
+        .collect()
+}
+
+fn protective_replay(c: &mut Criterion) {
+    let ticks = run_ticks();
+    let cell = reference_cell("T1").unwrap();
+    let mut exact = ExactChecker::new(cell.clone());
+    let hits: Vec<bool> = ticks.iter().map(|t| exact.check(t).unwrap().collides()).collect();
+    let mut group = c.benchmark_group("protective_T1_practical_replay");
+    for (name, limits) in [("with speed limits", true), ("verdict only", false)] {
+        let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
+        let verdicts: Vec<Protective> = ticks.iter().map(|t| checker.check(t).unwrap().verdict).collect();
+        let mut i = 0;
+        group.bench_function(BenchmarkId::new("protective", name), |b| {
+            b.iter(|| {
+                let k = i % ticks.len();
+                if k == 0 {
+                    checker.reset();
+                }
+                i += 1;
+                assert_eq!(checker.check(black_box(&ticks[k])).unwrap().verdict, verdicts[k]);
+            })
+        });
+    }
+    let mut i = 0;
+    group.bench_function(BenchmarkId::new("exact", "SAT-cache"), |b| {
+        b.iter(|| {
+            let k = i % ticks.len();
+            i += 1;
+            assert_eq!(exact.check(black_box(&ticks[k])).unwrap().collides(), hits[k]);
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, protective_query, protective_replay);
 criterion_main!(benches);

@@ -261,8 +261,9 @@ typedef struct DcProtectiveReport {
    */
   uint32_t unreachable_mask;
   /*
-   Clearance of the cell now (mm): the smallest distance between boxes of robots that
-   can meet, 0 when touching or intersecting; NaN when not computed (status not OK).
+   Signed clearance of the cell now (mm, SPEC section 8): over the box pairs of robots that can
+   meet, the smallest gap when apart, minus the penetration depth when boxes intersect,
+   0 when touching; NaN when not computed (status not OK).
    */
   double clearance_mm;
   /*

@@ -84,6 +84,24 @@ fn tcp_toward_other(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
     }
 }
 
+/// A reachable TCP of robot `j` within 0 to 8 mm of its reach boundary (pushed out from
+/// [`tcp_toward_other`] along its radial direction), where elbows swing fastest.
+fn tcp_near_reach_boundary(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
+    let delta = &cell.robots[j].model.delta;
+    loop {
+        let p = tcp_toward_other(cell, j, rng);
+        let out = Vec3::new(p.x, p.y, 0.0).try_normalize(1e-9).unwrap_or(Vec3::x());
+        let mut step = 0.0;
+        while delta.is_reachable(&(p + out * (step + 1.0))) && step < 400.0 {
+            step += 1.0;
+        }
+        let q = p + out * (step - rng.random_range(0.0..8.0f64)).max(0.0);
+        if delta.is_reachable(&q) {
+            return q;
+        }
+    }
+}
+
 /// One robot's stopping motion, sampled every `DT`: reaction with random accelerations,
 /// then braking along a straight or curved path.
 struct Motion {
@@ -197,14 +215,17 @@ fn assert_stops_never_touch(cell: &Cell, tcps: &[Vec3; 2], vel: &[Vec3; 2], moti
 }
 
 /// Random states near each other; for each FREE one, random stops are simulated.
-fn brute_force(name: &str, stop: StopModel, states: usize, seed: u64) -> (usize, usize) {
+/// `precise`: the second tier's splits (0: the motor-angle table alone); `edge`: TCPs near the
+/// reach boundary.
+fn brute_force(name: &str, stop: StopModel, states: usize, seed: u64, precise: u32, edge: bool) -> (usize, usize) {
     let cell = cell(name, stop);
-    let mut checker = ProtectiveChecker::new(cell.clone(), 5.0).unwrap();
+    let mut checker = ProtectiveChecker::new(cell.clone(), 5.0).unwrap().with_precise_splits(precise);
     let mut rng = StdRng::seed_from_u64(seed);
     let (mut free, mut steps) = (0, 0);
     let tick = cell.tick_ms * 1e-3;
+    let sample = if edge { tcp_near_reach_boundary } else { tcp_toward_other };
     for _ in 0..states {
-        let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
+        let tcps = [sample(&cell, 0, &mut rng), sample(&cell, 1, &mut rng)];
         // Speeds mostly low (else nothing near is FREE), directions random.
         let v_fd: [Vec3; 2] =
             std::array::from_fn(|_| unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3));
@@ -235,12 +256,31 @@ fn free_verdicts_survive_simulated_stops() {
     let mut total = 0;
     for (i, name) in ["T1", "T2", "T3"].iter().enumerate() {
         for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
-            let (free, steps) = brute_force(name, stop, 150, 100 + 10 * i as u64 + k as u64);
+            let (free, steps) = brute_force(name, stop, 150, 100 + 10 * i as u64 + k as u64, 2, false);
             println!("{name} model {k}: {free} FREE/WARN states of 150, {steps} exact checks of simulated stops");
             total += free;
         }
     }
     assert!(total >= 60, "too few FREE states to test: {total}");
+}
+
+/// The first tier alone (motor angles from the table, no direct enclosure), near the reach
+/// boundary (elbows swinging fastest) and in the open: FREE still survives every simulated stop.
+#[test]
+fn free_verdicts_of_the_table_tier_survive_simulated_stops_near_the_reach_boundary() {
+    let (mut total, mut edge_total) = (0, 0);
+    for (i, name) in ["T1", "T2", "T3"].iter().enumerate() {
+        for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
+            for edge in [false, true] {
+                let seed = 500 + 10 * i as u64 + k as u64 + 100 * edge as u64;
+                let (free, steps) = brute_force(name, stop, 150, seed, 0, edge);
+                println!("{name} model {k} edge {edge}: {free} FREE/WARN of 150, {steps} exact checks");
+                total += free;
+                edge_total += free * edge as usize;
+            }
+        }
+    }
+    assert!(total >= 60 && edge_total >= 20, "too few FREE states to test: {total}, {edge_total} near the edge");
 }
 
 fn verdict_rank(v: Protective) -> u8 {
@@ -328,13 +368,24 @@ fn at_the_speed_limit_the_verdict_holds_and_ten_percent_above_it_does_not() {
     for name in ["T1", "T2", "T3"] {
         for stop in [STIFF, StopModel::DEFAULT] {
             let cell = cell(name, stop);
-            let mut c = ProtectiveChecker::new(cell.clone(), 0.0).unwrap();
+            let mut c = ProtectiveChecker::new(cell.clone(), 0.0).unwrap().with_precise_limits(true);
+            let mut cheap = ProtectiveChecker::new(cell.clone(), 0.0).unwrap();
             let resolution = stop.max_speed_mm_s / 256.0;
             for _ in 0..40 {
                 let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
                 let speeds = [rng.random_range(0.0..800.0), rng.random_range(0.0..800.0)];
                 let r: ProtectiveReport = c.check_at_speeds(&tcps, &speeds).unwrap().clone();
+                let fast = cheap.check_at_speeds(&tcps, &speeds).unwrap().clone();
+                assert_eq!(fast.verdict, r.verdict);
                 for j in 0..2 {
+                    // The table tier's limit: never above the precise one, and FREE at it.
+                    let low = fast.robots[j].speed_limit_mm_s;
+                    assert!(low <= r.robots[j].speed_limit_mm_s, "{name} {tcps:?} {speeds:?}: {low} > {r:?}");
+                    if low > 0.0 {
+                        let mut at = speeds;
+                        at[j] = low;
+                        assert_ne!(cheap.check_at_speeds(&tcps, &at).unwrap().verdict, Protective::Stop);
+                    }
                     let limit = r.robots[j].speed_limit_mm_s;
                     let mut at = speeds;
                     at[j] = limit;
@@ -428,15 +479,36 @@ fn scenario_counts(stop: StopModel, label: &str) {
     for s in parse_scenarios(&text).unwrap() {
         let cell = cell(&s.cell, stop);
         let mut c = ProtectiveChecker::new(cell.clone(), 10.0).unwrap();
+        let mut verdict_only = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+        let mut precise = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_precise_limits(true);
+        let (mut limit_ratio, mut limited) = (0.0, 0);
         let mut exact = ExactChecker::new(cell);
         let mut tcps = vec![Vec3::zeros(); s.robots.len()];
+        let (mut t_full, mut t_verdict, mut t_exact) =
+            (Vec::with_capacity(RUN_TICKS as usize), Vec::with_capacity(RUN_TICKS as usize), Vec::with_capacity(RUN_TICKS as usize));
         let (mut warn, mut stops, mut implausible) = (0, 0, 0);
         let (mut first_warn, mut first_stop, mut first_contact) = (None, None, None);
         let mut min_clear = Real::INFINITY;
         let started = std::time::Instant::now();
         for tick in 0..RUN_TICKS {
             s.tcps_at(tick, &mut tcps);
+            let t0 = std::time::Instant::now();
+            let v = verdict_only.check(&tcps).unwrap().verdict;
+            let t1 = std::time::Instant::now();
+            let hit = exact.check(&tcps).unwrap().collides();
+            let t2 = std::time::Instant::now();
             let r = c.check(&tcps).unwrap();
+            t_full.push(t2.elapsed().as_secs_f64() * 1e6);
+            let p = precise.check(&tcps).unwrap();
+            assert_eq!(p.verdict, r.verdict);
+            for (fast, slow) in r.robots.iter().zip(&p.robots) {
+                assert!(fast.speed_limit_mm_s <= slow.speed_limit_mm_s, "tick {tick}: {fast:?} {slow:?}");
+                if slow.speed_limit_mm_s > 0.0 {
+                    (limit_ratio, limited) = (limit_ratio + fast.speed_limit_mm_s / slow.speed_limit_mm_s, limited + 1);
+                }
+            }
+            (t_verdict.push((t1 - t0).as_secs_f64() * 1e6), t_exact.push((t2 - t1).as_secs_f64() * 1e6));
+            assert_eq!(v, r.verdict, "tick {tick}: the verdict does not depend on the speed limits");
             min_clear = min_clear.min(r.clearance_mm);
             implausible += matches!(r.status, ProtectiveStatus::ImplausibleMotion(_)) as u32;
             match r.verdict {
@@ -450,15 +522,23 @@ fn scenario_counts(stop: StopModel, label: &str) {
                 }
                 Protective::Free => {}
             }
-            if first_contact.is_none() && exact.check(&tcps).unwrap().collides() {
+            if first_contact.is_none() && hit {
                 first_contact = Some(tick);
             }
         }
         let us = started.elapsed().as_secs_f64() * 1e6 / RUN_TICKS as f64;
+        let median = |t: &mut Vec<f64>| {
+            t.sort_by(f64::total_cmp);
+            (t[t.len() / 2], t[t.len() * 99 / 100])
+        };
+        let ((full, full99), (verdict, verdict99), (plain, _)) =
+            (median(&mut t_full), median(&mut t_verdict), median(&mut t_exact));
         println!(
             "{label} {} {}: STOP {stops} WARN {warn} ticks of {RUN_TICKS}, first WARN {first_warn:?} first STOP \
-             {first_stop:?} first contact {first_contact:?}, min clearance {min_clear:.1} mm, implausible {implausible}, {us:.0} us/tick",
-            s.cell, s.case
+             {first_stop:?} first contact {first_contact:?}, min clearance {min_clear:.1} mm, implausible {implausible}, \
+             {us:.0} us/tick in all; median (p99) us per tick: with limits {full:.1} ({full99:.1}), verdict {verdict:.2} \
+             ({verdict99:.1}), exact {plain:.2}; table-tier speed limit / precise: {:.3} on average",
+            s.cell, s.case, limit_ratio / limited.max(1) as f64
         );
         assert_eq!(implausible, 0, "the scenarios respect the stopping model's limits");
         if let Some(contact) = first_contact {

@@ -31,27 +31,51 @@
 //!    ball of radius `S` that holds the TCP (weight `max e_k`): two sound forms of one bound
 //!    ([`SweepForms`]); a box pair is proved apart when any combination of forms proves it
 //!    (the cube is tighter where the separating axis is a world axis, the ball elsewhere).
+//!    The motor angles over the cube come in **tiers**, each a sound enclosure of the angle
+//!    of every reachable TCP of the cube (the only input of the bound that needs inverse
+//!    kinematics): tier 1 reads them from the robot's [`MotorTable`] (certified interval
+//!    inverse kinematics per 16 mm cell, computed in [`ProtectiveChecker::new`]; its module
+//!    doc proves the cover), 8 reads per arm; tier 2, only where tier 1 leaves the tick
+//!    unproved (STOP or WARN), intersects that with the direct enclosure over the cube in
+//!    [`PRECISE_SPLITS`]`^3` sub-boxes (two sound enclosures: so is their intersection, and
+//!    a narrower angle range gives a smaller sweep on every axis, so tier 2 proves whatever
+//!    the direct enclosure alone proved before the table existed).
 //! 5. **Apart.** Box `i` of robot `a` over the stop lies in `box_i(now) + sweep_i`, and
 //!    likewise for `b`; [`swept_boxes_apart`] proves the two sums disjoint on one of the 15
 //!    axes (with a positive gap). All box pairs of all pairs that can meet proved: FREE.
 //!    Proved again with `warn_mm` added to one sweep's ball: else WARN. Any unproved pair,
 //!    unreachable TCP, unbounded sweep or status other than OK: STOP.
+//! 6. **Certain STOP, before any sweep.** Every sweep of a lower-link, platform or tool box
+//!    holds the ball of radius `S'` (the radius of step 3's ball): form 0's support on any `n`
+//!    is at least `(1 + mu) sum_a S' |w_a . n| >= S' |n|` (the cube term with weight
+//!    `max e_k >= 1`, the arc and ball terms are `>= 0`), form 1's at least
+//!    `(1 + mu) S' |n|`. So on every axis the swept box's projection holds that of the box
+//!    swept by the ball `S'` alone (upper links: by nothing). When [`swept_boxes_apart`] does
+//!    not separate the boxes swept by those balls (radii shrunk by a relative 1e-9, far above
+//!    rounding), it cannot separate them with the real sweeps of any tier: STOP at once,
+//!    without inverse kinematics.
 //!
 //! The **speed limit** of a robot is the largest measured speed `|v_fd|` in `[0, v_max]` at
-//! which every pair involving it is still proved, the other robots as they are: bisection
-//! (at most [`LIMIT_STEPS`] + 2 evaluations) that keeps the last speed proved. 0 when not
-//! even standing still is proved; `v_max` when full speed is.
+//! which every pair involving it is still proved, the other robots as they are: bisection to
+//! `v_max / 2^LIMIT_STEPS` ([`LIMIT_STEPS`]) that keeps the last speed proved. 0 when not
+//! even standing still is proved; `v_max` when full speed is. By default the bisection uses
+//! tier 1 alone (a few us per robot): that limit is proved, and never above the limit of
+//! both tiers ([`ProtectiveChecker::with_precise_limits`] for that one: both tiers, the
+//! second only above the first's limit and below the speed where step 6 already fails).
 //!
 //! Nothing here allocates after [`ProtectiveChecker::new`].
 
 use crate::cell::exact::PairVerdict;
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
-use crate::cspace::guarantee::cube_box_sweeps;
-use crate::geometry::distance::obb_distance;
+use crate::cspace::guarantee::{cube_box_sweeps, cube_box_sweeps_with, theta_range, Enclosure};
+use crate::geometry::clearance::boxes_clearance;
+use crate::geometry::sweep::{swept_boxes_apart_with, FaceTerms};
 use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::{swept_boxes_apart, Obb, Sweep};
 use crate::math::{Real, Vec3};
-use crate::robot::{RobotBoxes, RobotModel, StopModel};
+use crate::robot::motor_table::{intersect, MotorTable};
+use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
+use alloc::sync::Arc;
 
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`SPLITS^3` per
 /// arm). The cubes here are tens to hundreds of mm, where finer splits shrink the sweeps by
@@ -62,6 +86,11 @@ pub const SPLITS: u32 = 2;
 /// The WARN threshold of the C ABI until `dc_set_stop_model` sets one (mm): the 10 mm by which
 /// the practical scenarios clear the robots (SPEC §5).
 pub const DEFAULT_WARN_MM: Real = 10.0;
+
+/// Sub-boxes per axis of the second tier: where the table alone does not prove FREE, the
+/// motor angles are enclosed again directly over the stopping cube with `PRECISE_SPLITS^3`
+/// sub-boxes and intersected with the table's enclosure (module doc, step 4).
+pub const PRECISE_SPLITS: u32 = 2;
 
 /// Bisection steps of a speed limit (after the checks at 0 and at `v_max`).
 pub const LIMIT_STEPS: u32 = 8;
@@ -138,8 +167,9 @@ pub struct ProtectiveReport {
     pub verdict: Protective,
     /// OK, or why there is no proof.
     pub status: ProtectiveStatus,
-    /// The clearance of the cell now (mm, SPEC §8; 0 when boxes touch or intersect,
-    /// `INFINITY` when no pair can meet, NaN when not computed).
+    /// The signed clearance of the cell now (mm, SPEC §8: the gap when apart, minus the
+    /// penetration depth when boxes intersect, 0 when they touch; `INFINITY` when no pair can
+    /// meet, NaN when not computed).
     pub clearance_mm: Real,
     /// The box pair of the smallest clearance now.
     pub closest: Option<BoxPair>,
@@ -166,12 +196,25 @@ pub struct ProtectiveChecker {
     history: alloc::vec::Vec<History>,
     /// Per robot, the WCS displacement sets of its boxes over the stop.
     sweeps: alloc::vec::Vec<SweepForms>,
+    /// Per robot, per form and box, the face terms of its reference box under that sweep.
+    faces: alloc::vec::Vec<[[FaceTerms; MAX_BOXES]; 2]>,
+    /// Per robot, the motor-angle table of its kinematics (shared by equal robots).
+    tables: alloc::vec::Vec<Arc<MotorTable>>,
     /// Per robot, the measured velocity of this tick (MCS, mm/s; zero when unknown).
     velocity: alloc::vec::Vec<Vec3>,
     /// Per robot, its boxes (WCS) at the reference TCP its sweeps are measured from.
     ref_boxes: alloc::vec::Vec<RobotBoxes>,
     /// Whether each tick also finds the speed limits (most of its time).
     speed_limits: bool,
+    /// Sub-boxes per axis of the second tier's direct enclosure (0: no second tier).
+    precise_splits: u32,
+    /// Whether the speed limits use the second tier too (else the table's alone).
+    precise_limits: bool,
+    /// Per robot, the centre (MCS) and radius of the ball holding its TCP over the stop.
+    centres: alloc::vec::Vec<Vec3>,
+    reach: alloc::vec::Vec<Real>,
+    /// Per robot, the tier its sweeps were computed with (`None`: not for this reference).
+    sweep_tier: alloc::vec::Vec<Option<(u32, u8)>>,
     report: ProtectiveReport,
 }
 
@@ -186,14 +229,28 @@ impl ProtectiveChecker {
             return Err(CellError::Invalid(alloc::format!("warn_mm = {warn_mm} must be finite and >= 0")));
         }
         let n = cell.robots.len();
+        let mut tables: alloc::vec::Vec<Arc<MotorTable>> = alloc::vec::Vec::with_capacity(n);
+        for robot in &cell.robots {
+            let shared = tables.iter().find(|t| *t.delta() == robot.model.delta).cloned();
+            tables.push(shared.unwrap_or_else(|| Arc::new(MotorTable::new(&robot.model.delta))));
+        }
+        let unit = Obb::new(Vec3::zeros(), crate::math::Mat3::identity(), Vec3::repeat(1.0));
+        let no_faces = FaceTerms::new(&unit, &Sweep::ZERO);
         Ok(ProtectiveChecker {
             exact: ExactChecker::new(cell),
             warn_mm,
             history: alloc::vec![NO_HISTORY; n],
             sweeps: alloc::vec![[[Sweep::ZERO; MAX_BOXES]; 2]; n],
+            faces: alloc::vec![[[no_faces; MAX_BOXES]; 2]; n],
+            tables,
             velocity: alloc::vec![Vec3::zeros(); n],
             ref_boxes: alloc::vec![RobotBoxes::empty(); n],
             speed_limits: true,
+            precise_splits: PRECISE_SPLITS,
+            precise_limits: false,
+            centres: alloc::vec![Vec3::zeros(); n],
+            reach: alloc::vec![0.0; n],
+            sweep_tier: alloc::vec![None; n],
             report: ProtectiveReport {
                 verdict: Protective::Stop,
                 status: ProtectiveStatus::Ok,
@@ -215,6 +272,20 @@ impl ProtectiveChecker {
     /// read NaN.
     pub fn with_speed_limits(self, on: bool) -> Self {
         ProtectiveChecker { speed_limits: on, ..self }
+    }
+
+    /// This checker with a second tier of `splits^3` direct sub-boxes ([`PRECISE_SPLITS`] by
+    /// default; 0: the table alone, faster, more STOPs).
+    pub fn with_precise_splits(self, splits: u32) -> Self {
+        ProtectiveChecker { precise_splits: splits, ..self }
+    }
+
+    /// This checker finding the speed limits with both tiers (`true`: the largest speed at
+    /// which the verdict itself proves FREE, to [`LIMIT_STEPS`] bisection steps; about 100 us
+    /// per robot) or with the table's tier alone (`false`, the default: a few us per robot,
+    /// never above the precise limit, so FREE holds at it too).
+    pub fn with_precise_limits(self, on: bool) -> Self {
+        ProtectiveChecker { precise_limits: on, ..self }
     }
 
     /// The WARN threshold (mm).
@@ -329,30 +400,56 @@ impl ProtectiveChecker {
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let v = self.report.robots[j].speed_mm_s;
-            let s = self.stop_sweeps(j, tcp, v);
+            let s = self.stop_reference(j, tcp, v);
             let bound = self.speed_bound(j, v);
             let r = &mut self.report.robots[j];
             (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
         }
-        let pairs = &self.exact.verdict().pairs;
-        let boxes = |j: usize| self.ref_boxes[j].as_slice();
-        self.report.limiting = first_unproved(pairs, &boxes, &self.sweeps, None, 0.0);
-        self.report.verdict = if self.report.limiting.is_some() {
-            Protective::Stop
-        } else if self.warn_mm > 0.0 {
-            self.report.limiting = first_unproved(pairs, &boxes, &self.sweeps, None, self.warn_mm);
-            if self.report.limiting.is_some() {
-                Protective::Warn
-            } else {
-                Protective::Free
-            }
+        let n = tcps_mcs.len();
+        if let Some(pair) = self.certain_stop(None) {
+            (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
         } else {
-            Protective::Free
-        };
+            (0..n).for_each(|j| self.sweeps_at(j, 0, 0));
+            (self.report.verdict, self.report.limiting) = self.prove();
+            // Tier 2, arm by arm: a box's sweep depends on its own arm's angles only, so the
+            // arms of the limiting pair are refined until it is proved or both are refined
+            // (then the full tier 2 fails on it too: the same verdict and limiting pair, as a
+            // pair proved with fewer arms refined stays proved with more).
+            let splits = self.precise_splits;
+            while let (Some(p), true) = (self.report.limiting, splits > 0) {
+                let (arms_a, arms_b) = (self.arm_bit(p.a, p.box_a), self.arm_bit(p.b, p.box_b));
+                let refined = |me: &Self, j: usize| me.sweep_tier[j].filter(|t| t.0 == splits).map_or(0, |t| t.1);
+                let (ra, rb) = (refined(self, p.a), refined(self, p.b));
+                if ra & arms_a == arms_a && rb & arms_b == arms_b {
+                    break;
+                }
+                self.sweeps_at(p.a, splits, ra | arms_a);
+                let rb = refined(self, p.b);
+                self.sweeps_at(p.b, splits, rb | arms_b);
+                (self.report.verdict, self.report.limiting) = self.prove();
+            }
+        }
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             self.report.robots[j].speed_limit_mm_s =
                 if self.speed_limits { self.speed_limit(j, tcp) } else { Real::NAN };
         }
+    }
+
+    /// The verdict and its limiting pair for the sweeps as they are (module doc, step 5).
+    fn prove(&self) -> (Protective, Option<BoxPair>) {
+        let pairs = &self.exact.verdict().pairs;
+        let boxes = |j: usize| self.ref_boxes[j].as_slice();
+        let limiting = first_unproved(pairs, &boxes, &self.sweeps, &self.faces, None, 0.0);
+        if limiting.is_some() {
+            return (Protective::Stop, limiting);
+        }
+        if self.warn_mm > 0.0 {
+            let limiting = first_unproved(pairs, &boxes, &self.sweeps, &self.faces, None, self.warn_mm);
+            if limiting.is_some() {
+                return (Protective::Warn, limiting);
+            }
+        }
+        (Protective::Free, None)
     }
 
     /// `v_b` of robot `j` for measured speed `v` (module doc, step 1).
@@ -366,9 +463,10 @@ impl ProtectiveChecker {
         }
     }
 
-    /// Sets robot `j`'s reference boxes and sweeps for TCP `tcp_mcs` at measured speed `v`
-    /// (along the measured velocity's direction, when known); returns `S`.
-    fn stop_sweeps(&mut self, j: usize, tcp_mcs: &Vec3, v: Real) -> Real {
+    /// Sets robot `j`'s reference boxes, the centre and radius of the ball that holds its TCP
+    /// over the stop (module doc, step 3) for TCP `tcp_mcs` at measured speed `v`, and marks its
+    /// sweeps as not computed; returns `S`.
+    fn stop_reference(&mut self, j: usize, tcp_mcs: &Vec3, v: Real) -> Real {
         let cell = self.exact.cell();
         let stop = cell.stops[j];
         let reaction_s = (stop.reaction_ms + cell.tick_ms) * 1e-3;
@@ -389,36 +487,123 @@ impl ProtectiveChecker {
                 *b = b.transformed(&rot, &t);
             }
         }
-        self.sweeps[j] = stop_sweeps_wcs(&robot.model, &rot, &centre, radius);
+        (self.centres[j], self.reach[j], self.sweep_tier[j]) = (centre, radius, None);
         s
+    }
+
+    /// The arm whose motor angle box `k` of robot `j` moves with, as a bit (0 for platform
+    /// and tool boxes, which move with the TCP alone).
+    fn arm_bit(&self, j: usize, k: usize) -> u8 {
+        match self.exact.cell().robots[j].model.box_kind(k) {
+            BoxKind::LowerLink(arm) | BoxKind::UpperLink(arm) => 1 << arm,
+            BoxKind::Platform | BoxKind::Tool => 0,
+        }
+    }
+
+    /// Computes robot `j`'s sweeps (and their face terms) about its reference ball, with the
+    /// motor angles of `tier` (0: the table alone; else also `tier^3` direct sub-boxes for the
+    /// arms in the bit mask `arms`).
+    fn sweeps_at(&mut self, j: usize, tier: u32, arms: u8) {
+        let arms = if tier == 0 { 0 } else { arms };
+        if self.sweep_tier[j] == Some((tier, arms)) {
+            return;
+        }
+        let robot = &self.exact.cell().robots[j];
+        let rot = robot.placement.rotation();
+        let (centre, radius) = (self.centres[j], self.reach[j]);
+        self.sweeps[j] = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, Some(&self.tables[j]), tier, arms);
+        let boxes = &self.ref_boxes[j];
+        for (form, faces) in self.faces[j].iter_mut().enumerate() {
+            for (k, b) in boxes.as_slice().iter().enumerate() {
+                faces[k] = FaceTerms::new(b, &self.sweeps[j][form][k]);
+            }
+        }
+        self.sweep_tier[j] = Some((tier, arms));
+    }
+
+    /// A box pair (of the pairs involving `only`, or of all) that no sweeps of any tier can
+    /// prove apart: every sweep of a lower link, platform or tool box holds the ball of the
+    /// TCP's stopping radius (module doc, step 6), so when the reference boxes swept by those
+    /// balls alone are not proved apart, neither are they with the full sweeps.
+    fn certain_stop(&self, only: Option<usize>) -> Option<BoxPair> {
+        let least = |j: usize, k: usize| {
+            let moves_with_tcp = !matches!(self.exact.cell().robots[j].model.box_kind(k), BoxKind::UpperLink(_));
+            Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO }
+        };
+        for p in self.exact.verdict().pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
+            for (i, box_a) in self.ref_boxes[p.a].as_slice().iter().enumerate() {
+                for (k, box_b) in self.ref_boxes[p.b].as_slice().iter().enumerate() {
+                    if !swept_boxes_apart(box_a, &least(p.a, i), box_b, &least(p.b, k)) {
+                        return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
+                    }
+                }
+            }
+        }
+        None
     }
 
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are.
     fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3) -> Real {
-        let saved = (self.sweeps[j], self.ref_boxes[j]);
-        let proved = |me: &mut Self, v: Real| {
-            me.stop_sweeps(j, tcp_mcs, v);
+        let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]);
+        // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
+        let proved = |me: &mut Self, v: Real, tier: Option<u32>| {
+            me.stop_reference(j, tcp_mcs, v);
+            if me.certain_stop(Some(j)).is_some() {
+                return false;
+            }
+            let Some(tier) = tier else { return true };
+            // The other robots as they are, with the motor angles of the same tier.
+            (0..me.centres.len()).for_each(|i| me.sweeps_at(i, tier, 0b111));
             let boxes = |i: usize| me.ref_boxes[i].as_slice();
-            first_unproved(&me.exact.verdict().pairs, &boxes, &me.sweeps, Some(j), 0.0).is_none()
+            first_unproved(&me.exact.verdict().pairs, &boxes, &me.sweeps, &me.faces, Some(j), 0.0).is_none()
         };
         let vmax = self.cell().stops[j].max_speed_mm_s;
-        let limit = if proved(self, vmax) {
-            vmax
-        } else if !proved(self, 0.0) {
-            0.0
-        } else {
-            let (mut lo, mut hi) = (0.0, vmax);
-            for _ in 0..LIMIT_STEPS {
+        let resolution = vmax / (1u32 << LIMIT_STEPS) as Real;
+        // From `lo` (proved) and `hi` (not), halves until they are `resolution` apart.
+        let bisect = |me: &mut Self, (mut lo, mut hi): (Real, Real), tier: Option<u32>| {
+            while hi - lo > resolution {
                 let mid = 0.5 * (lo + hi);
-                if proved(self, mid) {
+                if proved(me, mid, tier) {
                     lo = mid
                 } else {
                     hi = mid
                 }
             }
-            lo
+            (lo, hi)
         };
-        (self.sweeps[j], self.ref_boxes[j]) = saved;
+        // The bracket of one test alone below `top` (not proved there, unless `top = vmax`).
+        let limit_of = |me: &mut Self, tier: Option<u32>, top: Real| {
+            if top == vmax && proved(me, vmax, tier) {
+                (vmax, vmax)
+            } else if !proved(me, 0.0, tier) {
+                (0.0, 0.0)
+            } else {
+                bisect(me, (0.0, top), tier)
+            }
+        };
+        let tier = if self.precise_limits { self.precise_splits } else { 0 };
+        // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit, and the floor
+        // of the precise one.
+        let (lo, hi) = limit_of(self, Some(0), vmax);
+        let limit = if tier == 0 || lo == vmax {
+            lo
+        } else {
+            // Above `top` no tier proves anything: the certain-STOP test fails there.
+            let top = limit_of(self, None, vmax).1;
+            if top == 0.0 {
+                0.0
+            } else if hi == 0.0 {
+                // The table proves not even standing still: the second tier alone.
+                limit_of(self, Some(tier), top).0
+            } else if hi >= top || !proved(self, hi, Some(tier)) {
+                lo
+            } else if top == vmax && proved(self, vmax, Some(tier)) {
+                vmax
+            } else {
+                bisect(self, (hi, top), Some(tier)).0
+            }
+        };
+        (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
         limit
     }
 }
@@ -472,9 +657,42 @@ fn worse(a: ProtectiveStatus, b: ProtectiveStatus) -> ProtectiveStatus {
 }
 
 /// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
-/// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded.
-pub fn stop_sweeps_wcs(model: &RobotModel, rot_wcs: &crate::math::Mat3, tcp_mcs: &Vec3, s: Real) -> SweepForms {
-    match cube_box_sweeps(model, tcp_mcs, s, tcp_mcs, SPLITS) {
+/// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded. The motor
+/// angles come from `table` (built for `model.delta`) where it covers the cube, intersected,
+/// for the arms in the bit mask `arms`, with the interval inverse kinematics in `precise^3`
+/// sub-boxes (none when `precise` is 0); without the table, from the interval inverse
+/// kinematics with [`SPLITS`].
+pub fn stop_sweeps_wcs(
+    model: &RobotModel,
+    rot_wcs: &crate::math::Mat3,
+    tcp_mcs: &Vec3,
+    s: Real,
+    table: Option<&MotorTable>,
+    precise: u32,
+    arms: u8,
+) -> SweepForms {
+    let d = &model.delta;
+    let direct = |lo: &Vec3, hi: &Vec3, splits: u32| -> [Enclosure; 3] {
+        core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits))
+    };
+    let sweeps = match table.filter(|t| t.delta() == d) {
+        Some(t) => cube_box_sweeps_with(model, tcp_mcs, s, tcp_mcs, |lo, hi| match t.enclose(lo, hi) {
+            Some(th) if precise > 0 => {
+                let refine = |arm: usize| arms >> arm & 1 == 1;
+                core::array::from_fn(|arm| {
+                    if refine(arm) {
+                        intersect(th[arm], theta_range(d, arm, lo, hi, precise))
+                    } else {
+                        th[arm]
+                    }
+                })
+            }
+            Some(th) => th,
+            None => direct(lo, hi, SPLITS),
+        }),
+        None => cube_box_sweeps(model, tcp_mcs, s, tcp_mcs, SPLITS),
+    };
+    match sweeps {
         Some(sweeps) => {
             // The TCP's own displacement lies in the ball of radius `s` (widened as the cube
             // is in `cube_box_sweeps`), so its cube term may be traded for that ball.
@@ -500,21 +718,33 @@ pub type SweepForms = [[Sweep; MAX_BOXES]; 2];
 
 /// The first box pair (of the pairs involving `only`, or of all pairs) not proved apart
 /// with `extra` mm added to the first robot's sweep.
+/// `faces[j][form][k]` are the face terms of robot `j`'s box `k` under `sweeps[j][form][k]`.
 fn first_unproved<'a>(
     pairs: &[PairVerdict],
     boxes: &impl Fn(usize) -> &'a [Obb],
     sweeps: &[SweepForms],
+    faces: &[[[FaceTerms; MAX_BOXES]; 2]],
     only: Option<usize>,
     extra: Real,
 ) -> Option<BoxPair> {
     const FORMS: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
     for p in pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
+        // With `extra`, robot `a`'s face terms under its widened sweeps, once per pair.
+        let mut widened = [faces[p.a][0], faces[p.a][1]];
+        if extra != 0.0 {
+            for (form, terms) in widened.iter_mut().enumerate() {
+                for (i, box_a) in boxes(p.a).iter().enumerate() {
+                    let sa = &sweeps[p.a][form][i];
+                    terms[i] = FaceTerms::new(box_a, &Sweep { ball: sa.ball + extra, ..*sa });
+                }
+            }
+        }
         for (i, box_a) in boxes(p.a).iter().enumerate() {
             for (k, box_b) in boxes(p.b).iter().enumerate() {
                 let apart = |&(fa, fb): &(usize, usize)| {
-                    let sa = &sweeps[p.a][fa][i];
+                    let (sa, sb) = (&sweeps[p.a][fa][i], &sweeps[p.b][fb][k]);
                     let sa = Sweep { ball: sa.ball + extra, ..*sa };
-                    swept_boxes_apart(box_a, &sa, box_b, &sweeps[p.b][fb][k])
+                    swept_boxes_apart_with(box_a, &sa, &widened[fa][i], box_b, sb, &faces[p.b][fb][k])
                 };
                 if !FORMS.iter().any(apart) {
                     return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
@@ -525,18 +755,18 @@ fn first_unproved<'a>(
     None
 }
 
-/// The clearance of the cell as of the exact checker's last check and its closest box pair:
-/// the one place that computes it (mm; 0 when boxes touch or intersect).
+/// The signed clearance of the cell as of the exact checker's last check (SPEC §8: the gap
+/// when apart, minus the penetration depth when intersecting, 0 when touching) and its
+/// closest box pair: the one place that computes it (mm).
 pub fn clearance_now(exact: &ExactChecker) -> (Real, Option<BoxPair>) {
     let mut best = (Real::INFINITY, None);
     for p in &exact.verdict().pairs {
-        for (i, box_a) in exact.boxes(p.a).as_slice().iter().enumerate() {
-            for (k, box_b) in exact.boxes(p.b).as_slice().iter().enumerate() {
-                let d = obb_distance(box_a, box_b);
-                // A NaN distance (a non-finite box) wins, so it shows in the report.
-                if d.is_nan() || d < best.0 {
-                    best = (d, Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k }));
-                }
+        let c = boxes_clearance(exact.boxes(p.a).as_slice(), exact.boxes(p.b).as_slice());
+        // A NaN distance (a non-finite box) wins, so it shows in the report.
+        if c.distance.is_nan() || c.distance < best.0 {
+            best = (c.distance, Some(BoxPair { a: p.a, b: p.b, box_a: c.box_a, box_b: c.box_b }));
+            if c.distance.is_nan() {
+                break;
             }
         }
     }

@@ -266,13 +266,29 @@ fn unknown(model: &RobotModel) -> [Sweep; MAX_BOXES] {
 /// - upper link: `((1 + m/rf) dG + (d_u + m) dG / rf) D`;
 /// - platform and tool: `Z`.
 pub fn cube_box_sweeps(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, splits: u32) -> Option<[Sweep; MAX_BOXES]> {
+    let d = &model.delta;
+    cube_box_sweeps_with(model, c, h, p0, |lo, hi| core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits)))
+}
+
+/// As [`cube_box_sweeps`], with the motor angles over the widened cube `[lo, hi]` enclosed by
+/// `enclose` (per arm, with the meaning of [`theta_range`]: every reachable TCP of the box
+/// has its angle in the range), e.g. from a precomputed
+/// [`MotorTable`](crate::robot::motor_table::MotorTable).
+pub fn cube_box_sweeps_with(
+    model: &RobotModel,
+    c: &Vec3,
+    h: Real,
+    p0: &Vec3,
+    enclose: impl FnOnce(&Vec3, &Vec3) -> [Enclosure; 3],
+) -> Option<[Sweep; MAX_BOXES]> {
     let (d, o) = (&model.delta, &model.options);
     let n = model.box_count();
     let h = h * (1.0 + 1e-12) + 1e-12;
     let (lo, hi) = (c.add_scalar(-h), c.add_scalar(h));
     let mut th = [Interval::point(0.0); 3];
+    let enclosures = enclose(&lo, &hi);
     for (arm, slot) in th.iter_mut().enumerate() {
-        match theta_range(d, arm, &lo, &hi, splits) {
+        match enclosures[arm] {
             Enclosure::Empty => return None,
             Enclosure::Unbounded => return Some(unknown(model)),
             Enclosure::Range(r) => *slot = r,

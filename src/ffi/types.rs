@@ -257,8 +257,9 @@ pub struct DcProtectiveReport {
     pub verdict: DcVerdict,
     /// Bit j set: robot j's TCP is not finite, unreachable or moved implausibly.
     pub unreachable_mask: u32,
-    /// Clearance of the cell now (mm): the smallest distance between boxes of robots that
-    /// can meet, 0 when touching or intersecting; NaN when not computed (status not OK).
+    /// Signed clearance of the cell now (mm, SPEC section 8): over the box pairs of robots that can
+    /// meet, the smallest gap when apart, minus the penetration depth when boxes intersect,
+    /// 0 when touching; NaN when not computed (status not OK).
     pub clearance_mm: f64,
     /// Closest box pair now: robots and boxes, or `DC_BOX_NONE`.
     pub closest_robot_a: u32,

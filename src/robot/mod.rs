@@ -2,6 +2,8 @@
 
 pub mod delta3;
 pub mod model;
+#[cfg(feature = "std")]
+pub mod motor_table;
 pub mod stopping;
 
 pub use delta3::{ArmSolution, Delta3, MotorCosSin, Unreachable};
