@@ -21,10 +21,9 @@ pub mod symmetry;
 
 use alloc::vec::Vec;
 #[cfg(feature = "std")]
-pub use certify::{
-    label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, SubCells,
-    SubdividedLabels,
-};
+pub use certify::{label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, SubCells};
+#[cfg(feature = "eval")]
+pub use certify::SubdividedLabels;
 #[cfg(feature = "std")]
 pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};
 #[cfg(feature = "std")]

@@ -39,7 +39,7 @@ pub use build::{build_table, build_tables, BuildReport, Labelling, Variant};
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
 pub use lookup::{TableAnswer, TableChecker};
-#[cfg(feature = "std")]
+#[cfg(feature = "eval")]
 pub use quadtree4d::{subdivided_slices, SliceBound};
 pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
 pub use quadtree5d::LinearQuadtree5d;
