@@ -33,7 +33,9 @@ pub mod synthetic;
 #[cfg(test)]
 mod agreement_tests;
 
-use alloc::{format, string::String, vec, vec::Vec};
+use alloc::{format, string::String};
+#[cfg(feature = "eval")]
+use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
 pub use build::{build_table, build_tables, BuildReport, Labelling, Variant};
 pub use error::TableError;
@@ -123,7 +125,8 @@ impl Table {
     }
 
     /// The address and byte length of every array a query may read (for benchmarks that
-    /// flush them from the caches between queries).
+    /// flush them from the caches between queries; the report tool).
+    #[cfg(feature = "eval")]
     pub fn memory_regions(&self) -> Vec<(usize, usize)> {
         fn region<T>(v: &[T]) -> (usize, usize) {
             (v.as_ptr() as usize, core::mem::size_of_val(v))

@@ -237,6 +237,7 @@ impl Pool {
     }
 
     /// [`query`](Self::query) and its reads as `(address, bytes, step)`.
+    #[cfg(any(test, feature = "eval"))]
     pub(super) fn query_reads(&self, c: &[u16; 6], fine: u32) -> (bool, Vec<(usize, usize, u32)>) {
         let w = &self.words;
         let at = |i: usize| w.as_ptr() as usize + 8 * i;
