@@ -48,7 +48,7 @@ use crate::cell::exact::PairVerdict;
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::cspace::guarantee::cube_box_sweeps;
 use crate::geometry::distance::obb_distance;
-use crate::geometry::witness::MAX_BOXES;
+use crate::robot::MAX_BOXES;
 use crate::geometry::{swept_boxes_apart, Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::{RobotBoxes, RobotModel, StopModel};

@@ -70,7 +70,7 @@
 
 use crate::cspace::interval::Interval;
 use crate::cspace::sampler::SampleGrid;
-use crate::geometry::witness::MAX_BOXES;
+use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use crate::robot::delta3::{radial, tangent};

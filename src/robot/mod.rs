@@ -5,5 +5,5 @@ pub mod model;
 pub mod stopping;
 
 pub use delta3::{ArmSolution, Delta3, MotorCosSin, Unreachable};
-pub use model::{BoxKind, ModelOptions, RobotBoxes, RobotModel, ToolBox};
+pub use model::{BoxKind, ModelOptions, RobotBoxes, RobotModel, ToolBox, MAX_BOXES};
 pub use stopping::{StopModel, DEFAULT_TICK_MS};

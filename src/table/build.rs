@@ -69,6 +69,9 @@ pub struct BuildReport {
     pub symmetric: bool,
     /// Seconds spent labelling.
     pub label_secs: f64,
+    /// Subdivided tables only: the collision pairs cut into sub-cells and the seconds, of
+    /// `label_secs`, spent on them (the CLI shows it with its progress).
+    pub sub_cells: Option<(usize, f64)>,
     /// Seconds spent building the quadtree.
     pub build_secs: f64,
 }
@@ -109,16 +112,18 @@ pub fn build_tables(
     }
     let start = Instant::now();
     let subdivide = variants.contains(&Variant::SharedSubdivided);
-    let (mut space, sub, certification) = match labelling {
+    let (mut space, sub, sub_secs, certification) = match labelling {
         Labelling::Certified if subdivide => {
             let c = label_space_subdivided(cell, k, ws, progress)?;
-            (c.space, c.sub, Certification::SweptBound)
+            (c.space, c.sub, c.sub_secs, Certification::SweptBound)
         }
-        Labelling::Certified => (label_space_certified(cell, k, ws, progress)?.space, None, Certification::SweptBound),
+        Labelling::Certified => {
+            (label_space_certified(cell, k, ws, progress)?.space, None, 0.0, Certification::SweptBound)
+        }
         Labelling::ThesisMargin if subdivide => {
             return Err("sub-cells are certified; use the certified labelling".into())
         }
-        Labelling::ThesisMargin => (label_space_thesis(cell, k, ws, progress)?, None, Certification::ThesisBlowUp),
+        Labelling::ThesisMargin => (label_space_thesis(cell, k, ws, progress)?, None, 0.0, Certification::ThesisBlowUp),
     };
     let label_secs = start.elapsed().as_secs_f64();
     let symmetric = reflection_y(cell);
@@ -129,6 +134,7 @@ pub fn build_tables(
         unreachable: space.labels.iter().filter(|&&l| l == Label::Unreachable).count(),
         symmetric,
         label_secs,
+        sub_cells: sub.as_ref().map(|s| (s.pairs.len(), sub_secs)),
         build_secs: 0.0,
     };
     if labelling == Labelling::ThesisMargin {

@@ -293,6 +293,9 @@ fn build(args: &BuildArgs, progress: bool) -> Result<(), Failure> {
     let labelling = Labelling::from(args.labelling);
     check_memory(cell, k, &Workspace::THESIS)?;
     let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
+    if let (true, Some((pairs, secs))) = (progress, r.sub_cells) {
+        eprintln!("sub-cells of {pairs} collision pairs: {secs:.2} s");
+    }
     let bytes = to_bytes(&table, &header);
     files::write_file(output, |w| w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display())))?;
     println!("cell {} k {k}: {} x {} samples, {} pairs", cell.name, r.samples.0, r.samples.1, r.pairs);

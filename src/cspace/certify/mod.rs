@@ -62,7 +62,7 @@ use crate::cspace::label::{
 };
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::LabelledSpace;
-use crate::geometry::witness::MAX_BOXES;
+use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use refine::{octants_prove_free, refine_unknown_cells, sub_cells, Levels, SubOctants};
@@ -88,6 +88,9 @@ pub struct CertifiedSpace {
     pub refined: bool,
     /// With [`label_space_subdivided`]: the sub-cell labels of every pair labelled collision.
     pub sub: Option<SubCells>,
+    /// Seconds spent finding [`sub`](Self::sub) (0 without it), for the caller to report:
+    /// the library prints nothing.
+    pub sub_secs: f64,
 }
 
 /// Sub-cell labels of the pairs labelled collision: each such 6-D cell cut into its 64
@@ -186,25 +189,19 @@ fn label_space_certified_inner(
         let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
         let mut labels = label_pairs(&a0, &b0, collides, progress);
         refine_unknown_cells(&la, &lb, &mut labels);
-        let sub = subdivide.then(|| {
-            let start = std::time::Instant::now();
-            let sub = sub_cells(&la, &lb, &labels);
-            if progress {
-                eprintln!("sub-cells of {} collision pairs: {:.2} s", sub.pairs.len(), start.elapsed().as_secs_f64());
-            }
-            sub
-        });
-        (labels, sub)
+        let start = std::time::Instant::now();
+        let sub = subdivide.then(|| sub_cells(&la, &lb, &labels));
+        (labels, sub, start.elapsed().as_secs_f64())
     } else {
-        (label_pairs(&a0, &b0, |_, _| true, progress), None)
+        (label_pairs(&a0, &b0, |_, _| true, progress), None, 0.0)
     };
-    let (labels, sub) = labels;
+    let (labels, sub, sub_secs) = labels;
     let radii = |ss: &[[Sweep; MAX_BOXES]]| ss.iter().map(|s| s.map(|w| w.radius())).collect::<Vec<_>>();
     let (bounds_a, bounds_b) = (radii(&sweeps_a), radii(&sweeps_b));
     let used = |bs: &[[Real; MAX_BOXES]]| bs.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0, Real::max);
     let margin = used(&bounds_a).max(used(&bounds_b));
     let space = LabelledSpace { grid_a, grid_b, labels, margin };
-    Ok(CertifiedSpace { space, bounds_a, bounds_b, refined: refine, sub })
+    Ok(CertifiedSpace { space, bounds_a, bounds_b, refined: refine, sub, sub_secs: if subdivide { sub_secs } else { 0.0 } })
 }
 
 /// One robot's level-1 boxes: at each sample's reference point `refs[s]`, swept by its

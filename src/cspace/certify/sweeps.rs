@@ -7,7 +7,7 @@ use crate::cspace::guarantee::{box_sweeps, cube_box_sweeps, cube_unreachable, re
 use crate::cspace::label::Inflation;
 use crate::cspace::sampler::SampleGrid;
 use crate::cspace::symmetry::mirror_cell;
-use crate::geometry::witness::MAX_BOXES;
+use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use crate::robot::{BoxKind, RobotModel};
