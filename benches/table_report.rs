@@ -56,7 +56,8 @@ use std::time::Instant;
 use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, hottest_of_passes, percentiles, Clock};
 
 /// The tables of the report, by the key `--variants` takes, in report order (see
-/// [`entries`]; the two `-bound` keys are notes, [`Run::slice_bounds`]).
+/// [`entries`]; the plain kinds by their [`TableKind`] names, the two `-bound` keys are
+/// notes, [`Run::slice_bounds`]).
 const VARIANTS: [&str; 14] = [
     "6d",
     "5d",
@@ -494,18 +495,18 @@ fn entries<'a>(l: &'a Labellings<'a>, symmetric: bool, t_lossy: u32) -> Vec<Entr
     let mut out = vec![];
     if let Some(c) = &l.certified {
         let d4 = |axes, t| -> Build<'a> { Box::new(move |s| LinearQuadtree4d::build(s, symmetric, axes, t).map(Table::D4)) };
-        out.push(Entry::new("6d", "6D", c, Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6))));
-        out.push(Entry::new("5d", "5D", c, Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5))));
-        out.push(Entry::new("4d-yy", "4D/yy t=0", c, d4(SliceAxes::YY, 0)));
-        out.push(Entry::new("4d-zz", "4D/zz t=0", c, d4(SliceAxes::ZZ, 0)));
+        out.push(Entry::new(TableKind::D6.name(), "6D", c, Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6))));
+        out.push(Entry::new(TableKind::D5.name(), "5D", c, Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5))));
+        out.push(Entry::new(TableKind::D4yy.name(), "4D/yy t=0", c, d4(SliceAxes::YY, 0)));
+        out.push(Entry::new(TableKind::D4zz.name(), "4D/zz t=0", c, d4(SliceAxes::ZZ, 0)));
         out.push(Entry::new("4d-yy-lossy", format!("4D/yy t={t_lossy}"), c, d4(SliceAxes::YY, t_lossy)));
         let shared: Build = Box::new(move |s| SharedQuadtree6d::build(s, symmetric).map(Table::Shared));
-        out.push(Entry::new("shared", "6D-shared", c, shared));
+        out.push(Entry::new(TableKind::Shared.name(), "6D-shared", c, shared));
     }
     if let Some((sub, secs)) = l.subdivided {
         let sub_cells = sub.sub.as_ref().expect("sub-cells");
         let build: Build = Box::new(move |s| SharedQuadtree6d::build_subdivided(s, sub_cells, symmetric).map(Table::Shared));
-        out.push(Entry { key: "shared-sub", label: "6D-shared/sub".into(), space: &sub.space, label_secs: *secs, certified: true, of_sub_cell_labels: false, build });
+        out.push(Entry { key: TableKind::SharedSub.name(), label: "6D-shared/sub".into(), space: &sub.space, label_secs: *secs, certified: true, of_sub_cell_labels: false, build });
     }
     if let (Some((sub, _)), Some((fine, secs))) = (l.subdivided, &l.fine) {
         for (key, axes, name) in [("4d-yy-sub", SliceAxes::YY, "yy"), ("4d-zz-sub", SliceAxes::ZZ, "zz")] {

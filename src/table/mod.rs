@@ -21,6 +21,7 @@ pub mod build;
 pub mod code;
 pub mod error;
 pub mod format;
+mod kind;
 pub mod lookup;
 pub mod quadtree4d;
 pub mod quadtree5d;
@@ -40,6 +41,7 @@ use alloc::{vec, vec::Vec};
 pub use build::{build_table, build_tables, BuildReport, Labelling, Variant};
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
+pub use kind::{TableKind, UnknownTableKind};
 pub use lookup::{TableAnswer, TableChecker};
 #[cfg(feature = "eval")]
 pub use quadtree4d::{subdivided_slices, SliceBound};

@@ -289,7 +289,7 @@ fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
 
 fn build(args: &BuildArgs, progress: bool) -> Result<(), Failure> {
     let (cell, k, output) = (&args.cell, args.k, &args.output);
-    let variant = args.variant.variant(args.t.unwrap_or(0));
+    let variant = args.variant.0.variant(args.t.unwrap_or(0));
     let labelling = Labelling::from(args.labelling);
     check_memory(cell, k, &Workspace::THESIS)?;
     let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
