@@ -25,8 +25,6 @@ pub use certify::{label_space_certified, label_space_certified_with, label_space
 #[cfg(feature = "eval")]
 pub use certify::SubdividedLabels;
 #[cfg(feature = "std")]
-pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};
-#[cfg(feature = "std")]
 pub use label::{label_space, label_space_thesis};
 pub use sampler::{CellIndex, SampleGrid, Workspace};
 

@@ -113,7 +113,7 @@ mod tests {
     use crate::math::Vec3;
     use nalgebra::Rotation3;
 
-    use crate::geometry::TestRng as Rng;
+    use crate::test_rng::TestRng as Rng;
 
     fn link(center: Vec3, euler: Vec3) -> Obb {
         let rot = *Rotation3::from_euler_angles(euler.x, euler.y, euler.z).matrix();

@@ -282,7 +282,7 @@ mod tests {
     /// Chunks of 2 blocks, so that the few hundred groups span several chunks.
     #[test]
     fn exact_groups_are_those_of_the_first_fit_scan() {
-        let mut rng = crate::geometry::TestRng(0x9e37_79b9_7f4a_7c15);
+        let mut rng = crate::test_rng::TestRng(0x9e37_79b9_7f4a_7c15);
         let mut next = || {
             rng.unit();
             rng.0

@@ -331,11 +331,8 @@ mod tests {
     /// Sub-cells of every collision pair from a seeded hash (some "don't care").
     fn random_sub_cells(space: &LabelledSpace, seed: u64) -> SubCells {
         let mut out = SubCells::default();
-        let mut x = seed;
-        let mut next = || {
-            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            x ^ x >> 29
-        };
+        let mut rng = crate::test_rng::TestRng(seed.max(1));
+        let mut next = || rng.next_u64();
         for (pair, &l) in space.labels.iter().enumerate() {
             if l == Label::Collision {
                 let care = next() | next();

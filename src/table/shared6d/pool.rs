@@ -360,14 +360,13 @@ mod tests {
 
     fn cells(levels: u32, n: usize) -> impl Iterator<Item = [u16; 6]> {
         let k = 1u64 << levels;
-        let mut x = 0x9e37_79b9_7f4a_7c15u64 ^ u64::from(levels);
+        let mut rng = crate::test_rng::TestRng(0x9e37_79b9_7f4a_7c15u64 ^ u64::from(levels));
         let all = k.pow(6) as usize <= n;
         (0..n.min(k.pow(6) as usize)).map(move |i| {
             let v = if all {
                 i as u64
             } else {
-                x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                x >> 16
+                rng.next_u64()
             };
             core::array::from_fn(|j| (v >> (levels as usize * j) & (k - 1)) as u16)
         })
