@@ -188,11 +188,6 @@ impl SampleBoxes {
     pub fn len(&self) -> usize {
         self.slot.len()
     }
-
-    /// Whether there are no entries.
-    pub fn is_empty(&self) -> bool {
-        self.slot.is_empty()
-    }
 }
 
 /// Whether the closed boxes `[alo, ahi]` and `[blo, bhi]` are apart by more than the slack.

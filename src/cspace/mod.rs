@@ -9,13 +9,13 @@
 //! label types are here (loading a table needs them); labelling and certification need `std`.
 
 #[cfg(feature = "std")]
-pub mod certify;
+pub(crate) mod certify;
 #[cfg(feature = "std")]
 pub mod guarantee;
 #[cfg(feature = "std")]
-pub mod interval;
+pub(crate) mod interval;
 #[cfg(feature = "std")]
-pub mod label;
+pub(crate) mod label;
 pub mod sampler;
 pub mod symmetry;
 
