@@ -38,7 +38,7 @@ use alloc::{format, string::String};
 #[cfg(feature = "eval")]
 use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
-pub use build::{build_table, build_tables, BuildReport, Labelling, Variant};
+pub use build::{build_table, build_tables, BuildError, BuildReport, Labelling, Variant};
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
 pub use kind::{TableKind, UnknownTableKind};

@@ -47,6 +47,12 @@ impl From<String> for Failure {
     }
 }
 
+impl From<delta_collide::table::BuildError> for Failure {
+    fn from(e: delta_collide::table::BuildError) -> Failure {
+        Failure::Failed(e.to_string())
+    }
+}
+
 impl From<&str> for Failure {
     fn from(m: &str) -> Failure {
         Failure::Failed(m.to_string())
