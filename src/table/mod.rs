@@ -1,6 +1,6 @@
 //! Precomputed tables of the configuration space: the three linear quadtrees of the thesis,
 //! the shared 6-D quadtree, their file format, and one [`Table`] enum to query them
-//! (thesis 3.2.4-3.2.6 and 3.2.8; SPEC §6; issues 3 and 4).
+//! (thesis 3.2.4-3.2.6 and 3.2.8; SPEC §6).
 //!
 //! A table answers "is the 6-D grid cell `(ix, iy, iz, ix', iy', iz')` a collision" without
 //! allocating. Built from a [`LabelledSpace`](crate::cspace::LabelledSpace), it reports

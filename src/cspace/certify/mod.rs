@@ -1,5 +1,5 @@
 //! Certified labelling: free labels that are proofs for whole 6-D grid cells (SPEC §6,
-//! thesis 3.2.7; issues 3 and 4).
+//! thesis 3.2.7).
 //!
 //! Each robot's boxes at a cell's reference TCP are swept by their displacement sets over the
 //! cell ([`box_sweeps`], direction-aware, [`crate::cspace::guarantee`]); a box pair is proved
