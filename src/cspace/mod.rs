@@ -21,7 +21,10 @@ pub mod symmetry;
 
 use alloc::vec::Vec;
 #[cfg(feature = "std")]
-pub use certify::{label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, SubCells};
+pub use certify::{
+    label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, CertifyConfig, Refinement,
+    SubCells,
+};
 #[cfg(feature = "eval")]
 pub use certify::SubdividedLabels;
 #[cfg(feature = "std")]

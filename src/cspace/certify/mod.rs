@@ -125,13 +125,34 @@ pub fn sub_cell_index(i: usize, j: usize) -> u32 {
     b(i, 0) << 5 | b(i, 1) << 4 | b(i, 2) << 3 | b(j, 0) << 2 | b(j, 1) << 1 | b(j, 2)
 }
 
+/// How far the certified labelling refines (the levels of the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refinement {
+    /// Level 1 only: whole-cell bounds.
+    WholeCells,
+    /// Levels 1 and 2: octant pairs for what level 1 leaves open.
+    Octants,
+    /// Levels 1 to 3, keeping the sub-cell labels of the pairs that stay collisions
+    /// ([`CertifiedSpace::sub`]).
+    SubCells,
+}
+
+/// What the certified labelling does and shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CertifyConfig {
+    /// How far it refines.
+    pub refinement: Refinement,
+    /// Whether to draw a progress bar on stderr while labelling.
+    pub progress: bool,
+}
+
 /// Certified labels of every sample pair of the two-robot `cell` at `k` cells per axis, with
 /// octant refinement (see the module doc).
 ///
 /// # Errors
 /// As [`crate::cspace::label_space`].
 pub fn label_space_certified(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<CertifiedSpace, String> {
-    label_space_certified_with(cell, k, ws, true, progress)
+    label_space_certified_with(cell, k, ws, &CertifyConfig { refinement: Refinement::Octants, progress })
 }
 
 /// As [`label_space_certified`], and every pair labelled collision is subdivided into its 64
@@ -141,10 +162,11 @@ pub fn label_space_certified(cell: &Cell, k: u32, ws: &Workspace, progress: bool
 /// # Errors
 /// As [`crate::cspace::label_space`].
 pub fn label_space_subdivided(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<CertifiedSpace, String> {
-    label_space_certified_inner(cell, k, ws, true, true, progress)
+    label_space_certified_with(cell, k, ws, &CertifyConfig { refinement: Refinement::SubCells, progress })
 }
 
-/// As [`label_space_certified`]; `refine = false` stops at level 1 (whole-cell bounds only).
+/// Certified labels of every sample pair of the two-robot `cell` at `k` cells per axis,
+/// refined as far as `config` says.
 ///
 /// # Errors
 /// As [`crate::cspace::label_space`].
@@ -152,20 +174,11 @@ pub fn label_space_certified_with(
     cell: &Cell,
     k: u32,
     ws: &Workspace,
-    refine: bool,
-    progress: bool,
+    config: &CertifyConfig,
 ) -> Result<CertifiedSpace, String> {
-    label_space_certified_inner(cell, k, ws, refine, false, progress)
-}
-
-fn label_space_certified_inner(
-    cell: &Cell,
-    k: u32,
-    ws: &Workspace,
-    refine: bool,
-    subdivide: bool,
-    progress: bool,
-) -> Result<CertifiedSpace, String> {
+    let refine = config.refinement != Refinement::WholeCells;
+    let subdivide = config.refinement == Refinement::SubCells;
+    let progress = config.progress;
     let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
     let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
     let (sweeps_a, sweeps_b) = (cell_sweeps(&ra.model, &grid_a), cell_sweeps(&rb.model, &grid_b));
@@ -236,7 +249,8 @@ mod tests {
         for name in ["T2", "T3"] {
             let cell = reference_cell(name).unwrap();
             let exact = label_space(&cell, 16, &ws, 0.0, false).unwrap();
-            let coarse = label_space_certified_with(&cell, 16, &ws, false, false).unwrap();
+            let whole_cells = CertifyConfig { refinement: Refinement::WholeCells, progress: false };
+            let coarse = label_space_certified_with(&cell, 16, &ws, &whole_cells).unwrap();
             let fine = label_space_certified(&cell, 16, &ws, false).unwrap();
             let (mut freed, mut added) = (0, 0);
             for ((e, c), f) in exact.labels.iter().zip(&coarse.space.labels).zip(&fine.space.labels) {
