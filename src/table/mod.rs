@@ -17,16 +17,16 @@
 //! variant, [`synthetic`]) need `std`.
 
 #[cfg(feature = "std")]
-pub mod build;
+pub(crate) mod build;
 pub mod code;
-pub mod error;
+pub(crate) mod error;
 pub mod format;
 mod kind;
-pub mod lookup;
-pub mod quadtree4d;
-pub mod quadtree5d;
-pub mod quadtree6d;
-pub mod shared6d;
+pub(crate) mod lookup;
+pub(crate) mod quadtree4d;
+pub(crate) mod quadtree5d;
+pub(crate) mod quadtree6d;
+pub(crate) mod shared6d;
 mod space;
 #[cfg(feature = "std")]
 pub mod synthetic;
@@ -48,7 +48,7 @@ pub use quadtree4d::{subdivided_slices, SliceBound};
 pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
 pub use quadtree5d::LinearQuadtree5d;
 pub use quadtree6d::LinearQuadtree6d;
-pub use shared6d::{SharedParts, SharedQuadtree6d};
+pub use shared6d::{ChildIndices, SharedParts, SharedQuadtree6d};
 
 /// One of the three table variants of the thesis (3.2.4, 3.2.5, 3.2.6) or the shared 6-D
 /// quadtree.
