@@ -40,8 +40,8 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::symmetry::reflection_y;
 use delta_collide::cspace::{
-    label_space_certified, label_space_subdivided, label_space_thesis, LabelledSpace, SampleGrid, SubdividedLabels,
-    Workspace,
+    label_space_certified, label_space_subdivided, label_space_thesis, CertifiedSpace, LabelledSpace, SampleGrid,
+    SubdividedLabels, Workspace,
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
@@ -55,9 +55,9 @@ use std::collections::HashSet;
 use std::time::Instant;
 use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, hottest_of_passes, percentiles, Clock};
 
-/// The tables of the report, by the key `--variants` takes, in report order: the first six
-/// from the plain certified labels, then `shared-sub`, then (`[7..13]`) the thesis's tables
-/// of its sub-cell labels, then the thesis-style table.
+/// The tables of the report, by the key `--variants` takes, in report order (see
+/// [`entries`]; the plain kinds by their [`TableKind`] names, the two `-bound` keys are
+/// notes, [`Run::slice_bounds`]).
 const VARIANTS: [&str; 14] = [
     "6d",
     "5d",
@@ -397,6 +397,251 @@ fn contents(table: &Table) -> String {
     }
 }
 
+/// The labellings one cell's tables are built from, each with the seconds it took (only
+/// those a chosen table needs are made: the largest runs need the memory).
+struct Labellings<'s> {
+    /// The plain certified labels.
+    certified: Option<(LabelledSpace, f64)>,
+    /// The certified labels with sub-cells ([`subdivided`]).
+    subdivided: Option<&'s (CertifiedSpace, f64)>,
+    /// Its sub-cell labels at `2 k`, read pair by pair (their dense form takes 64 times the
+    /// bytes of the labels at `k`).
+    fine: Option<(SubdividedLabels<'s>, f64)>,
+    /// The same labels as one array, for the 6-D and 5-D builders.
+    dense: Option<(LabelledSpace, f64)>,
+    /// The thesis's `r / sqrt 2` labels.
+    thesis: Option<(LabelledSpace, f64)>,
+}
+
+/// Runs `f` and the seconds it took.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    let start = Instant::now();
+    (f(), start.elapsed().as_secs_f64())
+}
+
+/// The keys of the tables built from the sub-cell labels at `2 k`.
+const OF_SUB_CELL_LABELS: [&str; 6] =
+    ["4d-yy-sub", "4d-zz-sub", "4d-yy-sub-bound", "4d-zz-sub-bound", "6d-sub", "5d-sub"];
+
+/// The subdivided certified labelling of `cell`, when a table `wants` asks for needs it.
+fn subdivided(cell: &Cell, k: u32, ws: &Workspace, wants: &dyn Fn(&str) -> bool) -> Option<(CertifiedSpace, f64)> {
+    (wants("shared-sub") || OF_SUB_CELL_LABELS.iter().any(|key| wants(key)))
+        .then(|| timed(|| label_space_subdivided(cell, k, ws, false).expect("labelling")))
+}
+
+impl<'s> Labellings<'s> {
+    /// The other labellings of `cell` the tables `wants` asks for need.
+    fn make(
+        cell: &Cell,
+        k: u32,
+        ws: &Workspace,
+        wants: &dyn Fn(&str) -> bool,
+        subdivided: Option<&'s (CertifiedSpace, f64)>,
+    ) -> Labellings<'s> {
+        let needs = |keys: &[&str]| keys.iter().any(|key| wants(key));
+        // The 6-D table of the plain labels is also the reference the shared tables are
+        // checked against.
+        let plain = needs(&["6d", "5d", "4d-yy", "4d-zz", "4d-yy-lossy", "shared"]);
+        let certified = plain.then(|| timed(|| label_space_certified(cell, k, ws, false).expect("labelling").space));
+        let fine = subdivided.filter(|_| needs(&OF_SUB_CELL_LABELS)).map(|(s, secs)| {
+            let (f, more) = timed(|| SubdividedLabels::new(cell, ws, s).expect("2k grids"));
+            (f, secs + more)
+        });
+        let dense = fine.as_ref().filter(|_| needs(&["6d-sub", "5d-sub"])).map(|(f, secs)| {
+            let (d, more) = timed(|| f.to_dense());
+            (d, secs + more)
+        });
+        let thesis = wants("thesis").then(|| timed(|| label_space_thesis(cell, k, ws, false).expect("labelling")));
+        Labellings { certified, subdivided, fine, dense, thesis }
+    }
+
+    /// The grids every labelling shares (the first made).
+    fn grids(&self) -> &LabelledSpace {
+        (self.certified.as_ref().map(|c| &c.0))
+            .or(self.subdivided.map(|s| &s.0.space))
+            .or(self.thesis.as_ref().map(|t| &t.0))
+            .expect("a table to report")
+    }
+}
+
+type Build<'a> = Box<dyn Fn(&LabelledSpace) -> Result<Table, TableError> + 'a>;
+
+/// One table of the report.
+struct Entry<'a> {
+    /// Its key in `--variants`.
+    key: &'static str,
+    /// Its name in the report's rows.
+    label: String,
+    /// The labels it is built from and the seconds they took.
+    space: &'a LabelledSpace,
+    label_secs: f64,
+    /// Whether it answers for certified labels: a false negative fails the report.
+    certified: bool,
+    /// Whether it is a plain table of the sub-cell labels at `2 k`: it must answer as the
+    /// shared table of sub-cells.
+    of_sub_cell_labels: bool,
+    build: Build<'a>,
+}
+
+impl<'a> Entry<'a> {
+    fn new(key: &'static str, label: impl Into<String>, labels: &'a (LabelledSpace, f64), build: Build<'a>) -> Self {
+        let label = label.into();
+        Entry { key, label, space: &labels.0, label_secs: labels.1, certified: true, of_sub_cell_labels: false, build }
+    }
+}
+
+/// Every table the labellings made allow, in report order.
+fn entries<'a>(l: &'a Labellings<'a>, symmetric: bool, t_lossy: u32) -> Vec<Entry<'a>> {
+    let mut out = vec![];
+    if let Some(c) = &l.certified {
+        let d4 = |axes, t| -> Build<'a> { Box::new(move |s| LinearQuadtree4d::build(s, symmetric, axes, t).map(Table::D4)) };
+        out.push(Entry::new(TableKind::D6.name(), "6D", c, Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6))));
+        out.push(Entry::new(TableKind::D5.name(), "5D", c, Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5))));
+        out.push(Entry::new(TableKind::D4yy.name(), "4D/yy t=0", c, d4(SliceAxes::YY, 0)));
+        out.push(Entry::new(TableKind::D4zz.name(), "4D/zz t=0", c, d4(SliceAxes::ZZ, 0)));
+        out.push(Entry::new("4d-yy-lossy", format!("4D/yy t={t_lossy}"), c, d4(SliceAxes::YY, t_lossy)));
+        let shared: Build = Box::new(move |s| SharedQuadtree6d::build(s, symmetric).map(Table::Shared));
+        out.push(Entry::new(TableKind::Shared.name(), "6D-shared", c, shared));
+    }
+    if let Some((sub, secs)) = l.subdivided {
+        let sub_cells = sub.sub.as_ref().expect("sub-cells");
+        let build: Build = Box::new(move |s| SharedQuadtree6d::build_subdivided(s, sub_cells, symmetric).map(Table::Shared));
+        out.push(Entry { key: TableKind::SharedSub.name(), label: "6D-shared/sub".into(), space: &sub.space, label_secs: *secs, certified: true, of_sub_cell_labels: false, build });
+    }
+    if let (Some((sub, _)), Some((fine, secs))) = (l.subdivided, &l.fine) {
+        for (key, axes, name) in [("4d-yy-sub", SliceAxes::YY, "yy"), ("4d-zz-sub", SliceAxes::ZZ, "zz")] {
+            let build: Build = Box::new(move |_| LinearQuadtree4d::build_subdivided(fine, symmetric, axes, 0).map(Table::D4));
+            let label = format!("4D/{name} t=0 of the sub-cell labels (2k)");
+            out.push(Entry { key, label, space: &sub.space, label_secs: *secs, certified: true, of_sub_cell_labels: true, build });
+        }
+    }
+    if let Some(dense) = &l.dense {
+        let d6: Build = Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6));
+        let d5: Build = Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5));
+        out.push(Entry { of_sub_cell_labels: true, ..Entry::new("6d-sub", "6D of the sub-cell labels (2k)", dense, d6) });
+        out.push(Entry { of_sub_cell_labels: true, ..Entry::new("5d-sub", "5D of the sub-cell labels (2k)", dense, d5) });
+    }
+    if let Some(thesis) = &l.thesis {
+        let d6: Build = Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6));
+        out.push(Entry { certified: false, ..Entry::new("thesis", "thesis-style 6D (r/sqrt 2)", thesis, d6) });
+    }
+    out
+}
+
+/// What every table of one cell is evaluated on.
+struct Run<'a> {
+    name: &'a str,
+    opt: &'a Options,
+    clock: Clock,
+    configs: Vec<Config>,
+    /// The sampled configurations' cells at `2^fine_levels` per axis.
+    fine: Vec<[u16; 6]>,
+    fine_levels: u32,
+}
+
+impl Run<'_> {
+    /// The report row of `table` (`entry`): accuracy against the exact model, times in the
+    /// three regimes (with the separate-arrays peer of a shared table), and notes.
+    fn report(&self, entry: &Entry, table: &Table, build_secs: f64, notes: &mut Vec<String>) {
+        let (name, opt, label) = (self.name, self.opt, &entry.label);
+        let (mut tp, mut tn, mut fp, mut fn_) = (0u64, 0u64, 0u64, 0u64);
+        for c in &self.configs {
+            let Some(f) = c.fine else { continue };
+            match (table.query(query_cell(table, f, self.fine_levels)), c.collides) {
+                (true, true) => tp += 1,
+                (false, false) => tn += 1,
+                (true, false) => fp += 1,
+                (false, true) => fn_ += 1,
+            }
+        }
+        let is_shared = matches!(table, Table::Shared(_)) && table.sub_levels() == 0;
+        let cold = if is_shared { opt.cold_shared } else { opt.cold };
+        let cells: Vec<[u16; 6]> = self.fine.iter().map(|&f| query_cell(table, f, self.fine_levels)).collect();
+        let cold = cold.min(cells.len());
+        let peer = match table {
+            Table::Shared(t) => Some(SeparateArrays::new(t)),
+            _ => None,
+        };
+        let [times, peer_times] = match &peer {
+            Some(peer) => {
+                // The separate-arrays peer answers as the table on every configuration.
+                for &c in &cells {
+                    assert_eq!(peer.query(c), table.query(c), "{name} {label}: separate-arrays peer at {c:?}");
+                }
+                time_with_peer(self.clock, table, peer, &cells, cold)
+            }
+            None => [time_queries(self.clock, table, &cells, cold), Times::default()],
+        };
+        let [h, s, f] = timing_cells(&times, cold);
+        let accuracy = 100.0 * (tp + tn) as f64 / (tp + tn + fp + fn_).max(1) as f64;
+        println!(
+            "| {name} | {} | {label} | {} | {} | {build_secs:.2} | {h} | {s} | {f} | {tp} | {tn} | {fp} | {fn_} | {accuracy:.2} % |",
+            opt.k,
+            contents(table),
+            table.memory_bytes(),
+        );
+        if let Some(peer) = &peer {
+            let [h, s, f] = timing_cells(&peer_times, cold);
+            println!(
+                "| {name} | {} | {label}, separate arrays (same run, taking turns) | | {} | | {h} | {s} | {f} | | | | | |",
+                opt.k,
+                peer.memory_bytes(),
+            );
+        }
+        if entry.certified {
+            assert_eq!(fn_, 0, "{name} {label}: a false negative on a certified table");
+        }
+        let own = own_lines_flushed(self.clock, table, &cells[..opt.cold_own.min(cells.len())]);
+        if !own.is_empty() {
+            let n = own.len().min(cold);
+            let [_, _, all] = timing_cells(&Times { flushed: own.clone(), ..Times::default() }, own.len());
+            let [_, _, first] = timing_cells(&Times { flushed: own[..n].to_vec(), ..Times::default() }, n);
+            notes.push(format!(
+                "{label}: flushed with only its own lines evicted: {all}; its first {n} queries: {first} \
+                 (the whole table evicted: {f})"
+            ));
+        }
+        if opt.slowest > 0 {
+            notes.extend(slowest_report(self.clock, table, &cells, &times.hot, "hot", opt.slowest));
+            notes.extend(slowest_report(self.clock, table, &cells, &times.streamed, "streamed", opt.slowest));
+        }
+    }
+
+    /// Asserts that `table` answers as `reference` on every configuration drawn; with
+    /// `may_free`, it may instead free a configuration `reference` calls collision.
+    fn check_against(&self, label: &str, table: &Table, reference: &Table, may_free: bool) {
+        for &f in &self.fine {
+            let want = reference.query(query_cell(reference, f, self.fine_levels));
+            let got = table.query(query_cell(table, f, self.fine_levels));
+            assert!(got == want || (may_free && want), "{} {label}: {f:?}", self.name);
+        }
+    }
+
+    /// The notes on the lower bounds of the 4-D tables of the sub-cell labels, for when
+    /// building them would take hours ([`SliceBound`]).
+    fn slice_bounds(&self, fine: &SubdividedLabels, symmetric: bool, sub_table: Option<&Table>, wants: &dyn Fn(&str) -> bool) -> Vec<String> {
+        let bounds = [("4d-yy-sub-bound", SliceAxes::YY, "yy"), ("4d-zz-sub-bound", SliceAxes::ZZ, "zz")];
+        let mut notes = vec![];
+        for (_, axes, axes_name) in bounds.into_iter().filter(|b| wants(b.0)) {
+            let start = Instant::now();
+            let mut bound = SliceBound::new(fine.grid_a.levels, symmetric, axes);
+            subdivided_slices(fine, symmetric, axes, |_, s, care| bound.add(s, care)).expect("slices");
+            let ((groups, (r0, c0, side)), bytes) = (bound.groups_at_least(), bound.bytes_at_least());
+            let ratio = sub_table.map_or(String::new(), |t| {
+                let b = t.memory_bytes();
+                format!("; `6D-shared/sub` ({b} bytes) is {:.1} % of that", 100.0 * b as f64 / bytes as f64)
+            });
+            notes.push(format!(
+                "4D/{axes_name} t=0 of the sub-cell labels (2k), bounded in {:.0} s: {} codes, at least {groups} \
+                 slices (patterns in the {side} x {side} window at row {r0}, column {c0}), at least {bytes} bytes{ratio}",
+                start.elapsed().as_secs_f64(),
+                bound.codes,
+            ));
+        }
+        notes
+    }
+}
+
 fn main() {
     let opt = options();
     let wants = |key: &str| opt.variants.iter().any(|v| v == key);
@@ -411,244 +656,45 @@ fn main() {
     for name in &opt.cells {
         let cell = reference_cell(name).expect("a reference cell");
         let symmetric = reflection_y(&cell);
-        let timed = |f: &dyn Fn() -> LabelledSpace| {
-            let start = Instant::now();
-            (f(), start.elapsed().as_secs_f64())
-        };
-        // The plain certified labels: for the plain tables and the 6-D table the shared ones
-        // are checked against (not made when only subdivided or thesis-style tables are asked
-        // for: the largest runs need its memory).
-        let plain = VARIANTS[..6].iter().any(|v| wants(v));
-        let certified =
-            plain.then(|| timed(&|| label_space_certified(&cell, opt.k, &ws, false).expect("labelling").space));
-        let start = Instant::now();
-        let fine_wanted = VARIANTS[7..13].iter().any(|v| wants(v));
-        let subdivided = (wants("shared-sub") || fine_wanted)
-            .then(|| label_space_subdivided(&cell, opt.k, &ws, false).expect("labelling"));
-        let sub_secs = start.elapsed().as_secs_f64();
-        // The thesis's 4-D tables of the sub-cell labels at `2 k`, read pair by pair (their
-        // dense labels take 64 times the bytes of the labels at `k`).
-        let start = Instant::now();
-        let fine_labels = subdivided
-            .as_ref()
-            .filter(|_| fine_wanted)
-            .map(|s| SubdividedLabels::new(&cell, &ws, s).expect("2k grids"));
-        let fine_secs = sub_secs + start.elapsed().as_secs_f64();
-        // The same labels as one array, for the 6-D and 5-D builders (64 times the bytes of
-        // the labels at `k`).
-        let start = Instant::now();
-        let dense = (fine_labels.as_ref()).filter(|_| wants("6d-sub") || wants("5d-sub")).map(|f| f.to_dense());
-        let dense_secs = fine_secs + start.elapsed().as_secs_f64();
-        let thesis =
-            wants("thesis").then(|| timed(&|| label_space_thesis(&cell, opt.k, &ws, false).expect("labelling")));
-        let grids = (certified.as_ref().map(|c| &c.0))
-            .or(subdivided.as_ref().map(|s| &s.space))
-            .or(thesis.as_ref().map(|t| &t.0))
-            .expect("a table to report");
-        let configs = configurations(&cell, grids, opt.random, &ws);
+        let subdivided = subdivided(&cell, opt.k, &ws, &wants);
+        let labellings = Labellings::make(&cell, opt.k, &ws, &wants, subdivided.as_ref());
+        let configs = configurations(&cell, labellings.grids(), opt.random, &ws);
         let fine: Vec<[u16; 6]> = configs.iter().filter_map(|c| c.fine).collect();
         let outside = configs.len() - fine.len();
-        let t_lossy = if opt.k >= 64 { 545 } else { 150 };
-        type Build<'a> = Box<dyn Fn(&LabelledSpace) -> Result<Table, TableError> + 'a>;
-        let mut variants: Vec<(&str, String, &LabelledSpace, f64, Build)> = vec![];
-        if let Some((certified, label_secs)) = &certified {
-            variants.extend::<[(&str, String, &LabelledSpace, f64, Build); 6]>([
-                (
-                    "6d",
-                    "6D".into(),
-                    certified,
-                    *label_secs,
-                    Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
-                ),
-                (
-                    "5d",
-                    "5D".into(),
-                    certified,
-                    *label_secs,
-                    Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5)),
-                ),
-                (
-                    "4d-yy",
-                    "4D/yy t=0".into(),
-                    certified,
-                    *label_secs,
-                    Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, 0).map(Table::D4)),
-                ),
-                (
-                    "4d-zz",
-                    "4D/zz t=0".into(),
-                    certified,
-                    *label_secs,
-                    Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::ZZ, 0).map(Table::D4)),
-                ),
-                (
-                    "4d-yy-lossy",
-                    format!("4D/yy t={t_lossy}"),
-                    certified,
-                    *label_secs,
-                    Box::new(move |s| LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, t_lossy).map(Table::D4)),
-                ),
-                (
-                    "shared",
-                    "6D-shared (new)".into(),
-                    certified,
-                    *label_secs,
-                    Box::new(move |s| SharedQuadtree6d::build(s, symmetric).map(Table::Shared)),
-                ),
-            ]);
-        }
-        if let Some(sub) = &subdivided {
-            let sub_cells = sub.sub.as_ref().expect("sub-cells");
-            variants.push((
-                "shared-sub",
-                "6D-shared/sub (new)".into(),
-                &sub.space,
-                sub_secs,
-                Box::new(move |s| SharedQuadtree6d::build_subdivided(s, sub_cells, symmetric).map(Table::Shared)),
-            ));
-        }
-        if let (Some(sub), Some(fine_labels)) = (&subdivided, &fine_labels) {
-            for (key, axes, name) in [("4d-yy-sub", SliceAxes::YY, "yy"), ("4d-zz-sub", SliceAxes::ZZ, "zz")] {
-                variants.push((
-                    key,
-                    format!("4D/{name} t=0 of the sub-cell labels (2k)"),
-                    &sub.space,
-                    fine_secs,
-                    Box::new(move |_| {
-                        LinearQuadtree4d::build_subdivided(fine_labels, symmetric, axes, 0).map(Table::D4)
-                    }),
-                ));
-            }
-        }
-        if let Some(dense) = &dense {
-            variants.push((
-                "6d-sub",
-                "6D of the sub-cell labels (2k)".into(),
-                dense,
-                dense_secs,
-                Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
-            ));
-            variants.push((
-                "5d-sub",
-                "5D of the sub-cell labels (2k)".into(),
-                dense,
-                dense_secs,
-                Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5)),
-            ));
-        }
-        let fine_levels = opt.k.trailing_zeros() + 1;
-        if let Some((thesis, secs)) = &thesis {
-            variants.push((
-                "thesis",
-                "thesis-style 6D (r/sqrt 2)".into(),
-                thesis,
-                *secs,
-                Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6)),
-            ));
-        }
+        let run = Run { name, opt: &opt, clock, configs, fine, fine_levels: opt.k.trailing_zeros() + 1 };
         for c in [Some(Clock::Instant), tsc].into_iter().flatten() {
-            let (hot, _) = hottest_of_passes(&fine, |f| c.time(f, |f| f), None);
-            let streamed = fastest_of_passes(&fine, |f| c.time(f, |f| f));
+            let (hot, _) = hottest_of_passes(&run.fine, |f| c.time(f, |f| f), None);
+            let streamed = fastest_of_passes(&run.fine, |f| c.time(f, |f| f));
             let [h, s, _] = timing_cells(&Times { hot, streamed, flushed: vec![] }, 0);
             println!("| {name} | {} | timer: {} (two reads) | | | | {h} | {s} | | | | | | |", opt.k, c.name());
         }
         let shared_wanted = wants("shared") || wants("shared-sub");
         let (mut d6, mut sub_table): (Option<Table>, Option<Table>) = (None, None);
         let mut notes = vec![];
-        for (key, label, space, secs, build) in &variants {
+        let t_lossy = if opt.k >= 64 { 545 } else { 150 };
+        for entry in entries(&labellings, symmetric, t_lossy) {
             // The 6-D table is the shared tables' reference: built (not reported) when only they are asked for.
-            let report = wants(key);
-            if !(report || *key == "6d" && shared_wanted) {
+            let report = wants(entry.key);
+            if !(report || entry.key == "6d" && shared_wanted) {
                 continue;
             }
-            let start = Instant::now();
-            let table = build(space).expect("build");
-            let build_secs = secs + start.elapsed().as_secs_f64();
+            let (table, secs) = timed(|| (entry.build)(entry.space).expect("build"));
             if report {
-                let (mut tp, mut tn, mut fp, mut fn_) = (0u64, 0u64, 0u64, 0u64);
-                for c in &configs {
-                    let Some(f) = c.fine else { continue };
-                    match (table.query(query_cell(&table, f, fine_levels)), c.collides) {
-                        (true, true) => tp += 1,
-                        (false, false) => tn += 1,
-                        (true, false) => fp += 1,
-                        (false, true) => fn_ += 1,
-                    }
-                }
-                let is_shared = matches!(table, Table::Shared(_)) && table.sub_levels() == 0;
-                let cold = if is_shared { opt.cold_shared } else { opt.cold };
-                let cells: Vec<[u16; 6]> = fine.iter().map(|&f| query_cell(&table, f, fine_levels)).collect();
-                let cold = cold.min(cells.len());
-                let peer = match &table {
-                    Table::Shared(t) => Some(SeparateArrays::new(t)),
-                    _ => None,
-                };
-                let [times, peer_times] = match &peer {
-                    Some(peer) => {
-                        // The separate-arrays peer answers as the table on every configuration.
-                        for &c in &cells {
-                            assert_eq!(peer.query(c), table.query(c), "{name} {label}: separate-arrays peer at {c:?}");
-                        }
-                        time_with_peer(clock, &table, peer, &cells, cold)
-                    }
-                    None => [time_queries(clock, &table, &cells, cold), Times::default()],
-                };
-                let [h, s, f] = timing_cells(&times, cold);
-                let accuracy = 100.0 * (tp + tn) as f64 / (tp + tn + fp + fn_).max(1) as f64;
-                println!(
-                    "| {name} | {} | {label} | {} | {} | {build_secs:.2} | {h} | {s} | {f} | {tp} | {tn} | {fp} | {fn_} | {accuracy:.2} % |",
-                    opt.k,
-                    contents(&table),
-                    table.memory_bytes(),
-                );
-                if let Some(peer) = &peer {
-                    let [h, s, f] = timing_cells(&peer_times, cold);
-                    println!(
-                        "| {name} | {} | {label}, separate arrays (same run, taking turns) | | {} | | {h} | {s} | {f} | | | | | |",
-                        opt.k,
-                        peer.memory_bytes(),
-                    );
-                }
-                if !label.starts_with("thesis") {
-                    assert_eq!(fn_, 0, "{name} {label}: a false negative on a certified table");
-                }
-                let own = own_lines_flushed(clock, &table, &cells[..opt.cold_own.min(cells.len())]);
-                if !own.is_empty() {
-                    let n = own.len().min(cold);
-                    let [_, _, all] = timing_cells(&Times { flushed: own.clone(), ..Times::default() }, own.len());
-                    let [_, _, first] = timing_cells(&Times { flushed: own[..n].to_vec(), ..Times::default() }, n);
-                    notes.push(format!(
-                        "{label}: flushed with only its own lines evicted: {all}; its first {n} queries: {first} \
-                         (the whole table evicted: {f})"
-                    ));
-                }
-                if opt.slowest > 0 {
-                    notes.extend(slowest_report(clock, &table, &cells, &times.hot, "hot", opt.slowest));
-                    notes.extend(slowest_report(clock, &table, &cells, &times.streamed, "streamed", opt.slowest));
-                }
+                run.report(&entry, &table, entry.label_secs + secs, &mut notes);
             }
             // The plain table of the sub-cell labels answers as the subdivided table does.
-            if let (Some(subdivided), true) = (&sub_table, label.contains("sub-cell labels")) {
-                for &f in &fine {
-                    let want = subdivided.query(query_cell(subdivided, f, fine_levels));
-                    assert_eq!(table.query(query_cell(&table, f, fine_levels)), want, "{name} {label}: {f:?}");
-                }
+            if let (Some(subdivided), true) = (&sub_table, entry.of_sub_cell_labels) {
+                run.check_against(&entry.label, &table, subdivided, false);
             }
             if table.sub_levels() == 1 {
                 sub_table = Some(table.clone());
             }
             match (&d6, &table) {
                 (None, Table::D6(_)) => d6 = Some(table),
+                // The shared table answers as the 6-D table on every configuration drawn;
+                // with sub-cells it only frees configurations the 6-D table calls collision.
                 (Some(reference), Table::Shared(_)) => {
-                    // The shared table answers as the 6-D table on every configuration drawn;
-                    // with sub-cells it only frees configurations the 6-D table calls collision.
-                    for &f in &fine {
-                        let (want, got) = (
-                            reference.query(query_cell(reference, f, fine_levels)),
-                            table.query(query_cell(&table, f, fine_levels)),
-                        );
-                        assert!(got == want || (table.sub_levels() == 1 && want), "{name} {label}: {f:?}");
-                    }
+                    run.check_against(&entry.label, &table, reference, table.sub_levels() == 1)
                 }
                 _ => {}
             }
@@ -659,25 +705,8 @@ fn main() {
                 opt.k
             );
         }
-        // Lower bounds on the 4-D tables of the sub-cell labels, for when building them would
-        // take hours (`SliceBound`).
-        let bounds = [("4d-yy-sub-bound", SliceAxes::YY, "yy"), ("4d-zz-sub-bound", SliceAxes::ZZ, "zz")];
-        for (_, axes, axes_name) in bounds.into_iter().filter(|b| wants(b.0)) {
-            let fine_labels = fine_labels.as_ref().expect("sub-cell labels");
-            let start = Instant::now();
-            let mut bound = SliceBound::new(fine_labels.grid_a.levels, symmetric, axes);
-            subdivided_slices(fine_labels, symmetric, axes, |_, s, care| bound.add(s, care)).expect("slices");
-            let ((groups, (r0, c0, side)), bytes) = (bound.groups_at_least(), bound.bytes_at_least());
-            let ratio = sub_table.as_ref().map_or(String::new(), |t| {
-                let b = t.memory_bytes();
-                format!("; `6D-shared/sub` ({b} bytes) is {:.1} % of that", 100.0 * b as f64 / bytes as f64)
-            });
-            notes.push(format!(
-                "4D/{axes_name} t=0 of the sub-cell labels (2k), bounded in {:.0} s: {} codes, at least {groups} \
-                 slices (patterns in the {side} x {side} window at row {r0}, column {c0}), at least {bytes} bytes{ratio}",
-                start.elapsed().as_secs_f64(),
-                bound.codes,
-            ));
+        if let Some((fine, _)) = &labellings.fine {
+            notes.extend(run.slice_bounds(fine, symmetric, sub_table.as_ref(), &wants));
         }
         for n in notes {
             println!("{name}: {n}");

@@ -37,3 +37,5 @@ pub mod geometry;
 pub mod math;
 pub mod robot;
 pub mod table;
+#[cfg(test)]
+mod test_rng;

@@ -183,3 +183,60 @@ fn a_loaded_table_answers_as_the_built_one() {
         }
     }
 }
+
+/// The file name of each table of [`tables`] in `tests/data/golden/`.
+const GOLDEN_SYNTHETIC: [&str; 7] =
+    ["6d", "6d_sym", "5d", "4d_yy_t0_sym", "4d_zz_t3", "shared_sym", "shared_sub"];
+
+/// The variants built from a reference cell for `tests/data/golden/`, with their file names.
+fn golden_variants() -> Vec<(&'static str, Variant)> {
+    vec![
+        ("6d", Variant::D6),
+        ("5d", Variant::D5),
+        ("4d_yy_t0", Variant::D4 { axes: SliceAxes::YY, t: 0 }),
+        ("4d_zz_t2", Variant::D4 { axes: SliceAxes::ZZ, t: 2 }),
+        ("shared", Variant::Shared),
+        ("shared_sub", Variant::SharedSubdivided),
+    ]
+}
+
+/// Compares `fresh` with the committed file `tests/data/golden/{name}.dct` byte for byte
+/// (or writes it under `DC_REGENERATE_TABLE_DATA`).
+fn assert_golden(name: &str, fresh: &[u8]) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/golden").join(format!("{name}.dct"));
+    if std::env::var_os("DC_REGENERATE_TABLE_DATA").is_some() {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, fresh).unwrap();
+    }
+    let kept = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(kept == fresh, "{name}: the table built now differs from {} ({} bytes now, {} kept)", path.display(), fresh.len(), kept.len());
+}
+
+/// Every table kind built from fixed synthetic labels is byte for byte the committed file:
+/// a change of the builders or the writer that changes a file shows here.
+#[test]
+fn synthetic_tables_are_byte_identical_to_the_kept_files() {
+    let s = small_space();
+    for (t, name) in tables(&s).iter().zip(GOLDEN_SYNTHETIC) {
+        assert_golden(&format!("synthetic_{name}"), &to_bytes(t, &header(&s)));
+    }
+}
+
+/// Every table kind built from T1 and T3 at k = 16, the smallest the grid allows (certified
+/// labels with sub-cells; the thesis labelling for T1's shared table) is byte for byte the
+/// committed file: this covers the labelling as well as the builders and the writer.
+#[test]
+fn reference_cell_tables_are_byte_identical_to_the_kept_files() {
+    use delta_collide::cell::reference::reference_cell;
+    for cell_name in ["T1", "T3"] {
+        let cell = reference_cell(cell_name).unwrap();
+        let (names, variants): (Vec<_>, Vec<_>) = golden_variants().into_iter().unzip();
+        let (h, ts, _) = build_tables(&cell, 16, &Workspace::THESIS, &variants, Labelling::Certified, false).unwrap();
+        for (t, name) in ts.iter().zip(names) {
+            assert_golden(&format!("{}_k16_{name}", cell_name.to_lowercase()), &to_bytes(t, &h));
+        }
+    }
+    let cell = reference_cell("T1").unwrap();
+    let (h, t, _) = build_table(&cell, 16, &Workspace::THESIS, Variant::Shared, Labelling::ThesisMargin, false).unwrap();
+    assert_golden("t1_k16_shared_thesis", &to_bytes(&t, &h));
+}

@@ -4,7 +4,7 @@
 //! (at most `levels + sub_levels - 1` steps). Built from [`SharedQuadtree6d::parts`], so it
 //! holds the same nodes, and timed in the same run as the table's own layout.
 
-use delta_collide::table::shared6d::ChildIndices;
+use delta_collide::table::ChildIndices;
 use delta_collide::table::SharedQuadtree6d;
 
 /// The separate-arrays layout (see the module doc).

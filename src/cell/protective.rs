@@ -70,7 +70,7 @@ use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::cspace::guarantee::{cube_box_sweeps, cube_box_sweeps_with, theta_range, Enclosure};
 use crate::geometry::clearance::boxes_clearance;
 use crate::geometry::sweep::{swept_boxes_apart_with, FaceTerms};
-use crate::geometry::witness::MAX_BOXES;
+use crate::robot::MAX_BOXES;
 use crate::geometry::{swept_boxes_apart, Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::motor_table::{intersect, MotorTable};

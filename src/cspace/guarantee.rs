@@ -70,7 +70,7 @@
 
 use crate::cspace::interval::Interval;
 use crate::cspace::sampler::SampleGrid;
-use crate::geometry::witness::MAX_BOXES;
+use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use crate::robot::delta3::{radial, tangent};
@@ -229,15 +229,6 @@ pub fn reference_point(delta: &Delta3, c: &Vec3, h: Real) -> Option<Vec3> {
         .find(|p| delta.is_reachable(p))
 }
 
-/// Per box of `model` (in [`RobotModel::boxes`] order), a bound on how far any point of the
-/// box moves when the TCP moves from sample `sample`'s reference point ([`reference_point`]
-/// of its cell) to any reachable point of its closed cell (mm; the [`Sweep::radius`] of
-/// [`box_sweeps`]). `INFINITY` for every box when the cell has no reference point or the
-/// motor angles cannot be enclosed; entries past `model.box_count()` are 0.
-pub fn box_displacement_bounds(model: &RobotModel, grid: &SampleGrid, sample: usize) -> [Real; MAX_BOXES] {
-    box_sweeps(model, grid, sample).map(|s| s.radius())
-}
-
 /// Per box of `model`, the set of displacements of its points when the TCP moves from sample
 /// `sample`'s reference point to any reachable point of its closed cell, in the MCS (see the
 /// module doc). An infinite ball for every box when nothing can be bounded.
@@ -349,15 +340,9 @@ pub fn cube_box_sweeps_with(
     Some(out)
 }
 
-/// The largest of [`box_displacement_bounds`]: no point of the robot's model moves further
-/// than this while the TCP stays in sample `sample`'s cell (mm; `INFINITY` when unknown).
-pub fn displacement_bound(model: &RobotModel, grid: &SampleGrid, sample: usize) -> Real {
-    box_displacement_bounds(model, grid, sample).into_iter().fold(0.0, Real::max)
-}
-
 /// The thesis's global blow-up margin for spacing `r`: `r / sqrt(2)` (thesis 3.2.7; not a
 /// proof, kept for comparison).
-pub fn thesis_margin(r: Real) -> Real {
+pub(crate) fn thesis_margin(r: Real) -> Real {
     r * std::f64::consts::FRAC_1_SQRT_2
 }
 
@@ -526,6 +511,13 @@ mod tests {
         }
         assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -10.0), &Vec3::new(1.0, 1.0, 1.0), 2), Enclosure::Unbounded);
         assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -990.0), &Vec3::new(1.0, 1.0, -980.0), 2), Enclosure::Empty);
+    }
+
+    /// The largest [`Sweep::radius`] of [`box_sweeps`]: no point of the robot's model moves
+    /// further than this while the TCP stays in sample `sample`'s cell (mm; `INFINITY` when
+    /// unknown).
+    fn displacement_bound(model: &RobotModel, grid: &SampleGrid, sample: usize) -> Real {
+        box_sweeps(model, grid, sample).iter().map(|s| s.radius()).fold(0.0, Real::max)
     }
 
     #[test]

@@ -25,7 +25,7 @@ use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::sat::separating_axis;
 use crate::geometry::sweep::{swept_aabb_half, swept_boxes_apart_with, FaceTerms, Sweep};
-use crate::geometry::witness::MAX_BOXES;
+use crate::robot::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{max_or_nan, min_or_nan, Mat3, Real, Vec3};
 use crate::robot::{ModelOptions, RobotModel};
@@ -187,11 +187,6 @@ impl SampleBoxes {
     /// Entry count.
     pub fn len(&self) -> usize {
         self.slot.len()
-    }
-
-    /// Whether there are no entries.
-    pub fn is_empty(&self) -> bool {
-        self.slot.is_empty()
     }
 }
 

@@ -9,24 +9,24 @@
 //! label types are here (loading a table needs them); labelling and certification need `std`.
 
 #[cfg(feature = "std")]
-pub mod certify;
+pub(crate) mod certify;
 #[cfg(feature = "std")]
 pub mod guarantee;
 #[cfg(feature = "std")]
-pub mod interval;
+pub(crate) mod interval;
 #[cfg(feature = "std")]
-pub mod label;
+pub(crate) mod label;
 pub mod sampler;
 pub mod symmetry;
 
 use alloc::vec::Vec;
 #[cfg(feature = "std")]
 pub use certify::{
-    label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, SubCells,
-    SubdividedLabels,
+    label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, CertifyConfig, Refinement,
+    SubCells,
 };
-#[cfg(feature = "std")]
-pub use guarantee::{box_displacement_bounds, displacement_bound, thesis_margin};
+#[cfg(feature = "eval")]
+pub use certify::SubdividedLabels;
 #[cfg(feature = "std")]
 pub use label::{label_space, label_space_thesis};
 pub use sampler::{CellIndex, SampleGrid, Workspace};

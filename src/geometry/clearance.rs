@@ -610,9 +610,9 @@ mod tests {
 
     #[test]
     fn random_pairs_agree_with_obb_distance_when_apart() {
-        let mut rng = crate::geometry::TestRng(0x5eed_c1ea);
+        let mut rng = crate::test_rng::TestRng(0x5eed_c1ea);
         for _ in 0..20_000 {
-            let rot = |r: &mut crate::geometry::TestRng| {
+            let rot = |r: &mut crate::test_rng::TestRng| {
                 *nalgebra::Rotation3::from_euler_angles(r.unit() * 3.2, r.unit() * 3.2, r.unit() * 3.2).matrix()
             };
             let a = Obb::new(rng.vec(5.0), rot(&mut rng), rng.vec(2.0).abs().add_scalar(0.1));

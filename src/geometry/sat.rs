@@ -316,7 +316,7 @@ mod tests {
     /// that the unrolled test returns, no earlier axis separates and `k` does.
     #[test]
     fn unrolled_axes_match_the_generic_formula() {
-        let mut rng = crate::geometry::TestRng(0x9e37_79b9_7f4a_7c15_u64);
+        let mut rng = crate::test_rng::TestRng(0x9e37_79b9_7f4a_7c15_u64);
         let mut next = move || rng.unit();
         let mut seen = [0usize; 16];
         for _ in 0..200_000 {

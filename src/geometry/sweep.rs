@@ -475,7 +475,7 @@ mod tests {
     /// whose moved boxes intersect.
     #[test]
     fn always_meet_proves_many_intersections() {
-        let mut rng = crate::geometry::TestRng(0x2545_f491_4f6c_dd1d_u64);
+        let mut rng = crate::test_rng::TestRng(0x2545_f491_4f6c_dd1d_u64);
         let mut next = move || rng.unit();
         let (mut proved, mut intersecting) = (0, 0);
         for _ in 0..20_000 {

@@ -13,9 +13,7 @@
 use crate::geometry::obb::Obb;
 use crate::geometry::sat::{aabb_half_rounded_up, aabbs_disjoint, separating_axis, separating_axis_hinted, Axis};
 use crate::math::Real;
-
-/// Most boxes one robot model may have (3 lower links, 3 upper links, platform, tool).
-pub const MAX_BOXES: usize = 8;
+use crate::robot::MAX_BOXES;
 
 /// The rounded-up AABB half-extents of up to [`MAX_BOXES`] boxes, filled in place.
 ///
@@ -115,7 +113,7 @@ mod tests {
     use crate::math::Vec3;
     use nalgebra::Rotation3;
 
-    use crate::geometry::TestRng as Rng;
+    use crate::test_rng::TestRng as Rng;
 
     fn link(center: Vec3, euler: Vec3) -> Obb {
         let rot = *Rotation3::from_euler_angles(euler.x, euler.y, euler.z).matrix();

@@ -7,5 +7,5 @@ pub mod motor_table;
 pub mod stopping;
 
 pub use delta3::{ArmSolution, Delta3, MotorCosSin, Unreachable};
-pub use model::{BoxKind, ModelOptions, RobotBoxes, RobotModel, ToolBox};
+pub use model::{BoxKind, ModelOptions, RobotBoxes, RobotModel, ToolBox, MAX_BOXES};
 pub use stopping::{StopModel, DEFAULT_TICK_MS};

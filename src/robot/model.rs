@@ -16,7 +16,6 @@
 //! are derived from `G_i` and `E_i` by [`leg_angles`] so that the chain's pose is exactly the
 //! SPEC §3 box (no sign flips).
 
-use crate::geometry::witness::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{float, Mat3, Real, Vec3, MAX_LENGTH};
 use crate::robot::delta3::{radial, tangent, Delta3, MotorCosSin, Unreachable};
@@ -111,6 +110,11 @@ pub enum BoxKind {
     /// The tool.
     Tool,
 }
+
+/// Most boxes one robot model may have (3 lower links, 3 upper links, platform, tool): the
+/// size of every per-robot box array (the witness cache, the sweeps of the certified
+/// labelling), so that a tick never allocates.
+pub const MAX_BOXES: usize = 8;
 
 /// Up to [`MAX_BOXES`] boxes of one robot, in a fixed array (no allocation per tick).
 #[derive(Clone, Copy, Debug)]

@@ -19,7 +19,55 @@ use crate::table::{
     Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
     TableError,
 };
+use core::fmt;
 use std::time::Instant;
+
+/// Why a table could not be built (apart from [`TableError`], which says why a table file
+/// could not be loaded).
+#[derive(Clone, Debug, PartialEq)]
+pub enum BuildError {
+    /// Tables are built for two-robot cells only.
+    NotTwoRobots {
+        /// The cell's name.
+        cell: String,
+        /// How many robots it has.
+        robots: usize,
+    },
+    /// The labelling refused the grid: `k` not a power of two, or too small to hold the
+    /// workspace (the message names the fix).
+    Labelling(String),
+    /// Sub-cells are certified: `SharedSubdivided` needs the certified labelling.
+    SubCellsNeedCertified,
+    /// A builder refused the labels.
+    Table(TableError),
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BuildError::NotTwoRobots { cell, robots } => {
+                write!(f, "tables are built for two-robot cells; {cell} has {robots}")
+            }
+            BuildError::Labelling(m) => f.write_str(m),
+            BuildError::SubCellsNeedCertified => f.write_str("sub-cells are certified; use the certified labelling"),
+            BuildError::Table(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for BuildError {}
+
+impl From<TableError> for BuildError {
+    fn from(e: TableError) -> BuildError {
+        BuildError::Table(e)
+    }
+}
+
+impl From<BuildError> for String {
+    fn from(e: BuildError) -> String {
+        e.to_string()
+    }
+}
 
 /// Which linear quadtree to build.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,6 +117,9 @@ pub struct BuildReport {
     pub symmetric: bool,
     /// Seconds spent labelling.
     pub label_secs: f64,
+    /// Subdivided tables only: the collision pairs cut into sub-cells and the seconds, of
+    /// `label_secs`, spent on them (the CLI shows it with its progress).
+    pub sub_cells: Option<(usize, f64)>,
     /// Seconds spent building the quadtree.
     pub build_secs: f64,
 }
@@ -76,8 +127,8 @@ pub struct BuildReport {
 /// Samples and labels `cell` (two robots) at resolution `k`, then builds `variant`.
 ///
 /// # Errors
-/// A message when the cell does not have two robots, `k` is not a power of two, or the build
-/// fails.
+/// [`BuildError`]: the cell does not have two robots, `k` is not a power of two or too small
+/// for the workspace, sub-cells with the thesis labelling, or a builder refused the labels.
 pub fn build_table(
     cell: &Cell,
     k: u32,
@@ -85,9 +136,9 @@ pub fn build_table(
     variant: Variant,
     labelling: Labelling,
     progress: bool,
-) -> Result<(Header, Table, BuildReport), String> {
+) -> Result<(Header, Table, BuildReport), BuildError> {
     let (header, mut tables, report) = build_tables(cell, k, ws, &[variant], labelling, progress)?;
-    let table = tables.pop().ok_or("no table built")?;
+    let table = tables.pop().ok_or(BuildError::Table(TableError::BadInput { what: "no table built".into() }))?;
     Ok((header, table, report))
 }
 
@@ -103,22 +154,28 @@ pub fn build_tables(
     variants: &[Variant],
     labelling: Labelling,
     progress: bool,
-) -> Result<(Header, Vec<Table>, BuildReport), String> {
+) -> Result<(Header, Vec<Table>, BuildReport), BuildError> {
     if cell.robots.len() != 2 {
-        return Err(format!("tables are built for two-robot cells; {} has {}", cell.name, cell.robots.len()));
+        return Err(BuildError::NotTwoRobots { cell: cell.name.clone(), robots: cell.robots.len() });
     }
     let start = Instant::now();
     let subdivide = variants.contains(&Variant::SharedSubdivided);
-    let (mut space, sub, certification) = match labelling {
+    let (mut space, sub, sub_secs, certification) = match labelling {
         Labelling::Certified if subdivide => {
-            let c = label_space_subdivided(cell, k, ws, progress)?;
-            (c.space, c.sub, Certification::SweptBound)
+            let c = label_space_subdivided(cell, k, ws, progress).map_err(BuildError::Labelling)?;
+            (c.space, c.sub, c.sub_secs, Certification::SweptBound)
         }
-        Labelling::Certified => (label_space_certified(cell, k, ws, progress)?.space, None, Certification::SweptBound),
+        Labelling::Certified => {
+            let c = label_space_certified(cell, k, ws, progress).map_err(BuildError::Labelling)?;
+            (c.space, None, 0.0, Certification::SweptBound)
+        }
         Labelling::ThesisMargin if subdivide => {
-            return Err("sub-cells are certified; use the certified labelling".into())
+            return Err(BuildError::SubCellsNeedCertified)
         }
-        Labelling::ThesisMargin => (label_space_thesis(cell, k, ws, progress)?, None, Certification::ThesisBlowUp),
+        Labelling::ThesisMargin => {
+            let space = label_space_thesis(cell, k, ws, progress).map_err(BuildError::Labelling)?;
+            (space, None, 0.0, Certification::ThesisBlowUp)
+        }
     };
     let label_secs = start.elapsed().as_secs_f64();
     let symmetric = reflection_y(cell);
@@ -129,6 +186,7 @@ pub fn build_tables(
         unreachable: space.labels.iter().filter(|&&l| l == Label::Unreachable).count(),
         symmetric,
         label_secs,
+        sub_cells: sub.as_ref().map(|s| (s.pairs.len(), sub_secs)),
         build_secs: 0.0,
     };
     if labelling == Labelling::ThesisMargin {
@@ -148,7 +206,7 @@ pub fn build_tables(
                     None => Err(TableError::BadInput { what: "no sub-cells were labelled".into() }),
                 },
             };
-            table.map_err(|e| e.to_string())
+            table.map_err(BuildError::Table)
         })
         .collect::<Result<Vec<_>, _>>()?;
     report.build_secs = start.elapsed().as_secs_f64();

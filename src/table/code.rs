@@ -141,8 +141,10 @@ pub fn valid6(code: u64, levels: u32) -> bool {
 mod tests {
     use super::*;
 
-    fn lcg(s: &mut u64) -> u64 {
-        *s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    /// The next draw of the test generator seeded with (and advancing) `s`, 31 bits.
+    fn draw(s: &mut u64) -> u64 {
+        let mut rng = crate::test_rng::TestRng(*s);
+        *s = rng.next_u64();
         *s >> 33
     }
 
@@ -152,7 +154,7 @@ mod tests {
         for levels in 1..=MAX_LEVELS {
             let k = 1u64 << levels;
             for _ in 0..200 {
-                let c6: [u16; 6] = std::array::from_fn(|_| (lcg(&mut s) % k) as u16);
+                let c6: [u16; 6] = std::array::from_fn(|_| (draw(&mut s) % k) as u16);
                 for stride in [6, 7] {
                     assert_eq!(decode::<6>(encode(c6, stride), stride, levels), c6);
                 }
@@ -209,8 +211,8 @@ mod tests {
         let levels = 3;
         let mut s = 11;
         for _ in 0..300 {
-            let a: [u16; 6] = std::array::from_fn(|_| (lcg(&mut s) % 8) as u16);
-            let b: [u16; 6] = std::array::from_fn(|_| (lcg(&mut s) % 8) as u16);
+            let a: [u16; 6] = std::array::from_fn(|_| (draw(&mut s) % 8) as u16);
+            let b: [u16; 6] = std::array::from_fn(|_| (draw(&mut s) % 8) as u16);
             for free in 0..=levels {
                 let node = condensed6(encode(a, 6), free, levels);
                 assert!(valid6(node, levels));

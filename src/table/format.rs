@@ -39,7 +39,7 @@ use super::quadtree4d::{LinearQuadtree4d, SliceAxes};
 use super::quadtree5d::LinearQuadtree5d;
 use super::quadtree6d::LinearQuadtree6d;
 use super::shared6d::SharedQuadtree6d;
-use super::Table;
+use super::{Table, TableKind};
 #[cfg(feature = "std")]
 use crate::cspace::LabelledSpace;
 use crate::cspace::Workspace;
@@ -162,22 +162,23 @@ pub use crate::cell::fnv1a64;
 /// The bytes of `table` with `header` (see the module doc for the layout).
 pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
     let owned: Vec<u64>;
-    let (variant, axes, t, s0, s1, s2): (u32, u32, u32, &[u64], Vec<u32>, Vec<u8>) = match table {
-        Table::D6(q) => (6, 0, 0, q.codes(), vec![], vec![]),
+    let variant = TableKind::of(table).file_variant();
+    let (axes, t, s0, s1, s2): (u32, u32, &[u64], Vec<u32>, Vec<u8>) = match table {
+        Table::D6(q) => (0, 0, q.codes(), vec![], vec![]),
         Table::D5(q) => {
             let (codes, offsets, ivs) = q.parts();
-            (5, 0, 0, codes, offsets.to_vec(), ivs.iter().flatten().copied().collect())
+            (0, 0, codes, offsets.to_vec(), ivs.iter().flatten().copied().collect())
         }
         Table::D4(q) => {
             let (codes, slice_of, words) = q.parts();
             let axes = if q.axes() == SliceAxes::YY { 1 } else { 2 };
-            (4, axes, q.threshold(), codes, slice_of.to_vec(), words.iter().flat_map(|w| w.to_le_bytes()).collect())
+            (axes, q.threshold(), codes, slice_of.to_vec(), words.iter().flat_map(|w| w.to_le_bytes()).collect())
         }
         Table::Shared(q) => {
             let p = q.parts();
             owned = p.masks.iter().flatten().chain(&p.leaves).copied().collect();
             let aux = p.depth_start.iter().chain(&p.bases).copied().collect();
-            (7, 0, 0, &owned[..], aux, p.children.to_u32().iter().flat_map(|c| c.to_le_bytes()).collect())
+            (0, 0, &owned[..], aux, p.children.to_u32().iter().flat_map(|c| c.to_le_bytes()).collect())
         }
     };
     let n2 = match variant {

@@ -1,6 +1,6 @@
 //! Precomputed tables of the configuration space: the three linear quadtrees of the thesis,
 //! the shared 6-D quadtree, their file format, and one [`Table`] enum to query them
-//! (thesis 3.2.4-3.2.6 and 3.2.8; SPEC §6; issues 3 and 4).
+//! (thesis 3.2.4-3.2.6 and 3.2.8; SPEC §6).
 //!
 //! A table answers "is the 6-D grid cell `(ix, iy, iz, ix', iy', iz')` a collision" without
 //! allocating. Built from a [`LabelledSpace`](crate::cspace::LabelledSpace), it reports
@@ -17,15 +17,16 @@
 //! variant, [`synthetic`]) need `std`.
 
 #[cfg(feature = "std")]
-pub mod build;
+pub(crate) mod build;
 pub mod code;
-pub mod error;
+pub(crate) mod error;
 pub mod format;
-pub mod lookup;
-pub mod quadtree4d;
-pub mod quadtree5d;
-pub mod quadtree6d;
-pub mod shared6d;
+mod kind;
+pub(crate) mod lookup;
+pub(crate) mod quadtree4d;
+pub(crate) mod quadtree5d;
+pub(crate) mod quadtree6d;
+pub(crate) mod shared6d;
 mod space;
 #[cfg(feature = "std")]
 pub mod synthetic;
@@ -33,18 +34,21 @@ pub mod synthetic;
 #[cfg(test)]
 mod agreement_tests;
 
-use alloc::{format, string::String, vec, vec::Vec};
+use alloc::{format, string::String};
+#[cfg(feature = "eval")]
+use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
-pub use build::{build_table, build_tables, BuildReport, Labelling, Variant};
+pub use build::{build_table, build_tables, BuildError, BuildReport, Labelling, Variant};
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
+pub use kind::{TableKind, UnknownTableKind};
 pub use lookup::{TableAnswer, TableChecker};
-#[cfg(feature = "std")]
+#[cfg(feature = "eval")]
 pub use quadtree4d::{subdivided_slices, SliceBound};
 pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
 pub use quadtree5d::LinearQuadtree5d;
 pub use quadtree6d::LinearQuadtree6d;
-pub use shared6d::{SharedParts, SharedQuadtree6d};
+pub use shared6d::{ChildIndices, SharedParts, SharedQuadtree6d};
 
 /// One of the three table variants of the thesis (3.2.4, 3.2.5, 3.2.6) or the shared 6-D
 /// quadtree.
@@ -123,7 +127,8 @@ impl Table {
     }
 
     /// The address and byte length of every array a query may read (for benchmarks that
-    /// flush them from the caches between queries).
+    /// flush them from the caches between queries; the report tool).
+    #[cfg(feature = "eval")]
     pub fn memory_regions(&self) -> Vec<(usize, usize)> {
         fn region<T>(v: &[T]) -> (usize, usize) {
             (v.as_ptr() as usize, core::mem::size_of_val(v))

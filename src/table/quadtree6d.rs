@@ -39,6 +39,7 @@ pub struct LinearQuadtree6d {
 }
 
 /// Most levels the 6-D builder takes: its free map has `64^(levels-1)` bits (128 MiB at 6).
+#[cfg(feature = "std")]
 pub const MAX_BUILD_LEVELS_6D: u32 = 6;
 
 /// One bit per node of depth `d`, for `d` in `0..levels`: whether it holds a free sample.

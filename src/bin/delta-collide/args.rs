@@ -13,7 +13,7 @@ use delta_collide::cell::reference::{reference_cell, REFERENCE_CELL_FILES};
 use delta_collide::cell::Cell;
 use delta_collide::math::Vec3;
 use delta_collide::table::code::MAX_LEVELS;
-use delta_collide::table::{Labelling, SliceAxes, Variant};
+use delta_collide::table::{Labelling, TableKind};
 use std::path::PathBuf;
 use std::sync::LazyLock;
 
@@ -187,8 +187,8 @@ pub struct BuildArgs {
     pub k: u32,
     /// The table's kind
     #[arg(long, value_name = "VARIANT", default_value = "6d")]
-    #[arg(value_parser = choice::<VariantArg>())]
-    pub variant: VariantArg,
+    #[arg(value_parser = choice::<KindArg>())]
+    pub variant: KindArg,
     /// Similarity threshold of the 4-D table's slice groups, in differing grid cells
     /// (0: lossless; only with --variant 4d-yy or 4d-zz) [default: 0]
     #[arg(long, value_name = "T", value_parser = clipped(parse_number::<u32>))]
@@ -283,38 +283,21 @@ pub struct QuiltArgs {
     pub height: u32,
 }
 
-/// The table kinds `build` writes (the library's [`Variant`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum VariantArg {
-    /// Condensed 6-D linear quadtree (thesis 3.2.4)
-    #[value(name = "6d")]
-    D6,
-    /// 5-D quadtree with z' collision intervals (thesis 3.2.5)
-    #[value(name = "5d")]
-    D5,
-    /// 4-D quadtree of yy'-slices grouped by similarity (thesis 3.2.6)
-    #[value(name = "4d-yy")]
-    D4yy,
-    /// 4-D quadtree of zz'-slices grouped by similarity (thesis 3.2.6)
-    #[value(name = "4d-zz")]
-    D4zz,
-    /// 6-D quadtree with shared subtrees
-    Shared,
-    /// As shared, collision cells cut into 64 sub-cells (certified labelling only)
-    SharedSub,
-}
+/// The table kinds `build` writes: the library's [`TableKind`], with its names and help.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KindArg(pub TableKind);
 
-impl VariantArg {
-    /// The library's variant, with threshold `t` for the 4-D kinds.
-    pub fn variant(self, t: u32) -> Variant {
-        match self {
-            VariantArg::D6 => Variant::D6,
-            VariantArg::D5 => Variant::D5,
-            VariantArg::D4yy => Variant::D4 { axes: SliceAxes::YY, t },
-            VariantArg::D4zz => Variant::D4 { axes: SliceAxes::ZZ, t },
-            VariantArg::Shared => Variant::Shared,
-            VariantArg::SharedSub => Variant::SharedSubdivided,
-        }
+impl ValueEnum for KindArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        const ALL: [KindArg; 6] = {
+            let k = TableKind::ALL;
+            [KindArg(k[0]), KindArg(k[1]), KindArg(k[2]), KindArg(k[3]), KindArg(k[4]), KindArg(k[5])]
+        };
+        &ALL
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(self.0.name()).help(self.0.description()))
     }
 }
 
@@ -366,16 +349,15 @@ impl Cli {
     fn check(&self) -> Result<(), clap::Error> {
         match &self.command {
             Command::Build(b) => {
-                let four_d = matches!(b.variant, VariantArg::D4yy | VariantArg::D4zz);
-                if let (Some(t), false) = (b.t, four_d) {
-                    let v = b.variant.to_possible_value().map(|p| p.get_name().to_string()).unwrap_or_default();
+                if let (Some(t), false) = (b.t, b.variant.0.has_threshold()) {
+                    let v = b.variant.0;
                     return Err(usage_error(
                         "build",
                         ErrorKind::ArgumentConflict,
                         format!("--t {t} applies to --variant 4d-yy and 4d-zz only, not to --variant {v}"),
                     ));
                 }
-                if b.variant == VariantArg::SharedSub && b.labelling == LabellingArg::Thesis {
+                if b.variant.0 == TableKind::SharedSub && b.labelling == LabellingArg::Thesis {
                     return Err(usage_error(
                         "build",
                         ErrorKind::ArgumentConflict,

@@ -51,6 +51,12 @@ impl From<String> for Failure {
     }
 }
 
+impl From<delta_collide::table::BuildError> for Failure {
+    fn from(e: delta_collide::table::BuildError) -> Failure {
+        Failure::Failed(e.to_string())
+    }
+}
+
 impl From<&str> for Failure {
     fn from(m: &str) -> Failure {
         Failure::Failed(m.to_string())
@@ -228,10 +234,13 @@ fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
 
 fn build(args: &BuildArgs, progress: bool) -> Result<(), Failure> {
     let (cell, k, output) = (&args.cell, args.k, &args.output);
-    let variant = args.variant.variant(args.t.unwrap_or(0));
+    let variant = args.variant.0.variant(args.t.unwrap_or(0));
     let labelling = Labelling::from(args.labelling);
     check_memory(cell, k, &Workspace::THESIS)?;
     let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
+    if let (true, Some((pairs, secs))) = (progress, r.sub_cells) {
+        eprintln!("sub-cells of {pairs} collision pairs: {secs:.2} s");
+    }
     let bytes = to_bytes(&table, &header);
     files::write_file(output, |w| w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display())))?;
     println!("cell {} k {k}: {} x {} samples, {} pairs", cell.name, r.samples.0, r.samples.1, r.pairs);

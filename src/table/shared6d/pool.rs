@@ -237,6 +237,7 @@ impl Pool {
     }
 
     /// [`query`](Self::query) and its reads as `(address, bytes, step)`.
+    #[cfg(any(test, feature = "eval"))]
     pub(super) fn query_reads(&self, c: &[u16; 6], fine: u32) -> (bool, Vec<(usize, usize, u32)>) {
         let w = &self.words;
         let at = |i: usize| w.as_ptr() as usize + 8 * i;
@@ -359,14 +360,13 @@ mod tests {
 
     fn cells(levels: u32, n: usize) -> impl Iterator<Item = [u16; 6]> {
         let k = 1u64 << levels;
-        let mut x = 0x9e37_79b9_7f4a_7c15u64 ^ u64::from(levels);
+        let mut rng = crate::test_rng::TestRng(0x9e37_79b9_7f4a_7c15u64 ^ u64::from(levels));
         let all = k.pow(6) as usize <= n;
         (0..n.min(k.pow(6) as usize)).map(move |i| {
             let v = if all {
                 i as u64
             } else {
-                x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                x >> 16
+                rng.next_u64()
             };
             core::array::from_fn(|j| (v >> (levels as usize * j) & (k - 1)) as u16)
         })

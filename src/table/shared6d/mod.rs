@@ -29,20 +29,20 @@
 //! at most 8 cache lines (the arrays read directly: 9 reads on up to 14 lines). No search, no
 //! loop whose length depends on the data, no allocation.
 
+//!
+//! This file holds the table and its query; the builder is in `build.rs` and the query's
+//! layout in `pool.rs`.
+
+#[cfg(feature = "std")]
+mod build;
 mod pool;
 
 use super::code::MAX_LEVELS;
-#[cfg(feature = "std")]
-use super::error::bad_input;
 use super::error::{corrupt, TableError};
 use super::space::fold;
-#[cfg(feature = "std")]
-use super::space::SpaceView;
-#[cfg(feature = "std")]
-use crate::cspace::{Label, LabelledSpace, SubCells};
-use alloc::{format, vec, vec::Vec};
-#[cfg(feature = "std")]
-use std::collections::HashMap;
+#[cfg(any(test, feature = "eval"))]
+use alloc::vec;
+use alloc::{format, vec::Vec};
 
 /// Child indices of the pool, as narrow as the table allows.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -119,301 +119,7 @@ fn child_index(c: &[u16; 6], shift: u32) -> u32 {
     c.iter().fold(0, |i, &v| i << 1 | (u32::from(v) >> shift & 1))
 }
 
-/// An inner node while building: non-uniform mask, collision mask, child ids.
-#[cfg(feature = "std")]
-type InnerNode = (u64, u64, Vec<u32>);
-
-/// A child while building: don't care, uniform, or a stored node of the next depth.
-#[cfg(feature = "std")]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-enum Part {
-    DontCare,
-    Free,
-    Collision,
-    Node(u32),
-}
-
-/// Hash-consing builder over a [`SpaceView`].
-#[cfg(feature = "std")]
-struct Builder<'a> {
-    view: SpaceView<'a>,
-    /// Sub-cells of the pairs labelled collision, when subdividing.
-    sub: Option<&'a SubCells>,
-    k: usize,
-    /// Dense `k^3` maps from cell to sample index (`u32::MAX`: none, or not stored).
-    dense_a: Vec<u32>,
-    dense_b: Vec<u32>,
-    /// Per depth: which blocks hold a (stored) sample ([`occupancy`]).
-    occ_a: Vec<Vec<bool>>,
-    occ_b: Vec<Vec<bool>>,
-    /// Per inner depth: node -> id within the depth, and the nodes in id order.
-    inner: Vec<HashMap<InnerNode, u32>>,
-    inner_nodes: Vec<Vec<InnerNode>>,
-    leaf_ids: HashMap<u64, u32>,
-    leaves: Vec<u64>,
-}
-
-#[cfg(feature = "std")]
-const NONE: u32 = u32::MAX;
-
-#[cfg(feature = "std")]
-fn dense_map(cells: &[[u16; 3]], k: usize, keep: impl Fn(usize) -> bool) -> Vec<u32> {
-    let mut dense = vec![NONE; k * k * k];
-    for (i, c) in cells.iter().enumerate() {
-        if keep(i) {
-            dense[(usize::from(c[0]) * k + usize::from(c[1])) * k + usize::from(c[2])] = i as u32;
-        }
-    }
-    dense
-}
-
-/// `occ[d][block]`: whether the block of side `2^(levels - d)` holds a sample, `d` in `0..=levels`.
-#[cfg(feature = "std")]
-fn occupancy(dense: &[u32], k: usize, levels: u32) -> Vec<Vec<bool>> {
-    (0..=levels)
-        .map(|d| {
-            let n = 1usize << d;
-            let side = k / n;
-            let mut occ = vec![false; n * n * n];
-            for x in 0..k {
-                for y in 0..k {
-                    for z in 0..k {
-                        if dense[(x * k + y) * k + z] != NONE {
-                            occ[((x / side) * n + y / side) * n + z / side] = true;
-                        }
-                    }
-                }
-            }
-            occ
-        })
-        .collect()
-}
-
-#[cfg(feature = "std")]
-impl Builder<'_> {
-    /// The part for the 6-D block at depth `d` whose per-robot block coordinates are `a`, `b`
-    /// (in units of the block side).
-    fn build(&mut self, d: u32, a: [usize; 3], b: [usize; 3]) -> Part {
-        let n = 1usize << d;
-        let at = |c: [usize; 3]| (c[0] * n + c[1]) * n + c[2];
-        if !self.occ_a[d as usize][at(a)] || !self.occ_b[d as usize][at(b)] {
-            return Part::DontCare;
-        }
-        let last = d == self.view.levels - 1;
-        let mut kids = [Part::DontCare; 64];
-        for (i, kid) in kids.iter_mut().enumerate() {
-            let bit = |j: usize| (i >> (5 - j)) & 1;
-            let ca = [2 * a[0] + bit(0), 2 * a[1] + bit(1), 2 * a[2] + bit(2)];
-            let cb = [2 * b[0] + bit(3), 2 * b[1] + bit(4), 2 * b[2] + bit(5)];
-            *kid = match (last, self.sub) {
-                (false, _) => self.build(d + 1, ca, cb),
-                (true, None) => self.cell(ca, cb).0,
-                (true, Some(_)) => self.subdivided_cell(ca, cb),
-            };
-        }
-        if last && self.sub.is_none() {
-            // The children are cells: this block is a leaf.
-            let (mut care, mut value) = (0u64, 0u64);
-            for (i, p) in kids.iter().enumerate() {
-                match p {
-                    Part::Free => care |= 1 << i,
-                    Part::Collision => (care, value) = (care | 1 << i, value | 1 << i),
-                    Part::DontCare | Part::Node(_) => {}
-                }
-            }
-            return self.leaf(care, value);
-        }
-        self.node(d as usize, &kids)
-    }
-
-    /// The part of one cell pair without sub-cells, and its sample pair when both are sampled.
-    fn cell(&self, ca: [usize; 3], cb: [usize; 3]) -> (Part, Option<(usize, usize)>) {
-        let k = self.k;
-        let ia = self.dense_a[(ca[0] * k + ca[1]) * k + ca[2]];
-        let ib = self.dense_b[(cb[0] * k + cb[1]) * k + cb[2]];
-        if ia == NONE || ib == NONE {
-            return (Part::DontCare, None);
-        }
-        let (ia, ib) = (ia as usize, ib as usize);
-        let part = match self.view.label(ia, ib) {
-            Label::Free => Part::Free,
-            Label::Collision => Part::Collision,
-            Label::Unreachable => Part::DontCare,
-        };
-        (part, Some((ia, ib)))
-    }
-
-    /// The part of one cell pair cut into its 64 sub-cells ([`SubCells`]), merged with its
-    /// mirror pair under symmetry as [`SpaceView::label`] merges labels (collision wins).
-    fn subdivided_cell(&mut self, ca: [usize; 3], cb: [usize; 3]) -> Part {
-        let (part, Some((ia, ib))) = self.cell(ca, cb) else { return Part::DontCare };
-        if part != Part::Collision {
-            return part;
-        }
-        let (mut care, mut value) = self.sub_masks(ia, ib);
-        if let Some((ma, mb)) = self.view.mirror_pair(ia, ib) {
-            let (c, v) = self.sub_masks(ma, mb);
-            (care, value) = (care | mirror_sub_cells(c), value | mirror_sub_cells(v));
-        }
-        self.leaf(care, value)
-    }
-
-    /// `(care, collision)` of the sub-cells of one pair, by its own label.
-    fn sub_masks(&self, ia: usize, ib: usize) -> (u64, u64) {
-        match self.view.own_label(ia, ib) {
-            Label::Free => (u64::MAX, 0),
-            Label::Unreachable => (0, 0),
-            Label::Collision => {
-                let pair = (ia * self.view.space.grid_b.cells.len() + ib) as u64;
-                self.sub.and_then(|s| s.get(pair)).unwrap_or((u64::MAX, u64::MAX))
-            }
-        }
-    }
-
-    /// An inner node of depth `d` with these children (hash-consed), or the uniform part.
-    fn node(&mut self, d: usize, kids: &[Part; 64]) -> Part {
-        let has = |p: Part| kids.contains(&p);
-        let nodes = kids.iter().any(|p| matches!(p, Part::Node(_)));
-        match (has(Part::Free), has(Part::Collision), nodes) {
-            (false, false, false) => return Part::DontCare,
-            (true, false, false) => return Part::Free,
-            (false, true, false) => return Part::Collision,
-            _ => {}
-        }
-        let (mut nonuniform, mut collision, mut ids) = (0u64, 0u64, Vec::new());
-        for (i, p) in kids.iter().enumerate() {
-            match *p {
-                Part::Node(id) => {
-                    nonuniform |= 1 << i;
-                    ids.push(id);
-                }
-                Part::Collision => collision |= 1 << i,
-                Part::Free | Part::DontCare => {}
-            }
-        }
-        let key = (nonuniform, collision, ids);
-        if let Some(&id) = self.inner[d].get(&key) {
-            return Part::Node(id);
-        }
-        let id = self.inner_nodes[d].len() as u32;
-        self.inner_nodes[d].push(key.clone());
-        self.inner[d].insert(key, id);
-        Part::Node(id)
-    }
-
-    /// A leaf of 64 cells, `care` the cells that are not "don't care" and `value` the
-    /// collisions among them (hash-consed; see the module doc for the don't-care choice).
-    fn leaf(&mut self, care: u64, value: u64) -> Part {
-        let value = value & care;
-        if care == 0 {
-            return Part::DontCare;
-        }
-        if value == 0 {
-            return Part::Free;
-        }
-        if value == care {
-            return Part::Collision;
-        }
-        for candidate in [value, value | !care] {
-            if let Some(&id) = self.leaf_ids.get(&candidate) {
-                return Part::Node(id);
-            }
-        }
-        let id = self.leaves.len() as u32;
-        self.leaves.push(value);
-        self.leaf_ids.insert(value, id);
-        Part::Node(id)
-    }
-}
-
-/// A sub-cell mask of a pair mapped to its mirror pair's (`y -> -y` flips the y octant bit of
-/// both robots: child index bits 4 and 1).
-#[cfg(feature = "std")]
-fn mirror_sub_cells(mask: u64) -> u64 {
-    (0..64).filter(|&c| mask >> c & 1 == 1).fold(0, |m, c| m | 1 << (c ^ 0b01_0010))
-}
-
 impl SharedQuadtree6d {
-    /// Builds the table of `space` (see the module doc); with `symmetric`, only A's upper
-    /// half `iy >= k/2` is stored, as the other variants do.
-    ///
-    /// # Errors
-    /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
-    /// `2 <= levels <= MAX_LEVELS`, or the label count is wrong.
-    #[cfg(feature = "std")]
-    pub fn build(space: &LabelledSpace, symmetric: bool) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, None, symmetric)
-    }
-
-    /// As [`build`](Self::build) with every pair labelled collision cut into the sub-cells of
-    /// `sub` ([`crate::cspace::label_space_subdivided`]): one more level, queried with cell
-    /// indices at `2 k` per axis.
-    ///
-    /// # Errors
-    /// As [`build`](Self::build).
-    #[cfg(feature = "std")]
-    pub fn build_subdivided(
-        space: &LabelledSpace,
-        sub: &SubCells,
-        symmetric: bool,
-    ) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, Some(sub), symmetric)
-    }
-
-    #[cfg(feature = "std")]
-    fn build_with(
-        space: &LabelledSpace,
-        sub: Option<&SubCells>,
-        symmetric: bool,
-    ) -> Result<SharedQuadtree6d, TableError> {
-        let view = SpaceView::new(space, symmetric)?;
-        let levels = view.levels;
-        let sub_levels = u32::from(sub.is_some());
-        if levels < 2 || levels + sub_levels > MAX_LEVELS {
-            return Err(bad_input(format!(
-                "the shared 6-D quadtree needs 4 <= k <= 2^{MAX_LEVELS}, got k = {}",
-                view.k
-            )));
-        }
-        let k = view.k as usize;
-        let dense_a = dense_map(&space.grid_a.cells, k, |ia| view.stored(ia));
-        let dense_b = dense_map(&space.grid_b.cells, k, |_| true);
-        let (occ_a, occ_b) = (occupancy(&dense_a, k, levels), occupancy(&dense_b, k, levels));
-        let inner_depths = (levels + sub_levels) as usize - 1;
-        let mut b = Builder {
-            view,
-            sub,
-            k,
-            dense_a,
-            dense_b,
-            occ_a,
-            occ_b,
-            inner: vec![HashMap::new(); inner_depths],
-            inner_nodes: vec![Vec::new(); inner_depths],
-            leaf_ids: HashMap::new(),
-            leaves: Vec::new(),
-        };
-        let root = b.build(0, [0; 3], [0; 3]);
-        let (mut masks, mut bases, mut depth_start, mut children) = (vec![], vec![], vec![], vec![]);
-        match root {
-            // A uniform root is stored as one node with every child uniform.
-            Part::Node(_) => {}
-            Part::Collision => b.inner_nodes[0].push((0, u64::MAX, vec![])),
-            Part::Free | Part::DontCare => b.inner_nodes[0].push((0, 0, vec![])),
-        }
-        // Depth 0 now holds exactly the root.
-        for nodes in &b.inner_nodes {
-            depth_start.push(masks.len() as u32);
-            for (nonuniform, collision, ids) in nodes {
-                masks.push([*nonuniform, *collision]);
-                bases.push(children.len() as u32);
-                children.extend_from_slice(ids);
-            }
-        }
-        depth_start.push(masks.len() as u32);
-        Ok(Self::assemble(levels, sub_levels, symmetric, (masks, bases, depth_start, children, b.leaves)))
-    }
-
     /// The table of valid arrays, laid out for the query.
     fn assemble(levels: u32, sub_levels: u32, symmetric: bool, arrays: pool::Arrays) -> SharedQuadtree6d {
         let pool = pool::Pool::new(levels + sub_levels, symmetric, &arrays);
@@ -503,8 +209,9 @@ impl SharedQuadtree6d {
 
     /// The answer of [`query`](Self::query) and every table read it makes, in order, as
     /// `(address, bytes, step)`: reads of one step depend only on earlier steps, so a query
-    /// waits for at most one memory access per step. For benchmarks that count cache lines
-    /// and dependent loads per query; allocates, not the per-tick path.
+    /// waits for at most one memory access per step. For the report tool, which counts cache
+    /// lines and dependent loads per query; allocates, not the per-tick path.
+    #[cfg(any(test, feature = "eval"))]
     pub fn query_reads(&self, cell: [u16; 6]) -> (bool, Vec<(usize, usize, u32)>) {
         let fine = self.levels + self.sub_levels;
         match fold(cell, 1 << fine, self.symmetric) {
@@ -562,7 +269,10 @@ impl SharedQuadtree6d {
 
 #[cfg(test)]
 mod tests {
+    use super::build::mirror_sub_cells;
     use super::*;
+    use crate::cspace::{Label, LabelledSpace, SubCells};
+    use crate::table::space::SpaceView;
     use crate::table::synthetic::{space, Pattern};
     use crate::table::LinearQuadtree6d;
 
@@ -621,11 +331,8 @@ mod tests {
     /// Sub-cells of every collision pair from a seeded hash (some "don't care").
     fn random_sub_cells(space: &LabelledSpace, seed: u64) -> SubCells {
         let mut out = SubCells::default();
-        let mut x = seed;
-        let mut next = || {
-            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            x ^ x >> 29
-        };
+        let mut rng = crate::test_rng::TestRng(seed.max(1));
+        let mut next = || rng.next_u64();
         for (pair, &l) in space.labels.iter().enumerate() {
             if l == Label::Collision {
                 let care = next() | next();

@@ -1,0 +1,411 @@
+//! Certified labelling: free labels that are proofs for whole 6-D grid cells (SPEC §6,
+//! thesis 3.2.7).
+//!
+//! Each robot's boxes at a cell's reference TCP are swept by their displacement sets over the
+//! cell ([`box_sweeps`], direction-aware, [`crate::cspace::guarantee`]); a box pair is proved
+//! disjoint over a 6-D cell when the swept boxes are ([`crate::geometry::sweep`]). A pair of
+//! samples `(ia, ib)` is free when it is proved free at one of two levels:
+//! 1. every box pair is proved disjoint with the whole cells' sweeps; or, failing that,
+//! 2. (refinement) each robot's cell is cut into its 8 octants, each with its own reference
+//!    boxes and sweeps over the octant ([`cube_box_sweeps`], about half as large), and for
+//!    every pair (octant i of A, octant j of B) each box pair is proved disjoint by one of
+//!    the tests (A cell, B cell), (A octant i, B cell), (A cell, B octant j) or (A octant i,
+//!    B octant j) (a box pair proved disjoint by a coarser test is disjoint for every
+//!    configuration it covers). Octants that hold no reachable TCP are skipped. Pairs whose
+//!    physical boxes collide at the reference TCPs skip this level.
+//!
+//! Either way every configuration of the 6-D cell is covered by a disjoint pair of swept
+//! box sets, each of which contains the physical boxes for every TCP of its (sub)cell. Anything
+//! not proved is a collision. [`label_space_subdivided`] keeps level 2's answer per octant pair
+//! for the pairs that stay collisions ([`SubCells`]), with one more level for those:
+//! 3. an octant pair that level 2 leaves a collision, unless some box pair's octant cores
+//!    meet (a certain collision), is cut once more: each octant into its 8 sub-octants
+//!    (half-side `r/8`; boxes and sweeps made when an octant first needs them), and it is
+//!    free when, for every pair of sub-octants, each box pair that level 2 left open is
+//!    proved disjoint by (A sub-octant, B sub-octant), (A sub-octant, B octant) or
+//!    (A octant, B sub-octant). The sub-octants cover their octant, so the proof covers the
+//!    whole sub-cell. These sweeps are not made mirror-symmetric: the tables merge each
+//!    sub-cell with its mirror's, collision winning.
+//!
+//! The sub-cells are found faster than by 64 runs of level 2 (`sub_cell_masks`, same
+//! answers): an octant pair is a collision without its tests when a box pair certainly
+//! intersects for every configuration of a (sub)cell pair holding it (the boxes' *cores*
+//! overlap, [`crate::geometry::sweep`], "Certain intersection"); whole cells decide all 64
+//! at once, an octant with the other robot's whole cell decides a row or column of 8.
+//!
+//! A sample is labelled [`Label::Unreachable`](crate::cspace::Label) ("don't care") only
+//! when no TCP of its whole cell is reachable ([`cube_unreachable`]); a cell whose centre is
+//! unreachable but which holds reachable TCPs is measured from a reachable reference point,
+//! or, without one, has no displacement bound and is a collision.
+//!
+//! Sweeps are made mirror-symmetric (every size the larger of an entry's and its mirror's,
+//! arms 1 and 2 swapped), so that a symmetric cell gets symmetric labels (thesis 3.2.8).
+//!
+//! This file runs the labelling; `sweeps.rs` makes the displacement sets of cells and
+//! octants, `refine.rs` holds levels 2 and 3 and the sub-cell labels, and, for the report
+//! tool only (`eval` feature), `subdivided_labels.rs` spells the sub-cells out as labels at
+//! `2 k`.
+
+mod refine;
+#[cfg(feature = "eval")]
+mod subdivided_labels;
+mod sweeps;
+
+#[cfg(feature = "eval")]
+pub use subdivided_labels::SubdividedLabels;
+
+use crate::cell::{Cell, RobotSpec};
+use crate::cspace::guarantee::SPLITS;
+use crate::cspace::label::{
+    entries_collide, label_pairs,
+    two_robot_grids, Inflation, SampleBoxes,
+};
+use crate::cspace::sampler::{SampleGrid, Workspace};
+use crate::cspace::LabelledSpace;
+use crate::robot::MAX_BOXES;
+use crate::geometry::Sweep;
+use crate::math::{Real, Vec3};
+use refine::{octants_prove_free, refine_unknown_cells, sub_cells, Levels, SubOctants};
+use sweeps::{cell_sweeps, inflation, octants, references, unreachable_cells};
+
+
+/// Sub-boxes per axis when enclosing the motor angles over an octant (an octant is half as
+/// wide as a cell, so this gives the same sub-box size as [`SPLITS`] on a cell).
+pub const OCTANT_SPLITS: u32 = SPLITS / 2;
+
+/// A labelling whose free labels are proofs for whole 6-D cells, with the bounds it used.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CertifiedSpace {
+    /// The labels; `space.margin` is the largest whole-cell enlargement used (each box got
+    /// its own, never more than this).
+    pub space: LabelledSpace,
+    /// Per sample of A, per box: the radius of the whole-cell displacement set its box was
+    /// swept by ([`Sweep::radius`]).
+    pub bounds_a: Vec<[Real; MAX_BOXES]>,
+    /// Per sample of B, per box.
+    pub bounds_b: Vec<[Real; MAX_BOXES]>,
+    /// Whether level 2 (octant refinement) was used.
+    pub refined: bool,
+    /// With [`label_space_subdivided`]: the sub-cell labels of every pair labelled collision.
+    pub sub: Option<SubCells>,
+    /// Seconds spent finding [`sub`](Self::sub) (0 without it), for the caller to report:
+    /// the library prints nothing.
+    pub sub_secs: f64,
+}
+
+/// Sub-cell labels of the pairs labelled collision: each such 6-D cell cut into its 64
+/// sub-cells (A's octant `i` x B's octant `j`), each proved free or not with the octants'
+/// own bounds and, failing that, the sub-octants' (levels 2 and 3 of the module doc;
+/// adaptive resolution where the labels change).
+///
+/// Bit `c` of a mask is the sub-cell with child index `c = ax << 5 | ay << 4 | az << 3 |
+/// bx << 2 | by << 1 | bz` (octant bits x, y, z of A then B; the order of
+/// [`crate::table::code`]). A sub-cell outside `care` holds no reachable TCP of A or of B
+/// ("don't care"); one in `collision` could not be proved free.
+#[derive(Clone, Debug, PartialEq, Eq, Default)]
+pub struct SubCells {
+    /// Pair indices `ia * nb + ib`, increasing.
+    pub pairs: Vec<u64>,
+    /// Per pair: the sub-cells that hold reachable TCPs of both robots.
+    pub care: Vec<u64>,
+    /// Per pair: the sub-cells not proved free.
+    pub collision: Vec<u64>,
+}
+
+impl SubCells {
+    /// `(care, collision)` of pair `(ia, ib)`, or `None` when it was not subdivided.
+    pub fn get(&self, pair: u64) -> Option<(u64, u64)> {
+        self.pairs.binary_search(&pair).ok().map(|i| (self.care[i], self.collision[i]))
+    }
+}
+
+/// The child index of A's octant `i` and B's octant `j` (octant bits x, y, z = 0, 1, 2).
+pub fn sub_cell_index(i: usize, j: usize) -> u32 {
+    let b = |o: usize, bit: usize| (o >> bit & 1) as u32;
+    b(i, 0) << 5 | b(i, 1) << 4 | b(i, 2) << 3 | b(j, 0) << 2 | b(j, 1) << 1 | b(j, 2)
+}
+
+/// How far the certified labelling refines (the levels of the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refinement {
+    /// Level 1 only: whole-cell bounds.
+    WholeCells,
+    /// Levels 1 and 2: octant pairs for what level 1 leaves open.
+    Octants,
+    /// Levels 1 to 3, keeping the sub-cell labels of the pairs that stay collisions
+    /// ([`CertifiedSpace::sub`]).
+    SubCells,
+}
+
+/// What the certified labelling does and shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CertifyConfig {
+    /// How far it refines.
+    pub refinement: Refinement,
+    /// Whether to draw a progress bar on stderr while labelling.
+    pub progress: bool,
+}
+
+/// Certified labels of every sample pair of the two-robot `cell` at `k` cells per axis, with
+/// octant refinement (see the module doc).
+///
+/// # Errors
+/// As [`crate::cspace::label_space`].
+pub fn label_space_certified(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<CertifiedSpace, String> {
+    label_space_certified_with(cell, k, ws, &CertifyConfig { refinement: Refinement::Octants, progress })
+}
+
+/// As [`label_space_certified`], and every pair labelled collision is subdivided into its 64
+/// sub-cells, each certified with the octants' bounds or the sub-octants' (levels 2 and 3,
+/// [`CertifiedSpace::sub`]).
+///
+/// # Errors
+/// As [`crate::cspace::label_space`].
+pub fn label_space_subdivided(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<CertifiedSpace, String> {
+    label_space_certified_with(cell, k, ws, &CertifyConfig { refinement: Refinement::SubCells, progress })
+}
+
+/// Certified labels of every sample pair of the two-robot `cell` at `k` cells per axis,
+/// refined as far as `config` says.
+///
+/// # Errors
+/// As [`crate::cspace::label_space`].
+pub fn label_space_certified_with(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    config: &CertifyConfig,
+) -> Result<CertifiedSpace, String> {
+    let refine = config.refinement != Refinement::WholeCells;
+    let subdivide = config.refinement == Refinement::SubCells;
+    let progress = config.progress;
+    let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
+    let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
+    let (sweeps_a, sweeps_b) = (cell_sweeps(&ra.model, &grid_a), cell_sweeps(&rb.model, &grid_b));
+    let (empty_a, empty_b) = (unreachable_cells(&ra.model, &grid_a), unreachable_cells(&rb.model, &grid_b));
+    let (refs_a, refs_b) = (references(&ra.model, &grid_a), references(&rb.model, &grid_b));
+    let a0 = whole_cell_boxes(ra, &refs_a, &sweeps_a, &empty_a);
+    let b0 = whole_cell_boxes(rb, &refs_b, &sweeps_b, &empty_b);
+    let labels = if refine {
+        let (a1, b1) = (octant_boxes(ra, &grid_a), octant_boxes(rb, &grid_b));
+        // The physical boxes at the reference points: a pair that collides there is a
+        // collision without refinement.
+        let none = |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]);
+        let (xa, xb) = (
+            SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
+            SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
+        );
+        let (mut la, mut lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+        if subdivide {
+            (la.subs, lb.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+        }
+        let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
+        let mut labels = label_pairs(&a0, &b0, collides, progress);
+        refine_unknown_cells(&la, &lb, &mut labels);
+        let start = std::time::Instant::now();
+        let sub = subdivide.then(|| sub_cells(&la, &lb, &labels));
+        (labels, sub, start.elapsed().as_secs_f64())
+    } else {
+        (label_pairs(&a0, &b0, |_, _| true, progress), None, 0.0)
+    };
+    let (labels, sub, sub_secs) = labels;
+    let radii = |ss: &[[Sweep; MAX_BOXES]]| ss.iter().map(|s| s.map(|w| w.radius())).collect::<Vec<_>>();
+    let (bounds_a, bounds_b) = (radii(&sweeps_a), radii(&sweeps_b));
+    let used = |bs: &[[Real; MAX_BOXES]]| bs.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0, Real::max);
+    let margin = used(&bounds_a).max(used(&bounds_b));
+    let space = LabelledSpace { grid_a, grid_b, labels, margin };
+    Ok(CertifiedSpace { space, bounds_a, bounds_b, refined: refine, sub, sub_secs: if subdivide { sub_secs } else { 0.0 } })
+}
+
+/// One robot's level-1 boxes: at each sample's reference point `refs[s]`, swept by its
+/// whole-cell displacement sets (`Unreachable` where the whole cell is, `empty[s]`).
+fn whole_cell_boxes(robot: &RobotSpec, refs: &[Vec3], sweeps: &[[Sweep; MAX_BOXES]], empty: &[bool]) -> SampleBoxes {
+    let inflate = |s: usize| if empty[s] { Inflation::Unreachable } else { inflation(sweeps[s]) };
+    SampleBoxes::new(&robot.model, &robot.placement, refs, inflate)
+}
+
+/// One robot's level-2 boxes: entry `8 s + i` for octant `i` of sample `s` ([`octants`]).
+fn octant_boxes(robot: &RobotSpec, grid: &SampleGrid) -> SampleBoxes {
+    let (refs, inflate) = octants(&robot.model, grid);
+    SampleBoxes::new(&robot.model, &robot.placement, &refs, |s| inflate[s])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::refine::*;
+    use super::sweeps::octant_centre;
+    use super::*;
+    use crate::geometry::Obb;
+    use crate::cspace::label::{all_box_pairs, Slot};
+    use crate::cell::reference::reference_cell;
+    use crate::cspace::{label_space, Label};
+
+    /// Certified labels only add collisions to the exact centre labels, are "unreachable" only
+    /// where the centre is, and refinement only removes collisions that level 1 could not
+    /// prove free.
+    #[test]
+    fn certified_labels_contain_exact_collisions_and_refinement_only_frees() {
+        let ws = Workspace::THESIS;
+        for name in ["T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let exact = label_space(&cell, 16, &ws, 0.0, false).unwrap();
+            let whole_cells = CertifyConfig { refinement: Refinement::WholeCells, progress: false };
+            let coarse = label_space_certified_with(&cell, 16, &ws, &whole_cells).unwrap();
+            let fine = label_space_certified(&cell, 16, &ws, false).unwrap();
+            let (mut freed, mut added) = (0, 0);
+            for ((e, c), f) in exact.labels.iter().zip(&coarse.space.labels).zip(&fine.space.labels) {
+                assert!(*f != Label::Unreachable || *e == Label::Unreachable);
+                assert_eq!(*c == Label::Unreachable, *f == Label::Unreachable);
+                assert!(*e != Label::Collision || *f == Label::Collision);
+                assert!(*c != Label::Free || *f == Label::Free);
+                freed += (*c == Label::Collision && *f == Label::Free) as usize;
+                added += (*e == Label::Free && *f == Label::Collision) as usize;
+            }
+            assert!(freed > 0 && added > 0, "{name}: {freed} freed, {added} added");
+        }
+    }
+
+    /// Both robots' boxes at both levels, as [`label_space_subdivided`] builds them: `(a0, a1,
+    /// b0, b1)`.
+    fn level_boxes(cell: &Cell, k: u32) -> (SampleBoxes, SampleBoxes, SampleBoxes, SampleBoxes) {
+        let (grid_a, grid_b) = two_robot_grids(cell, k, &Workspace::THESIS).unwrap();
+        let whole = |r: &RobotSpec, g: &SampleGrid| {
+            whole_cell_boxes(r, &references(&r.model, g), &cell_sweeps(&r.model, g), &unreachable_cells(&r.model, g))
+        };
+        let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
+        (whole(ra, &grid_a), octant_boxes(ra, &grid_a), whole(rb, &grid_b), octant_boxes(rb, &grid_b))
+    }
+
+    /// Without level 3, the sub-cells are exactly those of the plain octant tests
+    /// ([`octant_pairs`]), pair by pair, on every collision pair at k = 16; a subdivided
+    /// labelling has the same pairs and care masks, and level 3 only frees sub-cells.
+    #[test]
+    fn sub_cells_are_those_of_the_plain_octant_tests() {
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let c = label_space_subdivided(&cell, 16, &Workspace::THESIS, false).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let nb = b0.len();
+            let mut want = SubCells::default();
+            for (p, _) in c.space.labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision) {
+                let (care, collision) = octant_pairs(&a0, &a1, &b0, &b1, p / nb, p % nb, false);
+                want.pairs.push(p as u64);
+                want.care.push(care);
+                want.collision.push(collision);
+            }
+            assert!(!want.pairs.is_empty());
+            let (a, b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+            assert!(
+                sub_cells(&a, &b, &c.space.labels) == want,
+                "{name}: the fast sub-cells differ from the plain ones"
+            );
+            let got = c.sub.as_ref().unwrap();
+            assert_eq!((&got.pairs, &got.care), (&want.pairs, &want.care), "{name}: pairs and care masks");
+            let (mut before, mut after) = (0, 0);
+            for (g, w) in got.collision.iter().zip(&want.collision) {
+                assert_eq!(g & !w, 0, "{name}: level 3 made a sub-cell a collision");
+                (before, after) = (before + w.count_ones(), after + g.count_ones());
+            }
+            assert!(after < before, "{name}: level 3 freed nothing ({before} sub-cells)");
+            // The labels' level 2 (first octant pair not proved free) answers as the plain one.
+            let unreachable = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Unreachable;
+            for ia in (0..a0.len()).filter(|&ia| !unreachable(&a0, ia)) {
+                for ib in (0..nb).filter(|&ib| !unreachable(&b0, ib)) {
+                    let plain = octant_pairs(&a0, &a1, &b0, &b1, ia, ib, true).1 == 0;
+                    assert_eq!(octants_prove_free(&a, &b, ia, ib), plain, "{name} pair ({ia}, {ib})");
+                }
+            }
+        }
+    }
+
+    /// At k = 32, where cores exist, the fast masks ([`sub_cell_masks`]) equal the plain ones on
+    /// a spread of pairs whose boxes may meet, among them pairs where each certificate of a
+    /// certain intersection (whole cells, A's octant with B's cell, A's cell with B's octant)
+    /// decides.
+    #[test]
+    fn fast_sub_cell_masks_match_the_plain_ones_where_cores_meet() {
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 32);
+            let (a, b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+            let (na, nb) = (a0.per_entry, b0.per_entry);
+            let all = all_box_pairs(na, nb);
+            let (mut tried, mut whole, mut row, mut column) = (0, 0, 0, 0);
+            for ia in (0..a0.len()).step_by(7) {
+                for ib in (ia % 11..b0.len()).step_by(11) {
+                    let boxes = a0.slot[ia] == Slot::Boxes && b0.slot[ib] == Slot::Boxes;
+                    if !boxes || !entries_collide(&a0, ia, &b0, ib) {
+                        continue;
+                    }
+                    tried += 1;
+                    let got = sub_cell_masks(&a, &b, ia, ib, false);
+                    assert_eq!(got, octant_pairs(&a0, &a1, &b0, &b1, ia, ib, false), "{name} pair ({ia}, {ib})");
+                    whole += cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) as usize;
+                    let octant_meets = |c: &[Option<Obb>], s: usize, d: &[Option<Obb>], e: usize, f: usize| {
+                        (0..8).any(|i| {
+                            if f == 0 {
+                                cores_meet(c, 8 * s + i, na, d, e, nb, all)
+                            } else {
+                                cores_meet(c, s, na, d, 8 * e + i, nb, all)
+                            }
+                        })
+                    };
+                    row += octant_meets(&a.oct_cores, ia, &b.whole_cores, ib, 0) as usize;
+                    column += octant_meets(&a.whole_cores, ia, &b.oct_cores, ib, 1) as usize;
+                }
+            }
+            assert!(
+                whole > 0 && row > whole && column > whole,
+                "{name}: {tried} pairs, cores meet {whole} {row} {column}"
+            );
+        }
+    }
+
+    /// Level 3 is sound: in every sub-cell that it frees (a collision at level 2, on T1, T2
+    /// and T3 at k = 16), 16 random configurations, each TCP uniform in its octant, are free
+    /// for the exact model.
+    #[test]
+    fn sub_cells_freed_by_level_3_hold_no_collision() {
+        use crate::cell::{ExactChecker, SatMethod};
+        use rand::{rngs::StdRng, RngExt, SeedableRng};
+        let ws = Workspace::THESIS;
+        let mut rng = StdRng::seed_from_u64(3);
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let c = label_space_subdivided(&cell, 16, &ws, false).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let plain = sub_cells(&Levels::new(&a0, &a1), &Levels::new(&b0, &b1), &c.space.labels);
+            let got = c.sub.as_ref().unwrap();
+            let (ga, gb, nb) = (&c.space.grid_a, &c.space.grid_b, c.space.grid_b.cells.len());
+            let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
+            let octant = |g: &SampleGrid, s: usize, o: usize| octant_centre(&g.sample_center(s), o, 0.25 * g.r);
+            let (mut freed, mut checked) = (0, 0);
+            for (e, &pair) in got.pairs.iter().enumerate() {
+                let (ia, ib) = (pair as usize / nb, pair as usize % nb);
+                for (i, j) in (0..8).flat_map(|i| (0..8).map(move |j| (i, j))) {
+                    let bit = 1u64 << sub_cell_index(i, j);
+                    if plain.collision[e] & bit == 0 || got.collision[e] & bit != 0 {
+                        continue;
+                    }
+                    freed += 1;
+                    let (ca, cb) = (octant(ga, ia, i), octant(gb, ib, j));
+                    for _ in 0..16 {
+                        let mut point = |c: &Vec3, g: &SampleGrid| {
+                            c + Vec3::from_fn(|_, _| (rng.random::<Real>() - 0.5) * 0.5 * g.r)
+                        };
+                        let tcps = [point(&ca, ga), point(&cb, gb)];
+                        let v = exact.check(&tcps).unwrap();
+                        if v.unreachable_mask == 0 {
+                            checked += 1;
+                            assert!(
+                                !v.collides(),
+                                "{name}: sub-cell ({i}, {j}) of pair ({ia}, {ib}) collides at {tcps:?}"
+                            );
+                        }
+                    }
+                }
+            }
+            assert!(freed > 1000 && checked > 8 * freed, "{name}: {freed} freed sub-cells, {checked} configurations");
+        }
+    }
+}

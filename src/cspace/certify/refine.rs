@@ -1,0 +1,443 @@
+//! Levels 2 and 3 of the certified labelling (module doc of `certify`): octant pairs proved
+//! free with the octants' own sweeps, sub-octant pairs for what level 2 leaves open, and the
+//! sub-cell labels ([`SubCells`]) of the pairs that stay collisions.
+
+use crate::cell::RobotSpec;
+use crate::cspace::guarantee::reference_point;
+use crate::cspace::label::{
+    aabbs_apart, all_box_pairs, boxes_may_touch, collision_mask, entries_apart, Inflation, SampleBoxes, Slot,
+};
+use crate::cspace::sampler::SampleGrid;
+use crate::cspace::Label;
+use crate::geometry::sweep::{boxes_overlap_deeply, core};
+use crate::geometry::Obb;
+use crate::math::{max_or_nan, min_or_nan, Real, Vec3};
+use rayon::prelude::*;
+use super::sweeps::{inflation, octant_centre, octant_sweeps};
+use super::{sub_cell_index, SubCells};
+use std::sync::OnceLock;
+
+/// Rows of A whose sub-cells are found together ([`sub_cells`]; a cache blocking, any value
+/// gives the same answers).
+const SUB_CELL_ROWS: usize = 16;
+
+
+/// One robot's boxes at both levels with their cores ([`core`]: what every configuration of
+/// the (sub)cell covers; `None` for a box without one or an entry without boxes).
+pub(super) struct Levels<'a> {
+    pub(super) whole: &'a SampleBoxes,
+    pub(super) octs: &'a SampleBoxes,
+    pub(super) whole_cores: Vec<Option<Obb>>,
+    pub(super) oct_cores: Vec<Option<Obb>>,
+    /// Level 3, for the sub-cells only.
+    pub(super) subs: Option<SubOctants<'a>>,
+}
+
+impl<'a> Levels<'a> {
+    pub(super) fn new(whole: &'a SampleBoxes, octs: &'a SampleBoxes) -> Self {
+        Levels { whole, octs, whole_cores: cores(whole), oct_cores: cores(octs), subs: None }
+    }
+}
+
+/// Level 3 (sub-cells only, module doc): each octant cut into its 8 sub-octants (half-side
+/// `r/8`), their boxes and sweeps made when an octant first needs them.
+pub(super) struct SubOctants<'a> {
+    robot: &'a RobotSpec,
+    grid: &'a SampleGrid,
+    /// Per octant entry `8 s + i`: its sub-octants, entry `u` offset by `+/- r/8` along x,
+    /// y, z for bits 0, 1, 2 of `u`.
+    boxes: Vec<OnceLock<SampleBoxes>>,
+}
+
+impl<'a> SubOctants<'a> {
+    pub(super) fn new(robot: &'a RobotSpec, grid: &'a SampleGrid) -> Self {
+        SubOctants { robot, grid, boxes: (0..8 * grid.cells.len()).map(|_| OnceLock::new()).collect() }
+    }
+
+    /// The sub-octants of octant entry `e`.
+    fn of(&self, e: usize) -> &SampleBoxes {
+        self.boxes[e].get_or_init(|| {
+            let (model, r) = (&self.robot.model, self.grid.r);
+            let octant = octant_centre(&self.grid.sample_center(e / 8), e % 8, 0.25 * r);
+            let h = 0.125 * r;
+            let cs: Vec<Vec3> = (0..8).map(|u| octant_centre(&octant, u, h)).collect();
+            let refs: Vec<Vec3> = cs.iter().map(|c| reference_point(&model.delta, c, h).unwrap_or(*c)).collect();
+            let inflate = |u: usize| octant_sweeps(model, &cs[u], h, &refs[u]).map_or(Inflation::Vacuous, inflation);
+            SampleBoxes::new(model, &self.robot.placement, &refs, inflate)
+        })
+    }
+}
+
+/// Whether level 3 proves octant pair (A's entry `sa`, B's entry `sb`) free: for each pair
+/// of their sub-octants, each box pair of `open` (those the octant pair's tests left open) is
+/// proved disjoint by (A sub-octant, B sub-octant), (A sub-octant, B octant) or (A octant,
+/// B sub-octant). Never when a box pair's octant cores meet (a certain collision). The
+/// sub-octant pair `hint` (`8 u + v`) is tried first; it is set to the one that fails.
+pub(super) fn sub_octants_prove_free(
+    a: &Levels,
+    b: &Levels,
+    sa: usize,
+    sb: usize,
+    first: usize,
+    open: impl FnOnce() -> u64,
+    hint: &mut usize,
+) -> bool {
+    let (Some(sub_a), Some(sub_b)) = (&a.subs, &b.subs) else { return false };
+    let (a1, b1, na, nb) = (a.octs, b.octs, a.octs.per_entry, b.octs.per_entry);
+    let (x, y) = (sub_a.of(sa), sub_b.of(sb));
+    let usable = |slot: Slot| slot == Slot::Boxes || slot == Slot::Vacuous;
+    if !x.slot[..8].iter().chain(&y.slot[..8]).all(|&s| usable(s)) {
+        return false;
+    }
+    let fine = |u: usize, v: usize, open: u64| {
+        if open == 0 || entries_apart(x, u, y, v) {
+            0
+        } else {
+            collision_mask(x, u, y, v, open)
+        }
+    };
+    // The pair that failed last first, on box pair `first`, finest test first: a collision
+    // usually fails there.
+    let (u0, v0) = (*hint / 8, *hint % 8);
+    let stays = |open: u64| {
+        let left = fine(u0, v0, open);
+        left != 0 && collision_mask(x, u0, b1, sb, left) & collision_mask(a1, sa, y, v0, left) != 0
+    };
+    let hinted = x.slot[u0] == Slot::Boxes && y.slot[v0] == Slot::Boxes;
+    if hinted && stays(1 << first) {
+        return false;
+    }
+    let open = open();
+    if cores_meet(&a.oct_cores, sa, na, &b.oct_cores, sb, nb, open) || hinted && stays(open & !(1 << first)) {
+        return false;
+    }
+    // Then each sub-octant against the other octant, and the finest test for what is left.
+    let mut columns = [None; 8];
+    for u in (0..8).filter(|&u| x.slot[u] == Slot::Boxes) {
+        let row = collision_mask(x, u, b1, sb, open);
+        if row == 0 {
+            continue;
+        }
+        for v in (0..8).filter(|&v| y.slot[v] == Slot::Boxes) {
+            let column = *columns[v].get_or_insert_with(|| collision_mask(a1, sa, y, v, open));
+            if fine(u, v, row & column) != 0 {
+                *hint = 8 * u + v;
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Per box of `boxes`: its core under its sweep, when its entry has boxes and the core exists.
+pub(super) fn cores(boxes: &SampleBoxes) -> Vec<Option<Obb>> {
+    let n = boxes.per_entry;
+    (0..boxes.boxes.len())
+        .into_par_iter()
+        .map(|i| if boxes.slot[i / n] == Slot::Boxes { core(&boxes.boxes[i].obb, &boxes.boxes[i].sweep) } else { None })
+        .collect()
+}
+
+/// Whether some box pair among `mask` (as [`collision_mask`]) of A's entry `ia` and B's entry
+/// `ib` certainly intersects: their cores overlap deeply ([`boxes_overlap_deeply`]), so the
+/// boxes meet for every configuration of the two (sub)cells.
+pub(super) fn cores_meet(a: &[Option<Obb>], ia: usize, na: usize, b: &[Option<Obb>], ib: usize, nb: usize, mask: u64) -> bool {
+    let mut rest = mask;
+    while rest != 0 {
+        let bit = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        if let (Some(x), Some(y)) = (&a[ia * na + bit / 8], &b[ib * nb + bit % 8]) {
+            if boxes_overlap_deeply(x, y) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// The sub-cell labels of every pair labelled collision (see [`SubCells`]).
+///
+/// Rows of A are taken [`SUB_CELL_ROWS`] at a time, column by column, so that B's boxes of a
+/// column are used by every row of the block while they are in the cache.
+pub(super) fn sub_cells(a: &Levels, b: &Levels, labels: &[Label]) -> SubCells {
+    let nb = b.whole.len();
+    if nb == 0 {
+        return SubCells::default();
+    }
+    let rows: Vec<Vec<(u64, u64, u64)>> = labels
+        .par_chunks(nb * SUB_CELL_ROWS)
+        .enumerate()
+        .map(|(block, rows)| {
+            let mut out = vec![];
+            for ib in 0..nb {
+                for (r, row) in rows.chunks(nb).enumerate() {
+                    if row[ib] == Label::Collision {
+                        let ia = block * SUB_CELL_ROWS + r;
+                        let (care, collision) = sub_cell_masks(a, b, ia, ib, false);
+                        out.push(((ia * nb + ib) as u64, care, collision));
+                    }
+                }
+            }
+            out.sort_unstable_by_key(|&(pair, _, _)| pair);
+            out
+        })
+        .collect();
+    // Each block's rows are freed as they are copied, and the copies never reallocate: the
+    // peak stays near one copy of the sub-cells (at k = 64 on T2, gigabytes).
+    let n = rows.iter().map(Vec::len).sum();
+    let mut out =
+        SubCells { pairs: Vec::with_capacity(n), care: Vec::with_capacity(n), collision: Vec::with_capacity(n) };
+    for (pair, care, collision) in rows.into_iter().flatten() {
+        out.pairs.push(pair);
+        out.care.push(care);
+        out.collision.push(collision);
+    }
+    out
+}
+
+
+/// The sub-cells of `(ia, ib)` that hold reachable TCPs of both robots: neither octant is
+/// [`Slot::Vacuous`].
+pub(super) fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize) -> u64 {
+    // `sub_cell_index(i, j) = 8 sub_cell_index(i, 0) + sub_cell_index(0, j)`: B's occupied
+    // octants as one byte, shifted to each occupied octant of A's byte.
+    let column =
+        (0..8).filter(|&j| b1.slot[8 * ib + j] != Slot::Vacuous).fold(0u64, |m, j| m | 1 << sub_cell_index(0, j));
+    (0..8).filter(|&i| a1.slot[8 * ia + i] != Slot::Vacuous).fold(0, |m, i| m | column << sub_cell_index(i, 0))
+}
+
+/// `(care, collision)` over the 64 octant pairs of `(ia, ib)`, as [`octant_pairs`] gives
+/// them, faster (every change only skips tests whose answers are implied, or reorders tests
+/// whose answers are combined by "and"/"or"):
+/// - an octant pair is a collision as soon as a box pair certainly intersects for every
+///   configuration of a (sub)cell pair that holds it ([`cores_meet`]): of the whole cells
+///   (then every octant pair is), of A's octant and B's cell (its row), of A's cell and B's
+///   octant (its column). Such an octant pair is never proved free by [`octant_pairs`]: its
+///   octants are [`Slot::Boxes`] only with reachable reference TCPs, a configuration of the
+///   pair that collides, and its tests are sound; other octants it calls collisions anyway.
+/// - a box pair of an octant pair is proved disjoint when one of the tests (A octant, B
+///   cell), (A cell, B octant), (A octant, B octant) proves it (after the whole cells left it
+///   open); an octant pair is free when all its box pairs are. The octant-cell tests are
+///   shared by the 8 pairs of a row or column and run only when first needed; the box pairs
+///   are tried from the one that last stopped an octant pair, and an octant pair stops at
+///   its first box pair that no test proves.
+///
+/// With `first_only`, stops at the first octant pair not proved free.
+pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first_only: bool) -> (u64, u64) {
+    let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
+    let (na, nb) = (a0.per_entry, b0.per_entry);
+    let care = care_mask(a1, ia, b1, ib);
+    let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
+    let all = all_box_pairs(na, nb);
+    // A box pair whose cores meet is never proved disjoint: no need to look for it among
+    // those the whole cells leave open.
+    if whole_a && whole_b && cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) {
+        return (care, care);
+    }
+    let open0 = if whole_a && whole_b { collision_mask(a0, ia, b0, ib, all) } else { all };
+    let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
+    let row_meets: [bool; 8] = std::array::from_fn(|i| {
+        let sa = 8 * ia + i;
+        whole_b && boxes(a1, sa) && cores_meet(&a.oct_cores, sa, na, &b.whole_cores, ib, nb, open0)
+    });
+    let column_meets: [bool; 8] = std::array::from_fn(|j| {
+        let sb = 8 * ib + j;
+        whole_a && boxes(b1, sb) && cores_meet(&a.whole_cores, ia, na, &b.oct_cores, sb, nb, open0)
+    });
+    // Whether box pair `bit` may touch between A's entry `ea` of `x` and B's entry `eb` of `y`.
+    let touch = |x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize| {
+        boxes_may_touch(x, ea * na + bit / 8, y, eb * nb + bit % 8)
+    };
+    let (mut rows, mut columns) = (Memo::default(), Memo::default());
+    let mut hint = open0.trailing_zeros() as usize;
+    let mut hint3 = 0;
+    let mut collision = 0u64;
+    for (i, &row_meet) in row_meets.iter().enumerate() {
+        for (j, &column_meet) in column_meets.iter().enumerate() {
+            let bit = 1u64 << sub_cell_index(i, j);
+            if care & bit == 0 {
+                continue;
+            }
+            let (sa, sb) = (8 * ia + i, 8 * ib + j);
+            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meet || column_meet;
+            // Whether box pair `p` stays open: no test of the octant pair proves it.
+            let mut open = |p: usize| {
+                rows.open(i, p, || !whole_b || touch(a1, sa, b0, ib, p))
+                    && columns.open(j, p, || !whole_a || touch(a0, ia, b1, sb, p))
+                    && touch(a1, sa, b1, sb, p)
+            };
+            let stopper = if decided {
+                None
+            } else if entries_apart(a1, sa, b1, sb) {
+                Some(None)
+            } else {
+                Some(hint_first(open0, hint).find(|&p| open(p)))
+            };
+            match stopper {
+                Some(None) => continue,
+                Some(Some(p)) => {
+                    hint = p;
+                    if !first_only {
+                        let left = || hint_first(open0, p).filter(|&q| open(q)).fold(0u64, |m, q| m | 1 << q);
+                        if sub_octants_prove_free(a, b, sa, sb, p, left, &mut hint3) {
+                            continue;
+                        }
+                    }
+                }
+                None => {}
+            }
+            collision |= bit;
+            if first_only {
+                return (care, collision);
+            }
+        }
+    }
+    (care, collision)
+}
+
+/// The answers of one kind of coarse test (an octant against the other robot's whole cell),
+/// found when first asked: per octant `o`, bit `p` of `known[o]` says whether box pair `p` was
+/// tested, of `open[o]` whether it stayed open.
+#[derive(Default)]
+pub(super) struct Memo {
+    known: [u64; 8],
+    open: [u64; 8],
+}
+
+impl Memo {
+    /// Whether box pair `p` of octant `o` stays open; `test` finds it the first time.
+    fn open(&mut self, o: usize, p: usize, test: impl FnOnce() -> bool) -> bool {
+        let bit = 1u64 << p;
+        if self.known[o] & bit == 0 {
+            self.known[o] |= bit;
+            if test() {
+                self.open[o] |= bit;
+            }
+        }
+        self.open[o] & bit != 0
+    }
+}
+
+/// The set bits of `mask` (box pair indices), `hint` first when set, then the others upward.
+pub(super) fn hint_first(mask: u64, hint: usize) -> impl Iterator<Item = usize> {
+    let first = (hint < 64 && mask >> hint & 1 == 1).then_some(hint);
+    let mut rest = first.map_or(mask, |h| mask & !(1u64 << h));
+    first.into_iter().chain(std::iter::from_fn(move || {
+        let p = rest.trailing_zeros() as usize;
+        rest &= rest.wrapping_sub(1);
+        (p < 64).then_some(p)
+    }))
+}
+
+/// `(care, collision)` over the 64 octant pairs of `(ia, ib)`: an octant pair is free when
+/// every box pair is proved disjoint by one of the tests (A cell, B cell), (A octant,
+/// B cell), (A cell, B octant) or (A octant, B octant), each valid for all of it. Only the
+/// box pairs a coarser test left open go on to a finer one. With `first_only`, stops at the
+/// first octant pair not proved free. The plain form of [`sub_cell_masks`], kept to test it.
+#[cfg(test)]
+pub(super) fn octant_pairs(
+    a0: &SampleBoxes,
+    a1: &SampleBoxes,
+    b0: &SampleBoxes,
+    b1: &SampleBoxes,
+    ia: usize,
+    ib: usize,
+    first_only: bool,
+) -> (u64, u64) {
+    let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
+    let all = all_box_pairs(a0.per_entry, b0.per_entry);
+    let open0 = if whole_a && whole_b { collision_mask(a0, ia, b0, ib, all) } else { all };
+    let (mut care, mut collision) = (0u64, 0u64);
+    for i in 0..8 {
+        let sa = 8 * ia + i;
+        let a_slot = a1.slot[sa];
+        if a_slot == Slot::Vacuous {
+            continue;
+        }
+        let open_a = if a_slot == Slot::Boxes && whole_b { collision_mask(a1, sa, b0, ib, open0) } else { open0 };
+        for j in 0..8 {
+            let sb = 8 * ib + j;
+            let b_slot = b1.slot[sb];
+            if b_slot == Slot::Vacuous {
+                continue;
+            }
+            let bit = 1u64 << sub_cell_index(i, j);
+            care |= bit;
+            let proved = a_slot == Slot::Boxes && b_slot == Slot::Boxes && {
+                let open = if whole_a { collision_mask(a0, ia, b1, sb, open_a) } else { open_a };
+                open == 0 || entries_apart(a1, sa, b1, sb) || collision_mask(a1, sa, b1, sb, open) == 0
+            };
+            if !proved {
+                collision |= bit;
+                if first_only {
+                    return (care, collision);
+                }
+            }
+        }
+    }
+    (care, collision)
+}
+
+/// Level 2 for a pair whose whole-cell test failed or could not run (a sample without a
+/// whole-cell bound, [`Slot::Unknown`]: its centre is unreachable but its cell is not):
+/// every octant pair proved free ([`sub_cell_masks`], stopping at the first that is not).
+pub(super) fn octants_prove_free(a: &Levels, b: &Levels, ia: usize, ib: usize) -> bool {
+    sub_cell_masks(a, b, ia, ib, true).1 == 0
+}
+
+/// Level 2 for the pairs that [`label_pairs`] made collisions because a sample has no
+/// whole-cell bound ([`Slot::Unknown`]): each is retried octant by octant.
+pub(super) fn refine_unknown_cells(a: &Levels, b: &Levels, labels: &mut [Label]) {
+    let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
+    let unknown_b: Vec<usize> = (0..b0.len()).filter(|&ib| b0.slot[ib] == Slot::Unknown).collect();
+    let (cover_a, cover_b) = (octant_covers(a1), octant_covers(b1));
+    let nb = b0.len();
+    if nb == 0 {
+        return;
+    }
+    labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| {
+        let mut retry = |ib: usize| {
+            if row[ib] == Label::Collision
+                && b0.slot[ib] != Slot::Unreachable
+                && (cover_apart(&cover_a[ia], &cover_b[ib]) || octants_prove_free(a, b, ia, ib))
+            {
+                row[ib] = Label::Free;
+            }
+        };
+        match a0.slot[ia] {
+            Slot::Unknown => (0..nb).for_each(&mut retry),
+            Slot::Boxes => unknown_b.iter().for_each(|&ib| retry(ib)),
+            Slot::Unreachable | Slot::Vacuous => {}
+        }
+    });
+}
+
+/// Per sample: the AABB of its 8 octants' boxes (empty when every octant is vacuous), or
+/// `None` when an octant has no bound (nothing can be proved from it).
+pub(super) fn octant_covers(octs: &SampleBoxes) -> Vec<Option<([Real; 3], [Real; 3])>> {
+    (0..octs.len() / 8)
+        .map(|s| {
+            let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
+            for e in s * 8..s * 8 + 8 {
+                match octs.slot[e] {
+                    Slot::Vacuous => continue,
+                    Slot::Boxes => {}
+                    Slot::Unreachable | Slot::Unknown => return None,
+                }
+                for a in 0..3 {
+                    lo[a] = min_or_nan(lo[a], octs.lo[e][a]);
+                    hi[a] = max_or_nan(hi[a], octs.hi[e][a]);
+                }
+            }
+            Some((lo, hi))
+        })
+        .collect()
+}
+
+/// Whether two octant covers are apart (AABBs disjoint by more than the slack).
+pub(super) fn cover_apart(a: &Option<([Real; 3], [Real; 3])>, b: &Option<([Real; 3], [Real; 3])>) -> bool {
+    match (a, b) {
+        (Some((alo, ahi)), Some((blo, bhi))) => aabbs_apart(alo, ahi, blo, bhi),
+        _ => false,
+    }
+}

@@ -1,0 +1,156 @@
+//! For the report tool only (`eval` feature): the labels a subdivided labelling stands for,
+//! spelled out on the grid of `2 k` cells per axis, so that the thesis's tables of them can be
+//! built as a baseline for the shared table of sub-cells.
+
+use crate::cell::Cell;
+use crate::cspace::label::two_robot_grids;
+use crate::cspace::sampler::{SampleGrid, Workspace};
+use crate::cspace::{Label, LabelledSpace};
+use rayon::prelude::*;
+use super::{sub_cell_index, CertifiedSpace, SubCells};
+
+
+/// The labels a subdivided labelling ([`label_space_subdivided`]) stands for, on the grid of
+/// `2k` cells per axis (the octants of the `k` grid), found pair by pair: a sub-cell takes
+/// its pair's label, or, for a pair with sub-cells, its own ("don't care" outside `care`). A
+/// sample of the `2k` grid whose parent cell is not sampled at `k` is "don't care": queries
+/// there never reach the table. A plain table built from these labels answers as the
+/// subdivided one does on every sub-cell (the baseline for its size); at `k = 64` the dense
+/// labels ([`SubdividedLabels::to_dense`]) would not fit in memory, so the 4-D builder reads them
+/// here ([`crate::table::LinearQuadtree4d::build_subdivided`]).
+pub struct SubdividedLabels<'a> {
+    coarse: &'a LabelledSpace,
+    sub: &'a SubCells,
+    /// A's samples at `2k`.
+    pub grid_a: SampleGrid,
+    /// B's samples at `2k`.
+    pub grid_b: SampleGrid,
+    /// Per sample at `2k`: its parent sample at `k` and its octant (bits x, y, z = 0, 1, 2).
+    parent_a: Vec<Option<(u32, u8)>>,
+    parent_b: Vec<Option<(u32, u8)>>,
+    /// `sub.pairs[row_start[ia]..row_start[ia + 1]]` are the pairs of A's sample `ia` at `k`.
+    row_start: Vec<usize>,
+}
+
+impl<'a> SubdividedLabels<'a> {
+    /// The `2k` grids of `cell` and the parents of their samples in `certified`'s grids.
+    ///
+    /// # Errors
+    /// When `certified` has no sub-cells, or as [`crate::cspace::label_space`].
+    pub fn new(cell: &Cell, ws: &Workspace, certified: &'a CertifiedSpace) -> Result<SubdividedLabels<'a>, String> {
+        let sub = certified.sub.as_ref().ok_or("the labelling has no sub-cells")?;
+        let coarse = &certified.space;
+        let (grid_a, grid_b) = two_robot_grids(cell, 2 * coarse.grid_a.k, ws)?;
+        let parents = |fine: &SampleGrid, coarse: &SampleGrid| -> Vec<Option<(u32, u8)>> {
+            let of = |c: &[u16; 3]| {
+                let p = coarse.index_of([c[0] / 2, c[1] / 2, c[2] / 2])?;
+                Some((p as u32, (c[0] & 1) as u8 | ((c[1] & 1) as u8) << 1 | ((c[2] & 1) as u8) << 2))
+            };
+            fine.cells.iter().map(of).collect()
+        };
+        let (parent_a, parent_b) = (parents(&grid_a, &coarse.grid_a), parents(&grid_b, &coarse.grid_b));
+        let nb0 = coarse.grid_b.cells.len() as u64;
+        let row_start =
+            (0..=coarse.grid_a.cells.len() as u64).map(|ia| sub.pairs.partition_point(|&p| p < ia * nb0)).collect();
+        Ok(SubdividedLabels { coarse, sub, grid_a, grid_b, parent_a, parent_b, row_start })
+    }
+
+    /// These labels as one array (`8^2` times the bytes of the labels at `k`).
+    pub fn to_dense(&self) -> LabelledSpace {
+        let nb = self.grid_b.cells.len();
+        let ibs: Vec<u32> = (0..nb as u32).collect();
+        let mut labels = vec![Label::Unreachable; self.grid_a.cells.len() * nb];
+        if nb > 0 {
+            labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| self.row(Some(ia), &ibs, row));
+        }
+        let (grid_a, grid_b) = (self.grid_a.clone(), self.grid_b.clone());
+        LabelledSpace { grid_a, grid_b, labels, margin: self.coarse.margin }
+    }
+
+    /// The labels at `k` the sub-cells refine.
+    pub fn coarse(&self) -> &LabelledSpace {
+        self.coarse
+    }
+
+    /// The labels of A's sample `ia` with each of B's samples `ibs` (`u32::MAX`, or `ia =
+    /// None`: no sample, "don't care"), into `out`.
+    pub fn row(&self, ia: Option<usize>, ibs: &[u32], out: &mut [Label]) {
+        let Some((pa, i)) = ia.and_then(|ia| self.parent_a[ia]) else {
+            out.fill(Label::Unreachable);
+            return;
+        };
+        let (pa, nb0) = (pa as usize, self.coarse.grid_b.cells.len());
+        let labels = &self.coarse.labels[pa * nb0..(pa + 1) * nb0];
+        let (first, last) = (self.row_start[pa], self.row_start[pa + 1]);
+        let row = &self.sub.pairs[first..last];
+        for (l, &ib) in out.iter_mut().zip(ibs) {
+            let Some(&Some((pb, j))) = self.parent_b.get(ib as usize) else {
+                *l = Label::Unreachable;
+                continue;
+            };
+            *l = match labels[pb as usize] {
+                Label::Collision => match row.binary_search(&((pa * nb0) as u64 + u64::from(pb))) {
+                    Ok(e) => {
+                        let bit = 1u64 << sub_cell_index(usize::from(i), usize::from(j));
+                        if self.sub.care[first + e] & bit == 0 {
+                            Label::Unreachable
+                        } else if self.sub.collision[first + e] & bit != 0 {
+                            Label::Collision
+                        } else {
+                            Label::Free
+                        }
+                    }
+                    Err(_) => Label::Collision,
+                },
+                label => label,
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::reference::reference_cell;
+    use crate::cspace::certify::label_space_subdivided;
+
+    /// The `2k` labels of a subdivided labelling: every sub-cell of a collision pair as its
+    /// mask says (looked up the plain way), everything else as its parent pair.
+    #[test]
+    fn subdivided_labels_spell_out_the_sub_cells() {
+        let ws = Workspace::THESIS;
+        let cell = reference_cell("T2").unwrap();
+        let c = label_space_subdivided(&cell, 16, &ws, false).unwrap();
+        let fine = SubdividedLabels::new(&cell, &ws, &c).unwrap().to_dense();
+        let sub = c.sub.as_ref().unwrap();
+        let (coarse, nb0) = (&c.space, c.space.grid_b.cells.len());
+        let (mut seen, mut freed) = (0, 0);
+        for (ja, ca) in fine.grid_a.cells.iter().enumerate() {
+            for (jb, cb) in fine.grid_b.cells.iter().enumerate() {
+                let up = |g: &SampleGrid, x: &[u16; 3]| g.index_of([x[0] / 2, x[1] / 2, x[2] / 2]);
+                let octant =
+                    |x: &[u16; 3]| usize::from(x[0] & 1) | usize::from(x[1] & 1) << 1 | usize::from(x[2] & 1) << 2;
+                let want = match (up(&coarse.grid_a, ca), up(&coarse.grid_b, cb)) {
+                    (Some(ia), Some(ib)) => match sub.get((ia * nb0 + ib) as u64) {
+                        Some((care, collision)) => {
+                            seen += 1;
+                            let bit = 1u64 << sub_cell_index(octant(ca), octant(cb));
+                            match (care & bit != 0, collision & bit != 0) {
+                                (false, _) => Label::Unreachable,
+                                (true, true) => Label::Collision,
+                                (true, false) => {
+                                    freed += 1;
+                                    Label::Free
+                                }
+                            }
+                        }
+                        None => coarse.label(ia, ib),
+                    },
+                    _ => Label::Unreachable,
+                };
+                assert_eq!(fine.label(ja, jb), want, "fine pair ({ja}, {jb})");
+            }
+        }
+        assert!(seen > 0 && freed > 0, "{seen} sub-cells, {freed} freed");
+    }
+}
