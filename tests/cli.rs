@@ -285,6 +285,13 @@ fn readme_help_block() -> String {
     block.split("\n```").next().unwrap().to_string()
 }
 
+/// The README is a manual read in one sitting; measurements belong in `docs/record/`.
+#[test]
+fn readme_stays_a_manual_under_25_kb() {
+    let bytes = std::fs::metadata(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap().len();
+    assert!(bytes < 25_000, "README.md is {bytes} bytes: move detail to docs/ or docs/record/");
+}
+
 fn trim_lines(s: &str) -> String {
     s.trim_end().lines().map(str::trim_end).collect::<Vec<_>>().join("\n")
 }
