@@ -11,7 +11,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker};
-use delta_collide::cspace::{label_space, label_space_certified, Label, SampleGrid, Workspace};
+use delta_collide::cspace::{label_space, label_space_certified, Label, Progress, SampleGrid, Workspace};
 use rayon::prelude::*;
 use std::hint::black_box;
 
@@ -47,20 +47,20 @@ fn collisions(labels: &[Label]) -> usize {
 fn bench_labelling(c: &mut Criterion) {
     let cell = reference_cell("T1").unwrap();
     let ws = Workspace::THESIS;
-    let ours = label_space(&cell, K, &ws, 0.0, false).unwrap();
+    let ours = label_space(&cell, K, &ws, 0.0, Progress::Silent).unwrap();
     let naive = naive_labels(&cell, &ours.grid_a, &ours.grid_b);
     assert_eq!(ours.labels.len(), naive.len());
     let differ = ours.labels.iter().zip(&naive).filter(|(a, b)| a != b).count();
     assert_eq!(differ, 0, "product-structure labels differ from the per-pair exact check");
     let expected = collisions(&naive);
     assert!(expected > 0);
-    let certified_expected = collisions(&label_space_certified(&cell, K, &ws, false).unwrap().space.labels);
+    let certified_expected = collisions(&label_space_certified(&cell, K, &ws, Progress::Silent).unwrap().space.labels);
 
     let mut group = c.benchmark_group(format!("label_T1_k{K}_{}_pairs", naive.len()));
     group.sample_size(10);
     group.bench_function("ours_product_pruned", |b| {
         b.iter(|| {
-            let s = label_space(black_box(&cell), K, &ws, 0.0, false).unwrap();
+            let s = label_space(black_box(&cell), K, &ws, 0.0, Progress::Silent).unwrap();
             assert_eq!(collisions(&s.labels), expected);
         })
     });
@@ -72,7 +72,7 @@ fn bench_labelling(c: &mut Criterion) {
     });
     group.bench_function("ours_certified_refined", |b| {
         b.iter(|| {
-            let s = label_space_certified(black_box(&cell), K, &ws, false).unwrap();
+            let s = label_space_certified(black_box(&cell), K, &ws, Progress::Silent).unwrap();
             assert_eq!(collisions(&s.space.labels), certified_expected);
         })
     });
@@ -83,12 +83,12 @@ fn bench_labelling(c: &mut Criterion) {
 fn bench_labelling_k32(c: &mut Criterion) {
     let cell = reference_cell("T1").unwrap();
     let ws = Workspace::THESIS;
-    let expected = collisions(&label_space(&cell, 32, &ws, 0.0, false).unwrap().labels);
+    let expected = collisions(&label_space(&cell, 32, &ws, 0.0, Progress::Silent).unwrap().labels);
     let mut group = c.benchmark_group("label_T1_k32_all_pairs");
     group.sample_size(10);
     group.bench_function("ours_product_pruned", |b| {
         b.iter(|| {
-            let s = label_space(black_box(&cell), 32, &ws, 0.0, false).unwrap();
+            let s = label_space(black_box(&cell), 32, &ws, 0.0, Progress::Silent).unwrap();
             assert_eq!(collisions(&s.labels), expected);
         })
     });

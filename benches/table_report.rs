@@ -40,8 +40,8 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::symmetry::reflection_y;
 use delta_collide::cspace::{
-    label_space_certified, label_space_subdivided, label_space_thesis, CertifiedSpace, LabelledSpace, SampleGrid,
-    SubdividedLabels, Workspace,
+    label_space_certified, label_space_subdivided, label_space_thesis, CertifiedSpace, LabelledSpace, Progress,
+    SampleGrid, SubdividedLabels, Workspace,
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
@@ -426,7 +426,7 @@ const OF_SUB_CELL_LABELS: [&str; 6] =
 /// The subdivided certified labelling of `cell`, when a table `wants` asks for needs it.
 fn subdivided(cell: &Cell, k: u32, ws: &Workspace, wants: &dyn Fn(&str) -> bool) -> Option<(CertifiedSpace, f64)> {
     (wants("shared-sub") || OF_SUB_CELL_LABELS.iter().any(|key| wants(key)))
-        .then(|| timed(|| label_space_subdivided(cell, k, ws, false).expect("labelling")))
+        .then(|| timed(|| label_space_subdivided(cell, k, ws, Progress::Silent).expect("labelling")))
 }
 
 impl<'s> Labellings<'s> {
@@ -442,7 +442,7 @@ impl<'s> Labellings<'s> {
         // The 6-D table of the plain labels is also the reference the shared tables are
         // checked against.
         let plain = needs(&["6d", "5d", "4d-yy", "4d-zz", "4d-yy-lossy", "shared"]);
-        let certified = plain.then(|| timed(|| label_space_certified(cell, k, ws, false).expect("labelling").space));
+        let certified = plain.then(|| timed(|| label_space_certified(cell, k, ws, Progress::Silent).expect("labelling").space));
         let fine = subdivided.filter(|_| needs(&OF_SUB_CELL_LABELS)).map(|(s, secs)| {
             let (f, more) = timed(|| SubdividedLabels::new(cell, ws, s).expect("2k grids"));
             (f, secs + more)
@@ -451,7 +451,7 @@ impl<'s> Labellings<'s> {
             let (d, more) = timed(|| f.to_dense());
             (d, secs + more)
         });
-        let thesis = wants("thesis").then(|| timed(|| label_space_thesis(cell, k, ws, false).expect("labelling")));
+        let thesis = wants("thesis").then(|| timed(|| label_space_thesis(cell, k, ws, Progress::Silent).expect("labelling")));
         Labellings { certified, subdivided, fine, dense, thesis }
     }
 

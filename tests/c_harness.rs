@@ -11,7 +11,7 @@
 //! `target/<profile>/deps/c_harness-HASH` and the library lies next to it in `deps/`.
 
 use delta_collide::cell::reference::reference_cell;
-use delta_collide::cspace::Workspace;
+use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::table::{build_tables, to_bytes, Labelling, Variant};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -98,7 +98,7 @@ fn table_files(c: usize) -> &'static [PathBuf] {
         let start = std::time::Instant::now();
         let variants: Vec<Variant> = KINDS.iter().map(|&(_, v)| v).collect();
         let (header, tables, _) =
-            build_tables(&cell, TABLE_K, &Workspace::THESIS, &variants, Labelling::Certified, false)
+            build_tables(&cell, TABLE_K, &Workspace::THESIS, &variants, Labelling::Certified, Progress::Silent)
                 .unwrap_or_else(|e| panic!("building the {name} tables: {e}"));
         let _ = std::fs::remove_file(&stamp);
         for (path, table) in paths.iter().zip(&tables) {

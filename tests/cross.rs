@@ -19,7 +19,7 @@ mod harness_build;
 mod native_libs;
 
 use delta_collide::cell::reference::reference_cell;
-use delta_collide::cspace::Workspace;
+use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::table::{build_tables, to_bytes, Labelling, Variant};
 use harness_build::{both, compile_harness, repo_root, run, scratch_dir};
 use native_libs::{native_static_libs, CROSS_NATIVE_LIBS, NATIVE_LIBS};
@@ -143,7 +143,7 @@ fn table_args() -> &'static [String] {
         for (name, variant) in [("T1", Variant::D6), ("T2", Variant::Shared), ("T3", Variant::D6)] {
             let cell = reference_cell(name).expect("reference cell");
             let (header, tables, _) =
-                build_tables(&cell, TABLE_K, &Workspace::THESIS, &[variant], Labelling::Certified, false)
+                build_tables(&cell, TABLE_K, &Workspace::THESIS, &[variant], Labelling::Certified, Progress::Silent)
                     .unwrap_or_else(|e| panic!("building the {name} table: {e}"));
             let path = dir.join(format!("{name}_k{TABLE_K}.dct"));
             std::fs::write(&path, to_bytes(&tables[0], &header)).expect("write table");

@@ -17,7 +17,7 @@
 mod targets;
 
 use delta_collide::cell::reference::reference_cell;
-use delta_collide::cspace::Workspace;
+use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::table::format::to_bytes;
 use delta_collide::table::synthetic::{space, Pattern};
 use delta_collide::table::*;
@@ -89,7 +89,7 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
                 _ => Variant::D4 { axes: SliceAxes::ZZ, t: 2 },
             };
             let (header, table, _) =
-                build_table(&cell, 16, &Workspace::THESIS, variant, Labelling::Certified, false).unwrap();
+                build_table(&cell, 16, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent).unwrap();
             if let Some(small) = cut(&table, 24) {
                 out.push((format!("{cell_name}_k16_{v}_cut.dct"), to_bytes(&small, &header)));
             }

@@ -23,7 +23,7 @@ mod native_libs;
 mod workload;
 
 use delta_collide::cell::reference::reference_cell;
-use delta_collide::cspace::Workspace;
+use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::table::{build_tables, to_bytes, Labelling, SliceAxes, Variant};
 use native_libs::{native_static_libs, NATIVE_LIBS};
 use std::path::{Path, PathBuf};
@@ -167,7 +167,7 @@ fn consumer_tables() -> &'static (PathBuf, Vec<Vec<u8>>) {
         ];
         let cell = reference_cell("T1").expect("T1");
         let kinds: Vec<Variant> = variants.iter().map(|v| v.1).collect();
-        let (header, tables, _) = build_tables(&cell, 16, &Workspace::THESIS, &kinds, Labelling::Certified, false)
+        let (header, tables, _) = build_tables(&cell, 16, &Workspace::THESIS, &kinds, Labelling::Certified, Progress::Silent)
             .unwrap_or_else(|e| panic!("building the T1 tables: {e}"));
         let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("no_std_tables");
         std::fs::create_dir_all(&dir).expect("create the table dir");

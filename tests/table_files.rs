@@ -2,7 +2,7 @@
 //! specific `TableError`, never a panic nor a table that loads. Corrupted files kept in
 //! `tests/data/` are described in `tests/data/README.md`.
 
-use delta_collide::cspace::{LabelledSpace, Workspace};
+use delta_collide::cspace::{LabelledSpace, Progress, Workspace};
 use delta_collide::table::format::{fnv1a64, from_bytes_for_cell};
 use delta_collide::table::synthetic::{space, Pattern};
 use delta_collide::table::*;
@@ -231,12 +231,12 @@ fn reference_cell_tables_are_byte_identical_to_the_kept_files() {
     for cell_name in ["T1", "T3"] {
         let cell = reference_cell(cell_name).unwrap();
         let (names, variants): (Vec<_>, Vec<_>) = golden_variants().into_iter().unzip();
-        let (h, ts, _) = build_tables(&cell, 16, &Workspace::THESIS, &variants, Labelling::Certified, false).unwrap();
+        let (h, ts, _) = build_tables(&cell, 16, &Workspace::THESIS, &variants, Labelling::Certified, Progress::Silent).unwrap();
         for (t, name) in ts.iter().zip(names) {
             assert_golden(&format!("{}_k16_{name}", cell_name.to_lowercase()), &to_bytes(t, &h));
         }
     }
     let cell = reference_cell("T1").unwrap();
-    let (h, t, _) = build_table(&cell, 16, &Workspace::THESIS, Variant::Shared, Labelling::ThesisMargin, false).unwrap();
+    let (h, t, _) = build_table(&cell, 16, &Workspace::THESIS, Variant::Shared, Labelling::ThesisMargin, Progress::Silent).unwrap();
     assert_golden("t1_k16_shared_thesis", &to_bytes(&t, &h));
 }

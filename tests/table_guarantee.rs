@@ -10,7 +10,7 @@
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::ExactChecker;
 use delta_collide::cspace::symmetry::{grid_is_y_symmetric, mirror_cell, reflection_y};
-use delta_collide::cspace::{label_space, label_space_certified, label_space_thesis, Label, LabelledSpace, Workspace};
+use delta_collide::cspace::{label_space, label_space_certified, label_space_thesis, Label, LabelledSpace, Progress, Workspace};
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::Delta3;
 use rand::{rngs::StdRng, RngExt, SeedableRng};
@@ -130,9 +130,9 @@ fn hunt_thesis_false_negatives(
 fn evaluate(name: &str, seed: u64) -> (Confusion, Confusion) {
     let cell = reference_cell(name).unwrap();
     let ws = Workspace::THESIS;
-    let certified = label_space_certified(&cell, K, &ws, false).unwrap();
-    let thesis = label_space_thesis(&cell, K, &ws, false).unwrap();
-    let tighter = label_space(&cell, K, &ws, 1.25 * thesis.margin, false).unwrap();
+    let certified = label_space_certified(&cell, K, &ws, Progress::Silent).unwrap();
+    let thesis = label_space_thesis(&cell, K, &ws, Progress::Silent).unwrap();
+    let tighter = label_space(&cell, K, &ws, 1.25 * thesis.margin, Progress::Silent).unwrap();
     let (searched, bad, example) = hunt_thesis_false_negatives(&cell, &thesis, &tighter);
     println!(
         "{name}: thesis margin {:.3} mm vs certified bounds up to {:.3} mm; corner search over {searched} thesis-free pairs with the least clearance: {bad} collide at a corner (e.g. {example:?})",
@@ -209,7 +209,7 @@ fn t3_certified_labels_have_no_false_negatives() {
 fn t1_certified_labels_are_mirror_symmetric_at_k32() {
     let cell = reference_cell("T1").unwrap();
     assert!(reflection_y(&cell));
-    let s = label_space_certified(&cell, K, &Workspace::THESIS, false).unwrap().space;
+    let s = label_space_certified(&cell, K, &Workspace::THESIS, Progress::Silent).unwrap().space;
     let (ga, gb) = (&s.grid_a, &s.grid_b);
     assert!(grid_is_y_symmetric(ga) && grid_is_y_symmetric(gb));
     let mb: Vec<usize> = gb.cells.iter().map(|&c| gb.index_of(mirror_cell(gb, c)).unwrap()).collect();

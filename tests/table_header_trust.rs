@@ -6,7 +6,7 @@
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker};
-use delta_collide::cspace::Workspace;
+use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::format::{fnv1a64, from_bytes};
 use delta_collide::table::{
@@ -33,7 +33,7 @@ fn files(cell: &Cell) -> Vec<(Variant, Vec<u8>)> {
     static T3: OnceLock<Files> = OnceLock::new();
     let build = || {
         let (header, tables, _) =
-            build_tables(cell, 16, &Workspace::THESIS, &VARIANTS, Labelling::Certified, false).unwrap();
+            build_tables(cell, 16, &Workspace::THESIS, &VARIANTS, Labelling::Certified, Progress::Silent).unwrap();
         VARIANTS.iter().copied().zip(tables.iter().map(|t| to_bytes(t, &header))).collect()
     };
     match cell.name.as_str() {

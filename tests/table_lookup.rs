@@ -4,7 +4,7 @@
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::ExactChecker;
-use delta_collide::cspace::Workspace;
+use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
     build_table, build_tables, to_bytes, Labelling, SliceAxes, TableAnswer, TableChecker, TableError, Variant,
@@ -30,7 +30,7 @@ fn every_variant_has_no_false_negative_on_random_configurations() {
         Variant::SharedSubdivided,
     ];
     let (header, tables, _) =
-        build_tables(&cell, 16, &Workspace::THESIS, &variants, Labelling::Certified, false).unwrap();
+        build_tables(&cell, 16, &Workspace::THESIS, &variants, Labelling::Certified, Progress::Silent).unwrap();
     let mut checkers: Vec<TableChecker> =
         tables.iter().map(|t| TableChecker::new(cell.clone(), &to_bytes(t, &header)).unwrap()).collect();
     let mut rng = rand::rngs::StdRng::seed_from_u64(7);
@@ -64,7 +64,7 @@ fn every_variant_has_no_false_negative_on_random_configurations() {
 fn a_table_refuses_another_cell() {
     let t1 = reference_cell("T1").unwrap();
     let (header, table, report) =
-        build_table(&t1, 16, &Workspace::THESIS, Variant::D6, Labelling::Certified, false).unwrap();
+        build_table(&t1, 16, &Workspace::THESIS, Variant::D6, Labelling::Certified, Progress::Silent).unwrap();
     assert!(report.symmetric, "T1 is mirror-symmetric (SPEC section 5)");
     let bytes = to_bytes(&table, &header);
     let err = TableChecker::new(reference_cell("T2").unwrap(), &bytes).unwrap_err();

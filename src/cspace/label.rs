@@ -32,6 +32,27 @@ use crate::robot::{ModelOptions, RobotModel};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
+/// Whether a labelling draws progress bars on stderr. The library prints nothing unless the
+/// caller asks: a controller or a test builds silently, the CLI with bars.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Progress {
+    /// Nothing on stderr.
+    #[default]
+    Silent,
+    /// A progress bar per labelling pass on stderr.
+    Bars,
+}
+
+impl Progress {
+    /// A bar of `len` steps, hidden when silent.
+    fn bar(self, len: u64) -> ProgressBar {
+        match self {
+            Progress::Silent => ProgressBar::hidden(),
+            Progress::Bars => ProgressBar::new(len),
+        }
+    }
+}
+
 /// Slack (mm) of every axis-aligned pre-test: boxes closer than this go on to the exact test.
 pub const AABB_SLACK: Real = 1e-6;
 
@@ -263,8 +284,8 @@ pub fn all_box_pairs(na: usize, nb: usize) -> u64 {
 /// The label of every pair `(ia, ib)` at `ia * b.len() + ib`: `Unreachable` when either
 /// centre is unreachable, `Collision` when either is `Unknown` or some pair of boxes
 /// intersects and `second_look(ia, ib)` (called only then) confirms it, else `Free`.
-/// Rows are labelled in parallel; `progress` draws a bar on stderr.
-pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, progress: bool) -> Vec<Label>
+/// Rows are labelled in parallel; [`Progress::Bars`] draws a bar on stderr.
+pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, progress: Progress) -> Vec<Label>
 where
     F: Fn(usize, usize) -> bool + Sync,
 {
@@ -285,7 +306,7 @@ where
     let widest = order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
     // The same entries stored in that order: a row's candidates are read in memory order.
     let sorted = b.subset(&order);
-    let bar = if progress { ProgressBar::new(na as u64) } else { ProgressBar::hidden() };
+    let bar = progress.bar(na as u64);
     if let Ok(style) = ProgressStyle::with_template("labelling {bar:40} {pos}/{len} rows of A, {elapsed} (eta {eta})") {
         bar.set_style(style);
     }
@@ -346,7 +367,13 @@ pub(crate) fn two_robot_grids(cell: &Cell, k: u32, ws: &Workspace) -> Result<(Sa
 /// # Errors
 /// When the cell does not have exactly two robots, `margin` is not finite and >= 0, or the
 /// grid cannot be built ([`SampleGrid::new`]).
-pub fn label_space(cell: &Cell, k: u32, ws: &Workspace, margin: Real, progress: bool) -> Result<LabelledSpace, String> {
+pub fn label_space(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    margin: Real,
+    progress: Progress,
+) -> Result<LabelledSpace, String> {
     if !(margin.is_finite() && margin >= 0.0) {
         return Err(format!("labelling margin = {margin} must be finite and >= 0 (mm)"));
     }
@@ -364,7 +391,7 @@ pub fn label_space(cell: &Cell, k: u32, ws: &Workspace, margin: Real, progress: 
 ///
 /// # Errors
 /// As [`label_space`].
-pub fn label_space_thesis(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<LabelledSpace, String> {
+pub fn label_space_thesis(cell: &Cell, k: u32, ws: &Workspace, progress: Progress) -> Result<LabelledSpace, String> {
     let (g, _) = two_robot_grids(cell, k, ws)?;
     label_space(cell, k, ws, thesis_margin(g.r), progress)
 }

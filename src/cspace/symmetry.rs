@@ -94,19 +94,19 @@ mod tests {
 
     #[test]
     fn labels_of_symmetric_cells_agree_with_their_mirrors() {
-        use crate::cspace::{label_space, label_space_certified, Workspace};
+        use crate::cspace::{label_space, label_space_certified, Progress, Workspace};
         let ws = Workspace::THESIS;
         for name in ["T1", "T2"] {
             let cell = reference_cell(name).unwrap();
             assert!(reflection_y(&cell));
-            let exact = label_space(&cell, 16, &ws, 0.0, false).unwrap();
+            let exact = label_space(&cell, 16, &ws, 0.0, Progress::Silent).unwrap();
             assert_eq!(mirror_mismatches(&exact), 0, "{name} exact");
-            let certified = label_space_certified(&cell, 16, &ws, false).unwrap();
+            let certified = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap();
             assert_eq!(mirror_mismatches(&certified.space), 0, "{name} certified");
         }
         // T3 is not symmetric, and its labels show it.
         let t3 = reference_cell("T3").unwrap();
         assert!(!reflection_y(&t3));
-        assert!(mirror_mismatches(&label_space(&t3, 16, &ws, 0.0, false).unwrap()) > 0);
+        assert!(mirror_mismatches(&label_space(&t3, 16, &ws, 0.0, Progress::Silent).unwrap()) > 0);
     }
 }

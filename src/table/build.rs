@@ -14,7 +14,7 @@ use crate::cell::Cell;
 use crate::cspace::certify::{label_space_certified, label_space_subdivided};
 use crate::cspace::label::label_space_thesis;
 use crate::cspace::symmetry::reflection_y;
-use crate::cspace::{Label, Workspace};
+use crate::cspace::{Label, Progress, Workspace};
 use crate::table::{
     Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
     TableError,
@@ -135,7 +135,7 @@ pub fn build_table(
     ws: &Workspace,
     variant: Variant,
     labelling: Labelling,
-    progress: bool,
+    progress: Progress,
 ) -> Result<(Header, Table, BuildReport), BuildError> {
     let (header, mut tables, report) = build_tables(cell, k, ws, &[variant], labelling, progress)?;
     let table = tables.pop().ok_or(BuildError::Table(TableError::BadInput { what: "no table built".into() }))?;
@@ -153,7 +153,7 @@ pub fn build_tables(
     ws: &Workspace,
     variants: &[Variant],
     labelling: Labelling,
-    progress: bool,
+    progress: Progress,
 ) -> Result<(Header, Vec<Table>, BuildReport), BuildError> {
     if cell.robots.len() != 2 {
         return Err(BuildError::NotTwoRobots { cell: cell.name.clone(), robots: cell.robots.len() });

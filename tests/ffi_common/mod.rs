@@ -4,7 +4,7 @@
 #![allow(dead_code)] // each test file uses a subset
 
 use delta_collide::cell::reference::reference_cell;
-use delta_collide::cspace::Workspace;
+use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::ffi::*;
 use delta_collide::table::{build_table, to_bytes, Labelling, Variant};
 use std::sync::OnceLock;
@@ -29,7 +29,7 @@ pub fn table_bytes(name: &str) -> &'static [u8] {
     let slot = ["T1", "T2"].iter().position(|n| *n == name).expect("tables of T1 and T2 only");
     TABLES[slot].get_or_init(|| {
         let cell = reference_cell(name).unwrap();
-        let (header, table, _) = build_table(&cell, 16, &Workspace::THESIS, Variant::D6, Labelling::Certified, false)
+        let (header, table, _) = build_table(&cell, 16, &Workspace::THESIS, Variant::D6, Labelling::Certified, Progress::Silent)
             .unwrap_or_else(|e| panic!("building the {name} table: {e}"));
         to_bytes(&table, &header)
     })

@@ -27,7 +27,7 @@ use args::{BuildArgs, CheckArgs, Cli, Command, EvalArgs, InspectArgs};
 use clap::CommandFactory;
 use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
-use delta_collide::cspace::{Label, SampleGrid, Workspace};
+use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{build_table, from_bytes, to_bytes, Labelling, Table, TableAnswer, TableChecker};
 use std::io::{BufRead, Write};
@@ -71,7 +71,7 @@ impl From<clap::Error> for Failure {
 
 fn main() {
     let cli = Cli::parse_checked();
-    let progress = !cli.quiet;
+    let progress = if cli.quiet { Progress::Silent } else { Progress::Bars };
     let result = match &cli.command {
         Command::Demo(a) => demo::demo(a),
         Command::Check(a) => check(a),
@@ -232,13 +232,13 @@ fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
     TableChecker::new(cell.clone(), &bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-fn build(args: &BuildArgs, progress: bool) -> Result<(), Failure> {
+fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
     let (cell, k, output) = (&args.cell, args.k, &args.output);
     let variant = args.variant.0.variant(args.t.unwrap_or(0));
     let labelling = Labelling::from(args.labelling);
     check_memory(cell, k, &Workspace::THESIS)?;
     let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
-    if let (true, Some((pairs, secs))) = (progress, r.sub_cells) {
+    if let (Progress::Bars, Some((pairs, secs))) = (progress, r.sub_cells) {
         eprintln!("sub-cells of {pairs} collision pairs: {secs:.2} s");
     }
     let bytes = to_bytes(&table, &header);

@@ -56,10 +56,7 @@ pub use subdivided_labels::SubdividedLabels;
 
 use crate::cell::{Cell, RobotSpec};
 use crate::cspace::guarantee::SPLITS;
-use crate::cspace::label::{
-    entries_collide, label_pairs,
-    two_robot_grids, Inflation, SampleBoxes,
-};
+use crate::cspace::label::{entries_collide, label_pairs, two_robot_grids, Inflation, Progress, SampleBoxes};
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::LabelledSpace;
 use crate::robot::MAX_BOXES;
@@ -143,7 +140,7 @@ pub struct CertifyConfig {
     /// How far it refines.
     pub refinement: Refinement,
     /// Whether to draw a progress bar on stderr while labelling.
-    pub progress: bool,
+    pub progress: Progress,
 }
 
 /// Certified labels of every sample pair of the two-robot `cell` at `k` cells per axis, with
@@ -151,7 +148,12 @@ pub struct CertifyConfig {
 ///
 /// # Errors
 /// As [`crate::cspace::label_space`].
-pub fn label_space_certified(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<CertifiedSpace, String> {
+pub fn label_space_certified(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    progress: Progress,
+) -> Result<CertifiedSpace, String> {
     label_space_certified_with(cell, k, ws, &CertifyConfig { refinement: Refinement::Octants, progress })
 }
 
@@ -161,7 +163,12 @@ pub fn label_space_certified(cell: &Cell, k: u32, ws: &Workspace, progress: bool
 ///
 /// # Errors
 /// As [`crate::cspace::label_space`].
-pub fn label_space_subdivided(cell: &Cell, k: u32, ws: &Workspace, progress: bool) -> Result<CertifiedSpace, String> {
+pub fn label_space_subdivided(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    progress: Progress,
+) -> Result<CertifiedSpace, String> {
     label_space_certified_with(cell, k, ws, &CertifyConfig { refinement: Refinement::SubCells, progress })
 }
 
@@ -248,10 +255,10 @@ mod tests {
         let ws = Workspace::THESIS;
         for name in ["T2", "T3"] {
             let cell = reference_cell(name).unwrap();
-            let exact = label_space(&cell, 16, &ws, 0.0, false).unwrap();
-            let whole_cells = CertifyConfig { refinement: Refinement::WholeCells, progress: false };
+            let exact = label_space(&cell, 16, &ws, 0.0, Progress::Silent).unwrap();
+            let whole_cells = CertifyConfig { refinement: Refinement::WholeCells, progress: Progress::Silent };
             let coarse = label_space_certified_with(&cell, 16, &ws, &whole_cells).unwrap();
-            let fine = label_space_certified(&cell, 16, &ws, false).unwrap();
+            let fine = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap();
             let (mut freed, mut added) = (0, 0);
             for ((e, c), f) in exact.labels.iter().zip(&coarse.space.labels).zip(&fine.space.labels) {
                 assert!(*f != Label::Unreachable || *e == Label::Unreachable);
@@ -283,7 +290,7 @@ mod tests {
     fn sub_cells_are_those_of_the_plain_octant_tests() {
         for name in ["T1", "T2", "T3"] {
             let cell = reference_cell(name).unwrap();
-            let c = label_space_subdivided(&cell, 16, &Workspace::THESIS, false).unwrap();
+            let c = label_space_subdivided(&cell, 16, &Workspace::THESIS, Progress::Silent).unwrap();
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let nb = b0.len();
             let mut want = SubCells::default();
@@ -372,7 +379,7 @@ mod tests {
         let mut rng = StdRng::seed_from_u64(3);
         for name in ["T1", "T2", "T3"] {
             let cell = reference_cell(name).unwrap();
-            let c = label_space_subdivided(&cell, 16, &ws, false).unwrap();
+            let c = label_space_subdivided(&cell, 16, &ws, Progress::Silent).unwrap();
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let plain = sub_cells(&Levels::new(&a0, &a1), &Levels::new(&b0, &b1), &c.space.labels);
             let got = c.sub.as_ref().unwrap();

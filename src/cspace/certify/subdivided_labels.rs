@@ -113,6 +113,7 @@ mod tests {
     use super::*;
     use crate::cell::reference::reference_cell;
     use crate::cspace::certify::label_space_subdivided;
+    use crate::cspace::Progress;
 
     /// The `2k` labels of a subdivided labelling: every sub-cell of a collision pair as its
     /// mask says (looked up the plain way), everything else as its parent pair.
@@ -120,7 +121,7 @@ mod tests {
     fn subdivided_labels_spell_out_the_sub_cells() {
         let ws = Workspace::THESIS;
         let cell = reference_cell("T2").unwrap();
-        let c = label_space_subdivided(&cell, 16, &ws, false).unwrap();
+        let c = label_space_subdivided(&cell, 16, &ws, Progress::Silent).unwrap();
         let fine = SubdividedLabels::new(&cell, &ws, &c).unwrap().to_dense();
         let sub = c.sub.as_ref().unwrap();
         let (coarse, nb0) = (&c.space, c.space.grid_b.cells.len());

@@ -206,10 +206,10 @@ mod tests {
     fn subdivided_build_is_the_dense_build_of_the_sub_cell_labels() {
         use crate::cell::reference::reference_cell;
         use crate::cspace::symmetry::reflection_y;
-        use crate::cspace::{label_space_subdivided, SubdividedLabels, Workspace};
+        use crate::cspace::{label_space_subdivided, Progress, SubdividedLabels, Workspace};
         for name in ["T1", "T2", "T3"] {
             let cell = reference_cell(name).unwrap();
-            let mut certified = label_space_subdivided(&cell, 16, &Workspace::THESIS, false).unwrap();
+            let mut certified = label_space_subdivided(&cell, 16, &Workspace::THESIS, Progress::Silent).unwrap();
             // Every fifth pair's sub-cells all collisions: labels no longer mirror-symmetric,
             // so the symmetric tables must merge each pair with its mirror as the dense one does.
             let sub = certified.sub.as_mut().unwrap();
