@@ -12,23 +12,20 @@ use delta_collide::table::*;
 use std::hint::black_box;
 use std::time::Instant;
 
-const LEN: usize = 1 << 7;
+#[allow(dead_code)]
+#[path = "support/rng.rs"]
+mod rng;
+use rng::BenchRng;
 
-fn splitmix(x: &mut u64) -> u64 {
-    *x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    let mut z = *x;
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
+const LEN: usize = 1 << 7;
 
 /// 128 reachable samples, half collision and half free: (cell, expected answer).
 fn ring(s: &LabelledSpace) -> Vec<([u16; 6], bool)> {
     let (na, nb) = (s.grid_a.cells.len(), s.grid_b.cells.len());
-    let mut seed = 2024;
+    let mut rng = BenchRng(2024);
     let mut out = Vec::new();
     while out.len() < LEN {
-        let (ia, ib) = (splitmix(&mut seed) as usize % na, splitmix(&mut seed) as usize % nb);
+        let (ia, ib) = (rng.next_u64() as usize % na, rng.next_u64() as usize % nb);
         let want = out.len() % 2 == 0;
         let label = s.labels[ia * nb + ib];
         if label != Label::Unreachable && (label == Label::Collision) == want {

@@ -45,11 +45,14 @@ use delta_collide::cspace::{
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
+#[path = "support/rng.rs"]
+mod rng;
 #[path = "support/shared_peer.rs"]
 mod shared_peer;
 #[path = "support/timing.rs"]
 mod timing;
 
+use rng::BenchRng;
 use shared_peer::SeparateArrays;
 use std::collections::HashSet;
 use std::time::Instant;
@@ -156,14 +159,6 @@ fn options() -> Options {
     }
 }
 
-/// xorshift64*: uniform in [0, 1).
-fn uniform(seed: &mut u64) -> f64 {
-    *seed ^= *seed << 13;
-    *seed ^= *seed >> 7;
-    *seed ^= *seed << 17;
-    (seed.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-}
-
 /// A random configuration's table cell (or `None` outside the sampled grid) and whether the
 /// exact model finds a collision.
 struct Config {
@@ -198,12 +193,12 @@ fn configurations(cell: &Cell, space: &LabelledSpace, n: usize, ws: &Workspace) 
     let sampled = |g: &SampleGrid| g.cells.iter().copied().collect::<HashSet<_>>();
     let (sa, sb) = (sampled(&space.grid_a), sampled(&space.grid_b));
     let (rmax, dmax) = (ws.rcy, ws.max_depth());
-    let mut seed = 1u64;
+    let mut rng = BenchRng(1);
     let mut out = Vec::with_capacity(n);
     let mut tcps = [Vec3::zeros(); 2];
     while out.len() < n {
         for t in &mut tcps {
-            let (x, y, d) = (uniform(&mut seed), uniform(&mut seed), uniform(&mut seed));
+            let (x, y, d) = (rng.uniform(), rng.uniform(), rng.uniform());
             *t = Vec3::new(rmax * (2.0 * x - 1.0), rmax * (2.0 * y - 1.0), -(ws.zu + (dmax - ws.zu) * d));
         }
         if !tcps.iter().all(|t| ws.contains(t)) {
