@@ -23,6 +23,7 @@ mod init;
 
 use super::input::{Encoder, Input};
 use delta_collide::ffi::*;
+use delta_collide::table::TableKind;
 use std::ffi::CStr;
 
 /// Calls per input at most.
@@ -430,8 +431,15 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     out.push(("init_from_files", e.bytes));
     // InitWithTable: config (n, method, NULL flags, edit count), source, edit count, reseal,
     // NULL table, NULL out, init error capacity.
-    let tables = [("table_6d", 0), ("table_5d", 1), ("table_4d", 2), ("table_shared", 3), ("table_shared_sub", 4)];
-    for (name, source) in tables {
+    let tables = [
+        ("table_6d", TableKind::D6),
+        ("table_5d", TableKind::D5),
+        ("table_4d", TableKind::D4yy),
+        ("table_shared", TableKind::Shared),
+        ("table_shared_sub", TableKind::SharedSub),
+    ];
+    for (name, kind) in tables {
+        let source = init::table_source(kind).expect("a seed table of every kind listed");
         let mut e = Encoder::default();
         e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0);
         e.byte(source).byte(0).byte(0).byte(0).byte(0).byte(100);

@@ -9,21 +9,29 @@ use delta_collide::ffi::*;
 use delta_collide::math::Vec3;
 use delta_collide::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
 use delta_collide::table::format::fnv1a64;
-use delta_collide::table::{TableChecker, TableError};
+use delta_collide::table::{TableChecker, TableError, TableKind};
 use std::ffi::{c_char, CStr, CString};
 use std::sync::OnceLock;
 
 /// Robots per `dc_init` at most (32 are allowed; more must be refused).
 const MAX_INIT_ROBOTS: u8 = 40;
 
-/// Seed tables of cell T1 (k = 16) that `dc_init_with_table` starts from, one per variant.
-const TABLES: [&[u8]; 5] = [
-    include_bytes!("../../seeds/table_bytes/t1_k16_6d_cut.dct"),
-    include_bytes!("../../seeds/table_bytes/t1_k16_5d_cut.dct"),
-    include_bytes!("../../seeds/table_bytes/t1_k16_4d_yy_cut.dct"),
-    include_bytes!("../../seeds/table_bytes/t1_k16_shared_cut.dct"),
-    include_bytes!("../../seeds/table_bytes/t1_k16_shared_sub_cut.dct"),
+/// Seed tables of cell T1 (k = 16) that `dc_init_with_table` starts from, one per kind; a
+/// table's source byte is its index here ([`table_source`]), so committed inputs keep their
+/// meaning only while this order stays.
+const TABLES: [(TableKind, &[u8]); 5] = [
+    (TableKind::D6, include_bytes!("../../seeds/table_bytes/t1_k16_6d_cut.dct")),
+    (TableKind::D5, include_bytes!("../../seeds/table_bytes/t1_k16_5d_cut.dct")),
+    (TableKind::D4yy, include_bytes!("../../seeds/table_bytes/t1_k16_4d_yy_cut.dct")),
+    (TableKind::Shared, include_bytes!("../../seeds/table_bytes/t1_k16_shared_cut.dct")),
+    (TableKind::SharedSub, include_bytes!("../../seeds/table_bytes/t1_k16_shared_sub_cut.dct")),
 ];
+
+/// The source byte of `Op::InitWithTable` that starts from the seed table of `kind`, if
+/// there is one.
+pub(super) fn table_source(kind: TableKind) -> Option<u8> {
+    TABLES.iter().position(|&(k, _)| k == kind).map(|i| i as u8)
+}
 
 /// Sets field `field` of `r` from `input`; fields 0-5 are the geometry.
 pub(super) fn edit(r: &mut DcRobotConfig, field: u8, input: &mut Input) {
@@ -234,7 +242,7 @@ fn table_status(e: &TableError) -> DcStatus {
 fn table_bytes(input: &mut Input, cell: Option<&Cell>) -> Vec<u8> {
     let source = input.byte();
     let mut bytes = match TABLES.get(usize::from(source % 7)) {
-        Some(t) => t.to_vec(),
+        Some((_, t)) => t.to_vec(),
         None => {
             let len = usize::from(u16::from_le_bytes(input.bytes()) % 512);
             (0..len).map(|_| input.byte()).collect()
