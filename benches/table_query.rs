@@ -6,7 +6,7 @@
 //! The setup also prints build times and memory (ours and the thesis's formula) per variant.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use delta_collide::cspace::{Label, LabelledSpace};
+use delta_collide::cspace::{Label, LabelledSpace, Symmetry};
 use delta_collide::table::synthetic::{space, Pattern};
 use delta_collide::table::*;
 use std::hint::black_box;
@@ -101,14 +101,14 @@ fn build(s: &LabelledSpace) -> Vec<Table> {
     };
     for symmetric in [false, sym] {
         let tag = if symmetric { " sym" } else { "" };
-        timed(&format!("6D{tag}"), &|| Table::D6(LinearQuadtree6d::build(s, symmetric).unwrap()));
-        timed(&format!("5D{tag}"), &|| Table::D5(LinearQuadtree5d::build(s, symmetric).unwrap()));
+        timed(&format!("6D{tag}"), &|| Table::D6(LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).unwrap()));
+        timed(&format!("5D{tag}"), &|| Table::D5(LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).unwrap()));
         for (axes, t) in [(SliceAxes::YY, 0), (SliceAxes::YY, 150), (SliceAxes::ZZ, 0)] {
             timed(&format!("4D/{axes:?} t={t}{tag}"), &|| {
-                Table::D4(LinearQuadtree4d::build(s, symmetric, axes, t).unwrap())
+                Table::D4(LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), axes, t).unwrap())
             });
         }
-        timed(&format!("6D-shared{tag}"), &|| Table::Shared(SharedQuadtree6d::build(s, symmetric).unwrap()));
+        timed(&format!("6D-shared{tag}"), &|| Table::Shared(SharedQuadtree6d::build(s, Symmetry::from_flag(symmetric)).unwrap()));
         if !sym {
             break;
         }

@@ -41,7 +41,7 @@ use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::symmetry::reflection_y;
 use delta_collide::cspace::{
     label_space_certified, label_space_subdivided, label_space_thesis, CertifiedSpace, LabelledSpace, Progress,
-    SampleGrid, SubdividedLabels, Workspace,
+    SampleGrid, SubdividedLabels, Symmetry, Workspace,
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
@@ -489,35 +489,35 @@ impl<'a> Entry<'a> {
 fn entries<'a>(l: &'a Labellings<'a>, symmetric: bool, t_lossy: u32) -> Vec<Entry<'a>> {
     let mut out = vec![];
     if let Some(c) = &l.certified {
-        let d4 = |axes, t| -> Build<'a> { Box::new(move |s| LinearQuadtree4d::build(s, symmetric, axes, t).map(Table::D4)) };
-        out.push(Entry::new(TableKind::D6.name(), "6D", c, Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6))));
-        out.push(Entry::new(TableKind::D5.name(), "5D", c, Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5))));
+        let d4 = |axes, t| -> Build<'a> { Box::new(move |s| LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), axes, t).map(Table::D4)) };
+        out.push(Entry::new(TableKind::D6.name(), "6D", c, Box::new(move |s| LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::D6))));
+        out.push(Entry::new(TableKind::D5.name(), "5D", c, Box::new(move |s| LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).map(Table::D5))));
         out.push(Entry::new(TableKind::D4yy.name(), "4D/yy t=0", c, d4(SliceAxes::YY, 0)));
         out.push(Entry::new(TableKind::D4zz.name(), "4D/zz t=0", c, d4(SliceAxes::ZZ, 0)));
         out.push(Entry::new("4d-yy-lossy", format!("4D/yy t={t_lossy}"), c, d4(SliceAxes::YY, t_lossy)));
-        let shared: Build = Box::new(move |s| SharedQuadtree6d::build(s, symmetric).map(Table::Shared));
+        let shared: Build = Box::new(move |s| SharedQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::Shared));
         out.push(Entry::new(TableKind::Shared.name(), "6D-shared", c, shared));
     }
     if let Some((sub, secs)) = l.subdivided {
         let sub_cells = sub.sub.as_ref().expect("sub-cells");
-        let build: Build = Box::new(move |s| SharedQuadtree6d::build_subdivided(s, sub_cells, symmetric).map(Table::Shared));
+        let build: Build = Box::new(move |s| SharedQuadtree6d::build_subdivided(s, sub_cells, Symmetry::from_flag(symmetric)).map(Table::Shared));
         out.push(Entry { key: TableKind::SharedSub.name(), label: "6D-shared/sub".into(), space: &sub.space, label_secs: *secs, certified: true, of_sub_cell_labels: false, build });
     }
     if let (Some((sub, _)), Some((fine, secs))) = (l.subdivided, &l.fine) {
         for (key, axes, name) in [("4d-yy-sub", SliceAxes::YY, "yy"), ("4d-zz-sub", SliceAxes::ZZ, "zz")] {
-            let build: Build = Box::new(move |_| LinearQuadtree4d::build_subdivided(fine, symmetric, axes, 0).map(Table::D4));
+            let build: Build = Box::new(move |_| LinearQuadtree4d::build_subdivided(fine, Symmetry::from_flag(symmetric), axes, 0).map(Table::D4));
             let label = format!("4D/{name} t=0 of the sub-cell labels (2k)");
             out.push(Entry { key, label, space: &sub.space, label_secs: *secs, certified: true, of_sub_cell_labels: true, build });
         }
     }
     if let Some(dense) = &l.dense {
-        let d6: Build = Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6));
-        let d5: Build = Box::new(move |s| LinearQuadtree5d::build(s, symmetric).map(Table::D5));
+        let d6: Build = Box::new(move |s| LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::D6));
+        let d5: Build = Box::new(move |s| LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).map(Table::D5));
         out.push(Entry { of_sub_cell_labels: true, ..Entry::new("6d-sub", "6D of the sub-cell labels (2k)", dense, d6) });
         out.push(Entry { of_sub_cell_labels: true, ..Entry::new("5d-sub", "5D of the sub-cell labels (2k)", dense, d5) });
     }
     if let Some(thesis) = &l.thesis {
-        let d6: Build = Box::new(move |s| LinearQuadtree6d::build(s, symmetric).map(Table::D6));
+        let d6: Build = Box::new(move |s| LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::D6));
         out.push(Entry { certified: false, ..Entry::new("thesis", "thesis-style 6D (r/sqrt 2)", thesis, d6) });
     }
     out

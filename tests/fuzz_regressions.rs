@@ -2,7 +2,7 @@
 //! inputs that found them are kept in `tests/data/fuzz/<target>/` (listed in
 //! `tests/data/fuzz/README.md`) and replayed, with the seeds, by `tests/fuzz_short.rs`.
 
-use delta_collide::cspace::Workspace;
+use delta_collide::cspace::{Symmetry, Workspace};
 use delta_collide::ffi::*;
 use delta_collide::robot::Delta3;
 use delta_collide::table::format::fnv1a64;
@@ -40,7 +40,7 @@ fn a_nonzero_slice_axes_field_outside_4d_tables_is_corrupt() {
     let s = space(2, Pattern::Noise { p: 0.3, seed: 4 });
     let header = Header::for_space(&s, 1, Workspace::THESIS, Certification::SweptBound);
     let tables =
-        [Table::D6(LinearQuadtree6d::build(&s, false).unwrap()), Table::D5(LinearQuadtree5d::build(&s, true).unwrap())];
+        [Table::D6(LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap()), Table::D5(LinearQuadtree5d::build(&s, Symmetry::MirrorY).unwrap())];
     for t in tables {
         for axes in [1u32, 2, 3, 0x7a00, u32::MAX] {
             let mut b = to_bytes(&t, &header);

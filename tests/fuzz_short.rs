@@ -17,7 +17,7 @@
 mod targets;
 
 use delta_collide::cell::reference::reference_cell;
-use delta_collide::cspace::{Progress, Workspace};
+use delta_collide::cspace::{Progress, Symmetry, Workspace};
 use delta_collide::table::format::to_bytes;
 use delta_collide::table::synthetic::{space, Pattern};
 use delta_collide::table::*;
@@ -94,12 +94,12 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
     let s = space(2, Pattern::Noise { p: 0.3, seed: 4 });
     let header = Header::for_space(&s, 0x0123_4567_89ab_cdef, Workspace::THESIS, Certification::SweptBound);
     let synthetic = [
-        ("6d", Table::D6(LinearQuadtree6d::build(&s, false).unwrap())),
-        ("6d_symmetric", Table::D6(LinearQuadtree6d::build(&s, true).unwrap())),
-        ("5d", Table::D5(LinearQuadtree5d::build(&s, false).unwrap())),
-        ("4d_yy", Table::D4(LinearQuadtree4d::build(&s, true, SliceAxes::YY, 0).unwrap())),
-        ("4d_zz", Table::D4(LinearQuadtree4d::build(&s, false, SliceAxes::ZZ, 3).unwrap())),
-        ("shared", Table::Shared(SharedQuadtree6d::build(&s, true).unwrap())),
+        ("6d", Table::D6(LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap())),
+        ("6d_symmetric", Table::D6(LinearQuadtree6d::build(&s, Symmetry::MirrorY).unwrap())),
+        ("5d", Table::D5(LinearQuadtree5d::build(&s, Symmetry::Whole).unwrap())),
+        ("4d_yy", Table::D4(LinearQuadtree4d::build(&s, Symmetry::MirrorY, SliceAxes::YY, 0).unwrap())),
+        ("4d_zz", Table::D4(LinearQuadtree4d::build(&s, Symmetry::Whole, SliceAxes::ZZ, 3).unwrap())),
+        ("shared", Table::Shared(SharedQuadtree6d::build(&s, Symmetry::MirrorY).unwrap())),
     ];
     for (v, t) in synthetic {
         out.push((format!("synthetic_k4_{v}.dct"), to_bytes(&t, &header)));

@@ -2,7 +2,7 @@
 //! specific `TableError`, never a panic nor a table that loads. Corrupted files kept in
 //! `tests/data/` are described in `tests/data/README.md`.
 
-use delta_collide::cspace::{LabelledSpace, Progress, Workspace};
+use delta_collide::cspace::{LabelledSpace, Progress, Symmetry, Workspace};
 use delta_collide::table::format::{fnv1a64, from_bytes_for_cell};
 use delta_collide::table::synthetic::{space, Pattern};
 use delta_collide::table::*;
@@ -15,13 +15,13 @@ fn small_space() -> LabelledSpace {
 
 fn tables(s: &LabelledSpace) -> Vec<Table> {
     vec![
-        Table::D6(LinearQuadtree6d::build(s, false).unwrap()),
-        Table::D6(LinearQuadtree6d::build(s, true).unwrap()),
-        Table::D5(LinearQuadtree5d::build(s, false).unwrap()),
-        Table::D4(LinearQuadtree4d::build(s, true, SliceAxes::YY, 0).unwrap()),
-        Table::D4(LinearQuadtree4d::build(s, false, SliceAxes::ZZ, 3).unwrap()),
-        Table::Shared(SharedQuadtree6d::build(s, true).unwrap()),
-        Table::Shared(SharedQuadtree6d::build_subdivided(s, &sub_cells(s), false).unwrap()),
+        Table::D6(LinearQuadtree6d::build(s, Symmetry::Whole).unwrap()),
+        Table::D6(LinearQuadtree6d::build(s, Symmetry::MirrorY).unwrap()),
+        Table::D5(LinearQuadtree5d::build(s, Symmetry::Whole).unwrap()),
+        Table::D4(LinearQuadtree4d::build(s, Symmetry::MirrorY, SliceAxes::YY, 0).unwrap()),
+        Table::D4(LinearQuadtree4d::build(s, Symmetry::Whole, SliceAxes::ZZ, 3).unwrap()),
+        Table::Shared(SharedQuadtree6d::build(s, Symmetry::MirrorY).unwrap()),
+        Table::Shared(SharedQuadtree6d::build_subdivided(s, &sub_cells(s), Symmetry::Whole).unwrap()),
     ]
 }
 
@@ -174,7 +174,7 @@ fn checksum_valid_but_inconsistent_files_are_corrupt() {
 #[test]
 fn a_loaded_table_answers_as_the_built_one() {
     let s = space(3, Pattern::Blobs);
-    let t = Table::D4(LinearQuadtree4d::build(&s, true, SliceAxes::ZZ, 10).unwrap());
+    let t = Table::D4(LinearQuadtree4d::build(&s, Symmetry::MirrorY, SliceAxes::ZZ, 10).unwrap());
     let (_, back) = from_bytes(&to_bytes(&t, &header(&s))).unwrap();
     for a in &s.grid_a.cells {
         for b in &s.grid_b.cells {

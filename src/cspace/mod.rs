@@ -30,6 +30,7 @@ pub use certify::SubdividedLabels;
 #[cfg(feature = "std")]
 pub use label::{label_space, label_space_thesis, Progress};
 pub use sampler::{CellIndex, SampleGrid, Workspace};
+pub use symmetry::Symmetry;
 
 /// The label of one two-robot sample (one 6-D grid cell).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

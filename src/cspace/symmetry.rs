@@ -36,6 +36,39 @@ pub fn reflection_y(cell: &Cell) -> bool {
     })
 }
 
+/// Whether a table stores every configuration or one of each mirror pair under `y -> -y`
+/// (what the table builders take; a table file records it as a flag).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Symmetry {
+    /// Every configuration is stored; right for any cell.
+    Whole,
+    /// Only A's upper half `iy >= k/2` is stored, a query in the other half reads its
+    /// mirror; right only for a cell with [`reflection_y`].
+    MirrorY,
+}
+
+impl Symmetry {
+    /// [`Symmetry::MirrorY`] when `cell` has the reflection ([`reflection_y`]), else
+    /// [`Symmetry::Whole`].
+    pub fn of(cell: &Cell) -> Symmetry {
+        Symmetry::from_flag(reflection_y(cell))
+    }
+
+    /// [`Symmetry::MirrorY`] for `true` (a table file's symmetry flag), else [`Symmetry::Whole`].
+    pub const fn from_flag(mirrored: bool) -> Symmetry {
+        if mirrored {
+            Symmetry::MirrorY
+        } else {
+            Symmetry::Whole
+        }
+    }
+
+    /// Whether only half is stored.
+    pub const fn is_mirrored(self) -> bool {
+        matches!(self, Symmetry::MirrorY)
+    }
+}
+
 /// The mirror `(ix, k - 1 - iy, iz)` of a grid cell under `y -> -y`.
 pub fn mirror_cell(grid: &SampleGrid, cell: CellIndex) -> CellIndex {
     [cell[0], (grid.k - 1) as u16 - cell[1], cell[2]]

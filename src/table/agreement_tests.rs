@@ -4,14 +4,14 @@
 
 use super::synthetic::{space, Pattern};
 use super::*;
-use crate::cspace::{Label, LabelledSpace};
+use crate::cspace::{Label, LabelledSpace, Symmetry};
 
 fn variants(s: &LabelledSpace, symmetric: bool, t: u32) -> Vec<Table> {
     vec![
-        Table::D6(LinearQuadtree6d::build(s, symmetric).unwrap()),
-        Table::D5(LinearQuadtree5d::build(s, symmetric).unwrap()),
-        Table::D4(LinearQuadtree4d::build(s, symmetric, SliceAxes::YY, t).unwrap()),
-        Table::D4(LinearQuadtree4d::build(s, symmetric, SliceAxes::ZZ, t).unwrap()),
+        Table::D6(LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).unwrap()),
+        Table::D5(LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).unwrap()),
+        Table::D4(LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), SliceAxes::YY, t).unwrap()),
+        Table::D4(LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), SliceAxes::ZZ, t).unwrap()),
     ]
 }
 
@@ -98,9 +98,9 @@ fn lossy_4d_never_loses_a_collision() {
     let nfree = s.labels.iter().filter(|&&l| l == Label::Free).count();
     let mut last_slices = usize::MAX;
     for t in [0, 5, 25, 150] {
-        let yy = LinearQuadtree4d::build(&s, false, SliceAxes::YY, t).unwrap();
+        let yy = LinearQuadtree4d::build(&s, Symmetry::Whole, SliceAxes::YY, t).unwrap();
         let slices = yy.slice_count();
-        let tables = [Table::D6(LinearQuadtree6d::build(&s, false).unwrap()), Table::D4(yy)];
+        let tables = [Table::D6(LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap()), Table::D4(yy)];
         let fp = check_all(&s, &tables, t > 0)[1].0;
         eprintln!("k = 16 blobs 4D/yy t = {t}: {slices} slices, {fp} of {nfree} free samples answered collision");
         assert!(slices <= last_slices, "more slices at a larger t");

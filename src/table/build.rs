@@ -13,7 +13,7 @@
 use crate::cell::Cell;
 use crate::cspace::certify::{label_space_certified, label_space_subdivided};
 use crate::cspace::label::label_space_thesis;
-use crate::cspace::symmetry::reflection_y;
+use crate::cspace::symmetry::Symmetry;
 use crate::cspace::{Label, Progress, Workspace};
 use crate::table::{
     Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
@@ -178,13 +178,13 @@ pub fn build_tables(
         }
     };
     let label_secs = start.elapsed().as_secs_f64();
-    let symmetric = reflection_y(cell);
+    let symmetry = Symmetry::of(cell);
     let mut report = BuildReport {
         samples: (space.grid_a.cells.len(), space.grid_b.cells.len()),
         pairs: space.labels.len(),
         collisions: space.labels.iter().filter(|&&l| l == Label::Collision).count(),
         unreachable: space.labels.iter().filter(|&&l| l == Label::Unreachable).count(),
-        symmetric,
+        symmetric: symmetry.is_mirrored(),
         label_secs,
         sub_cells: sub.as_ref().map(|s| (s.pairs.len(), sub_secs)),
         build_secs: 0.0,
@@ -197,12 +197,12 @@ pub fn build_tables(
         .iter()
         .map(|&variant| {
             let table = match variant {
-                Variant::D6 => LinearQuadtree6d::build(&space, symmetric).map(Table::D6),
-                Variant::D5 => LinearQuadtree5d::build(&space, symmetric).map(Table::D5),
-                Variant::D4 { axes, t } => LinearQuadtree4d::build(&space, symmetric, axes, t).map(Table::D4),
-                Variant::Shared => SharedQuadtree6d::build(&space, symmetric).map(Table::Shared),
+                Variant::D6 => LinearQuadtree6d::build(&space, symmetry).map(Table::D6),
+                Variant::D5 => LinearQuadtree5d::build(&space, symmetry).map(Table::D5),
+                Variant::D4 { axes, t } => LinearQuadtree4d::build(&space, symmetry, axes, t).map(Table::D4),
+                Variant::Shared => SharedQuadtree6d::build(&space, symmetry).map(Table::Shared),
                 Variant::SharedSubdivided => match &sub {
-                    Some(sub) => SharedQuadtree6d::build_subdivided(&space, sub, symmetric).map(Table::Shared),
+                    Some(sub) => SharedQuadtree6d::build_subdivided(&space, sub, symmetry).map(Table::Shared),
                     None => Err(TableError::BadInput { what: "no sub-cells were labelled".into() }),
                 },
             };

@@ -13,6 +13,8 @@ use super::space::fold;
 #[cfg(feature = "std")]
 use super::space::SpaceView;
 #[cfg(feature = "std")]
+use crate::cspace::symmetry::Symmetry;
+#[cfg(feature = "std")]
 use crate::cspace::{Label, LabelledSpace};
 use alloc::{format, vec::Vec};
 
@@ -51,13 +53,14 @@ fn column_intervals(column: impl Iterator<Item = (u16, Label)>, out: &mut Vec<[u
 }
 
 impl LinearQuadtree5d {
-    /// Builds the table of `space` (thesis Algorithm 6); with `symmetric`, only A's upper
+    /// Builds the table of `space` (thesis Algorithm 6); with [`Symmetry::MirrorY`], only A's upper
     /// half `iy >= k/2` is stored.
     ///
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or the label count is wrong.
     #[cfg(feature = "std")]
-    pub fn build(space: &LabelledSpace, symmetric: bool) -> Result<LinearQuadtree5d, TableError> {
+    pub fn build(space: &LabelledSpace, symmetry: Symmetry) -> Result<LinearQuadtree5d, TableError> {
+        let symmetric = symmetry.is_mirrored();
         let view = SpaceView::new(space, symmetric)?;
         let cells_b = &space.grid_b.cells;
         // B's samples in (ix', iy', iz') order, cut into columns of equal (ix', iy').

@@ -27,6 +27,8 @@ use super::space::fold;
 #[cfg(feature = "std")]
 use super::space::SpaceView;
 #[cfg(feature = "std")]
+use crate::cspace::symmetry::Symmetry;
+#[cfg(feature = "std")]
 use crate::cspace::{Label, LabelledSpace};
 use alloc::{format, vec::Vec};
 
@@ -74,13 +76,14 @@ fn free_maps(view: &SpaceView, plain_a: &[u64], plain_b: &[u64], leaves: &mut Ve
 
 impl LinearQuadtree6d {
     /// Builds the table of `space` (thesis Algorithm 4 with the condensation of the module
-    /// doc); with `symmetric`, only A's upper half `iy >= k/2` is stored (see `space.rs`).
+    /// doc); with [`Symmetry::MirrorY`], only A's upper half `iy >= k/2` is stored (see `space.rs`).
     ///
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
     /// `levels <= MAX_BUILD_LEVELS_6D`, or the label count is wrong.
     #[cfg(feature = "std")]
-    pub fn build(space: &LabelledSpace, symmetric: bool) -> Result<LinearQuadtree6d, TableError> {
+    pub fn build(space: &LabelledSpace, symmetry: Symmetry) -> Result<LinearQuadtree6d, TableError> {
+        let symmetric = symmetry.is_mirrored();
         let view = SpaceView::new(space, symmetric)?;
         if view.levels > MAX_BUILD_LEVELS_6D {
             return Err(bad_input(format!("6-D builder takes levels <= {MAX_BUILD_LEVELS_6D}, got {}", view.levels)));
@@ -176,15 +179,16 @@ impl LinearQuadtree6d {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cspace::Symmetry;
     use crate::table::synthetic::{space, Pattern};
 
     #[test]
     fn all_collision_condenses_to_the_root() {
         let s = space(3, Pattern::AllCollision);
-        let t = LinearQuadtree6d::build(&s, false).unwrap();
+        let t = LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap();
         assert_eq!(t.codes().len(), 1, "no free sample: one root node");
         assert!(t.query([0; 6]) && t.query([7; 6]));
-        let f = LinearQuadtree6d::build(&space(3, Pattern::AllFree), false).unwrap();
+        let f = LinearQuadtree6d::build(&space(3, Pattern::AllFree), Symmetry::Whole).unwrap();
         assert!(f.codes().is_empty());
         assert!(!f.query([3, 3, 3, 3, 3, 3]));
     }
@@ -193,7 +197,7 @@ mod tests {
     fn condensation_never_covers_a_free_sample() {
         for (pattern, must_condense) in [(Pattern::Noise { p: 0.3, seed: 5 }, false), (Pattern::Blobs, true)] {
             let s = space(3, pattern);
-            let t = LinearQuadtree6d::build(&s, false).unwrap();
+            let t = LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap();
             let nb = s.grid_b.cells.len();
             let mut collisions = 0;
             for (ia, a) in s.grid_a.cells.iter().enumerate() {
@@ -222,7 +226,7 @@ mod tests {
 
     #[test]
     fn out_of_range_index_fails_closed() {
-        let t = LinearQuadtree6d::build(&space(2, Pattern::AllFree), false).unwrap();
+        let t = LinearQuadtree6d::build(&space(2, Pattern::AllFree), Symmetry::Whole).unwrap();
         assert!(t.query([4, 0, 0, 0, 0, 0]));
         assert!(t.query([0, 0, 0, 0, 0, u16::MAX]));
     }

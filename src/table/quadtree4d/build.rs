@@ -6,6 +6,7 @@ use super::{shape, LinearQuadtree4d, SliceAxes};
 use crate::cspace::{Label, LabelledSpace};
 use crate::table::error::TableError;
 use crate::table::space::SpaceView;
+use crate::cspace::symmetry::Symmetry;
 use std::collections::BTreeMap;
 
 
@@ -32,17 +33,18 @@ pub(super) fn put(s: &mut [u64], care: &mut [u64], bit: usize, label: Label) -> 
 
 impl LinearQuadtree4d {
     /// Builds the table of `space` with threshold `t` (thesis Algorithm 8); with
-    /// `symmetric`, only A's upper half `iy >= k/2` is stored.
+    /// [`Symmetry::MirrorY`], only A's upper half `iy >= k/2` is stored.
     ///
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or the label count is wrong.
     #[cfg(feature = "std")]
     pub fn build(
         space: &LabelledSpace,
-        symmetric: bool,
+        symmetry: Symmetry,
         axes: SliceAxes,
         t: u32,
     ) -> Result<LinearQuadtree4d, TableError> {
+        let symmetric = symmetry.is_mirrored();
         let view = SpaceView::new(space, symmetric)?;
         let (k, levels) = (view.k, view.levels);
         let (second, ignored) = axes.dims();

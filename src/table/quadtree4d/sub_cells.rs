@@ -8,6 +8,7 @@ use super::grouping::Grouping;
 use super::{shape, LinearQuadtree4d, SliceAxes};
 use crate::cspace::{Label, SubdividedLabels};
 use crate::table::error::TableError;
+use crate::cspace::symmetry::Symmetry;
 use crate::table::space::{check_grids, merge, reflections, NONE};
 use rayon::prelude::*;
 
@@ -20,10 +21,11 @@ impl LinearQuadtree4d {
     /// [`TableError::BadInput`] when the grids differ.
         pub fn build_subdivided(
         labels: &SubdividedLabels,
-        symmetric: bool,
+        symmetry: Symmetry,
         axes: SliceAxes,
         t: u32,
     ) -> Result<LinearQuadtree4d, TableError> {
+        let symmetric = symmetry.is_mirrored();
         let mut grouping = Grouping::new(labels.grid_a.levels, symmetric, axes, t);
         subdivided_slices(labels, symmetric, axes, |range, s, care| grouping.add(range, s, care))?;
         Ok(grouping.finish())
@@ -196,6 +198,7 @@ fn window_bits(words: &[u64], start: usize, len: usize) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cspace::Symmetry;
 
 
     /// The builder without dense labels makes the table the dense builder makes from the
@@ -219,8 +222,8 @@ mod tests {
             let symmetric = reflection_y(&cell);
             for axes in [SliceAxes::YY, SliceAxes::ZZ] {
                 for t in [0, 40] {
-                    let want = LinearQuadtree4d::build(&dense, symmetric, axes, t).unwrap();
-                    let got = LinearQuadtree4d::build_subdivided(&sparse, symmetric, axes, t).unwrap();
+                    let want = LinearQuadtree4d::build(&dense, Symmetry::from_flag(symmetric), axes, t).unwrap();
+                    let got = LinearQuadtree4d::build_subdivided(&sparse, Symmetry::from_flag(symmetric), axes, t).unwrap();
                     assert!(want.codes.len() > 100 && want.slice_count() > 10, "{name} {axes:?} t={t}: too small");
                     assert!(got == want, "{name} {axes:?} t={t}: the tables differ");
                     if t == 0 {

@@ -7,6 +7,7 @@ use crate::cspace::{Label, LabelledSpace, SubCells};
 use crate::table::code::MAX_LEVELS;
 use crate::table::error::{bad_input, TableError};
 use crate::table::space::SpaceView;
+use crate::cspace::symmetry::Symmetry;
 use alloc::format;
 use std::collections::HashMap;
 
@@ -218,14 +219,14 @@ pub(super) fn mirror_sub_cells(mask: u64) -> u64 {
 }
 
 impl SharedQuadtree6d {
-    /// Builds the table of `space` (see the module doc); with `symmetric`, only A's upper
+    /// Builds the table of `space` (see the module doc); with [`Symmetry::MirrorY`], only A's upper
     /// half `iy >= k/2` is stored, as the other variants do.
     ///
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
     /// `2 <= levels <= MAX_LEVELS`, or the label count is wrong.
-        pub fn build(space: &LabelledSpace, symmetric: bool) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, None, symmetric)
+        pub fn build(space: &LabelledSpace, symmetry: Symmetry) -> Result<SharedQuadtree6d, TableError> {
+        Self::build_with(space, None, symmetry.is_mirrored())
     }
 
     /// As [`build`](Self::build) with every pair labelled collision cut into the sub-cells of
@@ -237,9 +238,9 @@ impl SharedQuadtree6d {
         pub fn build_subdivided(
         space: &LabelledSpace,
         sub: &SubCells,
-        symmetric: bool,
+        symmetry: Symmetry,
     ) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, Some(sub), symmetric)
+        Self::build_with(space, Some(sub), symmetry.is_mirrored())
     }
 
         fn build_with(

@@ -271,7 +271,7 @@ impl SharedQuadtree6d {
 mod tests {
     use super::build::mirror_sub_cells;
     use super::*;
-    use crate::cspace::{Label, LabelledSpace, SubCells};
+    use crate::cspace::{Label, LabelledSpace, SubCells, Symmetry};
     use crate::table::space::SpaceView;
     use crate::table::synthetic::{space, Pattern};
     use crate::table::LinearQuadtree6d;
@@ -309,8 +309,8 @@ mod tests {
         ];
         for (seed, (pattern, levels, symmetric)) in cases.into_iter().enumerate() {
             let space = space(levels, pattern);
-            let shared = SharedQuadtree6d::build(&space, symmetric).unwrap();
-            let d6 = LinearQuadtree6d::build(&space, symmetric).unwrap();
+            let shared = SharedQuadtree6d::build(&space, Symmetry::from_flag(symmetric)).unwrap();
+            let d6 = LinearQuadtree6d::build(&space, Symmetry::from_flag(symmetric)).unwrap();
             let view = SpaceView::new(&space, symmetric).unwrap();
             let (ga, gb) = (&space.grid_a, &space.grid_b);
             for (ia, ca) in ga.cells.iter().enumerate().filter(|&(ia, _)| view.stored(ia)) {
@@ -357,7 +357,7 @@ mod tests {
         {
             let space = space(levels, pattern);
             let sub = random_sub_cells(&space, u64::from(levels));
-            let t = SharedQuadtree6d::build_subdivided(&space, &sub, symmetric).unwrap();
+            let t = SharedQuadtree6d::build_subdivided(&space, &sub, Symmetry::from_flag(symmetric)).unwrap();
             assert_eq!(t.sub_levels(), 1);
             let view = SpaceView::new(&space, symmetric).unwrap();
             let nb = space.grid_b.cells.len();
@@ -415,7 +415,7 @@ mod tests {
     #[test]
     fn out_of_range_cells_are_collisions() {
         let space = space(3, Pattern::Blobs);
-        let t = SharedQuadtree6d::build(&space, false).unwrap();
+        let t = SharedQuadtree6d::build(&space, Symmetry::Whole).unwrap();
         assert!(t.query([8, 0, 0, 0, 0, 0]));
         assert!(t.query([0, 0, 0, 0, 0, u16::MAX]));
     }
@@ -423,7 +423,7 @@ mod tests {
     #[test]
     fn malformed_parts_are_rejected() {
         let space = space(3, Pattern::Noise { p: 0.2, seed: 4 });
-        let t = SharedQuadtree6d::build(&space, false).unwrap();
+        let t = SharedQuadtree6d::build(&space, Symmetry::Whole).unwrap();
         let p = t.parts();
         let (m, b, ds, c, l) =
             (p.masks.to_vec(), p.bases.to_vec(), p.depth_start.to_vec(), p.children.to_u32(), p.leaves.to_vec());

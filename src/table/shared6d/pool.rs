@@ -337,6 +337,7 @@ fn top_entries(symmetric: bool, top_depths: u32, a: &Arrays, node: impl Fn(usize
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cspace::Symmetry;
     use crate::table::space::fold;
     use crate::table::synthetic::{space, Pattern};
     use crate::table::SharedQuadtree6d;
@@ -385,7 +386,7 @@ mod tests {
             (Pattern::AllCollision, 3, true),
             (Pattern::AllFree, 4, false),
         ] {
-            let t = SharedQuadtree6d::build(&space(levels, pattern), symmetric).unwrap();
+            let t = SharedQuadtree6d::build(&space(levels, pattern), Symmetry::from_flag(symmetric)).unwrap();
             let p = t.parts();
             let a = (p.masks, p.bases, p.depth_start, p.children.to_u32(), p.leaves);
             for wide in [None, Some(u32::MAX)] {
