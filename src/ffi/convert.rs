@@ -28,8 +28,9 @@ pub(crate) fn cell_error_status(e: &CellError) -> DcStatus {
     }
 }
 
-/// The status a table error maps to, one per [`TableError`] variant.
-pub(crate) fn table_error_status(e: &TableError) -> DcStatus {
+/// The status a table error maps to, one per [`TableError`] variant: what `dc_init_with_table`
+/// and `dc_init_from_files` return for it (the fuzz crate checks them against this map).
+pub fn table_error_status(e: &TableError) -> DcStatus {
     match e {
         TableError::Truncated { .. } => DC_STATUS_TABLE_TRUNCATED,
         TableError::BadMagic { .. } => DC_STATUS_TABLE_BAD_MAGIC,

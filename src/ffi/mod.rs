@@ -18,6 +18,7 @@ mod collider;
 mod convert;
 pub mod types;
 
+pub use convert::table_error_status;
 pub use types::*;
 
 use collider::{Collider, InitError};

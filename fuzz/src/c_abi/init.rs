@@ -9,7 +9,7 @@ use delta_collide::ffi::*;
 use delta_collide::math::Vec3;
 use delta_collide::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
 use delta_collide::table::format::fnv1a64;
-use delta_collide::table::{TableChecker, TableError, TableKind};
+use delta_collide::table::{TableChecker, TableKind};
 use std::ffi::{c_char, CStr, CString};
 use std::sync::OnceLock;
 
@@ -224,19 +224,6 @@ pub(super) fn init(input: &mut Input, live: &mut Vec<Live>) {
     keep(live, config.into_live(h));
 }
 
-/// The status `dc_init_with_table` gives for a table error (one per variant).
-fn table_status(e: &TableError) -> DcStatus {
-    match e {
-        TableError::Truncated { .. } => DC_STATUS_TABLE_TRUNCATED,
-        TableError::BadMagic { .. } => DC_STATUS_TABLE_BAD_MAGIC,
-        TableError::UnsupportedVersion { .. } => DC_STATUS_TABLE_UNSUPPORTED_VERSION,
-        TableError::WrongEndianness => DC_STATUS_TABLE_WRONG_ENDIANNESS,
-        TableError::Corrupt { .. } => DC_STATUS_TABLE_CORRUPT,
-        TableError::WrongCell { .. } => DC_STATUS_TABLE_WRONG_CELL,
-        TableError::BadInput { .. } => DC_STATUS_TABLE_NOT_TWO_ROBOTS,
-    }
-}
-
 /// Table bytes: a seed table or bytes of the input (source byte), up to 7 byte edits, and
 /// optionally resealed (fingerprint of `cell`, checksum) so that edits reach the field checks.
 fn table_bytes(input: &mut Input, cell: Option<&Cell>) -> Vec<u8> {
@@ -283,7 +270,7 @@ pub(super) fn init_with_table(input: &mut Input, live: &mut Vec<Live>) {
         (_, DC_STATUS_OK, _) if null_table => DC_STATUS_NULL_POINTER,
         (_, DC_STATUS_OK, Some(cell)) if cell.robots.len() != 2 => DC_STATUS_TABLE_NOT_TWO_ROBOTS,
         (_, DC_STATUS_OK, Some(cell)) => {
-            TableChecker::new(cell, &bytes).map_or_else(|e| table_status(&e), |_| DC_STATUS_OK)
+            TableChecker::new(cell, &bytes).map_or_else(|e| table_error_status(&e), |_| DC_STATUS_OK)
         }
         (_, s, _) => s,
     };
@@ -366,7 +353,7 @@ pub(super) fn init_from_files(input: &mut Input, live: &mut Vec<Live>) {
     let loaded = || {
         let bytes = std::fs::read(t1_table_path().to_str().unwrap()).unwrap();
         let t1 = delta_collide::cell::reference::reference_cell("T1").unwrap();
-        TableChecker::new(t1, &bytes).map_or_else(|e| table_status(&e), |_| DC_STATUS_OK)
+        TableChecker::new(t1, &bytes).map_or_else(|e| table_error_status(&e), |_| DC_STATUS_OK)
     };
     let expected = match (null_out, path_status(cell_kind), path_status(table_kind)) {
         (true, _, _) => DC_STATUS_NULL_POINTER,
