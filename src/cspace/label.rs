@@ -29,28 +29,19 @@ use crate::robot::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{max_or_nan, min_or_nan, Mat3, Real, Vec3};
 use crate::robot::{ModelOptions, RobotModel};
-use indicatif::{ProgressBar, ProgressStyle};
+use core::sync::atomic::{AtomicU64, Ordering};
 use rayon::prelude::*;
 
-/// Whether a labelling draws progress bars on stderr. The library prints nothing unless the
-/// caller asks: a controller or a test builds silently, the CLI with bars.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// Whether a labelling reports its progress. The library prints nothing: a controller or a
+/// test builds silently, and the CLI turns the reports into a progress bar.
+#[derive(Clone, Copy, Debug, Default)]
 pub enum Progress {
-    /// Nothing on stderr.
+    /// No reports.
     #[default]
     Silent,
-    /// A progress bar per labelling pass on stderr.
-    Bars,
-}
-
-impl Progress {
-    /// A bar of `len` steps, hidden when silent.
-    fn bar(self, len: u64) -> ProgressBar {
-        match self {
-            Progress::Silent => ProgressBar::hidden(),
-            Progress::Bars => ProgressBar::new(len),
-        }
-    }
+    /// `report(rows_done, rows)` after each row of A of a labelling pass, from the labelling's
+    /// worker threads (so it may see the counts out of order); `rows_done == rows` once per pass.
+    Rows(fn(u64, u64)),
 }
 
 /// Slack (mm) of every axis-aligned pre-test: boxes closer than this go on to the exact test.
@@ -284,7 +275,7 @@ pub fn all_box_pairs(na: usize, nb: usize) -> u64 {
 /// The label of every pair `(ia, ib)` at `ia * b.len() + ib`: `Unreachable` when either
 /// centre is unreachable, `Collision` when either is `Unknown` or some pair of boxes
 /// intersects and `second_look(ia, ib)` (called only then) confirms it, else `Free`.
-/// Rows are labelled in parallel; [`Progress::Bars`] draws a bar on stderr.
+/// Rows are labelled in parallel, each reported to `progress`.
 pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, progress: Progress) -> Vec<Label>
 where
     F: Fn(usize, usize) -> bool + Sync,
@@ -306,10 +297,7 @@ where
     let widest = order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
     // The same entries stored in that order: a row's candidates are read in memory order.
     let sorted = b.subset(&order);
-    let bar = progress.bar(na as u64);
-    if let Ok(style) = ProgressStyle::with_template("labelling {bar:40} {pos}/{len} rows of A, {elapsed} (eta {eta})") {
-        bar.set_style(style);
-    }
+    let rows_done = AtomicU64::new(0);
     let mut labels = vec![Label::Unreachable; na * nb];
     if nb > 0 {
         labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| {
@@ -336,10 +324,11 @@ where
                     }
                 }
             }
-            bar.inc(1);
+            if let Progress::Rows(report) = progress {
+                report(rows_done.fetch_add(1, Ordering::Relaxed) + 1, na as u64);
+            }
         });
     }
-    bar.finish_and_clear();
     labels
 }
 

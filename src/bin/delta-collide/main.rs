@@ -16,6 +16,7 @@ mod demo;
 mod files;
 mod picture;
 mod plot;
+mod progress;
 mod quilt;
 mod render;
 mod replay;
@@ -71,7 +72,7 @@ impl From<clap::Error> for Failure {
 
 fn main() {
     let cli = Cli::parse_checked();
-    let progress = if cli.quiet { Progress::Silent } else { Progress::Bars };
+    let progress = if cli.quiet { Progress::Silent } else { Progress::Rows(progress::labelling_rows) };
     let result = match &cli.command {
         Command::Demo(a) => demo::demo(a),
         Command::Check(a) => check(a),
@@ -238,7 +239,7 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
     let labelling = Labelling::from(args.labelling);
     check_memory(cell, k, &Workspace::THESIS)?;
     let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
-    if let (Progress::Bars, Some((pairs, secs))) = (progress, r.sub_cells) {
+    if let (Progress::Rows(_), Some((pairs, secs))) = (progress, r.sub_cells) {
         eprintln!("sub-cells of {pairs} collision pairs: {secs:.2} s");
     }
     let bytes = to_bytes(&table, &header);

@@ -135,11 +135,11 @@ pub enum Refinement {
 }
 
 /// What the certified labelling does and shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug)]
 pub struct CertifyConfig {
     /// How far it refines.
     pub refinement: Refinement,
-    /// Whether to draw a progress bar on stderr while labelling.
+    /// Where the labelling reports its progress.
     pub progress: Progress,
 }
 
