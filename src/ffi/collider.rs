@@ -48,8 +48,10 @@ pub(crate) struct Collider {
     protective: ProtectiveChecker,
 }
 
+/// The protective checker of a handle until `dc_set_stop_model` sets one: without the motor-angle
+/// tables, so that `dc_init` builds nothing a caller of `dc_query` alone would not use.
 fn protective_for(cell: &Cell) -> ProtectiveChecker {
-    ProtectiveChecker::new(cell.clone(), DEFAULT_WARN_MM).expect("the default warn_mm is valid")
+    ProtectiveChecker::without_motor_tables(cell.clone(), DEFAULT_WARN_MM).expect("the default warn_mm is valid")
 }
 
 impl Collider {
