@@ -3,7 +3,9 @@
  * See harness.h.
  */
 #include "harness.h"
+#include "pou.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -181,4 +183,90 @@ void free_tables(HarnessOptions *options)
         options->tables[c].bytes = NULL;
         options->tables[c].len = 0;
     }
+}
+
+int open_protective(const char *who, const char *cell_name, const char *case_name, const DcStopConfig *model,
+                    MrCell *cell, MrScenario *scenario, DcStopConfig stops[MR_MAX_ROBOTS], DcCollider **h,
+                    DcCollider **exact)
+{
+    DcRobotConfig robots[MR_MAX_ROBOTS];
+    DcCellConfig config;
+    DcStatus s;
+    size_t j;
+    *h = *exact = NULL;
+    if (mr_register_cell(cell_name, cell) != MR_OK
+        || mr_load_scenario(SCENARIO_FILE, cell_name, case_name, cell->n_robots, scenario) != MR_OK) {
+        return check(0, "%s %s %s: cannot load the scenario", who, cell_name, case_name);
+    }
+    pou_cell_config(cell, DC_METHOD_SAT_CACHE, robots, &config);
+    s = dc_init(&config, h);
+    check(s == DC_STATUS_OK, "%s %s: dc_init: %s", who, cell_name, dc_status_str(s));
+    s = dc_init(&config, exact);
+    check(s == DC_STATUS_OK, "%s %s: dc_init (exact): %s", who, cell_name, dc_status_str(s));
+    for (j = 0; j < cell->n_robots; ++j) {
+        stops[j] = *model;
+    }
+    s = *h == NULL ? DC_STATUS_NULL_POINTER : dc_set_stop_model(*h, 1.0, 10.0, stops, cell->n_robots);
+    if (!check(s == DC_STATUS_OK && *exact != NULL, "%s %s: dc_set_stop_model: %s", who, cell_name,
+               dc_status_str(s))) {
+        dc_destroy(*h);
+        dc_destroy(*exact);
+        *h = *exact = NULL;
+        return 0;
+    }
+    return 1;
+}
+
+int stop_substep(DcCollider *exact, const MrScenario *s, MrStop stop[MR_MAX_ROBOTS], StopStats *st)
+{
+    const double dt_ms = 1.0 / STOP_SUBSTEPS;
+    DcVec3 tcps[MR_MAX_ROBOTS];
+    DcVerdict v = DC_VERDICT_STOP;
+    DcStatus status;
+    int moving = 0;
+    size_t j;
+    for (j = 0; j < s->n_robots; ++j) {
+        moving |= mr_stop_step(&s->robots[j], &stop[j], dt_ms);
+        tcps[j] = vec3(stop[j].o.tcp[0], stop[j].o.tcp[1], stop[j].o.tcp[2]);
+    }
+    if (moving) {
+        st->moving_ms += dt_ms;
+    }
+    status = dc_query(exact, tcps, s->n_robots, &v, NULL);
+    st->samples++;
+    if (status != DC_STATUS_OK || v != DC_VERDICT_FREE) {
+        st->contacts++;
+    }
+    return moving;
+}
+
+VerdictTally tally_start(void)
+{
+    VerdictTally t = { -1, -1, 0, 0, 0, INFINITY };
+    return t;
+}
+
+int tally_verdict(VerdictTally *t, long tick, DcStatus s, DcVerdict v, const DcProtectiveReport *rep)
+{
+    if (s != DC_STATUS_OK) {
+        t->n_bad_status++;
+    }
+    if (rep->clearance_mm < t->min_clear) {
+        t->min_clear = rep->clearance_mm;
+    }
+    if (v == DC_VERDICT_WARN) {
+        t->n_warn++;
+        if (t->first_warn < 0) {
+            t->first_warn = tick;
+        }
+        return 0;
+    }
+    if (v == DC_VERDICT_FREE) {
+        return 0;
+    }
+    t->n_stop++;
+    if (t->first_stop < 0) {
+        t->first_stop = tick;
+    }
+    return 1;
 }

@@ -82,6 +82,41 @@ int run_table_scenario(const char *cell_name, const char *case_name, const Harne
  * table-mode ones when T1's table is loaded. */
 void bad_input(const HarnessOptions *options);
 
+/* Two handles on reference cell `cell_name` for a protective scenario: *h with every robot's
+ * stopping model `model` (warn_mm 10), *exact for the exact model beside it; and the scenario
+ * (cell_name, case_name). Returns 0 after a failed check naming `who` when one cannot be made
+ * (both handles are then destroyed and NULL). */
+int open_protective(const char *who, const char *cell_name, const char *case_name, const DcStopConfig *model,
+                    MrCell *cell, MrScenario *scenario, DcStopConfig stops[MR_MAX_ROBOTS], DcCollider **h,
+                    DcCollider **exact);
+
+#define STOP_SUBSTEPS 10 /* 0.1 ms steps per 1 ms tick of a simulated stop */
+
+/* What simulated stops found. */
+typedef struct StopStats {
+    unsigned long stops;    /* stops simulated */
+    unsigned long samples;  /* 0.1 ms steps checked with the exact model */
+    unsigned long contacts; /* of those, steps where boxes touch (or the check failed) */
+    double moving_ms;       /* time some robot was still moving */
+} StopStats;
+
+/* Advances every robot's stop by 0.1 ms and checks the TCPs with the exact handle; returns
+ * nonzero while some robot still moves. */
+int stop_substep(DcCollider *exact, const MrScenario *s, MrStop stop[MR_MAX_ROBOTS], StopStats *st);
+
+/* The protective verdicts of a run, tick by tick. */
+typedef struct VerdictTally {
+    long first_warn, first_stop; /* -1: none */
+    unsigned long n_warn, n_stop, n_bad_status;
+    double min_clear; /* the smallest clearance reported (mm) */
+} VerdictTally;
+
+/* A tally of no ticks. */
+VerdictTally tally_start(void);
+
+/* Counts tick `tick`'s status, verdict and report; returns nonzero when the verdict is STOP. */
+int tally_verdict(VerdictTally *t, long tick, DcStatus s, DcVerdict v, const DcProtectiveReport *rep);
+
 /* The trajectory scenarios with the protective verdict (protective.c): at the first STOP the
  * robots stop as their stopping models say, and every 0.1 ms of the stop is checked for
  * contact with the exact model. --quick runs T1 collision only. */

@@ -349,6 +349,57 @@ void mr_override_step(const MrTrajectory *traj, MrOverride *o, double dt_ticks, 
     o->speed = distance3(before, o->tcp) / dt_s;
 }
 
+/* Whether the robot holds waypoint tick `tick` exactly (the end of a braking segment). */
+static int at_waypoint(const MrTrajectory *traj, double tick)
+{
+    size_t i;
+    for (i = 0; i < traj->n_waypoints; ++i) {
+        if ((double)traj->tick[i] == tick) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+void mr_stop_start(const MrOverride *now, double reaction_ms, double decel_mm_s2, MrStop *stop)
+{
+    stop->o = *now;
+    stop->reaction_ms = reaction_ms;
+    stop->decel_mm_s2 = decel_mm_s2;
+    stop->elapsed_ms = 0.0;
+    stop->moving = 1;
+}
+
+int mr_stop_step(const MrTrajectory *traj, MrStop *stop, double dt_ms)
+{
+    MrOverride *o = &stop->o;
+    double next, end_tick;
+    if (!stop->moving) {
+        return 0;
+    }
+    stop->elapsed_ms += dt_ms;
+    if (stop->elapsed_ms <= stop->reaction_ms) {
+        mr_override_step(traj, o, dt_ms, dt_ms * 1e-3);
+        return 1;
+    }
+    if (stop->elapsed_ms - dt_ms <= stop->reaction_ms) {
+        o->cap = o->speed; /* braking starts from the speed the reaction ended at */
+    }
+    next = o->cap - stop->decel_mm_s2 * dt_ms * 1e-3;
+    next = next > 0.0 ? next : 0.0;
+    end_tick = o->cap > 0.0 ? mr_trajectory_advance(traj, o->path_tick, 0.5 * (o->cap + next) * dt_ms * 1e-3)
+                            : o->path_tick;
+    /* Holding a waypoint, or at the segment's end: the path-maintaining stop is over. */
+    if (end_tick == o->path_tick || at_waypoint(traj, end_tick)) {
+        next = 0.0;
+    }
+    o->path_tick = end_tick;
+    mr_trajectory_tcp_at(traj, end_tick, o->tcp);
+    o->cap = o->speed = next;
+    stop->moving = next > 0.0;
+    return stop->moving;
+}
+
 MrStatus mr_load_scenario(const char *path, const char *cell, const char *name, size_t n_robots,
                           MrScenario *out)
 {

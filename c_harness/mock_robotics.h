@@ -137,6 +137,24 @@ void mr_override_request(MrOverride *o, double wanted_mm_s, double ramp_mm_s2, d
  * segment's end). */
 void mr_override_step(const MrTrajectory *traj, MrOverride *o, double dt_ticks, double dt_s);
 
+/* A path-maintaining stop of one robot (SPEC section 8): from the STOP it keeps its motion for
+ * reaction_ms (the programmed motion, capped at the override cap it had: INFINITY for none),
+ * then brakes along its path, its speed falling by decel_mm_s2 per second, until it stands
+ * still; it never passes the end of the straight segment it brakes on (the next waypoint). */
+typedef struct MrStop {
+    MrOverride o;       /* the robot now; o.speed is the speed braking starts from */
+    double reaction_ms; /* from the STOP to the start of braking */
+    double decel_mm_s2;
+    double elapsed_ms;  /* since the STOP */
+    int moving;
+} MrStop;
+
+/* A stop starting from the robot's state `now` (copied). */
+void mr_stop_start(const MrOverride *now, double reaction_ms, double decel_mm_s2, MrStop *stop);
+
+/* Advances the stop by dt_ms; returns nonzero while the robot still moves. */
+int mr_stop_step(const MrTrajectory *traj, MrStop *stop, double dt_ms);
+
 /* Reads the scenario (cell, case) from a scenarios file (format at the top of the file).
  * Every robot 0..n_robots-1 must have at least one waypoint. */
 MrStatus mr_load_scenario(const char *path, const char *cell, const char *name, size_t n_robots,

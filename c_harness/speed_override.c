@@ -19,13 +19,10 @@
  * ticks touching T, smallest clearance X mm`.
  */
 #include "harness.h"
-#include "pou.h"
 
 #include <math.h>
 #include <stdio.h>
-#include <string.h>
 
-#define SUBSTEPS 10          /* 0.1 ms steps per 1 ms tick in a simulated stop */
 #define OVERRIDE_SHARE 0.9   /* share of the reported speed limit the override asks for */
 #define OVERRIDE_RAMP 0.5    /* share of max_accel_mm_s2 the cap may change by: the rest is
                               * left to the path's own acceleration (its corners and profile) */
@@ -65,75 +62,23 @@ static void tcps_of(const MrOverride o[MR_MAX_ROBOTS], size_t n, DcVec3 out[MR_M
     }
 }
 
-static int at_waypoint(const MrTrajectory *t, double tick)
-{
-    size_t i;
-    for (i = 0; i < t->n_waypoints; ++i) {
-        if ((double)t->tick[i] == tick) {
-            return 1;
-        }
-    }
-    return 0;
-}
-
-/* What the simulated stops found. */
-typedef struct StopStats {
-    unsigned long stops, samples, contacts;
-} StopStats;
-
-/* A stop from the robots' state `now` (copied): the reaction keeps each robot's commanded
- * motion (its cap frozen at its speed), then it brakes along its path at decel_mm_s2; every
- * 0.1 ms the exact handle checks for contact. */
+/* A stop from the robots' state `now`: the reaction keeps each robot's commanded motion (its
+ * cap frozen at its speed), then it brakes along its path; every 0.1 ms the exact handle
+ * checks for contact. */
 static void simulate_stop(DcCollider *exact, const MrScenario *s, const DcStopConfig stops[MR_MAX_ROBOTS],
                           const MrOverride now[MR_MAX_ROBOTS], StopStats *st)
 {
-    MrOverride o[MR_MAX_ROBOTS];
-    const double dt_ms = 1.0 / SUBSTEPS;
+    MrStop stop[MR_MAX_ROBOTS];
     double elapsed_ms = 0.0;
-    int moving = 1;
     size_t j;
-    memcpy(o, now, sizeof o);
     for (j = 0; j < s->n_robots; ++j) {
-        o[j].cap = o[j].speed;
+        MrOverride o = now[j];
+        o.cap = o.speed;
+        mr_stop_start(&o, stops[j].reaction_ms, stops[j].decel_mm_s2, &stop[j]);
     }
     st->stops++;
-    while (moving && elapsed_ms < 10000.0) {
-        DcVec3 tcps[MR_MAX_ROBOTS];
-        DcVerdict v = DC_VERDICT_STOP;
-        DcStatus status;
-        moving = 0;
-        elapsed_ms += dt_ms;
-        for (j = 0; j < s->n_robots; ++j) {
-            const MrTrajectory *t = &s->robots[j];
-            if (elapsed_ms <= stops[j].reaction_ms) {
-                mr_override_step(t, &o[j], dt_ms, dt_ms * 1e-3);
-                moving = 1;
-                continue;
-            }
-            if (elapsed_ms - dt_ms <= stops[j].reaction_ms) {
-                o[j].cap = o[j].speed; /* braking starts from the speed the reaction ended at */
-            }
-            if (o[j].cap > 0.0) {
-                double next = o[j].cap - stops[j].decel_mm_s2 * dt_ms * 1e-3;
-                double end_tick;
-                next = next > 0.0 ? next : 0.0;
-                end_tick = mr_trajectory_advance(t, o[j].path_tick, 0.5 * (o[j].cap + next) * dt_ms * 1e-3);
-                /* Holding a waypoint, or at the segment's end: the path-maintaining stop is over. */
-                if (end_tick == o[j].path_tick || at_waypoint(t, end_tick)) {
-                    next = 0.0;
-                }
-                o[j].path_tick = end_tick;
-                mr_trajectory_tcp_at(t, end_tick, o[j].tcp);
-                o[j].cap = next;
-                moving |= next > 0.0;
-            }
-        }
-        tcps_of(o, s->n_robots, tcps);
-        status = dc_query(exact, tcps, s->n_robots, &v, NULL);
-        st->samples++;
-        if (status != DC_STATUS_OK || v != DC_VERDICT_FREE) {
-            st->contacts++;
-        }
+    while (stop_substep(exact, s, stop, st) && elapsed_ms < 10000.0) {
+        elapsed_ms += 1.0 / STOP_SUBSTEPS;
     }
 }
 
@@ -163,39 +108,21 @@ static void run_override(const char *cell_name, const char *case_name)
 {
     MrCell cell;
     MrScenario scenario;
-    DcRobotConfig robots[MR_MAX_ROBOTS];
-    DcCellConfig config;
     DcStopConfig stops[MR_MAX_ROBOTS];
     DcCollider *h = NULL, *exact = NULL;
     MrOverride o[MR_MAX_ROBOTS];
-    StopStats st = { 0, 0, 0 };
-    long tick, cycle, max_ticks, first_stop = -1;
-    unsigned long n_stop = 0, n_warn = 0, touching = 0, n_bad_status = 0, n_unscaled;
-    double min_clear = INFINITY;
+    StopStats st = { 0, 0, 0, 0.0 };
+    VerdictTally t = tally_start();
+    long tick, cycle, max_ticks;
+    unsigned long touching = 0, n_unscaled;
     int done = 0;
     size_t j;
     DcStatus s;
 
-    if (mr_register_cell(cell_name, &cell) != MR_OK
-        || mr_load_scenario(SCENARIO_FILE, cell_name, case_name, cell.n_robots, &scenario) != MR_OK) {
-        check(0, "speed override %s %s: cannot load the scenario", cell_name, case_name);
+    DcStopConfig standard = dc_stop_config_default();
+    if (!open_protective("speed override", cell_name, case_name, &standard, &cell, &scenario, stops, &h, &exact)) {
         return;
     }
-    pou_cell_config(&cell, DC_METHOD_SAT_CACHE, robots, &config);
-    s = dc_init(&config, &h);
-    check(s == DC_STATUS_OK, "speed override %s: dc_init: %s", cell_name, dc_status_str(s));
-    s = dc_init(&config, &exact);
-    check(s == DC_STATUS_OK, "speed override %s: dc_init (exact): %s", cell_name, dc_status_str(s));
-    if (h == NULL || exact == NULL) {
-        dc_destroy(h);
-        dc_destroy(exact);
-        return;
-    }
-    for (j = 0; j < cell.n_robots; ++j) {
-        stops[j] = dc_stop_config_default();
-    }
-    s = dc_set_stop_model(h, 1.0, 10.0, stops, cell.n_robots);
-    check(s == DC_STATUS_OK, "speed override %s: dc_set_stop_model: %s", cell_name, dc_status_str(s));
     cycle = cycle_ticks(&scenario);
     max_ticks = MAX_CYCLES * cycle;
     n_unscaled = unscaled_stops(h, &scenario, cycle);
@@ -230,19 +157,7 @@ static void run_override(const char *cell_name, const char *case_name)
             touching++;
         }
         s = dc_protective_query(h, tcps, cell.n_robots, &v, &rep);
-        if (s != DC_STATUS_OK) {
-            n_bad_status++;
-        }
-        if (rep.clearance_mm < min_clear) {
-            min_clear = rep.clearance_mm;
-        }
-        if (v == DC_VERDICT_WARN) {
-            n_warn++;
-        } else if (v != DC_VERDICT_FREE) {
-            n_stop++;
-            if (first_stop < 0) {
-                first_stop = tick;
-            }
+        if (tally_verdict(&t, tick, s, v, &rep)) {
             simulate_stop(exact, &scenario, stops, o, &st);
         }
         for (j = 0; j < cell.n_robots; ++j) {
@@ -255,15 +170,15 @@ static void run_override(const char *cell_name, const char *case_name)
     check(touching == 0, "speed override %s %s: the boxes touch on %lu ticks", cell_name, case_name, touching);
     check(st.contacts == 0, "speed override %s %s: %lu of %lu samples of the simulated stops touch", cell_name,
           case_name, st.contacts, st.samples);
-    check(n_bad_status == 0, "speed override %s %s: %lu queries without status OK (implausible motion?)", cell_name,
-          case_name, n_bad_status);
+    check(t.n_bad_status == 0, "speed override %s %s: %lu queries without status OK (implausible motion?)", cell_name,
+          case_name, t.n_bad_status);
     check(done, "speed override %s %s: the cycle of %ld ticks did not complete in %ld ticks", cell_name, case_name,
           cycle, max_ticks);
     printf("speed override %s %s: cycle %s%ld ticks, unscaled %ld ticks (%+.1f %%), STOP %lu of %ld ticks (unscaled "
            "%lu), first STOP %ld, WARN %lu, stops simulated %lu (%lu exact samples, contacts %lu), ticks touching %lu, "
            "smallest clearance %.1f mm\n",
            cell_name, case_name, done ? "" : "NOT COMPLETED ", tick, cycle, 100.0 * (double)(tick - cycle) / (double)cycle,
-           n_stop, tick, n_unscaled, first_stop, n_warn, st.stops, st.samples, st.contacts, touching, min_clear);
+           t.n_stop, tick, n_unscaled, t.first_stop, t.n_warn, st.stops, st.samples, st.contacts, touching, t.min_clear);
     dc_destroy(h);
     dc_destroy(exact);
 }

@@ -16,7 +16,7 @@
 //! - `std` (default): everything above plus [`cspace`], the table builders and the C ABI.
 //!   Without it the crate is `#![no_std]` (with `alloc`, maths from `libm`) and holds the
 //!   per-tick code only: [`math`], [`geometry`], [`robot`], the exact check of [`cell`] and
-//!   the table queries (README "Portability and cross-compiling").
+//!   the table queries (docs/PORTABILITY.md).
 //! - `pictures` (default): the CLI's PNG pictures; the controller's library does not need it.
 //!
 //! Units: millimetres and radians everywhere. Frames: each robot's TCP is given in its own

@@ -4,11 +4,11 @@
 //! Tables of T1 and T2 are built here at k = 16.
 
 mod ffi_common;
-mod test_rng;
 
 use delta_collide::ffi::*;
 use ffi_common::*;
-use test_rng::TestRng;
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
 
 #[test]
 fn table_init_gives_each_table_error_its_own_status_and_no_handle() {
@@ -143,8 +143,8 @@ fn table_mode_reports_fail_closed_and_pair_results() {
 fn table_mode_never_answers_free_where_the_exact_model_collides() {
     let h = t1_table_handle();
     let exact = two_robot_cell(450.0, DC_METHOD_SAT);
-    let mut rng = TestRng(0x2545_f491_4f6c_dd1d);
-    let mut uniform = |lo: f64, hi: f64| rng.uniform(lo, hi);
+    let mut rng = StdRng::seed_from_u64(0x2545_f491_4f6c_dd1d);
+    let mut uniform = |lo: f64, hi: f64| rng.random_range(lo..hi);
     let (mut both, mut table_only, mut free, mut unreachable) = (0, 0, 0, 0);
     for i in 0..100_000 {
         // Robot A's TCP reaching toward B and B's toward A, often overlapping.

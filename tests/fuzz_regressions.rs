@@ -1,4 +1,4 @@
-//! Bugs the fuzz targets found (README "Fuzzing"), one test per case, named after it. The
+//! Bugs the fuzz targets found (docs/FUZZING.md), one test per case, named after it. The
 //! inputs that found them are kept in `tests/data/fuzz/<target>/` (listed in
 //! `tests/data/fuzz/README.md`) and replayed, with the seeds, by `tests/fuzz_short.rs`.
 

@@ -1,4 +1,4 @@
-//! Fuzzing in the test suite (README "Fuzzing"). The targets live in
+//! Fuzzing in the test suite (docs/FUZZING.md). The targets live in
 //! `fuzz/src/` and are compiled into this test as well (`#[path]`), so that:
 //! - every committed seed in `fuzz/seeds/<target>/` and every past finding in
 //!   `tests/data/fuzz/<target>/` is replayed in-process on every run, with no fuzzer needed (a

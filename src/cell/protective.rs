@@ -439,7 +439,10 @@ impl ProtectiveChecker {
             let splits = self.precise_splits;
             while let (Some(p), true) = (self.report.limiting, splits > 0) {
                 let (arms_a, arms_b) = (self.arm_bit(p.a, p.box_a), self.arm_bit(p.b, p.box_b));
-                let refined = |me: &Self, j: usize| me.sweep_tier[j].filter(|t| t.0 == splits).map_or(0, |t| t.1);
+                let refined = |me: &Self, j: usize| match me.tables[j] {
+                    None => 0b111,
+                    Some(_) => me.sweep_tier[j].filter(|t| t.0 == splits).map_or(0, |t| t.1),
+                };
                 let (ra, rb) = (refined(self, p.a), refined(self, p.b));
                 if ra & arms_a == arms_a && rb & arms_b == arms_b {
                     break;
@@ -525,7 +528,8 @@ impl ProtectiveChecker {
     /// motor angles of `tier` (0: the table alone; else also `tier^3` direct sub-boxes for the
     /// arms in the bit mask `arms`).
     fn sweeps_at(&mut self, j: usize, tier: u32, arms: u8) {
-        let arms = if tier == 0 { 0 } else { arms };
+        // Without a table, tier 1 is already the direct enclosure: a second tier repeats it.
+        let (tier, arms) = if tier == 0 || self.tables[j].is_none() { (0, 0) } else { (tier, arms) };
         if self.sweep_tier[j] == Some((tier, arms)) {
             return;
         }

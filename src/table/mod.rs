@@ -13,7 +13,7 @@
 //!
 //! Without the `std` feature this module holds the query side only: loading a table from
 //! bytes ([`from_bytes`], needs `alloc`), the queries of every variant and [`TableChecker`]
-//! (README "Portability and cross-compiling"). The builders ([`build`], `build` of each
+//! (docs/PORTABILITY.md). The builders ([`build`], `build` of each
 //! variant, [`synthetic`]) need `std`.
 
 #[cfg(feature = "std")]

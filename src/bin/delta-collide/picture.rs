@@ -186,3 +186,26 @@ mod tests {
         assert_eq!(convex_hull(&pts), vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
     }
 }
+
+/// A chart of `f64` against `f64` on a bitmap: the plots' one coordinate system.
+pub type Chart<'a, 'b> = ChartContext<
+    'a,
+    BitMapBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// The plots' grid, whole-number labels and axis names.
+pub fn draw_mesh(chart: &mut Chart, x_desc: &str, y_desc: &str) -> Result<(), String> {
+    chart
+        .configure_mesh()
+        .light_line_style(WHITE)
+        .bold_line_style(RGBColor(230, 230, 230))
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .label_style(text(12, BLACK))
+        .axis_desc_style(text(13, BLACK))
+        .draw()
+        .map_err(plot_err)
+}

@@ -7,7 +7,7 @@
 //! table tick labelled collision over a positive distance is a false positive; a tick labelled
 //! free at distance 0 would be a false negative.
 
-use crate::picture::{colour_strip, draw_png, legend, plot_err, text, Swatch, HIT, OUTSIDE, ROBOT};
+use crate::picture::{colour_strip, draw_mesh, draw_png, legend, plot_err, text, Swatch, HIT, OUTSIDE, ROBOT};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::geometry::obb_distance;
 use delta_collide::math::Vec3;
@@ -114,18 +114,7 @@ fn draw_trace(area: &DrawingArea<BitMapBackend, Shift>, trace: &Trace) -> Result
         .y_label_area_size(64)
         .build_cartesian_2d(0.0..n as f64, 0.0..max * 1.08)
         .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .light_line_style(WHITE)
-        .bold_line_style(RGBColor(230, 230, 230))
-        .x_desc("tick (1 ms)")
-        .y_desc("distance (mm)")
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.0}"))
-        .label_style(text(12, BLACK))
-        .axis_desc_style(text(13, BLACK))
-        .draw()
-        .map_err(plot_err)?;
+    draw_mesh(&mut chart, "tick (1 ms)", "distance (mm)")?;
     // The distance as line segments between unreachable ticks.
     let mut segment: Vec<(f64, f64)> = Vec::new();
     for (t, &d) in trace.distance.iter().enumerate().chain([(n, &f64::NAN)]) {

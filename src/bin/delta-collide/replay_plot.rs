@@ -4,7 +4,7 @@
 //! the protective distances the run is comfortably stoppable; the band shows where the
 //! verdict could not prove it.
 
-use crate::picture::{colour_strip, draw_png, legend, plot_err, text, Swatch, HIT, OUTSIDE, ROBOT};
+use crate::picture::{colour_strip, draw_mesh, draw_png, legend, plot_err, text, Chart, Swatch, HIT, OUTSIDE, ROBOT};
 use delta_collide::cell::protective::{Protective, ProtectiveReport, ProtectiveStatus};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -114,18 +114,7 @@ fn draw_run(area: &DrawingArea<BitMapBackend, Shift>, trace: &ReplayTrace) -> Re
         .y_label_area_size(64)
         .build_cartesian_2d(0.0..n.max(2) as f64 - 1.0, lo - pad..hi + pad)
         .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .light_line_style(WHITE)
-        .bold_line_style(RGBColor(230, 230, 230))
-        .x_desc("tick")
-        .y_desc("mm")
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.0}"))
-        .label_style(text(12, BLACK))
-        .axis_desc_style(text(13, BLACK))
-        .draw()
-        .map_err(plot_err)?;
+    draw_mesh(&mut chart, "tick", "mm")?;
     if lo < 0.0 {
         let zero = vec![(0.0, 0.0), (n as f64, 0.0)];
         chart.draw_series(LineSeries::new(zero, BLACK.stroke_width(1))).map_err(plot_err)?;
@@ -142,11 +131,6 @@ fn draw_run(area: &DrawingArea<BitMapBackend, Shift>, trace: &ReplayTrace) -> Re
     colour_strip(area, "verdict", (left, width), yr.end - by + 36 + 4, STRIP, &colours)
 }
 
-type Chart<'a, 'b> = ChartContext<
-    'a,
-    BitMapBackend<'b>,
-    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
->;
 
 /// `values` per tick as line segments between the NaN ticks.
 fn line(chart: &mut Chart, values: &[f64], colour: RGBColor) -> Result<(), String> {
