@@ -34,6 +34,11 @@
 #define DC_BOX_NONE UINT32_MAX
 
 /*
+ Most points of one `DcStopPath`.
+ */
+#define DC_MAX_PATH_POINTS 32
+
+/*
  An initialised collision checker for one cell, in exact or table mode (opaque to C).
  */
 typedef struct DcCollider DcCollider;
@@ -313,6 +318,29 @@ typedef struct DcProtectiveReport {
    */
   double speed_limit_mm_s[32];
 } DcProtectiveReport;
+
+/*
+ The path one robot's TCP will follow over its stop, as a controller performing a
+ path-maintaining stop knows it (SPEC section 8, "Where the controller knows more"), for
+ `dc_protective_query_with_paths`. It promises that from this tick until the robot stands
+ still its TCP stays within `tolerance_mm` of the polyline through `points`. `n_points` 0
+ (with `points` NULL or not): no path known for this robot.
+ */
+typedef struct DcStopPath {
+  /*
+   The polyline's vertices in the order the TCP follows them (MCS, mm); the TCP now must
+   be within `tolerance_mm` of the polyline.
+   */
+  const struct DcVec3 *points;
+  /*
+   How many (0 to `DC_MAX_PATH_POINTS`).
+   */
+  size_t n_points;
+  /*
+   How far the TCP may be from the polyline at any moment of the stop (mm, >= 0).
+   */
+  double tolerance_mm;
+} DcStopPath;
 
 /*
  One robot pair's result of the last query.
@@ -644,6 +672,26 @@ void dc_protective_reset(struct DcCollider *handle);
  NULL or writable.
  */
 DcStatus dc_protective_query(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, DcVerdict *out_verdict, struct DcProtectiveReport *out_report);
+
+/*
+ `dc_protective_query` for a controller that knows the path each robot's stop will follow
+ (a path-maintaining stop: its next set-points), which brings STOPs down toward the ticks
+ where a stop really cannot avoid contact. `paths[j]` is robot `j`'s `DcStopPath`
+ (`n_points` 0: not known; that robot is then bounded as by `dc_protective_query`). The
+ verdict is the better of the proof without paths and the proof along them; the speed
+ limits are those without paths. Statuses: those of `dc_protective_query`, and
+ `DC_STATUS_NULL_POINTER` (paths NULL, or a path's points NULL with `n_points` > 0),
+ `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths` differs from the robot count),
+ `DC_STATUS_INVALID_ARGUMENT` (a path with more than `DC_MAX_PATH_POINTS` points, a
+ non-finite point or tolerance, a negative tolerance, or the TCP now farther than the
+ tolerance from its path; `unreachable_mask` names the robot). On every status but OK the
+ verdict is STOP, and the next call assumes full speed. Never allocates, locks or does I/O.
+
+ # Safety
+ As `dc_protective_query`; `paths` must be NULL or point to `n_paths` readable
+ `DcStopPath`, each with `points` NULL or pointing to `n_points` readable `DcVec3`.
+ */
+DcStatus dc_protective_query_with_paths(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, const struct DcStopPath *paths, size_t n_paths, DcVerdict *out_verdict, struct DcProtectiveReport *out_report);
 
 /*
  Copies the per-pair results of the last query into `out[0..]` and their number into

@@ -585,3 +585,69 @@ fn the_c_entry_point_never_allocates_and_fills_the_report() {
     // SAFETY: live handle, destroyed once.
     unsafe { dc_destroy(h) };
 }
+
+/// `dc_protective_query_with_paths` through the C ABI: no allocation per call while the
+/// robots move toward each other along their paths, and a status naming the robot for every
+/// kind of bad path.
+#[test]
+fn the_c_entry_point_with_paths_never_allocates_and_names_a_bad_path() {
+    use delta_collide::ffi::*;
+    let mut robots = [dc_robot_config_thesis(); 2];
+    robots[1].translation = DcVec3 { x: 450.0, y: 0.0, z: 0.0 };
+    let config = DcCellConfig { robots: robots.as_ptr(), n_robots: 2, method: DC_METHOD_SAT_CACHE };
+    let mut h = std::ptr::null_mut();
+    // SAFETY: valid config and out pointer.
+    assert_eq!(unsafe { dc_init(&config, &mut h) }, DC_STATUS_OK);
+    let stops = [dc_stop_config_default(); 2];
+    // SAFETY: live handle, two readable configs.
+    assert_eq!(unsafe { dc_set_stop_model(h, 1.0, 10.0, stops.as_ptr(), 2) }, DC_STATUS_OK);
+    let at = |k: f64| {
+        [DcVec3 { x: -100.0 + 0.5 * k, y: 20.0, z: -450.0 }, DcVec3 { x: 100.0 - 0.5 * k, y: -20.0, z: -450.0 }]
+    };
+    // Each robot's path: straight on toward the other for 60 mm, then back up.
+    let path_of = |p: DcVec3, dx: f64| [p, DcVec3 { x: p.x + dx, ..p }, DcVec3 { x: p.x + dx, z: p.z + 80.0, ..p }];
+    let (mut verdict, mut report) = (DC_VERDICT_STOP, std::mem::MaybeUninit::<DcProtectiveReport>::zeroed());
+    let query = |h, tcps: &[DcVec3; 2], paths: &[DcStopPath], verdict: &mut DcVerdict, report: *mut DcProtectiveReport| {
+        // SAFETY: live handle, readable TCPs and paths (whose points outlive the call), writable outputs.
+        unsafe { dc_protective_query_with_paths(h, tcps.as_ptr(), 2, paths.as_ptr(), paths.len(), verdict, report) }
+    };
+    let (mut seen, before) = ([0u32; 3], allocations());
+    for k in 0..160 {
+        let tcps = at(k as f64);
+        let (pa, pb) = (path_of(tcps[0], 60.0), path_of(tcps[1], -60.0));
+        let paths = [
+            DcStopPath { points: pa.as_ptr(), n_points: 3, tolerance_mm: 0.5 },
+            DcStopPath { points: pb.as_ptr(), n_points: 3, tolerance_mm: 0.5 },
+        ];
+        assert_eq!(query(h, &tcps, &paths, &mut verdict, report.as_mut_ptr()), DC_STATUS_OK, "call {k}");
+        seen[verdict as usize] += 1;
+    }
+    assert_eq!(allocations(), before, "verdicts seen (free, warn, stop): {seen:?}");
+    let tcps = at(160.0);
+    let on = path_of(tcps[0], 60.0);
+    let good = DcStopPath { points: on.as_ptr(), n_points: 3, tolerance_mm: 0.5 };
+    let none = DcStopPath { points: std::ptr::null(), n_points: 0, tolerance_mm: 0.0 };
+    let off = [DcVec3 { y: 60.0, ..tcps[0] }, DcVec3 { x: 0.0, y: 60.0, z: -450.0 }];
+    let many = [tcps[1]; DC_MAX_PATH_POINTS + 1];
+    let cases = [
+        ([none, DcStopPath { points: std::ptr::null(), n_points: 2, tolerance_mm: 1.0 }], DC_STATUS_NULL_POINTER, 2),
+        ([DcStopPath { points: off.as_ptr(), n_points: 2, tolerance_mm: 1.0 }, none], DC_STATUS_INVALID_ARGUMENT, 1),
+        ([DcStopPath { tolerance_mm: f64::NAN, ..good }, none], DC_STATUS_INVALID_ARGUMENT, 1),
+        ([DcStopPath { tolerance_mm: -1.0, ..good }, none], DC_STATUS_INVALID_ARGUMENT, 1),
+        ([good, DcStopPath { points: many.as_ptr(), n_points: many.len(), tolerance_mm: 1.0 }], DC_STATUS_INVALID_ARGUMENT, 2),
+    ];
+    for (i, (paths, status, mask)) in cases.iter().enumerate() {
+        verdict = DC_VERDICT_FREE;
+        assert_eq!(query(h, &tcps, paths, &mut verdict, report.as_mut_ptr()), *status, "case {i}");
+        // SAFETY: written by the call.
+        let r = unsafe { report.assume_init_ref() };
+        assert_eq!((verdict, r.verdict, r.unreachable_mask), (DC_VERDICT_STOP, DC_VERDICT_STOP, *mask), "case {i}");
+    }
+    // One path per robot, and the paths array itself.
+    assert_eq!(query(h, &tcps, &[good], &mut verdict, report.as_mut_ptr()), DC_STATUS_WRONG_ROBOT_COUNT);
+    // SAFETY: live handle, readable TCPs; a NULL paths pointer is the case under test.
+    let s = unsafe { dc_protective_query_with_paths(h, tcps.as_ptr(), 2, std::ptr::null(), 2, &mut verdict, report.as_mut_ptr()) };
+    assert_eq!((s, verdict), (DC_STATUS_NULL_POINTER, DC_VERDICT_STOP));
+    // SAFETY: live handle, destroyed once.
+    unsafe { dc_destroy(h) };
+}

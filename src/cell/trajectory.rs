@@ -43,6 +43,26 @@ pub fn position_at(waypoints: &[Waypoint], tick: u32) -> Vec3 {
     }
 }
 
+/// The programmed path ahead of `tick` along `waypoints` (sorted by tick, at least one), as a
+/// controller performing a path-maintaining stop knows it: the TCP at `tick`, then the
+/// following waypoints until `out` is full or the path from the TCP is at least `length_mm`
+/// long (the last waypoint ends it: the robot holds there). Returns the number of points
+/// written (at least 1 when `out` is not empty).
+pub fn path_ahead(waypoints: &[Waypoint], tick: u32, length_mm: Real, out: &mut [Vec3]) -> usize {
+    let Some(first) = out.first_mut() else { return 0 };
+    *first = position_at(waypoints, tick);
+    let (mut n, mut length) = (1, 0.0);
+    for w in waypoints.iter().filter(|w| w.tick > tick) {
+        if n == out.len() || length >= length_mm {
+            break;
+        }
+        length += (w.tcp - out[n - 1]).norm();
+        out[n] = w.tcp;
+        n += 1;
+    }
+    n
+}
+
 /// One test case on one cell: a waypoint list per robot.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {

@@ -6,8 +6,10 @@
 //! allocates nothing in either mode.
 
 use crate::cell::exact::PairState;
-use crate::cell::protective::{BoxPair, Protective, ProtectiveChecker, ProtectiveStatus, DEFAULT_WARN_MM};
-use crate::cell::{Cell, ExactChecker};
+use crate::cell::protective::{
+    BoxPair, Protective, ProtectiveChecker, ProtectiveReport, ProtectiveStatus, StopPath, DEFAULT_WARN_MM,
+};
+use crate::cell::{Cell, ExactChecker, MAX_ROBOTS};
 use crate::ffi::convert::{cell_error_status, table_error_status};
 use crate::ffi::types::*;
 use crate::math::Vec3;
@@ -46,6 +48,8 @@ pub(crate) struct Collider {
     table_collides: bool,
     /// The protective verdict (either mode: it reads the exact boxes).
     protective: ProtectiveChecker,
+    /// Per robot, the points of its stop path of the current query, converted; sized once.
+    path_points: Vec<[Vec3; DC_MAX_PATH_POINTS]>,
 }
 
 /// The protective checker of a handle until `dc_set_stop_model` sets one: without the motor-angle
@@ -63,6 +67,7 @@ impl Collider {
             checker: Checker::Exact(Box::new(ExactChecker::new(cell))),
             tcps: vec![Vec3::zeros(); n],
             table_collides: false,
+            path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; n],
         }
     }
 
@@ -86,6 +91,7 @@ impl Collider {
             tcps: vec![Vec3::zeros(); 2],
             table_collides: false,
             protective,
+            path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; 2],
         })
     }
 
@@ -199,30 +205,39 @@ impl Collider {
             *dst = src.to_vec3();
         }
         let Ok(r) = self.protective.check(&self.tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };
-        report.n_robots = r.robots.len() as u32;
-        report.clearance_mm = r.clearance_mm;
-        for (j, robot) in r.robots.iter().enumerate() {
-            (report.protective_mm[j], report.speed_limit_mm_s[j]) = (robot.protective_mm, robot.speed_limit_mm_s);
+        write_protective(r, report)
+    }
+
+    /// The protective query with the robots' stop paths (`paths[j].n_points` 0: none; the
+    /// caller checked that every path's points are readable and at most
+    /// `DC_MAX_PATH_POINTS`): fills `report` as [`Collider::protective_query`] does.
+    pub(crate) fn protective_query_with_paths(
+        &mut self,
+        tcps: &[DcVec3],
+        paths: &[(&[DcVec3], f64)],
+        report: &mut DcProtectiveReport,
+    ) -> DcStatus {
+        if tcps.len() != self.tcps.len() || paths.len() != self.tcps.len() {
+            return DC_STATUS_WRONG_ROBOT_COUNT;
         }
-        let ids = |p: Option<BoxPair>| {
-            p.map_or([DC_BOX_NONE; 4], |p| [p.a as u32, p.b as u32, p.box_a as u32, p.box_b as u32])
+        for (dst, src) in self.tcps.iter_mut().zip(tcps) {
+            *dst = src.to_vec3();
+        }
+        for (dst, (src, _)) in self.path_points.iter_mut().zip(paths) {
+            for (d, s) in dst.iter_mut().zip(src.iter()) {
+                *d = s.to_vec3();
+            }
+        }
+        let mut stop_paths: [Option<StopPath>; MAX_ROBOTS] = [None; MAX_ROBOTS];
+        for (j, (points, tolerance_mm)) in paths.iter().enumerate() {
+            if !points.is_empty() {
+                stop_paths[j] = Some(StopPath { points: &self.path_points[j][..points.len()], tolerance_mm: *tolerance_mm });
+            }
+        }
+        let Ok(r) = self.protective.check_with_paths(&self.tcps, &stop_paths[..paths.len()]) else {
+            return DC_STATUS_WRONG_ROBOT_COUNT;
         };
-        [report.closest_robot_a, report.closest_robot_b, report.closest_box_a, report.closest_box_b] = ids(r.closest);
-        [report.limiting_robot_a, report.limiting_robot_b, report.limiting_box_a, report.limiting_box_b] =
-            ids(r.limiting);
-        let (status, robot) = match r.status {
-            ProtectiveStatus::Ok => (DC_STATUS_OK, None),
-            ProtectiveStatus::NonFinite(j) => (DC_STATUS_NON_FINITE, Some(j)),
-            ProtectiveStatus::Unreachable(j) => (DC_STATUS_UNREACHABLE, Some(j)),
-            ProtectiveStatus::ImplausibleMotion(j) => (DC_STATUS_IMPLAUSIBLE_MOTION, Some(j)),
-        };
-        report.unreachable_mask = robot.map_or(0, |j| 1 << j);
-        report.verdict = match r.verdict {
-            Protective::Free => DC_VERDICT_FREE,
-            Protective::Warn => DC_VERDICT_WARN,
-            Protective::Stop => DC_VERDICT_STOP,
-        };
-        status
+        write_protective(r, report)
     }
 
     /// Writes the per-pair results of the last query into `out[..pair_count()]`, which the
@@ -244,6 +259,35 @@ impl Collider {
             }
         }
     }
+}
+
+/// Writes the protective report `r` into the C report; returns its status.
+fn write_protective(r: &ProtectiveReport, report: &mut DcProtectiveReport) -> DcStatus {
+    report.n_robots = r.robots.len() as u32;
+    report.clearance_mm = r.clearance_mm;
+    for (j, robot) in r.robots.iter().enumerate() {
+        (report.protective_mm[j], report.speed_limit_mm_s[j]) = (robot.protective_mm, robot.speed_limit_mm_s);
+    }
+    let ids = |p: Option<BoxPair>| {
+        p.map_or([DC_BOX_NONE; 4], |p| [p.a as u32, p.b as u32, p.box_a as u32, p.box_b as u32])
+    };
+    [report.closest_robot_a, report.closest_robot_b, report.closest_box_a, report.closest_box_b] = ids(r.closest);
+    [report.limiting_robot_a, report.limiting_robot_b, report.limiting_box_a, report.limiting_box_b] =
+        ids(r.limiting);
+    let (status, robot) = match r.status {
+        ProtectiveStatus::Ok => (DC_STATUS_OK, None),
+        ProtectiveStatus::NonFinite(j) => (DC_STATUS_NON_FINITE, Some(j)),
+        ProtectiveStatus::Unreachable(j) => (DC_STATUS_UNREACHABLE, Some(j)),
+        ProtectiveStatus::ImplausibleMotion(j) => (DC_STATUS_IMPLAUSIBLE_MOTION, Some(j)),
+        ProtectiveStatus::InvalidPath(j) => (DC_STATUS_INVALID_ARGUMENT, Some(j)),
+    };
+    report.unreachable_mask = robot.map_or(0, |j| 1 << j);
+    report.verdict = match r.verdict {
+        Protective::Free => DC_VERDICT_FREE,
+        Protective::Warn => DC_VERDICT_WARN,
+        Protective::Stop => DC_VERDICT_STOP,
+    };
+    status
 }
 
 fn query_exact(checker: &mut ExactChecker, tcps: &[Vec3], report: &mut DcQueryReport) -> DcStatus {

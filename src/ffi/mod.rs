@@ -446,6 +446,82 @@ pub unsafe extern "C" fn dc_protective_query(
     status
 }
 
+/// `dc_protective_query` for a controller that knows the path each robot's stop will follow
+/// (a path-maintaining stop: its next set-points), which brings STOPs down toward the ticks
+/// where a stop really cannot avoid contact. `paths[j]` is robot `j`'s `DcStopPath`
+/// (`n_points` 0: not known; that robot is then bounded as by `dc_protective_query`). The
+/// verdict is the better of the proof without paths and the proof along them; the speed
+/// limits are those without paths. Statuses: those of `dc_protective_query`, and
+/// `DC_STATUS_NULL_POINTER` (paths NULL, or a path's points NULL with `n_points` > 0),
+/// `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths` differs from the robot count),
+/// `DC_STATUS_INVALID_ARGUMENT` (a path with more than `DC_MAX_PATH_POINTS` points, a
+/// non-finite point or tolerance, a negative tolerance, or the TCP now farther than the
+/// tolerance from its path; `unreachable_mask` names the robot). On every status but OK the
+/// verdict is STOP, and the next call assumes full speed. Never allocates, locks or does I/O.
+///
+/// # Safety
+/// As `dc_protective_query`; `paths` must be NULL or point to `n_paths` readable
+/// `DcStopPath`, each with `points` NULL or pointing to `n_points` readable `DcVec3`.
+#[no_mangle]
+pub unsafe extern "C" fn dc_protective_query_with_paths(
+    handle: *mut DcCollider,
+    tcps_mcs: *const DcVec3,
+    n_tcps: usize,
+    paths: *const DcStopPath,
+    n_paths: usize,
+    out_verdict: *mut DcVerdict,
+    out_report: *mut DcProtectiveReport,
+) -> DcStatus {
+    let mut report = DcProtectiveReport::STOP;
+    let status = boundary(|| {
+        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
+        if out_verdict.is_null() || tcps_mcs.is_null() || paths.is_null() {
+            return DC_STATUS_NULL_POINTER;
+        }
+        if h.poisoned {
+            return DC_STATUS_PANIC;
+        }
+        // SAFETY: non-null, and the caller guarantees `n_tcps` and `n_paths` readable elements.
+        let (tcps, paths) = unsafe { (std::slice::from_raw_parts(tcps_mcs, n_tcps), std::slice::from_raw_parts(paths, n_paths)) };
+        let mut views: [(&[DcVec3], f64); crate::cell::MAX_ROBOTS] = [(&[], 0.0); crate::cell::MAX_ROBOTS];
+        if n_paths > views.len() {
+            return DC_STATUS_WRONG_ROBOT_COUNT;
+        }
+        for (j, (view, path)) in views.iter_mut().zip(paths).enumerate() {
+            if path.n_points == 0 {
+                continue;
+            }
+            if path.points.is_null() || path.n_points > DC_MAX_PATH_POINTS {
+                report.unreachable_mask = 1 << j;
+                h.inner.reset_protective();
+                return if path.points.is_null() { DC_STATUS_NULL_POINTER } else { DC_STATUS_INVALID_ARGUMENT };
+            }
+            // SAFETY: non-null, and the caller guarantees `n_points` readable elements.
+            *view = (unsafe { std::slice::from_raw_parts(path.points, path.n_points) }, path.tolerance_mm);
+        }
+        let status = catch_unwind(AssertUnwindSafe(|| {
+            h.inner.protective_query_with_paths(tcps, &views[..n_paths], &mut report)
+        }));
+        status.unwrap_or_else(|_| {
+            h.poisoned = true;
+            DC_STATUS_PANIC
+        })
+    });
+    if status != DC_STATUS_OK {
+        report.verdict = DC_VERDICT_STOP;
+    }
+    if !out_verdict.is_null() {
+        // SAFETY: non-null; the caller guarantees it is writable.
+        unsafe { *out_verdict = report.verdict };
+    }
+    if !out_report.is_null() {
+        // SAFETY: non-null; the caller guarantees it is writable.
+        unsafe { *out_report = report };
+    }
+    status
+}
+
 /// Copies the per-pair results of the last query into `out[0..]` and their number into
 /// `*out_len`. Exact mode: the pairs whose reach can overlap (`dc_pair_count`), with the
 /// colliding boxes. Table mode: one pair (robots 0 and 1), `collides` as the last verdict,

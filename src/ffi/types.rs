@@ -249,6 +249,26 @@ pub struct DcStopConfig {
     pub max_speed_mm_s: f64,
 }
 
+/// Most points of one `DcStopPath`.
+pub const DC_MAX_PATH_POINTS: usize = 32;
+
+/// The path one robot's TCP will follow over its stop, as a controller performing a
+/// path-maintaining stop knows it (SPEC section 8, "Where the controller knows more"), for
+/// `dc_protective_query_with_paths`. It promises that from this tick until the robot stands
+/// still its TCP stays within `tolerance_mm` of the polyline through `points`. `n_points` 0
+/// (with `points` NULL or not): no path known for this robot.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct DcStopPath {
+    /// The polyline's vertices in the order the TCP follows them (MCS, mm); the TCP now must
+    /// be within `tolerance_mm` of the polyline.
+    pub points: *const DcVec3,
+    /// How many (0 to `DC_MAX_PATH_POINTS`).
+    pub n_points: usize,
+    /// How far the TCP may be from the polyline at any moment of the stop (mm, >= 0).
+    pub tolerance_mm: f64,
+}
+
 /// Summary of one protective query, written on every call when the pointer is not NULL.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -99,7 +99,14 @@ fn down(x: Real) -> f32 {
     if x.is_nan() {
         f32::NEG_INFINITY
     } else if (y as Real) > x {
-        y.next_down()
+        // The next `f32` toward -inf (`f32::next_down` needs Rust 1.86); `y` is not NaN.
+        if y == 0.0 {
+            -f32::from_bits(1)
+        } else if y > 0.0 {
+            f32::from_bits(y.to_bits() - 1)
+        } else {
+            f32::from_bits(y.to_bits() + 1)
+        }
     } else {
         y
     }
@@ -111,7 +118,14 @@ fn up(x: Real) -> f32 {
     if x.is_nan() {
         f32::INFINITY
     } else if (y as Real) < x {
-        y.next_up()
+        // The next `f32` toward +inf (`f32::next_up` needs Rust 1.86); `y` is not NaN.
+        if y == 0.0 {
+            f32::from_bits(1)
+        } else if y > 0.0 {
+            f32::from_bits(y.to_bits() + 1)
+        } else {
+            f32::from_bits(y.to_bits() - 1)
+        }
     } else {
         y
     }
@@ -278,6 +292,19 @@ pub fn intersect(a: Enclosure, b: Enclosure) -> Enclosure {
 mod tests {
     use super::*;
     use rand::{rngs::StdRng, RngExt, SeedableRng};
+
+    #[test]
+    fn outward_rounding_brackets_with_adjacent_f32s() {
+        for x in [1.0 + 1e-10, -1.0 - 1e-10, 1e-50, -1e-50, 0.1, -0.1, 3.4e38 * 1.000_000_1, 2.0, 0.0] {
+            let (lo, hi) = (down(x), up(x));
+            assert!((lo as Real) <= x && x <= hi as Real, "{x}: [{lo}, {hi}]");
+            // Equal when `x` is an `f32`, else neighbours: the number line's order is that of
+            // the bits for positives and the reverse for negatives.
+            let step = |a: f32, b: f32| (a.to_bits() as i64 - b.to_bits() as i64).abs();
+            let adjacent = lo == hi || (lo.is_sign_positive() == hi.is_sign_positive() && step(lo, hi) == 1) || (lo < 0.0 && hi >= 0.0 && step(lo, -0.0) + step(hi, 0.0) <= 1);
+            assert!(adjacent, "{x}: [{lo}, {hi}] are not neighbours");
+        }
+    }
 
     /// Every sampled reachable TCP of random boxes (small to 600 mm, near the reach boundary
     /// included) has its motor angles inside the table's enclosure, and large boxes get an

@@ -176,17 +176,6 @@ pub fn convex_hull(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     hull
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn hull_of_a_square_with_inner_points() {
-        let pts = [(0.0, 0.0), (1.0, 0.0), (0.5, 0.5), (1.0, 1.0), (0.0, 1.0), (0.2, 0.8), (1.0, 0.5)];
-        assert_eq!(convex_hull(&pts), vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
-    }
-}
-
 /// A chart of `f64` against `f64` on a bitmap: the plots' one coordinate system.
 pub type Chart<'a, 'b> = ChartContext<
     'a,
@@ -208,4 +197,15 @@ pub fn draw_mesh(chart: &mut Chart, x_desc: &str, y_desc: &str) -> Result<(), St
         .axis_desc_style(text(13, BLACK))
         .draw()
         .map_err(plot_err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hull_of_a_square_with_inner_points() {
+        let pts = [(0.0, 0.0), (1.0, 0.0), (0.5, 0.5), (1.0, 1.0), (0.0, 1.0), (0.2, 0.8), (1.0, 0.5)];
+        assert_eq!(convex_hull(&pts), vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
+    }
 }

@@ -66,6 +66,7 @@ fn replay_rows(
             ProtectiveStatus::NonFinite(j) => format!("non-finite {}", names[j]),
             ProtectiveStatus::ImplausibleMotion(j) => format!("implausible {}", names[j]),
             ProtectiveStatus::Unreachable(j) => format!("unreachable {}", names[j]),
+            ProtectiveStatus::InvalidPath(j) => format!("invalid path {}", names[j]),
         };
         let mut row = format!("{tick},{verdict},{status},{:.3}", r.clearance_mm);
         r.robots.iter().for_each(|x| row += &format!(",{:.3}", x.protective_mm));

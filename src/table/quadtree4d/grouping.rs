@@ -277,7 +277,6 @@ mod tests {
     }
 
     /// Slices made from a few patterns, each seen through one of a few care masks (some with
-
     /// a flipped bit), 16 x 16 bits: both searches of [`ExactGroups`] find the scan's group.
     /// Chunks of 2 blocks, so that the few hundred groups span several chunks.
     #[test]

@@ -77,6 +77,9 @@ use crate::robot::motor_table::{intersect, MotorTable};
 use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
 use alloc::sync::Arc;
 
+mod path;
+pub use path::StopPath;
+
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`SPLITS^3` per
 /// arm). The cubes here are tens to hundreds of mm, where finer splits shrink the sweeps by
 /// about 1 % for 7 times the time (2: about 11 us per robot, 4: 74 us); a tick evaluates up
@@ -99,8 +102,8 @@ pub const LIMIT_STEPS: u32 = 8;
 /// trajectory arithmetic must not read as an impossible motion.
 const PLAUSIBLE_SLACK: Real = 1e-9;
 
-/// The protective verdict of one tick.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The protective verdict of one tick, ordered from the best (`Free`) to the worst (`Stop`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Protective {
     /// Proved: a stop started now ends with every box apart.
     Free,
@@ -122,6 +125,9 @@ pub enum ProtectiveStatus {
     ImplausibleMotion(usize),
     /// Robot `.0`'s TCP is outside its reach or motor limits.
     Unreachable(usize),
+    /// Robot `.0`'s stop path is unusable: no point, a non-finite point or tolerance, a
+    /// negative tolerance, or the TCP now farther than the tolerance from it ([`StopPath`]).
+    InvalidPath(usize),
 }
 
 /// Box `box_a` of robot `a` and box `box_b` of robot `b`.
@@ -216,6 +222,8 @@ pub struct ProtectiveChecker {
     reach: alloc::vec::Vec<Real>,
     /// Per robot, the tier its sweeps were computed with (`None`: not for this reference).
     sweep_tier: alloc::vec::Vec<Option<(u32, u8)>>,
+    /// Face terms of no box (fills the unused entries of a box list).
+    no_faces: FaceTerms,
     report: ProtectiveReport,
 }
 
@@ -272,6 +280,7 @@ impl ProtectiveChecker {
             centres: alloc::vec![Vec3::zeros(); n],
             reach: alloc::vec![0.0; n],
             sweep_tier: alloc::vec![None; n],
+            no_faces,
             report: ProtectiveReport {
                 verdict: Protective::Stop,
                 status: ProtectiveStatus::Ok,
@@ -371,6 +380,45 @@ impl ProtectiveChecker {
             }
         } else {
             self.reset();
+        }
+        Ok(&self.report)
+    }
+
+    /// One tick like [`ProtectiveChecker::check`], where the controller also gives, per robot,
+    /// the path its stop will follow (`None`: not known), as a path-maintaining stop knows it
+    /// ([`StopPath`]: the promise it makes and the proof, in `protective/path.rs`). The
+    /// verdict is the better of the one without paths and the one over the paths: both are
+    /// proofs. The speed limits are those without paths (so they hold with any path).
+    ///
+    /// # Errors
+    /// [`QueryError::WrongRobotCount`] when either slice's length differs from the robot count
+    /// (the history is then left as it was).
+    pub fn check_with_paths(
+        &mut self,
+        tcps_mcs: &[Vec3],
+        paths: &[Option<StopPath>],
+    ) -> Result<&ProtectiveReport, QueryError> {
+        let n = self.cell().robots.len();
+        if paths.len() != n {
+            return Err(QueryError::WrongRobotCount { expected: n, found: paths.len() });
+        }
+        self.check(tcps_mcs)?;
+        if self.report.status != ProtectiveStatus::Ok {
+            return Ok(&self.report);
+        }
+        let invalid = paths.iter().zip(tcps_mcs).position(|(p, tcp)| p.as_ref().is_some_and(|p| !path::path_is_valid(p, tcp)));
+        if let Some(j) = invalid {
+            let report = &mut self.report;
+            (report.verdict, report.status, report.limiting) = (Protective::Stop, ProtectiveStatus::InvalidPath(j), None);
+            report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = 0.0);
+            self.reset();
+            return Ok(&self.report);
+        }
+        if self.report.verdict != Protective::Free && paths.iter().any(Option::is_some) {
+            let (verdict, limiting) = self.prove_with_paths(tcps_mcs, paths);
+            if verdict < self.report.verdict {
+                (self.report.verdict, self.report.limiting) = (verdict, limiting);
+            }
         }
         Ok(&self.report)
     }
@@ -665,14 +713,15 @@ fn capsule_ball(
     }
 }
 
-/// The status that wins when several robots fail: non-finite, then implausible, then
-/// unreachable; the lowest robot index first within one kind.
+/// The status that wins when several robots fail: non-finite, then implausible, then an
+/// invalid path, then unreachable; the lowest robot index first within one kind.
 fn worse(a: ProtectiveStatus, b: ProtectiveStatus) -> ProtectiveStatus {
     let rank = |s: &ProtectiveStatus| match s {
         ProtectiveStatus::Ok => 0,
         ProtectiveStatus::Unreachable(_) => 1,
-        ProtectiveStatus::ImplausibleMotion(_) => 2,
-        ProtectiveStatus::NonFinite(_) => 3,
+        ProtectiveStatus::InvalidPath(_) => 2,
+        ProtectiveStatus::ImplausibleMotion(_) => 3,
+        ProtectiveStatus::NonFinite(_) => 4,
     };
     if rank(&b) > rank(&a) {
         b
@@ -752,28 +801,46 @@ fn first_unproved<'a>(
     only: Option<usize>,
     extra: Real,
 ) -> Option<BoxPair> {
-    const FORMS: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
     for p in pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
-        // With `extra`, robot `a`'s face terms under its widened sweeps, once per pair.
-        let mut widened = [faces[p.a][0], faces[p.a][1]];
-        if extra != 0.0 {
-            for (form, terms) in widened.iter_mut().enumerate() {
-                for (i, box_a) in boxes(p.a).iter().enumerate() {
-                    let sa = &sweeps[p.a][form][i];
-                    terms[i] = FaceTerms::new(box_a, &Sweep { ball: sa.ball + extra, ..*sa });
-                }
+        let found = first_unproved_between(
+            (boxes(p.a), &sweeps[p.a], &faces[p.a]),
+            (boxes(p.b), &sweeps[p.b], &faces[p.b]),
+            extra,
+        );
+        if let Some((box_a, box_b)) = found {
+            return Some(BoxPair { a: p.a, b: p.b, box_a, box_b });
+        }
+    }
+    None
+}
+
+/// One robot's boxes, their sweeps, and the face terms of each box under each sweep form.
+type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MAX_BOXES]; 2]);
+
+/// The first box pair `(i, k)` of two robots' swept boxes not proved apart with `extra` mm
+/// added to the first robot's sweeps, any combination of sweep forms allowed.
+fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(usize, usize)> {
+    const FORMS: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
+    let ((boxes_a, sweeps_a, faces_a), (boxes_b, sweeps_b, faces_b)) = (a, b);
+    // With `extra`, the first robot's face terms under its widened sweeps.
+    let mut widened = *faces_a;
+    if extra != 0.0 {
+        for (form, terms) in widened.iter_mut().enumerate() {
+            for (i, box_a) in boxes_a.iter().enumerate() {
+                let sa = &sweeps_a[form][i];
+                terms[i] = FaceTerms::new(box_a, &Sweep { ball: sa.ball + extra, ..*sa });
             }
         }
-        for (i, box_a) in boxes(p.a).iter().enumerate() {
-            for (k, box_b) in boxes(p.b).iter().enumerate() {
-                let apart = |&(fa, fb): &(usize, usize)| {
-                    let (sa, sb) = (&sweeps[p.a][fa][i], &sweeps[p.b][fb][k]);
-                    let sa = Sweep { ball: sa.ball + extra, ..*sa };
-                    swept_boxes_apart_with(box_a, &sa, &widened[fa][i], box_b, sb, &faces[p.b][fb][k])
-                };
-                if !FORMS.iter().any(apart) {
-                    return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
-                }
+    }
+    for (i, box_a) in boxes_a.iter().enumerate() {
+        for (k, box_b) in boxes_b.iter().enumerate() {
+            let apart = |&(fa, fb): &(usize, usize)| {
+                let (sa, sb) = (&sweeps_a[fa][i], &sweeps_b[fb][k]);
+                let sa = Sweep { ball: sa.ball + extra, ..*sa };
+                swept_boxes_apart_with(box_a, &sa, &widened[fa][i], box_b, sb, &faces_b[fb][k])
+            };
+            if !FORMS.iter().any(apart) {
+                return Some((i, k));
             }
         }
     }

@@ -1,0 +1,309 @@
+//! The protective verdict when the controller knows the path of the stop (SPEC §8, "Where the
+//! controller knows more"): a controller that performs a path-maintaining stop can give, per
+//! robot, the polyline its TCP will follow until it stands still, with a tolerance.
+//!
+//! # The promise and the bound
+//! A [`StopPath`] promises that from this tick until the robot stands still its TCP stays
+//! within `tolerance_mm` of the polyline `points` (its commanded set-points, which the servo
+//! follows within that error). The stopping model still holds as well, so the TCP also stays
+//! within the stopping distance `S` of where it is now (module doc of `protective`, step 3).
+//! Every TCP of the stop therefore lies in `tube(Q, tol) ∩ ball(p, S)`.
+//!
+//! 1. **Cover.** Let `[s0, s1]` be the arc range of `Q` from the first to the last point of
+//!    `Q` within `S + tol` of `p` ([`arc_range`]). A TCP of the stop is within `tol` of a
+//!    point `q` of `Q` with `|q - p| <= S + tol`, so `q = Q(s)` with `s` in `[s0, s1]`. A
+//!    piece `[a, b]` of that range holds points within `(b - a) / 2` of `Q((a + b) / 2)`
+//!    (arc length is at least distance), so its TCPs lie in the ball of radius
+//!    `(b - a) / 2 + tol` around that point ([`piece_ball`]).
+//! 2. **Pieces apart.** Each piece's ball gives a reference and box sweeps exactly as the
+//!    whole stop's ball does (`stop_sweeps_wcs`, tier 1). When robot `a`'s piece and robot
+//!    `b`'s piece are proved apart, so is every pair of sub-pieces (their TCPs are subsets).
+//!    So the prover splits the larger piece of an unproved pair in halves and proves both
+//!    halves ([`MAX_DEPTH`] halvings per robot at most); all pairs proved: FREE.
+//! 3. **Fallback.** A robot without a path is one piece: the ball of the verdict without
+//!    paths. A piece whose ball is not smaller than that ball, or whose centre is unreachable,
+//!    uses that ball too. The path verdict is taken only where it is better than the verdict
+//!    without paths (both are proofs).
+//!
+//! A path that breaks its promise at once (the TCP now is farther than `tol` from `Q`, a
+//! non-finite point or tolerance, a negative tolerance, no point) is
+//! [`ProtectiveStatus::InvalidPath`]: STOP. Nothing here allocates.
+
+use super::{first_unproved_between, stop_sweeps_wcs, BoxPair, Protective, ProtectiveChecker, SweepForms};
+use crate::geometry::sweep::FaceTerms;
+use crate::math::{Real, Vec3};
+use crate::robot::{RobotBoxes, MAX_BOXES};
+
+/// Halvings of one robot's piece at most, per robot pair (up to `2^MAX_DEPTH` pieces).
+pub const MAX_DEPTH: u32 = 3;
+
+/// The path a robot's TCP will follow over its stop (module doc): the polyline through
+/// `points` (MCS, mm), left by at most `tolerance_mm`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StopPath<'a> {
+    /// The polyline's vertices, in the order the TCP follows them (MCS, mm).
+    pub points: &'a [Vec3],
+    /// How far the TCP may be from the polyline at any moment of the stop (mm).
+    pub tolerance_mm: Real,
+}
+
+/// Length of the polyline `points`.
+fn length(points: &[Vec3]) -> Real {
+    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+/// The point at arc length `s` (clamped) of the polyline `points`.
+pub fn point_at(points: &[Vec3], s: Real) -> Vec3 {
+    let mut rest = s.max(0.0);
+    for w in points.windows(2) {
+        let len = (w[1] - w[0]).norm();
+        if rest <= len && len > 0.0 {
+            return w[0] + (w[1] - w[0]) * (rest / len);
+        }
+        rest -= len;
+    }
+    points[points.len() - 1]
+}
+
+/// The distance from `p` to the polyline `points` (at least one point).
+pub fn distance_to(points: &[Vec3], p: &Vec3) -> Real {
+    let mut best = (points[0] - p).norm();
+    for w in points.windows(2) {
+        let d = w[1] - w[0];
+        let len2 = d.norm_squared();
+        let t = if len2 > 0.0 { ((p - w[0]).dot(&d) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        best = best.min((w[0] + d * t - p).norm());
+    }
+    best
+}
+
+/// The arc range `[s0, s1]` of the polyline `points` from its first to its last point within
+/// `r` of `c` (module doc, step 1); `None` when no point is.
+pub fn arc_range(points: &[Vec3], c: &Vec3, r: Real) -> Option<(Real, Real)> {
+    let mut range: Option<(Real, Real)> = None;
+    let mut start = 0.0;
+    let mut add = |s: Real| range = Some(range.map_or((s, s), |(a, b)| (a.min(s), b.max(s))));
+    if points.len() == 1 {
+        return ((points[0] - c).norm() <= r).then_some((0.0, 0.0));
+    }
+    for w in points.windows(2) {
+        let d = w[1] - w[0];
+        let len = d.norm();
+        // |w0 + t d - c|^2 <= r^2 for t in [0, 1]: t^2 |d|^2 + 2 t d.(w0 - c) + |w0 - c|^2 - r^2 <= 0.
+        let f = w[0] - c;
+        let (qa, qb, qc) = (d.norm_squared(), 2.0 * d.dot(&f), f.norm_squared() - r * r);
+        if qa == 0.0 {
+            if qc <= 0.0 {
+                add(start);
+            }
+            continue;
+        }
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc >= 0.0 {
+            let root = disc.sqrt();
+            let (t0, t1) = ((-qb - root) / (2.0 * qa), (-qb + root) / (2.0 * qa));
+            let (t0, t1) = (t0.max(0.0), t1.min(1.0));
+            if t0 <= t1 {
+                // Widened by a relative 1e-12: rounding must not cut a point off.
+                let slack = 1e-12 * (len + r);
+                add((start + t0 * len - slack).max(0.0));
+                add(start + t1 * len + slack);
+            }
+        }
+        start += len;
+    }
+    range.map(|(a, b)| (a, b.min(start)))
+}
+
+/// The ball holding every point within `tol` of the polyline's arc range `[a, b]`.
+pub fn piece_ball(points: &[Vec3], (a, b): (Real, Real), tol: Real) -> (Vec3, Real) {
+    let centre = point_at(points, 0.5 * (a + b));
+    // Widened as the stop's own ball is: rounding of the arc walk.
+    (centre, (0.5 * (b - a) + tol) * (1.0 + 1e-12) + 1e-9)
+}
+
+/// Whether `path` is usable for a robot whose TCP is `tcp` (module doc, last paragraph).
+pub fn path_is_valid(path: &StopPath, tcp: &Vec3) -> bool {
+    let finite = path.points.iter().all(|p| p.iter().all(|x| x.is_finite()));
+    finite
+        && !path.points.is_empty()
+        && path.tolerance_mm.is_finite()
+        && path.tolerance_mm >= 0.0
+        && length(path.points).is_finite()
+        && distance_to(path.points, tcp) <= path.tolerance_mm * (1.0 + 1e-9) + 1e-9
+}
+
+/// One piece of a robot's stop: the ball holding its TCPs, its boxes at the ball's centre and
+/// their sweeps over the ball.
+struct Piece {
+    /// The arc range of the path (`None`: the ball of the verdict without paths).
+    arc: Option<(Real, Real)>,
+    boxes: RobotBoxes,
+    sweeps: SweepForms,
+    faces: [[FaceTerms; MAX_BOXES]; 2],
+}
+
+impl ProtectiveChecker {
+    /// The piece of robot `j` for the arc range `arc` of its path (module doc, steps 1, 3).
+    fn piece(&self, j: usize, path: Option<&StopPath>, arc: Option<(Real, Real)>) -> Piece {
+        let robot = &self.cell().robots[j];
+        let (rot, t) = (robot.placement.rotation(), robot.placement.t);
+        let mut boxes = RobotBoxes::empty();
+        let ball = match (path, arc) {
+            (Some(p), Some(range)) => Some(piece_ball(p.points, range, p.tolerance_mm)),
+            _ => None,
+        };
+        let ball = ball.filter(|&(c, r)| r < self.reach[j] && robot.model.boxes_into(&c, &mut boxes).is_ok());
+        let (centre, radius, arc) = match ball {
+            Some((c, r)) => {
+                for b in &mut boxes.boxes[..boxes.len] {
+                    *b = b.transformed(&rot, &t);
+                }
+                (c, r, arc)
+            }
+            None => {
+                boxes = self.ref_boxes[j];
+                (self.centres[j], self.reach[j], None)
+            }
+        };
+        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref(), 0, 0);
+        let mut faces = [[self.no_faces; MAX_BOXES]; 2];
+        for (form, terms) in faces.iter_mut().enumerate() {
+            for (k, b) in boxes.as_slice().iter().enumerate() {
+                terms[k] = FaceTerms::new(b, &sweeps[form][k]);
+            }
+        }
+        Piece { arc, boxes, sweeps, faces }
+    }
+
+    /// The halves of `piece` of robot `j`, when it has a path range to split.
+    fn halves(&self, j: usize, path: Option<&StopPath>, piece: &Piece) -> Option<(Piece, Piece)> {
+        let (a, b) = piece.arc?;
+        let m = 0.5 * (a + b);
+        Some((self.piece(j, path, Some((a, m))), self.piece(j, path, Some((m, b)))))
+    }
+
+    /// The first box pair of robots `a < b` not proved apart over pieces `pa`, `pb`, halving
+    /// the larger piece (module doc, step 2) while `depth_a`, `depth_b` allow.
+    #[allow(clippy::too_many_arguments)]
+    fn prove_pieces(
+        &self,
+        (a, b): (usize, usize),
+        (path_a, path_b): (Option<&StopPath>, Option<&StopPath>),
+        pa: &Piece,
+        pb: &Piece,
+        (depth_a, depth_b): (u32, u32),
+        extra: Real,
+    ) -> Option<BoxPair> {
+        let unproved = first_unproved_between(
+            (pa.boxes.as_slice(), &pa.sweeps, &pa.faces),
+            (pb.boxes.as_slice(), &pb.sweeps, &pb.faces),
+            extra,
+        )
+        .map(|(box_a, box_b)| BoxPair { a, b, box_a, box_b })?;
+        let span = |p: &Piece| p.arc.map_or(-1.0, |(s0, s1)| s1 - s0);
+        let split_a = depth_a < MAX_DEPTH && (span(pa) >= span(pb) || depth_b >= MAX_DEPTH);
+        if split_a {
+            if let Some((h1, h2)) = self.halves(a, path_a, pa) {
+                let deeper = (depth_a + 1, depth_b);
+                return self
+                    .prove_pieces((a, b), (path_a, path_b), &h1, pb, deeper, extra)
+                    .or_else(|| self.prove_pieces((a, b), (path_a, path_b), &h2, pb, deeper, extra));
+            }
+        }
+        if depth_b < MAX_DEPTH {
+            if let Some((h1, h2)) = self.halves(b, path_b, pb) {
+                let deeper = (depth_a, depth_b + 1);
+                return self
+                    .prove_pieces((a, b), (path_a, path_b), pa, &h1, deeper, extra)
+                    .or_else(|| self.prove_pieces((a, b), (path_a, path_b), pa, &h2, deeper, extra));
+            }
+        }
+        Some(unproved)
+    }
+
+    /// The verdict and limiting pair over the pieces of the paths (module doc), for the
+    /// references and reaches of the last evaluation.
+    pub(super) fn prove_with_paths(
+        &self,
+        tcps_mcs: &[Vec3],
+        paths: &[Option<StopPath>],
+    ) -> (Protective, Option<BoxPair>) {
+        let whole = |j: usize| -> Piece {
+            let path = paths[j].as_ref();
+            let arc = path.and_then(|p| {
+                let tol = p.tolerance_mm;
+                arc_range(p.points, &tcps_mcs[j], self.report.robots[j].protective_mm + tol)
+            });
+            self.piece(j, path, arc)
+        };
+        for (extra, verdict) in [(0.0, Protective::Stop), (self.warn_mm, Protective::Warn)] {
+            if extra == 0.0 && verdict == Protective::Warn {
+                break;
+            }
+            for pair in &self.exact.verdict().pairs {
+                let (a, b) = (pair.a, pair.b);
+                let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
+                let found = self.prove_pieces((a, b), paths_ab, &whole(a), &whole(b), (0, 0), extra);
+                if found.is_some() {
+                    return (verdict, found);
+                }
+            }
+        }
+        (Protective::Free, None)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: Real, y: Real, z: Real) -> Vec3 {
+        Vec3::new(x, y, z)
+    }
+
+    #[test]
+    fn arc_range_of_a_line_through_a_ball_is_its_chord() {
+        let line = [v(-100.0, 0.0, 0.0), v(100.0, 0.0, 0.0)];
+        let (a, b) = arc_range(&line, &v(0.0, 30.0, 0.0), 50.0).unwrap();
+        // The chord at height 30 of a radius-50 ball: x in [-40, 40], arc 60..140.
+        assert!((a - 60.0).abs() < 1e-9 && (b - 140.0).abs() < 1e-9, "{a} {b}");
+        assert_eq!(arc_range(&line, &v(0.0, 60.0, 0.0), 50.0), None);
+    }
+
+    #[test]
+    fn arc_range_spans_every_segment_that_enters_the_ball() {
+        // Out along x, back along x 10 mm higher: both legs pass the ball.
+        let path = [v(0.0, 0.0, 0.0), v(200.0, 0.0, 0.0), v(200.0, 0.0, 10.0), v(0.0, 0.0, 10.0)];
+        let (a, b) = arc_range(&path, &v(0.0, 0.0, 0.0), 20.0).unwrap();
+        assert_eq!(a, 0.0);
+        assert!(b > 400.0, "the return leg ends inside the ball: {b}");
+    }
+
+    #[test]
+    fn piece_balls_hold_the_points_of_their_range() {
+        let path = [v(0.0, 0.0, 0.0), v(30.0, 0.0, 0.0), v(30.0, 40.0, 0.0), v(0.0, 40.0, -20.0)];
+        let total = length(&path);
+        for k in 0..50 {
+            let (a, b) = (total * k as Real / 61.0, total * (k as Real + 11.0) / 61.0);
+            let (c, r) = piece_ball(&path, (a, b), 2.0);
+            for i in 0..=20 {
+                let p = point_at(&path, a + (b - a) * i as Real / 20.0);
+                assert!((p - c).norm() + 2.0 <= r, "range {a}..{b}: {p:?} outside ({c:?}, {r})");
+            }
+        }
+    }
+
+    #[test]
+    fn a_path_must_start_within_its_tolerance_of_the_tcp() {
+        let pts = [v(0.0, 0.0, -400.0), v(100.0, 0.0, -400.0)];
+        let path = StopPath { points: &pts, tolerance_mm: 1.0 };
+        assert!(path_is_valid(&path, &v(50.0, 0.5, -400.0)));
+        assert!(!path_is_valid(&path, &v(50.0, 2.0, -400.0)));
+        assert!(!path_is_valid(&StopPath { points: &[], tolerance_mm: 1.0 }, &v(0.0, 0.0, -400.0)));
+        assert!(!path_is_valid(&StopPath { tolerance_mm: Real::NAN, ..path }, &v(50.0, 0.0, -400.0)));
+        assert!(!path_is_valid(&StopPath { tolerance_mm: -1.0, ..path }, &v(50.0, 0.0, -400.0)));
+        let bad = [v(0.0, 0.0, -400.0), v(Real::INFINITY, 0.0, -400.0)];
+        assert!(!path_is_valid(&StopPath { points: &bad, tolerance_mm: 1.0 }, &v(0.0, 0.0, -400.0)));
+    }
+}
