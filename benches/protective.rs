@@ -9,12 +9,15 @@
 //! The realistic mix (`protective_T1_practical_replay`): the 6,000 ticks of the run replayed in
 //! order through `check` (speeds from the tick history, as in operation), so the share of ticks
 //! that reach the slower tiers is the scenario's own; the exact query on the same ticks is the
-//! peer. The verdict of every tick is computed before timing and asserted.
+//! peer. The verdict of every tick is computed before timing and asserted. "verdict with
+//! paths" is the same replay through `check_with_paths`, each robot's stop path its programmed
+//! path ahead (up to 400 mm, 0.1 mm tolerance), as a controller with a path-maintaining stop
+//! would give it.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use delta_collide::cell::protective::{Protective, ProtectiveChecker};
+use delta_collide::cell::protective::{Protective, ProtectiveChecker, StopPath};
 use delta_collide::cell::reference::reference_cell;
-use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
+use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, RUN_TICKS};
 use delta_collide::cell::ExactChecker;
 use delta_collide::math::{Real, Vec3};
 use std::hint::black_box;
@@ -74,27 +77,39 @@ fn protective_query(c: &mut Criterion) {
     group.finish();
 }
 
-/// The run's TCPs, tick by tick.
-fn run_ticks() -> Vec<[Vec3; 2]> {
+/// One robot's stop path: its points and how many are used.
+type PathAhead = ([Vec3; 32], usize);
+
+/// The run's TCPs, tick by tick, with each robot's programmed path ahead.
+fn run_ticks() -> Vec<([Vec3; 2], [PathAhead; 2])> {
     let s = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
     (0..RUN_TICKS)
         .map(|tick| {
             let mut now = [Vec3::zeros(); 2];
             s.tcps_at(tick, &mut now);
-            now
+            let paths = std::array::from_fn(|j| {
+                let mut points = [Vec3::zeros(); 32];
+                let n = path_ahead(&s.robots[j], tick, 400.0, &mut points);
+                (points, n)
+            });
+            (now, paths)
         })
         .collect()
+}
+
+fn stop_paths(paths: &[PathAhead; 2]) -> [Option<StopPath<'_>>; 2] {
+    paths.each_ref().map(|(p, n)| Some(StopPath { points: &p[..*n], tolerance_mm: 0.1 }))
 }
 
 fn protective_replay(c: &mut Criterion) {
     let ticks = run_ticks();
     let cell = reference_cell("T1").unwrap();
     let mut exact = ExactChecker::new(cell.clone());
-    let hits: Vec<bool> = ticks.iter().map(|t| exact.check(t).unwrap().collides()).collect();
+    let hits: Vec<bool> = ticks.iter().map(|t| exact.check(&t.0).unwrap().collides()).collect();
     let mut group = c.benchmark_group("protective_T1_practical_replay");
     for (name, limits) in [("with speed limits", true), ("verdict only", false)] {
         let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
-        let verdicts: Vec<Protective> = ticks.iter().map(|t| checker.check(t).unwrap().verdict).collect();
+        let verdicts: Vec<Protective> = ticks.iter().map(|t| checker.check(&t.0).unwrap().verdict).collect();
         let mut i = 0;
         group.bench_function(BenchmarkId::new("protective", name), |b| {
             b.iter(|| {
@@ -103,16 +118,31 @@ fn protective_replay(c: &mut Criterion) {
                     checker.reset();
                 }
                 i += 1;
-                assert_eq!(checker.check(black_box(&ticks[k])).unwrap().verdict, verdicts[k]);
+                assert_eq!(checker.check(black_box(&ticks[k].0)).unwrap().verdict, verdicts[k]);
             })
         });
     }
+    let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+    let verdicts: Vec<Protective> =
+        ticks.iter().map(|(t, p)| checker.check_with_paths(t, &stop_paths(p)).unwrap().verdict).collect();
+    let mut i = 0;
+    group.bench_function(BenchmarkId::new("protective", "verdict with paths"), |b| {
+        b.iter(|| {
+            let k = i % ticks.len();
+            if k == 0 {
+                checker.reset();
+            }
+            i += 1;
+            let (tcps, paths) = &ticks[k];
+            assert_eq!(checker.check_with_paths(black_box(tcps), &stop_paths(paths)).unwrap().verdict, verdicts[k]);
+        })
+    });
     let mut i = 0;
     group.bench_function(BenchmarkId::new("exact", "SAT-cache"), |b| {
         b.iter(|| {
             let k = i % ticks.len();
             i += 1;
-            assert_eq!(exact.check(black_box(&ticks[k])).unwrap().collides(), hits[k]);
+            assert_eq!(exact.check(black_box(&ticks[k].0)).unwrap().collides(), hits[k]);
         })
     });
     group.finish();

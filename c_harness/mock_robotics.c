@@ -361,6 +361,23 @@ static int at_waypoint(const MrTrajectory *traj, double tick)
     return 0;
 }
 
+size_t mr_path_ahead(const MrTrajectory *traj, double tick, double length_mm, double out[][3], size_t capacity)
+{
+    size_t i, n = 0;
+    double length = 0.0;
+    if (capacity == 0) {
+        return 0;
+    }
+    mr_trajectory_tcp_at(traj, tick, out[n++]);
+    for (i = 0; i < traj->n_waypoints && n < capacity && length < length_mm; ++i) {
+        if ((double)traj->tick[i] > tick) {
+            length += distance3(out[n - 1], traj->tcp[i]);
+            memcpy(out[n++], traj->tcp[i], sizeof out[0]);
+        }
+    }
+    return n;
+}
+
 void mr_stop_start(const MrOverride *now, double reaction_ms, double decel_mm_s2, MrStop *stop)
 {
     stop->o = *now;

@@ -137,6 +137,11 @@ void mr_override_request(MrOverride *o, double wanted_mm_s, double ramp_mm_s2, d
  * segment's end). */
 void mr_override_step(const MrTrajectory *traj, MrOverride *o, double dt_ticks, double dt_s);
 
+/* The programmed path ahead of `tick`, as a controller performing a path-maintaining stop
+ * knows it: the commanded TCP at `tick`, then the following waypoints until `capacity` points
+ * are written or the path is at least `length_mm` long. Returns the number of points. */
+size_t mr_path_ahead(const MrTrajectory *traj, double tick, double length_mm, double out[][3], size_t capacity);
+
 /* A path-maintaining stop of one robot (SPEC section 8): from the STOP it keeps its motion for
  * reaction_ms (the programmed motion, capped at the override cap it had: INFINITY for none),
  * then brakes along its path, its speed falling by decel_mm_s2 per second, until it stands

@@ -1,21 +1,54 @@
 /*
  * protective.c: the protective verdict end to end (SPEC section 8). Each trajectory scenario
- * runs with dc_protective_query once per tick; at the first STOP every simulated robot keeps
+ * runs with dc_protective_query once per tick (with the stiff model also through
+ * dc_protective_query_with_paths, each robot's programmed path ahead as its stop path, which
+ * the simulated stop follows); at the first STOP every simulated robot keeps
  * its commanded motion for its reaction time, then brakes along its own path at its
  * configured deceleration until still (a path-maintaining stop that ends at the path's next
  * waypoint at the latest). Every 0.1 ms of that stop the exact model (dc_query on a second
  * handle) must find no contact. Prints per scenario the first WARN and STOP ticks, the STOP
  * and WARN counts, the smallest clearance and the stop's length. --quick (valgrind) runs the
- * first 200 ticks of T1 collision with the default model, which hold its whole stop.
+ * first 200 ticks of T1 collision with the default model, which hold its whole stop, with and
+ * without paths.
  */
 #include "harness.h"
 
 #include <math.h>
 #include <stdio.h>
 
-/* One scenario with the protective verdict, every robot with stopping model `model`, warn_mm 10. */
+#define PATH_AHEAD_MM 400.0 /* longer than any stop of the models here */
+
+/* The verdict of one tick: with each robot's programmed path ahead as its stop path
+ * (dc_protective_query_with_paths, the mock's commanded TCPs lie on it: 0.1 mm tolerance),
+ * or without paths. */
+static DcStatus query_tick(DcCollider *h, const MrScenario *s, const MrStop stop[MR_MAX_ROBOTS], int with_paths,
+                           DcVerdict *v, DcProtectiveReport *rep)
+{
+    DcVec3 tcps[MR_MAX_ROBOTS], points[MR_MAX_ROBOTS][DC_MAX_PATH_POINTS];
+    DcStopPath paths[MR_MAX_ROBOTS];
+    double ahead[DC_MAX_PATH_POINTS][3];
+    size_t j, k;
+    for (j = 0; j < s->n_robots; ++j) {
+        tcps[j] = vec3(stop[j].o.tcp[0], stop[j].o.tcp[1], stop[j].o.tcp[2]);
+        paths[j].n_points = mr_path_ahead(&s->robots[j], stop[j].o.path_tick, PATH_AHEAD_MM, ahead, DC_MAX_PATH_POINTS);
+        /* The path starts at the TCP itself (the stop moves on from there). */
+        points[j][0] = tcps[j];
+        for (k = 1; k < paths[j].n_points; ++k) {
+            points[j][k] = vec3(ahead[k][0], ahead[k][1], ahead[k][2]);
+        }
+        paths[j].points = points[j];
+        paths[j].tolerance_mm = 0.1;
+    }
+    if (!with_paths) {
+        return dc_protective_query(h, tcps, s->n_robots, v, rep);
+    }
+    return dc_protective_query_with_paths(h, tcps, s->n_robots, paths, s->n_robots, v, rep);
+}
+
+/* One scenario with the protective verdict, every robot with stopping model `model`, warn_mm
+ * 10, with or without the programmed path ahead as the stop path. */
 static void run_protective(const char *cell_name, const char *case_name, const char *model_name,
-                           const DcStopConfig *model, long n_ticks)
+                           const DcStopConfig *model, int with_paths, long n_ticks)
 {
     MrCell cell;
     MrScenario scenario;
@@ -32,7 +65,6 @@ static void run_protective(const char *cell_name, const char *case_name, const c
         return;
     }
     for (tick = -1; tick < n_ticks; ++tick) {
-        DcVec3 tcps[MR_MAX_ROBOTS];
         DcVerdict v = DC_VERDICT_FREE;
         DcProtectiveReport rep;
         int sub;
@@ -48,10 +80,7 @@ static void run_protective(const char *cell_name, const char *case_name, const c
                 stop_substep(exact, &scenario, stop, &st);
             }
         }
-        for (j = 0; j < cell.n_robots; ++j) {
-            tcps[j] = vec3(stop[j].o.tcp[0], stop[j].o.tcp[1], stop[j].o.tcp[2]);
-        }
-        s = dc_protective_query(h, tcps, cell.n_robots, &v, &rep);
+        s = query_tick(h, &scenario, stop, with_paths, &v, &rep);
         if (tick < 0) {
             continue;
         }
@@ -73,9 +102,9 @@ static void run_protective(const char *cell_name, const char *case_name, const c
     check(st.contacts == 0, "protective %s %s: %lu of %lu samples of the stop touch", cell_name, case_name,
           st.contacts, st.samples);
     check(t.first_stop < 0 || st.samples > 0, "protective %s %s: the stop was not simulated", cell_name, case_name);
-    printf("protective %s %-9s %-7s: first WARN %ld, first STOP %ld, STOP %lu WARN %lu of %ld ticks, statuses not OK %lu, "
+    printf("protective %s %-9s %-7s%s: first WARN %ld, first STOP %ld, STOP %lu WARN %lu of %ld ticks, statuses not OK %lu, "
            "smallest clearance %.1f mm, stop %.1f ms, %lu exact samples of the stop, contacts %lu\n",
-           cell_name, case_name, model_name, t.first_warn, t.first_stop, t.n_stop, t.n_warn, n_ticks, t.n_bad_status,
+           cell_name, case_name, model_name, with_paths ? " with paths" : "", t.first_warn, t.first_stop, t.n_stop, t.n_warn, n_ticks, t.n_bad_status,
            t.min_clear, st.moving_ms, st.samples, st.contacts);
     dc_destroy(h);
     dc_destroy(exact);
@@ -93,13 +122,18 @@ void protective_scenarios(const HarnessOptions *options)
     stiff.decel_mm_s2 = 120000.0;
     if (options->quick || options->protective_quick) {
         /* Valgrind: the default model stops at about tick 60 and stands still by tick 100. */
-        run_protective("T1", "collision", "default", &standard, 200);
+        run_protective("T1", "collision", "default", &standard, 0, 200);
+        run_protective("T1", "collision", "default", &standard, 1, 200); /* the path entry point */
         return;
     }
     for (c = 0; c < 3; ++c) {
         for (k = 0; k < 2; ++k) {
-            run_protective(cells[c], cases[k], "default", &standard, MR_TICKS_PER_RUN);
-            run_protective(cells[c], cases[k], "stiff", &stiff, MR_TICKS_PER_RUN);
+            run_protective(cells[c], cases[k], "default", &standard, 0, MR_TICKS_PER_RUN);
+            run_protective(cells[c], cases[k], "stiff", &stiff, 0, MR_TICKS_PER_RUN);
+            /* With the default model the first STOP comes in the first 100 ticks with or
+             * without paths (tests/protective_paths.rs counts every tick); with the stiff one
+             * the paths decide whether the practical runs stop at all. */
+            run_protective(cells[c], cases[k], "stiff", &stiff, 1, MR_TICKS_PER_RUN);
         }
     }
 }
