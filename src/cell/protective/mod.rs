@@ -57,7 +57,10 @@
 //!
 //! The **speed limit** of a robot is the largest measured speed `|v_fd|` in `[0, v_max]` at
 //! which every pair involving it is still proved, the other robots as they are: bisection to
-//! `v_max / 2^LIMIT_STEPS` ([`LIMIT_STEPS`]) that keeps the last speed proved. 0 when not
+//! `v_max / 2^LIMIT_STEPS` ([`LIMIT_STEPS`]) that keeps the last speed proved. Ticks of
+//! [`ProtectiveChecker::check`] start from the last tick's limit and step away from it by
+//! doubling steps to a bracket before bisecting: the same kind of answer (a grid speed proved,
+//! the next one up not) in a few tests where limits change little between ticks. 0 when not
 //! even standing still is proved; `v_max` when full speed is. By default the bisection uses
 //! tier 1 alone (a few us per robot): that limit is proved, and never above the limit of
 //! both tiers ([`ProtectiveChecker::with_precise_limits`] for that one: both tiers, the
@@ -190,9 +193,11 @@ struct History {
     tcp: Option<Vec3>,
     /// The last finite-difference velocity (mm/s).
     velocity: Option<Vec3>,
+    /// The last speed limit (mm/s): where this tick's search starts.
+    limit: Option<Real>,
 }
 
-const NO_HISTORY: History = History { tcp: None, velocity: None };
+const NO_HISTORY: History = History { tcp: None, velocity: None, limit: None };
 
 /// The protective check of one cell; keeps each robot's previous TCP between ticks.
 #[derive(Clone, Debug)]
@@ -372,11 +377,12 @@ impl ProtectiveChecker {
             self.velocity[j] = velocity;
             self.history[j].velocity = Some(velocity);
         }
-        self.evaluate(tcps_mcs, status);
+        self.evaluate(tcps_mcs, status, true);
         // Only a tick without error (unreachable included) becomes the next one's history.
         if self.report.status == ProtectiveStatus::Ok {
-            for (h, tcp) in self.history.iter_mut().zip(tcps_mcs) {
+            for ((h, tcp), r) in self.history.iter_mut().zip(tcps_mcs).zip(&self.report.robots) {
                 h.tcp = Some(*tcp);
+                h.limit = Some(r.speed_limit_mm_s).filter(|v| v.is_finite());
             }
         } else {
             self.reset();
@@ -448,12 +454,13 @@ impl ProtectiveChecker {
                 status = worse(status, ProtectiveStatus::NonFinite(j));
             }
         }
-        self.evaluate(tcps_mcs, status);
+        self.evaluate(tcps_mcs, status, false);
         Ok(&self.report)
     }
 
-    /// Fills the report from the TCPs and the measured speeds already in `report.robots`.
-    fn evaluate(&mut self, tcps_mcs: &[Vec3], status: ProtectiveStatus) {
+    /// Fills the report from the TCPs and the measured speeds already in `report.robots`;
+    /// with `from_history`, each speed limit's search starts at the last tick's limit.
+    fn evaluate(&mut self, tcps_mcs: &[Vec3], status: ProtectiveStatus, from_history: bool) {
         let report = &mut self.report;
         (report.verdict, report.status, report.clearance_mm) = (Protective::Stop, status, Real::NAN);
         (report.closest, report.limiting) = (None, None);
@@ -502,8 +509,9 @@ impl ProtectiveChecker {
             }
         }
         for (j, tcp) in tcps_mcs.iter().enumerate() {
+            let start = self.history[j].limit.filter(|_| from_history);
             self.report.robots[j].speed_limit_mm_s =
-                if self.speed_limits { self.speed_limit(j, tcp) } else { Real::NAN };
+                if self.speed_limits { self.speed_limit(j, tcp, start) } else { Real::NAN };
         }
     }
 
@@ -616,7 +624,7 @@ impl ProtectiveChecker {
     }
 
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are.
-    fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3) -> Real {
+    fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3, start: Option<Real>) -> Real {
         let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]);
         // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
         let proved = |me: &mut Self, v: Real, tier: Option<u32>| {
@@ -654,10 +662,31 @@ impl ProtectiveChecker {
                 bisect(me, (0.0, top), tier)
             }
         };
+        // The same bracket found from `h`, the last tick's limit: steps of doubling length up
+        // (while proved) or down (while not) to a bracket, then the bisection. Limits change
+        // little from tick to tick, so this takes a few tests instead of `LIMIT_STEPS + 2`.
+        let limit_near = |me: &mut Self, h: Real| {
+            let h = ((h / resolution).round() * resolution).clamp(0.0, vmax);
+            let up = proved(me, h, Some(0));
+            let (mut from, mut step) = (h, resolution);
+            loop {
+                let to = if up { (from + step).min(vmax) } else { (from - step).max(0.0) };
+                if to == from {
+                    return (from, from);
+                }
+                if proved(me, to, Some(0)) != up {
+                    return bisect(me, if up { (from, to) } else { (to, from) }, Some(0));
+                }
+                (from, step) = (to, 2.0 * step);
+            }
+        };
         let tier = if self.precise_limits { self.precise_splits } else { 0 };
         // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit, and the floor
         // of the precise one.
-        let (lo, hi) = limit_of(self, Some(0), vmax);
+        let (lo, hi) = match start {
+            Some(h) => limit_near(self, h),
+            None => limit_of(self, Some(0), vmax),
+        };
         let limit = if tier == 0 || lo == vmax {
             lo
         } else {
