@@ -689,3 +689,52 @@ fn replay_plot_refuses_bad_arguments_with_a_clear_message() {
     assert!(stderr(&out).contains("no rows"), "{}", stderr(&out));
     assert_eq!(names_in(&dir), ["run.csv"], "no picture is left behind by a failure");
 }
+
+/// `check` on the four-robot line of `cells/line4.toml` (12 coordinates a row) answers as
+/// the two-robot cells of each pair checked one by one with the library.
+#[test]
+fn check_on_a_line_of_four_answers_as_its_pairs_one_by_one() {
+    use delta_collide::cell::{placement::Placement, Cell};
+    use rand::{rngs::StdRng, RngExt, SeedableRng};
+    let t1 = reference_cell("T1").unwrap();
+    let pair_cell = |gap: usize| {
+        let mut robots = t1.robots.clone();
+        robots[1].placement = Placement { alpha: 0.0, t: Vec3::new(450.0 * gap as f64, 0.0, 0.0) };
+        ExactChecker::new(Cell::new(format!("gap{gap}"), robots, t1.method).unwrap())
+    };
+    let mut checkers: Vec<ExactChecker> = (1..4).map(pair_cell).collect();
+    let mut rng = StdRng::seed_from_u64(44);
+    let mut rows = Vec::new();
+    let mut truth = Vec::new();
+    while rows.len() < 400 {
+        let tcps: Vec<Vec3> = (0..4)
+            .map(|_| {
+                Vec3::new(rng.random_range(-250.0..250.0), rng.random_range(-150.0..150.0), rng.random_range(-560.0..-360.0))
+            })
+            .collect();
+        let mut reachable = true;
+        let mut collide = false;
+        for a in 0..4 {
+            for b in a + 1..4 {
+                let v = checkers[b - a - 1].check(&[tcps[a], tcps[b]]).unwrap();
+                reachable &= v.unreachable_mask == 0;
+                collide |= v.collides();
+            }
+        }
+        if !reachable {
+            continue;
+        }
+        truth.push(collide);
+        rows.push(tcps.iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(","));
+    }
+    let out = cli_stdin(&["check", "--cell", "cells/line4.toml"], &rows.join("\n"));
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let answers: Vec<&str> = text.lines().skip(1).collect();
+    assert_eq!(answers.len(), rows.len(), "{text}");
+    for ((line, hit), row) in answers.iter().zip(&truth).zip(&rows) {
+        assert_eq!(line.split(',').nth(1), Some(if *hit { "1" } else { "0" }), "{row}: {line}");
+    }
+    let hits = truth.iter().filter(|h| **h).count();
+    assert!(hits > 20 && hits < 380, "the rows mix free and colliding lines: {hits}");
+}

@@ -1,0 +1,82 @@
+//! Lines of 2, 4, 8 and 16 thesis robots along one conveyor, bases 450 mm apart (as T1 and
+//! `cells/line4.toml`): the exact query and the protective verdict (alone, and with speed
+//! limits) per tick, against the number of pairs that can meet. Robot `j` runs T1 practical's
+//! trajectory of robot A (even `j`) or B (odd `j`), so every other neighbour pair works as
+//! T1's pair does; the 6,000 ticks are replayed in order (`check`, speeds from the history)
+//! and every answer is asserted against one computed before timing. The exact query of the
+//! two-robot line is the peer of every other figure.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use delta_collide::cell::placement::Placement;
+use delta_collide::cell::protective::{Protective, ProtectiveChecker};
+use delta_collide::cell::reference::reference_cell;
+use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
+use delta_collide::cell::{Cell, ExactChecker, RobotSpec};
+use delta_collide::math::Vec3;
+use std::hint::black_box;
+
+const SCENARIOS: &str = include_str!("../c_harness/scenarios.txt");
+
+/// A line of `n` thesis robots, 450 mm apart along x.
+fn line(n: usize) -> Cell {
+    let t1 = reference_cell("T1").unwrap();
+    let robots = (0..n)
+        .map(|j| RobotSpec {
+            name: format!("R{}", j + 1),
+            placement: Placement { alpha: 0.0, t: Vec3::new(450.0 * j as f64, 0.0, 0.0) },
+            ..t1.robots[0].clone()
+        })
+        .collect();
+    Cell::new(format!("line{n}"), robots, t1.method).unwrap()
+}
+
+/// The ticks of the run for `n` robots.
+fn ticks(n: usize) -> Vec<Vec<Vec3>> {
+    let s = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    (0..RUN_TICKS)
+        .map(|tick| {
+            let mut pair = [Vec3::zeros(); 2];
+            s.tcps_at(tick, &mut pair);
+            (0..n).map(|j| pair[j % 2]).collect()
+        })
+        .collect()
+}
+
+fn lines(c: &mut Criterion) {
+    let mut group = c.benchmark_group("line_T1_practical_replay");
+    for n in [2, 4, 8, 16] {
+        let cell = line(n);
+        let pairs = cell.pairs_that_can_meet().len();
+        let run = ticks(n);
+        let mut exact = ExactChecker::new(cell.clone());
+        let hits: Vec<bool> = run.iter().map(|t| exact.check(t).unwrap().collides()).collect();
+        let label = format!("{n} robots, {pairs} pairs");
+        let mut i = 0;
+        group.bench_function(BenchmarkId::new("exact", &label), |b| {
+            b.iter(|| {
+                let k = i % run.len();
+                i += 1;
+                assert_eq!(exact.check(black_box(&run[k])).unwrap().collides(), hits[k]);
+            })
+        });
+        for (name, limits) in [("protective verdict", false), ("protective with speed limits", true)] {
+            let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
+            let verdicts: Vec<Protective> = run.iter().map(|t| checker.check(t).unwrap().verdict).collect();
+            let mut i = 0;
+            group.bench_function(BenchmarkId::new(name, &label), |b| {
+                b.iter(|| {
+                    let k = i % run.len();
+                    if k == 0 {
+                        checker.reset();
+                    }
+                    i += 1;
+                    assert_eq!(checker.check(black_box(&run[k])).unwrap().verdict, verdicts[k]);
+                })
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, lines);
+criterion_main!(benches);
