@@ -27,6 +27,8 @@ pub(crate) mod quadtree4d;
 pub(crate) mod quadtree5d;
 pub(crate) mod quadtree6d;
 pub(crate) mod shared6d;
+#[cfg(feature = "std")]
+pub mod shard;
 mod space;
 #[cfg(feature = "std")]
 pub mod synthetic;
