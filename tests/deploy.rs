@@ -86,7 +86,7 @@ fn the_indexed_job_gives_each_pod_its_shard_and_the_shared_volume() {
     let args: Vec<&str> = (0..).map_while(|i| doc.get(&format!("{c}.args.{i}")).map(String::as_str)).collect();
     let flag = |name: &str| args.iter().position(|a| *a == name).map(|i| args[i + 1]);
     assert_eq!(flag("--shard"), Some("auto"), "{args:?}");
-    assert!(flag("--output").is_some_and(|o| o.starts_with("/shards/") && o.contains("{i}")), "{args:?}");
+    assert!(flag("--output").is_some_and(|o| o.starts_with("/shards/") && o.contains("{index}")), "{args:?}");
     assert_eq!(get(&doc, &format!("{c}.env.0.name"), file), "DELTA_COLLIDE_SHARDS");
     assert_eq!(get(&doc, &format!("{c}.env.0.value"), file), completions, "the pods' shard count is completions");
     assert_eq!(get(&doc, &format!("{c}.volumeMounts.0.mountPath"), file), "/shards");
@@ -130,7 +130,7 @@ fn the_slurm_scripts_parse_and_submit_an_array_and_a_merge_after_it() {
     let submit = read("slurm/submit.sh");
     assert!(submit.contains("--array=\"0-$((shards - 1))\"") && submit.contains("--dependency=\"afterok:$array_id\""));
     let build = read("slurm/build-table.sbatch");
-    assert!(build.contains("--shard auto") && build.contains("shard-{i}-of-{n}.dcs"));
+    assert!(build.contains("--shard auto") && build.contains("shard-{index}-of-{count}.dcs"));
     assert!(read("slurm/merge-table.sbatch").contains("shard-$i-of-$DC_SHARDS.dcs"));
     // A missing option is a usage error (exit 2) before anything is submitted.
     let out = Command::new(deploy("slurm/submit.sh")).args(["--cell", "T1"]).output().unwrap();

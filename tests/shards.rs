@@ -52,7 +52,7 @@ fn build(cell: &str, extra: &[&str], out: &Path) {
 fn shards(cell: &str, extra: &[&str], n: u32, dir: &Path, tag: &str) -> Vec<PathBuf> {
     (0..n)
         .map(|i| {
-            let path = dir.join(format!("{tag}-{i}-of-{n}.dcs"));
+            let path = dir.join(format!("{tag}-{index}-of-{count}.dcs"));
             let shard = format!("{i}/{n}");
             let mut args = vec!["build", "--cell", cell, "--k", K, "--shard", &shard, "--output", s(&path)];
             args.extend_from_slice(extra);
@@ -142,7 +142,7 @@ fn shard_auto_reads_the_schedulers_environment() {
             c.env_remove(v);
         }
         c.envs(vars.iter().copied());
-        let out_path = dir.join("auto-{i}-of-{n}.dcs");
+        let out_path = dir.join("auto-{index}-of-{count}.dcs");
         c.args(["-q", "build", "--cell", "T3", "--k", K, "--shard", "auto", "--output", s(&out_path)]);
         c.args(extra).output().unwrap()
     };

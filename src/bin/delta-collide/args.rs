@@ -41,7 +41,7 @@ pub fn clip(s: &str) -> String {
 #[command(name = "delta-collide", version = VERSION_TEXT.as_str(), subcommand_required = true)]
 #[command(arg_required_else_help = true, disable_help_subcommand = true)]
 pub struct Cli {
-    /// Draw no progress bars (they go to stderr only, and only when it is a terminal)
+    /// Draw no progress bars
     #[arg(short, long, global = true)]
     pub quiet: bool,
     #[command(subcommand)]
@@ -50,7 +50,7 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Run the practical and collision scenarios: exact check and protective verdict
+    /// Run the scenarios: exact check and protective verdict
     ///
     /// Runs the scenarios of c_harness/scenarios.txt for the chosen cells and prints the
     /// first collision tick and the per-tick query times of the exact check (SAT and
@@ -85,7 +85,7 @@ pub enum Command {
     /// file for merge; --shard auto takes I and N from a Slurm array, a Kubernetes Indexed
     /// Job or an AWS Batch array job (docs/CLUSTER.md).
     Build(BuildArgs),
-    /// Merge the shard files of a build into its table
+    /// Merge a sharded build's files into its table
     ///
     /// Reads every shard file of one `build --shard I/N` run, in any order, and writes the
     /// table: byte for byte the one a one-shot build writes. A missing, repeated, truncated or
@@ -120,7 +120,10 @@ pub enum Command {
         #[arg(value_parser = choice::<clap_complete::Shell>())]
         shell: clap_complete::Shell,
     },
-    /// Print the man page, or write one page per command into a directory
+    /// Print the man page(s)
+    ///
+    /// Prints the man page on stdout, or with --output writes one page per command into a
+    /// directory.
     Man {
         /// Write delta-collide.1 and delta-collide-COMMAND.1 into this directory instead
         #[arg(long, value_name = "DIR")]
@@ -208,7 +211,7 @@ pub struct BuildArgs {
     pub labelling: LabellingArg,
     /// Label only shard I of N (I from 0 to N-1; every variant shards) into a shard file for
     /// merge, or `auto`: I and N from SLURM_ARRAY_TASK_ID/_COUNT/_MIN, JOB_COMPLETION_INDEX
-    /// (Kubernetes) or AWS_BATCH_JOB_ARRAY_INDEX. {i} and {n} in --output become I and N
+    /// (Kubernetes) or AWS_BATCH_JOB_ARRAY_INDEX. In --output, {index} and {count} become I and N
     #[arg(long, value_name = "I/N|auto", value_parser = clipped(parse_shard))]
     pub shard: Option<ShardArg>,
     /// With --shard auto: the count N where the scheduler gives only the index (Kubernetes:

@@ -92,10 +92,10 @@ pub fn shard_from_env(env: &dyn Fn(&str) -> Option<String>, shards: Option<u32>)
     Ok((index, count))
 }
 
-/// `output` with `{i}` and `{n}` replaced by the shard's index and count.
+/// `output` with `{index}` and `{count}` replaced by the shard's index and count.
 fn shard_path(output: &Path, shard: ShardIndex) -> PathBuf {
     let s = output.to_string_lossy();
-    PathBuf::from(s.replace("{i}", &shard.index().to_string()).replace("{n}", &shard.count().to_string()))
+    PathBuf::from(s.replace("{index}", &shard.index().to_string()).replace("{count}", &shard.count().to_string()))
 }
 
 /// `build --shard`: labels one shard and writes its file.
@@ -122,15 +122,9 @@ pub fn build(args: &BuildArgs, shard: &ShardArg, progress: Progress) -> Result<(
 
 /// `merge --output FILE SHARD...`: the table of all shards, as a one-shot build writes it.
 pub fn merge(args: &MergeArgs) -> Result<(), Failure> {
-    let mut contents = Vec::with_capacity(args.shards.len());
-    for path in &args.shards {
-        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        contents.push((path.display().to_string(), bytes));
-    }
-    let files: Vec<(String, &[u8])> = contents.iter().map(|(n, b)| (n.clone(), &b[..])).collect();
-    let (header, table, r) = merge_shards(&files).map_err(|e| e.to_string())?;
-    drop(files);
-    drop(contents);
+    let names: Vec<String> = args.shards.iter().map(|p| p.display().to_string()).collect();
+    let mut read = |name: &str| std::fs::read(name).map_err(|e| e.to_string());
+    let (header, table, r) = merge_shards(&names, &mut read).map_err(|e| e.to_string())?;
     let bytes = to_bytes(&table, &header);
     let output = &args.output;
     files::write_file(output, |w| w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display())))?;
@@ -201,7 +195,7 @@ mod tests {
     #[test]
     fn output_names_take_the_shard_index_and_count() {
         let s = ShardIndex::new(3, 8).unwrap();
-        assert_eq!(shard_path(Path::new("out/t1-{i}-of-{n}.dcs"), s), PathBuf::from("out/t1-3-of-8.dcs"));
+        assert_eq!(shard_path(Path::new("out/t1-{index}-of-{count}.dcs"), s), PathBuf::from("out/t1-3-of-8.dcs"));
         assert_eq!(shard_path(Path::new("plain.dcs"), s), PathBuf::from("plain.dcs"));
     }
 }

@@ -42,6 +42,11 @@ pub enum ShardError {
         /// The field and what is wrong with it.
         what: String,
     },
+    /// The file could not be read.
+    Unreadable {
+        /// Why (the system's message).
+        what: String,
+    },
     /// A shard file that could not be read, with the reason.
     InFile {
         /// The file's name as given.
@@ -111,6 +116,7 @@ impl fmt::Display for ShardError {
             ShardError::Corrupt { what } => {
                 write!(f, "shard is corrupt: {what}; build the shard again or copy it again")
             }
+            ShardError::Unreadable { what } => f.write_str(what),
             ShardError::InFile { file, error } => write!(f, "{file}: {error}"),
             ShardError::Foreign { file, first, what } => write!(
                 f,

@@ -3,79 +3,111 @@
 //! the table from them (the same builder, so the same bytes).
 
 use super::error::ShardError;
-use super::format::{parse, unpack_row, Parsed};
-use crate::cspace::{Label, LabelledSpace, SubCells};
+use super::format::{parse, unpack_row, Parsed, ShardInfo};
+use crate::cspace::{Label, LabelledSpace, SampleGrid, SubCells};
 use crate::table::build::{assemble, RowLabels};
-use crate::table::{BuildReport, Header, Table};
+use crate::table::{BuildReport, Header, Table, TableKind};
 
-/// Merges the shard files `files` (each a name for messages and the file's bytes), in any
-/// order, into the table a one-shot build writes: its header, the table and the build's
-/// report (`label_secs` is the sum of the shards' labelling times).
+/// Merges the shard files `files` (names, in any order; `read` gives a file's bytes) into
+/// the table a one-shot build writes: its header, the table and the build's report
+/// (`label_secs` is the sum of the shards' labelling times). The files are read one at a
+/// time, each dropped once its labels are copied: the merge holds the whole label set (one
+/// byte per pair of samples), the sub-cells and one file.
 ///
 /// # Errors
-/// [`ShardError::InFile`] for a file that is not a valid shard (naming it), `Foreign` for a
-/// shard of another cell, `k`, variant, labelling or shard count, `Duplicate`, `Missing`,
-/// `NoShards`, or `Build` when the table builder refuses the labels.
-pub fn merge_shards(files: &[(String, &[u8])]) -> Result<(Header, Table, BuildReport), ShardError> {
-    let mut shards = Vec::with_capacity(files.len());
-    for (name, bytes) in files {
-        let parsed = parse(bytes).map_err(|e| ShardError::InFile { file: name.clone(), error: Box::new(e) })?;
-        shards.push((name.as_str(), parsed));
-    }
-    let ((first_name, first), rest) = shards.split_first().ok_or(ShardError::NoShards)?;
-    for (name, s) in rest {
-        if let Some(what) = differs(first, s) {
-            return Err(ShardError::Foreign { file: name.to_string(), first: first_name.to_string(), what });
-        }
-    }
-    let count = first.info.shard.count();
-    let mut holder: Vec<Option<&str>> = vec![None; count as usize];
-    for (name, s) in &shards {
-        let i = s.info.shard.index();
-        if let Some(other) = holder[i as usize] {
-            return Err(ShardError::Duplicate { index: i, first: other.to_string(), second: name.to_string() });
-        }
-        holder[i as usize] = Some(name);
-    }
-    let missing: Vec<u32> = (0..count).filter(|&i| holder[i as usize].is_none()).collect();
-    if !missing.is_empty() {
-        return Err(ShardError::Missing { missing, count });
-    }
-    let info = &first.info;
-    let (na, nb) = info.samples;
-    let mut labels = vec![Label::Unreachable; na * nb];
+/// [`ShardError::InFile`] for a file that cannot be read or is not a valid shard (naming it),
+/// `Foreign` for a shard of another cell, `k`, variant, labelling or shard count than the
+/// first file's, `Duplicate`, `Missing`, `NoShards`, or `Build` when the table builder
+/// refuses the labels.
+pub fn merge_shards(
+    files: &[String],
+    read: &mut dyn FnMut(&str) -> Result<Vec<u8>, String>,
+) -> Result<(Header, Table, BuildReport), ShardError> {
+    let in_file = |file: &str, error: ShardError| ShardError::InFile { file: file.to_string(), error: Box::new(error) };
+    let mut first: Option<First> = None;
     let mut sub = Vec::new();
-    for (_, s) in &shards {
-        let rows = s.info.shard.rows();
+    let mut secs = (0.0, 0.0);
+    for name in files {
+        let bytes = read(name).map_err(|what| in_file(name, ShardError::Unreadable { what }))?;
+        let s = parse(&bytes).map_err(|e| in_file(name, e))?;
+        let f = match &mut first {
+            None => first.insert(First::new(name, &s)),
+            Some(f) => {
+                if let Some(what) = differs(f, &s) {
+                    return Err(ShardError::Foreign { file: name.clone(), first: f.name.clone(), what });
+                }
+                f
+            }
+        };
+        let i = s.info.shard.index() as usize;
+        if let Some(other) = f.holder[i].replace(name.clone()) {
+            return Err(ShardError::Duplicate { index: i as u32, first: other, second: name.clone() });
+        }
+        let (rows, nb) = (s.info.shard.rows(), s.info.samples.1);
         for j in 0..s.info.rows {
             let ia = rows.row(j);
-            unpack_row(s.labels, j, &mut labels[ia * nb..(ia + 1) * nb]);
+            unpack_row(s.labels, j, &mut f.labels[ia * nb..(ia + 1) * nb]);
         }
         sub.extend(s.sub.chunks_exact(24).map(|e| {
             let word = |w: usize| u64::from_le_bytes(core::array::from_fn(|i| e[8 * w + i]));
             (word(0), word(1), word(2))
         }));
+        secs = (secs.0 + s.info.label_secs, secs.1 + s.info.sub_secs);
+    }
+    let f = first.ok_or(ShardError::NoShards)?;
+    let missing: Vec<u32> = (0..f.holder.len() as u32).filter(|&i| f.holder[i as usize].is_none()).collect();
+    if !missing.is_empty() {
+        return Err(ShardError::Missing { missing, count: f.holder.len() as u32 });
     }
     sub.sort_unstable_by_key(|&(pair, _, _)| pair);
-    let sub = (info.kind == crate::table::TableKind::SharedSub).then(|| SubCells {
-        pairs: sub.iter().map(|e| e.0).collect(),
-        care: sub.iter().map(|e| e.1).collect(),
-        collision: sub.iter().map(|e| e.2).collect(),
-    });
-    let (grid_a, grid_b) = (first.grid_a.clone(), first.grid_b.clone());
-    let space = LabelledSpace { grid_a, grid_b, labels, margin: info.header.margin };
-    let secs = |f: fn(&Parsed) -> f64| shards.iter().map(|(_, s)| f(s)).sum::<f64>();
-    let (label_secs, sub_secs) = (secs(|s| s.info.label_secs), secs(|s| s.info.sub_secs));
-    let row_labels =
-        RowLabels { space, sub, sub_secs, certification: info.header.certification, labelling: info.labelling };
+    let mut cells = SubCells::default();
+    if f.info.kind == TableKind::SharedSub {
+        cells.pairs = sub.iter().map(|e| e.0).collect();
+        cells.care = sub.iter().map(|e| e.1).collect();
+        cells.collision = sub.iter().map(|e| e.2).collect();
+    }
+    drop(sub);
+    let info = f.info;
+    let space = LabelledSpace { grid_a: f.grid_a, grid_b: f.grid_b, labels: f.labels, margin: info.header.margin };
+    let sub = (info.kind == TableKind::SharedSub).then_some(cells);
+    let labels =
+        RowLabels { space, sub, sub_secs: secs.1, certification: info.header.certification, labelling: info.labelling };
     let variant = info.kind.variant(info.t);
-    let (mut tables, report) = assemble(row_labels, info.symmetry, &[variant], label_secs).map_err(ShardError::Build)?;
+    let (mut tables, report) = assemble(labels, info.symmetry, &[variant], secs.0).map_err(ShardError::Build)?;
     let table = tables.pop().ok_or(ShardError::NoShards)?;
-    Ok((info.header.clone(), table, report))
+    Ok((info.header, table, report))
+}
+
+/// The first shard read: what the others must match, and the merge's state.
+struct First {
+    name: String,
+    info: ShardInfo,
+    grid_bytes: Vec<u8>,
+    grid_a: SampleGrid,
+    grid_b: SampleGrid,
+    /// Per shard number, the file holding it.
+    holder: Vec<Option<String>>,
+    /// Every pair's label.
+    labels: Vec<Label>,
+}
+
+impl First {
+    fn new(name: &str, s: &Parsed) -> First {
+        let (na, nb) = s.info.samples;
+        First {
+            name: name.to_string(),
+            info: s.info.clone(),
+            grid_bytes: s.grid_bytes.to_vec(),
+            grid_a: s.grid_a.clone(),
+            grid_b: s.grid_b.clone(),
+            holder: vec![None; s.info.shard.count() as usize],
+            labels: vec![Label::Unreachable; na * nb],
+        }
+    }
 }
 
 /// What makes shard `b` part of another build than `a`, if anything.
-fn differs(a: &Parsed, b: &Parsed) -> Option<String> {
+fn differs(a: &First, b: &Parsed) -> Option<String> {
     let (x, y) = (&a.info, &b.info);
     let (hx, hy) = (&x.header, &y.header);
     Some(if hx.cell_fingerprint != hy.cell_fingerprint {

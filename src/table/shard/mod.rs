@@ -115,3 +115,70 @@ pub fn build_shard(
     let bytes = format::to_bytes(&info, &labels);
     Ok((bytes, ShardReport { rows, samples: (na, nb), pairs: rows * nb, label_secs }))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::format::parse;
+    use super::*;
+    use crate::cell::fnv1a64;
+    use crate::cell::reference::reference_cell;
+
+    /// Shard 0 of 200 of T3's `shared-sub` table at k = 16: five rows, with sub-cells.
+    fn small_shard() -> Vec<u8> {
+        let cell = reference_cell("T3").unwrap();
+        let shard = ShardIndex::new(0, 200).unwrap();
+        let kind = (TableKind::SharedSub, 0);
+        build_shard(&cell, 16, &Workspace::THESIS, kind, Labelling::Certified, shard, Progress::Silent).unwrap().0
+    }
+
+    /// `bytes` with the checksum recomputed, as a deliberate edit would leave it.
+    fn resealed(mut bytes: Vec<u8>) -> Vec<u8> {
+        let end = bytes.len() - 8;
+        let sum = fnv1a64(&bytes[..end]);
+        bytes[end..].copy_from_slice(&sum.to_le_bytes());
+        bytes
+    }
+
+    #[test]
+    fn shard_numbers_must_be_below_the_count() {
+        assert!(ShardIndex::new(0, 1).is_ok() && ShardIndex::new(4, 5).is_ok());
+        assert_eq!(ShardIndex::new(5, 5), Err(ShardError::BadIndex { index: 5, count: 5 }));
+        assert!(ShardIndex::new(0, 0).is_err());
+        let rows = ShardIndex::new(2, 5).unwrap().rows();
+        assert_eq!((rows.count(12), rows.row(0), rows.row(1)), (2, 2, 7));
+    }
+
+    #[test]
+    fn every_truncation_and_every_flipped_byte_is_refused_without_panic() {
+        let bytes = small_shard();
+        let info = parse(&bytes).unwrap().info;
+        assert_eq!((info.rows, info.shard.count()), (5, 200));
+        assert!(info.sub_entries > 0, "the rows hold collision pairs with sub-cells");
+        for n in 0..bytes.len() {
+            let e = parse(&bytes[..n]).err().unwrap_or_else(|| panic!("a shard cut to {n} bytes was read"));
+            assert!(matches!(e, ShardError::Truncated { .. } | ShardError::Corrupt { .. }), "cut to {n}: {e}");
+        }
+        for i in 0..bytes.len() {
+            let mut flipped = bytes.clone();
+            flipped[i] ^= 0x20;
+            assert!(parse(&flipped).is_err(), "byte {i} flipped was read");
+        }
+    }
+
+    #[test]
+    fn fields_are_checked_beyond_the_checksum() {
+        let bytes = small_shard();
+        let labels_end = bytes.len() - 8 - 24 * parse(&bytes).unwrap().info.sub_entries;
+        let mut undefined = bytes.clone();
+        undefined[labels_end - 1] |= 0b11;
+        let e = parse(&resealed(undefined)).err().unwrap().to_string();
+        assert!(e.contains("label 3"), "{e}");
+        let mut other_index = bytes.clone();
+        other_index[16] = 100;
+        let e = parse(&resealed(other_index)).err().unwrap().to_string();
+        assert!(e.contains("5 rows, shard 100 of 200"), "shard 100 of 200 has 4 rows: {e}");
+        let mut table = bytes.clone();
+        table[..8].copy_from_slice(&crate::table::format::MAGIC);
+        assert_eq!(parse(&table).err(), Some(ShardError::BadMagic { table: true }));
+    }
+}
