@@ -52,7 +52,7 @@ fn build(cell: &str, extra: &[&str], out: &Path) {
 fn shards(cell: &str, extra: &[&str], n: u32, dir: &Path, tag: &str) -> Vec<PathBuf> {
     (0..n)
         .map(|i| {
-            let path = dir.join(format!("{tag}-{index}-of-{count}.dcs"));
+            let path = dir.join(format!("{tag}-{i}-of-{n}.dcs"));
             let shard = format!("{i}/{n}");
             let mut args = vec!["build", "--cell", cell, "--k", K, "--shard", &shard, "--output", s(&path)];
             args.extend_from_slice(extra);
@@ -138,7 +138,9 @@ fn shard_auto_reads_the_schedulers_environment() {
         for v in ["SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_COUNT", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_STEP"] {
             c.env_remove(v);
         }
-        for v in ["JOB_COMPLETION_INDEX", "AWS_BATCH_JOB_ARRAY_INDEX", "DELTA_COLLIDE_SHARDS"] {
+        for v in
+            ["JOB_COMPLETION_INDEX", "AWS_BATCH_JOB_ARRAY_INDEX", "AWS_BATCH_JOB_ARRAY_SIZE", "DELTA_COLLIDE_SHARDS"]
+        {
             c.env_remove(v);
         }
         c.envs(vars.iter().copied());
@@ -152,7 +154,7 @@ fn shard_auto_reads_the_schedulers_environment() {
     let out = run(&[("JOB_COMPLETION_INDEX", "1")], &["--shards", "7"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(dir.join("auto-1-of-7.dcs").exists());
-    let out = run(&[("AWS_BATCH_JOB_ARRAY_INDEX", "0"), ("DELTA_COLLIDE_SHARDS", "9")], &[]);
+    let out = run(&[("AWS_BATCH_JOB_ARRAY_INDEX", "0"), ("AWS_BATCH_JOB_ARRAY_SIZE", "9")], &[]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(dir.join("auto-0-of-9.dcs").exists());
     let out = run(&[("JOB_COMPLETION_INDEX", "1")], &[]);

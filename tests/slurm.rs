@@ -147,7 +147,8 @@ fn start_cluster() -> Cluster {
     loop {
         let ping = cluster.command("scontrol").arg("ping").output().unwrap();
         let idle = cluster.command("sinfo").args(["-h", "-o", "%t"]).output().unwrap();
-        if String::from_utf8_lossy(&ping.stdout).contains("UP") && String::from_utf8_lossy(&idle.stdout).contains("idle")
+        if String::from_utf8_lossy(&ping.stdout).contains("UP")
+            && String::from_utf8_lossy(&idle.stdout).contains("idle")
         {
             return cluster;
         }

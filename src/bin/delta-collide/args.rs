@@ -211,11 +211,12 @@ pub struct BuildArgs {
     pub labelling: LabellingArg,
     /// Label only shard I of N (I from 0 to N-1; every variant shards) into a shard file for
     /// merge, or `auto`: I and N from SLURM_ARRAY_TASK_ID/_COUNT/_MIN, JOB_COMPLETION_INDEX
-    /// (Kubernetes) or AWS_BATCH_JOB_ARRAY_INDEX. In --output, {index} and {count} become I and N
+    /// (Kubernetes) or AWS_BATCH_JOB_ARRAY_INDEX/_SIZE. In --output, {index} and {count}
+    /// become I and N
     #[arg(long, value_name = "I/N|auto", value_parser = clipped(parse_shard))]
     pub shard: Option<ShardArg>,
     /// With --shard auto: the count N where the scheduler gives only the index (Kubernetes:
-    /// the Job's completions; AWS Batch: the array size) [default: env DELTA_COLLIDE_SHARDS]
+    /// the Job's completions) [default: env DELTA_COLLIDE_SHARDS]
     #[arg(long, value_name = "N", requires = "shard", value_parser = clipped(parse_number::<u32>))]
     pub shards: Option<u32>,
 }

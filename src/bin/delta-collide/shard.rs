@@ -6,7 +6,7 @@ use crate::args::{BuildArgs, MergeArgs, ShardArg};
 use crate::files;
 use crate::Failure;
 use delta_collide::cspace::{Progress, Workspace};
-use delta_collide::table::shard::{build_shard, merge_shards, ShardIndex};
+use delta_collide::table::shard::{build_shard, merge_shards, read_shard_info, ShardIndex};
 use delta_collide::table::{to_bytes, Labelling};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -18,10 +18,10 @@ pub const SHARDS_VAR: &str = "DELTA_COLLIDE_SHARDS";
 /// - Slurm job arrays: `SLURM_ARRAY_TASK_ID` minus `SLURM_ARRAY_TASK_MIN` (0 when unset) of
 ///   `SLURM_ARRAY_TASK_COUNT`; a step other than 1 (`SLURM_ARRAY_TASK_STEP`) is refused;
 /// - Kubernetes Indexed Jobs: `JOB_COMPLETION_INDEX`;
-/// - AWS Batch array jobs: `AWS_BATCH_JOB_ARRAY_INDEX`;
+/// - AWS Batch array jobs: `AWS_BATCH_JOB_ARRAY_INDEX` of `AWS_BATCH_JOB_ARRAY_SIZE`;
 ///
 /// with `N` from `shards` (`--shards`), else [`SHARDS_VAR`], where the scheduler does not
-/// give it (Kubernetes, AWS Batch; for Slurm it must agree when given).
+/// give it (Kubernetes; AWS Batch without the size); where it does, they must agree.
 ///
 /// # Errors
 /// No scheduler's variable, more than one scheduler's, a value that is not a number, no
@@ -66,17 +66,30 @@ pub fn shard_from_env(env: &dyn Fn(&str) -> Option<String>, shards: Option<u32>)
                     "--shard auto: {from} = {n} but the Slurm array has SLURM_ARRAY_TASK_COUNT = {count} tasks"
                 ));
             }
-            let index = id.checked_sub(min).ok_or(format!(
-                "--shard auto: SLURM_ARRAY_TASK_ID = {id} is below SLURM_ARRAY_TASK_MIN = {min}"
-            ))?;
+            let index = id
+                .checked_sub(min)
+                .ok_or(format!("--shard auto: SLURM_ARRAY_TASK_ID = {id} is below SLURM_ARRAY_TASK_MIN = {min}"))?;
             (index, count)
         }
         [name] => {
             let index = number(name)?.unwrap_or(0);
-            let (count, _) = given.ok_or(format!(
-                "--shard auto: {name} gives the shard's index but not the count; give --shards N or set \
-                 {SHARDS_VAR} (the Job's completions, the array job's size)"
-            ))?;
+            // AWS Batch gives the array's size too; Kubernetes gives the index only.
+            let size = if name == "AWS_BATCH_JOB_ARRAY_INDEX" { number("AWS_BATCH_JOB_ARRAY_SIZE")? } else { None };
+            let count = match (size, given) {
+                (Some(size), Some((n, from))) if n != size => {
+                    return Err(format!(
+                        "--shard auto: {from} = {n} but the AWS Batch array has AWS_BATCH_JOB_ARRAY_SIZE = {size}"
+                    ))
+                }
+                (Some(size), _) => size,
+                (None, Some((n, _))) => n,
+                (None, None) => {
+                    return Err(format!(
+                        "--shard auto: {name} gives the shard's index but not the count; give --shards N or \
+                         set {SHARDS_VAR} (the Job's completions, the array job's size)"
+                    ))
+                }
+            };
             (index, count)
         }
         _ => {
@@ -124,6 +137,22 @@ pub fn build(args: &BuildArgs, shard: &ShardArg, progress: Progress) -> Result<(
 pub fn merge(args: &MergeArgs) -> Result<(), Failure> {
     let names: Vec<String> = args.shards.iter().map(|p| p.display().to_string()).collect();
     let mut read = |name: &str| std::fs::read(name).map_err(|e| e.to_string());
+    // The merge holds one byte per pair: refuse, before allocating, what the memory cannot hold.
+    if let (Some(first), Some(total)) = (names.first(), crate::total_memory()) {
+        if let Ok((na, nb)) =
+            read(first).and_then(|b| read_shard_info(&b).map_err(|e| e.to_string())).map(|i| i.samples)
+        {
+            let needed = (na as u64).saturating_mul(nb as u64);
+            if needed > total {
+                return Err(Failure::Failed(format!(
+                    "merging needs about {} of memory for the labels alone ({na} x {nb} pairs, one byte \
+                     each), more than this machine's {}; merge on a larger machine",
+                    crate::gigabytes(needed),
+                    crate::gigabytes(total)
+                )));
+            }
+        }
+    }
     let (header, table, r) = merge_shards(&names, &mut read).map_err(|e| e.to_string())?;
     let bytes = to_bytes(&table, &header);
     let output = &args.output;
@@ -177,6 +206,10 @@ mod tests {
         assert_eq!(from(&[("JOB_COMPLETION_INDEX", "0"), (SHARDS_VAR, "2")], None), Ok((0, 2)));
         assert_eq!(from(&[("JOB_COMPLETION_INDEX", "1"), (SHARDS_VAR, "2")], Some(3)), Ok((1, 3)), "the flag wins");
         assert_eq!(from(&[("AWS_BATCH_JOB_ARRAY_INDEX", "9")], Some(10)), Ok((9, 10)));
+        let aws = [("AWS_BATCH_JOB_ARRAY_INDEX", "2"), ("AWS_BATCH_JOB_ARRAY_SIZE", "6")];
+        assert_eq!(from(&aws, None), Ok((2, 6)));
+        assert_eq!(from(&aws, Some(6)), Ok((2, 6)));
+        assert!(from(&aws, Some(5)).unwrap_err().contains("AWS_BATCH_JOB_ARRAY_SIZE = 6"));
         let e = from(&[("AWS_BATCH_JOB_ARRAY_INDEX", "9")], None).unwrap_err();
         assert!(e.contains("--shards N") && e.contains(SHARDS_VAR), "{e}");
         assert!(from(&[("JOB_COMPLETION_INDEX", "5")], Some(5)).unwrap_err().contains("index 5 of 5"));

@@ -5,7 +5,7 @@
 use crate::cell::RobotSpec;
 use crate::cspace::guarantee::reference_point;
 use crate::cspace::label::{
-    Rows, aabbs_apart, all_box_pairs, boxes_may_touch, collision_mask, entries_apart, Inflation, SampleBoxes, Slot,
+    aabbs_apart, all_box_pairs, boxes_may_touch, collision_mask, entries_apart, Inflation, Rows, SampleBoxes, Slot,
 };
 use crate::cspace::sampler::SampleGrid;
 use crate::cspace::Label;

@@ -123,10 +123,9 @@ impl fmt::Display for ShardError {
                 "{file}: shard of another build than {first} ({what}); merge the shards of one \
                  `build --shard I/N` run with the same cell, k, variant, labelling and N"
             ),
-            ShardError::Duplicate { index, first, second } => write!(
-                f,
-                "{first} and {second} both hold shard {index}; give each shard once"
-            ),
+            ShardError::Duplicate { index, first, second } => {
+                write!(f, "{first} and {second} both hold shard {index}; give each shard once")
+            }
             ShardError::Missing { missing, count } => {
                 let list: Vec<String> = missing.iter().take(20).map(u32::to_string).collect();
                 let more = if missing.len() > 20 { format!(" and {} more", missing.len() - 20) } else { String::new() };

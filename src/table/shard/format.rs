@@ -106,7 +106,9 @@ pub(super) fn to_bytes(info: &ShardInfo, labels: &RowLabels) -> Vec<u8> {
     let h = &info.header;
     let (ga, gb) = (&labels.space.grid_a, &labels.space.grid_b);
     let n = labels.space.labels.len();
-    let mut out = Vec::with_capacity(FIXED_LEN + 8 * h.cell_parameters.len() + 7 * (ga.cells.len() + gb.cells.len()) + n / 4 + 32);
+    let mut out = Vec::with_capacity(
+        FIXED_LEN + 8 * h.cell_parameters.len() + 7 * (ga.cells.len() + gb.cells.len()) + n / 4 + 32,
+    );
     put(&mut out, &MAGIC);
     let kind = TableKind::ALL.iter().position(|&k| k == info.kind).unwrap_or(0) as u32;
     let labelling = u32::from(info.labelling == Labelling::ThesisMargin);
@@ -269,7 +271,8 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     let cell_fingerprint = r.u64("cell fingerprint")?;
     let spacing = r.f64("r")?;
     let (origin_a, origin_b) = (r.f64x3("origin_a")?, r.f64x3("origin_b")?);
-    let ws: [f64; 5] = [r.f64("workspace")?, r.f64("workspace")?, r.f64("workspace")?, r.f64("workspace")?, r.f64("workspace")?];
+    let ws: [f64; 5] =
+        [r.f64("workspace")?, r.f64("workspace")?, r.f64("workspace")?, r.f64("workspace")?, r.f64("workspace")?];
     let margin = r.f64("margin")?;
     let certification = match r.u32("certification")? {
         1 => Certification::ThesisBlowUp,
@@ -280,12 +283,16 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
         return Err(corrupt("reserved field is not 0"));
     }
     let n_params = r.u64("cell parameter count")?;
-    let (na, nb, rows, m) = (r.size("samples of A")?, r.size("samples of B")?, r.size("rows")?, r.size("sub-cell count")?);
+    let (na, nb, rows, m) =
+        (r.size("samples of A")?, r.size("samples of B")?, r.size("rows")?, r.size("sub-cell count")?);
     if n_params > MAX_CELL_PARAMETERS {
         return Err(corrupt(format!("cell parameter count = {n_params} exceeds {MAX_CELL_PARAMETERS}")));
     }
     if rows != shard.rows().count(na) {
-        return Err(corrupt(format!("{rows} rows, shard {index} of {count} of {na} samples has {}", shard.rows().count(na))));
+        return Err(corrupt(format!(
+            "{rows} rows, shard {index} of {count} of {na} samples has {}",
+            shard.rows().count(na)
+        )));
     }
     if m > 0 && kind != TableKind::SharedSub {
         return Err(corrupt(format!("{m} sub-cell entries in a shard of kind {kind}")));
@@ -313,7 +320,8 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     check_labels(labels, pairs)?;
     check_sub_cells(sub, shard, na, nb)?;
     let workspace = Workspace { zu: ws[0], hcy: ws[1], rcy: ws[2], hco: ws[3], rco: ws[4] };
-    let header = Header { cell_fingerprint, r: spacing, origin_a, origin_b, workspace, margin, certification, cell_parameters };
+    let header =
+        Header { cell_fingerprint, r: spacing, origin_a, origin_b, workspace, margin, certification, cell_parameters };
     let info = ShardInfo {
         shard,
         k,
@@ -329,6 +337,16 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
         sub_entries: m,
     };
     Ok(Parsed { info, grid_bytes, grid_a, grid_b, labels, sub })
+}
+
+/// What shard file `bytes` records, validated as [`merge_shards`](super::merge_shards)
+/// validates it (its labels and sub-cells too).
+///
+/// # Errors
+/// As the merge, for this file: `Truncated`, `BadMagic`, `WrongEndianness`,
+/// `UnsupportedVersion` or `Corrupt`.
+pub fn read_shard_info(bytes: &[u8]) -> Result<ShardInfo, ShardError> {
+    parse(bytes).map(|p| p.info)
 }
 
 /// No label is 3, and the bits after the last label are 0.

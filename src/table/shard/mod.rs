@@ -19,7 +19,7 @@ mod format;
 mod merge;
 
 pub use error::ShardError;
-pub use format::{ShardInfo, MAGIC, VERSION};
+pub use format::{read_shard_info, ShardInfo, MAGIC, VERSION};
 pub use merge::merge_shards;
 
 use super::build::{label_rows, BuildError, Labelling};
