@@ -301,7 +301,8 @@ fn help_lists_every_command_and_the_readme_shows_it() {
     let out = cli(&["--help"]);
     assert_eq!(out.status.code(), Some(0));
     let help = stdout(&out);
-    for command in ["demo", "check", "build", "inspect", "eval", "render", "quilt", "completions", "man", "--quiet"] {
+    let commands = ["demo", "check", "build", "merge", "inspect", "eval", "render", "quilt", "completions", "man"];
+    for command in commands.into_iter().chain(["--quiet"]) {
         assert!(help.contains(command), "{command} in\n{help}");
     }
     assert_eq!(
@@ -327,8 +328,9 @@ fn each_command_explains_its_flags_units_and_defaults() {
     }
     assert!(help("demo").contains("T1, T2, T3, all"));
     let build = help("build");
-    for part in ["[default: 32]", "power of two from 2 to 256", "[default: 6d]", "4d-yy", "shared-sub", "[default: 0]"]
-    {
+    let parts = ["[default: 32]", "power of two from 2 to 256", "[default: 6d]", "4d-yy", "shared-sub", "[default: 0]"];
+    let shards = ["--shard <I/N|auto>", "every variant shards", "JOB_COMPLETION_INDEX", "DELTA_COLLIDE_SHARDS"];
+    for part in parts.into_iter().chain(shards) {
         assert!(build.contains(part), "build --help: {part}\n{build}");
     }
     assert!(help("render").contains("own MCS (mm)") && help("render").contains("[default: render.png]"));

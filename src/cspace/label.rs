@@ -44,6 +44,34 @@ pub enum Progress {
     Rows(fn(u64, u64)),
 }
 
+/// Which of robot A's samples (the rows of the label array) a labelling labels: every
+/// `step`-th from `first`. [`Rows::ALL`] is every row; a table built in shards
+/// ([`crate::table::shard`]) gives shard `i` of `n` the rows `i, i + n, i + 2 n, ...`, so that
+/// each shard gets rows from all over the grid and the shards do about equal work.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Rows {
+    /// The first row labelled.
+    pub first: usize,
+    /// The distance between two labelled rows (at least 1).
+    pub step: usize,
+}
+
+impl Rows {
+    /// Every row.
+    pub const ALL: Rows = Rows { first: 0, step: 1 };
+
+    /// How many of `na` rows are labelled.
+    pub fn count(self, na: usize) -> usize {
+        na.saturating_sub(self.first).div_ceil(self.step.max(1))
+    }
+
+    /// The row (A's sample index) of the `j`-th labelled row.
+    #[inline]
+    pub fn row(self, j: usize) -> usize {
+        self.first + j * self.step.max(1)
+    }
+}
+
 /// Slack (mm) of every axis-aligned pre-test: boxes closer than this go on to the exact test.
 pub const AABB_SLACK: Real = 1e-6;
 
@@ -272,11 +300,12 @@ pub fn all_box_pairs(na: usize, nb: usize) -> u64 {
     (0..na).flat_map(|i| (0..nb).map(move |j| 1u64 << (8 * i + j))).fold(0, |m, b| m | b)
 }
 
-/// The label of every pair `(ia, ib)` at `ia * b.len() + ib`: `Unreachable` when either
+/// The label of every pair `(ia, ib)` of the rows `rows` of A, at `j * b.len() + ib` for
+/// `ia = rows.row(j)` (at `ia * b.len() + ib` with [`Rows::ALL`]): `Unreachable` when either
 /// centre is unreachable, `Collision` when either is `Unknown` or some pair of boxes
 /// intersects and `second_look(ia, ib)` (called only then) confirms it, else `Free`.
 /// Rows are labelled in parallel, each reported to `progress`.
-pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, progress: Progress) -> Vec<Label>
+pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, rows: Rows, progress: Progress) -> Vec<Label>
 where
     F: Fn(usize, usize) -> bool + Sync,
 {
@@ -298,9 +327,11 @@ where
     // The same entries stored in that order: a row's candidates are read in memory order.
     let sorted = b.subset(&order);
     let rows_done = AtomicU64::new(0);
-    let mut labels = vec![Label::Unreachable; na * nb];
+    let labelled = rows.count(na);
+    let mut labels = vec![Label::Unreachable; labelled * nb];
     if nb > 0 {
-        labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| {
+        labels.par_chunks_mut(nb).enumerate().for_each(|(j, row)| {
+            let ia = rows.row(j);
             match a.slot[ia] {
                 Slot::Unreachable => {}
                 Slot::Vacuous => row
@@ -325,7 +356,7 @@ where
                 }
             }
             if let Progress::Rows(report) = progress {
-                report(rows_done.fetch_add(1, Ordering::Relaxed) + 1, na as u64);
+                report(rows_done.fetch_add(1, Ordering::Relaxed) + 1, labelled as u64);
             }
         });
     }
@@ -363,6 +394,22 @@ pub fn label_space(
     margin: Real,
     progress: Progress,
 ) -> Result<LabelledSpace, String> {
+    label_space_rows(cell, k, ws, margin, Rows::ALL, progress)
+}
+
+/// As [`label_space`] for the rows `rows` of A only: `labels` holds them as
+/// [`label_pairs`] returns them (all of them, in the usual order, with [`Rows::ALL`]).
+///
+/// # Errors
+/// As [`label_space`].
+pub(crate) fn label_space_rows(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    margin: Real,
+    rows: Rows,
+    progress: Progress,
+) -> Result<LabelledSpace, String> {
     if !(margin.is_finite() && margin >= 0.0) {
         return Err(format!("labelling margin = {margin} must be finite and >= 0 (mm)"));
     }
@@ -371,7 +418,7 @@ pub fn label_space(
     let (mb, pb) = robot_with_margin(cell, 1, margin);
     let a = SampleBoxes::new(&ma, &pa, &centres(&grid_a), |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]));
     let b = SampleBoxes::new(&mb, &pb, &centres(&grid_b), |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]));
-    let labels = label_pairs(&a, &b, |_, _| true, progress);
+    let labels = label_pairs(&a, &b, |_, _| true, rows, progress);
     Ok(LabelledSpace { grid_a, grid_b, labels, margin })
 }
 
@@ -381,8 +428,22 @@ pub fn label_space(
 /// # Errors
 /// As [`label_space`].
 pub fn label_space_thesis(cell: &Cell, k: u32, ws: &Workspace, progress: Progress) -> Result<LabelledSpace, String> {
+    label_space_thesis_rows(cell, k, ws, Rows::ALL, progress)
+}
+
+/// As [`label_space_thesis`] for the rows `rows` of A only (see [`label_space_rows`]).
+///
+/// # Errors
+/// As [`label_space`].
+pub(crate) fn label_space_thesis_rows(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    rows: Rows,
+    progress: Progress,
+) -> Result<LabelledSpace, String> {
     let (g, _) = two_robot_grids(cell, k, ws)?;
-    label_space(cell, k, ws, thesis_margin(g.r), progress)
+    label_space_rows(cell, k, ws, thesis_margin(g.r), rows, progress)
 }
 
 /// The centres of every sample of `grid`, in sample order.

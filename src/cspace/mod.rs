@@ -28,7 +28,7 @@ pub use certify::{
 #[cfg(feature = "eval")]
 pub use certify::SubdividedLabels;
 #[cfg(feature = "std")]
-pub use label::{label_space, label_space_thesis, Progress};
+pub use label::{label_space, label_space_thesis, Progress, Rows};
 pub use sampler::{CellIndex, SampleGrid, Workspace};
 pub use symmetry::Symmetry;
 

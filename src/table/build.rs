@@ -11,10 +11,10 @@
 //! cell), so for it the builder turns every `Unreachable` into `Collision` first.
 
 use crate::cell::Cell;
-use crate::cspace::certify::{label_space_certified, label_space_subdivided};
-use crate::cspace::label::label_space_thesis;
+use crate::cspace::certify::certify_rows;
+use crate::cspace::label::label_space_thesis_rows;
 use crate::cspace::symmetry::Symmetry;
-use crate::cspace::{Label, Progress, Workspace};
+use crate::cspace::{CertifyConfig, Label, LabelledSpace, Progress, Refinement, Rows, SubCells, Workspace};
 use crate::table::{
     Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
     TableError,
@@ -155,30 +155,75 @@ pub fn build_tables(
     labelling: Labelling,
     progress: Progress,
 ) -> Result<(Header, Vec<Table>, BuildReport), BuildError> {
+    let start = Instant::now();
+    let subdivide = variants.contains(&Variant::SharedSubdivided);
+    let labels = label_rows(cell, k, ws, subdivide, labelling, Rows::ALL, progress)?;
+    let label_secs = start.elapsed().as_secs_f64();
+    let header = Header::for_cell(&labels.space, cell, *ws, labels.certification);
+    let (tables, report) = assemble(labels, Symmetry::of(cell), variants, label_secs)?;
+    Ok((header, tables, report))
+}
+
+/// The labels of the rows `rows` of A (all of them for a one-shot build, one shard's
+/// otherwise), with the sub-cells when `subdivide`: what [`assemble`] builds from.
+pub(crate) struct RowLabels {
+    /// Grids, margin and the labels of the rows (`space.labels`, row `j` at `j * nb`).
+    pub space: LabelledSpace,
+    /// The sub-cells of the rows' collision pairs (pairs numbered `ia * nb + ib`).
+    pub sub: Option<SubCells>,
+    /// Seconds of the labelling spent on the sub-cells.
+    pub sub_secs: f64,
+    /// What the labelling proves.
+    pub certification: Certification,
+    /// How it labelled.
+    pub labelling: Labelling,
+}
+
+/// Labels the rows `rows` of A of `cell` (two robots) at `k`, with the sub-cells when
+/// `subdivide`.
+///
+/// # Errors
+/// As [`build_table`].
+pub(crate) fn label_rows(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    subdivide: bool,
+    labelling: Labelling,
+    rows: Rows,
+    progress: Progress,
+) -> Result<RowLabels, BuildError> {
     if cell.robots.len() != 2 {
         return Err(BuildError::NotTwoRobots { cell: cell.name.clone(), robots: cell.robots.len() });
     }
-    let start = Instant::now();
-    let subdivide = variants.contains(&Variant::SharedSubdivided);
-    let (mut space, sub, sub_secs, certification) = match labelling {
-        Labelling::Certified if subdivide => {
-            let c = label_space_subdivided(cell, k, ws, progress).map_err(BuildError::Labelling)?;
-            (c.space, c.sub, c.sub_secs, Certification::SweptBound)
-        }
+    let refinement = if subdivide { Refinement::SubCells } else { Refinement::Octants };
+    Ok(match labelling {
         Labelling::Certified => {
-            let c = label_space_certified(cell, k, ws, progress).map_err(BuildError::Labelling)?;
-            (c.space, None, 0.0, Certification::SweptBound)
+            let c = certify_rows(cell, k, ws, &CertifyConfig { refinement, progress }, rows)
+                .map_err(BuildError::Labelling)?;
+            let certification = Certification::SweptBound;
+            RowLabels { space: c.space, sub: c.sub, sub_secs: c.sub_secs, certification, labelling }
         }
-        Labelling::ThesisMargin if subdivide => {
-            return Err(BuildError::SubCellsNeedCertified)
-        }
+        Labelling::ThesisMargin if subdivide => return Err(BuildError::SubCellsNeedCertified),
         Labelling::ThesisMargin => {
-            let space = label_space_thesis(cell, k, ws, progress).map_err(BuildError::Labelling)?;
-            (space, None, 0.0, Certification::ThesisBlowUp)
+            let space = label_space_thesis_rows(cell, k, ws, rows, progress).map_err(BuildError::Labelling)?;
+            RowLabels { space, sub: None, sub_secs: 0.0, certification: Certification::ThesisBlowUp, labelling }
         }
-    };
-    let label_secs = start.elapsed().as_secs_f64();
-    let symmetry = Symmetry::of(cell);
+    })
+}
+
+/// Builds `variants` from the labels of every row (`labels.space.labels` whole): the
+/// tables in `variants`' order and the report, with `label_secs` as the labelling's time.
+///
+/// # Errors
+/// A builder refused the labels, or a subdivided table without sub-cells.
+pub(crate) fn assemble(
+    labels: RowLabels,
+    symmetry: Symmetry,
+    variants: &[Variant],
+    label_secs: f64,
+) -> Result<(Vec<Table>, BuildReport), BuildError> {
+    let RowLabels { mut space, sub, sub_secs, labelling, .. } = labels;
     let mut report = BuildReport {
         samples: (space.grid_a.cells.len(), space.grid_b.cells.len()),
         pairs: space.labels.len(),
@@ -210,5 +255,5 @@ pub fn build_tables(
         })
         .collect::<Result<Vec<_>, _>>()?;
     report.build_secs = start.elapsed().as_secs_f64();
-    Ok((Header::for_cell(&space, cell, *ws, certification), tables, report))
+    Ok((tables, report))
 }

@@ -26,6 +26,8 @@ pub(crate) mod lookup;
 pub(crate) mod quadtree4d;
 pub(crate) mod quadtree5d;
 pub(crate) mod quadtree6d;
+#[cfg(feature = "std")]
+pub mod shard;
 pub(crate) mod shared6d;
 mod space;
 #[cfg(feature = "std")]

@@ -41,7 +41,7 @@ pub fn clip(s: &str) -> String {
 #[command(name = "delta-collide", version = VERSION_TEXT.as_str(), subcommand_required = true)]
 #[command(arg_required_else_help = true, disable_help_subcommand = true)]
 pub struct Cli {
-    /// Draw no progress bars (they go to stderr only, and only when it is a terminal)
+    /// Draw no progress bars
     #[arg(short, long, global = true)]
     pub quiet: bool,
     #[command(subcommand)]
@@ -50,7 +50,7 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Run the practical and collision scenarios: exact check and protective verdict
+    /// Run the scenarios: exact check and protective verdict
     ///
     /// Runs the scenarios of c_harness/scenarios.txt for the chosen cells and prints the
     /// first collision tick and the per-tick query times of the exact check (SAT and
@@ -81,8 +81,17 @@ pub enum Command {
     /// Samples both robots' workspaces on a k x k x k grid, labels every pair of grid cells
     /// (certified per-cell bounds by default) and writes the table. Memory grows as k^6: a k
     /// whose labels do not fit in the machine's memory is refused before anything is
-    /// allocated.
+    /// allocated. --shard I/N labels only part of the grid (every variant shards) into a shard
+    /// file for merge; --shard auto takes I and N from a Slurm array, a Kubernetes Indexed
+    /// Job or an AWS Batch array job (docs/CLUSTER.md).
     Build(BuildArgs),
+    /// Merge a sharded build's files into its table
+    ///
+    /// Reads every shard file of one `build --shard I/N` run, in any order, and writes the
+    /// table: byte for byte the one a one-shot build writes. A missing, repeated, truncated or
+    /// corrupt shard, or one of another cell, k, variant, labelling or N, is an error naming
+    /// the file. Needs the memory of a one-shot build (one byte per pair of samples).
+    Merge(MergeArgs),
     /// Print what a table file holds
     Inspect(InspectArgs),
     /// Compare a table with the exact model
@@ -111,7 +120,10 @@ pub enum Command {
         #[arg(value_parser = choice::<clap_complete::Shell>())]
         shell: clap_complete::Shell,
     },
-    /// Print the man page, or write one page per command into a directory
+    /// Print the man page(s)
+    ///
+    /// Prints the man page on stdout, or with --output writes one page per command into a
+    /// directory.
     Man {
         /// Write delta-collide.1 and delta-collide-COMMAND.1 into this directory instead
         #[arg(long, value_name = "DIR")]
@@ -197,6 +209,35 @@ pub struct BuildArgs {
     #[arg(long, value_name = "LABELLING", default_value = "certified")]
     #[arg(value_parser = choice::<LabellingArg>())]
     pub labelling: LabellingArg,
+    /// Label only shard I of N (I from 0 to N-1; every variant shards) into a shard file for
+    /// merge, or `auto`: I and N from SLURM_ARRAY_TASK_ID/_COUNT/_MIN, JOB_COMPLETION_INDEX
+    /// (Kubernetes) or AWS_BATCH_JOB_ARRAY_INDEX/_SIZE. In --output, {index} and {count}
+    /// become I and N
+    #[arg(long, value_name = "I/N|auto", value_parser = clipped(parse_shard))]
+    pub shard: Option<ShardArg>,
+    /// With --shard auto: the count N where the scheduler gives only the index (Kubernetes:
+    /// the Job's completions) [default: env DELTA_COLLIDE_SHARDS]
+    #[arg(long, value_name = "N", requires = "shard", value_parser = clipped(parse_number::<u32>))]
+    pub shards: Option<u32>,
+}
+
+/// Which part of a build `build --shard` does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShardArg {
+    /// Shard I of N, given.
+    Fixed(u32, u32),
+    /// From the scheduler's environment.
+    Auto,
+}
+
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// The table file to write, replaced only once complete
+    #[arg(long, value_name = "FILE.dct")]
+    pub output: PathBuf,
+    /// Every shard file of the build, in any order
+    #[arg(value_name = "SHARD", required = true)]
+    pub shards: Vec<PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -355,6 +396,13 @@ impl Cli {
                         "build",
                         ErrorKind::ArgumentConflict,
                         format!("--t {t} applies to --variant 4d-yy and 4d-zz only, not to --variant {v}"),
+                    ));
+                }
+                if let (Some(n), Some(ShardArg::Fixed(..))) = (b.shards, b.shard) {
+                    return Err(usage_error(
+                        "build",
+                        ErrorKind::ArgumentConflict,
+                        format!("--shards {n} applies to --shard auto only; --shard I/N gives the count itself"),
                     ));
                 }
                 if b.variant.0 == TableKind::SharedSub && b.labelling == LabellingArg::Thesis {
@@ -527,6 +575,20 @@ fn parse_seed(s: &str) -> Result<u64, String> {
     match parse_number::<u64>(s)? {
         0 => Err("the seed must not be 0 (the generator would stay at 0)".into()),
         v => Ok(v),
+    }
+}
+
+/// `I/N` with `I < N`, or `auto`.
+fn parse_shard(s: &str) -> Result<ShardArg, String> {
+    if s.trim().eq_ignore_ascii_case("auto") {
+        return Ok(ShardArg::Auto);
+    }
+    let fix = "expected I/N (shard I of N, I from 0 to N-1, e.g. 0/4) or auto";
+    let (i, n) = s.split_once('/').ok_or(fix)?;
+    match (i.trim().parse::<u32>(), n.trim().parse::<u32>()) {
+        (Ok(i), Ok(n)) if i < n => Ok(ShardArg::Fixed(i, n)),
+        (Ok(i), Ok(n)) => Err(format!("shard {i} of {n}: {fix}")),
+        _ => Err(fix.into()),
     }
 }
 

@@ -22,6 +22,7 @@ mod render;
 mod replay;
 mod replay_plot;
 mod rows;
+mod shard;
 mod stop;
 
 use args::{BuildArgs, CheckArgs, Cli, Command, EvalArgs, InspectArgs};
@@ -77,7 +78,11 @@ fn main() {
         Command::Demo(a) => demo::demo(a),
         Command::Check(a) => check(a),
         Command::Replay(a) => replay::replay(a),
-        Command::Build(a) => build(a, progress),
+        Command::Build(a) => match &a.shard {
+            Some(s) => shard::build(a, s, progress),
+            None => build(a, progress),
+        },
+        Command::Merge(a) => shard::merge(a),
         Command::Inspect(a) => inspect(a),
         Command::Eval(a) => eval(a),
         Command::Render(a) => render::render(a),
@@ -237,7 +242,7 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
     let (cell, k, output) = (&args.cell, args.k, &args.output);
     let variant = args.variant.0.variant(args.t.unwrap_or(0));
     let labelling = Labelling::from(args.labelling);
-    check_memory(cell, k, &Workspace::THESIS)?;
+    check_memory(cell, k, &Workspace::THESIS, 1)?;
     let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
     if let (Progress::Rows(_), Some((pairs, secs))) = (progress, r.sub_cells) {
         eprintln!("sub-cells of {pairs} collision pairs: {secs:.2} s");
@@ -265,11 +270,12 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
 }
 
 /// Refuses, before anything big is allocated, a `k` whose label array (one byte per pair of
-/// sampled grid cells, about `(0.2 k^3)^2`) needs more memory than the machine has.
+/// sampled grid cells, about `(0.2 k^3)^2`, divided among `shards` shards) needs more memory
+/// than the machine has.
 ///
 /// # Errors
 /// The bytes needed and the bytes the machine has; or the grid's error for a bad `k`.
-fn check_memory(cell: &Cell, k: u32, ws: &Workspace) -> Result<(), String> {
+pub(crate) fn check_memory(cell: &Cell, k: u32, ws: &Workspace, shards: u32) -> Result<(), String> {
     let (Some(total), [a, b]) = (total_memory(), &cell.robots[..]) else {
         return Ok(()); // unknown memory, or not a two-robot cell (the build says so)
     };
@@ -278,12 +284,14 @@ fn check_memory(cell: &Cell, k: u32, ws: &Workspace) -> Result<(), String> {
     let scale = u64::from(k / k0).pow(3);
     let samples = |delta| SampleGrid::new(ws, k0, delta).map(|g| g.cells.len() as u64 * scale);
     let (na, nb) = (samples(&a.model.delta)?, samples(&b.model.delta)?);
-    let needed = na.saturating_mul(nb).saturating_mul(std::mem::size_of::<Label>() as u64);
+    let rows = na.div_ceil(u64::from(shards.max(1)));
+    let needed = rows.saturating_mul(nb).saturating_mul(std::mem::size_of::<Label>() as u64);
     if needed > total {
+        let per = if shards > 1 { format!(" per shard of {shards}") } else { String::new() };
         return Err(format!(
-            "k = {k}: labelling cell {} needs about {} of memory for its labels alone ({na} x {nb} \
+            "k = {k}: labelling cell {} needs about {} of memory{per} for its labels alone ({rows} x {nb} \
              sample pairs, {} byte each), more than this machine's {}; use a smaller k (each \
-             halving needs 64 times less)",
+             halving needs 64 times less) or more shards",
             cell.name,
             gigabytes(needed),
             std::mem::size_of::<Label>(),
@@ -293,12 +301,12 @@ fn check_memory(cell: &Cell, k: u32, ws: &Workspace) -> Result<(), String> {
     Ok(())
 }
 
-fn gigabytes(bytes: u64) -> String {
+pub(crate) fn gigabytes(bytes: u64) -> String {
     format!("{:.1} GB", bytes as f64 / 1e9)
 }
 
 /// The machine's memory in bytes (`MemTotal` of `/proc/meminfo`), where known.
-fn total_memory() -> Option<u64> {
+pub(crate) fn total_memory() -> Option<u64> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
     let kb: u64 = line.trim_start_matches("MemTotal:").trim().trim_end_matches("kB").trim().parse().ok()?;

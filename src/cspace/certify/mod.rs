@@ -56,7 +56,7 @@ pub use subdivided_labels::SubdividedLabels;
 
 use crate::cell::{Cell, RobotSpec};
 use crate::cspace::guarantee::SPLITS;
-use crate::cspace::label::{entries_collide, label_pairs, two_robot_grids, Inflation, Progress, SampleBoxes};
+use crate::cspace::label::{entries_collide, label_pairs, two_robot_grids, Inflation, Progress, Rows, SampleBoxes};
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::LabelledSpace;
 use crate::robot::MAX_BOXES;
@@ -183,6 +183,23 @@ pub fn label_space_certified_with(
     ws: &Workspace,
     config: &CertifyConfig,
 ) -> Result<CertifiedSpace, String> {
+    certify_rows(cell, k, ws, config, Rows::ALL)
+}
+
+/// As [`label_space_certified_with`] for the rows `rows` of A only (one shard of a table
+/// build): `space.labels` holds them as [`label_pairs`] returns them (row `j` of the
+/// selection at `j * nb`), and the sub-cells' pairs keep their numbers `ia * nb + ib`. Each
+/// robot's sweeps are made for its whole grid, so the labels are those of the whole build.
+///
+/// # Errors
+/// As [`crate::cspace::label_space`].
+pub(crate) fn certify_rows(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    config: &CertifyConfig,
+    rows: Rows,
+) -> Result<CertifiedSpace, String> {
     let refine = config.refinement != Refinement::WholeCells;
     let subdivide = config.refinement == Refinement::SubCells;
     let progress = config.progress;
@@ -207,13 +224,13 @@ pub fn label_space_certified_with(
             (la.subs, lb.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
         }
         let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
-        let mut labels = label_pairs(&a0, &b0, collides, progress);
-        refine_unknown_cells(&la, &lb, &mut labels);
+        let mut labels = label_pairs(&a0, &b0, collides, rows, progress);
+        refine_unknown_cells(&la, &lb, &mut labels, rows);
         let start = std::time::Instant::now();
-        let sub = subdivide.then(|| sub_cells(&la, &lb, &labels));
+        let sub = subdivide.then(|| sub_cells(&la, &lb, &labels, rows));
         (labels, sub, start.elapsed().as_secs_f64())
     } else {
-        (label_pairs(&a0, &b0, |_, _| true, progress), None, 0.0)
+        (label_pairs(&a0, &b0, |_, _| true, rows, progress), None, 0.0)
     };
     let (labels, sub, sub_secs) = labels;
     let radii = |ss: &[[Sweep; MAX_BOXES]]| ss.iter().map(|s| s.map(|w| w.radius())).collect::<Vec<_>>();
@@ -303,7 +320,7 @@ mod tests {
             assert!(!want.pairs.is_empty());
             let (a, b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
             assert!(
-                sub_cells(&a, &b, &c.space.labels) == want,
+                sub_cells(&a, &b, &c.space.labels, Rows::ALL) == want,
                 "{name}: the fast sub-cells differ from the plain ones"
             );
             let got = c.sub.as_ref().unwrap();
@@ -381,7 +398,7 @@ mod tests {
             let cell = reference_cell(name).unwrap();
             let c = label_space_subdivided(&cell, 16, &ws, Progress::Silent).unwrap();
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
-            let plain = sub_cells(&Levels::new(&a0, &a1), &Levels::new(&b0, &b1), &c.space.labels);
+            let plain = sub_cells(&Levels::new(&a0, &a1), &Levels::new(&b0, &b1), &c.space.labels, Rows::ALL);
             let got = c.sub.as_ref().unwrap();
             let (ga, gb, nb) = (&c.space.grid_a, &c.space.grid_b, c.space.grid_b.cells.len());
             let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });

@@ -5,7 +5,7 @@
 use crate::cell::RobotSpec;
 use crate::cspace::guarantee::reference_point;
 use crate::cspace::label::{
-    aabbs_apart, all_box_pairs, boxes_may_touch, collision_mask, entries_apart, Inflation, SampleBoxes, Slot,
+    aabbs_apart, all_box_pairs, boxes_may_touch, collision_mask, entries_apart, Inflation, Rows, SampleBoxes, Slot,
 };
 use crate::cspace::sampler::SampleGrid;
 use crate::cspace::Label;
@@ -155,11 +155,13 @@ pub(super) fn cores_meet(a: &[Option<Obb>], ia: usize, na: usize, b: &[Option<Ob
     false
 }
 
-/// The sub-cell labels of every pair labelled collision (see [`SubCells`]).
+/// The sub-cell labels of every pair labelled collision (see [`SubCells`]); `labels` holds
+/// the rows `selection` of A as [`crate::cspace::label::label_pairs`] returns them, the pairs
+/// come out numbered `ia * nb + ib` all the same.
 ///
 /// Rows of A are taken [`SUB_CELL_ROWS`] at a time, column by column, so that B's boxes of a
 /// column are used by every row of the block while they are in the cache.
-pub(super) fn sub_cells(a: &Levels, b: &Levels, labels: &[Label]) -> SubCells {
+pub(super) fn sub_cells(a: &Levels, b: &Levels, labels: &[Label], selection: Rows) -> SubCells {
     let nb = b.whole.len();
     if nb == 0 {
         return SubCells::default();
@@ -172,7 +174,7 @@ pub(super) fn sub_cells(a: &Levels, b: &Levels, labels: &[Label]) -> SubCells {
             for ib in 0..nb {
                 for (r, row) in rows.chunks(nb).enumerate() {
                     if row[ib] == Label::Collision {
-                        let ia = block * SUB_CELL_ROWS + r;
+                        let ia = selection.row(block * SUB_CELL_ROWS + r);
                         let (care, collision) = sub_cell_masks(a, b, ia, ib, false);
                         out.push(((ia * nb + ib) as u64, care, collision));
                     }
@@ -386,8 +388,9 @@ pub(super) fn octants_prove_free(a: &Levels, b: &Levels, ia: usize, ib: usize) -
 }
 
 /// Level 2 for the pairs that [`label_pairs`] made collisions because a sample has no
-/// whole-cell bound ([`Slot::Unknown`]): each is retried octant by octant.
-pub(super) fn refine_unknown_cells(a: &Levels, b: &Levels, labels: &mut [Label]) {
+/// whole-cell bound ([`Slot::Unknown`]): each is retried octant by octant (`labels` holds the
+/// rows `rows` of A).
+pub(super) fn refine_unknown_cells(a: &Levels, b: &Levels, labels: &mut [Label], rows: Rows) {
     let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
     let unknown_b: Vec<usize> = (0..b0.len()).filter(|&ib| b0.slot[ib] == Slot::Unknown).collect();
     let (cover_a, cover_b) = (octant_covers(a1), octant_covers(b1));
@@ -395,7 +398,8 @@ pub(super) fn refine_unknown_cells(a: &Levels, b: &Levels, labels: &mut [Label])
     if nb == 0 {
         return;
     }
-    labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| {
+    labels.par_chunks_mut(nb).enumerate().for_each(|(j, row)| {
+        let ia = rows.row(j);
         let mut retry = |ib: usize| {
             if row[ib] == Label::Collision
                 && b0.slot[ib] != Slot::Unreachable

@@ -1,0 +1,128 @@
+//! Merging the shards of a table build: check that they are exactly the `n` shards of one
+//! build, put their labels and sub-cells together in the one-shot build's order, and build
+//! the table from them (the same builder, so the same bytes).
+
+use super::error::ShardError;
+use super::format::{parse, unpack_row, Parsed, ShardInfo};
+use crate::cspace::{Label, LabelledSpace, SampleGrid, SubCells};
+use crate::table::build::{assemble, RowLabels};
+use crate::table::{BuildReport, Header, Table, TableKind};
+
+/// Merges the shard files `files` (names, in any order; `read` gives a file's bytes) into
+/// the table a one-shot build writes: its header, the table and the build's report
+/// (`label_secs` is the sum of the shards' labelling times). The files are read one at a
+/// time, each dropped once its labels are copied: the merge holds the whole label set (one
+/// byte per pair of samples), the sub-cells and one file.
+///
+/// # Errors
+/// [`ShardError::InFile`] for a file that cannot be read or is not a valid shard (naming it),
+/// `Foreign` for a shard of another cell, `k`, variant, labelling or shard count than the
+/// first file's, `Duplicate`, `Missing`, `NoShards`, or `Build` when the table builder
+/// refuses the labels.
+pub fn merge_shards(
+    files: &[String],
+    read: &mut dyn FnMut(&str) -> Result<Vec<u8>, String>,
+) -> Result<(Header, Table, BuildReport), ShardError> {
+    let in_file = |file: &str, error: ShardError| ShardError::InFile { file: file.to_string(), error: Box::new(error) };
+    let mut first: Option<First> = None;
+    let mut sub = Vec::new();
+    let mut secs = (0.0, 0.0);
+    for name in files {
+        let bytes = read(name).map_err(|what| in_file(name, ShardError::Unreadable { what }))?;
+        let s = parse(&bytes).map_err(|e| in_file(name, e))?;
+        let f = match &mut first {
+            None => first.insert(First::new(name, &s)),
+            Some(f) => {
+                if let Some(what) = differs(f, &s) {
+                    return Err(ShardError::Foreign { file: name.clone(), first: f.name.clone(), what });
+                }
+                f
+            }
+        };
+        let i = s.info.shard.index() as usize;
+        if let Some(other) = f.holder[i].replace(name.clone()) {
+            return Err(ShardError::Duplicate { index: i as u32, first: other, second: name.clone() });
+        }
+        let (rows, nb) = (s.info.shard.rows(), s.info.samples.1);
+        for j in 0..s.info.rows {
+            let ia = rows.row(j);
+            unpack_row(s.labels, j, &mut f.labels[ia * nb..(ia + 1) * nb]);
+        }
+        sub.extend(s.sub.chunks_exact(24).map(|e| {
+            let word = |w: usize| u64::from_le_bytes(core::array::from_fn(|i| e[8 * w + i]));
+            (word(0), word(1), word(2))
+        }));
+        secs = (secs.0 + s.info.label_secs, secs.1 + s.info.sub_secs);
+    }
+    let f = first.ok_or(ShardError::NoShards)?;
+    let missing: Vec<u32> = (0..f.holder.len() as u32).filter(|&i| f.holder[i as usize].is_none()).collect();
+    if !missing.is_empty() {
+        return Err(ShardError::Missing { missing, count: f.holder.len() as u32 });
+    }
+    sub.sort_unstable_by_key(|&(pair, _, _)| pair);
+    let mut cells = SubCells::default();
+    if f.info.kind == TableKind::SharedSub {
+        cells.pairs = sub.iter().map(|e| e.0).collect();
+        cells.care = sub.iter().map(|e| e.1).collect();
+        cells.collision = sub.iter().map(|e| e.2).collect();
+    }
+    drop(sub);
+    let info = f.info;
+    let space = LabelledSpace { grid_a: f.grid_a, grid_b: f.grid_b, labels: f.labels, margin: info.header.margin };
+    let sub = (info.kind == TableKind::SharedSub).then_some(cells);
+    let labels =
+        RowLabels { space, sub, sub_secs: secs.1, certification: info.header.certification, labelling: info.labelling };
+    let variant = info.kind.variant(info.t);
+    let (mut tables, report) = assemble(labels, info.symmetry, &[variant], secs.0).map_err(ShardError::Build)?;
+    let table = tables.pop().ok_or(ShardError::NoShards)?;
+    Ok((info.header, table, report))
+}
+
+/// The first shard read: what the others must match, and the merge's state.
+struct First {
+    name: String,
+    info: ShardInfo,
+    grid_bytes: Vec<u8>,
+    grid_a: SampleGrid,
+    grid_b: SampleGrid,
+    /// Per shard number, the file holding it.
+    holder: Vec<Option<String>>,
+    /// Every pair's label.
+    labels: Vec<Label>,
+}
+
+impl First {
+    fn new(name: &str, s: &Parsed) -> First {
+        let (na, nb) = s.info.samples;
+        First {
+            name: name.to_string(),
+            info: s.info.clone(),
+            grid_bytes: s.grid_bytes.to_vec(),
+            grid_a: s.grid_a.clone(),
+            grid_b: s.grid_b.clone(),
+            holder: vec![None; s.info.shard.count() as usize],
+            labels: vec![Label::Unreachable; na * nb],
+        }
+    }
+}
+
+/// What makes shard `b` part of another build than `a`, if anything.
+fn differs(a: &First, b: &Parsed) -> Option<String> {
+    let (x, y) = (&a.info, &b.info);
+    let (hx, hy) = (&x.header, &y.header);
+    Some(if hx.cell_fingerprint != hy.cell_fingerprint {
+        format!("cell {:#018x}, not {:#018x}", hy.cell_fingerprint, hx.cell_fingerprint)
+    } else if x.k != y.k {
+        format!("k = {}, not {}", y.k, x.k)
+    } else if (x.kind, x.t) != (y.kind, y.t) {
+        format!("variant {} t = {}, not {} t = {}", y.kind, y.t, x.kind, x.t)
+    } else if x.labelling != y.labelling {
+        format!("labelling {:?}, not {:?}", y.labelling, x.labelling)
+    } else if x.shard.count() != y.shard.count() {
+        format!("one of {} shards, not of {}", y.shard.count(), x.shard.count())
+    } else if hx != hy || x.symmetry != y.symmetry || x.samples != y.samples || a.grid_bytes != b.grid_bytes {
+        "the same cell and k, but another workspace, margin or sampling grid".to_string()
+    } else {
+        return None;
+    })
+}

@@ -1,0 +1,184 @@
+//! Tables built in shards: shard `i` of `n` labels a deterministic part of the grid (the rows
+//! `i, i + n, i + 2 n, ...` of robot A's samples, [`Rows`]), which is where a build spends its
+//! time; [`merge_shards`] puts the labels of all `n` shards together and builds the table,
+//! byte for byte the one a one-shot [`build_table`](super::build_table) writes (SPEC §6).
+//!
+//! Every variant shards: the shards carry labels (and, for `shared-sub`, the sub-cells of
+//! their collision pairs), not parts of a tree, so the merge builds whichever variant the
+//! shards were labelled for. The merge therefore needs the whole label set in memory (one byte
+//! per pair of samples), as a one-shot build does; the shards need `1/n` of it each.
+//!
+//! A shard file (`format.rs`) records the cell, `k`, the variant, the labelling, `i` and `n`
+//! and a checksum; [`merge_shards`] refuses a missing, duplicated, truncated or corrupt shard
+//! and one of another cell, `k`, variant, labelling or `n`, naming the file
+//! ([`ShardError`]). Scheduler environments (Slurm, Kubernetes, AWS Batch) are read by the
+//! command line, not here.
+
+mod error;
+mod format;
+mod merge;
+
+pub use error::ShardError;
+pub use format::{read_shard_info, ShardInfo, MAGIC, VERSION};
+pub use merge::merge_shards;
+
+use super::build::{label_rows, BuildError, Labelling};
+use super::{Header, TableKind};
+use crate::cell::Cell;
+use crate::cspace::{Progress, Rows, Symmetry, Workspace};
+use std::time::Instant;
+
+/// Which part of a build a shard does: shard `index` of `count`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShardIndex {
+    index: u32,
+    count: u32,
+}
+
+impl ShardIndex {
+    /// Shard `index` of `count` (`index` from 0 to `count - 1`).
+    ///
+    /// # Errors
+    /// [`ShardError::BadIndex`] when `count` is 0 or `index >= count`.
+    pub fn new(index: u32, count: u32) -> Result<ShardIndex, ShardError> {
+        if count == 0 || index >= count {
+            return Err(ShardError::BadIndex { index, count });
+        }
+        Ok(ShardIndex { index, count })
+    }
+
+    /// The shard's number, from 0.
+    pub fn index(self) -> u32 {
+        self.index
+    }
+
+    /// How many shards the build has.
+    pub fn count(self) -> u32 {
+        self.count
+    }
+
+    /// The rows of A this shard labels.
+    pub fn rows(self) -> Rows {
+        Rows { first: self.index as usize, step: self.count as usize }
+    }
+}
+
+/// What [`build_shard`] did, for the command line's summary.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShardReport {
+    /// Rows of A labelled (of `samples.0`).
+    pub rows: usize,
+    /// Samples per robot (A, B).
+    pub samples: (usize, usize),
+    /// Pairs labelled: `rows * samples.1`.
+    pub pairs: usize,
+    /// Seconds spent labelling.
+    pub label_secs: f64,
+}
+
+/// Labels shard `shard` of the table `kind` (threshold `t` for the 4-D kinds, else 0) of the
+/// two-robot `cell` at `k` and returns the shard file's bytes.
+///
+/// # Errors
+/// As [`build_table`](super::build_table): not two robots, a bad `k`, sub-cells with the
+/// thesis labelling.
+pub fn build_shard(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    (kind, t): (TableKind, u32),
+    labelling: Labelling,
+    shard: ShardIndex,
+    progress: Progress,
+) -> Result<(Vec<u8>, ShardReport), BuildError> {
+    let start = Instant::now();
+    let subdivide = kind == TableKind::SharedSub;
+    let labels = label_rows(cell, k, ws, subdivide, labelling, shard.rows(), progress)?;
+    let label_secs = start.elapsed().as_secs_f64();
+    let header = Header::for_cell(&labels.space, cell, *ws, labels.certification);
+    let (na, nb) = (labels.space.grid_a.cells.len(), labels.space.grid_b.cells.len());
+    let rows = shard.rows().count(na);
+    let info = ShardInfo {
+        shard,
+        k,
+        kind,
+        t: if kind.has_threshold() { t } else { 0 },
+        labelling,
+        symmetry: Symmetry::of(cell),
+        label_secs,
+        sub_secs: labels.sub_secs,
+        header,
+        samples: (na, nb),
+        rows,
+        sub_entries: labels.sub.as_ref().map_or(0, |s| s.pairs.len()),
+    };
+    let bytes = format::to_bytes(&info, &labels);
+    Ok((bytes, ShardReport { rows, samples: (na, nb), pairs: rows * nb, label_secs }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::format::parse;
+    use super::*;
+    use crate::cell::fnv1a64;
+    use crate::cell::reference::reference_cell;
+
+    /// Shard 0 of 200 of T3's `shared-sub` table at k = 16: five rows, with sub-cells.
+    fn small_shard() -> Vec<u8> {
+        let cell = reference_cell("T3").unwrap();
+        let shard = ShardIndex::new(0, 200).unwrap();
+        let kind = (TableKind::SharedSub, 0);
+        build_shard(&cell, 16, &Workspace::THESIS, kind, Labelling::Certified, shard, Progress::Silent).unwrap().0
+    }
+
+    /// `bytes` with the checksum recomputed, as a deliberate edit would leave it.
+    fn resealed(mut bytes: Vec<u8>) -> Vec<u8> {
+        let end = bytes.len() - 8;
+        let sum = fnv1a64(&bytes[..end]);
+        bytes[end..].copy_from_slice(&sum.to_le_bytes());
+        bytes
+    }
+
+    #[test]
+    fn shard_numbers_must_be_below_the_count() {
+        assert!(ShardIndex::new(0, 1).is_ok() && ShardIndex::new(4, 5).is_ok());
+        assert_eq!(ShardIndex::new(5, 5), Err(ShardError::BadIndex { index: 5, count: 5 }));
+        assert!(ShardIndex::new(0, 0).is_err());
+        let rows = ShardIndex::new(2, 5).unwrap().rows();
+        assert_eq!((rows.count(12), rows.row(0), rows.row(1)), (2, 2, 7));
+    }
+
+    #[test]
+    fn every_truncation_and_every_flipped_byte_is_refused_without_panic() {
+        let bytes = small_shard();
+        let info = parse(&bytes).unwrap().info;
+        assert_eq!((info.rows, info.shard.count()), (5, 200));
+        assert!(info.sub_entries > 0, "the rows hold collision pairs with sub-cells");
+        for n in 0..bytes.len() {
+            let e = parse(&bytes[..n]).err().unwrap_or_else(|| panic!("a shard cut to {n} bytes was read"));
+            assert!(matches!(e, ShardError::Truncated { .. } | ShardError::Corrupt { .. }), "cut to {n}: {e}");
+        }
+        for i in 0..bytes.len() {
+            let mut flipped = bytes.clone();
+            flipped[i] ^= 0x20;
+            assert!(parse(&flipped).is_err(), "byte {i} flipped was read");
+        }
+    }
+
+    #[test]
+    fn fields_are_checked_beyond_the_checksum() {
+        let bytes = small_shard();
+        let labels_end = bytes.len() - 8 - 24 * parse(&bytes).unwrap().info.sub_entries;
+        let mut undefined = bytes.clone();
+        undefined[labels_end - 1] |= 0b11;
+        let e = parse(&resealed(undefined)).err().unwrap().to_string();
+        assert!(e.contains("label 3"), "{e}");
+        let mut other_index = bytes.clone();
+        other_index[16] = 100;
+        let e = parse(&resealed(other_index)).err().unwrap().to_string();
+        assert!(e.contains("5 rows, shard 100 of 200"), "shard 100 of 200 has 4 rows: {e}");
+        let mut table = bytes.clone();
+        table[..8].copy_from_slice(&crate::table::format::MAGIC);
+        assert_eq!(parse(&table).err(), Some(ShardError::BadMagic { table: true }));
+    }
+}
