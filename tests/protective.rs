@@ -5,7 +5,6 @@
 //! monotonicity, the speed limit, no allocation per tick, and the counts on the scenarios.
 
 use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveReport, ProtectiveStatus};
-use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::math::{Real, Vec3};
@@ -45,44 +44,8 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-/// A stiffer robot than the default (short reaction, hard braking): FREE then happens with
-/// the robots close, where a wrong bound would show.
-const STIFF: StopModel =
-    StopModel { reaction_ms: 2.0, decel_mm_s2: 120_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 };
-
-fn cell(name: &str, stop: StopModel) -> Cell {
-    let c = reference_cell(name).unwrap();
-    let n = c.robots.len();
-    c.with_stopping(1.0, vec![stop; n]).unwrap()
-}
-
-fn unit(rng: &mut StdRng) -> Vec3 {
-    loop {
-        let v = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
-        let n = v.norm();
-        if n > 1e-3 && n <= 1.0 {
-            return v / n;
-        }
-    }
-}
-
-/// A reachable TCP of robot `j` (MCS) out toward the other robot, at a random depth.
-fn tcp_toward_other(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
-    let other = cell.robots[1 - j].placement.t - cell.robots[j].placement.t;
-    let alpha = cell.robots[j].placement.alpha;
-    let (s, c) = alpha.sin_cos();
-    // The direction to the other base in robot j's MCS: Rz(-alpha) applied.
-    let d = Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize();
-    let side = Vec3::new(-d.y, d.x, 0.0);
-    loop {
-        let p = d * rng.random_range(-60.0..230.0)
-            + side * rng.random_range(-140.0..140.0)
-            + Vec3::z() * rng.random_range(-530.0..-370.0);
-        if cell.robots[j].model.delta.is_reachable(&p) {
-            return p;
-        }
-    }
-}
+mod protective_common;
+use protective_common::{cell, tcp_toward_other, unit, STIFF};
 
 /// A reachable TCP of robot `j` within 0 to 8 mm of its reach boundary (pushed out from
 /// [`tcp_toward_other`] along its radial direction), where elbows swing fastest.
@@ -553,10 +516,8 @@ fn scenario_counts_with_the_default_and_a_stiff_model() {
     scenario_counts(STIFF, "stiff");
 }
 
-/// `dc_protective_query` through the C ABI: no allocation per call, FREE for robots standing
-/// apart, and the report's per-robot fields filled.
-#[test]
-fn the_c_entry_point_never_allocates_and_fills_the_report() {
+/// A C handle on T1's robots with the default stopping models.
+fn t1_handle_with_default_stops() -> *mut delta_collide::ffi::DcCollider {
     use delta_collide::ffi::*;
     let mut robots = [dc_robot_config_thesis(); 2];
     robots[1].translation = DcVec3 { x: 450.0, y: 0.0, z: 0.0 };
@@ -567,6 +528,15 @@ fn the_c_entry_point_never_allocates_and_fills_the_report() {
     let stops = [dc_stop_config_default(); 2];
     // SAFETY: live handle, two readable configs.
     assert_eq!(unsafe { dc_set_stop_model(h, 1.0, 10.0, stops.as_ptr(), 2) }, DC_STATUS_OK);
+    h
+}
+
+/// `dc_protective_query` through the C ABI: no allocation per call, FREE for robots standing
+/// apart, and the report's per-robot fields filled.
+#[test]
+fn the_c_entry_point_never_allocates_and_fills_the_report() {
+    use delta_collide::ffi::*;
+    let h = t1_handle_with_default_stops();
     let tcps = [DcVec3 { x: -150.0, y: 0.0, z: -450.0 }, DcVec3 { x: 150.0, y: 0.0, z: -450.0 }];
     let mut verdict = DC_VERDICT_STOP;
     let mut report = std::mem::MaybeUninit::<DcProtectiveReport>::zeroed();
@@ -592,15 +562,7 @@ fn the_c_entry_point_never_allocates_and_fills_the_report() {
 #[test]
 fn the_c_entry_point_with_paths_never_allocates_and_names_a_bad_path() {
     use delta_collide::ffi::*;
-    let mut robots = [dc_robot_config_thesis(); 2];
-    robots[1].translation = DcVec3 { x: 450.0, y: 0.0, z: 0.0 };
-    let config = DcCellConfig { robots: robots.as_ptr(), n_robots: 2, method: DC_METHOD_SAT_CACHE };
-    let mut h = std::ptr::null_mut();
-    // SAFETY: valid config and out pointer.
-    assert_eq!(unsafe { dc_init(&config, &mut h) }, DC_STATUS_OK);
-    let stops = [dc_stop_config_default(); 2];
-    // SAFETY: live handle, two readable configs.
-    assert_eq!(unsafe { dc_set_stop_model(h, 1.0, 10.0, stops.as_ptr(), 2) }, DC_STATUS_OK);
+    let h = t1_handle_with_default_stops();
     let at = |k: f64| {
         [DcVec3 { x: -100.0 + 0.5 * k, y: 20.0, z: -450.0 }, DcVec3 { x: 100.0 - 0.5 * k, y: -20.0, z: -450.0 }]
     };

@@ -7,7 +7,6 @@
 //! programmed path ahead as the stop path.
 
 use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveStatus, StopPath};
-use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::math::{Real, Vec3};
@@ -15,26 +14,8 @@ use delta_collide::robot::StopModel;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
-/// A stiff robot (short reaction, hard braking): proofs along paths then happen with the
-/// robots close, where a wrong bound would show.
-const STIFF: StopModel =
-    StopModel { reaction_ms: 2.0, decel_mm_s2: 120_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 };
-
-fn cell(name: &str, stop: StopModel) -> Cell {
-    let c = reference_cell(name).unwrap();
-    let n = c.robots.len();
-    c.with_stopping(1.0, vec![stop; n]).unwrap()
-}
-
-fn unit(rng: &mut StdRng) -> Vec3 {
-    loop {
-        let v = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
-        let n = v.norm();
-        if n > 1e-3 && n <= 1.0 {
-            return v / n;
-        }
-    }
-}
+mod protective_common;
+use protective_common::{cell, tcp_toward_other, unit, STIFF};
 
 /// The point at arc length `s` of the polyline `points` (written here, not the library's).
 fn along(points: &[Vec3], s: Real) -> Vec3 {
@@ -47,22 +28,6 @@ fn along(points: &[Vec3], s: Real) -> Vec3 {
         rest -= len;
     }
     *points.last().unwrap()
-}
-
-/// A reachable TCP of robot `j` (MCS) out toward the other robot.
-fn tcp_toward_other(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
-    let other = cell.robots[1 - j].placement.t - cell.robots[j].placement.t;
-    let (s, c) = cell.robots[j].placement.alpha.sin_cos();
-    let d = Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize();
-    let side = Vec3::new(-d.y, d.x, 0.0);
-    loop {
-        let p = d * rng.random_range(-80.0..200.0)
-            + side * rng.random_range(-150.0..150.0)
-            + Vec3::z() * rng.random_range(-520.0..-380.0);
-        if cell.robots[j].model.delta.is_reachable(&p) {
-            return p;
-        }
-    }
 }
 
 /// A random stop path from `tcp`: along `velocity` (or anywhere), with one or two corners,

@@ -414,36 +414,12 @@ pub unsafe extern "C" fn dc_protective_query(
     out_verdict: *mut DcVerdict,
     out_report: *mut DcProtectiveReport,
 ) -> DcStatus {
-    let mut report = DcProtectiveReport::STOP;
-    let status = boundary(|| {
-        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
-        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
-        if out_verdict.is_null() || tcps_mcs.is_null() {
-            return DC_STATUS_NULL_POINTER;
-        }
-        if h.poisoned {
-            return DC_STATUS_PANIC;
-        }
-        // SAFETY: non-null, and the caller guarantees `n_tcps` readable elements.
-        let tcps = unsafe { std::slice::from_raw_parts(tcps_mcs, n_tcps) };
-        let status = catch_unwind(AssertUnwindSafe(|| h.inner.protective_query(tcps, &mut report)));
-        status.unwrap_or_else(|_| {
-            h.poisoned = true;
-            DC_STATUS_PANIC
+    // SAFETY: the caller's guarantees on `handle`, `tcps_mcs` and the outputs are passed on.
+    unsafe {
+        protective_entry(handle, tcps_mcs, n_tcps, out_verdict, out_report, |h, tcps, report| {
+            h.protective_query(tcps, report)
         })
-    });
-    if status != DC_STATUS_OK {
-        report.verdict = DC_VERDICT_STOP;
     }
-    if !out_verdict.is_null() {
-        // SAFETY: non-null; the caller guarantees it is writable.
-        unsafe { *out_verdict = report.verdict };
-    }
-    if !out_report.is_null() {
-        // SAFETY: non-null; the caller guarantees it is writable.
-        unsafe { *out_report = report };
-    }
-    status
 }
 
 /// `dc_protective_query` for a controller that knows the path each robot's stop will follow
@@ -472,37 +448,66 @@ pub unsafe extern "C" fn dc_protective_query_with_paths(
     out_verdict: *mut DcVerdict,
     out_report: *mut DcProtectiveReport,
 ) -> DcStatus {
+    if paths.is_null() {
+        // SAFETY: as below; the query is not run.
+        return unsafe {
+            protective_entry(handle, tcps_mcs, n_tcps, out_verdict, out_report, |_, _, _| DC_STATUS_NULL_POINTER)
+        };
+    }
+    // SAFETY: the caller's guarantees on `handle`, `tcps_mcs` and the outputs are passed on.
+    unsafe {
+        protective_entry(handle, tcps_mcs, n_tcps, out_verdict, out_report, |h, tcps, report| {
+            // SAFETY: non-null, and the caller guarantees `n_paths` readable elements.
+            let paths = std::slice::from_raw_parts(paths, n_paths);
+            let mut views: [(&[DcVec3], f64); crate::cell::MAX_ROBOTS] = [(&[], 0.0); crate::cell::MAX_ROBOTS];
+            if n_paths > views.len() {
+                return DC_STATUS_WRONG_ROBOT_COUNT;
+            }
+            for (j, (view, path)) in views.iter_mut().zip(paths).enumerate() {
+                if path.n_points == 0 {
+                    continue;
+                }
+                if path.points.is_null() || path.n_points > DC_MAX_PATH_POINTS {
+                    report.unreachable_mask = 1 << j;
+                    h.reset_protective();
+                    return if path.points.is_null() { DC_STATUS_NULL_POINTER } else { DC_STATUS_INVALID_ARGUMENT };
+                }
+                // SAFETY: non-null, and the caller guarantees `n_points` readable elements.
+                *view = (std::slice::from_raw_parts(path.points, path.n_points), path.tolerance_mm);
+            }
+            h.protective_query_with_paths(tcps, &views[..n_paths], report)
+        })
+    }
+}
+
+/// The common part of the protective entry points: checks the handle and the pointers, runs
+/// `query` on the handle's collider with the TCPs (a panic poisons the handle), and writes
+/// the outputs on every call, the verdict STOP on every status but OK.
+///
+/// # Safety
+/// `handle` must be NULL or a live handle not used by another thread; `tcps_mcs` NULL or
+/// `n_tcps` readable elements; the outputs NULL or writable.
+unsafe fn protective_entry(
+    handle: *mut DcCollider,
+    tcps_mcs: *const DcVec3,
+    n_tcps: usize,
+    out_verdict: *mut DcVerdict,
+    out_report: *mut DcProtectiveReport,
+    query: impl FnOnce(&mut Collider, &[DcVec3], &mut DcProtectiveReport) -> DcStatus,
+) -> DcStatus {
     let mut report = DcProtectiveReport::STOP;
     let status = boundary(|| {
         // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
         let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
-        if out_verdict.is_null() || tcps_mcs.is_null() || paths.is_null() {
+        if out_verdict.is_null() || tcps_mcs.is_null() {
             return DC_STATUS_NULL_POINTER;
         }
         if h.poisoned {
             return DC_STATUS_PANIC;
         }
-        // SAFETY: non-null, and the caller guarantees `n_tcps` and `n_paths` readable elements.
-        let (tcps, paths) = unsafe { (std::slice::from_raw_parts(tcps_mcs, n_tcps), std::slice::from_raw_parts(paths, n_paths)) };
-        let mut views: [(&[DcVec3], f64); crate::cell::MAX_ROBOTS] = [(&[], 0.0); crate::cell::MAX_ROBOTS];
-        if n_paths > views.len() {
-            return DC_STATUS_WRONG_ROBOT_COUNT;
-        }
-        for (j, (view, path)) in views.iter_mut().zip(paths).enumerate() {
-            if path.n_points == 0 {
-                continue;
-            }
-            if path.points.is_null() || path.n_points > DC_MAX_PATH_POINTS {
-                report.unreachable_mask = 1 << j;
-                h.inner.reset_protective();
-                return if path.points.is_null() { DC_STATUS_NULL_POINTER } else { DC_STATUS_INVALID_ARGUMENT };
-            }
-            // SAFETY: non-null, and the caller guarantees `n_points` readable elements.
-            *view = (unsafe { std::slice::from_raw_parts(path.points, path.n_points) }, path.tolerance_mm);
-        }
-        let status = catch_unwind(AssertUnwindSafe(|| {
-            h.inner.protective_query_with_paths(tcps, &views[..n_paths], &mut report)
-        }));
+        // SAFETY: non-null, and the caller guarantees `n_tcps` readable elements.
+        let tcps = unsafe { std::slice::from_raw_parts(tcps_mcs, n_tcps) };
+        let status = catch_unwind(AssertUnwindSafe(|| query(&mut h.inner, tcps, &mut report)));
         status.unwrap_or_else(|_| {
             h.poisoned = true;
             DC_STATUS_PANIC
