@@ -105,3 +105,13 @@ pub(crate) fn corrupt(what: impl Into<String>) -> TableError {
 pub(crate) fn bad_input(what: impl Into<String>) -> TableError {
     TableError::BadInput { what: what.into() }
 }
+
+impl crate::table::reader::ReadError for TableError {
+    fn truncated(what: &'static str, needed: usize, have: usize) -> Self {
+        TableError::Truncated { what, needed, have }
+    }
+
+    fn corrupt(what: String) -> Self {
+        corrupt(what)
+    }
+}

@@ -35,6 +35,7 @@
 //! (via the variants' `from_parts`), so a loaded table never panics nor reads out of bounds.
 
 use super::error::{corrupt, TableError};
+use super::reader::Reader;
 use super::quadtree4d::{LinearQuadtree4d, SliceAxes};
 use super::quadtree5d::LinearQuadtree5d;
 use super::quadtree6d::LinearQuadtree6d;
@@ -213,43 +214,6 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
     out
 }
 
-/// Bounds-checked little-endian reads; every error names the field.
-struct Reader<'a> {
-    buf: &'a [u8],
-    pos: usize,
-}
-
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8], TableError> {
-        let end = self.pos.checked_add(n).ok_or_else(|| corrupt(format!("{what}: length overflows")))?;
-        let bytes =
-            self.buf.get(self.pos..end).ok_or(TableError::Truncated { what, needed: end, have: self.buf.len() })?;
-        self.pos = end;
-        Ok(bytes)
-    }
-
-    fn u32(&mut self, what: &'static str) -> Result<u32, TableError> {
-        self.take(4, what).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-    }
-
-    fn u64(&mut self, what: &'static str) -> Result<u64, TableError> {
-        self.take(8, what).map(|b| u64::from_le_bytes(core::array::from_fn(|i| b[i])))
-    }
-
-    fn f64(&mut self, what: &'static str) -> Result<f64, TableError> {
-        let v = f64::from_bits(self.u64(what)?);
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(corrupt(format!("{what} = {v} is not finite")))
-        }
-    }
-
-    fn f64x3(&mut self, what: &'static str) -> Result<[f64; 3], TableError> {
-        Ok([self.f64(what)?, self.f64(what)?, self.f64(what)?])
-    }
-}
-
 /// Fixed header fields that decide the table's shape.
 struct Shape {
     variant: u32,
@@ -260,7 +224,7 @@ struct Shape {
     t: u32,
 }
 
-fn read_prefix(r: &mut Reader) -> Result<Shape, TableError> {
+fn read_prefix(r: &mut Reader<TableError>) -> Result<Shape, TableError> {
     let magic = r.take(8, "magic")?;
     if magic != MAGIC {
         return Err(TableError::BadMagic { found: core::array::from_fn(|i| magic[i]) });
@@ -297,7 +261,7 @@ fn read_prefix(r: &mut Reader) -> Result<Shape, TableError> {
     Ok(Shape { variant, levels, sub_levels: flags >> 1, symmetric: flags & 1 == 1, axes, t })
 }
 
-fn read_header(r: &mut Reader) -> Result<Header, TableError> {
+fn read_header(r: &mut Reader<TableError>) -> Result<Header, TableError> {
     let cell_fingerprint = r.u64("cell fingerprint")?;
     let grid_r = r.f64("r")?;
     let origin_a = r.f64x3("origin_a")?;
@@ -362,7 +326,7 @@ fn check_unstored_half(shape: &Shape, words: &[u64]) -> Result<(), TableError> {
 const MAX_CELL_PARAMETERS: u64 = 4096;
 
 /// The cell parameter values; when present, their fingerprint must be the recorded one.
-fn read_cell_parameters(r: &mut Reader, fingerprint: u64) -> Result<Vec<f64>, TableError> {
+fn read_cell_parameters(r: &mut Reader<TableError>, fingerprint: u64) -> Result<Vec<f64>, TableError> {
     let n = r.u64("cell parameter count")?;
     if n > MAX_CELL_PARAMETERS {
         return Err(corrupt(format!("cell parameter count = {n} exceeds {MAX_CELL_PARAMETERS}")));
@@ -385,7 +349,7 @@ fn words<const N: usize, T>(bytes: &[u8], f: impl Fn([u8; N]) -> T) -> Vec<T> {
 /// The specific [`TableError`]: `Truncated`, `BadMagic`, `WrongEndianness`,
 /// `UnsupportedVersion`, or `Corrupt` naming the field (checksum, lengths, order, indices).
 pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
-    let mut r = Reader { buf: bytes, pos: 0 };
+    let mut r = Reader::<TableError>::new(bytes);
     let shape = read_prefix(&mut r)?;
     let mut header = read_header(&mut r)?;
     let counts = [r.u64("section 0 count")?, r.u64("section 1 count")?, r.u64("section 2 count")?];
@@ -406,10 +370,10 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
         }
     }
     let sections = [r.take(lens[0], names[0])?, r.take(lens[1], names[1])?, r.take(lens[2], names[2])?];
-    let body_end = r.pos;
+    let body_end = r.pos();
     let stored = r.u64("checksum")?;
-    if r.pos != bytes.len() {
-        return Err(corrupt(format!("{} trailing bytes after the checksum", bytes.len() - r.pos)));
+    if r.pos() != bytes.len() {
+        return Err(corrupt(format!("{} trailing bytes after the checksum", bytes.len() - r.pos())));
     }
     let computed = fnv1a64(&bytes[..body_end]);
     if stored != computed {

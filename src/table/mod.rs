@@ -29,6 +29,7 @@ pub(crate) mod quadtree6d;
 #[cfg(feature = "std")]
 pub mod shard;
 pub(crate) mod shared6d;
+mod reader;
 mod space;
 #[cfg(feature = "std")]
 pub mod synthetic;

@@ -149,3 +149,13 @@ impl std::error::Error for ShardError {}
 pub(super) fn corrupt(what: impl Into<String>) -> ShardError {
     ShardError::Corrupt { what: what.into() }
 }
+
+impl crate::table::reader::ReadError for ShardError {
+    fn truncated(what: &'static str, needed: usize, have: usize) -> Self {
+        ShardError::Truncated { what, needed, have }
+    }
+
+    fn corrupt(what: String) -> Self {
+        corrupt(what)
+    }
+}

@@ -33,6 +33,7 @@
 //! ```
 
 use super::error::{corrupt, ShardError};
+use crate::table::reader::Reader;
 use super::ShardIndex;
 use crate::cell::{fingerprint_of, fnv1a64};
 use crate::cspace::{CellIndex, Label, SampleGrid, Symmetry, Workspace};
@@ -148,56 +149,8 @@ pub(super) fn to_bytes(info: &ShardInfo, labels: &RowLabels) -> Vec<u8> {
     out
 }
 
-/// Bounds-checked little-endian reads; every error names the field.
-struct Reader<'a> {
-    buf: &'a [u8],
-    pos: usize,
-}
-
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8], ShardError> {
-        let end = self.pos.checked_add(n).ok_or_else(|| corrupt(format!("{what}: length overflows")))?;
-        let bytes =
-            self.buf.get(self.pos..end).ok_or(ShardError::Truncated { what, needed: end, have: self.buf.len() })?;
-        self.pos = end;
-        Ok(bytes)
-    }
-
-    fn u32(&mut self, what: &'static str) -> Result<u32, ShardError> {
-        self.take(4, what).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-    }
-
-    fn u64(&mut self, what: &'static str) -> Result<u64, ShardError> {
-        self.take(8, what).map(|b| u64::from_le_bytes(core::array::from_fn(|i| b[i])))
-    }
-
-    fn size(&mut self, what: &'static str) -> Result<usize, ShardError> {
-        let v = self.u64(what)?;
-        usize::try_from(v).map_err(|_| corrupt(format!("{what} = {v} does not fit in memory")))
-    }
-
-    fn f64(&mut self, what: &'static str) -> Result<f64, ShardError> {
-        let v = f64::from_bits(self.u64(what)?);
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(corrupt(format!("{what} = {v} is not finite")))
-        }
-    }
-
-    fn f64x3(&mut self, what: &'static str) -> Result<[f64; 3], ShardError> {
-        Ok([self.f64(what)?, self.f64(what)?, self.f64(what)?])
-    }
-
-    /// `n` items of `size` bytes each.
-    fn items(&mut self, n: usize, size: usize, what: &'static str) -> Result<&'a [u8], ShardError> {
-        let len = n.checked_mul(size).ok_or_else(|| corrupt(format!("{what}: {n} entries overflow")))?;
-        self.take(len, what)
-    }
-}
-
 /// The prefix up to the header fields: magic, endianness, version.
-fn read_prefix(r: &mut Reader) -> Result<(), ShardError> {
+fn read_prefix(r: &mut Reader<ShardError>) -> Result<(), ShardError> {
     let magic = r.take(8, "magic")?;
     if magic != MAGIC {
         return Err(ShardError::BadMagic { table: magic == crate::table::format::MAGIC });
@@ -214,7 +167,7 @@ fn read_prefix(r: &mut Reader) -> Result<(), ShardError> {
 }
 
 /// One robot's grid: `n` cells and their reachability, at spacing `r` from `origin`.
-fn read_grid(r: &mut Reader, n: usize, k: u32, spacing: f64, origin: [f64; 3]) -> Result<SampleGrid, ShardError> {
+fn read_grid(r: &mut Reader<ShardError>, n: usize, k: u32, spacing: f64, origin: [f64; 3]) -> Result<SampleGrid, ShardError> {
     let cells: Vec<CellIndex> = r
         .items(n, 6, "grid cells")?
         .chunks_exact(6)
@@ -241,7 +194,7 @@ fn read_grid(r: &mut Reader, n: usize, k: u32, spacing: f64, origin: [f64; 3]) -
 /// The specific [`ShardError`]: `Truncated`, `BadMagic`, `WrongEndianness`,
 /// `UnsupportedVersion`, or `Corrupt` naming the field (checksum, lengths, indices, labels).
 pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
-    let mut r = Reader { buf: bytes, pos: 0 };
+    let mut r = Reader::<ShardError>::new(bytes);
     read_prefix(&mut r)?;
     let (index, count, k) = (r.u32("shard index")?, r.u32("shard count")?, r.u32("k")?);
     let shard = ShardIndex::new(index, count).map_err(|_| corrupt(format!("shard {index} of {count}")))?;
@@ -301,17 +254,17 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     if fingerprint_of(cell_parameters.iter().copied()) != cell_fingerprint {
         return Err(corrupt("cell parameters do not give the recorded cell fingerprint"));
     }
-    let grids_start = r.pos;
+    let grids_start = r.pos();
     let grid_a = read_grid(&mut r, na, k, spacing, origin_a)?;
     let grid_b = read_grid(&mut r, nb, k, spacing, origin_b)?;
-    let grid_bytes = &bytes[grids_start..r.pos];
+    let grid_bytes = &bytes[grids_start..r.pos()];
     let pairs = rows.checked_mul(nb).ok_or_else(|| corrupt("rows x samples of B overflows"))?;
     let labels = r.take(pairs.div_ceil(4), "labels")?;
     let sub = r.items(m, 24, "sub-cells")?;
-    let body_end = r.pos;
+    let body_end = r.pos();
     let stored = r.u64("checksum")?;
-    if r.pos != bytes.len() {
-        return Err(corrupt(format!("{} trailing bytes after the checksum", bytes.len() - r.pos)));
+    if r.pos() != bytes.len() {
+        return Err(corrupt(format!("{} trailing bytes after the checksum", bytes.len() - r.pos())));
     }
     let computed = fnv1a64(&bytes[..body_end]);
     if stored != computed {
