@@ -41,7 +41,7 @@ pub fn clip(s: &str) -> String {
 #[command(name = "delta-collide", version = VERSION_TEXT.as_str(), subcommand_required = true)]
 #[command(arg_required_else_help = true, disable_help_subcommand = true)]
 pub struct Cli {
-    /// Draw no progress bars
+    /// Draw no progress bars (they go to stderr only, and only when it is a terminal)
     #[arg(short, long, global = true)]
     pub quiet: bool,
     #[command(subcommand)]
@@ -50,7 +50,7 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Run the scenarios: exact check and protective verdict
+    /// Run the practical and collision scenarios: exact check and protective verdict
     ///
     /// Runs the scenarios of c_harness/scenarios.txt for the chosen cells and prints the
     /// first collision tick and the per-tick query times of the exact check (SAT and
