@@ -31,7 +31,7 @@ pub const MAX_OPS: usize = 64;
 /// Live handles at most; a further init destroys the oldest.
 pub const MAX_HANDLES: usize = 4;
 /// Number of opcodes.
-const OPS: u8 = 11;
+const OPS: u8 = 12;
 
 /// The opcodes.
 #[derive(Clone, Copy, Debug)]
@@ -68,6 +68,12 @@ pub enum Op {
     /// `dc_init_from_files`: cell and table path kinds (as `InitFromFile`; the real table is
     /// a T1 seed), NULL out flag.
     InitFromFiles = 10,
+    /// `dc_protective_query` or, with a flag, `dc_protective_query_with_paths`: handle, count
+    /// and points as for `Query`; with paths, per robot a point count (byte % 40; above
+    /// `DC_MAX_PATH_POINTS` is refused), its points and a tolerance, and a NULL flag for the
+    /// paths array; NULL flags (tcps, out_verdict, out_report). `dc_set_stop_model` is not
+    /// called: its motor-angle table takes about 0.3 s to build.
+    Protective = 11,
 }
 
 /// A live handle and the robots it was made from.
@@ -95,7 +101,8 @@ pub fn c_abi(data: &[u8]) {
             7 => destroy(&mut input, &mut live),
             8 => init::init_from_file(&mut input, &mut live),
             9 => init::init_with_table(&mut input, &mut live),
-            _ => init::init_from_files(&mut input, &mut live),
+            10 => init::init_from_files(&mut input, &mut live),
+            _ => protective(&mut input, &live),
         }
     }
     for l in live {
@@ -202,6 +209,69 @@ fn query(input: &mut Input, live: &[Live]) {
         DC_STATUS_UNREACHABLE => assert_eq!(report.unreachable_mask, unreachable),
         _ => check_ok_report(l, &report),
     }
+}
+
+fn protective(input: &mut Input, live: &[Live]) {
+    let l = pick(input, live);
+    let n = l.map_or(0, |l| l.robots.len());
+    let count = match input.byte() {
+        b @ 192.. => usize::from(b % 40),
+        _ => n,
+    };
+    let point = |input: &mut Input| {
+        let [x, y, z] = input.point();
+        DcVec3 { x, y, z }
+    };
+    let tcps: Vec<DcVec3> = (0..count).map(|_| point(input)).collect();
+    let with_paths = input.flag();
+    let points: Vec<Vec<DcVec3>> = if with_paths {
+        (0..count).map(|_| (0..input.byte() % 40).map(|_| point(input)).collect()).collect()
+    } else {
+        Vec::new()
+    };
+    let paths: Vec<DcStopPath> = points
+        .iter()
+        .map(|p| DcStopPath { points: p.as_ptr(), n_points: p.len(), tolerance_mm: input.f64() })
+        .collect();
+    let null_paths = with_paths && input.flag();
+    let nulls = input.byte();
+    let mut verdict = DC_VERDICT_COLLISION;
+    // SAFETY: all-zero is a valid `DcProtectiveReport` (numbers and integers only).
+    let mut report: DcProtectiveReport = unsafe { std::mem::zeroed() };
+    report.verdict = 7;
+    let tcps_ptr = if nulls & 1 != 0 { std::ptr::null() } else { tcps.as_ptr() };
+    let (out_verdict, out_report) = (null_if(nulls & 2 != 0, &mut verdict), null_if(nulls & 4 != 0, &mut report));
+    // SAFETY: the handle is NULL or live; `tcps` holds `count` points, `paths` one path per
+    // TCP whose points it holds; outputs are NULL or writable.
+    let status = unsafe {
+        if with_paths {
+            let paths_ptr = if null_paths { std::ptr::null() } else { paths.as_ptr() };
+            dc_protective_query_with_paths(handle_of(l), tcps_ptr, count, paths_ptr, count, out_verdict, out_report)
+        } else {
+            dc_protective_query(handle_of(l), tcps_ptr, count, out_verdict, out_report)
+        }
+    };
+    assert_ne!(status, DC_STATUS_PANIC, "the protective query panicked");
+    if nulls & 2 == 0 {
+        assert!([DC_VERDICT_FREE, DC_VERDICT_WARN, DC_VERDICT_STOP].contains(&verdict), "verdict {verdict}");
+        assert!(status == DC_STATUS_OK || verdict == DC_VERDICT_STOP, "status {status} with verdict {verdict}");
+    }
+    if nulls & 4 == 0 {
+        assert!(nulls & 2 != 0 || report.verdict == verdict, "report {}, verdict {verdict}", report.verdict);
+        assert!(status == DC_STATUS_OK || report.verdict == DC_VERDICT_STOP, "status {status}, report verdict {}", report.verdict);
+    }
+    if l.is_none() || nulls & 3 != 0 || null_paths {
+        return assert_eq!(status, DC_STATUS_NULL_POINTER);
+    }
+    if count != n {
+        return assert_eq!(status, DC_STATUS_WRONG_ROBOT_COUNT);
+    }
+    // A path too long for the call is refused before the TCPs are read.
+    if paths.iter().any(|p| p.n_points > DC_MAX_PATH_POINTS) {
+        return assert_eq!(status, DC_STATUS_INVALID_ARGUMENT, "a path of more than {DC_MAX_PATH_POINTS} points");
+    }
+    let tcp_finite = tcps.iter().all(|p| p.x.is_finite() && p.y.is_finite() && p.z.is_finite());
+    assert!(tcp_finite || status == DC_STATUS_NON_FINITE, "non-finite TCPs {tcps:?}: status {status}");
 }
 
 /// Whether `dc_delta3_inverse_kinematics` accepts `tcp` for `geometry`.
@@ -398,6 +468,18 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.byte(0).byte(255);
     query2(&mut e, [200.0, 0.0, -400.0], [-200.0, 0.0, -400.0]);
     out.push(("edited_config", e.bytes));
+    let mut e = Encoder::default();
+    init(&mut e, 2, 1, 0);
+    // Protective: handle 0, two TCPs, no paths, no NULLs; twice (speeds from the first).
+    for _ in 0..2 {
+        e.byte(Op::Protective as u8).byte(0).byte(0).point([-150.0, 0.0, -450.0]).point([150.0, 0.0, -450.0]);
+        e.byte(0).byte(0);
+    }
+    // With paths: robot 0 along x for 50 mm (tolerance 1), robot 1 none.
+    e.byte(Op::Protective as u8).byte(0).byte(0).point([-150.0, 0.0, -450.0]).point([150.0, 0.0, -450.0]).byte(1);
+    e.byte(2).point([-150.0, 0.0, -450.0]).point([-100.0, 0.0, -450.0]).byte(0);
+    e.f64(1.0).f64(0.0).byte(0).byte(0);
+    out.push(("protective", e.bytes));
     let mut e = Encoder::default();
     e.byte(Op::Init as u8).byte(2).byte(0).byte(0).byte(1).byte(0).byte(0).f64(-100.0).byte(0).byte(8);
     init(&mut e, 0, 0, 0);

@@ -460,7 +460,7 @@ pub unsafe extern "C" fn dc_protective_query_with_paths(
             // SAFETY: non-null, and the caller guarantees `n_paths` readable elements.
             let paths = std::slice::from_raw_parts(paths, n_paths);
             let mut views: [(&[DcVec3], f64); crate::cell::MAX_ROBOTS] = [(&[], 0.0); crate::cell::MAX_ROBOTS];
-            if n_paths > views.len() {
+            if n_paths != h.robot_count() || tcps.len() != h.robot_count() {
                 return DC_STATUS_WRONG_ROBOT_COUNT;
             }
             for (j, (view, path)) in views.iter_mut().zip(paths).enumerate() {
