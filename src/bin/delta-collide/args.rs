@@ -13,7 +13,7 @@ use delta_collide::cell::reference::{reference_cell, REFERENCE_CELL_FILES};
 use delta_collide::cell::Cell;
 use delta_collide::math::Vec3;
 use delta_collide::table::code::MAX_LEVELS;
-use delta_collide::table::{Labelling, TableKind};
+use delta_collide::table::{Confirmation, Labelling, TableKind};
 use std::path::PathBuf;
 use std::sync::LazyLock;
 
@@ -134,6 +134,10 @@ pub struct CheckArgs {
     /// Answer from this table (built for the same cell) instead of the exact check
     #[arg(long, value_name = "FILE.dct")]
     pub table: Option<PathBuf>,
+    /// With --table: what a row the table says collides gets (exact: the exact check's
+    /// answer, so the output is that of check without --table) [default: exact]
+    #[arg(long, value_name = "CONFIRM", value_parser = choice::<ConfirmArg>())]
+    pub confirm: Option<ConfirmArg>,
     /// Read the rows from this file [default: stdin]
     #[arg(long, value_name = "FILE.csv")]
     pub input: Option<PathBuf>,
@@ -319,6 +323,25 @@ impl From<LabellingArg> for Labelling {
     }
 }
 
+/// What `check --table` does with a row the table says collides (the library's
+/// [`Confirmation`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ConfirmArg {
+    /// Confirm by the exact check: the answers of check without --table
+    Exact,
+    /// The table's label: it may say collide where the robots are a little apart
+    None,
+}
+
+impl From<ConfirmArg> for Confirmation {
+    fn from(c: ConfirmArg) -> Confirmation {
+        match c {
+            ConfirmArg::Exact => Confirmation::Exact,
+            ConfirmArg::None => Confirmation::None,
+        }
+    }
+}
+
 /// The slice pairs of `quilt`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum QuiltAxes {
@@ -364,6 +387,13 @@ impl Cli {
                         "--variant shared-sub certifies sub-cells: it needs --labelling certified".into(),
                     ));
                 }
+            }
+            Command::Check(c) if c.confirm.is_some() && c.table.is_none() => {
+                return Err(usage_error(
+                    "check",
+                    ErrorKind::MissingRequiredArgument,
+                    "--confirm applies to --table: without a table every row is answered by the exact check".into(),
+                ));
             }
             Command::Replay(r) => {
                 if let Some(plot) = &r.plot {
