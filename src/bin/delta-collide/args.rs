@@ -88,7 +88,9 @@ pub enum Command {
     /// Compare a table with the exact model
     ///
     /// Compares the table with the exact physical model (margin 0) on the cell's scenarios and
-    /// on N random reachable configurations: TP, TN, FP, FN, accuracy, query times. --plot
+    /// on N random reachable configurations: TP, TN, FP, FN, accuracy, query times; then, per
+    /// scenario, the ticks a COLLISION lookup is confirmed by the exact check and the per-tick
+    /// times of table mode with confirmation against exact mode, in the same run. --plot
     /// draws, per scenario and tick, the distance between the robots' boxes and the labels
     /// reported by the table and by the exact model.
     Eval(EvalArgs),

@@ -12,6 +12,7 @@
 
 mod args;
 mod clearance;
+mod confirm;
 mod demo;
 mod files;
 mod picture;
@@ -440,5 +441,6 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
         ns.len(),
         table.fallbacks()
     );
+    confirm::report(cell, &table, SCENARIOS)?;
     Ok(())
 }
