@@ -58,7 +58,11 @@ fn confirmed_table_mode_answers_as_exact_mode_on_every_scenario_tick() {
             );
             assert_eq!(confirmed.confirmations(), lookup_hits, "{name} {case}: one confirmation per COLLISION lookup");
             assert_eq!((raw.confirmations(), confirmed.fallbacks()), (0, raw.fallbacks()), "{name} {case}");
-            assert_eq!(case == "collision", collisions > 0, "{name} {case}: the run collides only in the collision case");
+            assert_eq!(
+                case == "collision",
+                collisions > 0,
+                "{name} {case}: the run collides only in the collision case"
+            );
             false_alarms_cleared += alarms;
         }
     }
