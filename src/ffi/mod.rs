@@ -11,6 +11,9 @@
 //! - `dc_init*` allocate; `dc_query` never allocates, locks or does I/O.
 //! - Two modes behind one handle: exact (`dc_init`, `dc_init_from_cell_file`) and table
 //!   (`dc_init_with_table`, `dc_init_from_files`; two-robot cells); `dc_query` is the same.
+//! - Table mode confirms a COLLISION lookup by the exact check unless
+//!   `dc_set_table_confirmation` (or the cell file's `table_confirm`) says otherwise, so it
+//!   answers as exact mode; `dc_table_confirmations` counts those ticks.
 //! - A handle is used by one thread at a time; distinct handles are independent.
 #![allow(unsafe_code)]
 
