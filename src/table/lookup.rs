@@ -23,9 +23,11 @@ use alloc::{format, string::String, vec, vec::Vec};
 /// The answer of one table-backed query.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TableAnswer {
-    /// The table proves the configuration free (or the exact fallback found it free).
+    /// The table proves the configuration free (or the exact check, a fallback or a
+    /// confirmation, found it free).
     Free,
-    /// The table stores the cell as collision (or the exact fallback found a collision).
+    /// The table stores the cell as collision (confirmed by the exact check with
+    /// [`Confirmation::Exact`]), or the exact fallback found a collision.
     Collision,
     /// Bit j set: robot j's TCP is unreachable or not finite.
     Unreachable(u32),
