@@ -4,12 +4,14 @@
  *
  * Start-up reads the cell's table file into memory, initialises the POU with
  * dc_init_with_table and frees the buffer before the first tick (the library keeps a copy);
- * a second table handle comes from dc_init_from_files. Beside them run exact-mode handles
- * (DC_METHOD_SAT) on the same TCPs. Per tick the harness asserts that the table never says
- * FREE where the exact model collides, on the POU's (stopped) trajectory and on the
- * unstopped one, and at the end that the table's stop tick is not later than the exact
- * model's first collision tick. The table may stop earlier (it is conservative): the number
- * of such ticks is printed, not asserted.
+ * a second table handle comes from dc_init_from_files. Both confirm a COLLISION lookup by
+ * the exact check (DC_CONFIRMATION_EXACT, the default). On the unstopped trajectory run a
+ * "shadow" with the confirmation off (the table's labels) and a confirmed handle. Beside
+ * them run exact-mode handles (DC_METHOD_SAT) on the same TCPs. Per tick the harness
+ * asserts that the shadow never says FREE where the exact model collides and that the
+ * confirmed handles answer as exact mode, on the POU's (stopped) trajectory and on the
+ * unstopped one; at the end, that each COLLISION lookup of the shadow was confirmed once.
+ * The shadow may stop earlier (it is conservative): the number of such ticks is printed.
  */
 #include "harness.h"
 #include "pou.h"
@@ -76,7 +78,8 @@ static void check_stop_report(const char *cell_name, const char *case_name, cons
 
 /* Start-up of the table-mode handles; returns 0 (after destroying what was made) on failure. */
 static int start_up(const char *cell_name, const DcCellConfig *config, const HarnessTable *table, Pou *pou,
-                    DcCollider **shadow, DcCollider **from_files, DcCollider **exact_pou, DcCollider **exact_free)
+                    DcCollider **shadow, DcCollider **confirmed, DcCollider **from_files, DcCollider **exact_pou,
+                    DcCollider **exact_free)
 {
     unsigned char *bytes = NULL;
     size_t len = 0;
@@ -87,6 +90,10 @@ static int start_up(const char *cell_name, const DcCellConfig *config, const Har
                 cell_name, dc_status_str(s));
     s = dc_init_with_table(config, bytes, len, shadow);
     ok &= check(s == DC_STATUS_OK, "%s table: dc_init_with_table (shadow): %s", cell_name, dc_status_str(s));
+    s = dc_set_table_confirmation(*shadow, DC_CONFIRMATION_NONE);
+    ok &= check(s == DC_STATUS_OK, "%s table: dc_set_table_confirmation: %s", cell_name, dc_status_str(s));
+    s = dc_init_with_table(config, bytes, len, confirmed);
+    ok &= check(s == DC_STATUS_OK, "%s table: dc_init_with_table (confirmed): %s", cell_name, dc_status_str(s));
     /* The library copied what it needs: scribble over the buffer and free it before any tick. */
     if (bytes != NULL) {
         memset(bytes, 0xA5, len);
@@ -103,6 +110,7 @@ static int start_up(const char *cell_name, const DcCellConfig *config, const Har
     if (!ok) {
         pou_destroy(pou);
         dc_destroy(*shadow);
+        dc_destroy(*confirmed);
         dc_destroy(*from_files);
         dc_destroy(*exact_pou);
         dc_destroy(*exact_free);
@@ -118,12 +126,13 @@ int run_table_scenario(const char *cell_name, const char *case_name, const Harne
     DcRobotConfig robots[MR_MAX_ROBOTS];
     DcCellConfig config;
     Pou pou;
-    DcCollider *shadow = NULL, *from_files = NULL, *exact_pou = NULL, *exact_free = NULL;
-    Compare on_pou, on_free;
+    DcCollider *shadow = NULL, *confirmed = NULL, *from_files = NULL, *exact_pou = NULL, *exact_free = NULL;
+    Compare on_pou, on_free, on_confirmed;
+    unsigned long lookup_hits = 0;
     int stopped[MR_MAX_ROBOTS] = { 0 };
     double held[MR_MAX_ROBOTS][3];
     unsigned long mock_errors = 0, file_disagree = 0, not_held = 0;
-    char stop_text[24], exact_text[24];
+    char stop_text[24], exact_text[24], shadow_text[24];
     size_t j;
 
     result->stop_tick = -1;
@@ -131,13 +140,14 @@ int run_table_scenario(const char *cell_name, const char *case_name, const Harne
     memset(held, 0, sizeof held);
     compare_init(&on_pou);
     compare_init(&on_free);
+    compare_init(&on_confirmed);
     if (!check(mr_register_cell(cell_name, &cell) == MR_OK, "%s: registry has no cell", cell_name)
         || !check(mr_load_scenario(SCENARIO_FILE, cell_name, case_name, cell.n_robots, &scenario) == MR_OK,
                   "%s %s: cannot load %s", cell_name, case_name, SCENARIO_FILE)) {
         return 0;
     }
     pou_cell_config(&cell, DC_METHOD_SAT, robots, &config);
-    if (!start_up(cell_name, &config, table, &pou, &shadow, &from_files, &exact_pou, &exact_free)) {
+    if (!start_up(cell_name, &config, table, &pou, &shadow, &confirmed, &from_files, &exact_pou, &exact_free)) {
         return 0;
     }
 
@@ -145,9 +155,10 @@ int run_table_scenario(const char *cell_name, const char *case_name, const Harne
     for (mr_clock_start(&clock); clock.tick < MR_TICKS_PER_RUN; mr_clock_advance(&clock)) {
         MrTickState free_run, pou_run;
         DcVec3 tcps_free[MR_MAX_ROBOTS], tcps_pou[MR_MAX_ROBOTS];
-        DcVerdict v_pou, vt = DC_VERDICT_STOP, ve = DC_VERDICT_STOP, v_file = DC_VERDICT_STOP;
-        DcStatus st, se, s_file;
+        DcVerdict v_pou, vt = DC_VERDICT_STOP, ve = DC_VERDICT_STOP, v_file = DC_VERDICT_STOP, vc = DC_VERDICT_STOP;
+        DcStatus st, se, s_file, sc;
         long tick = clock.tick;
+        uint64_t fallbacks = dc_table_fallbacks(shadow);
 
         /* The unstopped trajectory: table and exact side by side. */
         if (mr_robot_state(&cell, &scenario, tick, NULL, NULL, &free_run) != MR_OK) {
@@ -156,7 +167,12 @@ int run_table_scenario(const char *cell_name, const char *case_name, const Harne
         to_dc(&free_run, cell.n_robots, tcps_free);
         st = dc_query(shadow, tcps_free, cell.n_robots, &vt, NULL);
         se = dc_query(exact_free, tcps_free, cell.n_robots, &ve, NULL);
+        sc = dc_query(confirmed, tcps_free, cell.n_robots, &vc, NULL);
         compare_tick(&on_free, tick, st, vt, se, ve);
+        compare_tick(&on_confirmed, tick, sc, vc, se, ve);
+        if (vt == DC_VERDICT_COLLISION && dc_table_fallbacks(shadow) == fallbacks) {
+            lookup_hits++; /* a COLLISION lookup, which the confirmed handle checked exactly */
+        }
 
         /* What the controller runs: the table POU stops the robots. */
         if (mr_robot_state(&cell, &scenario, tick, stopped, (const double(*)[3])held, &pou_run) != MR_OK) {
@@ -193,6 +209,12 @@ int run_table_scenario(const char *cell_name, const char *case_name, const Harne
           cell_name, case_name, on_pou.false_free, on_pou.first_false_free);
     check(on_free.false_free == 0, "%s %s table: FREE where the exact model collides on %lu unstopped ticks (first %ld)",
           cell_name, case_name, on_free.false_free, on_free.first_false_free);
+    check(on_confirmed.false_free + on_confirmed.table_only + on_pou.table_only == 0,
+          "%s %s table: the confirmed handles differ from exact mode on %lu unstopped, %lu POU ticks", cell_name,
+          case_name, on_confirmed.false_free + on_confirmed.table_only, on_pou.table_only);
+    check(dc_table_confirmations(confirmed) == lookup_hits && dc_table_confirmations(shadow) == 0,
+          "%s %s table: %lu confirmations for %lu COLLISION lookups", cell_name, case_name,
+          (unsigned long)dc_table_confirmations(confirmed), lookup_hits);
     check(file_disagree == 0, "%s %s table: dc_init_from_files handle disagrees with the POU on %lu ticks", cell_name,
           case_name, file_disagree);
     check(not_held == 0, "%s %s table: %lu ticks after the stop were not COLLISION at the held pose", cell_name,
@@ -200,26 +222,29 @@ int run_table_scenario(const char *cell_name, const char *case_name, const Harne
     check(pou.stop_tick < 0 || pou.stop_verdict == DC_VERDICT_COLLISION,
           "%s %s table: the POU stopped with verdict %u (an error), not COLLISION", cell_name, case_name,
           (unsigned)pou.stop_verdict);
-    check(pou.stop_tick == on_free.table_first, "%s %s table: POU stop tick %ld != first table COLLISION tick %ld",
-          cell_name, case_name, pou.stop_tick, on_free.table_first);
+    check(pou.stop_tick == on_confirmed.table_first, "%s %s table: POU stop tick %ld != first COLLISION tick %ld",
+          cell_name, case_name, pou.stop_tick, on_confirmed.table_first);
     if (strcmp(case_name, "practical") == 0) {
         check(on_free.exact_first < 0, "%s practical table: the exact model collides at tick %ld", cell_name,
               on_free.exact_first);
     } else {
-        check(on_free.exact_first >= 0 && pou.stop_tick >= 0 && pou.stop_tick <= on_free.exact_first,
-              "%s collision table: table stop tick %ld is not <= the exact first collision tick %ld", cell_name,
-              pou.stop_tick, on_free.exact_first);
+        check(on_free.exact_first >= 0 && on_free.table_first >= 0 && on_free.table_first <= on_free.exact_first,
+              "%s collision table: the shadow's first COLLISION %ld is not <= the exact first collision tick %ld",
+              cell_name, on_free.table_first, on_free.exact_first);
     }
     tick_text(pou.stop_tick, stop_text);
     tick_text(on_free.exact_first, exact_text);
+    tick_text(on_free.table_first, shadow_text);
     printf("%s %-9s table: stop tick %s (table POU), first collision tick %s (exact, unstopped); "
-           "FREE ticks %lu/%d; unstopped: %lu table-only COLLISION ticks, %lu FREE where exact collides; "
-           "exact fallbacks %lu\n",
+           "FREE ticks %lu/%d; unstopped: %lu table-only COLLISION ticks (first %s) with confirmation off, "
+           "%lu FREE where exact collides; confirmed ticks %lu; exact fallbacks %lu\n",
            cell_name, case_name, stop_text, exact_text, pou.n_free, MR_TICKS_PER_RUN, on_free.table_only,
-           on_free.false_free + on_pou.false_free, (unsigned long)dc_table_fallbacks(shadow));
+           shadow_text, on_free.false_free + on_pou.false_free, (unsigned long)dc_table_confirmations(confirmed),
+           (unsigned long)dc_table_fallbacks(shadow));
 
     pou_destroy(&pou);
     dc_destroy(shadow);
+    dc_destroy(confirmed);
     dc_destroy(from_files);
     dc_destroy(exact_pou);
     dc_destroy(exact_free);

@@ -374,6 +374,12 @@ typedef struct DcPairResult {
 typedef uint32_t DcMode;
 
 /*
+ Table mode: what a query does when the table's lookup says COLLISION
+ (`dc_set_table_confirmation`). A lookup's FREE is a proof and is answered as it is.
+ */
+typedef uint32_t DcConfirmation;
+
+/*
  The call succeeded.
  */
 #define DC_STATUS_OK 0
@@ -506,6 +512,17 @@ typedef uint32_t DcMode;
  */
 #define DC_MODE_TABLE 2
 
+/*
+ Answer the table's label: COLLISION may come where the robots are a little apart.
+ */
+#define DC_CONFIRMATION_NONE 0
+
+/*
+ Confirm by the exact check and answer its verdict: table mode then answers as exact mode.
+ The default of every new table-mode handle (a cell file may say `table_confirm = "none"`).
+ */
+#define DC_CONFIRMATION_EXACT 1
+
 #ifdef __cplusplus
 extern "C" {
 #endif /* __cplusplus */
@@ -550,8 +567,10 @@ DcStatus dc_init_from_cell_file(const char *path, struct DcCollider **out_handle
  Creates a table-mode checker (POU start-up) for the two-robot cell `config` from the bytes
  of a table file built offline for that cell (`delta-collide build --cell ...`): each
  query is then one table lookup (`dc_mode` gives `DC_MODE_TABLE`). The table never answers
- FREE where the exact model collides; it may answer COLLISION where the exact model is
- free (the price of a 1 ms-safe lookup).
+ FREE where the exact model collides; where its lookup says COLLISION the exact check
+ confirms it (`DC_CONFIRMATION_EXACT`, the default), so the verdicts are exact mode's;
+ `dc_set_table_confirmation` with `DC_CONFIRMATION_NONE` answers the table's label instead
+ (it may say COLLISION where the exact model is free).
 
  The buffer is validated once, here (magic, endianness, version, lengths, checksum, every
  index, and that it was built for this cell), and copied: the caller may free it as soon
@@ -569,7 +588,8 @@ DcStatus dc_init_with_table(const struct DcCellConfig *config, const uint8_t *ta
 
 /*
  Creates a table-mode checker from a TOML cell file and a table file, both read once,
- here: `dc_init_from_cell_file` followed by `dc_init_with_table` on the file's bytes.
+ here: `dc_init_from_cell_file` followed by `dc_init_with_table` on the file's bytes. The
+ cell file's `table_confirm = "exact"` (the default) or `"none"` sets the confirmation.
 
  `*out_handle` as for `dc_init`. Statuses: those of `dc_init_from_cell_file` (for either
  path; `DC_STATUS_IO` when a file cannot be read) and those of `dc_init_with_table`.
@@ -725,6 +745,32 @@ DcMode dc_mode(const struct DcCollider *handle);
  `handle` must be NULL or live.
  */
 uint64_t dc_table_fallbacks(const struct DcCollider *handle);
+
+/*
+ Table mode: chooses what a query does when the table's lookup says COLLISION, from the
+ next query on: `DC_CONFIRMATION_EXACT` (the default) runs the exact check and answers its
+ verdict, so the handle answers as exact mode; `DC_CONFIRMATION_NONE` answers the table's
+ label. Setup only, like `dc_set_stop_model`; the per-tick query still never allocates.
+ On an exact-mode handle it changes nothing (exact mode always answers exactly).
+
+ Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_INVALID_ARGUMENT` (a value
+ that is neither; the handle keeps its setting and `dc_last_init_error` says so),
+ `DC_STATUS_PANIC` (a poisoned handle).
+
+ # Safety
+ `handle` must be NULL or a live handle not used by another thread.
+ */
+DcStatus dc_set_table_confirmation(struct DcCollider *handle, DcConfirmation confirmation);
+
+/*
+ Table mode: how many queries so far the table's lookup said COLLISION and the exact check
+ confirmed or refuted it (`DC_CONFIRMATION_EXACT`); ticks answered by the exact fallback
+ are counted by `dc_table_fallbacks` instead. 0 in exact mode and for NULL.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+uint64_t dc_table_confirmations(const struct DcCollider *handle);
 
 /*
  Number of robots of the handle's cell; 0 for NULL.

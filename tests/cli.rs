@@ -740,3 +740,43 @@ fn check_on_a_line_of_four_answers_as_its_pairs_one_by_one() {
     let hits = truth.iter().filter(|h| **h).count();
     assert!(hits > 20 && hits < 380, "the rows mix free and colliding lines: {hits}");
 }
+
+#[test]
+fn check_with_a_table_confirmed_answers_row_for_row_as_check_without_one() {
+    let dir = fresh_dir("confirm");
+    let table = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/golden/t1_k16_6d.dct");
+    let table = table.to_str().unwrap();
+    let mut false_alarms = 0;
+    for case in ["practical", "collision"] {
+        let input = dir.join(format!("{case}.csv"));
+        std::fs::write(&input, scenario_rows("T1", case, 6000)).unwrap();
+        let run = |extra: &[&str]| {
+            let mut args = vec!["check", "--cell", "T1", "--input", input.to_str().unwrap()];
+            args.extend_from_slice(extra);
+            let out = cli(&args);
+            assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+            stdout(&out)
+        };
+        let exact = run(&[]);
+        let confirmed = run(&["--table", table, "--confirm", "exact"]);
+        let raw = run(&["--table", table, "--confirm", "none"]);
+        assert_eq!(exact.lines().count(), 6001, "a header and one row per tick");
+        for (tick, (e, c)) in exact.lines().zip(confirmed.lines()).enumerate().skip(1) {
+            assert_eq!(c, e, "T1 {case} tick {}: --confirm exact and the exact check differ", tick - 1);
+        }
+        assert_eq!(run(&["--table", table]), confirmed, "--confirm exact is the default");
+        for (tick, (e, r)) in exact.lines().zip(raw.lines()).enumerate().skip(1) {
+            assert!(r == e || r == "1,1", "T1 {case} tick {}: the table says {r}, the exact check {e}", tick - 1);
+            false_alarms += usize::from(r != e);
+        }
+        assert_eq!(exact.contains("1,1"), case == "collision", "T1 {case}");
+    }
+    assert!(false_alarms > 0, "the k = 16 table raises false alarms, so the comparison above can fail");
+    let out = cli(&["check", "--cell", "T1", "--confirm", "exact"]);
+    assert_eq!(out.status.code(), Some(2), "--confirm without --table is a usage error");
+    assert!(stderr(&out).contains("--confirm applies to --table"), "{}", stderr(&out));
+    let out = cli(&["check", "--cell", "T1", "--table", table, "--confirm", "maybe"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("use exact or none"), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

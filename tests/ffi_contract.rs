@@ -88,7 +88,6 @@ fn query_does_not_allocate_over_a_million_ticks() {
 
 #[test]
 fn table_mode_query_does_not_allocate_over_a_million_ticks() {
-    let h = t1_table_handle();
     // Toward each other through the shared space; every 16th tick robot A is above the
     // sampled workspace (z = -340, reachable): the exact fallback must not allocate either.
     let ring: Vec<[DcVec3; 2]> = (0..128)
@@ -98,14 +97,27 @@ fn table_mode_query_does_not_allocate_over_a_million_ticks() {
             [v(-150.0 + 330.0 * s, 30.0, z), v(150.0 - 330.0 * s, -20.0, -430.0)]
         })
         .collect();
-    let (free, hit, allocated) = query_million_ticks(h, &ring);
-    assert_eq!(allocated, 0, "dc_query allocated in table mode");
-    assert!(free > 0 && hit > 0, "the ring covers both verdicts ({free} free, {hit} collisions)");
-    // SAFETY: live handle.
-    let fallbacks = unsafe { dc_table_fallbacks(h) };
-    assert_eq!(fallbacks, 1_000_000 / 16, "one exact fallback per out-of-grid tick");
-    // SAFETY: live handle, destroyed once.
-    unsafe { dc_destroy(h) };
+    // With and without the exact check confirming a COLLISION lookup.
+    for confirmation in [DC_CONFIRMATION_EXACT, DC_CONFIRMATION_NONE] {
+        let h = t1_table_handle();
+        // SAFETY: live handle.
+        assert_eq!(unsafe { dc_set_table_confirmation(h, confirmation) }, DC_STATUS_OK);
+        let (free, hit, allocated) = query_million_ticks(h, &ring);
+        assert_eq!(allocated, 0, "dc_query allocated in table mode (confirmation {confirmation})");
+        assert!(free > 0 && hit > 0, "the ring covers both verdicts ({free} free, {hit} collisions)");
+        // SAFETY: live handle.
+        let (fallbacks, confirmations) = unsafe { (dc_table_fallbacks(h), dc_table_confirmations(h)) };
+        assert_eq!(fallbacks, 1_000_000 / 16, "one exact fallback per out-of-grid tick");
+        if confirmation == DC_CONFIRMATION_EXACT {
+            // A COLLISION verdict comes from a confirmed lookup or from a fallback.
+            assert!(confirmations + fallbacks >= u64::from(hit), "{confirmations} confirmed, {hit} collisions");
+            assert!(confirmations > 0 && confirmations < 1_000_000 - fallbacks, "{confirmations} confirmed");
+        } else {
+            assert_eq!(confirmations, 0, "nothing is confirmed with DC_CONFIRMATION_NONE");
+        }
+        // SAFETY: live handle, destroyed once.
+        unsafe { dc_destroy(h) };
+    }
 }
 
 #[test]

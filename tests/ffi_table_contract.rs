@@ -140,21 +140,31 @@ fn table_mode_reports_fail_closed_and_pair_results() {
 }
 
 #[test]
-fn table_mode_never_answers_free_where_the_exact_model_collides() {
-    let h = t1_table_handle();
+fn table_mode_never_answers_free_where_the_exact_model_collides_and_confirmed_answers_as_exact_mode() {
+    let raw = t1_table_handle();
+    // SAFETY: live handle.
+    assert_eq!(unsafe { dc_set_table_confirmation(raw, DC_CONFIRMATION_NONE) }, DC_STATUS_OK);
+    let confirmed = t1_table_handle(); // DC_CONFIRMATION_EXACT: the default of a new handle
     let exact = two_robot_cell(450.0, DC_METHOD_SAT);
     let mut rng = StdRng::seed_from_u64(0x2545_f491_4f6c_dd1d);
     let mut uniform = |lo: f64, hi: f64| rng.random_range(lo..hi);
-    let (mut both, mut table_only, mut free, mut unreachable) = (0, 0, 0, 0);
+    let (mut both, mut table_only, mut free, mut unreachable, mut lookup_hits) = (0, 0, 0, 0, 0u64);
     for i in 0..100_000 {
         // Robot A's TCP reaching toward B and B's toward A, often overlapping.
         let tcps = [
             v(uniform(-100.0, 260.0), uniform(-200.0, 200.0), uniform(-540.0, -360.0)),
             v(uniform(-260.0, 100.0), uniform(-200.0, 200.0), uniform(-540.0, -360.0)),
         ];
-        let (st, vt, _) = query(h, &tcps);
+        // SAFETY: live handle.
+        let fallbacks_before = unsafe { dc_table_fallbacks(raw) };
+        let (st, vt, _) = query(raw, &tcps);
+        // SAFETY: live handle.
+        let fell_back = unsafe { dc_table_fallbacks(raw) } != fallbacks_before;
         let (se, ve, _) = query(exact, &tcps);
+        let (sc, vc, _) = query(confirmed, &tcps);
         assert_eq!(st, se, "case {i}: {tcps:?}: both modes agree on reachability");
+        assert_eq!((sc, vc), (se, ve), "case {i}: {tcps:?}: the confirmed table answers as exact mode");
+        lookup_hits += u64::from(vt == DC_VERDICT_COLLISION && !fell_back);
         match (se, ve, vt) {
             (DC_STATUS_UNREACHABLE, ..) => unreachable += 1,
             (_, DC_VERDICT_COLLISION, DC_VERDICT_COLLISION) => both += 1,
@@ -165,11 +175,74 @@ fn table_mode_never_answers_free_where_the_exact_model_collides() {
     }
     println!("100,000 configurations: {both} collide, {table_only} only the table stops, {free} free, {unreachable} unreachable");
     assert!(both > 1000 && free > 1000 && unreachable > 0, "the sample covers every outcome");
+    assert!(table_only > 100, "the unconfirmed table stops where the robots are apart ({table_only})");
     // SAFETY: live handles.
     unsafe {
+        assert_eq!(dc_table_confirmations(confirmed), lookup_hits, "one confirmation per COLLISION lookup");
+        assert_eq!(dc_table_confirmations(raw), 0);
+        dc_destroy(raw);
+        dc_destroy(confirmed);
+        dc_destroy(exact);
+    }
+}
+
+#[test]
+fn table_confirmation_is_chosen_per_handle_checked_and_read_from_the_cell_file() {
+    let colliding = [v(180.0, 0.0, -450.0), v(-180.0, 0.0, -450.0)];
+    let h = t1_table_handle();
+    let exact = two_robot_cell(450.0, DC_METHOD_SAT);
+    // SAFETY: live handles, NULL, and values that are no DcConfirmation are the inputs under test.
+    unsafe {
+        assert_eq!(query(h, &colliding).1, DC_VERDICT_COLLISION);
+        assert_eq!(dc_table_confirmations(h), 1, "new handles confirm");
+        assert_eq!(dc_set_table_confirmation(std::ptr::null_mut(), DC_CONFIRMATION_NONE), DC_STATUS_NULL_POINTER);
+        for bad in [2, 7, u32::MAX] {
+            assert_eq!(dc_set_table_confirmation(h, bad), DC_STATUS_INVALID_ARGUMENT, "{bad}");
+            assert!(last_init_error().contains(&format!("confirmation = {bad}")), "{}", last_init_error());
+        }
+        assert_eq!(query(h, &colliding).1, DC_VERDICT_COLLISION);
+        assert_eq!(dc_table_confirmations(h), 2, "a refused value keeps the setting");
+        assert_eq!(dc_set_table_confirmation(h, DC_CONFIRMATION_NONE), DC_STATUS_OK);
+        assert_eq!(last_init_error(), "");
+        assert_eq!(query(h, &colliding).1, DC_VERDICT_COLLISION);
+        assert_eq!(dc_table_confirmations(h), 2, "not confirmed once switched off");
+        assert_eq!(dc_set_table_confirmation(exact, DC_CONFIRMATION_NONE), DC_STATUS_OK, "exact mode: no effect");
+        assert_eq!(query(exact, &colliding).1, DC_VERDICT_COLLISION);
+        assert_eq!((dc_table_confirmations(exact), dc_table_confirmations(std::ptr::null())), (0, 0));
         dc_destroy(h);
         dc_destroy(exact);
     }
+    // The cell file's table_confirm, read by dc_init_from_files.
+    let dir = std::env::temp_dir().join(format!("dc-ffi-confirm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let table_path = dir.join("t1_k16.dct");
+    std::fs::write(&table_path, table_bytes("T1")).unwrap();
+    let t1 = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cells/t1.toml")).unwrap();
+    let table = format!("{}\0", table_path.display());
+    for (key, want_status, want_confirmations) in [
+        ("", DC_STATUS_OK, 1),
+        ("table_confirm = \"exact\"\n", DC_STATUS_OK, 1),
+        ("table_confirm = \"none\"\n", DC_STATUS_OK, 0),
+        ("table_confirm = \"sometimes\"\n", DC_STATUS_PARSE, 0),
+    ] {
+        let cell_path = dir.join("cell.toml");
+        std::fs::write(&cell_path, format!("{key}{t1}")).unwrap();
+        let cell = format!("{}\0", cell_path.display());
+        let mut h = std::ptr::null_mut();
+        // SAFETY: NUL-terminated paths, valid out pointer; the handle is live or NULL.
+        unsafe {
+            let s = dc_init_from_files(cell.as_ptr().cast(), table.as_ptr().cast(), &mut h);
+            assert_eq!(s, want_status, "{key:?}: {}", last_init_error());
+            if s == DC_STATUS_OK {
+                assert_eq!(query(h, &colliding).1, DC_VERDICT_COLLISION, "{key:?}");
+                assert_eq!(dc_table_confirmations(h), want_confirmations, "{key:?}");
+            } else {
+                assert!(last_init_error().contains("sometimes"), "{}", last_init_error());
+            }
+            dc_destroy(h);
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

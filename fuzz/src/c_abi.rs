@@ -46,7 +46,8 @@ pub enum Op {
     Query = 1,
     /// `dc_pair_results`: handle, capacity (byte * 2), NULL flags (byte: out, out_len).
     PairResults = 2,
-    /// `dc_robot_count`, `dc_pair_count`, `dc_mode`, `dc_table_fallbacks`: handle.
+    /// `dc_robot_count`, `dc_pair_count`, `dc_mode`, `dc_table_fallbacks`,
+    /// `dc_table_confirmations`, then `dc_set_table_confirmation`: handle.
     Counts = 3,
     /// `dc_delta3_inverse_kinematics`: edits (byte % 4) of the thesis geometry, point, NULL
     /// flags (byte: geometry, out_theta).
@@ -356,6 +357,20 @@ fn counts(input: &mut Input, live: &[Live]) {
     let expected_mode = if l.is_none() { DC_MODE_NONE } else { mode.clamp(DC_MODE_EXACT, DC_MODE_TABLE) };
     assert_eq!(mode, expected_mode, "dc_mode");
     assert!(mode == DC_MODE_TABLE || fallbacks == 0, "{fallbacks} table fallbacks in mode {mode}");
+    // Then switches the table confirmation by the counts seen so far (no input read), with a
+    // value that is no DcConfirmation one time in three.
+    // SAFETY: NULL or live.
+    let confirmations = unsafe { dc_table_confirmations(handle_of(l)) };
+    assert!(mode == DC_MODE_TABLE || confirmations == 0, "{confirmations} confirmations in mode {mode}");
+    let value = ((fallbacks + confirmations) % 3) as DcConfirmation;
+    // SAFETY: NULL or live.
+    let status = unsafe { dc_set_table_confirmation(handle_of(l), value) };
+    let expected = match (l, value) {
+        (None, _) => DC_STATUS_NULL_POINTER,
+        (_, DC_CONFIRMATION_EXACT | DC_CONFIRMATION_NONE) => DC_STATUS_OK,
+        _ => DC_STATUS_INVALID_ARGUMENT,
+    };
+    assert_eq!(status, expected, "dc_set_table_confirmation({value})");
 }
 
 /// The thesis geometry with up to three edits; also says whether it is unedited.

@@ -18,12 +18,14 @@
 //! ```
 //!
 //! The top-level `tick_ms` (default 1) and each robot's `stop` (SPEC §8; defaults in
-//! [`StopModel::DEFAULT`]) serve the protective verdict only.
+//! [`StopModel::DEFAULT`]) serve the protective verdict only; the top-level `table_confirm`
+//! (`"exact"`, the default, or `"none"`) serves table mode only ([`Confirmation`]).
 
 use crate::cell::placement::Placement;
 use crate::cell::{Cell, CellError, RobotSpec, SatMethod};
 use crate::math::{Real, Vec3};
 use crate::robot::{Delta3, ModelOptions, RobotModel, StopModel, ToolBox, DEFAULT_TICK_MS};
+use crate::table::Confirmation;
 use serde::Deserialize;
 
 #[derive(Deserialize)]
@@ -35,6 +37,8 @@ struct CellFile {
     method: Option<String>,
     #[serde(default)]
     tick_ms: Option<Real>,
+    #[serde(default)]
+    table_confirm: Option<String>,
     #[serde(rename = "robot")]
     robots: Vec<RobotFile>,
 }
@@ -152,13 +156,36 @@ fn tool_box(b: &BoxFile) -> ToolBox {
     ToolBox { offset: Vec3::from(b.offset), half: Vec3::from(b.half) }
 }
 
+/// What a cell file holds: the validated cell and the settings of table mode.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CellFileContents {
+    /// The cell.
+    pub cell: Cell,
+    /// `table_confirm`: what table mode does with a COLLISION lookup (default exact).
+    pub table_confirmation: Confirmation,
+}
+
 /// Parses a cell file's text into a validated [`Cell`].
 ///
 /// # Errors
-/// [`CellError::Parse`] for TOML or schema errors (with line and column), and the
-/// validation errors of [`Cell::new`].
+/// As [`parse_cell_file`].
 pub fn parse_cell(text: &str) -> Result<Cell, CellError> {
+    parse_cell_file(text).map(|f| f.cell)
+}
+
+/// Parses a cell file's text into a validated [`Cell`] and its table-mode settings.
+///
+/// # Errors
+/// [`CellError::Parse`] for TOML or schema errors (with line and column) and an unknown
+/// `table_confirm`, and the validation errors of [`Cell::new`].
+pub fn parse_cell_file(text: &str) -> Result<CellFileContents, CellError> {
     let file: CellFile = toml::from_str(text).map_err(|e| CellError::Parse(e.to_string()))?;
+    let table_confirmation = match file.table_confirm.as_deref() {
+        None => Confirmation::default(),
+        Some(name) => Confirmation::from_name(name).ok_or_else(|| {
+            CellError::Parse(format!("table_confirm = \"{name}\" is unknown; use \"exact\" or \"none\""))
+        })?,
+    };
     let method = match file.method.as_deref() {
         None | Some("sat-cache") => SatMethod::SatCache,
         Some("sat") => SatMethod::Sat,
@@ -203,8 +230,9 @@ pub fn parse_cell(text: &str) -> Result<Cell, CellError> {
             max_speed_mm_s: r.stop.max_speed_mm_s,
         })
         .collect();
-    Cell::new(file.name.unwrap_or_else(|| "unnamed".into()), robots, method)?
-        .with_stopping(file.tick_ms.unwrap_or(DEFAULT_TICK_MS), stops)
+    let cell = Cell::new(file.name.unwrap_or_else(|| "unnamed".into()), robots, method)?
+        .with_stopping(file.tick_ms.unwrap_or(DEFAULT_TICK_MS), stops)?;
+    Ok(CellFileContents { cell, table_confirmation })
 }
 
 #[cfg(test)]
@@ -242,5 +270,16 @@ mod tests {
         assert!(err("[[robot]]\nstop = { max_speed_mm_s = nan }\n").contains("max_speed_mm_s"));
         assert!(err("[[robot]]\nstop = { decel_mm_s2 = 200000.0 }\n").contains("max_accel_mm_s2"));
         assert!(err("tick_ms = 0.0\n[[robot]]\n").contains("tick_ms"));
+    }
+
+    #[test]
+    fn table_confirm_is_read_defaulted_and_checked() {
+        let confirm = |text: &str| parse_cell_file(text).map(|f| f.table_confirmation);
+        assert_eq!(confirm("[[robot]]\n"), Ok(Confirmation::Exact));
+        assert_eq!(confirm("table_confirm = \"exact\"\n[[robot]]\n"), Ok(Confirmation::Exact));
+        assert_eq!(confirm("table_confirm = \"none\"\n[[robot]]\n"), Ok(Confirmation::None));
+        let err = confirm("table_confirm = \"maybe\"\n[[robot]]\n").unwrap_err().to_string();
+        assert!(err.contains("maybe") && err.contains("\"none\""), "{err}");
+        assert!(confirm("table_confirm = true\n[[robot]]\n").is_err());
     }
 }

@@ -15,7 +15,7 @@ pub mod reference;
 pub mod trajectory;
 
 #[cfg(feature = "std")]
-pub use config::parse_cell;
+pub use config::{parse_cell, parse_cell_file, CellFileContents};
 pub use exact::{CellVerdict, ExactChecker, PairVerdict, QueryError};
 pub use placement::Placement;
 
@@ -175,10 +175,19 @@ impl Cell {
     /// Reads and validates a TOML cell file.
     ///
     /// # Errors
-    /// [`CellError::Io`] when the file cannot be read, [`CellError::Parse`] when it is not
-    /// UTF-8 text, else as [`parse_cell`].
+    /// As [`Cell::read_file`].
     #[cfg(feature = "std")]
     pub fn from_file(path: &std::path::Path) -> Result<Cell, CellError> {
+        Cell::read_file(path).map(|f| f.cell)
+    }
+
+    /// Reads and validates a TOML cell file, with its table-mode settings.
+    ///
+    /// # Errors
+    /// [`CellError::Io`] when the file cannot be read, [`CellError::Parse`] when it is not
+    /// UTF-8 text, else as [`parse_cell_file`].
+    #[cfg(feature = "std")]
+    pub fn read_file(path: &std::path::Path) -> Result<CellFileContents, CellError> {
         let bytes = std::fs::read(path).map_err(|e| CellError::Io(format!("{}: {e}", path.display())))?;
         // A file that was read but is not text is a parse error (not TOML), not an I/O error.
         let text = String::from_utf8(bytes).map_err(|e| {
@@ -188,7 +197,7 @@ impl Cell {
                 e.utf8_error().valid_up_to()
             ))
         })?;
-        parse_cell(&text)
+        parse_cell_file(&text)
     }
 
     /// A horizontal radius around robot `i`'s base axis that holds every point of every box

@@ -14,7 +14,7 @@ use crate::ffi::convert::{cell_error_status, table_error_status};
 use crate::ffi::types::*;
 use crate::math::Vec3;
 use crate::robot::StopModel;
-use crate::table::{TableAnswer, TableChecker};
+use crate::table::{Confirmation, TableAnswer, TableChecker};
 use std::path::Path;
 
 /// Why a collider could not be made: the status for C and a message naming the cause and
@@ -72,8 +72,9 @@ impl Collider {
     }
 
     /// A table-mode collider for the two-robot `cell` from a table file's bytes, validated
-    /// and copied here (the caller's buffer is not kept).
-    pub(crate) fn table(cell: Cell, bytes: &[u8]) -> Result<Collider, InitError> {
+    /// and copied here (the caller's buffer is not kept), answering a COLLISION lookup as
+    /// `confirmation` says.
+    pub(crate) fn table(cell: Cell, bytes: &[u8], confirmation: Confirmation) -> Result<Collider, InitError> {
         if cell.robots.len() != 2 {
             return Err(InitError::new(
                 DC_STATUS_TABLE_NOT_TWO_ROBOTS,
@@ -84,8 +85,8 @@ impl Collider {
             ));
         }
         let protective = protective_for(&cell);
-        let checker =
-            TableChecker::new(cell, bytes).map_err(|e| InitError::new(table_error_status(&e), e.to_string()))?;
+        let checker = TableChecker::with_confirmation(cell, bytes, confirmation)
+            .map_err(|e| InitError::new(table_error_status(&e), e.to_string()))?;
         Ok(Collider {
             checker: Checker::Table(Box::new(checker)),
             tcps: vec![Vec3::zeros(); 2],
@@ -95,13 +96,14 @@ impl Collider {
         })
     }
 
-    /// A table-mode collider from a TOML cell file and a table file, each read once, here.
+    /// A table-mode collider from a TOML cell file and a table file, each read once, here;
+    /// the cell file's `table_confirm` chooses the confirmation.
     pub(crate) fn from_files(cell_path: &Path, table_path: &Path) -> Result<Collider, InitError> {
-        let cell = Cell::from_file(cell_path).map_err(|e| InitError::new(cell_error_status(&e), e.to_string()))?;
+        let file = Cell::read_file(cell_path).map_err(|e| InitError::new(cell_error_status(&e), e.to_string()))?;
         let bytes = std::fs::read(table_path).map_err(|e| {
             InitError::new(DC_STATUS_IO, format!("cannot read table file {}: {e}", table_path.display()))
         })?;
-        Collider::table(cell, &bytes)
+        Collider::table(file.cell, &bytes, file.table_confirmation)
     }
 
     /// `DC_MODE_EXACT` or `DC_MODE_TABLE`.
@@ -132,6 +134,23 @@ impl Collider {
         match &self.checker {
             Checker::Exact(_) => 0,
             Checker::Table(t) => t.fallbacks(),
+        }
+    }
+
+    /// Table mode: queries so far whose lookup said COLLISION and were confirmed by the exact
+    /// check; 0 in exact mode.
+    pub(crate) fn table_confirmations(&self) -> u64 {
+        match &self.checker {
+            Checker::Exact(_) => 0,
+            Checker::Table(t) => t.confirmations(),
+        }
+    }
+
+    /// Table mode: chooses what a COLLISION lookup does from the next query on; exact mode
+    /// answers exactly whatever is chosen.
+    pub(crate) fn set_table_confirmation(&mut self, confirmation: Confirmation) {
+        if let Checker::Table(t) = &mut self.checker {
+            t.set_confirmation(confirmation);
         }
     }
 

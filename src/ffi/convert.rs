@@ -19,6 +19,15 @@ pub(crate) fn stop_config_default() -> DcStopConfig {
     }
 }
 
+/// The confirmation a C value names, or `None` for a value that names none.
+pub(crate) fn confirmation_from_c(c: DcConfirmation) -> Option<crate::table::Confirmation> {
+    match c {
+        DC_CONFIRMATION_EXACT => Some(crate::table::Confirmation::Exact),
+        DC_CONFIRMATION_NONE => Some(crate::table::Confirmation::None),
+        _ => None,
+    }
+}
+
 /// The status a cell error maps to.
 pub(crate) fn cell_error_status(e: &CellError) -> DcStatus {
     match e {

@@ -11,6 +11,9 @@
 //! - `dc_init*` allocate; `dc_query` never allocates, locks or does I/O.
 //! - Two modes behind one handle: exact (`dc_init`, `dc_init_from_cell_file`) and table
 //!   (`dc_init_with_table`, `dc_init_from_files`; two-robot cells); `dc_query` is the same.
+//! - Table mode confirms a COLLISION lookup by the exact check unless
+//!   `dc_set_table_confirmation` (or the cell file's `table_confirm`) says otherwise, so it
+//!   answers as exact mode; `dc_table_confirmations` counts those ticks.
 //! - A handle is used by one thread at a time; distinct handles are independent.
 #![allow(unsafe_code)]
 
@@ -173,8 +176,10 @@ pub unsafe extern "C" fn dc_init_from_cell_file(path: *const c_char, out_handle:
 /// Creates a table-mode checker (POU start-up) for the two-robot cell `config` from the bytes
 /// of a table file built offline for that cell (`delta-collide build --cell ...`): each
 /// query is then one table lookup (`dc_mode` gives `DC_MODE_TABLE`). The table never answers
-/// FREE where the exact model collides; it may answer COLLISION where the exact model is
-/// free (the price of a 1 ms-safe lookup).
+/// FREE where the exact model collides; where its lookup says COLLISION the exact check
+/// confirms it (`DC_CONFIRMATION_EXACT`, the default), so the verdicts are exact mode's;
+/// `dc_set_table_confirmation` with `DC_CONFIRMATION_NONE` answers the table's label instead
+/// (it may say COLLISION where the exact model is free).
 ///
 /// The buffer is validated once, here (magic, endianness, version, lengths, checksum, every
 /// index, and that it was built for this cell), and copied: the caller may free it as soon
@@ -202,14 +207,15 @@ pub unsafe extern "C" fn dc_init_with_table(
         }
         // SAFETY: non-null, and the caller guarantees `table_len` readable bytes.
         let bytes = unsafe { std::slice::from_raw_parts(table, table_len) };
-        Collider::table(cell, bytes)
+        Collider::table(cell, bytes, crate::table::Confirmation::Exact)
     };
     // SAFETY: the caller guarantees `out_handle` is NULL or writable.
     unsafe { init_handle(out_handle, make) }
 }
 
 /// Creates a table-mode checker from a TOML cell file and a table file, both read once,
-/// here: `dc_init_from_cell_file` followed by `dc_init_with_table` on the file's bytes.
+/// here: `dc_init_from_cell_file` followed by `dc_init_with_table` on the file's bytes. The
+/// cell file's `table_confirm = "exact"` (the default) or `"none"` sets the confirmation.
 ///
 /// `*out_handle` as for `dc_init`. Statuses: those of `dc_init_from_cell_file` (for either
 /// path; `DC_STATUS_IO` when a file cannot be read) and those of `dc_init_with_table`.
@@ -584,6 +590,53 @@ pub unsafe extern "C" fn dc_mode(handle: *const DcCollider) -> DcMode {
 pub unsafe extern "C" fn dc_table_fallbacks(handle: *const DcCollider) -> u64 {
     // SAFETY: the caller guarantees `handle` is NULL or live.
     unsafe { handle.as_ref() }.map_or(0, |h| h.inner.table_fallbacks())
+}
+
+/// Table mode: chooses what a query does when the table's lookup says COLLISION, from the
+/// next query on: `DC_CONFIRMATION_EXACT` (the default) runs the exact check and answers its
+/// verdict, so the handle answers as exact mode; `DC_CONFIRMATION_NONE` answers the table's
+/// label. Setup only, like `dc_set_stop_model`; the per-tick query still never allocates.
+/// On an exact-mode handle it changes nothing (exact mode always answers exactly).
+///
+/// Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_INVALID_ARGUMENT` (a value
+/// that is neither; the handle keeps its setting and `dc_last_init_error` says so),
+/// `DC_STATUS_PANIC` (a poisoned handle).
+///
+/// # Safety
+/// `handle` must be NULL or a live handle not used by another thread.
+#[no_mangle]
+pub unsafe extern "C" fn dc_set_table_confirmation(handle: *mut DcCollider, confirmation: DcConfirmation) -> DcStatus {
+    boundary(|| {
+        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
+        if h.poisoned {
+            return DC_STATUS_PANIC;
+        }
+        let (status, message) = match convert::confirmation_from_c(confirmation) {
+            Some(c) => {
+                h.inner.set_table_confirmation(c);
+                (DC_STATUS_OK, String::new())
+            }
+            None => (
+                DC_STATUS_INVALID_ARGUMENT,
+                format!("confirmation = {confirmation}: use DC_CONFIRMATION_EXACT or DC_CONFIRMATION_NONE"),
+            ),
+        };
+        let _ = LAST_INIT_ERROR.try_with(|m| *m.borrow_mut() = message);
+        status
+    })
+}
+
+/// Table mode: how many queries so far the table's lookup said COLLISION and the exact check
+/// confirmed or refuted it (`DC_CONFIRMATION_EXACT`); ticks answered by the exact fallback
+/// are counted by `dc_table_fallbacks` instead. 0 in exact mode and for NULL.
+///
+/// # Safety
+/// `handle` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn dc_table_confirmations(handle: *const DcCollider) -> u64 {
+    // SAFETY: the caller guarantees `handle` is NULL or live.
+    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.table_confirmations())
 }
 
 /// Number of robots of the handle's cell; 0 for NULL.

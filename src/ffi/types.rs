@@ -75,6 +75,15 @@ pub const DC_MODE_EXACT: DcMode = 1;
 /// table of a two-robot cell, which never answers FREE where the robots collide.
 pub const DC_MODE_TABLE: DcMode = 2;
 
+/// Table mode: what a query does when the table's lookup says COLLISION
+/// (`dc_set_table_confirmation`). A lookup's FREE is a proof and is answered as it is.
+pub type DcConfirmation = u32;
+/// Answer the table's label: COLLISION may come where the robots are a little apart.
+pub const DC_CONFIRMATION_NONE: DcConfirmation = 0;
+/// Confirm by the exact check and answer its verdict: table mode then answers as exact mode.
+/// The default of every new table-mode handle (a cell file may say `table_confirm = "none"`).
+pub const DC_CONFIRMATION_EXACT: DcConfirmation = 1;
+
 /// Plain separating axis test.
 pub const DC_METHOD_SAT: u32 = 0;
 /// Separating axis test with the two-layer witness cache (thesis 3.1.4).

@@ -4,7 +4,11 @@
 //! Per tick: each TCP is checked for reachability (inverse kinematics, no box model), mapped
 //! to its grid cell, and the 6-D cell is looked up. A reachable TCP outside the sampled grid
 //! has no table entry: that tick falls back to the exact check (counted in
-//! [`TableChecker::fallbacks`]), so the answer is never a guess. Nothing allocates per tick.
+//! [`TableChecker::fallbacks`]), so the answer is never a guess. A cell labelled COLLISION may
+//! hold free configurations (only FREE labels are proofs); with [`Confirmation::Exact`] such a
+//! tick is answered by the exact check (counted in [`TableChecker::confirmations`]), so table
+//! mode then answers as exact mode while a free cell costs one lookup. Nothing allocates per
+//! tick.
 
 use crate::cell::{Cell, ExactChecker, QueryError};
 use crate::cspace::symmetry::reflection_y;
@@ -19,12 +23,45 @@ use alloc::{format, string::String, vec, vec::Vec};
 /// The answer of one table-backed query.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TableAnswer {
-    /// The table proves the configuration free (or the exact fallback found it free).
+    /// The table proves the configuration free (or the exact check, a fallback or a
+    /// confirmation, found it free).
     Free,
-    /// The table stores the cell as collision (or the exact fallback found a collision).
+    /// The table stores the cell as collision (confirmed by the exact check with
+    /// [`Confirmation::Exact`]), or the exact fallback found a collision.
     Collision,
     /// Bit j set: robot j's TCP is unreachable or not finite.
     Unreachable(u32),
+}
+
+/// What table mode does when its lookup says COLLISION (the lookup's FREE is a proof and is
+/// answered as it is).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Confirmation {
+    /// Confirm by the exact check and answer its verdict: the same verdicts as exact mode, at
+    /// the exact check's cost on those ticks only. The default of C handles, cell files and
+    /// `check --table`.
+    #[default]
+    Exact,
+    /// Answer the table's label: COLLISION may come where the robots are a little apart.
+    None,
+}
+
+impl Confirmation {
+    /// Every setting, by its name in cell files and on the command line.
+    pub const ALL: [(&'static str, Confirmation); 2] = [("exact", Confirmation::Exact), ("none", Confirmation::None)];
+
+    /// The setting named `name` (`"exact"` or `"none"`).
+    pub fn from_name(name: &str) -> Option<Confirmation> {
+        Confirmation::ALL.iter().find(|(n, _)| *n == name).map(|&(_, c)| c)
+    }
+
+    /// Its name in cell files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Confirmation::Exact => "exact",
+            Confirmation::None => "none",
+        }
+    }
 }
 
 /// Refuses a table whose header disagrees with what the cell determines: the workspace its
@@ -92,16 +129,29 @@ pub struct TableChecker {
     query_r: f64,
     exact: ExactChecker,
     fallbacks: u64,
+    confirmation: Confirmation,
+    confirmations: u64,
 }
 
 impl TableChecker {
-    /// Loads `bytes` (a table file's content) for `cell`, validating it once.
+    /// Loads `bytes` (a table file's content) for `cell`, validating it once; the checker
+    /// answers the table's labels ([`Confirmation::None`]), as the table's evaluation needs:
+    /// [`TableChecker::with_confirmation`] chooses.
+    ///
+    /// # Errors
+    /// As [`TableChecker::with_confirmation`].
+    pub fn new(cell: Cell, bytes: &[u8]) -> Result<TableChecker, TableError> {
+        TableChecker::with_confirmation(cell, bytes, Confirmation::None)
+    }
+
+    /// Loads `bytes` (a table file's content) for `cell`, validating it once, answering a
+    /// COLLISION lookup as `confirmation` says.
     ///
     /// # Errors
     /// Every [`TableError`] of loading; [`TableError::WrongCell`] when the table was built for
     /// another cell; [`TableError::BadInput`] when the cell does not have two robots or the
     /// header's grid differs from the one its parameters define.
-    pub fn new(cell: Cell, bytes: &[u8]) -> Result<TableChecker, TableError> {
+    pub fn with_confirmation(cell: Cell, bytes: &[u8], confirmation: Confirmation) -> Result<TableChecker, TableError> {
         if cell.robots.len() != 2 {
             return Err(TableError::BadInput {
                 what: format!("tables serve two-robot cells; this one has {}", cell.robots.len()),
@@ -134,6 +184,8 @@ impl TableChecker {
             header,
             table,
             fallbacks: 0,
+            confirmation,
+            confirmations: 0,
         })
     }
 
@@ -150,6 +202,22 @@ impl TableChecker {
     /// How many queries so far fell back to the exact check (TCP outside the sampled grid).
     pub fn fallbacks(&self) -> u64 {
         self.fallbacks
+    }
+
+    /// How a COLLISION lookup is answered.
+    pub fn confirmation(&self) -> Confirmation {
+        self.confirmation
+    }
+
+    /// Chooses how a COLLISION lookup is answered from the next query on.
+    pub fn set_confirmation(&mut self, confirmation: Confirmation) {
+        self.confirmation = confirmation;
+    }
+
+    /// How many queries so far the table said COLLISION and the exact check was asked
+    /// ([`Confirmation::Exact`]); fallbacks are not counted here.
+    pub fn confirmations(&self) -> u64 {
+        self.confirmations
     }
 
     /// The cell of robot `j`'s TCP at the table's query resolution (`2^sub_levels` per grid
@@ -180,18 +248,31 @@ impl TableChecker {
         }
         match (self.cell_of(0, &tcps_mcs[0]), self.cell_of(1, &tcps_mcs[1])) {
             (Some(a), Some(b)) => {
-                let hit = self.table.query([a[0], a[1], a[2], b[0], b[1], b[2]]);
-                Ok(if hit { TableAnswer::Collision } else { TableAnswer::Free })
+                if !self.table.query([a[0], a[1], a[2], b[0], b[1], b[2]]) {
+                    return Ok(TableAnswer::Free);
+                }
+                match self.confirmation {
+                    Confirmation::None => Ok(TableAnswer::Collision),
+                    Confirmation::Exact => {
+                        self.confirmations += 1;
+                        self.exact_answer(tcps_mcs)
+                    }
+                }
             }
             _ => {
                 self.fallbacks += 1;
-                let v = self.exact.check(tcps_mcs)?;
-                Ok(match (v.unreachable_mask, v.collides()) {
-                    (0, true) => TableAnswer::Collision,
-                    (0, false) => TableAnswer::Free,
-                    (m, _) => TableAnswer::Unreachable(m),
-                })
+                self.exact_answer(tcps_mcs)
             }
         }
+    }
+
+    /// The exact check's verdict in the table's terms.
+    fn exact_answer(&mut self, tcps_mcs: &[Vec3]) -> Result<TableAnswer, QueryError> {
+        let v = self.exact.check(tcps_mcs)?;
+        Ok(match (v.unreachable_mask, v.collides()) {
+            (0, true) => TableAnswer::Collision,
+            (0, false) => TableAnswer::Free,
+            (m, _) => TableAnswer::Unreachable(m),
+        })
     }
 }

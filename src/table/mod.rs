@@ -45,7 +45,7 @@ pub use build::{build_table, build_tables, BuildError, BuildReport, Labelling, V
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
 pub use kind::{TableKind, UnknownTableKind};
-pub use lookup::{TableAnswer, TableChecker};
+pub use lookup::{Confirmation, TableAnswer, TableChecker};
 #[cfg(feature = "eval")]
 pub use quadtree4d::{subdivided_slices, SliceBound};
 pub use quadtree4d::{LinearQuadtree4d, SliceAxes};

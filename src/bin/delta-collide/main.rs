@@ -12,6 +12,7 @@
 
 mod args;
 mod clearance;
+mod confirm;
 mod demo;
 mod files;
 mod picture;
@@ -31,7 +32,9 @@ use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
-use delta_collide::table::{build_table, from_bytes, to_bytes, Labelling, Table, TableAnswer, TableChecker};
+use delta_collide::table::{
+    build_table, from_bytes, to_bytes, Confirmation, Labelling, Table, TableAnswer, TableChecker,
+};
 use std::io::{BufRead, Write};
 use std::path::Path;
 use std::time::Instant;
@@ -140,6 +143,9 @@ pub(crate) fn percentile(sorted: &[u64], p: f64) -> u64 {
 fn check(args: &CheckArgs) -> Result<(), Failure> {
     let cell = &args.cell;
     let mut table = args.table.as_deref().map(|p| load_table(cell, p)).transpose()?;
+    if let Some(t) = table.as_mut() {
+        t.set_confirmation(args.confirm.map_or(Confirmation::Exact, Confirmation::from));
+    }
     let mut input = open_input(args.input.as_deref())?;
     let clearance = args.clearance;
     let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut(), clearance);
@@ -443,5 +449,6 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
         ns.len(),
         table.fallbacks()
     );
+    confirm::report(cell, &table, SCENARIOS)?;
     Ok(())
 }
