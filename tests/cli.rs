@@ -780,3 +780,28 @@ fn check_with_a_table_confirmed_answers_row_for_row_as_check_without_one() {
     assert!(stderr(&out).contains("use exact or none"), "{}", stderr(&out));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `replay --stop-path-mm`: each robot's stop path is its recorded run ahead; the verdict is
+/// never worse than without paths, and on T1's practical run it STOPs on fewer ticks.
+#[test]
+fn replay_with_stop_paths_from_the_rows_ahead_stops_less() {
+    let rows = scenario_rows("T1", "practical", 3000);
+    let verdicts = |extra: &[&str]| -> Vec<String> {
+        let out = cli_stdin(&[&["replay", "--cell", "T1"][..], extra].concat(), &rows);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stdout(&out).lines().skip(1).map(|l| l.split(',').nth(1).unwrap().to_string()).collect()
+    };
+    let (without, with) = (verdicts(&[]), verdicts(&["--stop-path-mm", "400", "--path-tolerance-mm", "0.5"]));
+    assert_eq!(without.len(), with.len());
+    let rank = |v: &str| ["FREE", "WARN", "STOP"].iter().position(|x| *x == v).unwrap();
+    for (tick, (a, b)) in without.iter().zip(&with).enumerate() {
+        assert!(rank(b) <= rank(a), "tick {tick}: {b} with paths, {a} without");
+    }
+    let stops = |v: &[String]| v.iter().filter(|x| *x == "STOP").count();
+    assert!(stops(&with) < stops(&without), "{} STOP ticks with paths, {} without", stops(&with), stops(&without));
+    for bad in [["--stop-path-mm", "0"], ["--stop-path-mm", "nan"]] {
+        assert_eq!(cli(&[&["replay", "--cell", "T1"][..], &bad[..]].concat()).status.code(), Some(2), "{bad:?}");
+    }
+    let tolerance_alone = cli(&["replay", "--cell", "T1", "--path-tolerance-mm", "1"]);
+    assert_eq!(tolerance_alone.status.code(), Some(2), "--path-tolerance-mm needs --stop-path-mm");
+}

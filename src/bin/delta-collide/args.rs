@@ -178,6 +178,14 @@ pub struct ReplayArgs {
     /// WARN when a stop is proved with less than this to spare (mm)
     #[arg(long, value_name = "MM", default_value_t = 10.0)]
     pub warn_mm: f64,
+    /// Give each robot's stop path as the recorded rows ahead, this far along (mm): a
+    /// path-maintaining stop that follows the recorded path (SPEC 8) [default: no paths]
+    #[arg(long, value_name = "MM", value_parser = clipped(positive_mm))]
+    pub stop_path_mm: Option<f64>,
+    /// How far the TCP may leave its stop path (mm; only with --stop-path-mm)
+    #[arg(long, value_name = "MM", default_value_t = 0.5, requires = "stop_path_mm")]
+    #[arg(value_parser = clipped(non_negative_mm))]
+    pub path_tolerance_mm: f64,
     /// Also draw the clearance, each robot's protective distance and the verdict per tick
     /// into this PNG file
     #[arg(long, value_name = "FILE.png")]
@@ -631,6 +639,22 @@ fn parse_k(s: &str) -> Result<u32, String> {
     match s.trim().parse::<u32>() {
         Ok(k) if k >= 2 && k <= max && k.is_power_of_two() => Ok(k),
         _ => Err(fix),
+    }
+}
+
+/// A finite length above 0 (mm).
+fn positive_mm(s: &str) -> Result<f64, String> {
+    match parse_number::<f64>(s)? {
+        v if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err("expected a finite length above 0 mm".into()),
+    }
+}
+
+/// A finite length of at least 0 (mm).
+fn non_negative_mm(s: &str) -> Result<f64, String> {
+    match parse_number::<f64>(s)? {
+        v if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err("expected a finite length of at least 0 mm".into()),
     }
 }
 

@@ -6,7 +6,8 @@ use crate::args::ReplayArgs;
 use crate::clearance::signed_clearance;
 use crate::replay_plot::{draw_replay, ReplayTrace};
 use crate::{open_input, write_output, Failure};
-use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveStatus};
+use delta_collide::cell::protective::{path_through_samples, Protective, ProtectiveChecker, ProtectiveStatus, StopPath};
+use delta_collide::math::Vec3;
 use std::io::{BufRead, Write};
 
 pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
@@ -14,7 +15,8 @@ pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     let mut input = open_input(args.input.as_deref())?;
     let names = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
     let mut trace = args.plot.as_ref().map(|_| ReplayTrace::new(names));
-    write_output(args.output.as_deref(), |out| replay_rows(&mut input, out, &mut checker, trace.as_mut()))?;
+    let paths = args.stop_path_mm.map(|length_mm| PathsAhead { length_mm, tolerance_mm: args.path_tolerance_mm });
+    write_output(args.output.as_deref(), |out| replay_rows(&mut input, out, &mut checker, paths, trace.as_mut()))?;
     if let (Some(path), Some(trace)) = (&args.plot, &trace) {
         let source = args.input.as_ref().map_or("stdin".to_string(), |p| p.display().to_string());
         let title = format!(
@@ -29,8 +31,18 @@ pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Replays every row of `input` (one tick each) and writes one line per tick on `out`;
-/// records each tick into `trace` when given.
+/// Each robot's stop path taken from the recorded rows ahead (`replay --stop-path-mm`).
+#[derive(Clone, Copy)]
+struct PathsAhead {
+    length_mm: f64,
+    tolerance_mm: f64,
+}
+
+/// Most points of a stop path (the C ABI's `DC_MAX_PATH_POINTS`).
+const PATH_POINTS: usize = delta_collide::ffi::DC_MAX_PATH_POINTS;
+
+/// Replays every row of `input` (one tick each) and writes one line per tick on `out`, with
+/// stop paths from the rows ahead when `paths` is given; records each tick into `trace`.
 ///
 /// # Errors
 /// A row that is not `3 n` numbers (naming its line; the first line may be a header), or a
@@ -39,6 +51,7 @@ fn replay_rows(
     input: &mut dyn BufRead,
     out: &mut dyn Write,
     checker: &mut ProtectiveChecker,
+    paths: Option<PathsAhead>,
     mut trace: Option<&mut ReplayTrace>,
 ) -> Result<(), String> {
     let names: Vec<String> = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
@@ -47,9 +60,32 @@ fn replay_rows(
     let columns = |prefix: &str| names.iter().map(|r| format!(",{prefix}_{r}")).collect::<String>();
     writeln!(out, "tick,verdict,status,clearance_mm{}{}", columns("protective_mm"), columns("speed_limit_mm_s"))
         .map_err(write_err)?;
-    let mut tick = 0u64;
-    crate::rows::for_each_row(input, n, |line_no, tcps| {
-        checker.check(tcps).map_err(|e| format!("line {line_no}: {e}"))?;
+    let mut rows: Vec<Vec<Vec3>> = Vec::new();
+    crate::rows::for_each_row(input, n, |_, tcps| {
+        rows.push(tcps.to_vec());
+        Ok(())
+    })?;
+    let mut points = vec![[Vec3::zeros(); PATH_POINTS]; n];
+    for (tick, tcps) in rows.iter().enumerate() {
+        match paths {
+            None => checker.check(tcps),
+            Some(p) => {
+                // Robot j's samples ahead: its TCP in this row and the rows that follow.
+                let lens: Vec<Option<usize>> = (0..n)
+                    .map(|j| {
+                        let ahead: Vec<Vec3> = rows[tick..].iter().map(|r| r[j]).collect();
+                        path_through_samples(&ahead, p.length_mm, p.tolerance_mm, &mut points[j])
+                    })
+                    .collect();
+                let stop_paths: Vec<Option<StopPath>> = lens
+                    .iter()
+                    .zip(&points)
+                    .map(|(len, pts)| len.map(|len| StopPath { points: &pts[..len], tolerance_mm: p.tolerance_mm }))
+                    .collect();
+                checker.check_with_paths(tcps, &stop_paths)
+            }
+        }
+        .map_err(|e| format!("row {tick}: {e}"))?;
         let r = checker.report();
         if let Some(t) = trace.as_deref_mut() {
             // The exact check under the verdict ran only when the status is OK.
@@ -72,7 +108,6 @@ fn replay_rows(
         r.robots.iter().for_each(|x| row += &format!(",{:.3}", x.protective_mm));
         r.robots.iter().for_each(|x| row += &format!(",{:.1}", x.speed_limit_mm_s));
         writeln!(out, "{row}").map_err(write_err)?;
-        tick += 1;
-        Ok(())
-    })
+    }
+    Ok(())
 }

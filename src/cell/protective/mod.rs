@@ -81,7 +81,7 @@ use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
 use alloc::sync::Arc;
 
 mod path;
-pub use path::StopPath;
+pub use path::{path_through_samples, StopPath};
 
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`SPLITS^3` per
 /// arm). The cubes here are tens to hundreds of mm, where finer splits shrink the sweeps by

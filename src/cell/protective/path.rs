@@ -133,6 +133,35 @@ pub fn path_is_valid(path: &StopPath, tcp: &Vec3) -> bool {
         && distance_to(path.points, tcp) <= path.tolerance_mm * (1.0 + 1e-9) + 1e-9
 }
 
+/// A stop path of at most `out.len()` points through sampled TCPs ahead, for a controller
+/// (or a replay) that knows its commanded path only as samples: `samples[0]` is the TCP now,
+/// the rest the commanded TCPs that follow. Greedy: each segment runs from its start sample
+/// as far as every sample in between stays within `tolerance_mm` of it; the path ends at the
+/// first sample at least `length_mm` along it (or the last sample, where the robot holds).
+/// Returns the number of points written, or `None` when `out` is too short for that: a path
+/// cut short would break its promise.
+pub fn path_through_samples(samples: &[Vec3], length_mm: Real, tolerance_mm: Real, out: &mut [Vec3]) -> Option<usize> {
+    *out.first_mut()? = *samples.first()?;
+    let (mut n, mut start, mut arc) = (1, 0, 0.0);
+    for i in 1..samples.len() {
+        arc += (samples[i] - samples[i - 1]).norm();
+        let last = arc >= length_mm || i + 1 == samples.len();
+        // Does the segment from `samples[start]` to the next sample hold every sample between?
+        let extend = !last && {
+            let chord = [samples[start], samples[i + 1]];
+            samples[start + 1..=i].iter().all(|p| distance_to(&chord, p) <= tolerance_mm)
+        };
+        if !extend {
+            *out.get_mut(n)? = samples[i];
+            (n, start) = (n + 1, i);
+            if last {
+                break;
+            }
+        }
+    }
+    Some(n)
+}
+
 /// One piece of a robot's stop: the ball holding its TCPs, its boxes at the ball's centre and
 /// their sweeps over the ball.
 struct Piece {
@@ -292,6 +321,27 @@ mod tests {
                 assert!((p - c).norm() + 2.0 <= r, "range {a}..{b}: {p:?} outside ({c:?}, {r})");
             }
         }
+    }
+
+    #[test]
+    fn a_path_through_samples_holds_every_sample_and_reaches_the_length() {
+        // Samples along an L: 100 mm along x, then 100 mm along y, every 1 mm.
+        let samples: Vec<Vec3> = (0..=200)
+            .map(|i| if i <= 100 { v(i as Real, 0.0, 0.0) } else { v(100.0, (i - 100) as Real, 0.0) })
+            .collect();
+        let mut out = [Vec3::zeros(); 8];
+        let n = path_through_samples(&samples, 150.0, 0.5, &mut out).unwrap();
+        let path = &out[..n];
+        assert!(n <= 4, "a corner needs three points: {path:?}");
+        // Every sample up to 150 mm along lies within the tolerance of the path.
+        for p in &samples[..=150] {
+            assert!(distance_to(path, p) <= 0.5, "{p:?} is off {path:?}");
+        }
+        assert!(length(path) >= 150.0 - 1e-9);
+        // Too few points for the corner: no path rather than a short one.
+        assert_eq!(path_through_samples(&samples, 150.0, 0.5, &mut out[..2]), None);
+        // A path that ends: the robot holds its last sample.
+        assert_eq!(path_through_samples(&samples[..50], 150.0, 0.5, &mut out), Some(2));
     }
 
     #[test]
