@@ -370,15 +370,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
         }
     }
     let sections = [r.take(lens[0], names[0])?, r.take(lens[1], names[1])?, r.take(lens[2], names[2])?];
-    let body_end = r.pos();
-    let stored = r.u64("checksum")?;
-    if r.pos() != bytes.len() {
-        return Err(corrupt(format!("{} trailing bytes after the checksum", bytes.len() - r.pos())));
-    }
-    let computed = fnv1a64(&bytes[..body_end]);
-    if stored != computed {
-        return Err(corrupt(format!("checksum = {stored:#018x}, the bytes give {computed:#018x}")));
-    }
+    r.checksum()?;
     let codes = words(sections[0], u64::from_le_bytes);
     let aux = words(sections[1], u32::from_le_bytes);
     if shape.symmetric {

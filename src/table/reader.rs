@@ -66,6 +66,21 @@ impl<'a, E: ReadError> Reader<'a, E> {
         Ok([self.f64(what)?, self.f64(what)?, self.f64(what)?])
     }
 
+    /// The FNV-1a checksum that ends the file: it must be the last 8 bytes and match every
+    /// byte before it.
+    pub(crate) fn checksum(&mut self) -> Result<(), E> {
+        let body_end = self.pos;
+        let stored = self.u64("checksum")?;
+        if self.pos != self.buf.len() {
+            return Err(E::corrupt(format!("{} trailing bytes after the checksum", self.buf.len() - self.pos)));
+        }
+        let computed = crate::cell::fnv1a64(&self.buf[..body_end]);
+        if stored != computed {
+            return Err(E::corrupt(format!("checksum = {stored:#018x}, the bytes give {computed:#018x}")));
+        }
+        Ok(())
+    }
+
     /// `n` items of `size` bytes each.
     pub(crate) fn items(&mut self, n: usize, size: usize, what: &'static str) -> Result<&'a [u8], E> {
         let len = n.checked_mul(size).ok_or_else(|| E::corrupt(format!("{what}: {n} entries overflow")))?;

@@ -261,15 +261,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     let pairs = rows.checked_mul(nb).ok_or_else(|| corrupt("rows x samples of B overflows"))?;
     let labels = r.take(pairs.div_ceil(4), "labels")?;
     let sub = r.items(m, 24, "sub-cells")?;
-    let body_end = r.pos();
-    let stored = r.u64("checksum")?;
-    if r.pos() != bytes.len() {
-        return Err(corrupt(format!("{} trailing bytes after the checksum", bytes.len() - r.pos())));
-    }
-    let computed = fnv1a64(&bytes[..body_end]);
-    if stored != computed {
-        return Err(corrupt(format!("checksum = {stored:#018x}, the bytes give {computed:#018x}")));
-    }
+    r.checksum()?;
     check_labels(labels, pairs)?;
     check_sub_cells(sub, shard, na, nb)?;
     let workspace = Workspace { zu: ws[0], hcy: ws[1], rcy: ws[2], hco: ws[3], rco: ws[4] };
