@@ -65,6 +65,9 @@ fn replay_rows(
         rows.push(tcps.to_vec());
         Ok(())
     })?;
+    // Per robot, its TCPs tick by tick: the samples ahead of a tick are a slice of these.
+    let runs: Vec<Vec<Vec3>> =
+        if paths.is_some() { (0..n).map(|j| rows.iter().map(|r| r[j]).collect()).collect() } else { Vec::new() };
     let mut points = vec![[Vec3::zeros(); PATH_POINTS]; n];
     for (tick, tcps) in rows.iter().enumerate() {
         match paths {
@@ -72,10 +75,7 @@ fn replay_rows(
             Some(p) => {
                 // Robot j's samples ahead: its TCP in this row and the rows that follow.
                 let lens: Vec<Option<usize>> = (0..n)
-                    .map(|j| {
-                        let ahead: Vec<Vec3> = rows[tick..].iter().map(|r| r[j]).collect();
-                        path_through_samples(&ahead, p.length_mm, p.tolerance_mm, &mut points[j])
-                    })
+                    .map(|j| path_through_samples(&runs[j][tick..], p.length_mm, p.tolerance_mm, &mut points[j]))
                     .collect();
                 let stop_paths: Vec<Option<StopPath>> = lens
                     .iter()
