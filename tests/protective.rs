@@ -246,6 +246,47 @@ fn free_verdicts_of_the_table_tier_survive_simulated_stops_near_the_reach_bounda
     assert!(total >= 60 && edge_total >= 20, "too few FREE states to test: {total}, {edge_total} near the edge");
 }
 
+/// FREE by a proof kept from an earlier tick (or made for wider balls) survives simulated
+/// stops: the runs of the C harness (practical and collision, T1-T3, both models) replayed
+/// tick by tick; at every third kept-proof FREE tick, random stops from the true velocity (the
+/// finite difference moved within `a_max T`).
+#[test]
+fn free_verdicts_of_kept_proofs_survive_simulated_stops() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let mut rng = StdRng::seed_from_u64(7);
+    let (mut kept_total, mut tested) = (0, 0);
+    for s in parse_scenarios(&text).unwrap() {
+        for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
+            let cell = cell(&s.cell, stop);
+            let tick = cell.tick_ms * 1e-3;
+            let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let (mut tcps, mut prev) = ([Vec3::zeros(); 2], [Vec3::zeros(); 2]);
+            let mut kept = 0;
+            for t in 0..RUN_TICKS {
+                s.tcps_at(t, &mut tcps);
+                let r = checker.check(&tcps).unwrap();
+                if r.kept_proof {
+                    assert_eq!(r.verdict, Protective::Free);
+                    kept += 1;
+                    if kept % 3 == 0 {
+                        let vel = std::array::from_fn(|j| {
+                            let w = (tcps[j] - prev[j]) / tick + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
+                            w * (stop.max_speed_mm_s / w.norm()).min(1.0)
+                        });
+                        assert_stops_never_touch(&cell, &tcps, &vel, 4, &mut rng);
+                        tested += 1;
+                    }
+                }
+                prev = tcps;
+            }
+            println!("{} {} model {k}: {kept} ticks FREE by a kept proof", s.cell, s.case);
+            kept_total += kept;
+        }
+    }
+    println!("{tested} kept-proof ticks checked with 4 simulated stops each");
+    assert!(kept_total >= 10_000, "too few kept proofs to test: {kept_total}");
+}
+
 fn verdict_rank(v: Protective) -> u8 {
     match v {
         Protective::Free => 0,

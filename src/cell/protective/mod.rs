@@ -66,6 +66,10 @@
 //! both tiers ([`ProtectiveChecker::with_precise_limits`] for that one: both tiers, the
 //! second only above the first's limit and below the speed where step 6 already fails).
 //!
+//! **Kept proofs** (`protective/kept.rs`): a FREE proof made for stop balls that hold this
+//! tick's balls covers this tick too, so FREE ticks that follow FREE ticks mostly reuse one
+//! instead of computing sweeps ([`ProtectiveReport::kept_proof`]).
+//!
 //! Nothing here allocates after [`ProtectiveChecker::new`].
 
 use crate::cell::exact::PairVerdict;
@@ -80,7 +84,9 @@ use crate::robot::motor_table::{intersect, MotorTable};
 use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
 use alloc::sync::Arc;
 
+mod kept;
 mod path;
+pub use kept::{KEPT_MARGIN_MM, KEPT_WIDEN};
 pub use path::{path_through_samples, StopPath};
 
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`SPLITS^3` per
@@ -186,6 +192,9 @@ pub struct ProtectiveReport {
     pub limiting: Option<BoxPair>,
     /// One entry per robot.
     pub robots: alloc::vec::Vec<RobotProtection>,
+    /// Whether the verdict is FREE by a proof kept from an earlier tick or made for balls
+    /// wider than this tick's (`protective/kept.rs`) rather than by this tick's own proof.
+    pub kept_proof: bool,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -229,6 +238,8 @@ pub struct ProtectiveChecker {
     sweep_tier: alloc::vec::Vec<Option<(u32, u8)>>,
     /// Face terms of no box (fills the unused entries of a box list).
     no_faces: FaceTerms,
+    /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
+    kept: kept::Kept,
     report: ProtectiveReport,
 }
 
@@ -270,8 +281,10 @@ impl ProtectiveChecker {
         }
         let unit = Obb::new(Vec3::zeros(), crate::math::Mat3::identity(), Vec3::repeat(1.0));
         let no_faces = FaceTerms::new(&unit, &Sweep::ZERO);
+        let exact = ExactChecker::new(cell);
+        let kept = kept::Kept::new(n, exact.verdict().pairs.len());
         Ok(ProtectiveChecker {
-            exact: ExactChecker::new(cell),
+            exact,
             warn_mm,
             history: alloc::vec![NO_HISTORY; n],
             sweeps: alloc::vec![[[Sweep::ZERO; MAX_BOXES]; 2]; n],
@@ -286,6 +299,7 @@ impl ProtectiveChecker {
             reach: alloc::vec![0.0; n],
             sweep_tier: alloc::vec![None; n],
             no_faces,
+            kept,
             report: ProtectiveReport {
                 verdict: Protective::Stop,
                 status: ProtectiveStatus::Ok,
@@ -293,6 +307,7 @@ impl ProtectiveChecker {
                 closest: None,
                 limiting: None,
                 robots: alloc::vec![RobotProtection::UNKNOWN; n],
+                kept_proof: false,
             },
         })
     }
@@ -461,9 +476,10 @@ impl ProtectiveChecker {
     /// Fills the report from the TCPs and the measured speeds already in `report.robots`;
     /// with `from_history`, each speed limit's search starts at the last tick's limit.
     fn evaluate(&mut self, tcps_mcs: &[Vec3], status: ProtectiveStatus, from_history: bool) {
+        let was_free = self.report.verdict == Protective::Free;
         let report = &mut self.report;
         (report.verdict, report.status, report.clearance_mm) = (Protective::Stop, status, Real::NAN);
-        (report.closest, report.limiting) = (None, None);
+        (report.closest, report.limiting, report.kept_proof) = (None, None, false);
         if status != ProtectiveStatus::Ok {
             return;
         }
@@ -476,17 +492,34 @@ impl ProtectiveChecker {
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let v = self.report.robots[j].speed_mm_s;
-            let s = self.stop_reference(j, tcp, v);
+            let (s, ball) = self.stop_ball(j, tcp, v);
+            self.kept.set_inside(j, &[ball, (*tcp, s)]);
             let bound = self.speed_bound(j, v);
             let r = &mut self.report.robots[j];
             (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
         }
+        let kept = self.kept_free(None);
+        if kept && !self.speed_limits {
+            (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
+            self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
+            return;
+        }
+        for (j, tcp) in tcps_mcs.iter().enumerate() {
+            self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
+        }
         let n = tcps_mcs.len();
-        if let Some(pair) = self.certain_stop(None) {
+        if kept {
+            (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
+        } else if let Some(pair) = self.certain_stop(None) {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
+        } else if was_free && self.keep_and_prove() {
+            (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else {
             (0..n).for_each(|j| self.sweeps_at(j, 0, 0));
             (self.report.verdict, self.report.limiting) = self.prove();
+            if self.report.verdict == Protective::Free {
+                self.keep_references();
+            }
             // Tier 2, arm by arm: a box's sweep depends on its own arm's angles only, so the
             // arms of the limiting pair are refined until it is proved or both are refined
             // (then the full tier 2 fails on it too: the same verdict and limiting pair, as a
@@ -543,16 +576,23 @@ impl ProtectiveChecker {
         }
     }
 
-    /// Sets robot `j`'s reference boxes, the centre and radius of the ball that holds its TCP
-    /// over the stop (module doc, step 3) for TCP `tcp_mcs` at measured speed `v`, and marks its
-    /// sweeps as not computed; returns `S`.
-    fn stop_reference(&mut self, j: usize, tcp_mcs: &Vec3, v: Real) -> Real {
+    /// `S` of robot `j` for TCP `tcp_mcs` at measured speed `v`, and the ball (centre MCS,
+    /// radius) that holds its TCP over the stop (module doc, step 3), its centre not
+    /// necessarily reachable.
+    fn stop_ball(&self, j: usize, tcp_mcs: &Vec3, v: Real) -> (Real, (Vec3, Real)) {
         let cell = self.exact.cell();
         let stop = cell.stops[j];
         let reaction_s = (stop.reaction_ms + cell.tick_ms) * 1e-3;
         let s = stop.stopping_distance(self.speed_bound(j, v), reaction_s);
-        let (centre, radius) = capsule_ball(&stop, cell.tick_ms * 1e-3, reaction_s, tcp_mcs, &self.velocity[j], v, s);
-        let robot = &cell.robots[j];
+        (s, capsule_ball(&stop, cell.tick_ms * 1e-3, reaction_s, tcp_mcs, &self.velocity[j], v, s))
+    }
+
+    /// Sets robot `j`'s reference boxes, the centre and radius of the ball that holds its TCP
+    /// over the stop (module doc, step 3) for TCP `tcp_mcs` at measured speed `v`, and marks its
+    /// sweeps as not computed; returns `S`.
+    fn stop_reference(&mut self, j: usize, tcp_mcs: &Vec3, v: Real) -> Real {
+        let (s, (centre, radius)) = self.stop_ball(j, tcp_mcs, v);
+        let robot = &self.exact.cell().robots[j];
         let (rot, t) = (robot.placement.rotation(), robot.placement.t);
         let (centre, radius) = match robot.model.boxes_into(&centre, &mut self.ref_boxes[j]) {
             Ok(()) if centre != *tcp_mcs => (centre, radius),
@@ -626,9 +666,13 @@ impl ProtectiveChecker {
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are.
     fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3, start: Option<Real>) -> Real {
         let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]);
+        let inside = self.kept.inside(j);
         // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
         let proved = |me: &mut Self, v: Real, tier: Option<u32>| {
-            me.stop_reference(j, tcp_mcs, v);
+            let s = me.stop_reference(j, tcp_mcs, v);
+            if me.kept.set_inside(j, &[(me.centres[j], me.reach[j]), (*tcp_mcs, s)]) && me.kept_free(Some(j)) {
+                return true;
+            }
             if me.certain_stop(Some(j)).is_some() {
                 return false;
             }
@@ -706,6 +750,7 @@ impl ProtectiveChecker {
             }
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
+        self.kept.restore_inside(j, inside);
         limit
     }
 }
@@ -844,7 +889,7 @@ fn first_unproved<'a>(
 }
 
 /// One robot's boxes, their sweeps, and the face terms of each box under each sweep form.
-type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MAX_BOXES]; 2]);
+pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MAX_BOXES]; 2]);
 
 /// The first box pair `(i, k)` of two robots' swept boxes not proved apart with `extra` mm
 /// added to the first robot's sweeps, any combination of sweep forms allowed.

@@ -1,0 +1,206 @@
+//! FREE proofs kept from tick to tick: a robot moves a few millimetres per tick while its stop
+//! ball is tens to hundreds of millimetres across, so a proof made for a larger ball keeps
+//! covering the stops of the ticks that follow.
+//!
+//! # Why a kept proof still proves
+//! The sweeps of a ball `B(c0, R0)` bound the boxes of every reachable TCP of that ball
+//! (module doc of `protective`, step 4), and the swept-box test proves two such sets apart
+//! with `warn_mm` to spare. When this tick's stop ball `B(c, R)` lies inside `B(c0, R0)`,
+//! that is `|c - c0| + R <= R0`, every TCP of this tick's stop is a TCP of the kept ball, so
+//! its boxes lie in the kept swept sets: when every robot's stop ball lies in its kept ball
+//! and every pair that can meet was proved for those kept balls, the tick is FREE. Either
+//! ball of step 3 may be tested (the capsule's ball or the ball of radius `S` around the TCP):
+//! each holds every TCP of the stop.
+//!
+//! # When a ball is kept
+//! - When the full proof proves FREE with the table's tier alone, every robot keeps the ball
+//!   and sweeps of that proof (nothing more to compute; they cover later stops that lie
+//!   inside, as when the robot stands or slows down).
+//! - On the tick after a FREE tick, a robot whose stop ball has left its kept ball gets a
+//!   wider one: its stop ball widened by [`KEPT_WIDEN`] and [`KEPT_MARGIN_MM`], with the
+//!   table's tier of sweeps, so that the ticks that follow at speed stay inside. Each pair is
+//!   proved once per pair of kept balls (a generation number per ball). Where the wider balls
+//!   are not proved apart (robots close for their speed), the tick takes the full proof, and
+//!   wider balls are not tried again for [`KEPT_BACKOFF`] ticks.
+//!
+//! Keeping turns no verdict of the full proof into a worse one: it only adds a way to FREE.
+
+use super::{first_unproved_between, stop_sweeps_wcs, ProtectiveChecker, SweepForms};
+use crate::geometry::sweep::FaceTerms;
+use crate::math::{Real, Vec3};
+use crate::robot::{RobotBoxes, MAX_BOXES};
+
+/// A kept ball's radius is the stop ball's times `1 + KEPT_WIDEN`, plus [`KEPT_MARGIN_MM`].
+pub const KEPT_WIDEN: Real = 0.1;
+
+/// The part of a kept ball's widening that does not scale with the stop ball (mm): about
+/// two ticks at the fastest reference speed.
+pub const KEPT_MARGIN_MM: Real = 3.0;
+
+/// Ticks without trying wider balls after they failed to prove a pair.
+pub const KEPT_BACKOFF: u32 = 16;
+
+/// A robot's kept ball: where its sweeps were measured from, and the sweeps.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct KeptBall {
+    /// Centre (MCS) and radius of the ball.
+    centre: Vec3,
+    radius: Real,
+    /// The robot's boxes (WCS) at the centre, their sweeps over the ball, and face terms.
+    boxes: RobotBoxes,
+    sweeps: SweepForms,
+    faces: [[FaceTerms; MAX_BOXES]; 2],
+    /// Tells this ball from the robot's earlier ones.
+    generation: u64,
+}
+
+impl KeptBall {
+    /// The boxes, sweeps and face terms, as the swept-box proof reads them.
+    fn swept(&self) -> super::SweptBoxes<'_> {
+        (self.boxes.as_slice(), &self.sweeps, &self.faces)
+    }
+}
+
+/// What is kept: per robot its ball and whether this tick's stop lies in it, per pair that
+/// can meet the generations it was proved for and whether it was proved FREE.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Kept {
+    balls: alloc::vec::Vec<Option<KeptBall>>,
+    inside: alloc::vec::Vec<bool>,
+    pairs: alloc::vec::Vec<Option<(u64, u64, bool)>>,
+    next_generation: u64,
+    /// Ticks left before wider balls are tried again.
+    backoff: u32,
+}
+
+impl Kept {
+    /// Nothing kept yet, for `robots` robots and `pairs` pairs that can meet.
+    pub(super) fn new(robots: usize, pairs: usize) -> Self {
+        Kept {
+            balls: alloc::vec![None; robots],
+            inside: alloc::vec![false; robots],
+            pairs: alloc::vec![None; pairs],
+            next_generation: 0,
+            backoff: 0,
+        }
+    }
+
+    /// Records whether robot `j`'s stop, held by each of `balls` (centre MCS, radius), lies
+    /// in its kept ball; returns that.
+    pub(super) fn set_inside(&mut self, j: usize, balls: &[(Vec3, Real)]) -> bool {
+        let inside = self.balls[j]
+            .as_ref()
+            .is_some_and(|k| balls.iter().any(|(c, r)| r.is_finite() && (c - k.centre).norm() + r <= k.radius));
+        self.inside[j] = inside;
+        inside
+    }
+
+    /// Whether robot `j`'s stop lay in its kept ball at the last [`Kept::set_inside`].
+    pub(super) fn inside(&self, j: usize) -> bool {
+        self.inside[j]
+    }
+
+    /// Sets back what [`Kept::inside`] returned for robot `j`.
+    pub(super) fn restore_inside(&mut self, j: usize, inside: bool) {
+        self.inside[j] = inside;
+    }
+
+    /// Whether every robot of pair `k` = `(a, b)` is inside its kept ball and the pair was
+    /// proved FREE for those balls.
+    fn pair_free(&self, k: usize, a: usize, b: usize) -> bool {
+        match (&self.balls[a], &self.balls[b], self.pairs[k]) {
+            (Some(ka), Some(kb), Some((ga, gb, free))) => {
+                free && self.inside[a] && self.inside[b] && (ga, gb) == (ka.generation, kb.generation)
+            }
+            _ => false,
+        }
+    }
+}
+
+impl ProtectiveChecker {
+    /// Whether the kept proofs cover every pair that can meet (of the pairs involving `only`,
+    /// or of all), as of the last [`Kept::set_inside`] of each robot.
+    pub(super) fn kept_free(&self, only: Option<usize>) -> bool {
+        let pairs = &self.exact.verdict().pairs;
+        pairs
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| only.is_none_or(|j| p.a == j || p.b == j))
+            .all(|(k, p)| self.kept.pair_free(k, p.a, p.b))
+    }
+
+    /// After the references of this tick are set (`centres`, `reach`, `ref_boxes`): gives
+    /// every robot outside its kept ball a wider one, proves the pairs not yet proved for
+    /// their balls, and returns whether all pairs now are (module doc). `false` at once
+    /// while backing off.
+    pub(super) fn keep_and_prove(&mut self) -> bool {
+        if self.kept.backoff > 0 {
+            self.kept.backoff -= 1;
+            return false;
+        }
+        for j in 0..self.kept.balls.len() {
+            if !self.kept.inside[j] {
+                self.keep_wider(j);
+            }
+        }
+        let extra = self.warn_mm;
+        let pairs = &self.exact.verdict().pairs;
+        for (k, p) in pairs.iter().enumerate() {
+            let (Some(ka), Some(kb)) = (&self.kept.balls[p.a], &self.kept.balls[p.b]) else { continue };
+            if self.kept.pairs[k].is_some_and(|(ga, gb, _)| (ga, gb) == (ka.generation, kb.generation)) {
+                continue;
+            }
+            let free = first_unproved_between(ka.swept(), kb.swept(), extra).is_none();
+            self.kept.pairs[k] = Some((ka.generation, kb.generation, free));
+        }
+        let free = self.kept_free(None);
+        if !free {
+            self.kept.backoff = KEPT_BACKOFF;
+        }
+        free
+    }
+
+    /// After the full proof proved every pair FREE with every robot's sweeps of the table's
+    /// tier about its reference: keeps those balls and marks every pair proved for them.
+    pub(super) fn keep_references(&mut self) {
+        for j in 0..self.kept.balls.len() {
+            debug_assert_eq!(self.sweep_tier[j], Some((0, 0)));
+            let ball = (self.centres[j], self.reach[j], self.sweeps[j], self.faces[j]);
+            self.keep(j, ball);
+        }
+        let balls = &self.kept.balls;
+        let pairs = &self.exact.verdict().pairs;
+        for (slot, p) in self.kept.pairs.iter_mut().zip(pairs) {
+            *slot = balls[p.a].as_ref().zip(balls[p.b].as_ref()).map(|(a, b)| (a.generation, b.generation, true));
+        }
+    }
+
+    /// A wider kept ball for robot `j` around its reference centre (module doc).
+    fn keep_wider(&mut self, j: usize) {
+        let robot = &self.exact.cell().robots[j];
+        let (centre, radius) = (self.centres[j], self.reach[j] * (1.0 + KEPT_WIDEN) + KEPT_MARGIN_MM);
+        let rot = robot.placement.rotation();
+        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref(), 0, 0);
+        let faces = core::array::from_fn(|form| {
+            core::array::from_fn(|k| match self.ref_boxes[j].as_slice().get(k) {
+                Some(b) => FaceTerms::new(b, &sweeps[form][k]),
+                None => self.no_faces,
+            })
+        });
+        self.keep(j, (centre, radius, sweeps, faces));
+    }
+
+    /// Keeps, for robot `j`, the ball `(centre, radius)` with its sweeps and face terms about
+    /// the reference boxes, under a new generation.
+    fn keep(
+        &mut self,
+        j: usize,
+        (centre, radius, sweeps, faces): (Vec3, Real, SweepForms, [[FaceTerms; MAX_BOXES]; 2]),
+    ) {
+        let generation = self.kept.next_generation;
+        self.kept.next_generation += 1;
+        let boxes = self.ref_boxes[j];
+        self.kept.balls[j] = Some(KeptBall { centre, radius, boxes, sweeps, faces, generation });
+        self.kept.inside[j] = true;
+    }
+}
