@@ -366,15 +366,16 @@ struct Best {
 /// normalised gap reaches the largest gap `g` over the 15 axes (to rounding) need their edge
 /// pair, and none does when a vertex is already at distance `g`.
 fn separated(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
-    let mut best = vertices(rel);
     // Rounding of a normalised gap: about 1e-16 * size / |n|, |n| >= CROSS_AXIS_MIN_NORM.
     // Generous for choosing edge pairs (an extra pair costs time only), tight for stopping
     // at a vertex (a vertex above the true distance by the tolerance would be kept).
     let size = rel.t.iter().chain(&rel.a).chain(&rel.b).map(|x| x.abs()).sum::<Real>();
     let tol = 1e-8 * size + 1e-12;
-    let mut g = Real::NEG_INFINITY;
-    for ax in &axes[..6] {
-        g = g.max(ax.lhs.abs() - ax.rhs);
+    let (mut g, mut widest) = (Real::NEG_INFINITY, 0);
+    for (k, ax) in axes[..6].iter().enumerate() {
+        if ax.lhs.abs() - ax.rhs > g {
+            (g, widest) = (ax.lhs.abs() - ax.rhs, k);
+        }
     }
     let mut gap = [Real::NEG_INFINITY; 9];
     for (m, ax) in axes[6..].iter().enumerate() {
@@ -385,7 +386,9 @@ fn separated(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
             let low = g - tol;
             if raw > 0.0 && (low < 0.0 || raw * raw > low * low * ax.norm2) {
                 gap[m] = raw / float::sqrt(ax.norm2);
-                g = g.max(gap[m]);
+                if gap[m] > g {
+                    (g, widest) = (gap[m], 6 + m);
+                }
             }
         } else {
             // Too short to normalise accurately: always tried.
@@ -393,6 +396,16 @@ fn separated(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
         }
     }
     let reach = (g + 1e-13 * size).max(0.0);
+    // The features that support the axis of the largest gap: when they are `g` apart (to
+    // rounding), no pair of points is closer, and the rest is not needed.
+    let widest = supporting_features(rel, widest, axes[widest].lhs);
+    if widest.d2 <= reach * reach {
+        return Clearance { distance: float::sqrt(widest.d2), point_a: to_world(a, &widest.p), point_b: to_world(a, &widest.q) };
+    }
+    let mut best = vertices(rel);
+    if widest.d2 < best.d2 {
+        best = widest;
+    }
     if best.d2 > reach * reach {
         let near = |m: usize| gap[m] >= g - tol;
         // Written out so that each call is inlined with constant indices.
@@ -425,6 +438,44 @@ fn separated(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
         }
     }
     Clearance { distance: float::sqrt(best.d2), point_a: to_world(a, &best.p), point_b: to_world(a, &best.q) }
+}
+
+/// A pair of points of the two boxes on the features that support axis `k` (numbered as
+/// [`Axis`](crate::geometry::Axis)): for a face axis of one box, the other box's vertex
+/// deepest toward it and that vertex's closest point of the first box; for a cross axis, its
+/// supporting edge pair (every pair when a sign is within rounding of 0). Where the gap on
+/// axis `k` is the distance, these points realise it (module doc, "Method"); elsewhere they
+/// are still two points of the boxes, so never closer than the distance.
+#[inline(always)]
+fn supporting_features(rel: &Rel, k: usize, lhs: Real) -> Best {
+    let (r, t, tb, a, b) = (&rel.r, &rel.t, &rel.tb, &rel.a, &rel.b);
+    let side = sign(lhs);
+    match k {
+        0..=2 => {
+            // B's vertex lowest along side * A_k, in A's frame, and its clamp into A.
+            let sg: [Real; 3] = core::array::from_fn(|l| -side * sign(r[k][l]));
+            let q: [Real; 3] =
+                core::array::from_fn(|m| t[m] + sg[0] * b[0] * r[m][0] + sg[1] * b[1] * r[m][1] + sg[2] * b[2] * r[m][2]);
+            let p: [Real; 3] = core::array::from_fn(|m| q[m].clamp(-a[m], a[m]));
+            Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q }
+        }
+        3..=5 => {
+            // A's vertex highest along side * B_j, and its clamp into B, back in A's frame.
+            let j = k - 3;
+            let p: [Real; 3] = core::array::from_fn(|m| side * sign(r[m][j]) * a[m]);
+            let xb: [Real; 3] = core::array::from_fn(|l| {
+                (-tb[l] + p[0] * r[0][l] + p[1] * r[1][l] + p[2] * r[2][l]).clamp(-b[l], b[l])
+            });
+            let q: [Real; 3] =
+                core::array::from_fn(|m| t[m] + r[m][0] * xb[0] + r[m][1] * xb[1] + r[m][2] * xb[2]);
+            Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q }
+        }
+        _ => {
+            let mut best = Best { d2: Real::INFINITY, p: [0.0; 3], q: [0.0; 3] };
+            edge_axis(rel, (k - 6) / 3, (k - 6) % 3, &mut best);
+            best
+        }
+    }
 }
 
 /// The vertex of the 16 that is closest to the other box, with its closest point.
