@@ -12,13 +12,16 @@
 //! peer. The verdict of every tick is computed before timing and asserted. "verdict with
 //! paths" is the same replay through `check_with_paths`, each robot's stop path its programmed
 //! path ahead (up to 400 mm, 0.1 mm tolerance), as a controller with a path-maintaining stop
-//! would give it.
+//! would give it. `protective_T1_practical_replay_stiff` replays the same run for robots with
+//! the stiff stopping model of the protective tests (2 ms reaction, 120 m/s^2 braking), where
+//! most ticks are FREE and most FREE ticks reuse a kept proof.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use delta_collide::cell::protective::{Protective, ProtectiveChecker, StopPath};
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, RUN_TICKS};
-use delta_collide::cell::ExactChecker;
+use delta_collide::cell::{Cell, ExactChecker};
+use delta_collide::robot::StopModel;
 use delta_collide::math::{Real, Vec3};
 use std::hint::black_box;
 
@@ -102,11 +105,16 @@ fn stop_paths(paths: &[PathAhead; 2]) -> [Option<StopPath<'_>>; 2] {
 }
 
 fn protective_replay(c: &mut Criterion) {
+    replay(c, "protective_T1_practical_replay", reference_cell("T1").unwrap());
+    let stiff = StopModel { reaction_ms: 2.0, decel_mm_s2: 120_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 };
+    replay(c, "protective_T1_practical_replay_stiff", reference_cell("T1").unwrap().with_stopping(1.0, vec![stiff; 2]).unwrap());
+}
+
+fn replay(c: &mut Criterion, name: &str, cell: Cell) {
     let ticks = run_ticks();
-    let cell = reference_cell("T1").unwrap();
     let mut exact = ExactChecker::new(cell.clone());
     let hits: Vec<bool> = ticks.iter().map(|t| exact.check(&t.0).unwrap().collides()).collect();
-    let mut group = c.benchmark_group("protective_T1_practical_replay");
+    let mut group = c.benchmark_group(name);
     for (name, limits) in [("with speed limits", true), ("verdict only", false)] {
         let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
         let verdicts: Vec<Protective> = ticks.iter().map(|t| checker.check(&t.0).unwrap().verdict).collect();
