@@ -216,7 +216,8 @@ typedef struct DcQueryReport {
    */
   uint32_t first_robot_b;
   /*
-   Box of `first_robot_a`: 0..2 lower links, then upper links, platform, tool.
+   Box of `first_robot_a`: 0..2 lower links, then upper links, platform, tool. In table
+   mode `DC_BOX_NONE` when the lookup alone answered (no exact check ran).
    */
   uint32_t first_box_a;
   /*

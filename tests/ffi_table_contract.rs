@@ -107,13 +107,26 @@ fn table_mode_reports_fail_closed_and_pair_results() {
         out[0]
     };
     let none = |collides| DcPairResult { robot_a: 0, robot_b: 1, collides, box_a: DC_BOX_NONE, box_b: DC_BOX_NONE };
-    let (s, verdict, r) = query(h, &[v(180.0, 0.0, -450.0), v(-180.0, 0.0, -450.0)]);
+    let crossed = [v(180.0, 0.0, -450.0), v(-180.0, 0.0, -450.0)];
+    let (s, verdict, r) = query(h, &crossed);
     assert_eq!(
         (s, verdict, r.colliding_pairs, r.first_robot_a, r.first_robot_b),
         (DC_STATUS_OK, DC_VERDICT_COLLISION, 1, 0, 1)
     );
-    assert_eq!((r.first_box_a, r.first_box_b, r.unreachable_mask), (DC_BOX_NONE, DC_BOX_NONE, 0));
+    // Confirmed by the exact check (the handle's default): its boxes, as exact mode names them.
+    let (_, exact_verdict, e) = query(exact, &crossed);
+    assert_eq!(exact_verdict, DC_VERDICT_COLLISION);
+    assert_ne!(e.first_box_a, DC_BOX_NONE);
+    assert_eq!((r.first_box_a, r.first_box_b, r.unreachable_mask), (e.first_box_a, e.first_box_b, 0));
+    assert_eq!(pair(h), DcPairResult { box_a: e.first_box_a, box_b: e.first_box_b, ..none(1) });
+    // Without confirmation the lookup alone answers: the cell, not the boxes.
+    // SAFETY: live handle.
+    assert_eq!(unsafe { dc_set_table_confirmation(h, DC_CONFIRMATION_NONE) }, DC_STATUS_OK);
+    let (_, verdict, r) = query(h, &crossed);
+    assert_eq!((verdict, r.first_box_a, r.first_box_b), (DC_VERDICT_COLLISION, DC_BOX_NONE, DC_BOX_NONE));
     assert_eq!(pair(h), none(1));
+    // SAFETY: live handle.
+    assert_eq!(unsafe { dc_set_table_confirmation(h, DC_CONFIRMATION_EXACT) }, DC_STATUS_OK);
     let (s, verdict, r) = query(h, &[v(-150.0, 0.0, -450.0), v(150.0, 0.0, -450.0)]);
     assert_eq!((s, verdict, r.colliding_pairs, r.first_robot_a), (DC_STATUS_OK, DC_VERDICT_FREE, 0, DC_BOX_NONE));
     assert_eq!(pair(h), none(0));

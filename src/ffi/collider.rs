@@ -272,9 +272,11 @@ impl Collider {
                     *o = DcPairResult { robot_a: p.a as u32, robot_b: p.b as u32, collides, box_a, box_b };
                 }
             }
-            Checker::Table(_) => {
+            Checker::Table(t) => {
                 let collides = u32::from(self.table_collides);
-                out[0] = DcPairResult { robot_a: 0, robot_b: 1, collides, box_a: DC_BOX_NONE, box_b: DC_BOX_NONE };
+                let boxes = t.colliding_boxes().filter(|_| self.table_collides);
+                let [box_a, box_b] = boxes.map_or([DC_BOX_NONE; 2], |(a, b)| [a as u32, b as u32]);
+                out[0] = DcPairResult { robot_a: 0, robot_b: 1, collides, box_a, box_b };
             }
         }
     }
@@ -340,6 +342,9 @@ fn query_table(checker: &mut TableChecker, tcps: &[Vec3], report: &mut DcQueryRe
         Ok(TableAnswer::Collision) => {
             (report.verdict, report.colliding_pairs) = (DC_VERDICT_COLLISION, 1);
             (report.first_robot_a, report.first_robot_b) = (0, 1);
+            if let Some((a, b)) = checker.colliding_boxes() {
+                (report.first_box_a, report.first_box_b) = (a as u32, b as u32);
+            }
             DC_STATUS_OK
         }
     }

@@ -206,7 +206,8 @@ pub struct DcQueryReport {
     pub first_robot_a: u32,
     /// First colliding pair's second robot, or `DC_BOX_NONE`.
     pub first_robot_b: u32,
-    /// Box of `first_robot_a`: 0..2 lower links, then upper links, platform, tool.
+    /// Box of `first_robot_a`: 0..2 lower links, then upper links, platform, tool. In table
+    /// mode `DC_BOX_NONE` when the lookup alone answered (no exact check ran).
     pub first_box_a: u32,
     /// Box of `first_robot_b`.
     pub first_box_b: u32,

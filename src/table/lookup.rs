@@ -10,6 +10,7 @@
 //! mode then answers as exact mode while a free cell costs one lookup. Nothing allocates per
 //! tick.
 
+use crate::cell::exact::PairState;
 use crate::cell::{Cell, ExactChecker, QueryError};
 use crate::cspace::symmetry::reflection_y;
 use crate::cspace::SampleGrid;
@@ -131,6 +132,8 @@ pub struct TableChecker {
     fallbacks: u64,
     confirmation: Confirmation,
     confirmations: u64,
+    /// The colliding box pair of the last check, when the exact check answered it.
+    exact_boxes: Option<(usize, usize)>,
 }
 
 impl TableChecker {
@@ -186,6 +189,7 @@ impl TableChecker {
             fallbacks: 0,
             confirmation,
             confirmations: 0,
+            exact_boxes: None,
         })
     }
 
@@ -220,6 +224,13 @@ impl TableChecker {
         self.confirmations
     }
 
+    /// The colliding boxes (robot 0's, robot 1's; [`RobotModel::boxes`] order) of the last
+    /// check when it answered COLLISION through the exact check (a confirmation or a
+    /// fallback); `None` otherwise: a lookup knows the cell, not the boxes.
+    pub fn colliding_boxes(&self) -> Option<(usize, usize)> {
+        self.exact_boxes
+    }
+
     /// The cell of robot `j`'s TCP at the table's query resolution (`2^sub_levels` per grid
     /// cell and axis), or `None` when its grid cell is not sampled.
     fn cell_of(&self, j: usize, tcp: &Vec3) -> Option<[u16; 3]> {
@@ -242,6 +253,7 @@ impl TableChecker {
         if tcps_mcs.len() != 2 {
             return Err(QueryError::WrongRobotCount { expected: 2, found: tcps_mcs.len() });
         }
+        self.exact_boxes = None;
         let mask = (0..2).fold(0u32, |m, j| m | (!self.models[j].delta.is_reachable(&tcps_mcs[j]) as u32) << j);
         if mask != 0 {
             return Ok(TableAnswer::Unreachable(mask));
@@ -269,6 +281,10 @@ impl TableChecker {
     /// The exact check's verdict in the table's terms.
     fn exact_answer(&mut self, tcps_mcs: &[Vec3]) -> Result<TableAnswer, QueryError> {
         let v = self.exact.check(tcps_mcs)?;
+        self.exact_boxes = v.first_collision().and_then(|p| match p.state {
+            PairState::Collides(a, b) => Some((a, b)),
+            _ => None,
+        });
         Ok(match (v.unreachable_mask, v.collides()) {
             (0, true) => TableAnswer::Collision,
             (0, false) => TableAnswer::Free,
