@@ -315,7 +315,8 @@ typedef struct DcProtectiveReport {
   double protective_mm[32];
   /*
    Per robot: the largest measured TCP speed (mm/s) at which FREE would still hold, the
-   other robots as they are; 0 when not even standing still is proved.
+   other robots as they are; 0 when not even standing still is proved; NaN when the
+   handle's speed limits are off (`dc_set_speed_limits`).
    */
   double speed_limit_mm_s[32];
 } DcProtectiveReport;
@@ -762,6 +763,22 @@ uint64_t dc_table_fallbacks(const struct DcCollider *handle);
  `handle` must be NULL or a live handle not used by another thread.
  */
 DcStatus dc_set_table_confirmation(struct DcCollider *handle, DcConfirmation confirmation);
+
+/*
+ Whether `dc_protective_query` (and `..._with_paths`) finds each robot's speed limit (`on`
+ 1, the default) or leaves `speed_limit_mm_s` NaN (`on` 0): the verdict is the same
+ either way, and without the limits a tick takes a fraction of the time (the limits search
+ several speeds per robot; README, "Stopping before contact"). Setup only, like
+ `dc_set_stop_model`, and kept by it.
+
+ Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_INVALID_ARGUMENT` (`on`
+ neither 0 nor 1; the handle keeps its setting and `dc_last_init_error` says so),
+ `DC_STATUS_PANIC` (a poisoned handle).
+
+ # Safety
+ `handle` must be NULL or a live handle not used by another thread.
+ */
+DcStatus dc_set_speed_limits(struct DcCollider *handle, uint32_t on);
 
 /*
  Table mode: how many queries so far the table's lookup said COLLISION and the exact check

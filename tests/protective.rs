@@ -597,6 +597,53 @@ fn the_c_entry_point_never_allocates_and_fills_the_report() {
     unsafe { dc_destroy(h) };
 }
 
+/// `dc_set_speed_limits`: with the limits off the verdicts of T1's practical run through the C
+/// ABI are those with the limits on, the limits read NaN, nothing allocates, the setting
+/// survives `dc_set_stop_model`, and a bad value or NULL handle is a status.
+#[test]
+fn speed_limits_off_give_the_same_verdicts_and_nan_limits() {
+    use delta_collide::ffi::*;
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let (on, off) = (t1_handle_with_default_stops(), t1_handle_with_default_stops());
+    // SAFETY: live handles (and NULL, rejected).
+    unsafe {
+        assert_eq!(dc_set_speed_limits(off, 2), DC_STATUS_INVALID_ARGUMENT);
+        assert_eq!(dc_set_speed_limits(std::ptr::null_mut(), 0), DC_STATUS_NULL_POINTER);
+        assert_eq!(dc_set_speed_limits(off, 0), DC_STATUS_OK);
+        let stops = [dc_stop_config_default(); 2];
+        assert_eq!(dc_set_stop_model(off, 1.0, 10.0, stops.as_ptr(), 2), DC_STATUS_OK);
+    }
+    let mut tcps = [Vec3::zeros(); 2];
+    // SAFETY: the report holds numbers only, for which all-zero bytes are valid values.
+    let zeroed = || unsafe { std::mem::MaybeUninit::<DcProtectiveReport>::zeroed().assume_init() };
+    let (mut report_on, mut report_off) = (zeroed(), zeroed());
+    let (mut verdict_on, mut verdict_off, mut free) = (DC_VERDICT_STOP, DC_VERDICT_STOP, 0);
+    let mut allocated = 0;
+    for tick in 0..RUN_TICKS {
+        s.tcps_at(tick, &mut tcps);
+        let c = tcps.map(|t| DcVec3 { x: t.x, y: t.y, z: t.z });
+        // SAFETY: live handles, two readable TCPs, writable outputs.
+        unsafe {
+            assert_eq!(dc_protective_query(on, c.as_ptr(), 2, &mut verdict_on, &mut report_on), DC_STATUS_OK);
+            let before = allocations();
+            assert_eq!(dc_protective_query(off, c.as_ptr(), 2, &mut verdict_off, &mut report_off), DC_STATUS_OK);
+            allocated += allocations() - before;
+        }
+        assert_eq!(verdict_off, verdict_on, "tick {tick}");
+        assert!(report_off.speed_limit_mm_s[..2].iter().all(|v| v.is_nan()), "tick {tick}");
+        assert!(report_on.speed_limit_mm_s[..2].iter().all(|v| v.is_finite()), "tick {tick}");
+        free += (verdict_on == DC_VERDICT_FREE) as u32;
+    }
+    assert_eq!(allocated, 0);
+    assert!(free > 1_000, "{free} FREE ticks");
+    // SAFETY: live handles, destroyed once.
+    unsafe {
+        dc_destroy(on);
+        dc_destroy(off);
+    }
+}
+
 /// `dc_protective_query_with_paths` through the C ABI: no allocation per call while the
 /// robots move toward each other along their paths, and a status naming the robot for every
 /// kind of bad path.

@@ -205,8 +205,15 @@ impl Collider {
             })
             .collect();
         let cell = self.protective.cell().clone().with_stopping(tick_ms, models).map_err(|e| invalid(e.to_string()))?;
-        self.protective = ProtectiveChecker::new(cell, warn_mm).map_err(|e| invalid(e.to_string()))?;
+        let limits = self.protective.speed_limits();
+        self.protective =
+            ProtectiveChecker::new(cell, warn_mm).map_err(|e| invalid(e.to_string()))?.with_speed_limits(limits);
         Ok(())
+    }
+
+    /// Whether the protective queries to come find each robot's speed limit.
+    pub(crate) fn set_speed_limits(&mut self, on: bool) {
+        self.protective.set_speed_limits(on);
     }
 
     /// Forgets the previous TCPs of the protective verdict.

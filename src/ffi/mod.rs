@@ -627,6 +627,38 @@ pub unsafe extern "C" fn dc_set_table_confirmation(handle: *mut DcCollider, conf
     })
 }
 
+/// Whether `dc_protective_query` (and `..._with_paths`) finds each robot's speed limit (`on`
+/// 1, the default) or leaves `speed_limit_mm_s` NaN (`on` 0): the verdict is the same
+/// either way, and without the limits a tick takes a fraction of the time (the limits search
+/// several speeds per robot; README, "Stopping before contact"). Setup only, like
+/// `dc_set_stop_model`, and kept by it.
+///
+/// Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_INVALID_ARGUMENT` (`on`
+/// neither 0 nor 1; the handle keeps its setting and `dc_last_init_error` says so),
+/// `DC_STATUS_PANIC` (a poisoned handle).
+///
+/// # Safety
+/// `handle` must be NULL or a live handle not used by another thread.
+#[no_mangle]
+pub unsafe extern "C" fn dc_set_speed_limits(handle: *mut DcCollider, on: u32) -> DcStatus {
+    boundary(|| {
+        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
+        if h.poisoned {
+            return DC_STATUS_PANIC;
+        }
+        let (status, message) = match on {
+            0 | 1 => {
+                h.inner.set_speed_limits(on == 1);
+                (DC_STATUS_OK, String::new())
+            }
+            _ => (DC_STATUS_INVALID_ARGUMENT, format!("on = {on}: use 1 (speed limits) or 0 (verdict only)")),
+        };
+        let _ = LAST_INIT_ERROR.try_with(|m| *m.borrow_mut() = message);
+        status
+    })
+}
+
 /// Table mode: how many queries so far the table's lookup said COLLISION and the exact check
 /// confirmed or refuted it (`DC_CONFIRMATION_EXACT`); ticks answered by the exact fallback
 /// are counted by `dc_table_fallbacks` instead. 0 in exact mode and for NULL.

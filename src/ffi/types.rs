@@ -313,7 +313,8 @@ pub struct DcProtectiveReport {
     /// Per robot: how far its TCP may travel until it stands still after a stop now (mm).
     pub protective_mm: [f64; 32],
     /// Per robot: the largest measured TCP speed (mm/s) at which FREE would still hold, the
-    /// other robots as they are; 0 when not even standing still is proved.
+    /// other robots as they are; 0 when not even standing still is proved; NaN when the
+    /// handle's speed limits are off (`dc_set_speed_limits`).
     pub speed_limit_mm_s: [f64; 32],
 }
 

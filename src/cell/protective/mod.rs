@@ -324,6 +324,16 @@ impl ProtectiveChecker {
         ProtectiveChecker { speed_limits: on, ..self }
     }
 
+    /// Turns the speed limits of the ticks to come on or off ([`ProtectiveChecker::with_speed_limits`]).
+    pub fn set_speed_limits(&mut self, on: bool) {
+        self.speed_limits = on;
+    }
+
+    /// Whether each tick finds the speed limits.
+    pub fn speed_limits(&self) -> bool {
+        self.speed_limits
+    }
+
     /// This checker with a second tier of `splits^3` direct sub-boxes ([`PRECISE_SPLITS`] by
     /// default; 0: the table alone, faster, more STOPs).
     pub fn with_precise_splits(self, splits: u32) -> Self {
