@@ -693,7 +693,8 @@ fn replay_plot_refuses_bad_arguments_with_a_clear_message() {
 }
 
 /// `check` on the four-robot line of `cells/line4.toml` (12 coordinates a row) answers as
-/// the two-robot cells of each pair checked one by one with the library.
+/// the two-robot cells of each pair checked one by one with the library, and so does each
+/// column of `--pairs`.
 #[test]
 fn check_on_a_line_of_four_answers_as_its_pairs_one_by_one() {
     use delta_collide::cell::{placement::Placement, Cell};
@@ -708,6 +709,7 @@ fn check_on_a_line_of_four_answers_as_its_pairs_one_by_one() {
     let mut rng = StdRng::seed_from_u64(44);
     let mut rows = Vec::new();
     let mut truth = Vec::new();
+    let mut pair_truth: Vec<String> = Vec::new();
     while rows.len() < 400 {
         let tcps: Vec<Vec3> = (0..4)
             .map(|_| {
@@ -716,17 +718,20 @@ fn check_on_a_line_of_four_answers_as_its_pairs_one_by_one() {
             .collect();
         let mut reachable = true;
         let mut collide = false;
+        let mut flags = String::new();
         for a in 0..4 {
             for b in a + 1..4 {
                 let v = checkers[b - a - 1].check(&[tcps[a], tcps[b]]).unwrap();
                 reachable &= v.unreachable_mask == 0;
                 collide |= v.collides();
+                flags += if v.collides() { ",1" } else { ",0" };
             }
         }
         if !reachable {
             continue;
         }
         truth.push(collide);
+        pair_truth.push(flags);
         rows.push(tcps.iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(","));
     }
     let out = cli_stdin(&["check", "--cell", "cells/line4.toml"], &rows.join("\n"));
@@ -739,6 +744,17 @@ fn check_on_a_line_of_four_answers_as_its_pairs_one_by_one() {
     }
     let hits = truth.iter().filter(|h| **h).count();
     assert!(hits > 20 && hits < 380, "the rows mix free and colliding lines: {hits}");
+    // --pairs: one column per pair that can meet (every pair of this line: the pruning keeps
+    // robots 1,350 mm apart, whose reach disks of radius 675 mm touch), in the loop's order.
+    let out = cli_stdin(&["check", "--cell", "cells/line4.toml", "--pairs"], &rows.join("\n"));
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let mut lines = text.lines();
+    let header = "reachable,collide,collide_R1_R2,collide_R1_R3,collide_R1_R4,collide_R2_R3,collide_R2_R4,collide_R3_R4";
+    assert_eq!(lines.next(), Some(header));
+    for ((line, flags), row) in lines.zip(&pair_truth).zip(&rows) {
+        assert_eq!(&line[line.find(',').unwrap() + 2..], flags.as_str(), "{row}: {line}");
+    }
 }
 
 #[test]

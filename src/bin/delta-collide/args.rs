@@ -162,6 +162,10 @@ pub struct CheckArgs {
     /// intersect; NA when a TCP is unreachable), also with --table
     #[arg(long)]
     pub clearance: bool,
+    /// Add one column per robot pair that can meet, collide_A_B (A, B the robots' names):
+    /// 1 when that pair collides, 0 when not, NA when either TCP is unreachable
+    #[arg(long)]
+    pub pairs: bool,
 }
 
 #[derive(Args, Debug)]

@@ -29,6 +29,7 @@ mod stop;
 use args::{BuildArgs, CheckArgs, Cli, Command, EvalArgs, InspectArgs};
 use clap::CommandFactory;
 use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
+use delta_collide::cell::exact::PairState;
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
@@ -147,8 +148,8 @@ fn check(args: &CheckArgs) -> Result<(), Failure> {
         t.set_confirmation(args.confirm.map_or(Confirmation::Exact, Confirmation::from));
     }
     let mut input = open_input(args.input.as_deref())?;
-    let clearance = args.clearance;
-    let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut(), clearance);
+    let columns = Columns { clearance: args.clearance, pairs: args.pairs };
+    let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut(), columns);
     match &args.output {
         Some(path) => files::write_file(path, |w| rows(w))?,
         None => {
@@ -186,9 +187,18 @@ pub(crate) fn write_output(
     }
 }
 
-/// Answers every row of `input` on `out`, after the line `reachable,collide` (with
-/// `,clearance_mm` when `clearance`: the exact signed clearance, NA when a TCP is unreachable,
-/// computed by the exact model also in table mode).
+/// The columns `check` adds to `reachable,collide`.
+#[derive(Clone, Copy)]
+struct Columns {
+    /// `clearance_mm`: the exact signed clearance, NA when a TCP is unreachable, computed by
+    /// the exact model also in table mode.
+    clearance: bool,
+    /// `collide_A_B` per pair that can meet (table mode: its one pair, the table's answer).
+    pairs: bool,
+}
+
+/// Answers every row of `input` on `out`, after the line `reachable,collide` and the
+/// header of the `columns` asked for.
 ///
 /// # Errors
 /// A row that is not `3 n` numbers (naming its line; the first line may be a header, a line
@@ -198,11 +208,18 @@ fn check_rows(
     out: &mut dyn Write,
     cell: &Cell,
     mut table: Option<&mut TableChecker>,
-    clearance: bool,
+    columns: Columns,
 ) -> Result<(), String> {
     let mut checker = ExactChecker::new(cell.clone());
     let write_err = |e: std::io::Error| format!("writing the answers: {e}");
-    writeln!(out, "reachable,collide{}", if clearance { ",clearance_mm" } else { "" }).map_err(write_err)?;
+    let name = |j: usize| &cell.robots[j].name;
+    let pair_names: String = checker.verdict().pairs.iter().map(|p| format!(",collide_{}_{}", name(p.a), name(p.b))).collect();
+    let header = format!(
+        "reachable,collide{}{}",
+        if columns.clearance { ",clearance_mm" } else { "" },
+        if columns.pairs { pair_names.as_str() } else { "" }
+    );
+    writeln!(out, "{header}").map_err(write_err)?;
     rows::for_each_row(input, cell.robots.len(), |line_no, tcps| {
         let at_line = |e: delta_collide::cell::QueryError| format!("line {line_no}: {e}");
         let answer = match table.as_deref_mut() {
@@ -215,7 +232,7 @@ fn check_rows(
             TableAnswer::Free => "1,0",
         };
         out.write_all(row.as_bytes()).map_err(write_err)?;
-        if clearance {
+        if columns.clearance {
             if table.is_some() {
                 checker.check(tcps).map_err(at_line)?;
             }
@@ -226,8 +243,31 @@ fn check_rows(
             }
             .map_err(write_err)?;
         }
+        if columns.pairs {
+            write_pair_columns(out, &checker, table.is_some().then_some(answer)).map_err(write_err)?;
+        }
         out.write_all(b"\n").map_err(write_err)
     })
+}
+
+/// One `,0`, `,1` or `,NA` per pair that can meet: the exact checker's last states, or in
+/// table mode (`table_answer`, two robots, one pair) the table's answer.
+fn write_pair_columns(out: &mut dyn Write, exact: &ExactChecker, table_answer: Option<TableAnswer>) -> std::io::Result<()> {
+    if let Some(answer) = table_answer {
+        return out.write_all(match answer {
+            TableAnswer::Unreachable(_) => b",NA",
+            TableAnswer::Collision => b",1",
+            TableAnswer::Free => b",0",
+        });
+    }
+    for p in &exact.verdict().pairs {
+        out.write_all(match p.state {
+            PairState::Collides(..) => b",1",
+            PairState::Free => b",0",
+            PairState::Undecided => b",NA",
+        })?;
+    }
+    Ok(())
 }
 
 /// The exact verdict in the table's terms.
