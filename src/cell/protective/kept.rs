@@ -160,13 +160,15 @@ impl ProtectiveChecker {
         free
     }
 
-    /// After the full proof proved every pair FREE with every robot's sweeps of the table's
-    /// tier about its reference: keeps those balls and marks every pair proved for them.
+    /// After the full proof proved every pair FREE with the sweeps of the table's tier about
+    /// each robot's reference: keeps those balls (of every robot that has sweeps: every robot
+    /// of a pair that can meet) and marks every pair proved for them.
     pub(super) fn keep_references(&mut self) {
         for j in 0..self.kept.balls.len() {
-            debug_assert_eq!(self.sweep_tier[j], Some((0, 0)));
-            let ball = (self.centres[j], self.reach[j], self.sweeps[j], self.faces[j]);
-            self.keep(j, ball);
+            if self.sweep_tier[j] == Some((0, 0)) {
+                let ball = (self.centres[j], self.reach[j], self.sweeps[j], self.faces[j]);
+                self.keep(j, ball);
+            }
         }
         let balls = &self.kept.balls;
         let pairs = &self.exact.verdict().pairs;

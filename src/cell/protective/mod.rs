@@ -517,7 +517,6 @@ impl ProtectiveChecker {
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
         }
-        let n = tcps_mcs.len();
         if kept {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else if let Some(pair) = self.certain_stop(None) {
@@ -525,7 +524,6 @@ impl ProtectiveChecker {
         } else if was_free && self.keep_and_prove() {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else {
-            (0..n).for_each(|j| self.sweeps_at(j, 0, 0));
             (self.report.verdict, self.report.limiting) = self.prove();
             if self.report.verdict == Protective::Free {
                 self.keep_references();
@@ -559,17 +557,22 @@ impl ProtectiveChecker {
     }
 
     /// The verdict and its limiting pair for the sweeps as they are (module doc, step 5).
-    fn prove(&self) -> (Protective, Option<BoxPair>) {
-        let pairs = &self.exact.verdict().pairs;
-        let boxes = |j: usize| self.ref_boxes[j].as_slice();
-        let limiting = first_unproved(pairs, &boxes, &self.sweeps, &self.faces, None, 0.0);
-        if limiting.is_some() {
-            return (Protective::Stop, limiting);
-        }
-        if self.warn_mm > 0.0 {
-            let limiting = first_unproved(pairs, &boxes, &self.sweeps, &self.faces, None, self.warn_mm);
-            if limiting.is_some() {
-                return (Protective::Warn, limiting);
+    /// A robot without sweeps for this tick's reference gets those of the table's tier first,
+    /// pair by pair: a line's STOP is often found before most robots need any.
+    fn prove(&mut self) -> (Protective, Option<BoxPair>) {
+        let passes = [(0.0, Protective::Stop), (self.warn_mm, Protective::Warn)];
+        for (extra, verdict) in passes.into_iter().filter(|&(extra, v)| v == Protective::Stop || extra > 0.0) {
+            for k in 0..self.exact.verdict().pairs.len() {
+                let p = self.exact.verdict().pairs[k];
+                for j in [p.a, p.b] {
+                    if self.sweep_tier[j].is_none() {
+                        self.sweeps_at(j, 0, 0);
+                    }
+                }
+                let swept = |j: usize| (self.ref_boxes[j].as_slice(), &self.sweeps[j], &self.faces[j]);
+                if let Some((box_a, box_b)) = first_unproved_between(swept(p.a), swept(p.b), extra) {
+                    return (verdict, Some(BoxPair { a: p.a, b: p.b, box_a, box_b }));
+                }
             }
         }
         (Protective::Free, None)
@@ -687,8 +690,14 @@ impl ProtectiveChecker {
                 return false;
             }
             let Some(tier) = tier else { return true };
-            // The other robots as they are, with the motor angles of the same tier.
-            (0..me.centres.len()).for_each(|i| me.sweeps_at(i, tier, 0b111));
+            // The robots that can meet `j` as they are, with the motor angles of the same tier.
+            for k in 0..me.exact.verdict().pairs.len() {
+                let p = me.exact.verdict().pairs[k];
+                if p.a == j || p.b == j {
+                    me.sweeps_at(p.a, tier, 0b111);
+                    me.sweeps_at(p.b, tier, 0b111);
+                }
+            }
             let boxes = |i: usize| me.ref_boxes[i].as_slice();
             first_unproved(&me.exact.verdict().pairs, &boxes, &me.sweeps, &me.faces, Some(j), 0.0).is_none()
         };
