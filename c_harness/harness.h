@@ -28,7 +28,8 @@ typedef struct HarnessTable {
 
 /* The command line: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]...
  *   --quick  runs the T1 collision scenario only (exact and table mode), for valgrind;
- *            the kinematics grid and every bad-input scenario still run;
+ *            the kinematics grid, every bad-input scenario and the line's collision case
+ *            in exact mode still run;
  *   --protective-quick  the protective scenarios on T1 collision only (under qemu, where the
  *            interval arithmetic of every scenario would take many minutes);
  *   --tmp    a directory for scratch files (default ".");
@@ -138,8 +139,8 @@ VerdictTally run_protective(const char *cell_name, const char *case_name, const 
                             const DcStopConfig *model, int with_paths, long n_ticks);
 
 /* The four-robot line (line.c): both cases in exact mode through the POU, and with the
- * protective verdict and a simulated stop. --quick skips it, --protective-quick runs exact
- * mode only. */
+ * protective verdict and a simulated stop. --quick runs the collision case in exact mode
+ * only, --protective-quick both cases in exact mode only. */
 void line_scenarios(const HarnessOptions *options);
 
 /* The practical scenarios with the speed limits of the protective verdict applied as a speed

@@ -18,7 +18,7 @@
  *
  * Usage (from the repository root):
  *   c_harness [--quick] [--tmp DIR] [--table T1=PATH] [--table T2=PATH] [--table T3=PATH]
- * --quick runs only the T1 collision scenario (for valgrind); see harness.h.
+ * --quick runs only the T1 collision scenario and the line's (for valgrind); see harness.h.
  * Prints one line per failed check, a summary per scenario, and finally `N passed, N failed`;
  * exits 0 only when nothing failed.
  */
@@ -344,7 +344,7 @@ int main(int argc, char **argv)
         return 2;
     }
     printf("delta-collide C harness, library %s%s\n", dc_version(),
-           options.quick ? " (--quick: T1 collision only)" : "");
+           options.quick ? " (--quick: T1 collision, and the line's in exact mode, only)" : "");
     kinematics_grid();
     for (c = 0; c < 3; ++c) {
         for (k = 0; k < 2; ++k) {

@@ -345,7 +345,8 @@ fn c_harness_is_clean_under_valgrind_memcheck() {
     compile_probe(&probe_dir, &[]);
     let out = run(Command::new("valgrind").args(memcheck).arg(probe_dir.join("probe")).arg("leak"));
     assert_eq!(out.status.code(), Some(99), "valgrind missed the probe's leak:\n{}", text(&out.stderr));
-    // The harness: the T1 collision scenario in both modes, all bad inputs, T1's table.
+    // The harness: the T1 collision scenario in both modes, all bad inputs, T1's table, the
+    // line's collision case in exact mode.
     let tmp = scratch_dir("c_harness");
     let out = run(Command::new("valgrind")
         .args(memcheck)
@@ -360,6 +361,7 @@ fn c_harness_is_clean_under_valgrind_memcheck() {
     let stdout = assert_harness_passed(&format!("c_harness --quick under {}", version.trim()), &out);
     assert!(stdout.contains("T1 collision table: stop tick"), "the table-mode scenario did not run under valgrind");
     assert!(stdout.contains("bad input: done (exact and table mode)"), "bad inputs did not all run under valgrind");
+    assert!(stdout.contains("colliding pairs at the stop 2-3"), "the line's collision case did not run under valgrind");
 }
 
 #[test]
