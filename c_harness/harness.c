@@ -80,6 +80,11 @@ const char *cell_file(const char *cell)
     return i < 0 ? "cells/unknown.toml" : files[i];
 }
 
+const char *scenario_file(const char *cell)
+{
+    return strcmp(cell, "line4") == 0 ? LINE_SCENARIO_FILE : SCENARIO_FILE;
+}
+
 void tick_text(long tick, char out[24])
 {
     if (tick < 0) {
@@ -195,7 +200,7 @@ int open_protective(const char *who, const char *cell_name, const char *case_nam
     size_t j;
     *h = *exact = NULL;
     if (mr_register_cell(cell_name, cell) != MR_OK
-        || mr_load_scenario(SCENARIO_FILE, cell_name, case_name, cell->n_robots, scenario) != MR_OK) {
+        || mr_load_scenario(scenario_file(cell_name), cell_name, case_name, cell->n_robots, scenario) != MR_OK) {
         return check(0, "%s %s %s: cannot load the scenario", who, cell_name, case_name);
     }
     pou_cell_config(cell, DC_METHOD_SAT_CACHE, robots, &config);
@@ -242,7 +247,7 @@ int stop_substep(DcCollider *exact, const MrScenario *s, MrStop stop[MR_MAX_ROBO
 
 VerdictTally tally_start(void)
 {
-    VerdictTally t = { -1, -1, 0, 0, 0, INFINITY };
+    VerdictTally t = { -1, -1, 0, 0, 0, INFINITY, DC_BOX_NONE, DC_BOX_NONE };
     return t;
 }
 
@@ -267,6 +272,8 @@ int tally_verdict(VerdictTally *t, long tick, DcStatus s, DcVerdict v, const DcP
     t->n_stop++;
     if (t->first_stop < 0) {
         t->first_stop = tick;
+        t->stop_robot_a = rep->limiting_robot_a;
+        t->stop_robot_b = rep->limiting_robot_b;
     }
     return 1;
 }

@@ -12,6 +12,10 @@
 
 #define HARNESS_N_CELLS 3
 #define SCENARIO_FILE "c_harness/scenarios.txt"
+/* The four-robot line's cell and cases: a file of their own, since other tests and benches run
+ * every case of SCENARIO_FILE on a two-robot reference cell. */
+#define LINE_CELL_FILE "cells/line4.toml"
+#define LINE_SCENARIO_FILE "c_harness/line_scenarios.txt"
 #define STOP_AFTER_TICK 3000L /* the collision case collides only in the last part of the run */
 
 /* One reference cell's table file (given on the command line) and its bytes, read once at
@@ -24,7 +28,8 @@ typedef struct HarnessTable {
 
 /* The command line: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]...
  *   --quick  runs the T1 collision scenario only (exact and table mode), for valgrind;
- *            the kinematics grid and every bad-input scenario still run;
+ *            the kinematics grid, every bad-input scenario and the line's collision case
+ *            in exact mode still run;
  *   --protective-quick  the protective scenarios on T1 collision only (under qemu, where the
  *            interval arithmetic of every scenario would take many minutes);
  *   --tmp    a directory for scratch files (default ".");
@@ -51,6 +56,9 @@ int cell_index(const char *cell);
 
 /* The TOML file of a reference cell, relative to the repository root. */
 const char *cell_file(const char *cell);
+
+/* The scenario file holding the cases of cell `cell` (LINE_SCENARIO_FILE for "line4"). */
+const char *scenario_file(const char *cell);
 
 /* "none" for -1, else the tick number. */
 void tick_text(long tick, char out[24]);
@@ -109,6 +117,7 @@ typedef struct VerdictTally {
     long first_warn, first_stop; /* -1: none */
     unsigned long n_warn, n_stop, n_bad_status;
     double min_clear; /* the smallest clearance reported (mm) */
+    uint32_t stop_robot_a, stop_robot_b; /* the pair that limited the first STOP, DC_BOX_NONE if none */
 } VerdictTally;
 
 /* A tally of no ticks. */
@@ -121,6 +130,18 @@ int tally_verdict(VerdictTally *t, long tick, DcStatus s, DcVerdict v, const DcP
  * robots stop as their stopping models say, and every 0.1 ms of the stop is checked for
  * contact with the exact model. --quick runs T1 collision only. */
 void protective_scenarios(const HarnessOptions *options);
+
+/* One scenario with the protective verdict, every robot with stopping model `model` (warn_mm
+ * 10), with or without each robot's programmed path ahead as its stop path, for n_ticks; the
+ * stop simulated at the first STOP is checked every 0.1 ms for contact (protective.c).
+ * Prints one line and returns the verdicts' tally. */
+VerdictTally run_protective(const char *cell_name, const char *case_name, const char *model_name,
+                            const DcStopConfig *model, int with_paths, long n_ticks);
+
+/* The four-robot line (line.c): both cases in exact mode through the POU, and with the
+ * protective verdict and a simulated stop. --quick runs the collision case in exact mode
+ * only, --protective-quick both cases in exact mode only. */
+void line_scenarios(const HarnessOptions *options);
 
 /* The practical scenarios with the speed limits of the protective verdict applied as a speed
  * override (speed_override.c): cycle time against the unscaled cycle, STOP ticks, contacts.

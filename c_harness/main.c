@@ -12,12 +12,13 @@
  * table file is given for the cell, each scenario runs once more with the POU in table mode
  * (table_mode.c), and once with the protective verdict and a simulated stop (protective.c);
  * the practical ones once more with the speed limits applied as a speed override
- * (speed_override.c). Then the bad-input scenarios (bad_input.c) check every documented error
- * status and the fail-closed outputs, in both modes.
+ * (speed_override.c). The four-robot line (line.c) runs its two cases in exact mode and with
+ * the protective verdict. Then the bad-input scenarios (bad_input.c) check every documented
+ * error status and the fail-closed outputs, in both modes.
  *
  * Usage (from the repository root):
  *   c_harness [--quick] [--tmp DIR] [--table T1=PATH] [--table T2=PATH] [--table T3=PATH]
- * --quick runs only the T1 collision scenario (for valgrind); see harness.h.
+ * --quick runs only the T1 collision scenario and the line's (for valgrind); see harness.h.
  * Prints one line per failed check, a summary per scenario, and finally `N passed, N failed`;
  * exits 0 only when nothing failed.
  */
@@ -343,7 +344,7 @@ int main(int argc, char **argv)
         return 2;
     }
     printf("delta-collide C harness, library %s%s\n", dc_version(),
-           options.quick ? " (--quick: T1 collision only)" : "");
+           options.quick ? " (--quick: T1 collision, and the line's in exact mode, only)" : "");
     kinematics_grid();
     for (c = 0; c < 3; ++c) {
         for (k = 0; k < 2; ++k) {
@@ -360,6 +361,7 @@ int main(int argc, char **argv)
             }
         }
     }
+    line_scenarios(&options);
     protective_scenarios(&options);
     speed_override_scenarios(&options);
     bad_input(&options);

@@ -87,6 +87,18 @@ MrStatus mr_register_cell(const char *name, MrCell *out)
             return MR_OK;
         }
     }
+    if (strcmp(name, "line4") == 0) {
+        /* The packaging line of cells/line4.toml: four robots along x, 450 mm apart as in T1. */
+        static const char *names[4] = { "R1", "R2", "R3", "R4" };
+        size_t j;
+        memset(out, 0, sizeof *out);
+        copy_name(out->name, name);
+        out->n_robots = 4;
+        for (j = 0; j < 4; ++j) {
+            out->robots[j] = mr_thesis_robot(names[j], 0.0, 450.0 * (double)j, 0.0, 0.0);
+        }
+        return MR_OK;
+    }
     return MR_NOT_FOUND;
 }
 

@@ -5,7 +5,7 @@
  * set-up through a small "robotics API". This mock stands in for it on a desktop:
  *   - a robot registry: robots with their Delta3 geometry, box sizes and placement
  *     (SPEC section 1, 2, 3), filled from a hard-coded table of the reference cells
- *     T1, T2, T3 (SPEC section 5);
+ *     T1, T2, T3 (SPEC section 5) and the four-robot line of cells/line4.toml;
  *   - its own kinematics engine in C (SPEC section 2), written independently of the Rust
  *     one so that the harness can cross-check the two;
  *   - a trajectory generator: linear moves between waypoints with the minimum-jerk
@@ -86,7 +86,7 @@ typedef struct MrClock {
 /* Short text for a status. */
 const char *mr_status_str(MrStatus status);
 
-/* Registry: fills *out with the reference cell "T1", "T2" or "T3". */
+/* Registry: fills *out with the reference cell "T1", "T2" or "T3", or the line "line4". */
 MrStatus mr_register_cell(const char *name, MrCell *out);
 
 /* The thesis robot (f 100, rf 150, re 400, e 40, limits [-pi/2, 2pi/3], H 70, D 17.5). */

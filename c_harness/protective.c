@@ -45,10 +45,8 @@ static DcStatus query_tick(DcCollider *h, const MrScenario *s, const MrStop stop
     return dc_protective_query_with_paths(h, tcps, s->n_robots, paths, s->n_robots, v, rep);
 }
 
-/* One scenario with the protective verdict, every robot with stopping model `model`, warn_mm
- * 10, with or without the programmed path ahead as the stop path. */
-static void run_protective(const char *cell_name, const char *case_name, const char *model_name,
-                           const DcStopConfig *model, int with_paths, long n_ticks)
+VerdictTally run_protective(const char *cell_name, const char *case_name, const char *model_name,
+                            const DcStopConfig *model, int with_paths, long n_ticks)
 {
     MrCell cell;
     MrScenario scenario;
@@ -62,7 +60,7 @@ static void run_protective(const char *cell_name, const char *case_name, const c
     DcStatus s;
 
     if (!open_protective("protective", cell_name, case_name, model, &cell, &scenario, stops, &h, &exact)) {
-        return;
+        return t;
     }
     for (tick = -1; tick < n_ticks; ++tick) {
         DcVerdict v = DC_VERDICT_FREE;
@@ -102,12 +100,17 @@ static void run_protective(const char *cell_name, const char *case_name, const c
     check(st.contacts == 0, "protective %s %s: %lu of %lu samples of the stop touch", cell_name, case_name,
           st.contacts, st.samples);
     check(t.first_stop < 0 || st.samples > 0, "protective %s %s: the stop was not simulated", cell_name, case_name);
-    printf("protective %s %-9s %-7s%s: first WARN %ld, first STOP %ld, STOP %lu WARN %lu of %ld ticks, statuses not OK %lu, "
-           "smallest clearance %.1f mm, stop %.1f ms, %lu exact samples of the stop, contacts %lu\n",
-           cell_name, case_name, model_name, with_paths ? " with paths" : "", t.first_warn, t.first_stop, t.n_stop, t.n_warn, n_ticks, t.n_bad_status,
-           t.min_clear, st.moving_ms, st.samples, st.contacts);
+    printf("protective %s %-9s %-7s%s: first WARN %ld, first STOP %ld", cell_name, case_name, model_name,
+           with_paths ? " with paths" : "", t.first_warn, t.first_stop);
+    if (t.stop_robot_a != DC_BOX_NONE) {
+        printf(" (robots %u-%u)", (unsigned)t.stop_robot_a, (unsigned)t.stop_robot_b);
+    }
+    printf(", STOP %lu WARN %lu of %ld ticks, statuses not OK %lu, smallest clearance %.1f mm, stop %.1f ms, "
+           "%lu exact samples of the stop, contacts %lu\n",
+           t.n_stop, t.n_warn, n_ticks, t.n_bad_status, t.min_clear, st.moving_ms, st.samples, st.contacts);
     dc_destroy(h);
     dc_destroy(exact);
+    return t;
 }
 
 void protective_scenarios(const HarnessOptions *options)

@@ -5,7 +5,8 @@
 //! table mode and checks its verdict line. The same harness runs clean under AddressSanitizer
 //! with UndefinedBehaviorSanitizer (and LeakSanitizer where it can run) and, with `--quick`,
 //! under valgrind memcheck. Also compiles the header into two C++ translation units (wasmtime's
-//! double-include check) and records whether it is valid C89.
+//! double-include check) and records whether it is valid C89. The four-robot line runs in
+//! exact mode and with the protective verdict (`c_harness/line.c`).
 //!
 //! The static library is the one cargo builds in the same run: the test executable is
 //! `target/<profile>/deps/c_harness-HASH` and the library lies next to it in `deps/`.
@@ -143,15 +144,17 @@ fn assert_harness_passed(what: &str, out: &Output) -> String {
     stdout
 }
 
+/// The number that follows `before` in a harness output line.
+fn number(line: &str, before: &str) -> f64 {
+    let rest = line.split(before).nth(1).unwrap_or_else(|| panic!("no `{before}` in: {line}"));
+    let field = rest.split([' ', ',', ')']).find(|f| !f.is_empty()).unwrap();
+    field.parse().unwrap_or_else(|_| panic!("`{before}` is not followed by a number in: {line}"))
+}
+
 /// The speed-override lines (`c_harness/speed_override.c`), one per practical scenario: the
 /// boxes never touch (every tick, and every 0.1 ms of each stop simulated at a STOP), the
 /// scaled run completes its cycle, no sooner than the unscaled one, with fewer STOP ticks.
 fn assert_speed_override(stdout: &str) {
-    let number = |line: &str, before: &str| -> f64 {
-        let rest = line.split(before).nth(1).unwrap_or_else(|| panic!("no `{before}` in: {line}"));
-        let field = rest.split([' ', ',', ')']).find(|f| !f.is_empty()).unwrap();
-        field.parse().unwrap_or_else(|_| panic!("`{before}` is not followed by a number in: {line}"))
-    };
     for cell in ["T1", "T2", "T3"] {
         let prefix = format!("speed override {cell} practical: ");
         let line = stdout.lines().find(|l| l.starts_with(&prefix)).unwrap_or_else(|| panic!("no `{prefix}` line"));
@@ -163,6 +166,37 @@ fn assert_speed_override(stdout: &str) {
         let (stops, unscaled_stops) = (number(line, "STOP "), number(line, "(unscaled "));
         assert!(stops < unscaled_stops, "the override needs fewer stops than the unscaled run: {line}");
         assert_eq!(number(line, "stops simulated "), stops, "a stop is simulated at every STOP: {line}");
+    }
+}
+
+/// The four-robot line's lines (`c_harness/line.c`): in exact mode the practical case is FREE on
+/// every tick; the collision case stops after tick 3000, at the exact model's first colliding
+/// tick, on the pair R3-R4 (robots 2-3, `tests/line_scenarios.rs`). With the protective verdict
+/// (default and stiff models, the stiff one also with paths) no simulated stop touches, and in
+/// the collision case every first STOP comes no later than that tick. T1's table is refused.
+fn assert_line(stdout: &str) {
+    let line = |prefix: &str| -> &str {
+        stdout.lines().find(|l| l.starts_with(prefix)).unwrap_or_else(|| panic!("no `{prefix}` line"))
+    };
+    let practical = line("line4 practical");
+    assert!(practical.contains("POU stop tick none, first exact collision none, FREE ticks 6000/6000"), "{practical}");
+    let collision = line("line4 collision");
+    let (stop, first) = (number(collision, "POU stop tick "), number(collision, "first exact collision "));
+    assert!(stop > 3000.0 && stop == first, "{collision}");
+    assert!(collision.ends_with("colliding pairs at the stop 2-3"), "{collision}");
+    assert!(number(collision, "pairs that can meet ") >= 5.0, "{collision}");
+    assert!(line("line4 table mode").contains("tables serve two-robot cells"), "T1's table refused for the line");
+    let protective: Vec<&str> = stdout.lines().filter(|l| l.starts_with("protective line4 ")).collect();
+    assert_eq!(protective.len(), 6, "three protective runs per case: {protective:?}");
+    for l in protective {
+        assert_eq!(number(l, "contacts "), 0.0, "{l}");
+        assert_eq!(number(l, "statuses not OK "), 0.0, "{l}");
+        assert!(number(l, "smallest clearance ") > 10.0, "{l}");
+        if l.starts_with("protective line4 collision") {
+            let first_stop = number(l, "first STOP ");
+            assert!(first_stop >= 0.0 && first_stop <= first, "STOP after the first collision tick {first}: {l}");
+            assert!(number(l, ", stop ") > 0.0, "the stop was simulated: {l}");
+        }
     }
 }
 
@@ -199,6 +233,7 @@ fn harness_passes_with_tables(kind: usize) {
     let stdout = assert_harness_passed(&format!("c_harness (exact and {} table mode, T1 T2 T3)", KINDS[kind].0), &out);
     assert!(stdout.contains("bad input: done (exact and table mode)"), "table-mode bad inputs did not run");
     assert_speed_override(&stdout);
+    assert_line(&stdout);
     let runs = summaries(&stdout);
     assert_eq!(runs.len(), 6, "one table-mode summary per cell and case: {runs:?}");
     for (cell, case, table_stop, exact_first) in &runs {
@@ -310,7 +345,8 @@ fn c_harness_is_clean_under_valgrind_memcheck() {
     compile_probe(&probe_dir, &[]);
     let out = run(Command::new("valgrind").args(memcheck).arg(probe_dir.join("probe")).arg("leak"));
     assert_eq!(out.status.code(), Some(99), "valgrind missed the probe's leak:\n{}", text(&out.stderr));
-    // The harness: the T1 collision scenario in both modes, all bad inputs, T1's table.
+    // The harness: the T1 collision scenario in both modes, all bad inputs, T1's table, the
+    // line's collision case in exact mode.
     let tmp = scratch_dir("c_harness");
     let out = run(Command::new("valgrind")
         .args(memcheck)
@@ -325,6 +361,7 @@ fn c_harness_is_clean_under_valgrind_memcheck() {
     let stdout = assert_harness_passed(&format!("c_harness --quick under {}", version.trim()), &out);
     assert!(stdout.contains("T1 collision table: stop tick"), "the table-mode scenario did not run under valgrind");
     assert!(stdout.contains("bad input: done (exact and table mode)"), "bad inputs did not all run under valgrind");
+    assert!(stdout.contains("colliding pairs at the stop 2-3"), "the line's collision case did not run under valgrind");
 }
 
 #[test]

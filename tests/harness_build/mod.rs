@@ -47,6 +47,7 @@ pub fn harness_sources() -> Vec<PathBuf> {
     let expected = [
         "bad_input.c",
         "harness.c",
+        "line.c",
         "main.c",
         "mock_robotics.c",
         "pou.c",
