@@ -266,6 +266,21 @@ impl TableChecker {
         }
     }
 
+    /// The certified lower bound on the clearance (SPEC §8, mm) that a clearance table
+    /// ([`Table::Clearance`]) stores for the grid cell of `tcps_mcs` (robot j's TCP in its own
+    /// MCS): every configuration of that cell has at least this clearance. `None` when
+    /// nothing is proved: no level for the cell (it may collide), a TCP unreachable or outside
+    /// the table's grid, not two TCPs, or not a clearance table. One lookup, no allocation.
+    pub fn clearance_bound(&self, tcps_mcs: &[Vec3]) -> Option<f64> {
+        let table = self.table.as_clearance()?;
+        let [ta, tb] = tcps_mcs else { return None };
+        if !(self.models[0].delta.is_reachable(ta) && self.models[1].delta.is_reachable(tb)) {
+            return None;
+        }
+        let (a, b) = (self.cell_of(0, ta)?, self.cell_of(1, tb)?);
+        table.bound_mm([a[0], a[1], a[2], b[0], b[1], b[2]])
+    }
+
     /// The exact check's verdict in the table's terms.
     fn exact_answer(&mut self, tcps_mcs: &[Vec3]) -> Result<TableAnswer, QueryError> {
         let v = self.exact.check(tcps_mcs)?;
