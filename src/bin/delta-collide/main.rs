@@ -431,6 +431,7 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
     let plot_size = (args.width, args.height);
     let table_name = format!("{} k = {}", table.table().name(), 1u32 << table.table().levels());
     let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
+    let is_clearance = table.table().as_clearance().is_some();
     let mut ns = Vec::new();
     // The table's answer and the exact verdict; counted in `c` unless a TCP is unreachable.
     let mut compare = |tcps: &[Vec3], c: &mut Confusion, ns: &mut Vec<u64>| -> Result<TableAnswer, String> {
@@ -478,6 +479,8 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
     let (rmax, dmax) = (ws.rcy, ws.zu + ws.hcy + ws.hco);
     let mut c = Confusion::default();
     let mut kept = 0;
+    // A clearance table's bound is timed on the same configurations afterwards.
+    let mut kept_tcps = Vec::new();
     while kept < n {
         for t in tcps.iter_mut() {
             *t =
@@ -487,6 +490,9 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
             && !matches!(compare(&tcps, &mut c, &mut ns)?, TableAnswer::Unreachable(_))
         {
             kept += 1;
+            if is_clearance {
+                kept_tcps.push([tcps[0], tcps[1]]);
+            }
         }
     }
     println!("{}", c.line(&format!("{n} random configurations")));
@@ -499,6 +505,24 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
         ns.len(),
         table.fallbacks()
     );
+    if let Some(q) = table.table().as_clearance() {
+        let (mut ns, mut per_level) = (Vec::with_capacity(kept_tcps.len()), vec![0u64; q.ladder().len() + 1]);
+        for tcps in &kept_tcps {
+            let start = Instant::now();
+            let bound = table.clearance_bound(std::hint::black_box(tcps));
+            ns.push(start.elapsed().as_nanos() as u64);
+            per_level[bound.map_or(0, |b| 1 + q.ladder().mm().iter().position(|&l| l == b).unwrap_or(0))] += 1;
+        }
+        ns.sort_unstable();
+        println!(
+            "clearance bound incl. IK reachability: median {} ns, p99.9 {} ns, max {} ns over {} queries",
+            percentile(&ns, 0.5),
+            percentile(&ns, 0.999),
+            ns[ns.len() - 1],
+            ns.len()
+        );
+        println!("{}", levels_line("random configurations", q, &per_level));
+    }
     confirm::report(cell, &table, SCENARIOS)?;
     Ok(())
 }
