@@ -242,7 +242,7 @@ impl TableChecker {
         if tcps_mcs.len() != 2 {
             return Err(QueryError::WrongRobotCount { expected: 2, found: tcps_mcs.len() });
         }
-        let mask = (0..2).fold(0u32, |m, j| m | (!self.models[j].delta.is_reachable(&tcps_mcs[j]) as u32) << j);
+        let mask = self.unreachable_mask(tcps_mcs);
         if mask != 0 {
             return Ok(TableAnswer::Unreachable(mask));
         }
@@ -264,6 +264,13 @@ impl TableChecker {
                 self.exact_answer(tcps_mcs)
             }
         }
+    }
+
+    /// Bit j set: robot j's TCP (of the first two of `tcps_mcs`, each in its own MCS) is
+    /// unreachable or not finite.
+    pub fn unreachable_mask(&self, tcps_mcs: &[Vec3]) -> u32 {
+        let reachable = |j: usize| tcps_mcs.get(j).is_some_and(|t| self.models[j].delta.is_reachable(t));
+        (0..2).fold(0u32, |m, j| m | u32::from(!reachable(j)) << j)
     }
 
     /// The certified lower bound on the clearance (SPEC §8, mm) that a clearance table
