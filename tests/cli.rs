@@ -251,6 +251,15 @@ fn clearance_table_through_build_inspect_eval_and_check() {
         levelled += 1;
     }
     assert!(levelled > 10 && none > 0, "{levelled} rows with a level, {none} without:\n{text}");
+    // quilt shades free cells by level: the middle levels' blues cover many cells.
+    let png = dir.join("quilt.png");
+    let out = cli(&["quilt", "--cell", "T1", "--table", table, "--axes", "zz", "--output", png.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (_, _, pixels) = read_png(&png);
+    // The quilt's level colours for 4 levels: white, two blues between, the top's dark blue.
+    let middle = [[177u8, 193, 227], [98, 132, 198]];
+    let shaded = pixels.iter().filter(|p| middle.contains(p)).count();
+    assert!(shaded > 1000, "{shaded} pixels of the middle levels' colours");
 }
 
 /// Signed clearance of the cell `cell` at `tcps` computed here, apart from
