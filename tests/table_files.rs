@@ -22,7 +22,7 @@ fn tables(s: &LabelledSpace) -> Vec<Table> {
         Table::D4(LinearQuadtree4d::build(s, Symmetry::Whole, SliceAxes::ZZ, 3).unwrap()),
         Table::Shared(SharedQuadtree6d::build(s, Symmetry::MirrorY).unwrap()),
         Table::Shared(SharedQuadtree6d::build_subdivided(s, &sub_cells(s), Symmetry::Whole).unwrap()),
-        Table::Clearance(ClearanceTable::build(s, &level_counts(s), Ladder::default_ladder(), Symmetry::MirrorY).unwrap()),
+        Table::Clearance(Box::new(ClearanceTable::build(s, &level_counts(s), Ladder::default_ladder(), Symmetry::MirrorY).unwrap())),
     ]
 }
 

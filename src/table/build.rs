@@ -274,7 +274,7 @@ pub(crate) fn assemble(
                     None => Err(TableError::BadInput { what: "no sub-cells were labelled".into() }),
                 },
                 Variant::Clearance(ladder) => match clearance.iter().find(|(l, _)| *l == ladder) {
-                    Some((_, counts)) => ClearanceTable::build(&space, counts, ladder, symmetry).map(Table::Clearance),
+                    Some((_, counts)) => ClearanceTable::build(&space, counts, ladder, symmetry).map(|t| Table::Clearance(Box::new(t))),
                     None => Err(TableError::BadInput {
                         what: "no clearance levels were labelled (clearance tables are built in one run)".into(),
                     }),

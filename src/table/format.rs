@@ -418,7 +418,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
         }
         let children = words(sections[2], u32::from_le_bytes);
         let table = clearance_from_sections(&shape, &ladder, &counts, codes, aux, children)?;
-        return Ok((header, Table::Clearance(table)));
+        return Ok((header, Table::Clearance(alloc::boxed::Box::new(table))));
     }
     if shape.symmetric {
         check_unstored_half(&shape, &codes)?;

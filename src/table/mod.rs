@@ -67,8 +67,9 @@ pub enum Table {
     D4(LinearQuadtree4d),
     /// 6-D quadtree with shared subtrees (beyond the thesis).
     Shared(SharedQuadtree6d),
-    /// Certified clearance levels per grid cell in a shared 6-D quadtree.
-    Clearance(ClearanceTable),
+    /// Certified clearance levels per grid cell (two shared 6-D quadtrees; boxed, being the
+    /// largest variant by far).
+    Clearance(alloc::boxed::Box<ClearanceTable>),
 }
 
 impl Table {

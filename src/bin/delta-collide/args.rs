@@ -670,7 +670,7 @@ fn parse_k(s: &str) -> Result<u32, String> {
 
 /// A clearance ladder: comma-separated lengths in mm, increasing.
 fn parse_ladder(s: &str) -> Result<Ladder, String> {
-    let mm = s.split(',').map(|v| parse_number::<f64>(v)).collect::<Result<Vec<_>, _>>()?;
+    let mm = s.split(',').map(parse_number::<f64>).collect::<Result<Vec<_>, _>>()?;
     Ladder::new(&mm).map_err(|e| e.to_string())
 }
 
