@@ -65,7 +65,8 @@ pub enum Command {
     /// with no number in it is a header) and writes one line `reachable,collide` per row;
     /// collide is NA when a TCP is unreachable. A malformed row is an error naming its line.
     /// --clearance adds the column clearance_mm: the exact signed clearance of the cell (mm;
-    /// the gap when apart, minus the penetration depth when intersecting; SPEC section 8).
+    /// the gap when apart, minus the penetration depth when intersecting; SPEC section 8);
+    /// with a clearance table, the table's certified lower bound (-inf: none proved).
     Check(CheckArgs),
     /// Replay a trajectory through the protective verdict
     ///
