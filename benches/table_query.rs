@@ -84,12 +84,14 @@ fn build(s: &LabelledSpace) -> Vec<Table> {
             Table::D5(q) => q.thesis_bytes(),
             Table::D4(q) => q.thesis_bytes(b),
             Table::Shared(q) => q.memory_bytes(),
+            Table::Clearance(q) => q.memory_bytes(),
         };
         let detail = match &t {
             Table::D6(q) => format!("{} codes ({} condensed)", q.codes().len(), q.condensed()),
             Table::D5(q) => format!("{} codes, {} intervals", q.parts().0.len(), q.parts().2.len()),
             Table::D4(q) => format!("{} codes, {} slices", q.parts().0.len(), q.slice_count()),
             Table::Shared(q) => format!("nodes per depth, leaves {:?}", q.nodes_per_depth()),
+            Table::Clearance(q) => format!("level tree at k / {}", 1u32 << q.shift()),
         };
         eprintln!(
             "  {name:<22} build {:>7.3} s  {detail:<32} ours {:>10} B  thesis formula {:>10} B",

@@ -389,6 +389,7 @@ fn contents(table: &Table) -> String {
             let bits: Vec<String> = q.slot_bits().iter().map(|b| b.to_string()).collect();
             format!("{} nodes ({}; slot bits {})", per_depth.iter().sum::<usize>(), depths.join("/"), bits.join("/"))
         }
+        Table::Clearance(q) => format!("{} levels, level tree at k / {}", q.ladder().len(), 1u32 << q.shift()),
     }
 }
 

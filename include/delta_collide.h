@@ -749,6 +749,24 @@ DcMode dc_mode(const struct DcCollider *handle);
 uint64_t dc_table_fallbacks(const struct DcCollider *handle);
 
 /*
+ Table mode with a clearance table (`delta-collide build --variant clearance`): the
+ certified lower bound on the robots' clearance (mm, SPEC section 8) over the table's grid
+ cell of `tcps_mcs` (robot j's TCP in its own MCS): every configuration of that cell keeps
+ the robots' boxes at least this far apart. One lookup; never allocates.
+
+ Writes `*out_mm` on every call: the bound with `DC_STATUS_OK`, or `-INFINITY` when
+ nothing is proved (the cell may collide, a TCP lies outside the table's grid, an
+ exact-mode handle or a boolean table) and on any error. Statuses as `dc_query`:
+ `DC_STATUS_NULL_POINTER` (handle, tcps_mcs or out_mm NULL), `DC_STATUS_WRONG_ROBOT_COUNT`,
+ `DC_STATUS_NON_FINITE`, `DC_STATUS_UNREACHABLE`, `DC_STATUS_PANIC`.
+
+ # Safety
+ `handle` must be NULL or a live handle not used by another thread; `tcps_mcs` must be
+ NULL or point to `n_tcps` readable `DcVec3`; `out_mm` must be NULL or writable.
+ */
+DcStatus dc_table_clearance_bound(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, double *out_mm);
+
+/*
  Table mode: chooses what a query does when the table's lookup says COLLISION, from the
  next query on: `DC_CONFIRMATION_EXACT` (the default) runs the exact check and answers its
  verdict, so the handle answers as exact mode; `DC_CONFIRMATION_NONE` answers the table's

@@ -189,6 +189,79 @@ fn build_inspect_eval_and_check_with_a_table() {
     assert_eq!(rows[2], ["0", "NA", "NA"]);
 }
 
+/// A clearance table through the command line: `build --variant clearance --levels`,
+/// `inspect` shows the levels and the grid cells per level, `eval` finds no false
+/// negative, and `check --table --clearance` writes the table's bound, never above the
+/// independent oracle's clearance, `-inf` where a row's cell may collide, NA when unreachable.
+#[test]
+fn clearance_table_through_build_inspect_eval_and_check() {
+    let dir = fresh_dir("clearance-table");
+    let table = dir.join("t1c.dct");
+    let table = table.to_str().unwrap();
+    let out = cli(&["build", "--cell", "T1", "--k", "16", "--variant", "clearance", "--levels", "0,10,30,90", "--output", table]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("sample pairs per level: no level"), "{}", stdout(&out));
+    let out = cli(&["inspect", table]);
+    let text = stdout(&out);
+    assert!(out.status.success() && text.contains("6D-clearance") && text.contains("[0.0, 10.0, 30.0, 90.0]"), "{text}");
+    assert!(text.contains(">= 90 mm") && text.contains("grid cells (all k^6, as stored) per level"), "{text}");
+    let out = cli(&["eval", "--cell", "T1", "--table", table, "--random", "20000"]);
+    let text = stdout(&out);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let fns: Vec<&str> =
+        text.lines().filter_map(|l| l.split("FN").nth(1)).map(|r| r.split_whitespace().next().unwrap()).collect();
+    assert_eq!(fns, vec!["0", "0", "0"], "practical, collision and random: no false negative");
+    // T1's collision scenario every 20 ticks (far apart, then intersecting), and one unreachable row.
+    let scenarios = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt")).unwrap();
+    let scenarios = delta_collide::cell::trajectory::parse_scenarios(&scenarios).unwrap();
+    let s = scenarios.iter().find(|s| s.cell == "T1" && s.case == "collision").unwrap();
+    let mut configs: Vec<Vec<Vec3>> = (0..6000)
+        .step_by(20)
+        .map(|tick| {
+            let mut t = vec![Vec3::zeros(); 2];
+            s.tcps_at(tick, &mut t);
+            t
+        })
+        .collect();
+    configs.push(vec![Vec3::new(0.0, 0.0, -900.0), Vec3::new(0.0, 0.0, -450.0)]);
+    let rows: Vec<String> =
+        configs.iter().map(|t| format!("{},{},{},{},{},{}", t[0].x, t[0].y, t[0].z, t[1].x, t[1].y, t[1].z)).collect();
+    let input = dir.join("in.csv");
+    std::fs::write(&input, rows.join("\n")).unwrap();
+    let out = cli(&["check", "--cell", "T1", "--table", table, "--clearance", "--input", input.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("reachable,collide,clearance_mm"));
+    let (mut levelled, mut none) = (0, 0);
+    for (line, t) in lines.zip(&configs) {
+        let f: Vec<&str> = line.split(',').collect();
+        let Some(truth) = oracle_clearance("T1", t) else {
+            assert_eq!(f, ["0", "NA", "NA"], "{t:?}");
+            continue;
+        };
+        if f[2] == "-inf" {
+            none += 1;
+            continue;
+        }
+        let bound: f64 = f[2].parse().unwrap();
+        assert!([0.0, 10.0, 30.0, 90.0].contains(&bound), "{line}");
+        assert!(bound <= truth, "{t:?}: the table's bound {bound} exceeds the clearance {truth}");
+        assert_eq!(f[1], "0", "a row with a level is free: {line}");
+        levelled += 1;
+    }
+    assert!(levelled > 10 && none > 0, "{levelled} rows with a level, {none} without:\n{text}");
+    // quilt shades free cells by level: the middle levels' blues cover many cells.
+    let png = dir.join("quilt.png");
+    let out = cli(&["quilt", "--cell", "T1", "--table", table, "--axes", "zz", "--output", png.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (_, _, pixels) = read_png(&png);
+    // The quilt's level colours for 4 levels: white, two blues between, the top's dark blue.
+    let middle = [[177u8, 193, 227], [98, 132, 198]];
+    let shaded = pixels.iter().filter(|p| middle.contains(p)).count();
+    assert!(shaded > 1000, "{shaded} pixels of the middle levels' colours");
+}
+
 /// Signed clearance of the cell `cell` at `tcps` computed here, apart from
 /// `geometry::clearance`: apart, the smallest box distance of `geometry::distance` (vertex and
 /// edge distances); intersecting, minus the smallest overlap (the shift that separates them)
@@ -364,7 +437,7 @@ fn usage_errors_exit_with_2_and_say_what_is_wrong() {
         (&["build", "--cell", "T1", "--output", table, "--k", "lots"], "power of two"),
         (
             &["build", "--cell", "T1", "--output", table, "--variant", "7d"],
-            "use 6d, 5d, 4d-yy, 4d-zz, shared or shared-sub",
+            "use 6d, 5d, 4d-yy, 4d-zz, shared, shared-sub or clearance",
         ),
         (
             &["build", "--cell", "T1", "--output", table, "--variant", "6d", "--t", "5"],
@@ -375,6 +448,14 @@ fn usage_errors_exit_with_2_and_say_what_is_wrong() {
             &["build", "--cell", "T1", "--output", table, "--variant", "shared-sub", "--labelling", "thesis"],
             "certified",
         ),
+        (&["build", "--cell", "T1", "--output", table, "--levels", "0,5"], "--variant clearance only"),
+        (&["build", "--cell", "T1", "--output", table, "--variant", "clearance", "--levels", "5,5"], "must increase"),
+        (&["build", "--cell", "T1", "--output", table, "--variant", "clearance", "--levels", "0,x"], "'0,x'"),
+        (
+            &["build", "--cell", "T1", "--output", table, "--variant", "clearance", "--labelling", "thesis"],
+            "certified",
+        ),
+        (&["build", "--cell", "T1", "--output", table, "--variant", "clearance", "--shard", "0/2"], "drop --shard"),
         (&["build", "--cell", "T9", "--output", table], "T1, T2, T3"),
         (&["build", "--cell", "cells/nope.toml", "--output", table], "nope.toml"),
         (&["inspect", "A", "B"], "unexpected argument 'B'"),

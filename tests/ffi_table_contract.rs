@@ -316,3 +316,74 @@ fn table_files_init_the_same_checker_as_buffers() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `dc_table_clearance_bound` on a T1 clearance table at k = 16: the handle's bound is the
+/// Rust `TableChecker`'s, never above the exact clearance, `-inf` exactly where the table
+/// says the cell may collide; errors and other handles give `-inf` with their status.
+#[test]
+fn clearance_bound_through_the_c_abi_matches_the_table_and_stays_under_the_exact_clearance() {
+    use delta_collide::cell::protective::clearance_now;
+    use delta_collide::cell::reference::reference_cell;
+    use delta_collide::cell::ExactChecker;
+    use delta_collide::cspace::{Progress, Workspace};
+    use delta_collide::math::Vec3;
+    use delta_collide::table::{build_table, to_bytes, Ladder, Labelling, TableChecker, Variant};
+    let cell = reference_cell("T1").unwrap();
+    let variant = Variant::Clearance(Ladder::default_ladder());
+    let (header, table, _) =
+        build_table(&cell, 16, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent).unwrap();
+    let bytes = to_bytes(&table, &header);
+    let checker = TableChecker::new(cell.clone(), &bytes).unwrap();
+    let config = Config::cell(450.0, 2);
+    let (s, h) = init_table(&config.c(), &bytes);
+    assert_eq!(s, DC_STATUS_OK, "{}", last_init_error());
+    let bound = |h: *mut DcCollider, tcps: &[DcVec3]| {
+        let mut mm = 12345.0;
+        // SAFETY: `h` is live or NULL, `tcps` readable, `mm` writable.
+        let s = unsafe { dc_table_clearance_bound(h, tcps.as_ptr(), tcps.len(), &mut mm) };
+        (s, mm)
+    };
+    let mut exact = ExactChecker::new(cell.clone());
+    let mut rng = StdRng::seed_from_u64(18);
+    let (mut levelled, mut none) = (0, 0);
+    for _ in 0..50_000 {
+        let p = |rng: &mut StdRng| {
+            v(rng.random_range(-230.0..230.0), rng.random_range(-230.0..230.0), rng.random_range(-530.0..-365.0))
+        };
+        let tcps = [p(&mut rng), p(&mut rng)];
+        let rust: Vec<Vec3> = tcps.iter().map(|t| Vec3::new(t.x, t.y, t.z)).collect();
+        let (s, mm) = bound(h, &tcps);
+        let verdict = exact.check(&rust).unwrap();
+        if !verdict.all_reachable() {
+            assert_eq!((s, mm), (DC_STATUS_UNREACHABLE, f64::NEG_INFINITY));
+            continue;
+        }
+        assert_eq!(s, DC_STATUS_OK);
+        assert_eq!(mm, checker.clearance_bound(&rust).unwrap_or(f64::NEG_INFINITY));
+        if mm == f64::NEG_INFINITY {
+            none += 1;
+        } else {
+            assert!(mm <= clearance_now(&exact).0, "{rust:?}: bound {mm} above the clearance");
+            levelled += 1;
+        }
+    }
+    assert!(levelled > 1000 && none > 100, "{levelled} with a level, {none} without");
+    let home = [v(150.0, 0.0, -450.0), v(-150.0, 0.0, -450.0)];
+    assert_eq!(bound(h, &home[..1]), (DC_STATUS_WRONG_ROBOT_COUNT, f64::NEG_INFINITY));
+    assert_eq!(bound(h, &[v(f64::NAN, 0.0, -450.0), home[1]]), (DC_STATUS_NON_FINITE, f64::NEG_INFINITY));
+    assert_eq!(bound(std::ptr::null_mut(), &home), (DC_STATUS_NULL_POINTER, f64::NEG_INFINITY));
+    // SAFETY: a live handle, readable TCPs; a NULL output is refused, not written.
+    assert_eq!(unsafe { dc_table_clearance_bound(h, home.as_ptr(), 2, std::ptr::null_mut()) }, DC_STATUS_NULL_POINTER);
+    // An exact-mode handle and a boolean table prove no bound.
+    let exact_handle = two_robot_cell(450.0, DC_METHOD_SAT);
+    assert_eq!(bound(exact_handle, &home), (DC_STATUS_OK, f64::NEG_INFINITY));
+    let (s, boolean) = init_table(&config.c(), table_bytes("T1"));
+    assert_eq!(s, DC_STATUS_OK);
+    assert_eq!(bound(boolean, &home), (DC_STATUS_OK, f64::NEG_INFINITY));
+    // SAFETY: live handles, destroyed once.
+    unsafe {
+        dc_destroy(h);
+        dc_destroy(exact_handle);
+        dc_destroy(boolean);
+    }
+}

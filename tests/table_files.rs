@@ -22,7 +22,14 @@ fn tables(s: &LabelledSpace) -> Vec<Table> {
         Table::D4(LinearQuadtree4d::build(s, Symmetry::Whole, SliceAxes::ZZ, 3).unwrap()),
         Table::Shared(SharedQuadtree6d::build(s, Symmetry::MirrorY).unwrap()),
         Table::Shared(SharedQuadtree6d::build_subdivided(s, &sub_cells(s), Symmetry::Whole).unwrap()),
+        Table::Clearance(Box::new(ClearanceTable::build(s, &level_counts(s), Ladder::default_ladder(), Symmetry::MirrorY).unwrap())),
     ]
+}
+
+/// Clearance level counts of every pair: 0 unless free, else 1 to 7 from the pair's number.
+fn level_counts(s: &LabelledSpace) -> Vec<u8> {
+    let free = |l: &delta_collide::cspace::Label| *l == delta_collide::cspace::Label::Free;
+    s.labels.iter().enumerate().map(|(i, l)| if free(l) { 1 + (i * 7 / 3 % 7) as u8 } else { 0 }).collect()
 }
 
 /// Sub-cells of every collision pair: every other sub-cell a collision, some "don't care".
@@ -150,6 +157,16 @@ fn corrupted_files(s: &LabelledSpace) -> Vec<(&'static str, Vec<u8>, &'static st
     b[at..at + 4].copy_from_slice(&60_000u32.to_le_bytes());
     reseal(&mut b);
     out.push(("child_index_out_of_range_shared.dctable", b, "child index"));
+    // Clearance: the level tree's first leaf set to a word that is no level's.
+    let Table::Clearance(t) = &ts[7] else { unreachable!("tables() ends with the clearance table") };
+    let mut b = to_bytes(&ts[7], &header(s));
+    let (e, l) = t.parts();
+    assert!(!l.leaves.is_empty(), "the synthetic clearance table has level leaves");
+    let words = t.ladder().len() + 5 + 2 * e.masks.len() + e.leaves.len() + 2 * l.masks.len();
+    let at = SECTIONS + 8 * words;
+    b[at..at + 8].copy_from_slice(&0b1010u64.to_le_bytes());
+    reseal(&mut b);
+    out.push(("leaf_not_a_level_clearance.dctable", b, "clearance leaf"));
     out
 }
 
@@ -185,8 +202,8 @@ fn a_loaded_table_answers_as_the_built_one() {
 }
 
 /// The file name of each table of [`tables`] in `tests/data/golden/`.
-const GOLDEN_SYNTHETIC: [&str; 7] =
-    ["6d", "6d_sym", "5d", "4d_yy_t0_sym", "4d_zz_t3", "shared_sym", "shared_sub"];
+const GOLDEN_SYNTHETIC: [&str; 8] =
+    ["6d", "6d_sym", "5d", "4d_yy_t0_sym", "4d_zz_t3", "shared_sym", "shared_sub", "clearance_sym"];
 
 /// The variants built from a reference cell for `tests/data/golden/`, with their file names.
 fn golden_variants() -> Vec<(&'static str, Variant)> {
@@ -197,6 +214,7 @@ fn golden_variants() -> Vec<(&'static str, Variant)> {
         ("4d_zz_t2", Variant::D4 { axes: SliceAxes::ZZ, t: 2 }),
         ("shared", Variant::Shared),
         ("shared_sub", Variant::SharedSubdivided),
+        ("clearance", Variant::Clearance(Ladder::default_ladder())),
     ]
 }
 

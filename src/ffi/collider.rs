@@ -180,6 +180,32 @@ impl Collider {
         }
     }
 
+    /// Table mode with a clearance table: the certified lower bound on the clearance (mm) of
+    /// the grid cell of `tcps` ([`TableChecker::clearance_bound`]), `-inf` when nothing is
+    /// proved (no level, a TCP outside the grid, exact mode or a boolean table). The status
+    /// as [`query`](Self::query) gives it for the same TCPs; the bound is `-inf` unless OK.
+    /// Never allocates.
+    pub(crate) fn clearance_bound(&mut self, tcps: &[DcVec3]) -> (DcStatus, f64) {
+        let none = f64::NEG_INFINITY;
+        if tcps.len() != self.tcps.len() {
+            return (DC_STATUS_WRONG_ROBOT_COUNT, none);
+        }
+        if tcps.iter().any(|t| !t.is_finite()) {
+            return (DC_STATUS_NON_FINITE, none);
+        }
+        for (dst, src) in self.tcps.iter_mut().zip(tcps) {
+            *dst = src.to_vec3();
+        }
+        match &self.checker {
+            Checker::Exact(c) if c.cell().robots.iter().zip(&self.tcps).any(|(r, t)| !r.model.delta.is_reachable(t)) => {
+                (DC_STATUS_UNREACHABLE, none)
+            }
+            Checker::Exact(_) => (DC_STATUS_OK, none),
+            Checker::Table(t) if t.unreachable_mask(&self.tcps) != 0 => (DC_STATUS_UNREACHABLE, none),
+            Checker::Table(t) => (DC_STATUS_OK, t.clearance_bound(&self.tcps).unwrap_or(none)),
+        }
+    }
+
     /// Replaces the tick, WARN threshold and stopping models of the protective verdict (and
     /// forgets the previous TCPs).
     pub(crate) fn set_stopping(&mut self, tick_ms: f64, warn_mm: f64, stops: &[DcStopConfig]) -> Result<(), InitError> {

@@ -592,6 +592,54 @@ pub unsafe extern "C" fn dc_table_fallbacks(handle: *const DcCollider) -> u64 {
     unsafe { handle.as_ref() }.map_or(0, |h| h.inner.table_fallbacks())
 }
 
+/// Table mode with a clearance table (`delta-collide build --variant clearance`): the
+/// certified lower bound on the robots' clearance (mm, SPEC section 8) over the table's grid
+/// cell of `tcps_mcs` (robot j's TCP in its own MCS): every configuration of that cell keeps
+/// the robots' boxes at least this far apart. One lookup; never allocates.
+///
+/// Writes `*out_mm` on every call: the bound with `DC_STATUS_OK`, or `-INFINITY` when
+/// nothing is proved (the cell may collide, a TCP lies outside the table's grid, an
+/// exact-mode handle or a boolean table) and on any error. Statuses as `dc_query`:
+/// `DC_STATUS_NULL_POINTER` (handle, tcps_mcs or out_mm NULL), `DC_STATUS_WRONG_ROBOT_COUNT`,
+/// `DC_STATUS_NON_FINITE`, `DC_STATUS_UNREACHABLE`, `DC_STATUS_PANIC`.
+///
+/// # Safety
+/// `handle` must be NULL or a live handle not used by another thread; `tcps_mcs` must be
+/// NULL or point to `n_tcps` readable `DcVec3`; `out_mm` must be NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn dc_table_clearance_bound(
+    handle: *mut DcCollider,
+    tcps_mcs: *const DcVec3,
+    n_tcps: usize,
+    out_mm: *mut f64,
+) -> DcStatus {
+    let mut bound = f64::NEG_INFINITY;
+    let status = boundary(|| {
+        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
+        if out_mm.is_null() || tcps_mcs.is_null() {
+            return DC_STATUS_NULL_POINTER;
+        }
+        if h.poisoned {
+            return DC_STATUS_PANIC;
+        }
+        // SAFETY: non-null, and the caller guarantees `n_tcps` readable elements.
+        let tcps = unsafe { std::slice::from_raw_parts(tcps_mcs, n_tcps) };
+        let answer = catch_unwind(AssertUnwindSafe(|| h.inner.clearance_bound(tcps)));
+        let (status, mm) = answer.unwrap_or_else(|_| {
+            h.poisoned = true;
+            (DC_STATUS_PANIC, f64::NEG_INFINITY)
+        });
+        bound = mm;
+        status
+    });
+    if !out_mm.is_null() {
+        // SAFETY: non-null; the caller guarantees it is writable.
+        unsafe { *out_mm = if status == DC_STATUS_OK { bound } else { f64::NEG_INFINITY } };
+    }
+    status
+}
+
 /// Table mode: chooses what a query does when the table's lookup says COLLISION, from the
 /// next query on: `DC_CONFIRMATION_EXACT` (the default) runs the exact check and answers its
 /// verdict, so the handle answers as exact mode; `DC_CONFIRMATION_NONE` answers the table's

@@ -12,11 +12,12 @@
 
 use crate::cell::Cell;
 use crate::cspace::certify::certify_rows;
+use crate::cspace::certify::clearance::clearance_counts;
 use crate::cspace::label::label_space_thesis_rows;
 use crate::cspace::symmetry::Symmetry;
 use crate::cspace::{CertifyConfig, Label, LabelledSpace, Progress, Refinement, Rows, SubCells, Workspace};
 use crate::table::{
-    Certification, Header, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
+    Certification, ClearanceTable, Header, Ladder, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
     TableError,
 };
 use core::fmt;
@@ -38,6 +39,8 @@ pub enum BuildError {
     Labelling(String),
     /// Sub-cells are certified: `SharedSubdivided` needs the certified labelling.
     SubCellsNeedCertified,
+    /// Clearance levels are proofs: `Clearance` needs the certified labelling.
+    ClearanceNeedsCertified,
     /// A builder refused the labels.
     Table(TableError),
 }
@@ -50,6 +53,9 @@ impl fmt::Display for BuildError {
             }
             BuildError::Labelling(m) => f.write_str(m),
             BuildError::SubCellsNeedCertified => f.write_str("sub-cells are certified; use the certified labelling"),
+            BuildError::ClearanceNeedsCertified => {
+                f.write_str("clearance levels are certified; use the certified labelling")
+            }
             BuildError::Table(e) => write!(f, "{e}"),
         }
     }
@@ -89,6 +95,9 @@ pub enum Variant {
     /// certified on their own ([`crate::cspace::label_space_subdivided`]; certified labelling
     /// only).
     SharedSubdivided,
+    /// Certified clearance levels of the ladder per grid cell ([`ClearanceTable`]; certified
+    /// labelling only).
+    Clearance(Ladder),
 }
 
 /// How the samples are labelled.
@@ -157,7 +166,17 @@ pub fn build_tables(
 ) -> Result<(Header, Vec<Table>, BuildReport), BuildError> {
     let start = Instant::now();
     let subdivide = variants.contains(&Variant::SharedSubdivided);
-    let labels = label_rows(cell, k, ws, subdivide, labelling, Rows::ALL, progress)?;
+    let mut labels = label_rows(cell, k, ws, subdivide, labelling, Rows::ALL, progress)?;
+    for &variant in variants {
+        if let Variant::Clearance(ladder) = variant {
+            if labelling != Labelling::Certified {
+                return Err(BuildError::ClearanceNeedsCertified);
+            }
+            let counts = clearance_counts(cell, k, ws, &labels.space.labels, ladder.mm(), Rows::ALL)
+                .map_err(BuildError::Labelling)?;
+            labels.clearance.push((ladder, counts));
+        }
+    }
     let label_secs = start.elapsed().as_secs_f64();
     let header = Header::for_cell(&labels.space, cell, *ws, labels.certification);
     let (tables, report) = assemble(labels, Symmetry::of(cell), variants, label_secs)?;
@@ -177,6 +196,9 @@ pub(crate) struct RowLabels {
     pub certification: Certification,
     /// How it labelled.
     pub labelling: Labelling,
+    /// Per clearance ladder asked for: how many of its levels each pair proves (one-shot
+    /// builds only).
+    pub clearance: Vec<(Ladder, Vec<u8>)>,
 }
 
 /// Labels the rows `rows` of A of `cell` (two robots) at `k`, with the sub-cells when
@@ -202,12 +224,13 @@ pub(crate) fn label_rows(
             let c = certify_rows(cell, k, ws, &CertifyConfig { refinement, progress }, rows)
                 .map_err(BuildError::Labelling)?;
             let certification = Certification::SweptBound;
-            RowLabels { space: c.space, sub: c.sub, sub_secs: c.sub_secs, certification, labelling }
+            RowLabels { space: c.space, sub: c.sub, sub_secs: c.sub_secs, certification, labelling, clearance: vec![] }
         }
         Labelling::ThesisMargin if subdivide => return Err(BuildError::SubCellsNeedCertified),
         Labelling::ThesisMargin => {
             let space = label_space_thesis_rows(cell, k, ws, rows, progress).map_err(BuildError::Labelling)?;
-            RowLabels { space, sub: None, sub_secs: 0.0, certification: Certification::ThesisBlowUp, labelling }
+            let certification = Certification::ThesisBlowUp;
+            RowLabels { space, sub: None, sub_secs: 0.0, certification, labelling, clearance: vec![] }
         }
     })
 }
@@ -223,7 +246,7 @@ pub(crate) fn assemble(
     variants: &[Variant],
     label_secs: f64,
 ) -> Result<(Vec<Table>, BuildReport), BuildError> {
-    let RowLabels { mut space, sub, sub_secs, labelling, .. } = labels;
+    let RowLabels { mut space, sub, sub_secs, labelling, clearance, .. } = labels;
     let mut report = BuildReport {
         samples: (space.grid_a.cells.len(), space.grid_b.cells.len()),
         pairs: space.labels.len(),
@@ -250,6 +273,12 @@ pub(crate) fn assemble(
                     Some(sub) => SharedQuadtree6d::build_subdivided(&space, sub, symmetry).map(Table::Shared),
                     None => Err(TableError::BadInput { what: "no sub-cells were labelled".into() }),
                 },
+                Variant::Clearance(ladder) => match clearance.iter().find(|(l, _)| *l == ladder) {
+                    Some((_, counts)) => ClearanceTable::build(&space, counts, ladder, symmetry).map(|t| Table::Clearance(Box::new(t))),
+                    None => Err(TableError::BadInput {
+                        what: "no clearance levels were labelled (clearance tables are built in one run)".into(),
+                    }),
+                },
             };
             table.map_err(BuildError::Table)
         })
@@ -257,3 +286,4 @@ pub(crate) fn assemble(
     report.build_secs = start.elapsed().as_secs_f64();
     Ok((tables, report))
 }
+

@@ -7,12 +7,12 @@
 //!      0    8  magic b"DCTABLE\0"
 //!      8    4  endianness marker 0x01020304 (reads 0x04030201 when byte-swapped)
 //!     12    4  format version (VERSION)
-//!     16    4  variant: 6, 5, 4, or 7 (the shared 6-D quadtree)
+//!     16    4  variant: 6, 5, 4, 7 (the shared 6-D quadtree) or 8 (clearance levels)
 //!     20    4  levels        24  4  k = 2^levels
 //!     28    4  flags: bit 0 = symmetric (reflection, thesis 3.2.8); bit 1 = sub-cells (one
 //!              extra level, variant 7 only); other bits 0
 //!     32    4  slice axes: 0 (6D, 5D), 1 = yy', 2 = zz' (4D)
-//!     36    4  similarity threshold t (0 unless 4D)
+//!     36    4  similarity threshold t (0 unless 4D); variant 8: the number n of clearance levels
 //!     40    8  fingerprint of the cell (`Cell::fingerprint`)
 //!     48    8  r (mm)        56 24  origin of A's grid (mm)    80 24  origin of B's grid
 //!    104   40  workspace Zu, Hcy, Rcy, Hco, Rco (mm)
@@ -28,6 +28,12 @@
 //!              section 1 = depth starts (levels entries) then per-node bases (u32);
 //!              section 2 = child indices (u32); bases are the running counts (as
 //!              written; loading lays the nodes out again for the query, `shared6d/pool.rs`)
+//!              variant 8 (flag bit 1 clear), two shared trees, exact then level
+//!              (`clearance/mod.rs`): section 0 = the n levels in mm (f64 bits), then
+//!              shift, nodes and leaves of the exact tree, nodes and leaves of the level
+//!              tree (u64 each), then per tree masks then leaves; section 1 = per tree depth
+//!              starts (levels, then levels - shift + 1 entries) then bases; section 2 = per
+//!              tree child indices (the exact tree's: its masks' non-uniform count)
 //!    end-8  8  FNV-1a 64 of every byte before it
 //! ```
 //! Loading checks magic, endianness and version first (so those errors are specific), then
@@ -39,7 +45,8 @@ use super::reader::Reader;
 use super::quadtree4d::{LinearQuadtree4d, SliceAxes};
 use super::quadtree5d::LinearQuadtree5d;
 use super::quadtree6d::LinearQuadtree6d;
-use super::shared6d::SharedQuadtree6d;
+use super::clearance::{ClearanceTable, TreeParts};
+use super::shared6d::{SharedParts, SharedQuadtree6d};
 use super::{Table, TableKind};
 #[cfg(feature = "std")]
 use crate::cspace::LabelledSpace;
@@ -176,15 +183,24 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
             (axes, q.threshold(), codes, slice_of.to_vec(), words.iter().flat_map(|w| w.to_le_bytes()).collect())
         }
         Table::Shared(q) => {
-            let p = q.parts();
-            owned = p.masks.iter().flatten().chain(&p.leaves).copied().collect();
-            let aux = p.depth_start.iter().chain(&p.bases).copied().collect();
-            (0, 0, &owned[..], aux, p.children.to_u32().iter().flat_map(|c| c.to_le_bytes()).collect())
+            let (words, aux, children) = shared_sections(&[], q.parts());
+            owned = words;
+            (0, 0, &owned[..], aux, children)
+        }
+        Table::Clearance(q) => {
+            let (e, l) = q.parts();
+            let mut head: Vec<u64> = q.ladder().mm().iter().map(|v| v.to_bits()).collect();
+            let len = |n: usize| n as u64;
+            head.extend([u64::from(q.shift()), len(e.masks.len()), len(e.leaves.len()), len(l.masks.len()), len(l.leaves.len())]);
+            owned = head.into_iter().chain(tree_words(&e)).chain(tree_words(&l)).collect();
+            let aux = e.depth_start.iter().chain(&e.bases).chain(&l.depth_start).chain(&l.bases).copied().collect();
+            let children = e.children.iter().chain(&l.children).flat_map(|c| c.to_le_bytes()).collect();
+            (0, q.ladder().len() as u32, &owned[..], aux, children)
         }
     };
     let n2 = match variant {
         5 => s2.len() / 2,
-        7 => s2.len() / 4,
+        7 | 8 => s2.len() / 4,
         _ => s2.len() / 8,
     };
     let mut out = Vec::with_capacity(HEADER_LEN + 8 * s0.len() + 4 * s1.len() + s2.len() + 8);
@@ -212,6 +228,19 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
     let sum = fnv1a64(&out);
     out.extend_from_slice(&sum.to_le_bytes());
     out
+}
+
+/// The sections of a shared tree: `head` then masks then leaves (u64), depth starts then
+/// bases (u32), child indices as bytes.
+fn shared_sections(head: &[u64], p: SharedParts) -> (Vec<u64>, Vec<u32>, Vec<u8>) {
+    let words = head.iter().chain(p.masks.iter().flatten()).chain(&p.leaves).copied().collect();
+    let aux = p.depth_start.iter().chain(&p.bases).copied().collect();
+    (words, aux, p.children.to_u32().iter().flat_map(|c| c.to_le_bytes()).collect())
+}
+
+/// A tree's masks then leaves, as section 0 holds them.
+fn tree_words(p: &TreeParts) -> impl Iterator<Item = u64> + '_ {
+    p.masks.iter().flatten().chain(&p.leaves).copied()
 }
 
 /// Fixed header fields that decide the table's shape.
@@ -244,8 +273,8 @@ fn read_prefix(r: &mut Reader<TableError>) -> Result<Shape, TableError> {
     let flags = r.u32("flags")?;
     let axes = r.u32("slice axes")?;
     let t = r.u32("threshold t")?;
-    if !matches!(variant, 4..=7) {
-        return Err(corrupt(format!("variant = {variant}, expected 6, 5, 4 or 7")));
+    if !matches!(variant, 4..=8) {
+        return Err(corrupt(format!("variant = {variant}, expected 6, 5, 4, 7 or 8")));
     }
     if levels == 0 || levels > super::code::MAX_LEVELS || k != 1 << levels {
         return Err(corrupt(format!("levels = {levels}, k = {k}: k must be 2^levels, levels in 1..=8")));
@@ -255,7 +284,11 @@ fn read_prefix(r: &mut Reader<TableError>) -> Result<Shape, TableError> {
             "flags = {flags:#x}: only bit 0 (symmetric) and, for variant 7, bit 1 (sub-cells) are defined"
         )));
     }
-    if (variant == 4 && !matches!(axes, 1 | 2)) || (variant != 4 && (axes != 0 || t != 0)) {
+    let rungs = super::clearance::MAX_RUNGS as u32;
+    if variant == 8 && (axes != 0 || !(1..=rungs).contains(&t)) {
+        return Err(corrupt(format!("variant 8 with slice axes = {axes}, {t} clearance levels (1 to {rungs})")));
+    }
+    if (variant == 4 && !matches!(axes, 1 | 2)) || (!matches!(variant, 4 | 8) && (axes != 0 || t != 0)) {
         return Err(corrupt(format!("variant {variant} with slice axes = {axes}, t = {t}")));
     }
     Ok(Shape { variant, levels, sub_levels: flags >> 1, symmetric: flags & 1 == 1, axes, t })
@@ -308,7 +341,7 @@ fn check_unstored_half(shape: &Shape, words: &[u64]) -> Result<(), TableError> {
         },
         5 => words.iter().position(|&c| top(5, c) & 1 << 3 == 0).map_or(Ok(()), |i| Err(lower(i))),
         4 if shape.axes == 2 => words.iter().position(|&c| top(4, c) & 1 << 2 == 0).map_or(Ok(()), |i| Err(lower(i))),
-        7 => {
+        7 | 8 => {
             // The root's 64 children, child index `bx << 5 | by << 4 | ...`: those with by = 0.
             let lower_children = (0..64u64).filter(|c| c >> 4 & 1 == 0).fold(0u64, |m, c| m | 1 << c);
             match words.get(..2) {
@@ -357,7 +390,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
     let sizes: [usize; 3] = match shape.variant {
         6 => [8, 4, 0],
         5 => [8, 4, 2],
-        7 => [8, 4, 4],
+        7 | 8 => [8, 4, 4],
         _ => [8, 4, 8],
     };
     let names = ["section 0 (codes)", "section 1 (offsets or slice indices)", "section 2 (intervals or slices)"];
@@ -371,8 +404,22 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
     }
     let sections = [r.take(lens[0], names[0])?, r.take(lens[1], names[1])?, r.take(lens[2], names[2])?];
     r.checksum()?;
-    let codes = words(sections[0], u64::from_le_bytes);
+    let mut codes = words(sections[0], u64::from_le_bytes);
     let aux = words(sections[1], u32::from_le_bytes);
+    if shape.variant == 8 {
+        let n = shape.t as usize;
+        if codes.len() < n + 5 {
+            return Err(corrupt(format!("section 0 has {} words, fewer than the {n} clearance levels and 5 counts", codes.len())));
+        }
+        let ladder: Vec<f64> = codes.drain(..n).map(f64::from_bits).collect();
+        let counts: Vec<u64> = codes.drain(..5).collect();
+        if shape.symmetric {
+            check_unstored_half(&shape, &codes)?;
+        }
+        let children = words(sections[2], u32::from_le_bytes);
+        let table = clearance_from_sections(&shape, &ladder, &counts, codes, aux, children)?;
+        return Ok((header, Table::Clearance(alloc::boxed::Box::new(table))));
+    }
     if shape.symmetric {
         check_unstored_half(&shape, &codes)?;
     }
@@ -419,6 +466,48 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
         }
     };
     Ok((header, table))
+}
+
+/// Splits `n` items off the front of `v`, or says which field is short.
+fn split_front<T>(v: &mut Vec<T>, n: u64, what: &str) -> Result<Vec<T>, TableError> {
+    match usize::try_from(n).ok().filter(|&n| n <= v.len()) {
+        Some(n) => Ok(v.drain(..n).collect()),
+        None => Err(corrupt(format!("{what}: {n} entries, the section has {} left", v.len()))),
+    }
+}
+
+/// The two trees of a clearance table from its sections (module doc: variant 8), `counts`
+/// being shift, nodes and leaves of the exact tree, nodes and leaves of the level tree.
+fn clearance_from_sections(
+    shape: &Shape,
+    ladder: &[f64],
+    counts: &[u64],
+    mut words: Vec<u64>,
+    mut aux: Vec<u32>,
+    mut children: Vec<u32>,
+) -> Result<ClearanceTable, TableError> {
+    let &[shift, nodes_e, leaves_e, nodes_l, leaves_l] = counts else {
+        return Err(corrupt("clearance table counts"));
+    };
+    let shift = u32::try_from(shift).ok().filter(|&s| s + 2 <= shape.levels).ok_or_else(|| {
+        corrupt(format!("clearance level tree shift = {shift} with levels = {}: need levels - shift >= 2", shape.levels))
+    })?;
+    let mut tree = |nodes: u64, leaves: u64, depths: u32, what: &str| -> Result<TreeParts, TableError> {
+        let m = split_front(&mut words, nodes.saturating_mul(2), what)?;
+        let masks: Vec<[u64; 2]> = m.chunks_exact(2).map(|m| [m[0], m[1]]).collect();
+        let leaves = split_front(&mut words, leaves, what)?;
+        let depth_start = split_front(&mut aux, u64::from(depths), what)?;
+        let bases = split_front(&mut aux, nodes, what)?;
+        let n_children: u64 = masks.iter().map(|m| u64::from(m[0].count_ones())).sum();
+        let children = split_front(&mut children, n_children, what)?;
+        Ok(TreeParts { masks, bases, depth_start, children, leaves })
+    };
+    let exact = tree(nodes_e, leaves_e, shape.levels, "clearance exact tree")?;
+    let levels = tree(nodes_l, leaves_l, shape.levels - shift + 1, "clearance level tree")?;
+    if !(words.is_empty() && aux.is_empty() && children.is_empty()) {
+        return Err(corrupt("clearance table sections hold more than their two trees"));
+    }
+    ClearanceTable::from_parts(shape.levels, shape.symmetric, ladder, shift, exact, levels)
 }
 
 /// [`from_bytes`], then [`Header::check_cell`] against the controller's cell fingerprint.

@@ -21,12 +21,21 @@ pub enum TableKind {
     Shared,
     /// As `Shared`, collision cells cut into 64 sub-cells (certified labelling only).
     SharedSub,
+    /// Certified clearance levels per grid cell (certified labelling only).
+    Clearance,
 }
 
 impl TableKind {
     /// Every kind, in the order the CLI lists them.
-    pub const ALL: [TableKind; 6] =
-        [TableKind::D6, TableKind::D5, TableKind::D4yy, TableKind::D4zz, TableKind::Shared, TableKind::SharedSub];
+    pub const ALL: [TableKind; 7] = [
+        TableKind::D6,
+        TableKind::D5,
+        TableKind::D4yy,
+        TableKind::D4zz,
+        TableKind::Shared,
+        TableKind::SharedSub,
+        TableKind::Clearance,
+    ];
 
     /// The name the CLI takes and prints (`--variant`).
     pub const fn name(self) -> &'static str {
@@ -37,6 +46,7 @@ impl TableKind {
             TableKind::D4zz => "4d-zz",
             TableKind::Shared => "shared",
             TableKind::SharedSub => "shared-sub",
+            TableKind::Clearance => "clearance",
         }
     }
 
@@ -49,18 +59,20 @@ impl TableKind {
             TableKind::D4zz => "4-D quadtree of zz'-slices grouped by similarity (thesis 3.2.6)",
             TableKind::Shared => "6-D quadtree with shared subtrees",
             TableKind::SharedSub => "As shared, collision cells cut into 64 sub-cells (certified labelling only)",
+            TableKind::Clearance => "Certified clearance levels per grid cell (--levels; certified labelling only)",
         }
     }
 
     /// The variant number a table file stores (`src/table/format.rs`); the 4-D kinds share
     /// 4 and tell their slice axes apart in a field of their own, the shared kinds share 7
-    /// and tell sub-cells apart by a flag.
+    /// and tell sub-cells apart by a flag; clearance tables are 8.
     pub const fn file_variant(self) -> u32 {
         match self {
             TableKind::D6 => 6,
             TableKind::D5 => 5,
             TableKind::D4yy | TableKind::D4zz => 4,
             TableKind::Shared | TableKind::SharedSub => 7,
+            TableKind::Clearance => 8,
         }
     }
 
@@ -78,10 +90,13 @@ impl TableKind {
             Table::D4(_) => TableKind::D4zz,
             Table::Shared(t) if t.sub_levels() > 0 => TableKind::SharedSub,
             Table::Shared(_) => TableKind::Shared,
+            Table::Clearance(_) => TableKind::Clearance,
         }
     }
 
-    /// What the builder makes for this kind, with threshold `t` for the 4-D kinds.
+    /// What the builder makes for this kind, with threshold `t` for the 4-D kinds (and the
+    /// default ladder for clearance tables: [`Variant::Clearance`](super::Variant) takes
+    /// another).
     #[cfg(feature = "std")]
     pub fn variant(self, t: u32) -> super::Variant {
         use super::Variant;
@@ -92,6 +107,7 @@ impl TableKind {
             TableKind::D4zz => Variant::D4 { axes: SliceAxes::ZZ, t },
             TableKind::Shared => Variant::Shared,
             TableKind::SharedSub => Variant::SharedSubdivided,
+            TableKind::Clearance => Variant::Clearance(super::Ladder::default_ladder()),
         }
     }
 }
@@ -108,7 +124,7 @@ pub struct UnknownTableKind;
 
 impl fmt::Display for UnknownTableKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("not a table kind; use 6d, 5d, 4d-yy, 4d-zz, shared or shared-sub")
+        f.write_str("not a table kind; use 6d, 5d, 4d-yy, 4d-zz, shared, shared-sub or clearance")
     }
 }
 

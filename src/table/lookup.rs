@@ -254,7 +254,7 @@ impl TableChecker {
             return Err(QueryError::WrongRobotCount { expected: 2, found: tcps_mcs.len() });
         }
         self.exact_boxes = None;
-        let mask = (0..2).fold(0u32, |m, j| m | (!self.models[j].delta.is_reachable(&tcps_mcs[j]) as u32) << j);
+        let mask = self.unreachable_mask(tcps_mcs);
         if mask != 0 {
             return Ok(TableAnswer::Unreachable(mask));
         }
@@ -276,6 +276,28 @@ impl TableChecker {
                 self.exact_answer(tcps_mcs)
             }
         }
+    }
+
+    /// Bit j set: robot j's TCP (of the first two of `tcps_mcs`, each in its own MCS) is
+    /// unreachable or not finite.
+    pub fn unreachable_mask(&self, tcps_mcs: &[Vec3]) -> u32 {
+        let reachable = |j: usize| tcps_mcs.get(j).is_some_and(|t| self.models[j].delta.is_reachable(t));
+        (0..2).fold(0u32, |m, j| m | u32::from(!reachable(j)) << j)
+    }
+
+    /// The certified lower bound on the clearance (SPEC §8, mm) that a clearance table
+    /// ([`Table::Clearance`]) stores for the grid cell of `tcps_mcs` (robot j's TCP in its own
+    /// MCS): every configuration of that cell has at least this clearance. `None` when
+    /// nothing is proved: no level for the cell (it may collide), a TCP unreachable or outside
+    /// the table's grid, not two TCPs, or not a clearance table. One lookup, no allocation.
+    pub fn clearance_bound(&self, tcps_mcs: &[Vec3]) -> Option<f64> {
+        let table = self.table.as_clearance()?;
+        let [ta, tb] = tcps_mcs else { return None };
+        if !(self.models[0].delta.is_reachable(ta) && self.models[1].delta.is_reachable(tb)) {
+            return None;
+        }
+        let (a, b) = (self.cell_of(0, ta)?, self.cell_of(1, tb)?);
+        table.bound_mm([a[0], a[1], a[2], b[0], b[1], b[2]])
     }
 
     /// The exact check's verdict in the table's terms.

@@ -18,6 +18,7 @@
 
 #[cfg(feature = "std")]
 pub(crate) mod build;
+pub mod clearance;
 pub mod code;
 pub(crate) mod error;
 pub mod format;
@@ -42,6 +43,7 @@ use alloc::{format, string::String};
 use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
 pub use build::{build_table, build_tables, BuildError, BuildReport, Labelling, Variant};
+pub use clearance::{ClearanceTable, Ladder};
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
 pub use kind::{TableKind, UnknownTableKind};
@@ -65,6 +67,9 @@ pub enum Table {
     D4(LinearQuadtree4d),
     /// 6-D quadtree with shared subtrees (beyond the thesis).
     Shared(SharedQuadtree6d),
+    /// Certified clearance levels per grid cell (two shared 6-D quadtrees; boxed, being the
+    /// largest variant by far).
+    Clearance(alloc::boxed::Box<ClearanceTable>),
 }
 
 impl Table {
@@ -77,6 +82,15 @@ impl Table {
             Table::D5(t) => t.query(cell6),
             Table::D4(t) => t.query(cell6),
             Table::Shared(t) => t.query(cell6),
+            Table::Clearance(t) => t.query(cell6),
+        }
+    }
+
+    /// The clearance table, when this is one.
+    pub fn as_clearance(&self) -> Option<&ClearanceTable> {
+        match self {
+            Table::Clearance(t) => Some(t),
+            _ => None,
         }
     }
 
@@ -97,6 +111,7 @@ impl Table {
             Table::D5(t) => t.levels(),
             Table::D4(t) => t.levels(),
             Table::Shared(t) => t.levels(),
+            Table::Clearance(t) => t.levels(),
         }
     }
 
@@ -116,6 +131,7 @@ impl Table {
             Table::D5(t) => t.symmetric(),
             Table::D4(t) => t.symmetric(),
             Table::Shared(t) => t.symmetric(),
+            Table::Clearance(t) => t.symmetric(),
         }
     }
 
@@ -126,6 +142,7 @@ impl Table {
             Table::D5(t) => t.memory_bytes(),
             Table::D4(t) => t.memory_bytes(),
             Table::Shared(t) => t.memory_bytes(),
+            Table::Clearance(t) => t.memory_bytes(),
         }
     }
 
@@ -147,6 +164,7 @@ impl Table {
                 vec![region(codes), region(slice_of), region(slices)]
             }
             Table::Shared(t) => vec![t.memory_region()],
+            Table::Clearance(t) => vec![t.exact_tree().memory_region(), t.level_tree().memory_region()],
         }
     }
 
@@ -158,6 +176,7 @@ impl Table {
             Table::D4(t) => format!("4D/{} t={}", if t.axes() == SliceAxes::YY { "yy" } else { "zz" }, t.threshold()),
             Table::Shared(t) if t.sub_levels() > 0 => "6D-shared/sub".into(),
             Table::Shared(_) => "6D-shared".into(),
+            Table::Clearance(_) => "6D-clearance".into(),
         }
     }
 }

@@ -13,7 +13,7 @@ use delta_collide::cell::reference::{reference_cell, REFERENCE_CELL_FILES};
 use delta_collide::cell::Cell;
 use delta_collide::math::Vec3;
 use delta_collide::table::code::MAX_LEVELS;
-use delta_collide::table::{Confirmation, Labelling, TableKind};
+use delta_collide::table::{Confirmation, Labelling, Ladder, TableKind};
 use std::path::PathBuf;
 use std::sync::LazyLock;
 
@@ -65,7 +65,8 @@ pub enum Command {
     /// with no number in it is a header) and writes one line `reachable,collide` per row;
     /// collide is NA when a TCP is unreachable. A malformed row is an error naming its line.
     /// --clearance adds the column clearance_mm: the exact signed clearance of the cell (mm;
-    /// the gap when apart, minus the penetration depth when intersecting; SPEC section 8).
+    /// the gap when apart, minus the penetration depth when intersecting; SPEC section 8);
+    /// with a clearance table, the table's certified lower bound (-inf: none proved).
     Check(CheckArgs),
     /// Replay a trajectory through the protective verdict
     ///
@@ -159,7 +160,8 @@ pub struct CheckArgs {
     #[arg(long, value_name = "FILE.csv")]
     pub output: Option<PathBuf>,
     /// Add the column clearance_mm: the exact signed clearance (mm, negative when the boxes
-    /// intersect; NA when a TCP is unreachable), also with --table
+    /// intersect; NA when a TCP is unreachable), also with --table; with a clearance table
+    /// (build --variant clearance), the table's certified lower bound (-inf: no level)
     #[arg(long)]
     pub clearance: bool,
     /// Add one column per robot pair that can meet, collide_A_B (A, B the robots' names):
@@ -223,6 +225,10 @@ pub struct BuildArgs {
     /// (0: lossless; only with --variant 4d-yy or 4d-zz) [default: 0]
     #[arg(long, value_name = "T", value_parser = clipped(parse_number::<u32>))]
     pub t: Option<u32>,
+    /// The clearance levels a clearance table proves per grid cell, increasing, in mm (1 to
+    /// 16 of them; only with --variant clearance) [default: 0,5,10,20,40,80,160]
+    #[arg(long, value_name = "MM,MM,...", value_parser = clipped(parse_ladder))]
+    pub levels: Option<Ladder>,
     /// How the samples are labelled
     #[arg(long, value_name = "LABELLING", default_value = "certified")]
     #[arg(value_parser = choice::<LabellingArg>())]
@@ -348,9 +354,9 @@ pub struct KindArg(pub TableKind);
 
 impl ValueEnum for KindArg {
     fn value_variants<'a>() -> &'a [Self] {
-        const ALL: [KindArg; 6] = {
+        const ALL: [KindArg; 7] = {
             let k = TableKind::ALL;
-            [KindArg(k[0]), KindArg(k[1]), KindArg(k[2]), KindArg(k[3]), KindArg(k[4]), KindArg(k[5])]
+            [KindArg(k[0]), KindArg(k[1]), KindArg(k[2]), KindArg(k[3]), KindArg(k[4]), KindArg(k[5]), KindArg(k[6])]
         };
         &ALL
     }
@@ -440,6 +446,27 @@ impl Cli {
                         "build",
                         ErrorKind::ArgumentConflict,
                         format!("--shards {n} applies to --shard auto only; --shard I/N gives the count itself"),
+                    ));
+                }
+                if b.levels.is_some() && b.variant.0 != TableKind::Clearance {
+                    return Err(usage_error(
+                        "build",
+                        ErrorKind::ArgumentConflict,
+                        format!("--levels applies to --variant clearance only, not to --variant {}", b.variant.0),
+                    ));
+                }
+                if b.variant.0 == TableKind::Clearance && b.labelling == LabellingArg::Thesis {
+                    return Err(usage_error(
+                        "build",
+                        ErrorKind::ArgumentConflict,
+                        "--variant clearance proves its levels: it needs --labelling certified".into(),
+                    ));
+                }
+                if b.variant.0 == TableKind::Clearance && b.shard.is_some() {
+                    return Err(usage_error(
+                        "build",
+                        ErrorKind::ArgumentConflict,
+                        "--variant clearance is built in one run: drop --shard".into(),
                     ));
                 }
                 if b.variant.0 == TableKind::SharedSub && b.labelling == LabellingArg::Thesis {
@@ -644,6 +671,12 @@ fn parse_k(s: &str) -> Result<u32, String> {
         Ok(k) if k >= 2 && k <= max && k.is_power_of_two() => Ok(k),
         _ => Err(fix),
     }
+}
+
+/// A clearance ladder: comma-separated lengths in mm, increasing.
+fn parse_ladder(s: &str) -> Result<Ladder, String> {
+    let mm = s.split(',').map(parse_number::<f64>).collect::<Result<Vec<_>, _>>()?;
+    Ladder::new(&mm).map_err(|e| e.to_string())
 }
 
 /// A finite length above 0 (mm).

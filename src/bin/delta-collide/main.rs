@@ -34,7 +34,7 @@ use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
-    build_table, from_bytes, to_bytes, Confirmation, Labelling, Table, TableAnswer, TableChecker,
+    build_table, from_bytes, to_bytes, Confirmation, Labelling, Table, TableAnswer, TableChecker, TableKind, Variant,
 };
 use std::io::{BufRead, Write};
 use std::path::Path;
@@ -191,7 +191,8 @@ pub(crate) fn write_output(
 #[derive(Clone, Copy)]
 struct Columns {
     /// `clearance_mm`: the exact signed clearance, NA when a TCP is unreachable, computed by
-    /// the exact model also in table mode.
+    /// the exact model also with a boolean table; with a clearance table, the table's
+    /// certified lower bound, `-inf` where it proves no level.
     clearance: bool,
     /// `collide_A_B` per pair that can meet (table mode: its one pair, the table's answer).
     pairs: bool,
@@ -232,7 +233,15 @@ fn check_rows(
             TableAnswer::Free => "1,0",
         };
         out.write_all(row.as_bytes()).map_err(write_err)?;
-        if columns.clearance {
+        if let (true, Some(bound)) = (columns.clearance, table.as_deref().filter(|t| t.table().as_clearance().is_some())) {
+            // A clearance table's certified bound: -inf where it proves no level.
+            let mm = bound.clearance_bound(tcps).unwrap_or(f64::NEG_INFINITY);
+            match answer {
+                TableAnswer::Unreachable(_) => write!(out, ",NA"),
+                _ => write!(out, ",{mm:.3}"),
+            }
+            .map_err(write_err)?;
+        } else if columns.clearance {
             if table.is_some() {
                 checker.check(tcps).map_err(at_line)?;
             }
@@ -286,7 +295,10 @@ fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
 
 fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
     let (cell, k, output) = (&args.cell, args.k, &args.output);
-    let variant = args.variant.0.variant(args.t.unwrap_or(0));
+    let variant = match (args.variant.0, args.levels) {
+        (TableKind::Clearance, Some(ladder)) => Variant::Clearance(ladder),
+        (kind, _) => kind.variant(args.t.unwrap_or(0)),
+    };
     let labelling = Labelling::from(args.labelling);
     check_memory(cell, k, &Workspace::THESIS, 1)?;
     let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
@@ -305,6 +317,9 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
         r.collisions, r.unreachable, r.symmetric
     );
     println!("labelling {:.2} s, building {:.2} s", r.label_secs, r.build_secs);
+    if let Some(q) = table.as_clearance() {
+        println!("{}", levels_line("sample pairs", q, &sampled_levels(cell, q)?));
+    }
     println!(
         "{}: {} ({} bytes in memory, {} bytes on disk)",
         output.display(),
@@ -368,7 +383,37 @@ fn describe(table: &Table) -> String {
         Table::D5(q) => format!("{}: thesis formula {} bytes", table.name(), q.thesis_bytes()),
         Table::D4(q) => format!("{}: {} slices", table.name(), q.slice_count()),
         Table::Shared(q) => format!("{}: nodes per depth then leaves {:?}", table.name(), q.nodes_per_depth()),
+        Table::Clearance(q) => format!(
+            "{}: levels {:?} mm; exact tree: nodes per depth then leaves {:?}; level tree at k / {}: {:?}",
+            table.name(),
+            q.ladder().mm(),
+            q.exact_tree().nodes_per_depth(),
+            1u32 << q.shift(),
+            q.level_tree().nodes_per_depth()
+        ),
     }
+}
+
+/// `counts` (index 0: no level, then one per level of `table`) as one line.
+fn levels_line(what: &str, table: &delta_collide::table::ClearanceTable, counts: &[u64]) -> String {
+    let mut parts = vec![format!("no level {}", counts[0])];
+    parts.extend(table.ladder().mm().iter().zip(&counts[1..]).map(|(mm, n)| format!(">= {mm} mm {n}")));
+    format!("{what} per level: {}", parts.join(", "))
+}
+
+/// Sample pairs per level of a clearance table (both TCPs' grid cells sampled; pairs whose
+/// cells are proved unreachable count as what is stored).
+fn sampled_levels(cell: &Cell, table: &delta_collide::table::ClearanceTable) -> Result<Vec<u64>, String> {
+    let k = 1u32 << table.levels();
+    let grid = |j: usize| SampleGrid::new(&Workspace::THESIS, k, &cell.robots[j].model.delta);
+    let (ga, gb) = (grid(0)?, grid(1)?);
+    let mut counts = vec![0u64; table.ladder().len() + 1];
+    for a in &ga.cells {
+        for b in &gb.cells {
+            counts[table.level_count([a[0], a[1], a[2], b[0], b[1], b[2]])] += 1;
+        }
+    }
+    Ok(counts)
 }
 
 fn inspect(args: &InspectArgs) -> Result<(), Failure> {
@@ -381,6 +426,11 @@ fn inspect(args: &InspectArgs) -> Result<(), Failure> {
     println!("cell fingerprint {:#018x}, margin {} mm ({:?})", h.cell_fingerprint, h.margin, h.certification);
     println!("grid origins A {:?} B {:?}; workspace {:?}", h.origin_a, h.origin_b, h.workspace);
     println!("memory {} bytes", table.memory_bytes());
+    match table.as_clearance() {
+        Some(q) if q.levels() <= 4 => println!("{}", levels_line("grid cells (all k^6, as stored)", q, &q.cells_per_level())),
+        Some(_) => println!("grid cells per level: k > 16, see build's sample pairs per level"),
+        None => {}
+    }
     Ok(())
 }
 
@@ -421,6 +471,7 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
     let plot_size = (args.width, args.height);
     let table_name = format!("{} k = {}", table.table().name(), 1u32 << table.table().levels());
     let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
+    let is_clearance = table.table().as_clearance().is_some();
     let mut ns = Vec::new();
     // The table's answer and the exact verdict; counted in `c` unless a TCP is unreachable.
     let mut compare = |tcps: &[Vec3], c: &mut Confusion, ns: &mut Vec<u64>| -> Result<TableAnswer, String> {
@@ -468,6 +519,8 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
     let (rmax, dmax) = (ws.rcy, ws.zu + ws.hcy + ws.hco);
     let mut c = Confusion::default();
     let mut kept = 0;
+    // A clearance table's bound is timed on the same configurations afterwards.
+    let mut kept_tcps = Vec::new();
     while kept < n {
         for t in tcps.iter_mut() {
             *t =
@@ -477,6 +530,9 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
             && !matches!(compare(&tcps, &mut c, &mut ns)?, TableAnswer::Unreachable(_))
         {
             kept += 1;
+            if is_clearance {
+                kept_tcps.push([tcps[0], tcps[1]]);
+            }
         }
     }
     println!("{}", c.line(&format!("{n} random configurations")));
@@ -489,6 +545,24 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
         ns.len(),
         table.fallbacks()
     );
+    if let Some(q) = table.table().as_clearance() {
+        let (mut ns, mut per_level) = (Vec::with_capacity(kept_tcps.len()), vec![0u64; q.ladder().len() + 1]);
+        for tcps in &kept_tcps {
+            let start = Instant::now();
+            let bound = table.clearance_bound(std::hint::black_box(tcps));
+            ns.push(start.elapsed().as_nanos() as u64);
+            per_level[bound.map_or(0, |b| 1 + q.ladder().mm().iter().position(|&l| l == b).unwrap_or(0))] += 1;
+        }
+        ns.sort_unstable();
+        println!(
+            "clearance bound incl. IK reachability: median {} ns, p99.9 {} ns, max {} ns over {} queries",
+            percentile(&ns, 0.5),
+            percentile(&ns, 0.999),
+            ns[ns.len() - 1],
+            ns.len()
+        );
+        println!("{}", levels_line("random configurations", q, &per_level));
+    }
     confirm::report(cell, &table, SCENARIOS)?;
     Ok(())
 }

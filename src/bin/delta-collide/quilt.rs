@@ -13,7 +13,9 @@
 //! where either robot's cell is proved wholly unreachable ([`cube_unreachable`]: no query can
 //! land there, the table may store anything), grey where either cell lies outside the sampled
 //! grid (no table entry: queries there fall back to the exact check). A cell whose centre is
-//! unreachable but which may hold reachable TCPs shows the table's answer.
+//! unreachable but which may hold reachable TCPs shows the table's answer. A clearance
+//! table's free cells are shaded by their proved clearance level, white for the lowest to
+//! dark blue for the top.
 
 use crate::args::{usage_error, QuiltArgs, QuiltAxes};
 use crate::picture::{draw_png, legend, plot_err, text, Swatch, COLLISION, FREE, OUTSIDE, UNREACHABLE};
@@ -300,8 +302,19 @@ fn colour_of(maps: &[GridMap; 2], table: &Table, c: [u16; 6]) -> (usize, RGBColo
         (Sampled::Outside, _) | (_, Sampled::Outside) => (3, OUTSIDE),
         (Sampled::Unreachable, _) | (_, Sampled::Unreachable) => (2, UNREACHABLE),
         _ if table.query_grid_cell(c) => (0, COLLISION),
-        _ => (1, FREE),
+        _ => match table.as_clearance() {
+            Some(t) => (1, level_colour(t.level_count(c), t.ladder().len())),
+            None => (1, FREE),
+        },
     }
+}
+
+/// The colour of a free cell of a clearance table with `count` of `n` levels proved: white
+/// for the lowest level, darker blue for each level above, the darkest for the top.
+fn level_colour(count: usize, n: usize) -> RGBColor {
+    let t = count.saturating_sub(1) as f64 / n.saturating_sub(1).max(1) as f64;
+    let mix = |a: f64, b: f64| (a + (b - a) * t).round() as u8;
+    RGBColor(mix(255.0, 20.0), mix(255.0, 70.0), mix(255.0, 170.0))
 }
 
 /// Every cell of every panel: `(panel, i, j, 6-D cell)`.
@@ -333,12 +346,16 @@ fn draw(root: &DrawingArea<BitMapBackend, Shift>, q: &Quilt, maps: &[GridMap; 2]
     for (n, line) in q.title.lines().enumerate() {
         root.draw(&Text::new(line.to_string(), (PAD as i32, 6 + 19 * n as i32), text(15, BLACK))).map_err(plot_err)?;
     }
-    let entries = [
+    let top = table.as_clearance().map(|t| (t.ladder().len(), format!("free, >= {} mm", t.ladder().mm()[t.ladder().len() - 1])));
+    let mut entries = vec![
         (Swatch::Square(COLLISION), "collision"),
-        (Swatch::Square(FREE), "free"),
-        (Swatch::Square(UNREACHABLE), "a cell proved unreachable (don't care)"),
-        (Swatch::Square(OUTSIDE), "outside the sampled grid"),
+        (Swatch::Square(FREE), if top.is_some() { "free, lowest level" } else { "free" }),
     ];
+    if let Some((n, label)) = &top {
+        entries.push((Swatch::Square(level_colour(*n, *n)), label.as_str()));
+    }
+    entries.push((Swatch::Square(UNREACHABLE), "a cell proved unreachable (don't care)"));
+    entries.push((Swatch::Square(OUTSIDE), "outside the sampled grid"));
     legend(root, (PAD as i32, TITLE as i32 - 20), &entries)?;
     let Layout { nh, nv, caption, gap, s } = layout(q, maps, (w, h))?;
     let (pw, ph) = (nh as f64 * s, nv as f64 * s);

@@ -46,6 +46,7 @@
 //! tool only (`eval` feature), `subdivided_labels.rs` spells the sub-cells out as labels at
 //! `2 k`.
 
+pub(crate) mod clearance;
 mod refine;
 #[cfg(feature = "eval")]
 mod subdivided_labels;

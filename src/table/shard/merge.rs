@@ -71,7 +71,14 @@ pub fn merge_shards(
     let space = LabelledSpace { grid_a: f.grid_a, grid_b: f.grid_b, labels: f.labels, margin: info.header.margin };
     let sub = (info.kind == TableKind::SharedSub).then_some(cells);
     let labels =
-        RowLabels { space, sub, sub_secs: secs.1, certification: info.header.certification, labelling: info.labelling };
+        RowLabels {
+            space,
+            sub,
+            sub_secs: secs.1,
+            certification: info.header.certification,
+            labelling: info.labelling,
+            clearance: vec![],
+        };
     let variant = info.kind.variant(info.t);
     let (mut tables, report) = assemble(labels, info.symmetry, &[variant], secs.0).map_err(ShardError::Build)?;
     let table = tables.pop().ok_or(ShardError::NoShards)?;

@@ -24,11 +24,22 @@ pub(super) enum Part {
     Node(u32),
 }
 
+/// What the extra level below the grid cells holds, when there is one.
+#[derive(Clone, Copy)]
+pub(crate) enum Fine<'a> {
+    /// Sub-cells of the pairs labelled collision (a subdivided table).
+    SubCells(&'a SubCells),
+    /// Per pair, a word that is one value for the whole grid cell (a clearance table's
+    /// levels, `crate::table::clearance`), not 64 places: its mirror pair's word merges in
+    /// unpermuted.
+    Words(&'a (dyn Fn(usize) -> u64 + Sync)),
+}
+
 /// Hash-consing builder over a [`SpaceView`].
 pub(super) struct Builder<'a> {
     view: SpaceView<'a>,
-    /// Sub-cells of the pairs labelled collision, when subdividing.
-    sub: Option<&'a SubCells>,
+    /// The level below the grid cells, if any.
+    sub: Option<Fine<'a>>,
     k: usize,
     /// Dense `k^3` maps from cell to sample index (`u32::MAX`: none, or not stored).
     dense_a: Vec<u32>,
@@ -139,7 +150,11 @@ impl Builder<'_> {
         let (mut care, mut value) = self.sub_masks(ia, ib);
         if let Some((ma, mb)) = self.view.mirror_pair(ia, ib) {
             let (c, v) = self.sub_masks(ma, mb);
-            (care, value) = (care | mirror_sub_cells(c), value | mirror_sub_cells(v));
+            let mirror = |m: u64| match self.sub {
+                Some(Fine::Words(_)) => m,
+                _ => mirror_sub_cells(m),
+            };
+            (care, value) = (care | mirror(c), value | mirror(v));
         }
         self.leaf(care, value)
     }
@@ -150,8 +165,12 @@ impl Builder<'_> {
             Label::Free => (u64::MAX, 0),
             Label::Unreachable => (0, 0),
             Label::Collision => {
-                let pair = (ia * self.view.space.grid_b.cells.len() + ib) as u64;
-                self.sub.and_then(|s| s.get(pair)).unwrap_or((u64::MAX, u64::MAX))
+                let pair = ia * self.view.space.grid_b.cells.len() + ib;
+                match self.sub {
+                    Some(Fine::SubCells(s)) => s.get(pair as u64).unwrap_or((u64::MAX, u64::MAX)),
+                    Some(Fine::Words(word)) => (u64::MAX, word(pair)),
+                    None => (u64::MAX, u64::MAX),
+                }
             }
         }
     }
@@ -240,12 +259,27 @@ impl SharedQuadtree6d {
         sub: &SubCells,
         symmetry: Symmetry,
     ) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, Some(sub), symmetry.is_mirrored())
+        Self::build_with(space, Some(Fine::SubCells(sub)), symmetry.is_mirrored())
+    }
+
+    /// As [`build`](Self::build) with one more level whose leaves hold, per pair labelled
+    /// collision, the word `word(pair)` (pairs numbered `ia * nb + ib`) for the whole grid
+    /// cell; a pair labelled free holds 0. Symmetric tables OR a pair's word with its mirror
+    /// pair's. Read back with [`query_word`](Self::query_word).
+    ///
+    /// # Errors
+    /// As [`build`](Self::build).
+    pub(crate) fn build_words(
+        space: &LabelledSpace,
+        word: &(dyn Fn(usize) -> u64 + Sync),
+        symmetry: Symmetry,
+    ) -> Result<SharedQuadtree6d, TableError> {
+        Self::build_with(space, Some(Fine::Words(word)), symmetry.is_mirrored())
     }
 
         fn build_with(
         space: &LabelledSpace,
-        sub: Option<&SubCells>,
+        sub: Option<Fine<'_>>,
         symmetric: bool,
     ) -> Result<SharedQuadtree6d, TableError> {
         let view = SpaceView::new(space, symmetric)?;

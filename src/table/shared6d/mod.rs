@@ -207,6 +207,19 @@ impl SharedQuadtree6d {
         }
     }
 
+    /// The stored word of the grid cell `cell` (indices at `2^levels`, every sub-cell of it
+    /// alike: a table whose sub-cell bits are not places but a per-cell value, as a clearance
+    /// table's are): a leaf, or `u64::MAX` / 0 for a uniform collision / free block, and
+    /// `u64::MAX` for an index beyond. The reads of [`query`](Self::query).
+    #[inline]
+    pub(crate) fn query_word(&self, cell: [u16; 6]) -> u64 {
+        let fine = self.levels + self.sub_levels;
+        match fold(cell, 1 << self.levels, self.symmetric) {
+            Some(c) => self.pool.query_word(&c.map(|v| v << self.sub_levels), fine),
+            None => u64::MAX,
+        }
+    }
+
     /// The answer of [`query`](Self::query) and every table read it makes, in order, as
     /// `(address, bytes, step)`: reads of one step depend only on earlier steps, so a query
     /// waits for at most one memory access per step. For the report tool, which counts cache

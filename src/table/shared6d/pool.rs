@@ -236,6 +236,30 @@ impl Pool {
         w[node] >> child_index(c, 0) & 1 == 1
     }
 
+    /// The whole stored word of the folded cell `c` (indices below `2^fine`, the last bit of
+    /// each ignored): a leaf's 64 bits, or all ones / all zeros for a uniform collision / free
+    /// block. The same reads as [`query`](Self::query); a clearance table's lookup.
+    #[inline(always)]
+    pub(super) fn query_word(&self, c: &[u16; 6], fine: u32) -> u64 {
+        let uniform = |collision: bool| if collision { u64::MAX } else { 0 };
+        let w = &self.words;
+        let entry = slot_of(w, self.is_wide(self.top_depths - 1), 0, self.top_index(c, fine));
+        if entry < 2 {
+            return uniform(entry == 1);
+        }
+        let mut node = self.region[self.top_depths as usize] as usize + entry - 2;
+        for d in self.top_depths..self.depths {
+            let bit = 1u64 << child_index(c, fine - 1 - d);
+            let (nonuniform, collision) = (w[node], w[node + 1]);
+            if nonuniform & bit == 0 {
+                return uniform(collision & bit != 0);
+            }
+            let rank = (nonuniform & (bit - 1)).count_ones() as usize;
+            node = self.region[d as usize + 1] as usize + slot_of(w, self.is_wide(d), node + 2, rank);
+        }
+        w[node]
+    }
+
     /// [`query`](Self::query) and its reads as `(address, bytes, step)`.
     #[cfg(any(test, feature = "eval"))]
     pub(super) fn query_reads(&self, c: &[u16; 6], fine: u32) -> (bool, Vec<(usize, usize, u32)>) {

@@ -1,0 +1,436 @@
+//! Certified clearance tables: per 6-D grid cell, a lower bound on the two robots'
+//! clearance taken from a ladder of levels fixed at build time (SPEC §6, §8).
+//!
+//! A level `L` is stored for a grid cell only when every configuration of the cell is proved
+//! to have clearance `>= L`: the whole-cell box sweeps of the certified labels with `L` mm
+//! added to robot A's sweeps are proved apart (`crate::cspace::certify`, the `extra` of the
+//! protective verdict's proof). A cell that may collide, or that no level can be proved for,
+//! has *no level*: the cells the boolean certified labels call COLLISION have none, and
+//! [`ClearanceTable::query`] answers exactly as the boolean `shared` table of the same labels.
+//!
+//! # Storage
+//! Two shared 6-D quadtrees ([`SharedQuadtree6d`]), looked up side by side (neither read
+//! depends on the other):
+//! - the *exact* tree: the boolean table of the certified labels, at `k` (free: level 0 or
+//!   more proved; collision: no level);
+//! - the *level* tree, at `k >> shift`: per coarse cell (a block of `2^shift` grid cells per
+//!   axis and robot) the smallest level proved for any free grid cell pair in it, as a
+//!   *thermometer word* below the coarse grid: `m` of the `n` levels proved gives bits
+//!   `m..64` set (`u64::MAX << m`), all `n` gives 0. Collision pairs are "don't care" there
+//!   (the exact tree answers them), a block of top-level cells is a uniform free child, and
+//!   the words in between are at most `n - 1` distinct leaves, stored once. The mirror merge
+//!   of a symmetric table ORs a pair's word with its mirror's: the smaller level wins.
+//!
+//! Storing a lower level than proved is always safe, so the builder takes the finest `shift`
+//! whose table is at most [`SIZE_BUDGET`] times the exact tree. A lookup is two descents of
+//! a fixed number of reads each; `trailing_zeros` of the word gives `m`.
+
+#[cfg(feature = "std")]
+mod coarse;
+
+use super::error::{corrupt, TableError};
+use super::shared6d::{SharedParts, SharedQuadtree6d};
+use alloc::{format, vec, vec::Vec};
+
+/// Most levels a ladder holds.
+pub const MAX_RUNGS: usize = 16;
+
+/// The levels of a clearance table (mm): finite, at least 0, strictly increasing, 1 to
+/// [`MAX_RUNGS`] of them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ladder {
+    len: u8,
+    mm: [f64; MAX_RUNGS],
+}
+
+// Every value is finite (checked in `Ladder::new`), so equality is reflexive.
+impl Eq for Ladder {}
+
+impl Ladder {
+    /// The default ladder: 0, 5, 10, 20, 40, 80, 160 mm.
+    pub const DEFAULT_MM: [f64; 7] = [0.0, 5.0, 10.0, 20.0, 40.0, 80.0, 160.0];
+
+    /// A ladder of `mm`.
+    ///
+    /// # Errors
+    /// [`TableError::BadInput`] naming the fault: no level, more than [`MAX_RUNGS`], a value
+    /// not finite or below 0, or not strictly increasing.
+    pub fn new(mm: &[f64]) -> Result<Ladder, TableError> {
+        let bad = |what: alloc::string::String| TableError::BadInput { what };
+        if mm.is_empty() || mm.len() > MAX_RUNGS {
+            return Err(bad(format!("a clearance ladder has 1 to {MAX_RUNGS} levels, got {}", mm.len())));
+        }
+        if let Some(v) = mm.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+            return Err(bad(format!("clearance level {v} mm must be finite and >= 0")));
+        }
+        if let Some(w) = mm.windows(2).find(|w| w[0] >= w[1]) {
+            return Err(bad(format!("clearance levels must increase: {} mm then {} mm", w[0], w[1])));
+        }
+        let mut out = [0.0; MAX_RUNGS];
+        out[..mm.len()].copy_from_slice(mm);
+        Ok(Ladder { len: mm.len() as u8, mm: out })
+    }
+
+    /// The default ladder ([`Ladder::DEFAULT_MM`]).
+    pub fn default_ladder() -> Ladder {
+        Ladder::new(&Ladder::DEFAULT_MM).expect("the default ladder is valid")
+    }
+
+    /// The levels (mm), lowest first.
+    pub fn mm(&self) -> &[f64] {
+        &self.mm[..usize::from(self.len)]
+    }
+
+    /// How many levels.
+    pub fn len(&self) -> usize {
+        usize::from(self.len)
+    }
+
+    /// Whether there is no level (never, for a ladder from [`Ladder::new`]).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// The thermometer word of a cell with `count` of `n` levels proved (module doc).
+pub(crate) fn word_of(count: usize, n: usize) -> u64 {
+    if count >= n {
+        0
+    } else {
+        u64::MAX << count
+    }
+}
+
+/// How many of `n` levels a stored word proves.
+#[inline]
+fn count_of(word: u64, n: usize) -> usize {
+    (word.trailing_zeros() as usize).min(n)
+}
+
+/// The builder's size limit: the level tree takes the finest coarsening that keeps the whole
+/// table at most this many times the exact (boolean) tree's bytes, or the coarsest.
+pub const SIZE_BUDGET: usize = 3;
+
+/// The stored arrays of one tree, as [`SharedQuadtree6d::from_parts`] takes them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TreeParts {
+    /// `[nonuniform, collision]` per inner node.
+    pub masks: Vec<[u64; 2]>,
+    /// Per inner node, where its children start.
+    pub bases: Vec<u32>,
+    /// First node of each inner depth, then the node count.
+    pub depth_start: Vec<u32>,
+    /// Child indices.
+    pub children: Vec<u32>,
+    /// Leaves.
+    pub leaves: Vec<u64>,
+}
+
+impl TreeParts {
+    fn of(t: &SharedQuadtree6d) -> TreeParts {
+        let p: SharedParts = t.parts();
+        let children = p.children.to_u32();
+        TreeParts { masks: p.masks, bases: p.bases, depth_start: p.depth_start, children, leaves: p.leaves }
+    }
+
+    fn tree(self, levels: u32, sub_levels: u32, symmetric: bool) -> Result<SharedQuadtree6d, TableError> {
+        let TreeParts { masks, bases, depth_start, children, leaves } = self;
+        SharedQuadtree6d::from_parts(levels, sub_levels, symmetric, masks, bases, depth_start, children, leaves)
+    }
+}
+
+/// A clearance table (module doc).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ClearanceTable {
+    exact: SharedQuadtree6d,
+    level_tree: SharedQuadtree6d,
+    shift: u32,
+    ladder: Ladder,
+}
+
+impl ClearanceTable {
+    /// The table of `space`'s certified labels and `counts` (per pair `ia * nb + ib`, how
+    /// many levels of `ladder` are proved; 0 for pairs not labelled free).
+    ///
+    /// # Errors
+    /// [`TableError::BadInput`] when `counts` and the labels disagree in length, or as
+    /// [`SharedQuadtree6d::build`].
+    #[cfg(feature = "std")]
+    pub fn build(
+        space: &crate::cspace::LabelledSpace,
+        counts: &[u8],
+        ladder: Ladder,
+        symmetry: crate::cspace::Symmetry,
+    ) -> Result<ClearanceTable, TableError> {
+        if counts.len() != space.labels.len() {
+            return Err(TableError::BadInput {
+                what: format!("{} clearance counts for {} labelled pairs", counts.len(), space.labels.len()),
+            });
+        }
+        let exact = SharedQuadtree6d::build(space, symmetry)?;
+        let levels = exact.levels();
+        let mut best = None;
+        for shift in 0..=levels.saturating_sub(2) {
+            let t = Self::build_at(space, counts, ladder, symmetry, exact.clone(), shift)?;
+            let fits = t.memory_bytes() <= SIZE_BUDGET * exact.memory_bytes();
+            best = Some(t);
+            if fits {
+                break;
+            }
+        }
+        best.ok_or_else(|| TableError::BadInput {
+            what: format!("k = {} is too small for a clearance table", 1u32 << levels),
+        })
+    }
+
+    /// As [`build`](Self::build) with the level tree coarsened by `shift` and `exact` the
+    /// boolean tree of `space`.
+    #[cfg(feature = "std")]
+    fn build_at(
+        space: &crate::cspace::LabelledSpace,
+        counts: &[u8],
+        ladder: Ladder,
+        symmetry: crate::cspace::Symmetry,
+        exact: SharedQuadtree6d,
+        shift: u32,
+    ) -> Result<ClearanceTable, TableError> {
+        let n = ladder.len();
+        let (coarse, coarse_counts) = coarse::coarsen(space, counts, shift, n as u8);
+        let word = |pair: usize| word_of(usize::from(coarse_counts[pair]), n);
+        let level_tree = SharedQuadtree6d::build_words(&coarse, &word, symmetry)?;
+        Ok(ClearanceTable { exact, level_tree, shift, ladder })
+    }
+
+    /// A table from stored parts: both trees as [`SharedQuadtree6d::from_parts`] validates
+    /// them (the level tree with one level of words below its coarse grid), and every leaf of
+    /// the level tree a thermometer word of a level strictly between none and the top.
+    ///
+    /// # Errors
+    /// [`TableError::Corrupt`] naming the first bad field.
+    pub fn from_parts(
+        levels: u32,
+        symmetric: bool,
+        ladder_mm: &[f64],
+        shift: u32,
+        exact: TreeParts,
+        level_tree: TreeParts,
+    ) -> Result<ClearanceTable, TableError> {
+        let ladder = Ladder::new(ladder_mm).map_err(|e| corrupt(format!("clearance ladder: {e}")))?;
+        let n = ladder.len();
+        if levels < 2 || shift > levels - 2 {
+            return Err(corrupt(format!(
+                "clearance level tree shift = {shift} with levels = {levels}: need levels - shift >= 2"
+            )));
+        }
+        let bad_leaf = |&w: &u64| !(1..n).contains(&count_of(w, n)) || word_of(count_of(w, n), n) != w;
+        if let Some((i, w)) = level_tree.leaves.iter().enumerate().find(|(_, w)| bad_leaf(w)) {
+            return Err(corrupt(format!("clearance leaf {i} = {w:#018x} is not the word of a level below the top")));
+        }
+        let exact = exact.tree(levels, 0, symmetric)?;
+        let level_tree = level_tree.tree(levels - shift, 1, symmetric)?;
+        Ok(ClearanceTable { exact, level_tree, shift, ladder })
+    }
+
+    /// How many levels are proved for the 6-D grid cell `cell` (indices at `k`; 0 for an
+    /// index beyond). Never allocates, never panics on a validated table.
+    #[inline]
+    pub fn level_count(&self, cell: [u16; 6]) -> usize {
+        let word = self.level_tree.query_word(cell.map(|v| v >> self.shift));
+        let collision = self.exact.query(cell);
+        // A free cell has level 0 proved when the ladder starts at 0 mm.
+        let floor = usize::from(self.ladder.mm[0] == 0.0);
+        if collision {
+            0
+        } else {
+            count_of(word, self.ladder.len()).max(floor)
+        }
+    }
+
+    /// The certified lower bound on the clearance over the grid cell `cell` (mm), or `None`
+    /// when no level is proved (the cell may collide).
+    #[inline]
+    pub fn bound_mm(&self, cell: [u16; 6]) -> Option<f64> {
+        self.level_count(cell).checked_sub(1).map(|i| self.ladder.mm[i])
+    }
+
+    /// Whether the grid cell is stored as collision (the exact tree's answer: the boolean
+    /// certified table's).
+    #[inline]
+    pub fn query(&self, cell: [u16; 6]) -> bool {
+        self.exact.query(cell)
+    }
+
+    /// The ladder.
+    pub fn ladder(&self) -> &Ladder {
+        &self.ladder
+    }
+
+    /// The level tree's coarsening: `2^shift` grid cells per axis and robot share a level.
+    pub fn shift(&self) -> u32 {
+        self.shift
+    }
+
+    /// Quadtree levels of the grid (`k = 2^levels`).
+    pub fn levels(&self) -> u32 {
+        self.exact.levels()
+    }
+
+    /// Whether only A's upper half is stored.
+    pub fn symmetric(&self) -> bool {
+        self.exact.symmetric()
+    }
+
+    /// The exact (boolean) tree.
+    pub fn exact_tree(&self) -> &SharedQuadtree6d {
+        &self.exact
+    }
+
+    /// The level tree.
+    pub fn level_tree(&self) -> &SharedQuadtree6d {
+        &self.level_tree
+    }
+
+    /// The stored arrays of both trees, exact then level (as
+    /// [`from_parts`](Self::from_parts) takes them).
+    pub fn parts(&self) -> (TreeParts, TreeParts) {
+        (TreeParts::of(&self.exact), TreeParts::of(&self.level_tree))
+    }
+
+    /// Bytes this table occupies in memory.
+    pub fn memory_bytes(&self) -> usize {
+        core::mem::size_of::<Self>() - 2 * core::mem::size_of::<SharedQuadtree6d>()
+            + self.exact.memory_bytes()
+            + self.level_tree.memory_bytes()
+    }
+
+    /// Grid cells per number of proved levels (index 0: no level), over every `k^6` grid
+    /// cell (a "don't care" cell counts as what is stored there). Queries every cell: for
+    /// reports at small `k`; allocates.
+    pub fn cells_per_level(&self) -> Vec<u64> {
+        let k = 1u32 << self.levels();
+        let mut out = vec![0u64; self.ladder.len() + 1];
+        let mut c = [0u16; 6];
+        for i in 0..(u64::from(k)).pow(6) {
+            for (j, v) in c.iter_mut().enumerate() {
+                *v = (i >> (self.levels() as usize * j) & u64::from(k - 1)) as u16;
+            }
+            out[self.level_count(c)] += 1;
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cspace::{Label, Symmetry};
+    use crate::table::synthetic::{space, Pattern};
+    use crate::table::SharedQuadtree6d;
+
+    #[test]
+    fn ladders_are_checked() {
+        assert!(Ladder::new(&Ladder::DEFAULT_MM).is_ok());
+        assert!(Ladder::new(&[]).is_err());
+        assert!(Ladder::new(&[0.0, 5.0, 5.0]).is_err());
+        assert!(Ladder::new(&[-1.0]).is_err());
+        assert!(Ladder::new(&[f64::NAN]).is_err());
+        assert!(Ladder::new(&[0.0; MAX_RUNGS + 1]).is_err());
+        assert_eq!(Ladder::new(&[1.0, 2.5]).unwrap().mm(), &[1.0, 2.5]);
+    }
+
+    #[test]
+    fn words_give_their_counts_back() {
+        for n in 1..=MAX_RUNGS {
+            for m in 0..=n {
+                assert_eq!(count_of(word_of(m, n), n), m, "n {n} m {m}");
+            }
+            // The OR of two words is the word of the smaller count (the mirror merge).
+            for (a, b) in [(0, n), (1, n), (n / 2, n - 1)] {
+                assert_eq!(word_of(a, n) | word_of(b, n), word_of(a.min(b), n));
+            }
+        }
+    }
+
+    /// Seeded counts: 0 on pairs not free, on free ones 1 to `n` from a hash of the pair.
+    fn counts_for(space: &crate::cspace::LabelledSpace, n: usize) -> Vec<u8> {
+        let hash = |i: usize| ((i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 58) as usize;
+        let count = |(i, l): (usize, &Label)| if *l == Label::Free { (1 + hash(i) % n) as u8 } else { 0 };
+        space.labels.iter().enumerate().map(count).collect()
+    }
+
+    /// Every sampled pair: no level exactly where the boolean shared table says collision;
+    /// otherwise a level proved for the pair (and its mirror), the smaller of the two at
+    /// `shift = 0`; the parts round trip.
+    #[test]
+    fn answers_every_pair_with_a_stored_level_it_has() {
+        let ladder = Ladder::default_ladder();
+        for (pattern, levels, symmetric) in [
+            (Pattern::Blobs, 2, false),
+            (Pattern::Noise { p: 0.3, seed: 1 }, 3, false),
+            (Pattern::Blobs, 4, true),
+            (Pattern::AsymmetricNoise { p: 0.2, seed: 5 }, 3, true),
+        ] {
+            let s = space(levels, pattern);
+            let counts = counts_for(&s, ladder.len());
+            let symmetry = Symmetry::from_flag(symmetric);
+            let boolean = SharedQuadtree6d::build(&s, symmetry).unwrap();
+            let view = crate::table::space::SpaceView::new(&s, symmetric).unwrap();
+            let nb = s.grid_b.cells.len();
+            for shift in 0..=levels - 2 {
+                let t = ClearanceTable::build_at(&s, &counts, ladder, symmetry, boolean.clone(), shift).unwrap();
+                let mut seen = vec![0usize; ladder.len() + 1];
+                for (ia, ca) in s.grid_a.cells.iter().enumerate() {
+                    for (ib, cb) in s.grid_b.cells.iter().enumerate() {
+                        if s.labels[ia * nb + ib] == Label::Unreachable {
+                            continue;
+                        }
+                        let cell = [ca[0], ca[1], ca[2], cb[0], cb[1], cb[2]];
+                        let mut own = usize::from(counts[ia * nb + ib]);
+                        if let Some((ma, mb)) = view.mirror_pair(ia, ib) {
+                            if s.labels[ma * nb + mb] != Label::Unreachable {
+                                own = own.min(usize::from(counts[ma * nb + mb]));
+                            }
+                        }
+                        let got = t.level_count(cell);
+                        assert_eq!(got == 0, boolean.query(cell), "{pattern:?} {shift} {cell:?}");
+                        assert!(got <= own, "{pattern:?} {shift} {cell:?}: {got} > {own}");
+                        if shift == 0 {
+                            assert_eq!(got, own, "{pattern:?} {cell:?}");
+                        }
+                        assert_eq!(t.bound_mm(cell), got.checked_sub(1).map(|i| ladder.mm()[i]));
+                        seen[got] += 1;
+                    }
+                }
+                // Coarse level trees may hold only the smallest level; the finest holds them all.
+                let distinct = seen.iter().filter(|&&c| c > 0).count();
+                assert!(distinct >= if shift == 0 { 3 } else { 2 }, "{pattern:?} {shift}: levels seen {seen:?}");
+                let (e, l) = t.parts();
+                let back = ClearanceTable::from_parts(levels, symmetric, ladder.mm(), shift, e, l).unwrap();
+                assert_eq!(back, t);
+                let k6 = (1u64 << levels).pow(6);
+                assert_eq!(t.cells_per_level().iter().sum::<u64>(), k6);
+            }
+        }
+    }
+
+    #[test]
+    fn leaves_that_are_not_level_words_are_refused() {
+        let s = space(3, Pattern::Noise { p: 0.3, seed: 1 });
+        let ladder = Ladder::default_ladder();
+        let counts = counts_for(&s, ladder.len());
+        let exact = SharedQuadtree6d::build(&s, Symmetry::Whole).unwrap();
+        let t = ClearanceTable::build_at(&s, &counts, ladder, Symmetry::Whole, exact, 0).unwrap();
+        let (e, l) = t.parts();
+        assert!(!l.leaves.is_empty());
+        for bad in [0u64, 0b1010, u64::MAX] {
+            let mut l = l.clone();
+            l.leaves[0] = bad;
+            let r = ClearanceTable::from_parts(3, false, ladder.mm(), 0, e.clone(), l);
+            assert!(matches!(r, Err(TableError::Corrupt { .. })), "{bad:#x}");
+        }
+        let r = ClearanceTable::from_parts(3, false, &[5.0, 1.0], 0, e.clone(), l.clone());
+        assert!(matches!(r, Err(TableError::Corrupt { .. })));
+        let r = ClearanceTable::from_parts(3, false, ladder.mm(), 2, e, l);
+        assert!(matches!(r, Err(TableError::Corrupt { .. })), "shift beyond levels - 2");
+    }
+}
