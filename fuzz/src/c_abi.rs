@@ -42,12 +42,14 @@ pub enum Op {
     /// flag (byte); then the capacity (byte) for `dc_last_init_error`, as after every init.
     Init = 0,
     /// `dc_query`: handle, count (byte: < 192 the robot count, else byte % 40), points, NULL
-    /// flags (byte: tcps, out_verdict, out_report).
+    /// flags (byte: tcps, out_verdict, out_report); then `dc_table_clearance_bound` of the
+    /// same TCPs.
     Query = 1,
     /// `dc_pair_results`: handle, capacity (byte * 2), NULL flags (byte: out, out_len).
     PairResults = 2,
     /// `dc_robot_count`, `dc_pair_count`, `dc_mode`, `dc_table_fallbacks`,
-    /// `dc_table_confirmations`, then `dc_set_table_confirmation`: handle.
+    /// `dc_table_confirmations`, then `dc_set_table_confirmation` and `dc_set_speed_limits`:
+    /// handle.
     Counts = 3,
     /// `dc_delta3_inverse_kinematics`: edits (byte % 4) of the thesis geometry, point, NULL
     /// flags (byte: geometry, out_theta).
@@ -178,6 +180,7 @@ fn query(input: &mut Input, live: &[Live]) {
         )
     };
     assert_ne!(status, DC_STATUS_PANIC, "dc_query panicked");
+    clearance_bound(l, tcps_ptr, count, (status == DC_STATUS_OK && nulls & 2 == 0).then_some(verdict));
     if nulls & 2 == 0 {
         assert!(verdict <= DC_VERDICT_COLLISION, "verdict {verdict}");
         assert_eq!(status == DC_STATUS_OK, verdict != DC_VERDICT_STOP, "status {status} with verdict {verdict}");
@@ -209,6 +212,25 @@ fn query(input: &mut Input, live: &[Live]) {
         DC_STATUS_NON_FINITE => assert_eq!(report.unreachable_mask, non_finite),
         DC_STATUS_UNREACHABLE => assert_eq!(report.unreachable_mask, unreachable),
         _ => check_ok_report(l, &report),
+    }
+}
+
+/// `dc_table_clearance_bound` on the TCPs of a `dc_query` (no input read): never a panic,
+/// `-inf` unless OK and always in exact mode, and a bound only where that query answered FREE
+/// (`verdict`: the query's, when it was OK and written).
+fn clearance_bound(l: Option<&Live>, tcps: *const DcVec3, count: usize, verdict: Option<DcVerdict>) {
+    let mut mm = f64::NAN;
+    // SAFETY: the handle is NULL or live; `tcps` is NULL or holds `count` points; `mm` is
+    // writable.
+    let status = unsafe { dc_table_clearance_bound(handle_of(l), tcps, count, &mut mm) };
+    assert_ne!(status, DC_STATUS_PANIC, "dc_table_clearance_bound panicked");
+    assert!(!mm.is_nan() && (status == DC_STATUS_OK || mm == f64::NEG_INFINITY), "status {status}, {mm} mm");
+    // SAFETY: NULL or live.
+    if unsafe { dc_mode(handle_of(l)) } != DC_MODE_TABLE {
+        assert_eq!(mm, f64::NEG_INFINITY);
+    }
+    if let (true, Some(v)) = (mm > f64::NEG_INFINITY, verdict) {
+        assert_eq!(v, DC_VERDICT_FREE, "a clearance bound of {mm} mm where the query says {v}");
     }
 }
 
@@ -341,7 +363,9 @@ fn pair_results(input: &mut Input, live: &[Live]) {
         // SAFETY: live handle.
         let exact = unsafe { dc_mode(l.handle) } == DC_MODE_EXACT;
         let no_boxes = p.box_a == DC_BOX_NONE && p.box_b == DC_BOX_NONE;
-        assert!(if exact { (p.collides == 0) == no_boxes } else { no_boxes }, "{p:?}");
+        // Table mode names boxes only when the exact check answered the collision.
+        assert_eq!(p.box_a == DC_BOX_NONE, p.box_b == DC_BOX_NONE, "{p:?}");
+        assert!(if exact { (p.collides == 0) == no_boxes } else { p.collides == 1 || no_boxes }, "{p:?}");
     }
 }
 
@@ -371,6 +395,17 @@ fn counts(input: &mut Input, live: &[Live]) {
         _ => DC_STATUS_INVALID_ARGUMENT,
     };
     assert_eq!(status, expected, "dc_set_table_confirmation({value})");
+    // And the speed limits by the same counts, with a value that is neither 0 nor 1 one time
+    // in three.
+    let on = ((fallbacks + confirmations + robots as u64) % 3) as u32;
+    // SAFETY: NULL or live.
+    let status = unsafe { dc_set_speed_limits(handle_of(l), on) };
+    let expected = match (l, on) {
+        (None, _) => DC_STATUS_NULL_POINTER,
+        (_, 0 | 1) => DC_STATUS_OK,
+        _ => DC_STATUS_INVALID_ARGUMENT,
+    };
+    assert_eq!(status, expected, "dc_set_speed_limits({on})");
 }
 
 /// The thesis geometry with up to three edits; also says whether it is unedited.
