@@ -654,21 +654,34 @@ pub unsafe extern "C" fn dc_table_clearance_bound(
 /// `handle` must be NULL or a live handle not used by another thread.
 #[no_mangle]
 pub unsafe extern "C" fn dc_set_table_confirmation(handle: *mut DcCollider, confirmation: DcConfirmation) -> DcStatus {
+    // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+    unsafe {
+        set_on_handle(handle, |c| match convert::confirmation_from_c(confirmation) {
+            Some(value) => {
+                c.set_table_confirmation(value);
+                Ok(())
+            }
+            None => Err(format!("confirmation = {confirmation}: use DC_CONFIRMATION_EXACT or DC_CONFIRMATION_NONE")),
+        })
+    }
+}
+
+/// The body of a setup setter: NULL and poisoned handles are statuses; `set` applies the
+/// value or says why it is refused (`DC_STATUS_INVALID_ARGUMENT`, the handle unchanged);
+/// `dc_last_init_error` holds that message, or is cleared.
+///
+/// # Safety
+/// `handle` must be NULL or a live handle not used by another thread.
+unsafe fn set_on_handle(handle: *mut DcCollider, set: impl FnOnce(&mut Collider) -> Result<(), String>) -> DcStatus {
     boundary(|| {
         // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
         let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
         if h.poisoned {
             return DC_STATUS_PANIC;
         }
-        let (status, message) = match convert::confirmation_from_c(confirmation) {
-            Some(c) => {
-                h.inner.set_table_confirmation(c);
-                (DC_STATUS_OK, String::new())
-            }
-            None => (
-                DC_STATUS_INVALID_ARGUMENT,
-                format!("confirmation = {confirmation}: use DC_CONFIRMATION_EXACT or DC_CONFIRMATION_NONE"),
-            ),
+        let (status, message) = match set(&mut h.inner) {
+            Ok(()) => (DC_STATUS_OK, String::new()),
+            Err(message) => (DC_STATUS_INVALID_ARGUMENT, message),
         };
         let _ = LAST_INIT_ERROR.try_with(|m| *m.borrow_mut() = message);
         status
@@ -689,22 +702,16 @@ pub unsafe extern "C" fn dc_set_table_confirmation(handle: *mut DcCollider, conf
 /// `handle` must be NULL or a live handle not used by another thread.
 #[no_mangle]
 pub unsafe extern "C" fn dc_set_speed_limits(handle: *mut DcCollider, on: u32) -> DcStatus {
-    boundary(|| {
-        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
-        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
-        if h.poisoned {
-            return DC_STATUS_PANIC;
-        }
-        let (status, message) = match on {
+    // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+    unsafe {
+        set_on_handle(handle, |c| match on {
             0 | 1 => {
-                h.inner.set_speed_limits(on == 1);
-                (DC_STATUS_OK, String::new())
+                c.set_speed_limits(on == 1);
+                Ok(())
             }
-            _ => (DC_STATUS_INVALID_ARGUMENT, format!("on = {on}: use 1 (speed limits) or 0 (verdict only)")),
-        };
-        let _ = LAST_INIT_ERROR.try_with(|m| *m.borrow_mut() = message);
-        status
-    })
+            _ => Err(format!("on = {on}: use 1 (speed limits) or 0 (verdict only)")),
+        })
+    }
 }
 
 /// Table mode: how many queries so far the table's lookup said COLLISION and the exact check

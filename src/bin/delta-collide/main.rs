@@ -137,6 +137,12 @@ fn man(dir: Option<&Path>) -> Result<(), Failure> {
     Ok(())
 }
 
+/// `median .. ns, p99.9 .. ns, max .. ns over .. queries` of sorted, non-empty times (ns).
+fn spread(ns: &[u64]) -> String {
+    let (median, p999, max) = (percentile(ns, 0.5), percentile(ns, 0.999), ns[ns.len() - 1]);
+    format!("median {median} ns, p99.9 {p999} ns, max {max} ns over {} queries", ns.len())
+}
+
 pub(crate) fn percentile(sorted: &[u64], p: f64) -> u64 {
     sorted[((sorted.len() - 1) as f64 * p).round() as usize]
 }
@@ -537,14 +543,7 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
     }
     println!("{}", c.line(&format!("{n} random configurations")));
     ns.sort_unstable();
-    println!(
-        "table query incl. IK reachability: median {} ns, p99.9 {} ns, max {} ns over {} queries; {} exact fallbacks",
-        percentile(&ns, 0.5),
-        percentile(&ns, 0.999),
-        ns[ns.len() - 1],
-        ns.len(),
-        table.fallbacks()
-    );
+    println!("table query incl. IK reachability: {}; {} exact fallbacks", spread(&ns), table.fallbacks());
     if let Some(q) = table.table().as_clearance() {
         let (mut ns, mut per_level) = (Vec::with_capacity(kept_tcps.len()), vec![0u64; q.ladder().len() + 1]);
         for tcps in &kept_tcps {
@@ -554,13 +553,7 @@ fn eval(args: &EvalArgs) -> Result<(), Failure> {
             per_level[bound.map_or(0, |b| 1 + q.ladder().mm().iter().position(|&l| l == b).unwrap_or(0))] += 1;
         }
         ns.sort_unstable();
-        println!(
-            "clearance bound incl. IK reachability: median {} ns, p99.9 {} ns, max {} ns over {} queries",
-            percentile(&ns, 0.5),
-            percentile(&ns, 0.999),
-            ns[ns.len() - 1],
-            ns.len()
-        );
+        println!("clearance bound incl. IK reachability: {}", spread(&ns));
         println!("{}", levels_line("random configurations", q, &per_level));
     }
     confirm::report(cell, &table, SCENARIOS)?;
