@@ -75,7 +75,7 @@
 use crate::cell::exact::PairVerdict;
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::cspace::guarantee::{cube_box_sweeps, cube_box_sweeps_with, theta_range, Enclosure};
-use crate::geometry::clearance::boxes_clearance;
+use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
 use crate::geometry::sweep::{swept_boxes_apart_with, FaceTerms};
 use crate::robot::MAX_BOXES;
 use crate::geometry::{swept_boxes_apart, Obb, Sweep};
@@ -240,6 +240,9 @@ pub struct ProtectiveChecker {
     no_faces: FaceTerms,
     /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
     kept: kept::Kept,
+    /// Per robot pair that can meet, what its clearance was at the last tick: where this
+    /// tick's computation starts (same answer, a fraction of the time).
+    clearances: alloc::vec::Vec<CoherentClearance>,
     report: ProtectiveReport,
 }
 
@@ -282,7 +285,8 @@ impl ProtectiveChecker {
         let unit = Obb::new(Vec3::zeros(), crate::math::Mat3::identity(), Vec3::repeat(1.0));
         let no_faces = FaceTerms::new(&unit, &Sweep::ZERO);
         let exact = ExactChecker::new(cell);
-        let kept = kept::Kept::new(n, exact.verdict().pairs.len());
+        let n_pairs = exact.verdict().pairs.len();
+        let kept = kept::Kept::new(n, n_pairs);
         Ok(ProtectiveChecker {
             exact,
             warn_mm,
@@ -299,6 +303,7 @@ impl ProtectiveChecker {
             reach: alloc::vec![0.0; n],
             sweep_tier: alloc::vec![None; n],
             no_faces,
+            clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             kept,
             report: ProtectiveReport {
                 verdict: Protective::Stop,
@@ -498,7 +503,8 @@ impl ProtectiveChecker {
             self.report.status = ProtectiveStatus::Unreachable(j);
             return;
         }
-        let (clearance, closest) = clearance_now(&self.exact);
+        let memory = &mut self.clearances;
+        let (clearance, closest) = clearance_over_pairs(&self.exact, |k, a, b| memory[k].boxes_clearance(a, b));
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let v = self.report.robots[j].speed_mm_s;
@@ -942,11 +948,20 @@ fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(
 
 /// The signed clearance of the cell as of the exact checker's last check (SPEC §8: the gap
 /// when apart, minus the penetration depth when intersecting, 0 when touching) and its
-/// closest box pair: the one place that computes it (mm).
+/// closest box pair (mm).
 pub fn clearance_now(exact: &ExactChecker) -> (Real, Option<BoxPair>) {
+    clearance_over_pairs(exact, |_, a, b| boxes_clearance(a, b))
+}
+
+/// [`clearance_now`] with each robot pair's clearance from `pair_clearance(pair index, boxes
+/// of a, boxes of b)`.
+fn clearance_over_pairs(
+    exact: &ExactChecker,
+    mut pair_clearance: impl FnMut(usize, &[Obb], &[Obb]) -> PairClearance,
+) -> (Real, Option<BoxPair>) {
     let mut best = (Real::INFINITY, None);
-    for p in &exact.verdict().pairs {
-        let c = boxes_clearance(exact.boxes(p.a).as_slice(), exact.boxes(p.b).as_slice());
+    for (k, p) in exact.verdict().pairs.iter().enumerate() {
+        let c = pair_clearance(k, exact.boxes(p.a).as_slice(), exact.boxes(p.b).as_slice());
         // A NaN distance (a non-finite box) wins, so it shows in the report.
         if c.distance.is_nan() || c.distance < best.0 {
             best = (c.distance, Some(BoxPair { a: p.a, b: p.b, box_a: c.box_a, box_b: c.box_b }));

@@ -34,6 +34,9 @@
 // "check it" or "colliding" side.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod coherent;
+pub use coherent::{CoherentClearance, WARM_MIN_GAP};
+
 use crate::geometry::obb::Obb;
 use crate::math::{float, Real, Vec3, CROSS_AXIS_MIN_NORM, SAT_EPSILON, SAT_TOUCH_TOLERANCE};
 
@@ -289,15 +292,21 @@ pub fn boxes_clearance_lower_bound(a: &[Obb], b: &[Obb]) -> Real {
 /// (a gap within the SAT's touch tolerance reads as touching). NaN or infinite input gives
 /// a NaN distance.
 pub fn obb_clearance(a: &Obb, b: &Obb) -> Clearance {
+    obb_clearance_with_feature(a, b).0
+}
+
+/// [`obb_clearance`] and, when apart, the features its closest points lie on.
+fn obb_clearance_with_feature(a: &Obb, b: &Obb) -> (Clearance, Feature) {
     if !finite(a, b) {
-        return Clearance { distance: Real::NAN, point_a: a.center, point_b: b.center };
+        return (Clearance { distance: Real::NAN, point_a: a.center, point_b: b.center }, Feature::None);
     }
     let rel = rel(a, b);
     let axes = all_axes(&rel);
     if axes.iter().any(|ax| ax.lhs.abs() > ax.rhs_guarded) {
-        separated(a, &rel, &axes)
+        let best = separated(&rel, &axes);
+        (best.clearance(a), best.feature)
     } else {
-        penetrating(a, &rel, &axes)
+        (penetrating(a, &rel, &axes), Feature::None)
     }
 }
 
@@ -351,11 +360,41 @@ fn penetrating(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
     Clearance { distance, point_a: to_world(a, &pa), point_b: to_world(a, &pb) }
 }
 
-/// The closest pair found so far, in A's frame.
+/// The closest pair found so far, in A's frame, and the features it lies on.
 struct Best {
     d2: Real,
     p: [Real; 3],
     q: [Real; 3],
+    feature: Feature,
+}
+
+impl Best {
+    /// The clearance these points give, in the world frame (`a` is box A).
+    #[inline(always)]
+    fn clearance(&self, a: &Obb) -> Clearance {
+        Clearance { distance: float::sqrt(self.d2), point_a: to_world(a, &self.p), point_b: to_world(a, &self.q) }
+    }
+}
+
+/// The pair of features a candidate pair of points lies on, by the signs (`-1` or `+1`) that
+/// pick a vertex or an edge of a box: what [`coherent`] recomputes first at the next tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) enum Feature {
+    /// Nothing to start from (penetrating, touching, or never computed).
+    #[default]
+    None,
+    /// B's vertex `t + sum_l sg_l b_l B_l` and its closest point of A.
+    VertexOfB([i8; 3]),
+    /// A's vertex `sum_k sg_k a_k A_k` and its closest point of B.
+    VertexOfA([i8; 3]),
+    /// A's edge along `A_i` against B's edge along `B_j`, with [`edge_pair`]'s signs.
+    Edges { i: u8, j: u8, sg: [i8; 4] },
+}
+
+/// The signs `sg` as a feature's compact form.
+#[inline(always)]
+fn signs<const N: usize>(sg: [Real; N]) -> [i8; N] {
+    sg.map(|x| if x < 0.0 { -1 } else { 1 })
 }
 
 /// Apart: the exact distance, from the 16 vertex-to-box distances and the supporting edge
@@ -365,7 +404,7 @@ struct Best {
 /// crossing edge pair of cross axis `k` it equals the distance: so only the cross axes whose
 /// normalised gap reaches the largest gap `g` over the 15 axes (to rounding) need their edge
 /// pair, and none does when a vertex is already at distance `g`.
-fn separated(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
+fn separated(rel: &Rel, axes: &[AxisTerms; 15]) -> Best {
     // Rounding of a normalised gap: about 1e-16 * size / |n|, |n| >= CROSS_AXIS_MIN_NORM.
     // Generous for choosing edge pairs (an extra pair costs time only), tight for stopping
     // at a vertex (a vertex above the true distance by the tolerance would be kept).
@@ -400,7 +439,7 @@ fn separated(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
     // rounding), no pair of points is closer, and the rest is not needed.
     let widest = supporting_features(rel, widest, axes[widest].lhs);
     if widest.d2 <= reach * reach {
-        return Clearance { distance: float::sqrt(widest.d2), point_a: to_world(a, &widest.p), point_b: to_world(a, &widest.q) };
+        return widest;
     }
     let mut best = vertices(rel);
     if widest.d2 < best.d2 {
@@ -437,7 +476,7 @@ fn separated(a: &Obb, rel: &Rel, axes: &[AxisTerms; 15]) -> Clearance {
             edge_axis(rel, 2, 2, &mut best);
         }
     }
-    Clearance { distance: float::sqrt(best.d2), point_a: to_world(a, &best.p), point_b: to_world(a, &best.q) }
+    best
 }
 
 /// A pair of points of the two boxes on the features that support axis `k` (numbered as
@@ -457,7 +496,7 @@ fn supporting_features(rel: &Rel, k: usize, lhs: Real) -> Best {
             let q: [Real; 3] =
                 core::array::from_fn(|m| t[m] + sg[0] * b[0] * r[m][0] + sg[1] * b[1] * r[m][1] + sg[2] * b[2] * r[m][2]);
             let p: [Real; 3] = core::array::from_fn(|m| q[m].clamp(-a[m], a[m]));
-            Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q }
+            Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q, feature: Feature::VertexOfB(signs(sg)) }
         }
         3..=5 => {
             // A's vertex highest along side * B_j, and its clamp into B, back in A's frame.
@@ -468,10 +507,11 @@ fn supporting_features(rel: &Rel, k: usize, lhs: Real) -> Best {
             });
             let q: [Real; 3] =
                 core::array::from_fn(|m| t[m] + r[m][0] * xb[0] + r[m][1] * xb[1] + r[m][2] * xb[2]);
-            Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q }
+            let feature = Feature::VertexOfA(core::array::from_fn(|m| if side * sign(r[m][j]) < 0.0 { -1 } else { 1 }));
+            Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q, feature }
         }
         _ => {
-            let mut best = Best { d2: Real::INFINITY, p: [0.0; 3], q: [0.0; 3] };
+            let mut best = Best { d2: Real::INFINITY, p: [0.0; 3], q: [0.0; 3], feature: Feature::None };
             edge_axis(rel, (k - 6) / 3, (k - 6) % 3, &mut best);
             best
         }
@@ -515,14 +555,14 @@ fn vertices(rel: &Rel) -> Best {
     if d2b[vb] <= d2a[va] {
         let q: [Real; 3] = core::array::from_fn(|k| t[k] + (0..3).map(|l| sgn(vb, l) * b[l] * r[k][l]).sum::<Real>());
         let p = core::array::from_fn(|k| q[k].clamp(-a[k], a[k]));
-        Best { d2: d2b[vb], p, q }
+        Best { d2: d2b[vb], p, q, feature: Feature::VertexOfB(core::array::from_fn(|l| sgn(vb, l) as i8)) }
     } else {
         // A's vertex in A's frame, and its closest point of B (clamped in B's frame) back in A's.
         let p: [Real; 3] = core::array::from_fn(|k| sgn(va, k) * a[k]);
         let xb: [Real; 3] =
             core::array::from_fn(|l| (-tb[l] + (0..3).map(|k| p[k] * r[k][l]).sum::<Real>()).clamp(-b[l], b[l]));
         let q = core::array::from_fn(|k| t[k] + (0..3).map(|l| r[k][l] * xb[l]).sum::<Real>());
-        Best { d2: d2a[va], p, q }
+        Best { d2: d2a[va], p, q, feature: Feature::VertexOfA(core::array::from_fn(|k| sgn(va, k) as i8)) }
     }
 }
 
@@ -573,7 +613,7 @@ fn edge_pair(rel: &Rel, i: usize, j: usize, n2: Real, sg: [Real; 4], best: &mut 
     let q: [Real; 3] = core::array::from_fn(|k| q0[k] + u * r[k][j]);
     let d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
     if d2 < best.d2 {
-        *best = Best { d2, p, q };
+        *best = Best { d2, p, q, feature: Feature::Edges { i: i as u8, j: j as u8, sg: signs(sg) } };
     }
 }
 
