@@ -1,6 +1,7 @@
 //! Signed clearance (`geometry::obb_clearance`, `boxes_clearance`) and its lower bound against
 //! an oracle written here from scratch, on random box pairs of many kinds and on random
-//! configurations of two thesis robots in cell T1; parry3d-f64's distance compared on a sample.
+//! configurations of two thesis robots in cell T1, also tick by tick along runs
+//! (`CoherentClearance`); parry3d-f64's distance compared on a sample.
 //!
 //! Oracle: apart when some of the 15 axes (each normalised, skipping only degenerate cross
 //! products) shows a positive gap between the projections of the 8 vertices of each box; then
@@ -14,7 +15,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use delta_collide::geometry::{
-    boxes_clearance, boxes_clearance_lower_bound, obb_clearance, obb_clearance_lower_bound, separating_axis, Obb,
+    boxes_clearance, boxes_clearance_lower_bound, obb_clearance, obb_clearance_lower_bound, separating_axis,
+    CoherentClearance, Obb,
 };
 use delta_collide::math::{Mat3, Real, Vec3, CROSS_AXIS_MIN_NORM};
 use delta_collide::robot::RobotModel;
@@ -442,27 +444,8 @@ fn random_configurations_of_cell_t1_match_the_oracle() {
         let a = ra.as_slice();
         let b: Vec<Obb> = rb.as_slice().iter().map(|o| o.transformed(&Mat3::identity(), &shift)).collect();
         let ours = boxes_clearance(a, &b);
-        // Oracle: the minimum over the nine pairs, the full feature search only where the
-        // oracle's own axis gap does not already rule the pair out.
-        let mut truth = Real::INFINITY;
-        let mut order: Vec<(Real, usize, usize)> = Vec::with_capacity(9);
-        for (i, x) in a.iter().enumerate() {
-            for (j, y) in b.iter().enumerate() {
-                // Bounding spheres: a lower bound on the distance.
-                order.push(((x.center - y.center).norm() - x.half.norm() - y.half.norm(), i, j));
-            }
-        }
-        order.sort_by(|p, q| p.0.total_cmp(&q.0));
-        for &(sphere_gap, i, j) in &order {
-            if sphere_gap >= truth {
-                break;
-            }
-            if axis_gap_only(&a[i], &b[j]) >= truth {
-                continue;
-            }
-            truth = truth.min(oracle(&a[i], &b[j]).distance);
-            pairs_checked += 1;
-        }
+        let (truth, checked) = oracle_over_pairs(a, &b);
+        pairs_checked += checked;
         let case = || format!("config {done}: a = {a:?}; b = {b:?}; ours {ours:?}, oracle {truth}");
         assert!((ours.distance - truth).abs() <= TOL, "{}", case());
         let pair = obb_clearance(&a[ours.box_a], &b[ours.box_b]);
@@ -474,6 +457,76 @@ fn random_configurations_of_cell_t1_match_the_oracle() {
     }
     println!("{N} configurations, {colliding} colliding, {pairs_checked} pairs through the full oracle");
     assert!(colliding > 10_000 && colliding < N / 2);
+}
+
+/// The oracle's clearance of two robots: the minimum over their box pairs, the full feature
+/// search only where the oracle's own bounds do not already rule a pair out; and how many
+/// pairs took the full search.
+fn oracle_over_pairs(a: &[Obb], b: &[Obb]) -> (Real, usize) {
+    let (mut truth, mut checked) = (Real::INFINITY, 0);
+    let mut order: Vec<(Real, usize, usize)> = Vec::with_capacity(a.len() * b.len());
+    for (i, x) in a.iter().enumerate() {
+        for (j, y) in b.iter().enumerate() {
+            // Bounding spheres: a lower bound on the distance.
+            order.push(((x.center - y.center).norm() - x.half.norm() - y.half.norm(), i, j));
+        }
+    }
+    order.sort_by(|p, q| p.0.total_cmp(&q.0));
+    for &(sphere_gap, i, j) in &order {
+        if sphere_gap >= truth {
+            break;
+        }
+        if axis_gap_only(&a[i], &b[j]) >= truth {
+            continue;
+        }
+        truth = truth.min(oracle(&a[i], &b[j]).distance);
+        checked += 1;
+    }
+    (truth, checked)
+}
+
+/// `CoherentClearance` along runs of cell T1 at 1 ms ticks, where it starts from the last
+/// tick's features: each TCP moves at up to 4.5 m/s and turns at up to 130 m/s^2 (the
+/// stiff stopping model's limits), bouncing off the workspace, through near, touching and
+/// colliding configurations.
+#[test]
+fn runs_of_cell_t1_tick_by_tick_match_the_oracle() {
+    const RUNS: usize = 300;
+    const TICKS: usize = 2_000;
+    let model = RobotModel::THESIS;
+    let shift = Vec3::new(450.0, 0.0, 0.0);
+    let mut rng = StdRng::seed_from_u64(0xc1ea_0004);
+    let (mut ticks, mut close) = (0, 0);
+    for _ in 0..RUNS {
+        let mut memory = CoherentClearance::new();
+        let mut tcp = [random_tcp(&mut rng), random_tcp(&mut rng)];
+        let mut vel = [random_unit(&mut rng) * 2.0, random_unit(&mut rng) * 2.0];
+        for _ in 0..TICKS {
+            for j in 0..2 {
+                // mm per tick; 0.13 mm per tick^2 is 130 m/s^2.
+                let v = vel[j] + random_unit(&mut rng) * 0.13 * rng.random::<Real>();
+                vel[j] = v * (4.5 / v.norm()).min(1.0);
+                let next = tcp[j] + vel[j];
+                if model.boxes(&next).is_ok() {
+                    tcp[j] = next;
+                } else {
+                    vel[j] = -vel[j];
+                }
+            }
+            let (Ok(ra), Ok(rb)) = (model.boxes(&tcp[0]), model.boxes(&tcp[1])) else { continue };
+            let a = ra.as_slice();
+            let b: Vec<Obb> = rb.as_slice().iter().map(|o| o.transformed(&Mat3::identity(), &shift)).collect();
+            let ours = memory.boxes_clearance(a, &b);
+            let (truth, _) = oracle_over_pairs(a, &b);
+            assert!((ours.distance - truth).abs() <= TOL, "tick {ticks}: a = {a:?}; b = {b:?}; ours {ours:?}, oracle {truth}");
+            let pair = obb_clearance(&a[ours.box_a], &b[ours.box_b]).distance;
+            assert!((pair - ours.distance).abs() <= TOL, "tick {ticks}: the pair named gives {pair}, {ours:?}");
+            close += usize::from(ours.distance < 20.0);
+            ticks += 1;
+        }
+    }
+    println!("{ticks} ticks in {RUNS} runs, {close} with clearance under 20 mm");
+    assert!(close > ticks / 20, "too few close ticks to test: {close} of {ticks}");
 }
 
 /// The oracle's largest projection gap over the 15 axes (a lower bound on the clearance).
