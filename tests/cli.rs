@@ -224,17 +224,9 @@ fn clearance_table_through_build_inspect_eval_and_check() {
         })
         .collect();
     configs.push(vec![Vec3::new(0.0, 0.0, -900.0), Vec3::new(0.0, 0.0, -450.0)]);
-    let rows: Vec<String> =
-        configs.iter().map(|t| format!("{},{},{},{},{},{}", t[0].x, t[0].y, t[0].z, t[1].x, t[1].y, t[1].z)).collect();
-    let input = dir.join("in.csv");
-    std::fs::write(&input, rows.join("\n")).unwrap();
-    let out = cli(&["check", "--cell", "T1", "--table", table, "--clearance", "--input", input.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let text = stdout(&out);
-    let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("reachable,collide,clearance_mm"));
+    let text = check_clearance(&dir, &["--cell", "T1", "--table", table], &configs);
     let (mut levelled, mut none) = (0, 0);
-    for (line, t) in lines.zip(&configs) {
+    for (line, t) in text.lines().skip(1).zip(&configs) {
         let f: Vec<&str> = line.split(',').collect();
         let Some(truth) = oracle_clearance("T1", t) else {
             assert_eq!(f, ["0", "NA", "NA"], "{t:?}");
@@ -308,12 +300,26 @@ fn oracle_clearance(cell: &str, tcps: &[Vec3]) -> Option<f64> {
     Some(best)
 }
 
+/// Runs `check ARGS --clearance` on the two-robot configurations `configs` (one CSV row each,
+/// written into `dir`) and returns its output, after checking that it succeeded and that
+/// its header names the clearance column.
+fn check_clearance(dir: &Path, args: &[&str], configs: &[Vec<Vec3>]) -> String {
+    let rows: Vec<String> =
+        configs.iter().map(|t| format!("{},{},{},{},{},{}", t[0].x, t[0].y, t[0].z, t[1].x, t[1].y, t[1].z)).collect();
+    let input = dir.join("in.csv");
+    std::fs::write(&input, rows.join("\n")).unwrap();
+    let out = cli(&[&["check"], args, &["--clearance", "--input", input.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert_eq!(text.lines().next(), Some("reachable,collide,clearance_mm"));
+    text
+}
+
 /// `check --clearance` along T1's collision scenario (far apart at first, intersecting at the
 /// end) and one unreachable row: every printed clearance matches the oracle.
 #[test]
 fn check_clearance_matches_an_independent_signed_distance() {
     let dir = fresh_dir("clearance");
-    let input = dir.join("in.csv");
     let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt")).unwrap();
     let scenarios = delta_collide::cell::trajectory::parse_scenarios(&text).unwrap();
     let s = scenarios.iter().find(|s| s.cell == "T1" && s.case == "collision").unwrap();
@@ -324,16 +330,9 @@ fn check_clearance_matches_an_independent_signed_distance() {
         configs.push(t);
     }
     configs.push(vec![Vec3::new(0.0, 0.0, 100.0), Vec3::new(150.0, 0.0, -450.0)]);
-    let rows: Vec<String> =
-        configs.iter().map(|t| format!("{},{},{},{},{},{}", t[0].x, t[0].y, t[0].z, t[1].x, t[1].y, t[1].z)).collect();
-    std::fs::write(&input, rows.join("\n")).unwrap();
-    let out = cli(&["check", "--cell", "T1", "--clearance", "--input", input.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let text = stdout(&out);
-    let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("reachable,collide,clearance_mm"));
+    let text = check_clearance(&dir, &["--cell", "T1"], &configs);
     let (mut negative, mut far) = (0, 0);
-    for (line, t) in lines.zip(&configs) {
+    for (line, t) in text.lines().skip(1).zip(&configs) {
         let f: Vec<&str> = line.split(',').collect();
         let Some(truth) = oracle_clearance("T1", t) else {
             assert_eq!(f, ["0", "NA", "NA"], "{t:?}");
