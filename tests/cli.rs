@@ -53,6 +53,27 @@ fn names_in(dir: &Path) -> Vec<String> {
     names
 }
 
+/// `demo --cell FILE` on the four-robot line runs its own scenarios
+/// (`c_harness/line_scenarios.txt`): no collision in the practical run, R3-R4 first meeting at
+/// tick 3810 in the collision run (as T1's pair), a STOP before it and a clear stop.
+#[test]
+fn demo_runs_the_line_of_four_robots() {
+    let out = cli(&["demo", "--cell", "cells/line4.toml"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let rows: Vec<Vec<&str>> =
+        text.lines().filter(|l| l.starts_with("line4")).map(|l| l.split_whitespace().collect()).collect();
+    let firsts: Vec<_> = rows.iter().filter(|r| r[2].starts_with("SAT")).map(|r| (r[1], r[3])).collect();
+    assert_eq!(firsts, [("practical", "none"), ("practical", "none"), ("collision", "tick"), ("collision", "tick")], "{text}");
+    let at_3810 = text.lines().filter(|l| l.starts_with("line4 collision") && l.contains("tick 3810")).count();
+    assert_eq!(at_3810, 2, "SAT and SAT-cache: R3-R4 meet at tick 3810\n{text}");
+    let protective: Vec<&Vec<&str>> = rows.iter().filter(|r| r.len() == 10).collect();
+    assert_eq!(protective.len(), 2, "{text}");
+    for r in protective {
+        assert!(r[3].parse::<u32>().unwrap() < 3810 && r[6] == "clear", "{r:?}");
+    }
+}
+
 #[test]
 fn demo_reports_no_collision_when_practical_the_same_first_tick_for_both_methods_and_a_clear_stop() {
     let out = cli(&["demo", "--cell", "all"]);

@@ -5,7 +5,7 @@
 
 use crate::args::DemoArgs;
 use crate::stop::simulate_stop;
-use crate::{percentile, Failure, SCENARIOS};
+use crate::{percentile, Failure, LINE_SCENARIOS, SCENARIOS};
 use delta_collide::cell::protective::{Protective, ProtectiveChecker};
 use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
@@ -49,14 +49,15 @@ fn run(cell: &Cell, scenario: &Scenario) -> Result<RunResult, String> {
 }
 
 pub fn demo(args: &DemoArgs) -> Result<(), Failure> {
-    let scenarios = parse_scenarios(SCENARIOS)?;
+    let mut scenarios = parse_scenarios(SCENARIOS)?;
+    scenarios.extend(parse_scenarios(LINE_SCENARIOS)?);
     let cells = &args.cell.0;
     println!(
         "delta-collide {} demo: exact check (SAT on the box model), {RUN_TICKS} ticks of 1 ms per run",
         env!("CARGO_PKG_VERSION")
     );
     println!(
-        "per-tick query time = 2 IK + box models + pair tests, measured with Instant (includes ~20 ns timer overhead)"
+        "per-tick query time = IK and boxes of every robot + pair tests, measured with Instant (includes ~20 ns timer overhead)"
     );
     println!(
         "{:<4} {:<10} {:<9} {:>15} {:>15} {:>10} {:>10} {:>10}",
@@ -65,7 +66,7 @@ pub fn demo(args: &DemoArgs) -> Result<(), Failure> {
     for cell in cells {
         let cases: Vec<&Scenario> = scenarios.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)).collect();
         if cases.is_empty() {
-            return Err(format!("no scenario for cell {} in c_harness/scenarios.txt", cell.name).into());
+            return Err(format!("no scenario for cell {} in c_harness/scenarios.txt or line_scenarios.txt", cell.name).into());
         }
         for scenario in cases {
             if scenario.robots.len() != cell.robots.len() {

@@ -42,6 +42,8 @@ use std::time::Instant;
 
 /// The scenario file shared with the C harness.
 pub(crate) const SCENARIOS: &str = include_str!("../../../c_harness/scenarios.txt");
+/// The trajectory cases of the lines of robots (`cells/line4.toml`), kept apart from [`SCENARIOS`].
+pub(crate) const LINE_SCENARIOS: &str = include_str!("../../../c_harness/line_scenarios.txt");
 
 /// Why a command did not finish.
 pub enum Failure {
