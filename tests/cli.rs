@@ -696,21 +696,49 @@ fn progress_never_goes_into_the_data() {
 }
 
 /// `replay`: one line per tick, the first tick STOP (no previous TCP), robots standing apart
-/// FREE afterwards, a malformed row an error naming its line.
+/// FREE afterwards; the header names the columns (`tick` and the others ignored columns kept
+/// out of the TCPs, in any order); without a header, `3 n` numbers per row; a malformed row
+/// is an error naming its line.
 #[test]
 fn replay_writes_one_verdict_per_tick() {
-    let rows = "x,y,z,x2,y2,z2\n-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n";
+    let rows = "tick,x,y,z,x2,y2,z2,note\n7,-150,0,-450,150,0,-450,a\n8,-150,0,-450,150,0,-450,b\n9,-150,0,-450,150,0,-450,c\n";
     let out = cli_stdin(&["replay", "--cell", "T1"], rows);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let text = stdout(&out);
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 4, "{text}");
-    assert!(lines[0].starts_with("tick,verdict,status,clearance_mm,protective_mm_A,protective_mm_B,speed_limit_mm_s_A"));
-    assert!(lines[1].starts_with("0,STOP,ok,"), "{text}");
-    assert!(lines[2].starts_with("1,FREE,ok,") && lines[3].starts_with("2,FREE,ok,"), "{text}");
-    let out = cli_stdin(&["replay", "--cell", "T1"], "1,2,3\n");
-    assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("line 1"), "{}", stderr(&out));
+    assert!(lines[0].starts_with("tick,verdict,clearance_mm,status,protective_mm_A,protective_mm_B,speed_limit_mm_s_A"));
+    assert!(lines[1].starts_with("7,stop,") && lines[1].split(',').nth(3) == Some("ok"), "{text}");
+    assert!(lines[2].starts_with("8,free,") && lines[3].starts_with("9,free,"), "{text}");
+    let clearance: f64 = lines[2].split(',').nth(2).unwrap().parse().unwrap();
+    assert!(clearance > 0.0, "{text}");
+    // Columns found by name: B's first, a tick last; no header: robot order, ticks from 0.
+    let swapped = "x2,y2,z2,x,y,z,tick\n150,0,-450,-150,0,-450,1\n150,0,-450,-150,0,-450,2\n";
+    let out = cli_stdin(&["replay", "--cell", "T1"], swapped);
+    let swapped_lines: Vec<String> = stdout(&out).lines().map(str::to_string).collect();
+    assert_eq!(swapped_lines[2].split_once(',').unwrap().1, lines[2].split_once(',').unwrap().1, "{swapped_lines:?}");
+    let out = cli_stdin(&["replay", "--cell", "T1"], "-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n");
+    assert!(stdout(&out).lines().nth(2).unwrap().starts_with("1,free,"), "{}", stdout(&out));
+    for (bad, line) in [("1,2,3\n", "line 1"), ("tick,x,y,z,x2,y2,z2\n0,1,2,3,4,5,six\n", "line 2")] {
+        let out = cli_stdin(&["replay", "--cell", "T1"], bad);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(stderr(&out).contains(line), "{}", stderr(&out));
+    }
+}
+
+/// `replay` on the four-robot line: columns `x,y,z` to `x4,y4,z4`, a protective distance and
+/// a speed limit per robot, the verdict of every pair that can meet.
+#[test]
+fn replay_runs_a_line_of_four_robots() {
+    let apart = "-100,0,-450,100,0,-450,-100,0,-450,100,0,-450";
+    let rows = format!("x,y,z,x2,y2,z2,x3,y3,z3,x4,y4,z4\n{apart}\n{apart}\n");
+    let out = cli_stdin(&["replay", "--cell", "cells/line4.toml"], &rows);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[0].ends_with("speed_limit_mm_s_R3,speed_limit_mm_s_R4"), "{text}");
+    assert!(lines[1].starts_with("0,stop,") && lines[2].starts_with("1,free,"), "{text}");
+    assert_eq!(lines[2].split(',').count(), 4 + 2 * 4, "{text}");
 }
 
 /// The rows of a scenario of `c_harness/scenarios.txt` for its first `ticks` ticks, as CSV.
@@ -753,7 +781,7 @@ fn replay_plot_writes_a_png_of_the_requested_size() {
     assert_eq!(verdicts.lines().count(), 4001);
     let (w, h, pixels) = read_png(&plot);
     assert_eq!((w, h), (900, 450));
-    for (name, colour) in [("FREE", [120, 200, 120]), ("WARN", [240, 170, 60]), ("STOP", [220, 30, 30])] {
+    for (name, colour) in [("free", [120, 200, 120]), ("warn", [240, 170, 60]), ("stop", [220, 30, 30])] {
         assert!(verdicts.contains(&format!(",{name},")), "the run has {name} ticks");
         assert!(pixels.iter().filter(|&&p| p == colour).count() > 20, "{name} band missing");
     }
@@ -910,11 +938,11 @@ fn replay_with_stop_paths_from_the_rows_ahead_stops_less() {
     };
     let (without, with) = (verdicts(&[]), verdicts(&["--stop-path-mm", "400", "--path-tolerance-mm", "0.5"]));
     assert_eq!(without.len(), with.len());
-    let rank = |v: &str| ["FREE", "WARN", "STOP"].iter().position(|x| *x == v).unwrap();
+    let rank = |v: &str| ["free", "warn", "stop"].iter().position(|x| *x == v).unwrap();
     for (tick, (a, b)) in without.iter().zip(&with).enumerate() {
         assert!(rank(b) <= rank(a), "tick {tick}: {b} with paths, {a} without");
     }
-    let stops = |v: &[String]| v.iter().filter(|x| *x == "STOP").count();
+    let stops = |v: &[String]| v.iter().filter(|x| *x == "stop").count();
     assert!(stops(&with) < stops(&without), "{} STOP ticks with paths, {} without", stops(&with), stops(&without));
     for bad in [["--stop-path-mm", "0"], ["--stop-path-mm", "nan"]] {
         assert_eq!(cli(&[&["replay", "--cell", "T1"][..], &bad[..]].concat()).status.code(), Some(2), "{bad:?}");

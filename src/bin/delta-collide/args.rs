@@ -61,8 +61,9 @@ pub enum Command {
     Demo(DemoArgs),
     /// Check configurations from a CSV file, exactly or with a table
     ///
-    /// Reads rows x,y,z,x2,y2,z2 (one TCP per robot, each in its own MCS, mm; a first line
-    /// with no number in it is a header) and writes one line `reachable,collide` per row;
+    /// Reads rows x,y,z,x2,y2,z2,... (one TCP per robot, each in its own MCS, mm; a header
+    /// naming x,y,z,x2,y2,z2,... picks those columns and ignores others, such as tick; without
+    /// one, 3 numbers per robot) and writes one line `reachable,collide` per row;
     /// collide is NA when a TCP is unreachable. A malformed row is an error naming its line.
     /// --clearance adds the column clearance_mm: the exact signed clearance of the cell (mm;
     /// the gap when apart, minus the penetration depth when intersecting; SPEC section 8);
@@ -70,11 +71,12 @@ pub enum Command {
     Check(CheckArgs),
     /// Replay a trajectory through the protective verdict
     ///
-    /// Reads one row x,y,z,x2,y2,z2 per controller tick (one TCP per robot, each in its own
-    /// MCS, mm; a first line with no number in it is a header), with the cell's tick_ms and
-    /// stopping models, and writes per tick
-    /// `tick,verdict,status,clearance_mm,protective_mm_<robot>...,speed_limit_mm_s_<robot>...`
-    /// (verdict FREE, WARN or STOP; SPEC section 8). --plot draws the clearance, the protective
+    /// Reads one row tick,x,y,z,x2,y2,z2,... per controller tick (one TCP per robot, each in
+    /// its own MCS, mm; columns found by the header's names, others ignored; without a header,
+    /// 3 numbers per robot and ticks counted from 0), with the cell's tick_ms and stopping
+    /// models, and writes per tick
+    /// `tick,verdict,clearance_mm,status,protective_mm_<robot>...,speed_limit_mm_s_<robot>...`
+    /// (verdict free, warn or stop; SPEC section 8). --plot draws the clearance, the protective
     /// distances and the verdict along the run.
     Replay(ReplayArgs),
     /// Sample, label and build a table file

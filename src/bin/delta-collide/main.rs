@@ -229,7 +229,7 @@ fn check_rows(
         if columns.pairs { pair_names.as_str() } else { "" }
     );
     writeln!(out, "{header}").map_err(write_err)?;
-    rows::for_each_row(input, cell.robots.len(), |line_no, tcps| {
+    rows::for_each_row(input, cell.robots.len(), |line_no, _, tcps| {
         let at_line = |e: delta_collide::cell::QueryError| format!("line {line_no}: {e}");
         let answer = match table.as_deref_mut() {
             Some(t) => t.check(tcps).map_err(at_line)?,

@@ -58,10 +58,11 @@ fn replay_rows(
     let n = names.len();
     let write_err = |e: std::io::Error| format!("writing the verdicts: {e}");
     let columns = |prefix: &str| names.iter().map(|r| format!(",{prefix}_{r}")).collect::<String>();
-    writeln!(out, "tick,verdict,status,clearance_mm{}{}", columns("protective_mm"), columns("speed_limit_mm_s"))
+    writeln!(out, "tick,verdict,clearance_mm,status{}{}", columns("protective_mm"), columns("speed_limit_mm_s"))
         .map_err(write_err)?;
-    let mut rows: Vec<Vec<Vec3>> = Vec::new();
-    crate::rows::for_each_row(input, n, |_, tcps| {
+    let (mut rows, mut ticks): (Vec<Vec<Vec3>>, Vec<String>) = (Vec::new(), Vec::new());
+    crate::rows::for_each_row(input, n, |_, tick, tcps| {
+        ticks.push(tick.map_or_else(|| rows.len().to_string(), str::to_string));
         rows.push(tcps.to_vec());
         Ok(())
     })?;
@@ -93,9 +94,9 @@ fn replay_rows(
             t.push(r, ok.then(|| signed_clearance(checker.exact())).flatten());
         }
         let verdict = match r.verdict {
-            Protective::Free => "FREE",
-            Protective::Warn => "WARN",
-            Protective::Stop => "STOP",
+            Protective::Free => "free",
+            Protective::Warn => "warn",
+            Protective::Stop => "stop",
         };
         let status = match r.status {
             ProtectiveStatus::Ok => "ok".to_string(),
@@ -104,7 +105,7 @@ fn replay_rows(
             ProtectiveStatus::Unreachable(j) => format!("unreachable {}", names[j]),
             ProtectiveStatus::InvalidPath(j) => format!("invalid path {}", names[j]),
         };
-        let mut row = format!("{tick},{verdict},{status},{:.3}", r.clearance_mm);
+        let mut row = format!("{},{verdict},{:.3},{status}", ticks[tick], r.clearance_mm);
         r.robots.iter().for_each(|x| row += &format!(",{:.3}", x.protective_mm));
         r.robots.iter().for_each(|x| row += &format!(",{:.1}", x.speed_limit_mm_s));
         writeln!(out, "{row}").map_err(write_err)?;

@@ -1,23 +1,52 @@
-//! Rows of TCPs from a CSV input, as `check` and `replay` read them: `3 n` numbers per row
-//! (`x,y,z` of each robot in its own MCS), blank lines skipped, a first line taken as a header
-//! only when none of its fields is a number (so a malformed first data row is an error).
+//! Rows of TCPs from a CSV input, as `check` and `replay` read them: `x,y,z` of each robot in
+//! its own MCS. Blank lines are skipped; a first line is a header only when none of its fields
+//! is a number (so a malformed first data row is an error). A header that names every robot's
+//! columns (`x,y,z` for the first robot, `x2,y2,z2` for the second, and so on) selects them
+//! by name, and its other columns (`tick`, anything else) are ignored; otherwise a row is
+//! exactly `3 n` numbers in robot order.
 
 use crate::args::clip;
 use delta_collide::math::Vec3;
 use std::io::BufRead;
 
-/// Calls `each(line_no, tcps)` for every data row of `input` (`line_no` from 1).
+/// Where a row's numbers are.
+enum Layout {
+    /// The `3 n` fields, in robot order, and nothing else.
+    InOrder,
+    /// Robot `j`'s `x, y, z` in fields `xyz[3 j..3 j + 3]`; `tick` the field of that name.
+    Named { xyz: Vec<usize>, tick: Option<usize> },
+}
+
+/// The layout a header gives for `n` robots.
+fn layout(header: &str, n: usize) -> Layout {
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    let find = |name: &str| names.iter().position(|f| f.eq_ignore_ascii_case(name));
+    let xyz: Option<Vec<usize>> = (0..n)
+        .flat_map(|j| {
+            let suffix = if j == 0 { String::new() } else { (j + 1).to_string() };
+            ["x", "y", "z"].map(|c| format!("{c}{suffix}"))
+        })
+        .map(|name| find(&name))
+        .collect();
+    match xyz {
+        Some(xyz) => Layout::Named { xyz, tick: find("tick") },
+        None => Layout::InOrder,
+    }
+}
+
+/// Calls `each(line_no, tick, tcps)` for every data row of `input` (`line_no` from 1; `tick`
+/// the row's `tick` field when the header names one).
 ///
 /// # Errors
-/// A row that is not `3 n` numbers (naming its line), a read error, or `each`'s error.
+/// A row without its numbers (naming its line), a read error, or `each`'s error.
 pub fn for_each_row(
     input: &mut dyn BufRead,
     n: usize,
-    mut each: impl FnMut(usize, &[Vec3]) -> Result<(), String>,
+    mut each: impl FnMut(usize, Option<&str>, &[Vec3]) -> Result<(), String>,
 ) -> Result<(), String> {
     let mut tcps = vec![Vec3::zeros(); n];
     let mut values = Vec::with_capacity(3 * n);
-    let mut first = true;
+    let (mut first, mut columns) = (true, Layout::InOrder);
     for (i, line) in input.lines().enumerate() {
         let line_no = i + 1;
         let line = line.map_err(|e| format!("line {line_no}: {e}"))?;
@@ -28,21 +57,32 @@ pub fn for_each_row(
         let header = first && line.split(',').all(|f| f.trim().parse::<f64>().is_err());
         first = false;
         if header {
+            columns = layout(line, n);
             continue;
         }
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
         values.clear();
-        let parsed = line.split(',').try_for_each(|f| f.trim().parse::<f64>().map(|v| values.push(v)));
-        if parsed.is_err() || values.len() != 3 * n {
-            return Err(format!(
-                "line {line_no}: expected {} numbers (x,y,z per robot) separated by commas, got `{}`",
-                3 * n,
-                clip(line)
-            ));
-        }
+        let tick = match &columns {
+            Layout::InOrder if fields.len() == 3 * n => {
+                fields.iter().try_for_each(|f| f.parse::<f64>().map(|v| values.push(v))).ok().map(|()| None)
+            }
+            Layout::InOrder => None,
+            Layout::Named { xyz, tick } => xyz
+                .iter()
+                .try_for_each(|&k| fields.get(k).and_then(|f| f.parse::<f64>().ok()).map(|v| values.push(v)))
+                .map(|()| tick.and_then(|k| fields.get(k).copied())),
+        };
+        let Some(tick) = tick else {
+            let expected = match columns {
+                Layout::InOrder => format!("{} numbers (x,y,z per robot) separated by commas", 3 * n),
+                Layout::Named { .. } => "a number in each of the header's x,y,z columns".to_string(),
+            };
+            return Err(format!("line {line_no}: expected {expected}, got `{}`", clip(line)));
+        };
         for (j, t) in tcps.iter_mut().enumerate() {
             *t = Vec3::new(values[3 * j], values[3 * j + 1], values[3 * j + 2]);
         }
-        each(line_no, &tcps)?;
+        each(line_no, tick, &tcps)?;
     }
     Ok(())
 }
