@@ -739,6 +739,16 @@ fn replay_runs_a_line_of_four_robots() {
     assert!(lines[0].ends_with("speed_limit_mm_s_R3,speed_limit_mm_s_R4"), "{text}");
     assert!(lines[1].starts_with("0,stop,") && lines[2].starts_with("1,free,"), "{text}");
     assert_eq!(lines[2].split(',').count(), 4 + 2 * 4, "{text}");
+    // --pairs: one clearance per pair that can meet (neighbours and pairs two apart, 1,350 mm
+    // of bases apart and more pruned), the smallest of them the cell's.
+    let out = cli_stdin(&["replay", "--cell", "cells/line4.toml", "--pairs"], &rows);
+    let text = stdout(&out);
+    let lines: Vec<&str> = text.lines().collect();
+    let header: Vec<&str> = lines[0].split(',').skip(12).collect();
+    assert!(header.len() >= 3 && header.contains(&"clearance_mm_R1_R2") && header.contains(&"clearance_mm_R3_R4"), "{text}");
+    let row: Vec<f64> = lines[2].split(',').skip(2).map(|f| f.parse().unwrap_or(f64::NAN)).collect();
+    let smallest = row[10..].iter().copied().fold(f64::INFINITY, f64::min);
+    assert!((smallest - row[0]).abs() < 2e-3 && row[0] > 0.0, "{text}");
 }
 
 /// The rows of a scenario of `c_harness/scenarios.txt` for its first `ticks` ticks, as CSV.

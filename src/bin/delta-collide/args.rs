@@ -194,6 +194,10 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "MM", default_value_t = 0.5, requires = "stop_path_mm")]
     #[arg(value_parser = clipped(non_negative_mm))]
     pub path_tolerance_mm: f64,
+    /// Add one column per robot pair that can meet, clearance_mm_A_B (A, B the robots'
+    /// names): that pair's exact signed clearance (mm), NA when the tick's status is not ok
+    #[arg(long)]
+    pub pairs: bool,
     /// Also draw the clearance, each robot's protective distance and the verdict per tick
     /// into this PNG file
     #[arg(long, value_name = "FILE.png")]

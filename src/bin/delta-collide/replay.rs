@@ -3,7 +3,7 @@
 //! ([`crate::replay_plot`]).
 
 use crate::args::ReplayArgs;
-use crate::clearance::signed_clearance;
+use crate::clearance::{pair_clearances, signed_clearance};
 use crate::replay_plot::{draw_replay, ReplayTrace};
 use crate::{open_input, write_output, Failure};
 use delta_collide::cell::protective::{path_through_samples, Protective, ProtectiveChecker, ProtectiveStatus, StopPath};
@@ -16,7 +16,9 @@ pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     let names = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
     let mut trace = args.plot.as_ref().map(|_| ReplayTrace::new(names));
     let paths = args.stop_path_mm.map(|length_mm| PathsAhead { length_mm, tolerance_mm: args.path_tolerance_mm });
-    write_output(args.output.as_deref(), |out| replay_rows(&mut input, out, &mut checker, paths, trace.as_mut()))?;
+    write_output(args.output.as_deref(), |out| {
+        replay_rows(&mut input, out, &mut checker, Columns { paths, pairs: args.pairs }, trace.as_mut())
+    })?;
     if let (Some(path), Some(trace)) = (&args.plot, &trace) {
         let source = args.input.as_ref().map_or("stdin".to_string(), |p| p.display().to_string());
         let title = format!(
@@ -31,6 +33,12 @@ pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// What a replay adds to the verdicts: stop paths from the rows ahead, per-pair clearances.
+struct Columns {
+    paths: Option<PathsAhead>,
+    pairs: bool,
+}
+
 /// Each robot's stop path taken from the recorded rows ahead (`replay --stop-path-mm`).
 #[derive(Clone, Copy)]
 struct PathsAhead {
@@ -42,7 +50,8 @@ struct PathsAhead {
 const PATH_POINTS: usize = delta_collide::ffi::DC_MAX_PATH_POINTS;
 
 /// Replays every row of `input` (one tick each) and writes one line per tick on `out`, with
-/// stop paths from the rows ahead when `paths` is given; records each tick into `trace`.
+/// stop paths from the rows ahead and per-pair clearances as `columns` says; records each
+/// tick into `trace`.
 ///
 /// # Errors
 /// A row that is not `3 n` numbers (naming its line; the first line may be a header), or a
@@ -51,15 +60,19 @@ fn replay_rows(
     input: &mut dyn BufRead,
     out: &mut dyn Write,
     checker: &mut ProtectiveChecker,
-    paths: Option<PathsAhead>,
+    Columns { paths, pairs }: Columns,
     mut trace: Option<&mut ReplayTrace>,
 ) -> Result<(), String> {
     let names: Vec<String> = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
     let n = names.len();
     let write_err = |e: std::io::Error| format!("writing the verdicts: {e}");
     let columns = |prefix: &str| names.iter().map(|r| format!(",{prefix}_{r}")).collect::<String>();
-    writeln!(out, "tick,verdict,clearance_mm,status{}{}", columns("protective_mm"), columns("speed_limit_mm_s"))
-        .map_err(write_err)?;
+    let pair_columns: String = match pairs {
+        true => checker.exact().verdict().pairs.iter().map(|p| format!(",clearance_mm_{}_{}", names[p.a], names[p.b])).collect(),
+        false => String::new(),
+    };
+    let (protective, limits) = (columns("protective_mm"), columns("speed_limit_mm_s"));
+    writeln!(out, "tick,verdict,clearance_mm,status{protective}{limits}{pair_columns}").map_err(write_err)?;
     let (mut rows, mut ticks): (Vec<Vec<Vec3>>, Vec<String>) = (Vec::new(), Vec::new());
     crate::rows::for_each_row(input, n, |_, tick, tcps| {
         ticks.push(tick.map_or_else(|| rows.len().to_string(), str::to_string));
@@ -108,6 +121,13 @@ fn replay_rows(
         let mut row = format!("{},{verdict},{:.3},{status}", ticks[tick], r.clearance_mm);
         r.robots.iter().for_each(|x| row += &format!(",{:.3}", x.protective_mm));
         r.robots.iter().for_each(|x| row += &format!(",{:.1}", x.speed_limit_mm_s));
+        if pairs {
+            let ok = r.status == ProtectiveStatus::Ok;
+            match ok.then(|| pair_clearances(checker.exact())).flatten() {
+                Some(c) => c.iter().for_each(|d| row += &format!(",{d:.3}")),
+                None => (0..checker.exact().verdict().pairs.len()).for_each(|_| row += ",NA"),
+            }
+        }
         writeln!(out, "{row}").map_err(write_err)?;
     }
     Ok(())
