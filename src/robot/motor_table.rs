@@ -218,6 +218,7 @@ impl MotorTable {
             let (i0, i1) = (index(lo[a], a), index(hi[a], a));
             let top = (self.levels[0].dims[a] - 1) as Real;
             // Also true for NaN.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
             if !(i0 <= i1) {
                 return None;
             }
