@@ -145,6 +145,30 @@ impl ExactChecker {
     /// # Errors
     /// [`QueryError::WrongRobotCount`] when `tcps_mcs.len()` differs from the robot count.
     pub fn check(&mut self, tcps_mcs: &[Vec3]) -> Result<&CellVerdict, QueryError> {
+        self.place_boxes(tcps_mcs)?;
+        for (k, pair) in self.verdict.pairs.iter_mut().enumerate() {
+            let (a, b) = (pair.a, pair.b);
+            pair.state = if self.verdict.unreachable_mask & (1 << a | 1 << b) != 0 {
+                PairState::Undecided
+            } else {
+                let robot = |j: usize| RobotInWcs { boxes: self.boxes[j].as_slice(), aabb: &self.aabb[j] };
+                let cache = match self.cell.method {
+                    SatMethod::Sat => None,
+                    SatMethod::SatCache => Some(&mut self.caches[k]),
+                };
+                pair_state(&robot(a), &robot(b), cache)
+            };
+        }
+        Ok(&self.verdict)
+    }
+
+    /// The first half of [`ExactChecker::check`]: every robot's boxes in the WCS and which
+    /// TCPs are unreachable, with every pair left [`PairState::Undecided`] (for callers that
+    /// measure the boxes' clearance instead of testing them).
+    ///
+    /// # Errors
+    /// [`QueryError::WrongRobotCount`] when `tcps_mcs.len()` differs from the robot count.
+    pub fn place_boxes(&mut self, tcps_mcs: &[Vec3]) -> Result<&CellVerdict, QueryError> {
         let n = self.cell.robots.len();
         if tcps_mcs.len() != n {
             return Err(QueryError::WrongRobotCount { expected: n, found: tcps_mcs.len() });
@@ -170,19 +194,7 @@ impl ExactChecker {
                 }
             }
         }
-        for (k, pair) in self.verdict.pairs.iter_mut().enumerate() {
-            let (a, b) = (pair.a, pair.b);
-            pair.state = if self.verdict.unreachable_mask & (1 << a | 1 << b) != 0 {
-                PairState::Undecided
-            } else {
-                let robot = |j: usize| RobotInWcs { boxes: self.boxes[j].as_slice(), aabb: &self.aabb[j] };
-                let cache = match self.cell.method {
-                    SatMethod::Sat => None,
-                    SatMethod::SatCache => Some(&mut self.caches[k]),
-                };
-                pair_state(&robot(a), &robot(b), cache)
-            };
-        }
+        self.verdict.pairs.iter_mut().for_each(|p| p.state = PairState::Undecided);
         Ok(&self.verdict)
     }
 }

@@ -358,7 +358,9 @@ impl ProtectiveChecker {
         self.warn_mm
     }
 
-    /// The exact checker underneath (its boxes are those of the last check).
+    /// The exact checker underneath: its boxes and unreachable robots are those of the last
+    /// check; its pairs are left undecided (the report's clearance says whether boxes
+    /// intersect: the verdict needs the boxes, not the separating axis test).
     pub fn exact(&self) -> &ExactChecker {
         &self.exact
     }
@@ -498,7 +500,7 @@ impl ProtectiveChecker {
         if status != ProtectiveStatus::Ok {
             return;
         }
-        let Ok(exact) = self.exact.check(tcps_mcs) else { return };
+        let Ok(exact) = self.exact.place_boxes(tcps_mcs) else { return };
         if let Some((j, _)) = exact.first_unreachable {
             self.report.status = ProtectiveStatus::Unreachable(j);
             return;
