@@ -161,6 +161,17 @@ impl TableChecker {
             });
         }
         let (header, table) = from_bytes(bytes)?;
+        TableChecker::from_loaded(cell, header, table, confirmation)
+    }
+
+    /// As [`TableChecker::with_confirmation`], from a table already read and validated as
+    /// bytes (a bundle's).
+    pub(crate) fn from_loaded(
+        cell: Cell,
+        header: Header,
+        table: Table,
+        confirmation: Confirmation,
+    ) -> Result<TableChecker, TableError> {
         header.check_cell_parameters(&cell)?;
         check_determined_by_cell(&header, &table, &cell)?;
         let k = 1u32 << table.levels();
