@@ -425,22 +425,26 @@ fn query_table(checker: &mut TableChecker, tcps: &[Vec3], report: &mut DcQueryRe
 /// A bundle's answer in the report: as exact mode's, with the first colliding pair's robots,
 /// and its boxes when the exact check answered it.
 fn query_bundle(checker: &mut BundleChecker, tcps: &[Vec3], report: &mut DcQueryReport) -> DcStatus {
-    match checker.check(tcps) {
-        Err(_) => DC_STATUS_WRONG_ROBOT_COUNT,
-        Ok(TableAnswer::Unreachable(mask)) => {
+    let Ok(answer) = checker.check(tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };
+    let colliding = checker.pairs().iter().filter(|p| p.answer == TableAnswer::Collision);
+    report.colliding_pairs = colliding.clone().count() as u32;
+    if let Some(p) = colliding.clone().next() {
+        (report.first_robot_a, report.first_robot_b) = (p.a as u32, p.b as u32);
+        if let Some((a, b)) = p.boxes {
+            (report.first_box_a, report.first_box_b) = (a as u32, b as u32);
+        }
+    }
+    match answer {
+        TableAnswer::Unreachable(mask) => {
             report.unreachable_mask = mask;
             DC_STATUS_UNREACHABLE
         }
-        Ok(answer) => {
-            let colliding = checker.pairs().iter().filter(|p| p.answer == TableAnswer::Collision);
-            report.colliding_pairs = colliding.clone().count() as u32;
-            if let Some(p) = colliding.clone().next() {
-                (report.first_robot_a, report.first_robot_b) = (p.a as u32, p.b as u32);
-                if let Some((a, b)) = p.boxes {
-                    (report.first_box_a, report.first_box_b) = (a as u32, b as u32);
-                }
-            }
-            report.verdict = if answer == TableAnswer::Collision { DC_VERDICT_COLLISION } else { DC_VERDICT_FREE };
+        TableAnswer::Collision => {
+            report.verdict = DC_VERDICT_COLLISION;
+            DC_STATUS_OK
+        }
+        TableAnswer::Free => {
+            report.verdict = DC_VERDICT_FREE;
             DC_STATUS_OK
         }
     }

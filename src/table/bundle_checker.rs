@@ -134,19 +134,19 @@ impl BundleChecker {
         if tcps_mcs.len() != self.models.len() {
             return Err(QueryError::WrongRobotCount { expected: self.models.len(), found: tcps_mcs.len() });
         }
+        // As the exact check: a pair with an unreachable robot has no answer, every other pair
+        // is answered, and the tick's answer is unreachable.
         let mask = self.unreachable_mask(tcps_mcs);
-        if mask != 0 {
-            self.pairs.iter_mut().for_each(|p| (p.answer, p.boxes) = (TableAnswer::Unreachable(mask), None));
-            return Ok(TableAnswer::Unreachable(mask));
-        }
-        let mut answer = TableAnswer::Free;
+        let mut answer = if mask != 0 { TableAnswer::Unreachable(mask) } else { TableAnswer::Free };
         for p in &mut self.pairs {
+            (p.answer, p.boxes) = (TableAnswer::Unreachable(mask), None);
+            if mask >> p.a & 1 == 1 || mask >> p.b & 1 == 1 {
+                continue;
+            }
             let checker = &mut self.checkers[p.table];
             p.answer = match checker.check(&[tcps_mcs[p.a], tcps_mcs[p.b]])? {
                 // The pair checker's bits name the pair's robots; fail closed on the cell's.
-                TableAnswer::Unreachable(m) => {
-                    TableAnswer::Unreachable((m & 1) << p.a | (m >> 1 & 1) << p.b)
-                }
+                TableAnswer::Unreachable(m) => TableAnswer::Unreachable((m & 1) << p.a | (m >> 1 & 1) << p.b),
                 other => other,
             };
             p.boxes = checker.colliding_boxes();
