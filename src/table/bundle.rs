@@ -160,6 +160,46 @@ pub fn bundle_to_bytes(
     Ok(out)
 }
 
+/// What [`build_bundle`] built: per table of the bundle (in its order) the header, the table,
+/// the build's report and the table file's bytes; the pairs; the bundle's bytes.
+#[cfg(feature = "std")]
+pub struct BuiltBundle {
+    /// The tables, one per pair cell.
+    pub tables: Vec<(Header, Table, super::BuildReport, Vec<u8>)>,
+    /// The pairs that can meet and their tables.
+    pub pairs: Vec<BundlePair>,
+    /// The bundle file's bytes.
+    pub bytes: Vec<u8>,
+}
+
+/// Builds the table of every pair cell `cell`'s pairs that can meet need ([`plan`]), each
+/// once, with [`super::build_table`]'s arguments, and the bundle of them.
+///
+/// # Errors
+/// The first build's error, prefixed by its pair.
+#[cfg(feature = "std")]
+pub fn build_bundle(
+    cell: &Cell,
+    k: u32,
+    ws: &crate::cspace::Workspace,
+    variant: super::Variant,
+    labelling: super::Labelling,
+    progress: crate::cspace::Progress,
+) -> Result<BuiltBundle, String> {
+    let (pair_cells, pairs) = plan(cell);
+    let mut tables = Vec::with_capacity(pair_cells.len());
+    for (i, pc) in pair_cells.iter().enumerate() {
+        let first = pairs.iter().find(|p| p.table == i).expect("every pair cell comes from a pair");
+        let (header, table, report) = super::build_table(pc, k, ws, variant, labelling, progress)
+            .map_err(|e| format!("table {i} for {}: {e}", describe_pair(cell, first.a, first.b)))?;
+        let bytes = super::to_bytes(&table, &header);
+        tables.push((header, table, report, bytes));
+    }
+    let files: Vec<Vec<u8>> = tables.iter().map(|t| t.3.clone()).collect();
+    let bytes = bundle_to_bytes(cell.fingerprint(), cell.robots.len(), &files, &pairs).map_err(|e| e.to_string())?;
+    Ok(BuiltBundle { tables, pairs, bytes })
+}
+
 /// Whether `bytes` start as a bundle (rather than as a table file).
 pub fn is_bundle(bytes: &[u8]) -> bool {
     bytes.starts_with(&BUNDLE_MAGIC)

@@ -4,8 +4,8 @@
 use crate::{check_memory, describe, files, Failure};
 use delta_collide::cell::Cell;
 use delta_collide::cspace::{Progress, Workspace};
-use delta_collide::table::bundle::{describe_pair, plan};
-use delta_collide::table::{build_table, bundle_from_bytes, bundle_to_bytes, to_bytes, Labelling, Variant};
+use delta_collide::table::bundle::{build_bundle as build_all, describe_pair, plan};
+use delta_collide::table::{bundle_from_bytes, Labelling, Variant};
 use std::io::Write;
 use std::path::Path;
 
@@ -14,7 +14,7 @@ use std::path::Path;
 ///
 /// # Errors
 /// A build's error (naming the pair cell), or writing the file.
-pub(crate) fn build_bundle(
+pub(crate) fn write_bundle(
     cell: &Cell,
     k: u32,
     variant: Variant,
@@ -30,39 +30,36 @@ pub(crate) fn build_bundle(
         pairs.len(),
         pair_cells.len()
     );
-    let mut tables = Vec::with_capacity(pair_cells.len());
-    for (i, pc) in pair_cells.iter().enumerate() {
-        let first = pairs.iter().find(|p| p.table == i).expect("every pair cell comes from a pair");
-        let what = describe_pair(cell, first.a, first.b);
+    for pc in &pair_cells {
         check_memory(pc, k, &Workspace::THESIS, 1)?;
-        let (header, table, r) = build_table(pc, k, &Workspace::THESIS, variant, labelling, progress)
-            .map_err(|e| format!("table {i} for {what}: {e}"))?;
-        let bytes = to_bytes(&table, &header);
+    }
+    let built = build_all(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
+    for (i, (_, table, r, bytes)) in built.tables.iter().enumerate() {
+        let first = pairs.iter().find(|p| p.table == i).expect("every table serves a pair");
         println!(
-            "table {i} for {what}: k {k}, {} x {} samples, {} collision labels, symmetric {}, labelling {:.2} s, \
+            "table {i} for {}: k {k}, {} x {} samples, {} collision labels, symmetric {}, labelling {:.2} s, \
              building {:.2} s, {}, {} bytes",
+            describe_pair(cell, first.a, first.b),
             r.samples.0,
             r.samples.1,
             r.collisions,
             r.symmetric,
             r.label_secs,
             r.build_secs,
-            describe(&table),
+            describe(table),
             bytes.len()
         );
-        tables.push(bytes);
     }
     for p in &pairs {
         println!("pair {}: table {}", describe_pair(cell, p.a, p.b), p.table);
     }
-    let bytes = bundle_to_bytes(cell.fingerprint(), cell.robots.len(), &tables, &pairs)
-        .map_err(|e| format!("{}: {e}", output.display()))?;
-    files::write_file(output, |w| w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display())))?;
-    let separate: usize = pairs.iter().map(|p| tables[p.table].len()).sum();
+    let bytes = &built.bytes;
+    files::write_file(output, |w| w.write_all(bytes).map_err(|e| format!("{}: {e}", output.display())))?;
+    let separate: usize = pairs.iter().map(|p| built.tables[p.table].3.len()).sum();
     println!(
         "{}: bundle of {} tables, {} bytes ({} bytes as one table file per pair)",
         output.display(),
-        tables.len(),
+        built.tables.len(),
         bytes.len(),
         separate
     );

@@ -350,7 +350,7 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
     };
     let labelling = Labelling::from(args.labelling);
     if cell.robots.len() > 2 {
-        return bundle::build_bundle(cell, k, variant, labelling, output, progress);
+        return bundle::write_bundle(cell, k, variant, labelling, output, progress);
     }
     check_memory(cell, k, &Workspace::THESIS, 1)?;
     let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
