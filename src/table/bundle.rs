@@ -52,9 +52,14 @@ const MAX_ENTRIES: u32 = 496;
 /// # Panics
 /// When `a` or `b` is not a robot of `cell`, or they are the same.
 pub fn pair_cell(cell: &Cell, a: usize, b: usize) -> Cell {
-    assert!(a != b && a < cell.robots.len() && b < cell.robots.len(), "pair ({a}, {b}) of {} robots", cell.robots.len());
+    assert!(
+        a != b && a < cell.robots.len() && b < cell.robots.len(),
+        "pair ({a}, {b}) of {} robots",
+        cell.robots.len()
+    );
     let (ra, rb) = (&cell.robots[a], &cell.robots[b]);
-    let relative = Placement { alpha: rb.placement.alpha - ra.placement.alpha, t: ra.placement.to_mcs(&rb.placement.t) };
+    let relative =
+        Placement { alpha: rb.placement.alpha - ra.placement.alpha, t: ra.placement.to_mcs(&rb.placement.t) };
     let robots = vec![
         RobotSpec { placement: Placement::IDENTITY, ..ra.clone() },
         RobotSpec { placement: relative, ..rb.clone() },
@@ -215,7 +220,12 @@ pub fn is_bundle(bytes: &[u8]) -> bool {
 pub fn bundle_from_bytes(bytes: &[u8]) -> Result<Bundle, TableError> {
     if !is_bundle(bytes) {
         let (header, table) = from_bytes(bytes)?;
-        return Ok(Bundle { cell_fingerprint: header.cell_fingerprint, robots: 2, tables: vec![(header, table)], pairs: vec![] });
+        return Ok(Bundle {
+            cell_fingerprint: header.cell_fingerprint,
+            robots: 2,
+            tables: vec![(header, table)],
+            pairs: vec![],
+        });
     }
     let mut r = Reader::<TableError>::new(bytes);
     r.take(8, "bundle magic")?;
@@ -264,7 +274,10 @@ pub fn bundle_from_bytes(bytes: &[u8]) -> Result<Bundle, TableError> {
     for (i, ([fingerprint, offset, len], sum)) in entries.into_iter().enumerate() {
         let t = &bytes[offset as usize..(offset + len) as usize];
         if fnv1a64(t) != sum {
-            return Err(corrupt(format!("bundle table {i}: checksum = {sum:#018x}, its bytes give {:#018x}", fnv1a64(t))));
+            return Err(corrupt(format!(
+                "bundle table {i}: checksum = {sum:#018x}, its bytes give {:#018x}",
+                fnv1a64(t)
+            )));
         }
         let (header, table) = from_bytes(t)?;
         if header.cell_fingerprint != fingerprint {
@@ -316,10 +329,15 @@ impl Bundle {
                 Err(TableError::WrongCell { differs: Some(d), .. }) => d,
                 _ => String::from("its pair cell's fingerprint differs"),
             };
-            return Err(TableError::WrongPair { what: format!("the bundle's table for {pair} was built for another pair: {differs}") });
+            return Err(TableError::WrongPair {
+                what: format!("the bundle's table for {pair} was built for another pair: {differs}"),
+            });
         }
         Err(TableError::MissingPair {
-            what: format!("the bundle holds no table for {pair} ({} tables, none for this pair cell)", self.tables.len()),
+            what: format!(
+                "the bundle holds no table for {pair} ({} tables, none for this pair cell)",
+                self.tables.len()
+            ),
         })
     }
 }
