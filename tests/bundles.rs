@@ -213,3 +213,68 @@ fn a_bundle_for_another_spacing_or_without_a_pair_is_refused_naming_the_pair() {
     // That bundle still serves a line of three.
     assert!(BundleChecker::new(line(3, 450.0, Vec3::zeros()), &short, Confirmation::Exact).is_ok());
 }
+
+/// `delta-collide` with `args`; panics with its stderr unless it succeeds. Returns stdout.
+fn cli(args: &[&str]) -> String {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_delta-collide"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run delta-collide");
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// `build` on the line writes one bundle, `inspect` lists its pairs and their tables, and
+/// `check --table BUNDLE --confirm exact` answers row for row (with every pair's column) as
+/// `check` without a table: on both line cases, tick by tick, and on random rows with
+/// unreachable TCPs.
+#[test]
+fn build_inspect_and_check_a_line_with_its_bundle() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bundles_cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bundle = dir.join("line4.dcb");
+    let b = bundle.to_str().unwrap();
+    let built = cli(&["-q", "build", "--cell", "cells/line4.toml", "--k", "16", "--variant", "shared", "--output", b]);
+    assert!(built.contains("6 pairs that can meet, 3 tables"), "{built}");
+    assert_eq!(std::fs::read(&bundle).unwrap(), line4_bundle(), "the CLI writes the library's bundle");
+    let inspected = cli(&["inspect", b]);
+    for (pair, table) in [("0-1", 0), ("0-2", 1), ("0-3", 2), ("1-2", 0), ("1-3", 1), ("2-3", 0)] {
+        assert!(inspected.contains(&format!("pair robots {pair}: table {table}")), "{pair}: {inspected}");
+    }
+    assert!(inspected.contains("second robot at (900, 0, 0) mm"), "{inspected}");
+    let scenarios =
+        delta_collide::cell::trajectory::parse_scenarios(include_str!("../c_harness/line_scenarios.txt")).unwrap();
+    let mut rows = String::from("x1,y1,z1,x2,y2,z2,x3,y3,z3,x4,y4,z4\n");
+    let mut tcps = vec![Vec3::zeros(); 4];
+    for s in &scenarios {
+        for tick in 0..delta_collide::cell::trajectory::RUN_TICKS {
+            s.tcps_at(tick, &mut tcps);
+            rows += &tcps.iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(",");
+            rows.push('\n');
+        }
+    }
+    let mut rng = Rng(3);
+    for _ in 0..20_000 {
+        rows += &(0..4).map(|_| rng.tcp()).map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(",");
+        rows.push('\n');
+    }
+    let input = dir.join("rows.csv");
+    std::fs::write(&input, rows).unwrap();
+    let i = input.to_str().unwrap();
+    let exact = cli(&["check", "--cell", "cells/line4.toml", "--input", i, "--pairs"]);
+    let table =
+        cli(&["check", "--cell", "cells/line4.toml", "--table", b, "--confirm", "exact", "--input", i, "--pairs"]);
+    let labels =
+        cli(&["check", "--cell", "cells/line4.toml", "--table", b, "--confirm", "none", "--input", i, "--pairs"]);
+    let count = |text: &str, what: &str| text.lines().filter(|l| l.starts_with(what)).count();
+    assert_eq!(exact.lines().count(), 1 + 12_000 + 20_000);
+    assert!(
+        count(&exact, "1,1") > 1000 && count(&exact, "1,0") > 1000 && count(&exact, "0,NA") > 1000,
+        "every outcome"
+    );
+    for (n, (e, t)) in exact.lines().zip(table.lines()).enumerate() {
+        assert_eq!(t, e, "row {n}: the bundle confirmed answers as exact mode");
+    }
+    assert!(count(&labels, "1,1") > count(&exact, "1,1"), "the labels alone stop early somewhere");
+}
