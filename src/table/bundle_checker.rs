@@ -144,7 +144,7 @@ impl BundleChecker {
                 continue;
             }
             let checker = &mut self.checkers[p.table];
-            p.answer = match checker.check(&[tcps_mcs[p.a], tcps_mcs[p.b]])? {
+            p.answer = match checker.check_reachable(&[tcps_mcs[p.a], tcps_mcs[p.b]])? {
                 // The pair checker's bits name the pair's robots; fail closed on the cell's.
                 TableAnswer::Unreachable(m) => TableAnswer::Unreachable((m & 1) << p.a | (m >> 1 & 1) << p.b),
                 other => other,
