@@ -313,7 +313,7 @@ fn exact_answer(v: &delta_collide::cell::CellVerdict) -> TableAnswer {
 /// What `check --table` answers from: a two-robot cell's table, or a bundle (one table per
 /// pair that can meet) for a cell of any number of robots.
 enum Loaded {
-    Table(TableChecker),
+    Table(Box<TableChecker>),
     Bundle(BundleChecker),
 }
 
@@ -336,7 +336,7 @@ fn load_table_or_bundle(cell: &Cell, path: &Path, confirmation: Confirmation) ->
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let at = |e: delta_collide::table::TableError| format!("{}: {e}", path.display());
     if cell.robots.len() == 2 && !is_bundle(&bytes) {
-        TableChecker::with_confirmation(cell.clone(), &bytes, confirmation).map(Loaded::Table).map_err(at)
+        TableChecker::with_confirmation(cell.clone(), &bytes, confirmation).map(|t| Loaded::Table(Box::new(t))).map_err(at)
     } else {
         BundleChecker::new(cell.clone(), &bytes, confirmation).map(Loaded::Bundle).map_err(at)
     }
