@@ -540,7 +540,8 @@ unsafe fn protective_entry(
 /// Copies the per-pair results of the last query into `out[0..]` and their number into
 /// `*out_len`. Exact mode: the pairs whose reach can overlap (`dc_pair_count`), with the
 /// colliding boxes. Table mode: one pair (robots 0 and 1), `collides` as the last verdict,
-/// boxes `DC_BOX_NONE`. After a query that did not return `DC_STATUS_OK` the results are
+/// boxes `DC_BOX_NONE` unless the exact check answered; with a bundle, as exact mode's pairs,
+/// each pair's own answer. After a query that did not return `DC_STATUS_OK` the results are
 /// not a decision (table mode: `collides` 0). Statuses: `DC_STATUS_NULL_POINTER`,
 /// `DC_STATUS_INVALID_ARGUMENT` (`capacity` smaller than `dc_pair_count`; `*out_len` then
 /// holds the count needed).
@@ -741,7 +742,8 @@ pub unsafe extern "C" fn dc_robot_count(handle: *const DcCollider) -> usize {
 }
 
 /// Number of robot pairs `dc_pair_results` reports: exact mode, the pairs that can meet
-/// (kept after pruning at init); table mode, 1; 0 for NULL.
+/// (kept after pruning at init); table mode, 1 (a bundle: the pairs that can meet, one lookup
+/// each); 0 for NULL.
 ///
 /// # Safety
 /// `handle` must be NULL or live.
