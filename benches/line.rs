@@ -4,7 +4,10 @@
 //! trajectory of robot A (even `j`) or B (odd `j`), so every other neighbour pair works as
 //! T1's pair does; the 6,000 ticks are replayed in order (`check`, speeds from the history)
 //! and every answer is asserted against one computed before timing. The exact query of the
-//! two-robot line is the peer of every other figure.
+//! two-robot line is the peer of every other figure. Table mode (one lookup per pair, COLLISION
+//! confirmed by the exact check) runs on the bundle of `cells/line4.toml`'s spacing, which
+//! serves every line here: k = 32 `shared` when benchmarking, k = 16 in `cargo test`'s quick
+//! pass (the build then takes a second, not half a minute).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use delta_collide::cell::placement::Placement;
@@ -12,7 +15,10 @@ use delta_collide::cell::protective::{Protective, ProtectiveChecker};
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker, RobotSpec};
+use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::Vec3;
+use delta_collide::table::bundle::build_bundle;
+use delta_collide::table::{BundleChecker, Confirmation, Labelling, TableAnswer, Variant};
 use std::hint::black_box;
 
 const SCENARIOS: &str = include_str!("../c_harness/scenarios.txt");
@@ -42,7 +48,17 @@ fn ticks(n: usize) -> Vec<Vec<Vec3>> {
         .collect()
 }
 
+/// The bundle of a line 450 mm apart (three tables: 450, 900 and 1350 mm), its k, and bytes.
+fn bundle() -> (u32, Vec<u8>) {
+    let k = if std::env::args().any(|a| a == "--bench") { 32 } else { 16 };
+    let built = build_bundle(&line(4), k, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
+        .expect("the line's bundle builds");
+    println!("bundle of line4, k = {k}: {} tables, {} bytes", built.tables.len(), built.bytes.len());
+    (k, built.bytes)
+}
+
 fn lines(c: &mut Criterion) {
+    let (k, bundle) = bundle();
     let mut group = c.benchmark_group("line_T1_practical_replay");
     for n in [2, 4, 8, 16] {
         let cell = line(n);
@@ -57,6 +73,15 @@ fn lines(c: &mut Criterion) {
                 let k = i % run.len();
                 i += 1;
                 assert_eq!(exact.check(black_box(&run[k])).unwrap().collides(), hits[k]);
+            })
+        });
+        let mut table = BundleChecker::new(cell.clone(), &bundle, Confirmation::Exact).unwrap();
+        let mut i = 0;
+        group.bench_function(BenchmarkId::new(format!("table k{k}, exact confirmation"), &label), |b| {
+            b.iter(|| {
+                let k = i % run.len();
+                i += 1;
+                assert_eq!(table.check(black_box(&run[k])).unwrap() == TableAnswer::Collision, hits[k]);
             })
         });
         for (name, limits) in [("protective verdict", false), ("protective with speed limits", true)] {

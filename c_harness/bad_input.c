@@ -334,7 +334,8 @@ static void bad_tables(const HarnessOptions *options, const DcCellConfig *t1_con
         expect_init_table("T2's table for T1's config", t1_config, t2->bytes, t2->len, DC_STATUS_TABLE_WRONG_CELL,
                           "built for cell");
     }
-    /* Not a two-robot cell; bad configs are reported before the table is read. */
+    /* Three robots 450 mm apart also need the pair 900 mm apart, which T1's table is not; one
+     * robot has no pair; bad configs are reported before the table is read. */
     three[0] = t1_config->robots[0];
     three[1] = t1_config->robots[1];
     three[2] = t1_config->robots[1];
@@ -342,7 +343,7 @@ static void bad_tables(const HarnessOptions *options, const DcCellConfig *t1_con
     broken = *t1_config;
     broken.robots = three;
     broken.n_robots = 3;
-    expect_init_table("three robots", &broken, t1.bytes, t1.len, DC_STATUS_TABLE_NOT_TWO_ROBOTS, "two-robot");
+    expect_init_table("three robots", &broken, t1.bytes, t1.len, DC_STATUS_TABLE_MISSING_PAIR, "no table for robot 0-robot 2");
     broken.n_robots = 1;
     expect_init_table("one robot", &broken, t1.bytes, t1.len, DC_STATUS_TABLE_NOT_TWO_ROBOTS, "two-robot");
     broken.n_robots = 0;

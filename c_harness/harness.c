@@ -142,6 +142,8 @@ int parse_options(int argc, char **argv, HarnessOptions *out)
             out->quick = 1;
         } else if (strcmp(argv[i], "--tmp") == 0 && i + 1 < argc) {
             out->tmp_dir = argv[++i];
+        } else if (strcmp(argv[i], "--line-bundle") == 0 && i + 1 < argc) {
+            out->line_bundle.path = argv[++i];
         } else if (strcmp(argv[i], "--table") == 0 && i + 1 < argc) {
             const char *arg = argv[++i];
             const char *eq = strchr(arg, '=');
@@ -160,7 +162,9 @@ int parse_options(int argc, char **argv, HarnessOptions *out)
             }
             out->tables[c].path = eq + 1;
         } else {
-            printf("unknown argument %s\nusage: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]...\n", argv[i]);
+            printf("unknown argument %s\nusage: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]... "
+                   "[--line-bundle PATH]\n",
+                   argv[i]);
             return 0;
         }
     }
@@ -177,6 +181,11 @@ int load_tables(HarnessOptions *options)
             ok = 0;
         }
     }
+    if (options->line_bundle.path != NULL
+        && !read_file(options->line_bundle.path, &options->line_bundle.bytes, &options->line_bundle.len)) {
+        printf("cannot read bundle file %s\n", options->line_bundle.path);
+        ok = 0;
+    }
     return ok;
 }
 
@@ -188,6 +197,9 @@ void free_tables(HarnessOptions *options)
         options->tables[c].bytes = NULL;
         options->tables[c].len = 0;
     }
+    free(options->line_bundle.bytes);
+    options->line_bundle.bytes = NULL;
+    options->line_bundle.len = 0;
 }
 
 int open_protective(const char *who, const char *cell_name, const char *case_name, const DcStopConfig *model,

@@ -33,12 +33,15 @@ typedef struct HarnessTable {
  *   --protective-quick  the protective scenarios on T1 collision only (under qemu, where the
  *            interval arithmetic of every scenario would take many minutes);
  *   --tmp    a directory for scratch files (default ".");
- *   --table  the table file of reference cell CELL (T1, T2 or T3): enables table mode. */
+ *   --table  the table file of reference cell CELL (T1, T2 or T3): enables table mode;
+ *   --line-bundle  the bundle of cells/line4.toml (`delta-collide build --cell
+ *            cells/line4.toml`): runs the line in table mode too. */
 typedef struct HarnessOptions {
     int quick;
     int protective_quick; /* --protective-quick: the protective verdict on T1 collision only */
     const char *tmp_dir;
     HarnessTable tables[HARNESS_N_CELLS]; /* T1, T2, T3 */
+    HarnessTable line_bundle;             /* cells/line4.toml's bundle */
 } HarnessOptions;
 
 /* Counts one check; prints `FAIL: <message>` when it fails. Returns ok. */

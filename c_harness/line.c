@@ -10,9 +10,13 @@
  *     the first STOP every robot stops as its stopping model says, and every 0.1 ms of the stop
  *     the exact model checks that no box of any pair touches; in the collision case the first
  *     STOP comes no later than the exact model's first colliding tick.
- * Table mode cannot run on the line: a table serves one two-robot cell, and a line needs one
- * per pair that can meet (a bundle), which the library does not build. With T1's table given,
- * the harness checks that dc_init_from_files refuses it for the line with a message.
+ *   - table mode (--line-bundle: the line's bundle, one table per spacing that can meet): the
+ *     POU runs on a handle from the mock's configuration and the bundle's bytes
+ *     (dc_init_with_table, exact confirmation of COLLISION lookups, the default), with the same
+ *     checks as exact mode: FREE on every practical tick, the collision case stopped at the
+ *     exact model's first colliding tick naming the same pairs; dc_init_from_files takes the
+ *     cell file and the bundle file alike. T1's table alone is refused for the line: it has
+ *     no table for the robots 900 and 1350 mm apart.
  */
 #include "harness.h"
 #include "pou.h"
@@ -46,18 +50,25 @@ static size_t colliding_pairs(const DcCollider *h, char out[64])
     return hits;
 }
 
-/* Both handles of the line: the POU's from the cell file, the exact one from the mock's
- * configuration; the robot and pair counts must agree. Returns 0 after a failed check. */
-static int open_line(const MrCell *cell, Pou *pou, DcCollider **exact)
+/* Both handles of the line: the POU's from the cell file (exact mode) or, given `bundle`,
+ * from the mock's configuration and the bundle's bytes (table mode); the exact one from the
+ * mock's configuration; the robot and pair counts must agree. Returns 0 after a failed check. */
+static int open_line(const MrCell *cell, Pou *pou, DcCollider **exact, const HarnessTable *bundle)
 {
     DcRobotConfig robots[MR_MAX_ROBOTS];
     DcCellConfig config;
     DcStatus s;
     *exact = NULL;
     pou_cell_config(cell, DC_METHOD_SAT, robots, &config);
-    s = pou_init_from_file(pou, LINE_CELL_FILE);
-    check(s == DC_STATUS_OK && pou->handle != NULL && dc_mode(pou->handle) == DC_MODE_EXACT,
-          "line4: dc_init_from_cell_file(%s): %s", LINE_CELL_FILE, dc_status_str(s));
+    if (bundle == NULL) {
+        s = pou_init_from_file(pou, LINE_CELL_FILE);
+        check(s == DC_STATUS_OK && pou->handle != NULL && dc_mode(pou->handle) == DC_MODE_EXACT,
+              "line4: dc_init_from_cell_file(%s): %s", LINE_CELL_FILE, dc_status_str(s));
+    } else {
+        s = pou_init_with_table(pou, &config, bundle->bytes, bundle->len);
+        check(s == DC_STATUS_OK && pou->handle != NULL && dc_mode(pou->handle) == DC_MODE_TABLE,
+              "line4: dc_init_with_table(the bundle %s): %s", bundle->path, dc_status_str(s));
+    }
     s = dc_init(&config, exact);
     check(s == DC_STATUS_OK, "line4: dc_init SAT: %s", dc_status_str(s));
     if (pou->handle == NULL || *exact == NULL) {
@@ -74,10 +85,11 @@ static int open_line(const MrCell *cell, Pou *pou, DcCollider **exact)
                  (unsigned long)dc_pair_count(pou->handle), (unsigned long)dc_pair_count(*exact));
 }
 
-/* One case in exact mode; returns the first exact colliding tick of the unstopped run (-1 if
- * none, -2 when the case could not run). */
-static long run_line_exact(const char *case_name)
+/* One case, in exact mode (`bundle` NULL) or table mode on the bundle; returns the first
+ * exact colliding tick of the unstopped run (-1 if none, -2 when the case could not run). */
+static long run_line(const char *case_name, const HarnessTable *bundle)
 {
+    const char *mode = bundle == NULL ? "" : "table ";
     MrCell cell;
     MrScenario scenario;
     Pou pou;
@@ -95,8 +107,8 @@ static long run_line_exact(const char *case_name)
     memset(&pou, 0, sizeof pou);
     if (!check(mr_register_cell("line4", &cell) == MR_OK
                    && mr_load_scenario(LINE_SCENARIO_FILE, "line4", case_name, LINE_ROBOTS, &scenario) == MR_OK,
-               "line4 %s: cannot load %s", case_name, LINE_SCENARIO_FILE)
-        || !open_line(&cell, &pou, &exact)) {
+               "line4 %s%s: cannot load %s", mode, case_name, LINE_SCENARIO_FILE)
+        || !open_line(&cell, &pou, &exact, bundle)) {
         pou_destroy(&pou);
         dc_destroy(exact);
         return -2;
@@ -146,7 +158,7 @@ static long run_line_exact(const char *case_name)
         if (pou.stop_requested && !stopped[0]) {
             size_t hits = colliding_pairs(pou.handle, stop_pairs);
             check(hits > 0 && pou.last_report.colliding_pairs == hits,
-                  "line4 %s: dc_pair_results names %lu colliding pairs at the stop tick, the report %u", case_name,
+                  "line4 %s%s: dc_pair_results names %lu colliding pairs at the stop tick, the report %u", mode, case_name,
                   (unsigned long)hits, (unsigned)pou.last_report.colliding_pairs);
             for (j = 0; j < cell.n_robots; ++j) {
                 stopped[j] = 1;
@@ -155,40 +167,57 @@ static long run_line_exact(const char *case_name)
         }
     }
 
-    check(mock_errors == 0, "line4 %s: %lu mock kinematics errors (a waypoint is unreachable?)", case_name,
+    check(mock_errors == 0, "line4 %s%s: %lu mock kinematics errors (a waypoint is unreachable?)", mode, case_name,
           mock_errors);
-    check(status_errors == 0, "line4 %s: %lu queries did not return OK", case_name, status_errors);
-    check(disagree == 0, "line4 %s: the handle from %s and the exact one disagree on %lu ticks (first %ld)",
-          case_name, LINE_CELL_FILE, disagree, first_disagree);
+    check(status_errors == 0, "line4 %s%s: %lu queries did not return OK", mode, case_name, status_errors);
+    check(disagree == 0, "line4 %s%s: the POU's handle (%s) and the exact one disagree on %lu ticks (first %ld)",
+          mode, case_name, bundle == NULL ? LINE_CELL_FILE : bundle->path, disagree, first_disagree);
     if (practical) {
         check(free_ticks == MR_TICKS_PER_RUN && pou.stop_tick < 0,
-              "line4 practical: FREE on %lu of %d ticks (POU stop tick %ld)", free_ticks, MR_TICKS_PER_RUN,
+              "line4 %spractical: FREE on %lu of %d ticks (POU stop tick %ld)", mode, free_ticks, MR_TICKS_PER_RUN,
               pou.stop_tick);
-        check(exact_first < 0, "line4 practical: the exact model collides at tick %ld", exact_first);
+        check(exact_first < 0, "line4 %spractical: the exact model collides at tick %ld", mode, exact_first);
     } else {
         check(pou.stop_tick > STOP_AFTER_TICK && pou.stop_verdict == DC_VERDICT_COLLISION,
-              "line4 collision: POU stop tick %ld (verdict %u), expected a COLLISION after tick %ld", pou.stop_tick,
-              (unsigned)pou.stop_verdict, STOP_AFTER_TICK);
+              "line4 %scollision: POU stop tick %ld (verdict %u), expected a COLLISION after tick %ld", mode,
+              pou.stop_tick, (unsigned)pou.stop_verdict, STOP_AFTER_TICK);
         check(exact_first >= 0 && pou.stop_tick == exact_first,
-              "line4 collision: POU stop tick %ld, first exact collision tick %ld", pou.stop_tick, exact_first);
+              "line4 %scollision: POU stop tick %ld, first exact collision tick %ld", mode, pou.stop_tick, exact_first);
         check(strcmp(stop_pairs, exact_pairs) == 0,
-              "line4 collision: the POU names pairs %s at its stop, the exact model %s at its first collision",
+              "line4 %scollision: the POU names pairs %s at its stop, the exact model %s at its first collision", mode,
               stop_pairs, exact_pairs);
-        check(not_held == 0, "line4 collision: %lu ticks after the stop were not COLLISION at the held pose",
+        check(not_held == 0, "line4 %scollision: %lu ticks after the stop were not COLLISION at the held pose", mode,
               not_held);
     }
     tick_text(pou.stop_tick, stop_text);
     tick_text(exact_first, exact_text);
-    printf("line4 %-9s: POU stop tick %s, first exact collision %s, FREE ticks %lu/%d, pairs that can meet %lu, "
-           "colliding pairs at the stop %s\n",
-           case_name, stop_text, exact_text, free_ticks, MR_TICKS_PER_RUN, (unsigned long)dc_pair_count(exact),
+    printf("line4 %s%-9s: POU stop tick %s, first exact collision %s, FREE ticks %lu/%d, pairs that can meet %lu, "
+           "colliding pairs at the stop %s",
+           mode, case_name, stop_text, exact_text, free_ticks, MR_TICKS_PER_RUN, (unsigned long)dc_pair_count(exact),
            stop_pairs);
+    if (bundle != NULL) {
+        printf(", lookups confirmed %llu, fallbacks %llu", (unsigned long long)dc_table_confirmations(pou.handle),
+               (unsigned long long)dc_table_fallbacks(pou.handle));
+    }
+    printf("\n");
     pou_destroy(&pou);
     dc_destroy(exact);
     return exact_first;
 }
 
-/* A two-robot table is no table for the line: dc_init_from_files must refuse it and say why. */
+/* The line's bundle file with the cell file: dc_init_from_files gives a table-mode handle of
+ * four robots and every pair that can meet. */
+static void line_bundle_from_files(const char *bundle_path)
+{
+    DcCollider *h = NULL;
+    DcStatus s = dc_init_from_files(LINE_CELL_FILE, bundle_path, &h);
+    check(s == DC_STATUS_OK && h != NULL && dc_mode(h) == DC_MODE_TABLE && dc_robot_count(h) == LINE_ROBOTS
+              && dc_pair_count(h) >= 5,
+          "line4: dc_init_from_files(%s, %s): %s", LINE_CELL_FILE, bundle_path, dc_status_str(s));
+    dc_destroy(h);
+}
+
+/* A two-robot table is no bundle for the line: dc_init_from_files must refuse it and say why. */
 static void line_refuses_a_pair_table(const char *table_path)
 {
     DcCollider *h = NULL;
@@ -197,8 +226,10 @@ static void line_refuses_a_pair_table(const char *table_path)
     size_t len = dc_last_init_error(why, sizeof why);
     check(s != DC_STATUS_OK && h == NULL && len > 0,
           "line4: dc_init_from_files(%s, T1's table) returned %s with no refusal", LINE_CELL_FILE, dc_status_str(s));
-    printf("line4 table mode: not available (one table per pair is not built); T1's table refused: %s: %s\n",
-           dc_status_str(s), len > 0 ? why : "(no message)");
+    check(s == DC_STATUS_TABLE_MISSING_PAIR, "line4: T1's table refused with %s, expected a missing pair",
+          dc_status_str(s));
+    printf("line4 T1's table alone: refused (a line needs its bundle): %s: %s\n", dc_status_str(s),
+           len > 0 ? why : "(no message)");
     dc_destroy(h);
 }
 
@@ -215,14 +246,22 @@ void line_scenarios(const HarnessOptions *options)
     stiff.decel_mm_s2 = 120000.0;
     if (options->quick) {
         /* Valgrind: the handles of four robots and their pair results, once. */
-        run_line_exact("collision");
+        run_line("collision", NULL);
         return;
     }
     if (options->tables[0].path != NULL) {
         line_refuses_a_pair_table(options->tables[0].path);
     }
+    if (options->line_bundle.path != NULL) {
+        line_bundle_from_files(options->line_bundle.path);
+    }
     for (k = 0; k < 2; ++k) {
-        long exact_first = run_line_exact(cases[k]);
+        long exact_first = run_line(cases[k], NULL);
+        if (options->line_bundle.bytes != NULL) {
+            long table_first = run_line(cases[k], &options->line_bundle);
+            check(table_first == exact_first, "line4 %s: the unstopped run's first collision differs between runs",
+                  cases[k]);
+        }
         if (options->protective_quick) {
             continue; /* under qemu the interval arithmetic of the verdict takes minutes */
         }

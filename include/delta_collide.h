@@ -466,7 +466,8 @@ typedef uint32_t DcConfirmation;
 #define DC_STATUS_TABLE_WRONG_CELL 15
 
 /*
- Table mode: tables serve two-robot cells only; use `dc_init` (exact mode) for this cell.
+ Table mode: the cell has fewer than two robots, so no pair for a table to answer; use
+ `dc_init` (exact mode) for it.
  */
 #define DC_STATUS_TABLE_NOT_TWO_ROBOTS 16
 
@@ -476,6 +477,20 @@ typedef uint32_t DcConfirmation;
  `unreachable_mask` names the robot. The next query has no previous TCP.
  */
 #define DC_STATUS_IMPLAUSIBLE_MOTION 17
+
+/*
+ Table mode, a cell of more than two robots: the bundle holds no table for a pair of robots
+ that can meet (`dc_last_init_error` names the pair and where it stands); rebuild the bundle
+ with `delta-collide build --cell ...` for this cell.
+ */
+#define DC_STATUS_TABLE_MISSING_PAIR 18
+
+/*
+ Table mode: the bundle's table for a pair of robots was built for another placement or
+ model of that pair (another spacing of the line; `dc_last_init_error` names the value that
+ differs); rebuild the bundle with `delta-collide build --cell ...` for this cell.
+ */
+#define DC_STATUS_TABLE_WRONG_PAIR 19
 
 /*
  Could not decide (any error): stop the robots.
@@ -510,7 +525,8 @@ typedef uint32_t DcConfirmation;
 
 /*
  Table mode (`dc_init_with_table`, `dc_init_from_files`): one lookup in a precomputed
- table of a two-robot cell, which never answers FREE where the robots collide.
+ table per pair of robots that can meet (a bundle for more than two robots), which never
+ answers FREE where the robots collide.
  */
 #define DC_MODE_TABLE 2
 
@@ -566,9 +582,11 @@ DcStatus dc_init(const struct DcCellConfig *config, struct DcCollider **out_hand
 DcStatus dc_init_from_cell_file(const char *path, struct DcCollider **out_handle);
 
 /*
- Creates a table-mode checker (POU start-up) for the two-robot cell `config` from the bytes
- of a table file built offline for that cell (`delta-collide build --cell ...`): each
- query is then one table lookup (`dc_mode` gives `DC_MODE_TABLE`). The table never answers
+ Creates a table-mode checker (POU start-up) for the cell `config` from the bytes of a table
+ file built offline for that cell (`delta-collide build --cell ...`): each query is then one
+ table lookup per pair of robots that can meet (`dc_mode` gives `DC_MODE_TABLE`). A
+ two-robot cell takes a table; a cell of more robots takes a bundle (the file `build` writes
+ for it), in which each pair finds the table of its relative placement. The table never answers
  FREE where the exact model collides; where its lookup says COLLISION the exact check
  confirms it (`DC_CONFIRMATION_EXACT`, the default), so the verdicts are exact mode's;
  `dc_set_table_confirmation` with `DC_CONFIRMATION_NONE` answers the table's label instead
@@ -580,7 +598,8 @@ DcStatus dc_init_from_cell_file(const char *path, struct DcCollider **out_handle
  fault. Statuses: those of `dc_init`, and `DC_STATUS_NULL_POINTER` (table is NULL),
  `DC_STATUS_TABLE_NOT_TWO_ROBOTS`, `DC_STATUS_TABLE_TRUNCATED` (also for table_len 0),
  `DC_STATUS_TABLE_BAD_MAGIC`, `DC_STATUS_TABLE_UNSUPPORTED_VERSION`,
- `DC_STATUS_TABLE_WRONG_ENDIANNESS`, `DC_STATUS_TABLE_CORRUPT`, `DC_STATUS_TABLE_WRONG_CELL`.
+ `DC_STATUS_TABLE_WRONG_ENDIANNESS`, `DC_STATUS_TABLE_CORRUPT`, `DC_STATUS_TABLE_WRONG_CELL`,
+ and for a bundle `DC_STATUS_TABLE_MISSING_PAIR` and `DC_STATUS_TABLE_WRONG_PAIR`.
 
  # Safety
  `config` as for `dc_init`; `table` must be NULL or point to `table_len` readable bytes;
@@ -719,7 +738,8 @@ DcStatus dc_protective_query_with_paths(struct DcCollider *handle, const struct 
  Copies the per-pair results of the last query into `out[0..]` and their number into
  `*out_len`. Exact mode: the pairs whose reach can overlap (`dc_pair_count`), with the
  colliding boxes. Table mode: one pair (robots 0 and 1), `collides` as the last verdict,
- boxes `DC_BOX_NONE`. After a query that did not return `DC_STATUS_OK` the results are
+ boxes `DC_BOX_NONE` unless the exact check answered; with a bundle, as exact mode's pairs,
+ each pair's own answer. After a query that did not return `DC_STATUS_OK` the results are
  not a decision (table mode: `collides` 0). Statuses: `DC_STATUS_NULL_POINTER`,
  `DC_STATUS_INVALID_ARGUMENT` (`capacity` smaller than `dc_pair_count`; `*out_len` then
  holds the count needed).
@@ -818,7 +838,8 @@ size_t dc_robot_count(const struct DcCollider *handle);
 
 /*
  Number of robot pairs `dc_pair_results` reports: exact mode, the pairs that can meet
- (kept after pruning at init); table mode, 1; 0 for NULL.
+ (kept after pruning at init); table mode, 1 (a bundle: the pairs that can meet, one lookup
+ each); 0 for NULL.
 
  # Safety
  `handle` must be NULL or live.

@@ -13,6 +13,8 @@
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::{Progress, Workspace};
+use delta_collide::cell::parse_cell;
+use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::{build_tables, to_bytes, Labelling, Variant};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -113,6 +115,39 @@ fn table_files(c: usize) -> &'static [PathBuf] {
     })
 }
 
+/// The bundle file of `cells/line4.toml` (the pipeline of `delta-collide build --cell
+/// cells/line4.toml --k 32 --variant shared`: one table per spacing that can meet), kept and
+/// reused as [`table_files`] are.
+fn line_bundle_file() -> &'static Path {
+    static FILE: OnceLock<PathBuf> = OnceLock::new();
+    FILE.get_or_init(|| {
+        let dir = scratch_dir("c_harness_tables");
+        let path = dir.join(format!("line4_k{TABLE_K}_shared.dcb"));
+        let stamp = dir.join(format!("line4_k{TABLE_K}.builder"));
+        let exe = std::fs::metadata(std::env::current_exe().expect("test executable")).expect("stat test executable");
+        let modified = exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+        let builder = format!("{} bytes, modified {:?}, k = {TABLE_K}", exe.len(), modified.unwrap_or_default());
+        if path.is_file() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder) {
+            return path;
+        }
+        let cell = parse_cell(&std::fs::read_to_string(repo_root().join("cells/line4.toml")).unwrap()).unwrap();
+        let start = std::time::Instant::now();
+        let built =
+            build_bundle(&cell, TABLE_K, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
+                .unwrap_or_else(|e| panic!("building the line4 bundle: {e}"));
+        let _ = std::fs::remove_file(&stamp);
+        std::fs::write(&path, &built.bytes).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+        std::fs::write(&stamp, builder).unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
+        println!(
+            "line4: bundle of {} tables k = {TABLE_K}, {} bytes, built in {:.1} s",
+            built.tables.len(),
+            built.bytes.len(),
+            start.elapsed().as_secs_f64()
+        );
+        path
+    })
+}
+
 /// The 6-D table file of `CELLS[c]`.
 fn table_file(c: usize) -> &'static Path {
     &table_files(c)[0]
@@ -173,7 +208,9 @@ fn assert_speed_override(stdout: &str) {
 /// every tick; the collision case stops after tick 3000, at the exact model's first colliding
 /// tick, on the pair R3-R4 (robots 2-3, `tests/line_scenarios.rs`). With the protective verdict
 /// (default and stiff models, the stiff one also with paths) no simulated stop touches, and in
-/// the collision case every first STOP comes no later than that tick. T1's table is refused.
+/// the collision case every first STOP comes no later than that tick. In table mode on the
+/// line's bundle (exact confirmation) the practical case is FREE on every tick and the
+/// collision case stops at the same tick on the same pair. T1's table alone is refused.
 fn assert_line(stdout: &str) {
     let line = |prefix: &str| -> &str {
         stdout.lines().find(|l| l.starts_with(prefix)).unwrap_or_else(|| panic!("no `{prefix}` line"))
@@ -185,7 +222,15 @@ fn assert_line(stdout: &str) {
     assert!(stop > 3000.0 && stop == first, "{collision}");
     assert!(collision.ends_with("colliding pairs at the stop 2-3"), "{collision}");
     assert!(number(collision, "pairs that can meet ") >= 5.0, "{collision}");
-    assert!(line("line4 table mode").contains("tables serve two-robot cells"), "T1's table refused for the line");
+    let t1_alone = line("line4 T1's table alone");
+    assert!(t1_alone.contains("holds no table for R1-R3"), "T1's table refused for the line: {t1_alone}");
+    let table_practical = line("line4 table practical");
+    assert!(table_practical.contains("POU stop tick none, first exact collision none, FREE ticks 6000/6000"), "{table_practical}");
+    let table_collision = line("line4 table collision");
+    assert_eq!(number(table_collision, "POU stop tick "), stop, "{table_collision}");
+    assert!(table_collision.contains("colliding pairs at the stop 2-3,"), "{table_collision}");
+    // The lookups said COLLISION near the contact and the exact check confirmed them.
+    assert!(number(table_collision, "lookups confirmed ") > 0.0, "{table_collision}");
     let protective: Vec<&str> = stdout.lines().filter(|l| l.starts_with("protective line4 ")).collect();
     assert_eq!(protective.len(), 6, "three protective runs per case: {protective:?}");
     for l in protective {
@@ -228,8 +273,13 @@ fn c_harness_passes_on_the_shared_table() {
 fn harness_passes_with_tables(kind: usize) {
     let exe = plain_harness();
     let tmp = scratch_dir(&format!("c_harness_{}", KINDS[kind].0));
-    let out =
-        run(Command::new(exe).arg("--tmp").arg(&tmp).args(table_args_of(&[0, 1, 2], kind)).current_dir(repo_root()));
+    let out = run(Command::new(exe)
+        .arg("--tmp")
+        .arg(&tmp)
+        .args(table_args_of(&[0, 1, 2], kind))
+        .arg("--line-bundle")
+        .arg(line_bundle_file())
+        .current_dir(repo_root()));
     let stdout = assert_harness_passed(&format!("c_harness (exact and {} table mode, T1 T2 T3)", KINDS[kind].0), &out);
     assert!(stdout.contains("bad input: done (exact and table mode)"), "table-mode bad inputs did not run");
     assert_speed_override(&stdout);

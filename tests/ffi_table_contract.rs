@@ -58,9 +58,10 @@ fn table_init_gives_each_table_error_its_own_status_and_no_handle() {
         let (s, verdict, _) = query(h, &[v(0.0, 0.0, -450.0); 2]);
         assert_eq!((s, verdict), (DC_STATUS_NULL_POINTER, DC_VERDICT_STOP), "{what}");
     }
-    // Tables serve two-robot cells only; a bad config is reported before the table is read.
+    // A table needs two robots; three 450 mm apart need the pair 900 mm apart too, which
+    // T1's table is not; a bad config is reported before the table is read.
     for (n, want) in
-        [(1, DC_STATUS_TABLE_NOT_TWO_ROBOTS), (3, DC_STATUS_TABLE_NOT_TWO_ROBOTS), (0, DC_STATUS_INVALID_CONFIG)]
+        [(1, DC_STATUS_TABLE_NOT_TWO_ROBOTS), (3, DC_STATUS_TABLE_MISSING_PAIR), (0, DC_STATUS_INVALID_CONFIG)]
     {
         let (s, h) = init_table(&Config::cell(450.0, n).c(), t1);
         assert_eq!((s, h.is_null()), (want, true), "{n} robots");
@@ -386,4 +387,80 @@ fn clearance_bound_through_the_c_abi_matches_the_table_and_stays_under_the_exact
         dc_destroy(exact_handle);
         dc_destroy(boolean);
     }
+}
+
+/// Pair results of a handle's last query.
+fn pair_results(h: *mut DcCollider) -> Vec<DcPairResult> {
+    let mut out = [DcPairResult { robot_a: 9, robot_b: 9, collides: 9, box_a: 9, box_b: 9 }; 8];
+    let mut len = 0;
+    // SAFETY: live handle, valid buffers.
+    assert_eq!(unsafe { dc_pair_results(h, out.as_mut_ptr(), out.len(), &mut len) }, DC_STATUS_OK);
+    out[..len].to_vec()
+}
+
+#[test]
+fn a_line_in_table_mode_answers_per_pair_as_exact_mode_from_its_bundle() {
+    let line = Config::cell(450.0, 4);
+    let (s, h) = init_table(&line.c(), line4_bundle_bytes());
+    assert_eq!(s, DC_STATUS_OK, "{}", last_init_error());
+    let mut exact = std::ptr::null_mut();
+    // SAFETY: valid config and out pointer; live handles.
+    unsafe {
+        assert_eq!(dc_init(&line.c(), &mut exact), DC_STATUS_OK);
+        assert_eq!((dc_mode(h), dc_robot_count(h), dc_pair_count(h)), (DC_MODE_TABLE, 4, dc_pair_count(exact)));
+        assert_eq!(dc_pair_count(h), 6);
+    }
+    let mut rng = StdRng::seed_from_u64(0x5eed_11fe);
+    let mut uniform = |lo: f64, hi: f64| rng.random_range(lo..hi);
+    let (mut collisions, mut unreachable) = (0, 0);
+    for i in 0..50_000 {
+        let tcps: Vec<DcVec3> =
+            (0..4).map(|_| v(uniform(-240.0, 240.0), uniform(-200.0, 200.0), uniform(-545.0, -355.0))).collect();
+        let (st, vt, rt) = query(h, &tcps);
+        let (se, ve, re) = query(exact, &tcps);
+        assert_eq!((st, vt, rt.colliding_pairs, rt.unreachable_mask), (se, ve, re.colliding_pairs, re.unreachable_mask), "case {i}: {tcps:?}");
+        assert_eq!((rt.first_robot_a, rt.first_robot_b), (re.first_robot_a, re.first_robot_b), "case {i}");
+        // Each pair as the exact model answers it; the boxes of a confirmed collision too.
+        let (pt, pe) = (pair_results(h), pair_results(exact));
+        assert_eq!(pt, pe, "case {i}: {tcps:?}");
+        collisions += usize::from(ve == DC_VERDICT_COLLISION);
+        unreachable += usize::from(se == DC_STATUS_UNREACHABLE);
+    }
+    assert!(collisions > 1000 && unreachable > 1000, "{collisions} collisions, {unreachable} unreachable");
+    // SAFETY: live handles.
+    unsafe {
+        assert!(dc_table_confirmations(h) > 0, "COLLISION lookups were confirmed");
+        dc_destroy(h);
+        dc_destroy(exact);
+    }
+}
+
+#[test]
+fn a_bundle_for_another_spacing_or_missing_a_pair_is_its_own_init_error() {
+    let cases = [
+        (Config::cell(460.0, 4), DC_STATUS_TABLE_WRONG_PAIR, "placement.translation.x is 450"),
+        // Five robots 450 mm apart need no other spacing: the bundle of four serves them.
+        (Config::cell(450.0, 5), DC_STATUS_OK, ""),
+        (Config::cell(340.0, 3), DC_STATUS_TABLE_WRONG_PAIR, "robot 1: placement.translation.x"),
+    ];
+    for (config, want, says) in cases {
+        let (s, h) = init_table(&config.c(), line4_bundle_bytes());
+        let message = last_init_error();
+        assert_eq!(s, want, "{} robots: {message}", config.robots.len());
+        assert!(message.contains(says) && (want == DC_STATUS_OK || message.contains("rebuild the bundle")), "{message}");
+        // SAFETY: the handle is NULL or live, destroyed once.
+        unsafe { dc_destroy(h) };
+    }
+    // A line whose outer robots stand 1340 mm apart (not 1350) and its neighbours 450 and 440:
+    // the pair R1-R3 at 890 mm has no table in the bundle and no directory entry of its own
+    // spacing; the bundle names the first pair it cannot serve.
+    let mut config = Config::cell(450.0, 3);
+    config.robots[2].translation.x = 890.0;
+    let (s, _) = init_table(&config.c(), line4_bundle_bytes());
+    assert_eq!(s, DC_STATUS_TABLE_WRONG_PAIR, "{}", last_init_error());
+    // T1's table alone for three robots: the neighbours find it, the pair 900 mm apart not.
+    let (s, _) = init_table(&Config::cell(450.0, 3).c(), table_bytes("T1"));
+    assert_eq!(s, DC_STATUS_TABLE_MISSING_PAIR);
+    let message = last_init_error();
+    assert!(message.contains("robots 0 and 2") && message.contains("(900, 0, 0)"), "{message}");
 }

@@ -468,7 +468,7 @@ fn status_str(input: &mut Input) {
     // SAFETY: `dc_status_str` returns a static NUL-terminated string.
     let text = unsafe { CStr::from_ptr(dc_status_str(status)) };
     assert!(!text.to_bytes().is_empty() && text.to_str().is_ok(), "status {status}: {text:?}");
-    if status <= DC_STATUS_TABLE_NOT_TWO_ROBOTS {
+    if status <= DC_STATUS_TABLE_WRONG_PAIR {
         assert_ne!(text.to_bytes(), b"unknown status", "status {status} has no description");
     }
     // SAFETY: `dc_version` returns a static NUL-terminated string.

@@ -14,7 +14,7 @@ use crate::ffi::convert::{cell_error_status, table_error_status};
 use crate::ffi::types::*;
 use crate::math::Vec3;
 use crate::robot::StopModel;
-use crate::table::{Confirmation, TableAnswer, TableChecker};
+use crate::table::{is_bundle, BundleChecker, Confirmation, TableAnswer, TableChecker};
 use std::path::Path;
 
 /// Why a collider could not be made: the status for C and a message naming the cause and
@@ -37,6 +37,8 @@ enum Checker {
     Exact(Box<ExactChecker>),
     /// One lookup in a table built offline for a two-robot cell (thesis 3.2).
     Table(Box<TableChecker>),
+    /// One lookup per pair of robots that can meet, each in its pair's table of a bundle.
+    Bundle(Box<BundleChecker>),
 }
 
 /// A collider: its checker and the buffers of one tick.
@@ -75,14 +77,18 @@ impl Collider {
     /// and copied here (the caller's buffer is not kept), answering a COLLISION lookup as
     /// `confirmation` says.
     pub(crate) fn table(cell: Cell, bytes: &[u8], confirmation: Confirmation) -> Result<Collider, InitError> {
-        if cell.robots.len() != 2 {
+        if cell.robots.len() < 2 {
             return Err(InitError::new(
                 DC_STATUS_TABLE_NOT_TWO_ROBOTS,
                 format!(
-                    "tables serve two-robot cells, this cell has {} robots; use dc_init (exact mode) for it",
+                    "tables serve cells of two or more robots (a two-robot cell or its pairs), this cell has {} \
+                     robot; use dc_init (exact mode) for it",
                     cell.robots.len()
                 ),
             ));
+        }
+        if cell.robots.len() > 2 || is_bundle(bytes) {
+            return Collider::bundle(cell, bytes, confirmation);
         }
         let protective = protective_for(&cell);
         let checker = TableChecker::with_confirmation(cell, bytes, confirmation)
@@ -93,6 +99,22 @@ impl Collider {
             table_collides: false,
             protective,
             path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; 2],
+        })
+    }
+
+    /// A table-mode collider for a cell of two or more robots from a bundle's bytes (or a table
+    /// file's, read as a bundle of one table), validated and copied here.
+    fn bundle(cell: Cell, bytes: &[u8], confirmation: Confirmation) -> Result<Collider, InitError> {
+        let n = cell.robots.len();
+        let protective = protective_for(&cell);
+        let checker = BundleChecker::new(cell, bytes, confirmation)
+            .map_err(|e| InitError::new(table_error_status(&e), e.to_string()))?;
+        Ok(Collider {
+            checker: Checker::Bundle(Box::new(checker)),
+            tcps: vec![Vec3::zeros(); n],
+            table_collides: false,
+            protective,
+            path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; n],
         })
     }
 
@@ -110,7 +132,7 @@ impl Collider {
     pub(crate) fn mode(&self) -> DcMode {
         match self.checker {
             Checker::Exact(_) => DC_MODE_EXACT,
-            Checker::Table(_) => DC_MODE_TABLE,
+            Checker::Table(_) | Checker::Bundle(_) => DC_MODE_TABLE,
         }
     }
 
@@ -125,6 +147,7 @@ impl Collider {
         match &self.checker {
             Checker::Exact(c) => c.verdict().pairs.len(),
             Checker::Table(_) => 1,
+            Checker::Bundle(b) => b.pairs().len(),
         }
     }
 
@@ -134,6 +157,7 @@ impl Collider {
         match &self.checker {
             Checker::Exact(_) => 0,
             Checker::Table(t) => t.fallbacks(),
+            Checker::Bundle(b) => b.fallbacks(),
         }
     }
 
@@ -143,14 +167,17 @@ impl Collider {
         match &self.checker {
             Checker::Exact(_) => 0,
             Checker::Table(t) => t.confirmations(),
+            Checker::Bundle(b) => b.confirmations(),
         }
     }
 
     /// Table mode: chooses what a COLLISION lookup does from the next query on; exact mode
     /// answers exactly whatever is chosen.
     pub(crate) fn set_table_confirmation(&mut self, confirmation: Confirmation) {
-        if let Checker::Table(t) = &mut self.checker {
-            t.set_confirmation(confirmation);
+        match &mut self.checker {
+            Checker::Table(t) => t.set_confirmation(confirmation),
+            Checker::Bundle(b) => b.set_confirmation(confirmation),
+            Checker::Exact(_) => {}
         }
     }
 
@@ -177,6 +204,7 @@ impl Collider {
                 self.table_collides = status == DC_STATUS_OK && report.verdict == DC_VERDICT_COLLISION;
                 status
             }
+            Checker::Bundle(b) => query_bundle(b, &self.tcps, report),
         }
     }
 
@@ -203,6 +231,8 @@ impl Collider {
             Checker::Exact(_) => (DC_STATUS_OK, none),
             Checker::Table(t) if t.unreachable_mask(&self.tcps) != 0 => (DC_STATUS_UNREACHABLE, none),
             Checker::Table(t) => (DC_STATUS_OK, t.clearance_bound(&self.tcps).unwrap_or(none)),
+            Checker::Bundle(b) if b.unreachable_mask(&self.tcps) != 0 => (DC_STATUS_UNREACHABLE, none),
+            Checker::Bundle(_) => (DC_STATUS_OK, none),
         }
     }
 
@@ -311,6 +341,15 @@ impl Collider {
                 let [box_a, box_b] = boxes.map_or([DC_BOX_NONE; 2], |(a, b)| [a as u32, b as u32]);
                 out[0] = DcPairResult { robot_a: 0, robot_b: 1, collides, box_a, box_b };
             }
+            Checker::Bundle(b) => {
+                for (o, p) in out.iter_mut().zip(b.pairs()) {
+                    let collides = p.answer == TableAnswer::Collision;
+                    let boxes = p.boxes.filter(|_| collides);
+                    let [box_a, box_b] = boxes.map_or([DC_BOX_NONE; 2], |(a, b)| [a as u32, b as u32]);
+                    let (robot_a, robot_b) = (p.a as u32, p.b as u32);
+                    *o = DcPairResult { robot_a, robot_b, collides: u32::from(collides), box_a, box_b };
+                }
+            }
         }
     }
 }
@@ -378,6 +417,34 @@ fn query_table(checker: &mut TableChecker, tcps: &[Vec3], report: &mut DcQueryRe
             if let Some((a, b)) = checker.colliding_boxes() {
                 (report.first_box_a, report.first_box_b) = (a as u32, b as u32);
             }
+            DC_STATUS_OK
+        }
+    }
+}
+
+/// A bundle's answer in the report: as exact mode's, with the first colliding pair's robots,
+/// and its boxes when the exact check answered it.
+fn query_bundle(checker: &mut BundleChecker, tcps: &[Vec3], report: &mut DcQueryReport) -> DcStatus {
+    let Ok(answer) = checker.check(tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };
+    let colliding = checker.pairs().iter().filter(|p| p.answer == TableAnswer::Collision);
+    report.colliding_pairs = colliding.clone().count() as u32;
+    if let Some(p) = colliding.clone().next() {
+        (report.first_robot_a, report.first_robot_b) = (p.a as u32, p.b as u32);
+        if let Some((a, b)) = p.boxes {
+            (report.first_box_a, report.first_box_b) = (a as u32, b as u32);
+        }
+    }
+    match answer {
+        TableAnswer::Unreachable(mask) => {
+            report.unreachable_mask = mask;
+            DC_STATUS_UNREACHABLE
+        }
+        TableAnswer::Collision => {
+            report.verdict = DC_VERDICT_COLLISION;
+            DC_STATUS_OK
+        }
+        TableAnswer::Free => {
+            report.verdict = DC_VERDICT_FREE;
             DC_STATUS_OK
         }
     }

@@ -47,6 +47,8 @@ pub fn table_error_status(e: &TableError) -> DcStatus {
         TableError::WrongEndianness => DC_STATUS_TABLE_WRONG_ENDIANNESS,
         TableError::Corrupt { .. } => DC_STATUS_TABLE_CORRUPT,
         TableError::WrongCell { .. } => DC_STATUS_TABLE_WRONG_CELL,
+        TableError::MissingPair { .. } => DC_STATUS_TABLE_MISSING_PAIR,
+        TableError::WrongPair { .. } => DC_STATUS_TABLE_WRONG_PAIR,
         // `TableChecker::new` reports a cell without two robots as bad input.
         TableError::BadInput { .. } => DC_STATUS_TABLE_NOT_TWO_ROBOTS,
     }
@@ -174,9 +176,13 @@ mod tests {
             TableError::Corrupt { what: "checksum".into() },
             TableError::WrongCell { expected: 1, found: 2, differs: None },
             TableError::BadInput { what: "three robots".into() },
+            TableError::MissingPair { what: "R3-R4".into() },
+            TableError::WrongPair { what: "R1-R2".into() },
         ];
         let statuses: Vec<DcStatus> = errors.iter().map(table_error_status).collect();
-        assert_eq!(statuses, (10..=16).collect::<Vec<_>>(), "one status per variant, in order, from 10");
+        // 17 is the protective query's; the bundle statuses came after it.
+        let expected: Vec<DcStatus> = (10..=16).chain([18, 19]).collect();
+        assert_eq!(statuses, expected, "one status per variant, in order, from 10");
         for s in statuses {
             // SAFETY: dc_status_str returns a static NUL-terminated string.
             let text = unsafe { CStr::from_ptr(crate::ffi::dc_status_str(s)) }.to_str().unwrap();

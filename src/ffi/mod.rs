@@ -10,7 +10,8 @@
 //!   `DC_VERDICT_FREE` only together with `DC_STATUS_OK` (fail closed).
 //! - `dc_init*` allocate; `dc_query` never allocates, locks or does I/O.
 //! - Two modes behind one handle: exact (`dc_init`, `dc_init_from_cell_file`) and table
-//!   (`dc_init_with_table`, `dc_init_from_files`; two-robot cells); `dc_query` is the same.
+//!   (`dc_init_with_table`, `dc_init_from_files`; a table, or a bundle of one table per pair
+//!   that can meet); `dc_query` is the same.
 //! - Table mode confirms a COLLISION lookup by the exact check unless
 //!   `dc_set_table_confirmation` (or the cell file's `table_confirm`) says otherwise, so it
 //!   answers as exact mode; `dc_table_confirmations` counts those ticks.
@@ -173,9 +174,11 @@ pub unsafe extern "C" fn dc_init_from_cell_file(path: *const c_char, out_handle:
     unsafe { init_handle(out_handle, make) }
 }
 
-/// Creates a table-mode checker (POU start-up) for the two-robot cell `config` from the bytes
-/// of a table file built offline for that cell (`delta-collide build --cell ...`): each
-/// query is then one table lookup (`dc_mode` gives `DC_MODE_TABLE`). The table never answers
+/// Creates a table-mode checker (POU start-up) for the cell `config` from the bytes of a table
+/// file built offline for that cell (`delta-collide build --cell ...`): each query is then one
+/// table lookup per pair of robots that can meet (`dc_mode` gives `DC_MODE_TABLE`). A
+/// two-robot cell takes a table; a cell of more robots takes a bundle (the file `build` writes
+/// for it), in which each pair finds the table of its relative placement. The table never answers
 /// FREE where the exact model collides; where its lookup says COLLISION the exact check
 /// confirms it (`DC_CONFIRMATION_EXACT`, the default), so the verdicts are exact mode's;
 /// `dc_set_table_confirmation` with `DC_CONFIRMATION_NONE` answers the table's label instead
@@ -187,7 +190,8 @@ pub unsafe extern "C" fn dc_init_from_cell_file(path: *const c_char, out_handle:
 /// fault. Statuses: those of `dc_init`, and `DC_STATUS_NULL_POINTER` (table is NULL),
 /// `DC_STATUS_TABLE_NOT_TWO_ROBOTS`, `DC_STATUS_TABLE_TRUNCATED` (also for table_len 0),
 /// `DC_STATUS_TABLE_BAD_MAGIC`, `DC_STATUS_TABLE_UNSUPPORTED_VERSION`,
-/// `DC_STATUS_TABLE_WRONG_ENDIANNESS`, `DC_STATUS_TABLE_CORRUPT`, `DC_STATUS_TABLE_WRONG_CELL`.
+/// `DC_STATUS_TABLE_WRONG_ENDIANNESS`, `DC_STATUS_TABLE_CORRUPT`, `DC_STATUS_TABLE_WRONG_CELL`,
+/// and for a bundle `DC_STATUS_TABLE_MISSING_PAIR` and `DC_STATUS_TABLE_WRONG_PAIR`.
 ///
 /// # Safety
 /// `config` as for `dc_init`; `table` must be NULL or point to `table_len` readable bytes;
@@ -536,7 +540,8 @@ unsafe fn protective_entry(
 /// Copies the per-pair results of the last query into `out[0..]` and their number into
 /// `*out_len`. Exact mode: the pairs whose reach can overlap (`dc_pair_count`), with the
 /// colliding boxes. Table mode: one pair (robots 0 and 1), `collides` as the last verdict,
-/// boxes `DC_BOX_NONE`. After a query that did not return `DC_STATUS_OK` the results are
+/// boxes `DC_BOX_NONE` unless the exact check answered; with a bundle, as exact mode's pairs,
+/// each pair's own answer. After a query that did not return `DC_STATUS_OK` the results are
 /// not a decision (table mode: `collides` 0). Statuses: `DC_STATUS_NULL_POINTER`,
 /// `DC_STATUS_INVALID_ARGUMENT` (`capacity` smaller than `dc_pair_count`; `*out_len` then
 /// holds the count needed).
@@ -737,7 +742,8 @@ pub unsafe extern "C" fn dc_robot_count(handle: *const DcCollider) -> usize {
 }
 
 /// Number of robot pairs `dc_pair_results` reports: exact mode, the pairs that can meet
-/// (kept after pruning at init); table mode, 1; 0 for NULL.
+/// (kept after pruning at init); table mode, 1 (a bundle: the pairs that can meet, one lookup
+/// each); 0 for NULL.
 ///
 /// # Safety
 /// `handle` must be NULL or live.
@@ -787,9 +793,15 @@ pub extern "C" fn dc_status_str(status: DcStatus) -> *const c_char {
         DC_STATUS_TABLE_WRONG_CELL => {
             c"the table was built for another cell: rebuild it with `delta-collide build --cell ...` for this cell"
         }
-        DC_STATUS_TABLE_NOT_TWO_ROBOTS => c"tables serve two-robot cells only: use dc_init (exact mode) for this cell",
+        DC_STATUS_TABLE_NOT_TWO_ROBOTS => c"a table serves a cell of two or more robots: use dc_init (exact mode) for this cell",
         DC_STATUS_IMPLAUSIBLE_MOTION => {
             c"a TCP moved further or changed its velocity more in one tick than its stopping model allows"
+        }
+        DC_STATUS_TABLE_MISSING_PAIR => {
+            c"the table bundle holds no table for a pair that can meet: rebuild it with `delta-collide build --cell ...`"
+        }
+        DC_STATUS_TABLE_WRONG_PAIR => {
+            c"the table bundle's table for a pair was built for another spacing: rebuild it with `delta-collide build --cell ...`"
         }
         _ => c"unknown status",
     };

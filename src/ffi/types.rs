@@ -43,12 +43,21 @@ pub const DC_STATUS_TABLE_CORRUPT: DcStatus = 14;
 /// Table mode: the table was built for another cell than the configured one (geometry, boxes,
 /// margins or placements differ); rebuild it with `delta-collide build --cell ...`.
 pub const DC_STATUS_TABLE_WRONG_CELL: DcStatus = 15;
-/// Table mode: tables serve two-robot cells only; use `dc_init` (exact mode) for this cell.
+/// Table mode: the cell has fewer than two robots, so no pair for a table to answer; use
+/// `dc_init` (exact mode) for it.
 pub const DC_STATUS_TABLE_NOT_TWO_ROBOTS: DcStatus = 16;
 /// Protective query: a TCP moved further, or changed its velocity more, in one tick than its
 /// robot's stopping model allows (`max_speed_mm_s`, `max_accel_mm_s2`); the report's
 /// `unreachable_mask` names the robot. The next query has no previous TCP.
 pub const DC_STATUS_IMPLAUSIBLE_MOTION: DcStatus = 17;
+/// Table mode, a cell of more than two robots: the bundle holds no table for a pair of robots
+/// that can meet (`dc_last_init_error` names the pair and where it stands); rebuild the bundle
+/// with `delta-collide build --cell ...` for this cell.
+pub const DC_STATUS_TABLE_MISSING_PAIR: DcStatus = 18;
+/// Table mode: the bundle's table for a pair of robots was built for another placement or
+/// model of that pair (another spacing of the line; `dc_last_init_error` names the value that
+/// differs); rebuild the bundle with `delta-collide build --cell ...` for this cell.
+pub const DC_STATUS_TABLE_WRONG_PAIR: DcStatus = 19;
 
 /// What the controller should do; 0 is STOP so that zeroed memory fails closed.
 pub type DcVerdict = u32;
@@ -72,7 +81,8 @@ pub const DC_MODE_NONE: DcMode = 0;
 /// Exact mode (`dc_init`, `dc_init_from_cell_file`): every box pair, separating axis test.
 pub const DC_MODE_EXACT: DcMode = 1;
 /// Table mode (`dc_init_with_table`, `dc_init_from_files`): one lookup in a precomputed
-/// table of a two-robot cell, which never answers FREE where the robots collide.
+/// table per pair of robots that can meet (a bundle for more than two robots), which never
+/// answers FREE where the robots collide.
 pub const DC_MODE_TABLE: DcMode = 2;
 
 /// Table mode: what a query does when the table's lookup says COLLISION

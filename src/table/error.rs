@@ -45,6 +45,17 @@ pub enum TableError {
         /// The first parameter that differs, when the table recorded its cell's parameters.
         differs: Option<String>,
     },
+    /// A bundle holds no table for a pair of robots that can meet.
+    MissingPair {
+        /// The pair, where it stands, and what the bundle holds.
+        what: String,
+    },
+    /// A bundle's table for a pair of robots was built for another placement or model of
+    /// that pair (another spacing of the line).
+    WrongPair {
+        /// The pair and the first value that differs.
+        what: String,
+    },
     /// The labelled space or the parameters given to a builder are not usable.
     BadInput {
         /// The input and what is wrong with it.
@@ -88,6 +99,11 @@ impl core::fmt::Display for TableError {
                 }
                 write!(f, "; rebuild with `delta-collide build --cell ...` for this cell")
             }
+            TableError::MissingPair { what } | TableError::WrongPair { what } => write!(
+                f,
+                "table bundle does not fit this cell: {what}; rebuild the bundle with \
+                 `delta-collide build --cell CELL_FILE --output BUNDLE` for this cell"
+            ),
             TableError::BadInput { what } => write!(f, "cannot build a table: {what}"),
         }
     }

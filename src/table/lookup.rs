@@ -161,6 +161,17 @@ impl TableChecker {
             });
         }
         let (header, table) = from_bytes(bytes)?;
+        TableChecker::from_loaded(cell, header, table, confirmation)
+    }
+
+    /// As [`TableChecker::with_confirmation`], from a table already read and validated as
+    /// bytes (a bundle's).
+    pub(crate) fn from_loaded(
+        cell: Cell,
+        header: Header,
+        table: Table,
+        confirmation: Confirmation,
+    ) -> Result<TableChecker, TableError> {
         header.check_cell_parameters(&cell)?;
         check_determined_by_cell(&header, &table, &cell)?;
         let k = 1u32 << table.levels();
@@ -258,6 +269,13 @@ impl TableChecker {
         if mask != 0 {
             return Ok(TableAnswer::Unreachable(mask));
         }
+        self.check_reachable(tcps_mcs)
+    }
+
+    /// [`TableChecker::check`] for two TCPs the caller has found reachable with this cell's
+    /// models (a bundle checks each robot once per tick, not once per pair).
+    pub(crate) fn check_reachable(&mut self, tcps_mcs: &[Vec3]) -> Result<TableAnswer, QueryError> {
+        self.exact_boxes = None;
         match (self.cell_of(0, &tcps_mcs[0]), self.cell_of(1, &tcps_mcs[1])) {
             (Some(a), Some(b)) => {
                 if !self.table.query([a[0], a[1], a[2], b[0], b[1], b[2]]) {

@@ -18,6 +18,8 @@
 
 #[cfg(feature = "std")]
 pub(crate) mod build;
+pub mod bundle;
+mod bundle_checker;
 pub mod clearance;
 pub mod code;
 pub(crate) mod error;
@@ -43,6 +45,8 @@ use alloc::{format, string::String};
 use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
 pub use build::{build_table, build_tables, BuildError, BuildReport, Labelling, Variant};
+pub use bundle::{bundle_from_bytes, bundle_to_bytes, is_bundle, pair_cell, Bundle, BundlePair};
+pub use bundle_checker::{BundleChecker, PairAnswer};
 pub use clearance::{ClearanceTable, Ladder};
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};

@@ -35,6 +35,25 @@ pub fn table_bytes(name: &str) -> &'static [u8] {
     })
 }
 
+/// The bytes of the bundle of `cells/line4.toml` (four thesis robots 450 mm apart: three
+/// shared 6-D tables at k = 16, certified), built once per process.
+pub fn line4_bundle_bytes() -> &'static [u8] {
+    static BUNDLE: OnceLock<Vec<u8>> = OnceLock::new();
+    BUNDLE.get_or_init(|| {
+        let cell = delta_collide::cell::parse_cell(include_str!("../../cells/line4.toml")).unwrap();
+        delta_collide::table::bundle::build_bundle(
+            &cell,
+            16,
+            &Workspace::THESIS,
+            Variant::Shared,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap_or_else(|e| panic!("building the line4 bundle: {e}"))
+        .bytes
+    })
+}
+
 /// `dc_init_with_table` on a copy of `bytes` that is freed before returning (the handle
 /// must not keep the caller's buffer); returns the status and the handle (NULL on failure).
 pub fn init_table(config: *const DcCellConfig, bytes: &[u8]) -> (DcStatus, *mut DcCollider) {

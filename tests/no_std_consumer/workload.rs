@@ -72,6 +72,8 @@ fn error_code(e: &TableError) -> u32 {
         TableError::Corrupt { .. } => 5,
         TableError::WrongCell { .. } => 6,
         TableError::BadInput { .. } => 7,
+        TableError::MissingPair { .. } => 8,
+        TableError::WrongPair { .. } => 9,
     }
 }
 

@@ -9,7 +9,7 @@ use delta_collide::ffi::*;
 use delta_collide::math::Vec3;
 use delta_collide::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
 use delta_collide::table::format::fnv1a64;
-use delta_collide::table::{TableChecker, TableKind};
+use delta_collide::table::{is_bundle, BundleChecker, Confirmation, TableChecker, TableKind};
 use std::ffi::{c_char, CStr, CString};
 use std::sync::OnceLock;
 
@@ -268,7 +268,11 @@ pub(super) fn init_with_table(input: &mut Input, live: &mut Vec<Live>) {
     let expected = match (null_out, config.expected_status(), cell) {
         (true, _, _) => DC_STATUS_NULL_POINTER,
         (_, DC_STATUS_OK, _) if null_table => DC_STATUS_NULL_POINTER,
-        (_, DC_STATUS_OK, Some(cell)) if cell.robots.len() != 2 => DC_STATUS_TABLE_NOT_TWO_ROBOTS,
+        (_, DC_STATUS_OK, Some(cell)) if cell.robots.len() < 2 => DC_STATUS_TABLE_NOT_TWO_ROBOTS,
+        // More robots, or a bundle: one table per pair that can meet, from the bundle.
+        (_, DC_STATUS_OK, Some(cell)) if cell.robots.len() > 2 || is_bundle(&bytes) => {
+            BundleChecker::new(cell, &bytes, Confirmation::Exact).map_or_else(|e| table_error_status(&e), |_| DC_STATUS_OK)
+        }
         (_, DC_STATUS_OK, Some(cell)) => {
             TableChecker::new(cell, &bytes).map_or_else(|e| table_error_status(&e), |_| DC_STATUS_OK)
         }
@@ -278,7 +282,8 @@ pub(super) fn init_with_table(input: &mut Input, live: &mut Vec<Live>) {
     let Some(h) = finish(status, (!null_out).then_some(out), input) else { return };
     // SAFETY: `h` is a live handle.
     let (count, pairs, mode) = unsafe { (dc_robot_count(h), dc_pair_count(h), dc_mode(h)) };
-    assert!(count == 2 && pairs == 1 && mode == DC_MODE_TABLE, "{count} robots, {pairs} pairs, mode {mode}");
+    let expected_pairs = if count == 2 && !is_bundle(&bytes) { 1 } else { config.cell().map_or(0, |c| c.pairs_that_can_meet().len()) };
+    assert!(count >= 2 && pairs == expected_pairs && mode == DC_MODE_TABLE, "{count} robots, {pairs} pairs, mode {mode}");
     keep(live, config.into_live(h));
 }
 

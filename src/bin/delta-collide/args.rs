@@ -148,7 +148,8 @@ pub struct CheckArgs {
     /// The cell: T1, T2, T3 or a .toml file
     #[arg(long, value_name = "CELL", value_parser = clipped(parse_cell))]
     pub cell: Cell,
-    /// Answer from this table (built for the same cell) instead of the exact check
+    /// Answer from this table (built for the same cell; for more than two robots, the bundle
+    /// build writes: one lookup per pair that can meet) instead of the exact check
     #[arg(long, value_name = "FILE.dct")]
     pub table: Option<PathBuf>,
     /// With --table: what a row the table says collides gets (exact: the exact check's
@@ -217,7 +218,8 @@ pub struct BuildArgs {
     /// The cell: T1, T2, T3 or a .toml file
     #[arg(long, value_name = "CELL", value_parser = clipped(parse_cell))]
     pub cell: Cell,
-    /// The table file to write, replaced only once complete
+    /// The table file to write, replaced only once complete; for a cell of more than two
+    /// robots, a bundle: one table per relative placement of the pairs that can meet
     #[arg(long, value_name = "FILE.dct")]
     pub output: PathBuf,
     /// Grid cells per axis and robot: a power of two from 2 to 256 (the table format's limit)
@@ -272,7 +274,7 @@ pub struct MergeArgs {
 
 #[derive(Args, Debug)]
 pub struct InspectArgs {
-    /// The table file
+    /// The table file, or a bundle (its tables and which table each pair uses)
     #[arg(value_name = "FILE.dct")]
     pub table: PathBuf,
 }

@@ -11,6 +11,7 @@
 //! [`quilt`], [`plot`], [`replay_plot`]; shared parts in [`picture`]).
 
 mod args;
+mod bundle;
 mod clearance;
 mod confirm;
 mod demo;
@@ -34,7 +35,8 @@ use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
-    build_table, from_bytes, to_bytes, Confirmation, Labelling, Table, TableAnswer, TableChecker, TableKind, Variant,
+    build_table, from_bytes, is_bundle, to_bytes, BundleChecker, Confirmation, Labelling, Table, TableAnswer,
+    TableChecker, TableKind, Variant,
 };
 use std::io::{BufRead, Write};
 use std::path::Path;
@@ -151,10 +153,8 @@ pub(crate) fn percentile(sorted: &[u64], p: f64) -> u64 {
 
 fn check(args: &CheckArgs) -> Result<(), Failure> {
     let cell = &args.cell;
-    let mut table = args.table.as_deref().map(|p| load_table(cell, p)).transpose()?;
-    if let Some(t) = table.as_mut() {
-        t.set_confirmation(args.confirm.map_or(Confirmation::Exact, Confirmation::from));
-    }
+    let confirmation = args.confirm.map_or(Confirmation::Exact, Confirmation::from);
+    let mut table = args.table.as_deref().map(|p| load_table_or_bundle(cell, p, confirmation)).transpose()?;
     let mut input = open_input(args.input.as_deref())?;
     let columns = Columns { clearance: args.clearance, pairs: args.pairs };
     let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut(), columns);
@@ -216,7 +216,7 @@ fn check_rows(
     input: &mut dyn BufRead,
     out: &mut dyn Write,
     cell: &Cell,
-    mut table: Option<&mut TableChecker>,
+    mut table: Option<&mut Loaded>,
     columns: Columns,
 ) -> Result<(), String> {
     let mut checker = ExactChecker::new(cell.clone());
@@ -241,7 +241,11 @@ fn check_rows(
             TableAnswer::Free => "1,0",
         };
         out.write_all(row.as_bytes()).map_err(write_err)?;
-        if let (true, Some(bound)) = (columns.clearance, table.as_deref().filter(|t| t.table().as_clearance().is_some())) {
+        let clearance_table = match table.as_deref() {
+            Some(Loaded::Table(t)) => Some(t).filter(|t| t.table().as_clearance().is_some()),
+            _ => None,
+        };
+        if let (true, Some(bound)) = (columns.clearance, clearance_table) {
             // A clearance table's certified bound: -inf where it proves no level.
             let mm = bound.clearance_bound(tcps).unwrap_or(f64::NEG_INFINITY);
             match answer {
@@ -261,7 +265,14 @@ fn check_rows(
             .map_err(write_err)?;
         }
         if columns.pairs {
-            write_pair_columns(out, &checker, table.is_some().then_some(answer)).map_err(write_err)?;
+            match table.as_deref() {
+                Some(Loaded::Bundle(b)) => {
+                    for p in b.pairs() {
+                        write_answer(out, p.answer).map_err(write_err)?;
+                    }
+                }
+                t => write_pair_columns(out, &checker, t.is_some().then_some(answer)).map_err(write_err)?,
+            }
         }
         out.write_all(b"\n").map_err(write_err)
     })
@@ -271,11 +282,7 @@ fn check_rows(
 /// table mode (`table_answer`, two robots, one pair) the table's answer.
 fn write_pair_columns(out: &mut dyn Write, exact: &ExactChecker, table_answer: Option<TableAnswer>) -> std::io::Result<()> {
     if let Some(answer) = table_answer {
-        return out.write_all(match answer {
-            TableAnswer::Unreachable(_) => b",NA",
-            TableAnswer::Collision => b",1",
-            TableAnswer::Free => b",0",
-        });
+        return write_answer(out, answer);
     }
     for p in &exact.verdict().pairs {
         out.write_all(match p.state {
@@ -287,6 +294,15 @@ fn write_pair_columns(out: &mut dyn Write, exact: &ExactChecker, table_answer: O
     Ok(())
 }
 
+/// `,0`, `,1` or `,NA`: one pair's table answer.
+fn write_answer(out: &mut dyn Write, answer: TableAnswer) -> std::io::Result<()> {
+    out.write_all(match answer {
+        TableAnswer::Unreachable(_) => b",NA",
+        TableAnswer::Collision => b",1",
+        TableAnswer::Free => b",0",
+    })
+}
+
 /// The exact verdict in the table's terms.
 fn exact_answer(v: &delta_collide::cell::CellVerdict) -> TableAnswer {
     match (v.unreachable_mask, v.collides()) {
@@ -296,9 +312,36 @@ fn exact_answer(v: &delta_collide::cell::CellVerdict) -> TableAnswer {
     }
 }
 
+/// What `check --table` answers from: a two-robot cell's table, or a bundle (one table per
+/// pair that can meet) for a cell of any number of robots.
+enum Loaded {
+    Table(Box<TableChecker>),
+    Bundle(BundleChecker),
+}
+
+impl Loaded {
+    fn check(&mut self, tcps: &[Vec3]) -> Result<TableAnswer, delta_collide::cell::QueryError> {
+        match self {
+            Loaded::Table(t) => t.check(tcps),
+            Loaded::Bundle(b) => b.check(tcps),
+        }
+    }
+}
+
 fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     TableChecker::new(cell.clone(), &bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The table or bundle at `path` for `cell`, answering a COLLISION lookup as `confirmation` says.
+fn load_table_or_bundle(cell: &Cell, path: &Path, confirmation: Confirmation) -> Result<Loaded, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let at = |e: delta_collide::table::TableError| format!("{}: {e}", path.display());
+    if cell.robots.len() == 2 && !is_bundle(&bytes) {
+        TableChecker::with_confirmation(cell.clone(), &bytes, confirmation).map(|t| Loaded::Table(Box::new(t))).map_err(at)
+    } else {
+        BundleChecker::new(cell.clone(), &bytes, confirmation).map(Loaded::Bundle).map_err(at)
+    }
 }
 
 fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
@@ -308,6 +351,9 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
         (kind, _) => kind.variant(args.t.unwrap_or(0)),
     };
     let labelling = Labelling::from(args.labelling);
+    if cell.robots.len() > 2 {
+        return bundle::write_bundle(cell, k, variant, labelling, output, progress);
+    }
     check_memory(cell, k, &Workspace::THESIS, 1)?;
     let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
     if let (Progress::Rows(_), Some((pairs, secs))) = (progress, r.sub_cells) {
@@ -383,7 +429,7 @@ pub(crate) fn total_memory() -> Option<u64> {
 }
 
 /// Variant, sizes and thesis-formula bytes of a table.
-fn describe(table: &Table) -> String {
+pub(crate) fn describe(table: &Table) -> String {
     match table {
         Table::D6(q) => {
             format!("{}: {} location codes, thesis formula {} bytes", table.name(), q.codes().len(), q.thesis_bytes())
@@ -427,6 +473,9 @@ fn sampled_levels(cell: &Cell, table: &delta_collide::table::ClearanceTable) -> 
 fn inspect(args: &InspectArgs) -> Result<(), Failure> {
     let path = args.table.display();
     let bytes = std::fs::read(&args.table).map_err(|e| format!("{path}: {e}"))?;
+    if is_bundle(&bytes) {
+        return bundle::inspect_bundle(&args.table, &bytes);
+    }
     let (h, table) = from_bytes(&bytes).map_err(|e| format!("{path}: {e}"))?;
     println!("{path}: {} bytes", bytes.len());
     println!("table: {}", describe(&table));

@@ -1,0 +1,162 @@
+//! Table-backed queries for a cell of any number of robots: one lookup per pair that can meet,
+//! each in the table of its pair cell from a bundle (thesis 3.2 query phase; SPEC §6).
+//!
+//! The pairs are the exact checker's ([`Cell::pairs_that_can_meet`]); a pair whose robots can
+//! never meet has no table and no lookup. Each distinct table is loaded once into a
+//! [`TableChecker`] of its pair cell, which every pair using it shares: a pair's lookup is that
+//! checker's lookup on the pair's two TCPs, each in its own MCS, with the same exact fallback
+//! and confirmation as for two robots. Nothing allocates per tick.
+
+use crate::cell::{Cell, QueryError};
+use crate::math::Vec3;
+use crate::robot::RobotModel;
+use crate::table::bundle::{bundle_from_bytes, pair_cell, Bundle};
+use crate::table::{Confirmation, TableAnswer, TableChecker, TableError};
+use alloc::vec::Vec;
+
+/// One pair's answer in the last query.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PairAnswer {
+    /// First robot (index in the cell), `a < b`.
+    pub a: usize,
+    /// Second robot.
+    pub b: usize,
+    /// Index of the pair's table (of [`BundleChecker::table_count`]).
+    pub table: usize,
+    /// The pair's answer; [`TableAnswer::Unreachable`] when a TCP of the cell was unreachable
+    /// (no lookup was made).
+    pub answer: TableAnswer,
+    /// The colliding boxes (robot `a`'s, robot `b`'s) when the exact check answered COLLISION.
+    pub boxes: Option<(usize, usize)>,
+}
+
+/// The loaded tables of a bundle and the pairs of the controller's cell that use them.
+#[derive(Clone, Debug)]
+pub struct BundleChecker {
+    cell: Cell,
+    models: Vec<RobotModel>,
+    checkers: Vec<TableChecker>,
+    pairs: Vec<PairAnswer>,
+}
+
+impl BundleChecker {
+    /// Loads the bundle `bytes` (or a single table file) for `cell`, validating it once; each
+    /// pair that can meet gets the table of its pair cell, and COLLISION lookups are answered
+    /// as `confirmation` says.
+    ///
+    /// # Errors
+    /// Every [`TableError`] of loading a bundle and its tables; [`TableError::MissingPair`] or
+    /// [`TableError::WrongPair`] for the first pair the bundle does not serve;
+    /// [`TableError::WrongCell`] when a table disagrees with what its pair cell determines.
+    pub fn new(cell: Cell, bytes: &[u8], confirmation: Confirmation) -> Result<BundleChecker, TableError> {
+        BundleChecker::from_bundle(cell, &bundle_from_bytes(bytes)?, confirmation)
+    }
+
+    /// As [`BundleChecker::new`], from a bundle already read.
+    ///
+    /// # Errors
+    /// As [`BundleChecker::new`], apart from reading.
+    pub fn from_bundle(cell: Cell, bundle: &Bundle, confirmation: Confirmation) -> Result<BundleChecker, TableError> {
+        let mut used: Vec<(usize, usize)> = Vec::new(); // (bundle table index, our index)
+        let mut checkers = Vec::new();
+        let mut pairs = Vec::new();
+        for (a, b) in cell.pairs_that_can_meet() {
+            let i = bundle.table_for(&cell, a, b)?;
+            let table = match used.iter().find(|(t, _)| *t == i) {
+                Some(&(_, ours)) => ours,
+                None => {
+                    let (header, table) = bundle.tables[i].clone();
+                    checkers.push(TableChecker::from_loaded(pair_cell(&cell, a, b), header, table, confirmation)?);
+                    used.push((i, checkers.len() - 1));
+                    checkers.len() - 1
+                }
+            };
+            pairs.push(PairAnswer { a, b, table, answer: TableAnswer::Unreachable(0), boxes: None });
+        }
+        let models = cell.robots.iter().map(|r| r.model).collect();
+        Ok(BundleChecker { cell, models, checkers, pairs })
+    }
+
+    /// The cell.
+    pub fn cell(&self) -> &Cell {
+        &self.cell
+    }
+
+    /// The distinct tables the pairs use.
+    pub fn table_count(&self) -> usize {
+        self.checkers.len()
+    }
+
+    /// The checker of table `i` (its pair cell, header and table).
+    pub fn table_checker(&self, i: usize) -> &TableChecker {
+        &self.checkers[i]
+    }
+
+    /// The pairs that can meet with their last answers.
+    pub fn pairs(&self) -> &[PairAnswer] {
+        &self.pairs
+    }
+
+    /// Queries so far answered by the exact check because a TCP lay outside a table's grid,
+    /// summed over the pairs.
+    pub fn fallbacks(&self) -> u64 {
+        self.checkers.iter().map(TableChecker::fallbacks).sum()
+    }
+
+    /// Lookups so far that said COLLISION and were confirmed by the exact check, summed over
+    /// the pairs.
+    pub fn confirmations(&self) -> u64 {
+        self.checkers.iter().map(TableChecker::confirmations).sum()
+    }
+
+    /// How a COLLISION lookup is answered.
+    pub fn confirmation(&self) -> Confirmation {
+        self.checkers.first().map_or(Confirmation::Exact, TableChecker::confirmation)
+    }
+
+    /// Chooses how a COLLISION lookup is answered from the next query on.
+    pub fn set_confirmation(&mut self, confirmation: Confirmation) {
+        self.checkers.iter_mut().for_each(|c| c.set_confirmation(confirmation));
+    }
+
+    /// Bit j set: robot j's TCP (in its own MCS) is unreachable or not finite.
+    pub fn unreachable_mask(&self, tcps_mcs: &[Vec3]) -> u32 {
+        let reachable = |j: usize| tcps_mcs.get(j).is_some_and(|t| self.models[j].delta.is_reachable(t));
+        (0..self.models.len()).fold(0u32, |m, j| m | u32::from(!reachable(j)) << j)
+    }
+
+    /// Answers one tick; `tcps_mcs[j]` is robot j's TCP in its own MCS. COLLISION when any
+    /// pair's answer is COLLISION; every pair is answered ([`BundleChecker::pairs`]).
+    ///
+    /// # Errors
+    /// [`QueryError::WrongRobotCount`] unless one TCP per robot is given.
+    pub fn check(&mut self, tcps_mcs: &[Vec3]) -> Result<TableAnswer, QueryError> {
+        if tcps_mcs.len() != self.models.len() {
+            return Err(QueryError::WrongRobotCount { expected: self.models.len(), found: tcps_mcs.len() });
+        }
+        // As the exact check: a pair with an unreachable robot has no answer, every other pair
+        // is answered, and the tick's answer is unreachable.
+        let mask = self.unreachable_mask(tcps_mcs);
+        let mut answer = if mask != 0 { TableAnswer::Unreachable(mask) } else { TableAnswer::Free };
+        for p in &mut self.pairs {
+            (p.answer, p.boxes) = (TableAnswer::Unreachable(mask), None);
+            if mask >> p.a & 1 == 1 || mask >> p.b & 1 == 1 {
+                continue;
+            }
+            let checker = &mut self.checkers[p.table];
+            p.answer = match checker.check_reachable(&[tcps_mcs[p.a], tcps_mcs[p.b]])? {
+                // The pair checker's bits name the pair's robots; fail closed on the cell's.
+                TableAnswer::Unreachable(m) => TableAnswer::Unreachable((m & 1) << p.a | (m >> 1 & 1) << p.b),
+                other => other,
+            };
+            p.boxes = checker.colliding_boxes();
+            answer = match (answer, p.answer) {
+                (TableAnswer::Unreachable(m), TableAnswer::Unreachable(n)) => TableAnswer::Unreachable(m | n),
+                (TableAnswer::Unreachable(m), _) | (_, TableAnswer::Unreachable(m)) => TableAnswer::Unreachable(m),
+                (TableAnswer::Collision, _) | (_, TableAnswer::Collision) => TableAnswer::Collision,
+                _ => TableAnswer::Free,
+            };
+        }
+        Ok(answer)
+    }
+}
