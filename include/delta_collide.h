@@ -269,11 +269,14 @@ typedef struct DcProtectiveReport {
   /*
    Signed clearance of the cell now (mm, SPEC section 8): over the box pairs of robots that can
    meet, the smallest gap when apart, minus the penetration depth when boxes intersect,
-   0 when touching; NaN when not computed (status not OK).
+   0 when touching; NaN when not computed (status not OK). On a tick answered FREE by a
+   clearance table's lookup alone (`dc_table_protective_lookups`), a certified lower
+   bound on it instead (the table's bound): never above the exact clearance.
    */
   double clearance_mm;
   /*
-   Closest box pair now: robots and boxes, or `DC_BOX_NONE`.
+   Closest box pair now: robots and boxes, or `DC_BOX_NONE` (also on a tick answered by a
+   clearance table's lookup alone).
    */
   uint32_t closest_robot_a;
   /*
@@ -675,7 +678,11 @@ void dc_protective_reset(struct DcCollider *handle);
  without any box touching a box of another robot? Robot j's TCP is `tcps_mcs[j]` (its
  MCS); its speed is estimated from the TCP of the previous call, so call it once per tick
  with the tick of `dc_set_stop_model` (works in exact and table mode: it reads the exact
- boxes).
+ boxes). In table mode with a clearance table, a tick whose certified clearance bound
+ exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup
+ alone (`dc_table_protective_lookups`; the report's `clearance_mm` is then the certified
+ bound, never above the exact clearance, and the closest pair `DC_BOX_NONE`); every other
+ tick takes the exact protective check, as in exact mode.
 
  Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
  `DC_VERDICT_FREE` (proved: every stop the models allow keeps the boxes apart),
@@ -807,6 +814,18 @@ DcStatus dc_set_speed_limits(struct DcCollider *handle, uint32_t on);
  `handle` must be NULL or live.
  */
 uint64_t dc_table_confirmations(const struct DcCollider *handle);
+
+/*
+ Table mode with a clearance table (`build --variant clearance`): how many protective
+ queries so far (`dc_protective_query`, `dc_protective_query_with_paths`) were answered
+ FREE by the table's certified clearance bound alone, which exceeded both robots' motion
+ bounds over their stops plus `warn_mm` (docs/PROTECTIVE.md); every other protective query
+ took the exact protective proof. 0 in exact mode, with a boolean table and for NULL.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+uint64_t dc_table_protective_lookups(const struct DcCollider *handle);
 
 /*
  Number of robots of the handle's cell; 0 for NULL.
