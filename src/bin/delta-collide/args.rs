@@ -75,7 +75,8 @@ pub enum Command {
     /// stopping models, and writes per tick
     /// `tick,verdict,status,clearance_mm,protective_mm_<robot>...,speed_limit_mm_s_<robot>...`
     /// (verdict FREE, WARN or STOP; SPEC section 8). --plot draws the clearance, the protective
-    /// distances and the verdict along the run.
+    /// distances and the verdict along the run. With --table, clearance_mm of a tick answered
+    /// by the lookup alone is the table's certified lower bound.
     Replay(ReplayArgs),
     /// Sample, label and build a table file
     ///
@@ -192,6 +193,11 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "MM", default_value_t = 0.5, requires = "stop_path_mm")]
     #[arg(value_parser = clipped(non_negative_mm))]
     pub path_tolerance_mm: f64,
+    /// Table mode: a tick this clearance table (build --variant clearance, same cell) proves
+    /// FREE is answered by its lookup alone, the others by the exact protective check; the
+    /// share answered by the lookup goes to stderr [default: exact mode]
+    #[arg(long, value_name = "FILE.dct")]
+    pub table: Option<PathBuf>,
     /// Also draw the clearance, each robot's protective distance and the verdict per tick
     /// into this PNG file
     #[arg(long, value_name = "FILE.png")]

@@ -294,7 +294,7 @@ fn exact_answer(v: &delta_collide::cell::CellVerdict) -> TableAnswer {
     }
 }
 
-fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
+pub(crate) fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     TableChecker::new(cell.clone(), &bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
