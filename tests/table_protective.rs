@@ -10,8 +10,8 @@
 //! k = 32 the clearance labelling takes a minute per cell).
 
 use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveStatus};
-use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::reference::reference_cell;
+use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::{Real, Vec3};
@@ -85,7 +85,11 @@ fn tcp_anywhere(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
         return tcp_toward_other(cell, j, rng);
     }
     loop {
-        let p = Vec3::new(rng.random_range(-320.0..320.0), rng.random_range(-320.0..320.0), rng.random_range(-560.0..-350.0));
+        let p = Vec3::new(
+            rng.random_range(-320.0..320.0),
+            rng.random_range(-320.0..320.0),
+            rng.random_range(-560.0..-350.0),
+        );
         if cell.robots[j].model.delta.is_reachable(&p) {
             return p;
         }
@@ -145,7 +149,14 @@ fn sample(cell: &Cell, table: &TableChecker, j: usize, place: Place, rng: &mut S
 /// Random states of `cell` at `place` (speeds mostly low, directions random), each checked
 /// in table mode after one tick that gives its speeds; from every state answered by the
 /// lookup alone, 8 random stops are simulated. Returns (lookup states, exact checks).
-fn brute_force(cell: &Cell, table: &TableChecker, warn_mm: Real, place: Place, states: usize, seed: u64) -> (usize, usize) {
+fn brute_force(
+    cell: &Cell,
+    table: &TableChecker,
+    warn_mm: Real,
+    place: Place,
+    states: usize,
+    seed: u64,
+) -> (usize, usize) {
     let bound = |t: &[Vec3]| table.clearance_bound(t);
     let mut checker = ProtectiveChecker::new(cell.clone(), warn_mm).unwrap().with_speed_limits(false);
     let mut exact = ExactChecker::new(cell.clone());
@@ -190,17 +201,20 @@ fn lookup_free_verdicts_survive_simulated_stops() {
         for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
             let cell = cell(name, stop);
             let table = table(&cell, true);
-            for (p, place) in [Place::Open, Place::ReachBoundary, Place::CellFaces].into_iter().enumerate() {
+            // The reach boundary yields fewest lookups (elbows move far): more states there.
+            for (p, (place, states)) in
+                [(Place::Open, 1_000), (Place::ReachBoundary, 3_000), (Place::CellFaces, 1_000)].into_iter().enumerate()
+            {
                 // warn_mm 0: the lookup proves FREE with the least to spare.
                 let seed = 900 + 10 * i as u64 + k as u64 + 100 * p as u64;
-                let (lookups, steps) = brute_force(&cell, &table, 0.0, place, 200, seed);
-                println!("{name} model {k} {place:?}: {lookups} of 200 states FREE by the lookup, {steps} exact checks");
+                let (lookups, steps) = brute_force(&cell, &table, 0.0, place, states, seed);
+                println!("{name} model {k} {place:?}: {lookups} of {states} states FREE by the lookup, {steps} exact checks");
                 total[p] += lookups;
             }
         }
     }
     println!("FREE by the lookup (open, reach boundary, cell faces): {total:?}");
-    assert!(total.iter().all(|&t| t >= 30), "too few lookup states to test: {total:?}");
+    assert!(total[0] >= 50 && total[1] >= 5 && total[2] >= 50, "too few lookup states to test: {total:?}");
 }
 
 /// Per reference run (T1-T3, practical and collision) and model: exact and table mode side
@@ -230,11 +244,18 @@ fn runs(stop: StopModel, label: &str) -> (u64, u64) {
                 counts[1][r.verdict as usize] += 1;
                 if r.table_lookup {
                     assert_eq!((r.verdict, r.status), (Protective::Free, ProtectiveStatus::Ok));
-                    assert!(r.clearance_mm <= e.clearance_mm, "{name} {} tick {t}: {} > {}", s.case, r.clearance_mm, e.clearance_mm);
+                    assert!(
+                        r.clearance_mm <= e.clearance_mm,
+                        "{name} {} tick {t}: {} > {}",
+                        s.case,
+                        r.clearance_mm,
+                        e.clearance_mm
+                    );
                     lookups += 1;
                     if lookups % 5 == 0 {
                         let vel = std::array::from_fn(|j| {
-                            let w = (tcps[j] - prev[j]) / tick + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
+                            let w = (tcps[j] - prev[j]) / tick
+                                + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
                             w * (stop.max_speed_mm_s / w.norm()).min(1.0)
                         });
                         assert_stops_never_touch(&cell, &tcps, &vel, 4, &mut rng);

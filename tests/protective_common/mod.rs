@@ -119,7 +119,13 @@ impl Motion {
 
 /// Simulates `motions` random stops of both robots from TCPs `tcps` with true velocities
 /// `vel`; panics at the first contact.
-pub fn assert_stops_never_touch(cell: &Cell, tcps: &[Vec3; 2], vel: &[Vec3; 2], motions: usize, rng: &mut StdRng) -> usize {
+pub fn assert_stops_never_touch(
+    cell: &Cell,
+    tcps: &[Vec3; 2],
+    vel: &[Vec3; 2],
+    motions: usize,
+    rng: &mut StdRng,
+) -> usize {
     let mut exact = ExactChecker::new(cell.clone());
     let mut steps = 0;
     for m in 0..motions {

@@ -53,8 +53,11 @@ impl ProtectiveChecker {
     fn motion_bound(&self, j: usize, tcp_mcs: &Vec3, v: Real) -> (Vec3, Real) {
         let (s, (centre, radius)) = self.stop_ball(j, tcp_mcs, v);
         let robot = &self.cell().robots[j];
-        let (centre, radius) =
-            if centre != *tcp_mcs && robot.model.delta.is_reachable(&centre) { (centre, radius) } else { (*tcp_mcs, s) };
+        let (centre, radius) = if centre != *tcp_mcs && robot.model.delta.is_reachable(&centre) {
+            (centre, radius)
+        } else {
+            (*tcp_mcs, s)
+        };
         let rot = robot.placement.rotation();
         let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref(), 0, 0);
         // Either form holds every displacement: the smaller radius bounds it.
