@@ -33,7 +33,7 @@
 //! rounding of the radii; sweeps that are not finite (a ball centre or cube out of reach of
 //! every bound) prove nothing.
 
-use super::{stop_sweeps_wcs, ProtectiveChecker};
+use super::ProtectiveChecker;
 use crate::math::{Real, Vec3};
 
 /// A certified lower bound on the clearance (SPEC §8, mm) of a two-robot cell at the given
@@ -46,35 +46,37 @@ pub type ClearanceBound<'a> = &'a dyn Fn(&[Vec3]) -> Option<Real>;
 pub const LOOKUP_SLACK_MM: Real = 1e-6;
 
 impl ProtectiveChecker {
-    /// Robot `j`'s stop ball for TCP `tcp_mcs` at measured speed `v` (the capsule's ball
-    /// when its centre is reachable, else the ball of radius `S` around the TCP), and `d_j`,
-    /// the farthest any of its box points moves from its place at the ball's centre over that
-    /// ball (module doc); `INFINITY` when no bound is found.
-    fn motion_bound(&self, j: usize, tcp_mcs: &Vec3, v: Real) -> (Vec3, Real) {
-        let (s, (centre, radius)) = self.stop_ball(j, tcp_mcs, v);
-        let robot = &self.cell().robots[j];
-        let (centre, radius) = if centre != *tcp_mcs && robot.model.delta.is_reachable(&centre) {
-            (centre, radius)
-        } else {
-            (*tcp_mcs, s)
-        };
-        let rot = robot.placement.rotation();
-        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref(), 0, 0);
+    /// Sets robot `j`'s stop reference for TCP `tcp_mcs` at measured speed `v` (its stop
+    /// ball's centre, the TCP when that is not reachable) with the table's tier of sweeps,
+    /// which the full proof reuses, and returns `d_j`: the farthest any of its box points
+    /// moves from its place at the reference over the stop (module doc); `INFINITY` when no
+    /// bound is found.
+    fn motion_bound(&mut self, j: usize, tcp_mcs: &Vec3, v: Real) -> Real {
+        self.stop_reference(j, tcp_mcs, v);
+        self.sweeps_at(j, 0, 0);
+        let [cube, ball] = &self.sweeps[j];
         // Either form holds every displacement: the smaller radius bounds it.
-        let moved = |k: usize| sweeps[0][k].radius().min(sweeps[1][k].radius());
-        let d = (0..sweeps[0].len()).map(moved).fold(0.0, Real::max);
-        (centre, if d.is_nan() { Real::INFINITY } else { d })
+        let d = cube.iter().zip(ball).map(|(c, b)| c.radius().min(b.radius())).fold(0.0, Real::max);
+        if d.is_nan() {
+            Real::INFINITY
+        } else {
+            d
+        }
     }
 
     /// Whether `bound` proves FREE with `warn_mm` to spare for the two robots at `tcps_mcs`
     /// (speeds in the report), and if so a certified lower bound on the clearance now (module
-    /// doc). `None` for any other number of robots, or when the bound does not prove it.
-    pub(super) fn lookup_free(&self, tcps_mcs: &[Vec3], bound: ClearanceBound) -> Option<Real> {
-        let [a, b] = tcps_mcs else { return None };
-        let (ca, da) = self.motion_bound(0, a, self.report.robots[0].speed_mm_s);
-        let (cb, db) = self.motion_bound(1, b, self.report.robots[1].speed_mm_s);
-        let motion = da + db;
-        let at_centres = bound(&[ca, cb])?;
+    /// doc). `None` for any other number of robots, or when the bound does not prove it. Sets
+    /// every robot's stop reference and table-tier sweeps either way.
+    pub(super) fn lookup_free(&mut self, tcps_mcs: &[Vec3], bound: ClearanceBound) -> Option<Real> {
+        let mut motion = 0.0;
+        for (j, tcp) in tcps_mcs.iter().enumerate() {
+            motion += self.motion_bound(j, tcp, self.report.robots[j].speed_mm_s);
+        }
+        if tcps_mcs.len() != 2 {
+            return None;
+        }
+        let at_centres = bound(&[self.centres[0], self.centres[1]])?;
         if !(motion.is_finite() && at_centres > motion + self.warn_mm + LOOKUP_SLACK_MM) {
             return None;
         }

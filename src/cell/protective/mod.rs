@@ -561,6 +561,7 @@ impl ProtectiveChecker {
             let r = &mut self.report.robots[j];
             (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
         }
+        // Sets the stop references and their table-tier sweeps: the proof below reuses them.
         if let Some(clearance) = table.and_then(|bound| self.lookup_free(tcps_mcs, bound)) {
             let report = &mut self.report;
             (report.verdict, report.table_lookup, report.clearance_mm) = (Protective::Free, true, clearance);
@@ -575,8 +576,10 @@ impl ProtectiveChecker {
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
             return;
         }
-        for (j, tcp) in tcps_mcs.iter().enumerate() {
-            self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
+        if table.is_none() {
+            for (j, tcp) in tcps_mcs.iter().enumerate() {
+                self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
+            }
         }
         if kept {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
@@ -613,17 +616,12 @@ impl ProtectiveChecker {
         self.speed_limits_of(tcps_mcs, from_history);
     }
 
-    /// Each robot's speed limit when they are asked for (else NaN), this tick's stop
-    /// references of every robot set first (the limits search about them).
+    /// Each robot's speed limit when they are asked for (else NaN), with this tick's stop
+    /// references of every robot already set (the limits search about them).
     fn speed_limits_of(&mut self, tcps_mcs: &[Vec3], from_history: bool) {
         if !self.speed_limits {
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
             return;
-        }
-        if self.report.table_lookup {
-            for (j, tcp) in tcps_mcs.iter().enumerate() {
-                self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
-            }
         }
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let start = self.history[j].limit.filter(|_| from_history);
