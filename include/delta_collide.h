@@ -269,14 +269,11 @@ typedef struct DcProtectiveReport {
   /*
    Signed clearance of the cell now (mm, SPEC section 8): over the box pairs of robots that can
    meet, the smallest gap when apart, minus the penetration depth when boxes intersect,
-   0 when touching; NaN when not computed (status not OK). On a tick answered FREE by a
-   clearance table's lookup alone (`dc_table_protective_lookups`), a certified lower
-   bound on it instead (the table's bound): never above the exact clearance.
+   0 when touching; NaN when not computed (status not OK). Exact in table mode too.
    */
   double clearance_mm;
   /*
-   Closest box pair now: robots and boxes, or `DC_BOX_NONE` (also on a tick answered by a
-   clearance table's lookup alone).
+   Closest box pair now: robots and boxes, or `DC_BOX_NONE`.
    */
   uint32_t closest_robot_a;
   /*
@@ -679,10 +676,9 @@ void dc_protective_reset(struct DcCollider *handle);
  MCS); its speed is estimated from the TCP of the previous call, so call it once per tick
  with the tick of `dc_set_stop_model` (works in exact and table mode: it reads the exact
  boxes). In table mode with a clearance table, a tick whose certified clearance bound
- exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup
- alone (`dc_table_protective_lookups`; the report's `clearance_mm` is then the certified
- bound, never above the exact clearance, and the closest pair `DC_BOX_NONE`); every other
- tick takes the exact protective check, as in exact mode.
+ exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup,
+ without the box-pair proof (`dc_table_protective_lookups`); every other tick takes the
+ exact protective check, as in exact mode. The report is filled alike in both modes.
 
  Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
  `DC_VERDICT_FREE` (proved: every stop the models allow keeps the boxes apart),

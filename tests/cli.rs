@@ -252,7 +252,7 @@ fn clearance_table_through_build_inspect_eval_and_check() {
     }
     assert!(levelled > 10 && none > 0, "{levelled} rows with a level, {none} without:\n{text}");
     // replay --table: T1 practical with a stiff stopping model; some ticks are answered by
-    // the lookup alone, the clearance column never exceeds exact mode's, the statuses agree.
+    // the lookup alone; statuses and the (exact) clearance agree with exact mode's.
     let cell = dir.join("t1_stiff.toml");
     let stop = "stop = { reaction_ms = 2.0, decel_mm_s2 = 120000.0, max_accel_mm_s2 = 130000.0, max_speed_mm_s = 4600.0 }";
     let toml = format!(
@@ -274,15 +274,10 @@ fn clearance_table_through_build_inspect_eval_and_check() {
     assert!(lookups > 0 && stderr(&table_mode).contains("answered FREE by the lookup alone"), "{}", stderr(&table_mode));
     let (exact, table_mode) = (stdout(&exact), stdout(&table_mode));
     assert_eq!(exact.lines().count(), table_mode.lines().count());
-    let mut lower = 0;
     for (e, t) in exact.lines().zip(table_mode.lines()).skip(1) {
         let (e, t): (Vec<&str>, Vec<&str>) = (e.split(',').collect(), t.split(',').collect());
-        assert_eq!((e[0], e[2]), (t[0], t[2]), "tick and status");
-        let (ce, ct): (f64, f64) = (e[3].parse().unwrap(), t[3].parse().unwrap());
-        assert!(ct <= ce + 1e-3, "tick {}: clearance {ct} in table mode above exact mode's {ce}", e[0]);
-        lower += usize::from(ct < ce - 1e-3);
+        assert_eq!((e[0], e[2], e[3]), (t[0], t[2], t[3]), "tick, status and clearance");
     }
-    assert!(lower > 0, "no tick reports the table's lower bound");
     // quilt shades free cells by level: the middle levels' blues cover many cells.
     let png = dir.join("quilt.png");
     let out = cli(&["quilt", "--cell", "T1", "--table", table, "--axes", "zz", "--output", png.to_str().unwrap()]);

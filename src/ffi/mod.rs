@@ -398,10 +398,9 @@ pub unsafe extern "C" fn dc_protective_reset(handle: *mut DcCollider) {
 /// MCS); its speed is estimated from the TCP of the previous call, so call it once per tick
 /// with the tick of `dc_set_stop_model` (works in exact and table mode: it reads the exact
 /// boxes). In table mode with a clearance table, a tick whose certified clearance bound
-/// exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup
-/// alone (`dc_table_protective_lookups`; the report's `clearance_mm` is then the certified
-/// bound, never above the exact clearance, and the closest pair `DC_BOX_NONE`); every other
-/// tick takes the exact protective check, as in exact mode.
+/// exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup,
+/// without the box-pair proof (`dc_table_protective_lookups`); every other tick takes the
+/// exact protective check, as in exact mode. The report is filled alike in both modes.
 ///
 /// Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
 /// `DC_VERDICT_FREE` (proved: every stop the models allow keeps the boxes apart),

@@ -289,12 +289,9 @@ pub struct DcProtectiveReport {
     pub unreachable_mask: u32,
     /// Signed clearance of the cell now (mm, SPEC section 8): over the box pairs of robots that can
     /// meet, the smallest gap when apart, minus the penetration depth when boxes intersect,
-    /// 0 when touching; NaN when not computed (status not OK). On a tick answered FREE by a
-    /// clearance table's lookup alone (`dc_table_protective_lookups`), a certified lower
-    /// bound on it instead (the table's bound): never above the exact clearance.
+    /// 0 when touching; NaN when not computed (status not OK). Exact in table mode too.
     pub clearance_mm: f64,
-    /// Closest box pair now: robots and boxes, or `DC_BOX_NONE` (also on a tick answered by a
-    /// clearance table's lookup alone).
+    /// Closest box pair now: robots and boxes, or `DC_BOX_NONE`.
     pub closest_robot_a: u32,
     /// See `closest_robot_a`.
     pub closest_robot_b: u32,

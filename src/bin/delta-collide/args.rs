@@ -75,8 +75,7 @@ pub enum Command {
     /// stopping models, and writes per tick
     /// `tick,verdict,status,clearance_mm,protective_mm_<robot>...,speed_limit_mm_s_<robot>...`
     /// (verdict FREE, WARN or STOP; SPEC section 8). --plot draws the clearance, the protective
-    /// distances and the verdict along the run. With --table, clearance_mm of a tick answered
-    /// by the lookup alone is the table's certified lower bound.
+    /// distances and the verdict along the run.
     Replay(ReplayArgs),
     /// Sample, label and build a table file
     ///

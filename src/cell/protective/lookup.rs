@@ -1,11 +1,12 @@
 //! The protective verdict from a certified clearance table (SPEC §8; clearance tables, SPEC
-//! §6): where the table's bound alone proves FREE, a tick costs two table lookups and one
-//! motion bound per robot instead of the swept-box proof of every box pair.
+//! §6): where the table's bound alone proves FREE, a tick costs one table lookup and one
+//! motion bound per robot instead of the swept-box proof of every box pair. It is tried
+//! after the cheaper answers (a kept proof, a certain STOP) and before the proof.
 //!
 //! # Why a lookup proves FREE
-//! Let robot `j`'s stop ball be `B(c_j, R_j)` (module doc of `protective`, step 3: the
-//! capsule's ball when its centre is reachable, else the ball of radius `S` around the TCP
-//! now): every TCP of the whole stop lies in it. Its sweeps (step 4, the table's tier of
+//! Let robot `j`'s stop ball be `B(c_j, R_j)` (its stop reference, module doc of
+//! `protective`, step 3: the capsule's ball when the boxes at its centre exist, else the ball
+//! of radius `S` around the TCP now): every TCP of the whole stop lies in it. Its sweeps (step 4, the table's tier of
 //! motor angles, either form) bound the displacement of every box point, for every
 //! reachable TCP of that ball, from the same point of the boxes at `c_j`; so no box point of
 //! robot `j` moves further than `d_j`, the largest [`crate::geometry::Sweep::radius`] of its boxes, from
@@ -24,9 +25,7 @@
 //! not answered: the full proof may still prove FREE there.
 //!
 //! # The clearance reported
-//! The TCPs now lie in the stop balls, so the clearance now is at least `L - d_A - d_B`
-//! (> `warn_mm`); the table's bound at the TCPs now, when it has a level there, is another
-//! certified lower bound. The report holds the larger: never above the exact clearance.
+//! Unchanged: every tick with status OK computes the exact clearance before any proof.
 //!
 //! # Numerics
 //! The proof asks `L` to exceed `d_A + d_B + warn_mm` by [`LOOKUP_SLACK_MM`], far above the
@@ -46,13 +45,11 @@ pub type ClearanceBound<'a> = &'a dyn Fn(&[Vec3]) -> Option<Real>;
 pub const LOOKUP_SLACK_MM: Real = 1e-6;
 
 impl ProtectiveChecker {
-    /// Sets robot `j`'s stop reference for TCP `tcp_mcs` at measured speed `v` (its stop
-    /// ball's centre, the TCP when that is not reachable) with the table's tier of sweeps,
-    /// which the full proof reuses, and returns `d_j`: the farthest any of its box points
-    /// moves from its place at the reference over the stop (module doc); `INFINITY` when no
-    /// bound is found.
-    fn motion_bound(&mut self, j: usize, tcp_mcs: &Vec3, v: Real) -> Real {
-        self.stop_reference(j, tcp_mcs, v);
+    /// Robot `j`'s `d_j` about its stop reference (set for this tick): the farthest any of
+    /// its box points moves from its place at the reference over the stop, from the table's
+    /// tier of sweeps, which the full proof then reuses (module doc); `INFINITY` when no bound
+    /// is found.
+    fn motion_bound(&mut self, j: usize) -> Real {
         self.sweeps_at(j, 0, 0);
         let [cube, ball] = &self.sweeps[j];
         // Either form holds every displacement: the smaller radius bounds it.
@@ -64,23 +61,14 @@ impl ProtectiveChecker {
         }
     }
 
-    /// Whether `bound` proves FREE with `warn_mm` to spare for the two robots at `tcps_mcs`
-    /// (speeds in the report), and if so a certified lower bound on the clearance now (module
-    /// doc). `None` for any other number of robots, or when the bound does not prove it. Sets
-    /// every robot's stop reference and table-tier sweeps either way.
-    pub(super) fn lookup_free(&mut self, tcps_mcs: &[Vec3], bound: ClearanceBound) -> Option<Real> {
-        let mut motion = 0.0;
-        for (j, tcp) in tcps_mcs.iter().enumerate() {
-            motion += self.motion_bound(j, tcp, self.report.robots[j].speed_mm_s);
+    /// Whether `bound` proves FREE with `warn_mm` to spare for two robots about this tick's
+    /// stop references (module doc); false for any other number of robots.
+    pub(super) fn lookup_free(&mut self, bound: ClearanceBound) -> bool {
+        if self.centres.len() != 2 {
+            return false;
         }
-        if tcps_mcs.len() != 2 {
-            return None;
-        }
-        let at_centres = bound(&[self.centres[0], self.centres[1]])?;
-        if !(motion.is_finite() && at_centres > motion + self.warn_mm + LOOKUP_SLACK_MM) {
-            return None;
-        }
-        let now = bound(tcps_mcs).unwrap_or(Real::NEG_INFINITY);
-        Some(now.max(at_centres - motion))
+        let motion = self.motion_bound(0) + self.motion_bound(1);
+        let Some(at_centres) = bound(&[self.centres[0], self.centres[1]]) else { return false };
+        motion.is_finite() && at_centres > motion + self.warn_mm + LOOKUP_SLACK_MM
     }
 }

@@ -70,9 +70,10 @@
 //! tick's balls covers this tick too, so FREE ticks that follow FREE ticks mostly reuse one
 //! instead of computing sweeps ([`ProtectiveReport::kept_proof`]).
 //!
-//! **Table mode** (`protective/lookup.rs`): with a certified clearance table, a tick whose
-//! table bound exceeds both robots' motion bounds (the largest displacement of any box point
-//! under step 4's sweeps) plus `warn_mm` is FREE by the lookup alone
+//! **Table mode** (`protective/lookup.rs`): with a certified clearance table, a tick not
+//! settled by a kept proof or a certain STOP whose table bound exceeds both robots' motion
+//! bounds (the largest displacement of any box point under step 4's sweeps) plus `warn_mm`
+//! is FREE by the lookup, without the box-pair proof
 //! ([`ProtectiveChecker::check_with_table`], [`ProtectiveReport::table_lookup`]); every other
 //! tick takes the proof above, unchanged.
 //!
@@ -192,12 +193,10 @@ pub struct ProtectiveReport {
     pub status: ProtectiveStatus,
     /// The signed clearance of the cell now (mm, SPEC §8: the gap when apart, minus the
     /// penetration depth when boxes intersect, 0 when they touch; `INFINITY` when no pair can
-    /// meet, NaN when not computed). On a tick answered by the table lookup alone
-    /// ([`ProtectiveReport::table_lookup`]) a certified lower bound on it instead (the table's
-    /// bound, `protective/lookup.rs`): never above the exact clearance.
+    /// meet, NaN when not computed). The exact clearance in table mode too: every tick with
+    /// status OK computes it before any proof, the table's lookup included.
     pub clearance_mm: Real,
-    /// The box pair of the smallest clearance now (`None` on a tick answered by the table
-    /// lookup alone: a table knows configurations, not boxes).
+    /// The box pair of the smallest clearance now.
     pub closest: Option<BoxPair>,
     /// The first box pair not proved apart (STOP) or not with `warn_mm` to spare (WARN).
     pub limiting: Option<BoxPair>,
@@ -561,13 +560,6 @@ impl ProtectiveChecker {
             let r = &mut self.report.robots[j];
             (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
         }
-        // Sets the stop references and their table-tier sweeps: the proof below reuses them.
-        if let Some(clearance) = table.and_then(|bound| self.lookup_free(tcps_mcs, bound)) {
-            let report = &mut self.report;
-            (report.verdict, report.table_lookup, report.clearance_mm) = (Protective::Free, true, clearance);
-            self.speed_limits_of(tcps_mcs, from_history);
-            return;
-        }
         let (clearance, closest) = clearance_now(&self.exact);
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         let kept = self.kept_free(None);
@@ -576,15 +568,17 @@ impl ProtectiveChecker {
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
             return;
         }
-        if table.is_none() {
-            for (j, tcp) in tcps_mcs.iter().enumerate() {
-                self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
-            }
+        for (j, tcp) in tcps_mcs.iter().enumerate() {
+            self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
         }
+        // The cheaper answers first: a kept proof (no sweeps), a certain STOP (none either),
+        // then the table's bound (the table's tier of sweeps, which the proof below reuses).
         if kept {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else if let Some(pair) = self.certain_stop(None) {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
+        } else if table.is_some_and(|bound| self.lookup_free(bound)) {
+            (self.report.verdict, self.report.table_lookup) = (Protective::Free, true);
         } else if was_free && self.keep_and_prove() {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else {
