@@ -90,8 +90,9 @@ fn group(c: &mut Criterion, model: &str, cell: &Cell, bytes: &[u8], ticks: &[[Ve
                 table_mode.reset();
             }
             i += 1;
-            let r = table_mode.check_with_table(black_box(&ticks[k]), &bound).unwrap();
-            assert_eq!((r.verdict, r.table_lookup), reports[k]);
+            // The verdict as in the first pass; whether the lookup or a proof kept from the
+            // previous pass gives it may differ (kept proofs outlive `reset`).
+            assert_eq!(table_mode.check_with_table(black_box(&ticks[k]), &bound).unwrap().verdict, reports[k].0);
         })
     });
     let mut i = 0;

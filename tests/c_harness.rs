@@ -195,7 +195,7 @@ fn assert_protective_table_mode(stdout: &str) {
     let shares: Vec<&str> = stdout.lines().filter(|l| l.contains("answered by the lookup alone")).collect();
     assert_eq!(shares.len(), 18, "{shares:?}");
     let lookups: f64 = shares.iter().filter(|l| l.contains(" stiff ")).map(|l| number(l, "table mode: ")).sum();
-    assert!(lookups > 1000.0, "the stiff runs in table mode answer few ticks by the lookup: {shares:?}");
+    assert!(lookups > 500.0, "the stiff runs in table mode answer few ticks by the lookup: {shares:?}");
 }
 
 /// The speed-override lines (`c_harness/speed_override.c`), one per practical scenario: the

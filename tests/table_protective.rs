@@ -203,12 +203,16 @@ fn lookup_free_verdicts_survive_simulated_stops() {
             let table = table(&cell, true);
             // The reach boundary yields fewest lookups (elbows move far): more states there.
             for (p, (place, states)) in
-                [(Place::Open, 1_000), (Place::ReachBoundary, 10_000), (Place::CellFaces, 1_000)].into_iter().enumerate()
+                [(Place::Open, 1_000), (Place::ReachBoundary, 10_000), (Place::CellFaces, 1_000)]
+                    .into_iter()
+                    .enumerate()
             {
                 // warn_mm 0: the lookup proves FREE with the least to spare.
                 let seed = 900 + 10 * i as u64 + k as u64 + 100 * p as u64;
                 let (lookups, steps) = brute_force(&cell, &table, 0.0, place, states, seed);
-                println!("{name} model {k} {place:?}: {lookups} of {states} states FREE by the lookup, {steps} exact checks");
+                println!(
+                    "{name} model {k} {place:?}: {lookups} of {states} states FREE by the lookup, {steps} exact checks"
+                );
                 total[p] += lookups;
             }
         }
@@ -220,7 +224,8 @@ fn lookup_free_verdicts_survive_simulated_stops() {
 /// Per reference run (T1-T3, practical and collision) and model: exact and table mode side
 /// by side. Every lookup tick is FREE, reports a clearance at most the exact one (which the
 /// exact-mode checker reports on the same tick), and at every fifth one random stops from
-/// the true velocity (the finite difference moved within `a_max T`) never touch.
+/// the true velocity (the finite difference moved within `a_max T`) never touch; so at every
+/// fifth tick FREE by a proof kept since a lookup (a lookup keeps its balls as a proof does).
 fn runs(stop: StopModel, label: &str) -> (u64, u64) {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
     let scenarios = parse_scenarios(&text).unwrap();
@@ -236,13 +241,16 @@ fn runs(stop: StopModel, label: &str) -> (u64, u64) {
             let mut lookup = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
             let (mut tcps, mut prev) = ([Vec3::zeros(); 2], [Vec3::zeros(); 2]);
             let (mut counts, mut lookups) = ([[0u32; 3]; 2], 0u64);
+            // Whether every tick since the last lookup was FREE (a kept proof may be its).
+            let (mut since_lookup, mut tested_ticks) = (false, 0u64);
             for t in 0..RUN_TICKS {
                 s.tcps_at(t, &mut tcps);
                 let e = exact.check(&tcps).unwrap().clone();
                 let r = lookup.check_with_table(&tcps, &bound).unwrap();
                 counts[0][e.verdict as usize] += 1;
                 counts[1][r.verdict as usize] += 1;
-                if r.table_lookup {
+                since_lookup = (since_lookup || r.table_lookup) && r.verdict == Protective::Free;
+                if r.table_lookup || (since_lookup && r.kept_proof) {
                     assert_eq!((r.verdict, r.status), (Protective::Free, ProtectiveStatus::Ok));
                     assert!(
                         r.clearance_mm <= e.clearance_mm,
@@ -251,8 +259,9 @@ fn runs(stop: StopModel, label: &str) -> (u64, u64) {
                         r.clearance_mm,
                         e.clearance_mm
                     );
-                    lookups += 1;
-                    if lookups % 5 == 0 {
+                    lookups += u64::from(r.table_lookup);
+                    tested_ticks += 1;
+                    if tested_ticks % 5 == 0 {
                         let vel = std::array::from_fn(|j| {
                             let w = (tcps[j] - prev[j]) / tick
                                 + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
@@ -310,7 +319,7 @@ fn a_table_mode_tick_never_allocates() {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
     let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
     let mut c = ProtectiveChecker::new(cell, 10.0).unwrap();
-    let ticks: Vec<[Vec3; 2]> = (0..2_000)
+    let ticks: Vec<[Vec3; 2]> = (0..RUN_TICKS)
         .map(|t| {
             let mut tcps = [Vec3::zeros(); 2];
             s.tcps_at(t, &mut tcps);
@@ -323,7 +332,7 @@ fn a_table_mode_tick_never_allocates() {
         lookups += u32::from(c.check_with_table(tcps, &bound).unwrap().table_lookup);
     }
     assert_eq!(ALLOCATIONS.with(|a| a.get()), before);
-    assert!(lookups > 100, "{lookups} lookup ticks: the lookup path was not exercised");
+    assert!(lookups > 10, "{lookups} lookup ticks: the lookup path was not exercised");
 }
 
 #[test]

@@ -67,8 +67,14 @@ impl ProtectiveChecker {
         if self.centres.len() != 2 {
             return false;
         }
-        let motion = self.motion_bound(0) + self.motion_bound(1);
         let Some(at_centres) = bound(&[self.centres[0], self.centres[1]]) else { return false };
+        // Every sweep of a lower-link, platform or tool box holds the ball of the stop's radius
+        // (module doc of `protective`, step 6), so `d_j >= R_j`: where the bound cannot exceed
+        // that, the sweeps are not computed (the proof below may still need them).
+        if !(at_centres > self.reach[0] + self.reach[1] + self.warn_mm) {
+            return false;
+        }
+        let motion = self.motion_bound(0) + self.motion_bound(1);
         motion.is_finite() && at_centres > motion + self.warn_mm + LOOKUP_SLACK_MM
     }
 }

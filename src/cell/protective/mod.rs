@@ -579,6 +579,8 @@ impl ProtectiveChecker {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
         } else if table.is_some_and(|bound| self.lookup_free(bound)) {
             (self.report.verdict, self.report.table_lookup) = (Protective::Free, true);
+            // The lookup proved FREE for every TCP of both stop balls: kept like a proof.
+            self.keep_references();
         } else if was_free && self.keep_and_prove() {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else {
