@@ -6,7 +6,7 @@
 
 use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveReport, ProtectiveStatus};
 use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
-use delta_collide::cell::{Cell, ExactChecker};
+use delta_collide::cell::ExactChecker;
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
 use rand::rngs::StdRng;

@@ -71,7 +71,8 @@ impl ProtectiveChecker {
         // Every sweep of a lower-link, platform or tool box holds the ball of the stop's radius
         // (module doc of `protective`, step 6), so `d_j >= R_j`: where the bound cannot exceed
         // that, the sweeps are not computed (the proof below may still need them).
-        if !(at_centres > self.reach[0] + self.reach[1] + self.warn_mm) {
+        let least = self.reach[0] + self.reach[1] + self.warn_mm;
+        if at_centres.partial_cmp(&least) != Some(core::cmp::Ordering::Greater) {
             return false;
         }
         let motion = self.motion_bound(0) + self.motion_bound(1);
