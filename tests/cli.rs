@@ -251,8 +251,13 @@ fn clearance_table_through_build_inspect_eval_and_check() {
         levelled += 1;
     }
     assert!(levelled > 10 && none > 0, "{levelled} rows with a level, {none} without:\n{text}");
-    // replay --table: T1 practical with a stiff stopping model; some ticks are answered by
-    // the lookup alone; statuses and the (exact) clearance agree with exact mode's.
+    // replay --table: T1 practical with a stiff stopping model on a table with the default
+    // levels; some ticks are answered by the lookup alone; statuses and the (exact) clearance
+    // agree with exact mode's.
+    let ladder_table = dir.join("t1d.dct");
+    let ladder_table = ladder_table.to_str().unwrap();
+    let out = cli(&["build", "--cell", "T1", "--k", "16", "--variant", "clearance", "--output", ladder_table]);
+    assert!(out.status.success(), "{}", stderr(&out));
     let cell = dir.join("t1_stiff.toml");
     let stop = "stop = { reaction_ms = 2.0, decel_mm_s2 = 120000.0, max_accel_mm_s2 = 130000.0, max_speed_mm_s = 4600.0 }";
     let toml = format!(
@@ -261,12 +266,12 @@ fn clearance_table_through_build_inspect_eval_and_check() {
     );
     std::fs::write(&cell, toml).unwrap();
     let cell = cell.to_str().unwrap();
-    let rows = scenario_rows("T1", "practical", 1500);
+    let rows = scenario_rows("T1", "practical", 6000);
     let exact = cli_stdin(&["replay", "--cell", cell], &rows);
-    let table_mode = cli_stdin(&["replay", "--cell", cell, "--table", table], &rows);
+    let table_mode = cli_stdin(&["replay", "--cell", cell, "--table", ladder_table], &rows);
     assert!(exact.status.success() && table_mode.status.success(), "{}", stderr(&table_mode));
     let lookups: u32 = stderr(&table_mode)
-        .split(" of 1500 ticks")
+        .split(" of 6000 ticks")
         .next()
         .and_then(|s| s.rsplit(' ').next())
         .and_then(|n| n.parse().ok())
