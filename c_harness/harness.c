@@ -144,26 +144,27 @@ int parse_options(int argc, char **argv, HarnessOptions *out)
             out->tmp_dir = argv[++i];
         } else if (strcmp(argv[i], "--line-bundle") == 0 && i + 1 < argc) {
             out->line_bundle.path = argv[++i];
-        } else if (strcmp(argv[i], "--table") == 0 && i + 1 < argc) {
+        } else if ((strcmp(argv[i], "--table") == 0 || strcmp(argv[i], "--clearance-table") == 0) && i + 1 < argc) {
+            HarnessTable *tables = strcmp(argv[i], "--table") == 0 ? out->tables : out->clearance_tables;
             const char *arg = argv[++i];
             const char *eq = strchr(arg, '=');
             char cell[8];
             int c;
             if (eq == NULL || (size_t)(eq - arg) >= sizeof cell) {
-                printf("bad --table %s: expected CELL=PATH\n", arg);
+                printf("bad %s %s: expected CELL=PATH\n", argv[i - 1], arg);
                 return 0;
             }
             memcpy(cell, arg, (size_t)(eq - arg));
             cell[eq - arg] = '\0';
             c = cell_index(cell);
             if (c < 0) {
-                printf("bad --table %s: CELL must be T1, T2 or T3\n", arg);
+                printf("bad %s %s: CELL must be T1, T2 or T3\n", argv[i - 1], arg);
                 return 0;
             }
-            out->tables[c].path = eq + 1;
+            tables[c].path = eq + 1;
         } else {
             printf("unknown argument %s\nusage: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]... "
-                   "[--line-bundle PATH]\n",
+                   "[--clearance-table CELL=PATH]... [--line-bundle PATH]\n",
                    argv[i]);
             return 0;
         }
@@ -174,8 +175,8 @@ int parse_options(int argc, char **argv, HarnessOptions *out)
 int load_tables(HarnessOptions *options)
 {
     int c, ok = 1;
-    for (c = 0; c < HARNESS_N_CELLS; ++c) {
-        HarnessTable *t = &options->tables[c];
+    for (c = 0; c < 2 * HARNESS_N_CELLS; ++c) {
+        HarnessTable *t = c < HARNESS_N_CELLS ? &options->tables[c] : &options->clearance_tables[c - HARNESS_N_CELLS];
         if (t->path != NULL && !read_file(t->path, &t->bytes, &t->len)) {
             printf("cannot read table file %s\n", t->path);
             ok = 0;
@@ -192,10 +193,11 @@ int load_tables(HarnessOptions *options)
 void free_tables(HarnessOptions *options)
 {
     int c;
-    for (c = 0; c < HARNESS_N_CELLS; ++c) {
-        free(options->tables[c].bytes);
-        options->tables[c].bytes = NULL;
-        options->tables[c].len = 0;
+    for (c = 0; c < 2 * HARNESS_N_CELLS; ++c) {
+        HarnessTable *t = c < HARNESS_N_CELLS ? &options->tables[c] : &options->clearance_tables[c - HARNESS_N_CELLS];
+        free(t->bytes);
+        t->bytes = NULL;
+        t->len = 0;
     }
     free(options->line_bundle.bytes);
     options->line_bundle.bytes = NULL;
@@ -203,8 +205,8 @@ void free_tables(HarnessOptions *options)
 }
 
 int open_protective(const char *who, const char *cell_name, const char *case_name, const DcStopConfig *model,
-                    MrCell *cell, MrScenario *scenario, DcStopConfig stops[MR_MAX_ROBOTS], DcCollider **h,
-                    DcCollider **exact)
+                    const HarnessTable *table, MrCell *cell, MrScenario *scenario, DcStopConfig stops[MR_MAX_ROBOTS],
+                    DcCollider **h, DcCollider **exact)
 {
     DcRobotConfig robots[MR_MAX_ROBOTS];
     DcCellConfig config;
@@ -216,8 +218,9 @@ int open_protective(const char *who, const char *cell_name, const char *case_nam
         return check(0, "%s %s %s: cannot load the scenario", who, cell_name, case_name);
     }
     pou_cell_config(cell, DC_METHOD_SAT_CACHE, robots, &config);
-    s = dc_init(&config, h);
-    check(s == DC_STATUS_OK, "%s %s: dc_init: %s", who, cell_name, dc_status_str(s));
+    s = table == NULL ? dc_init(&config, h) : dc_init_with_table(&config, table->bytes, table->len, h);
+    check(s == DC_STATUS_OK, "%s %s: dc_init%s: %s", who, cell_name, table == NULL ? "" : "_with_table",
+          dc_status_str(s));
     s = dc_init(&config, exact);
     check(s == DC_STATUS_OK, "%s %s: dc_init (exact): %s", who, cell_name, dc_status_str(s));
     for (j = 0; j < cell->n_robots; ++j) {

@@ -26,7 +26,7 @@ typedef struct HarnessTable {
     size_t len;
 } HarnessTable;
 
-/* The command line: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]...
+/* The command line: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]... [--clearance-table CELL=PATH]...
  *   --quick  runs the T1 collision scenario only (exact and table mode), for valgrind;
  *            the kinematics grid, every bad-input scenario and the line's collision case
  *            in exact mode still run;
@@ -36,12 +36,15 @@ typedef struct HarnessTable {
  *   --table  the table file of reference cell CELL (T1, T2 or T3): enables table mode;
  *   --line-bundle  the bundle of cells/line4.toml (`delta-collide build --cell
  *            cells/line4.toml`): runs the line in table mode too. */
+ *   --clearance-table  a clearance table file (build --variant clearance) of CELL: the
+ *            protective scenarios run once more in table mode on it. */
 typedef struct HarnessOptions {
     int quick;
     int protective_quick; /* --protective-quick: the protective verdict on T1 collision only */
     const char *tmp_dir;
     HarnessTable tables[HARNESS_N_CELLS]; /* T1, T2, T3 */
     HarnessTable line_bundle;             /* cells/line4.toml's bundle */
+    HarnessTable clearance_tables[HARNESS_N_CELLS]; /* T1, T2, T3 */
 } HarnessOptions;
 
 /* Counts one check; prints `FAIL: <message>` when it fails. Returns ok. */
@@ -94,12 +97,12 @@ int run_table_scenario(const char *cell_name, const char *case_name, const Harne
 void bad_input(const HarnessOptions *options);
 
 /* Two handles on reference cell `cell_name` for a protective scenario: *h with every robot's
- * stopping model `model` (warn_mm 10), *exact for the exact model beside it; and the scenario
- * (cell_name, case_name). Returns 0 after a failed check naming `who` when one cannot be made
- * (both handles are then destroyed and NULL). */
+ * stopping model `model` (warn_mm 10), in table mode on `table` when not NULL, *exact for the
+ * exact model beside it; and the scenario (cell_name, case_name). Returns 0 after a failed
+ * check naming `who` when one cannot be made (both handles are then destroyed and NULL). */
 int open_protective(const char *who, const char *cell_name, const char *case_name, const DcStopConfig *model,
-                    MrCell *cell, MrScenario *scenario, DcStopConfig stops[MR_MAX_ROBOTS], DcCollider **h,
-                    DcCollider **exact);
+                    const HarnessTable *table, MrCell *cell, MrScenario *scenario, DcStopConfig stops[MR_MAX_ROBOTS],
+                    DcCollider **h, DcCollider **exact);
 
 #define STOP_SUBSTEPS 10 /* 0.1 ms steps per 1 ms tick of a simulated stop */
 
@@ -135,11 +138,12 @@ int tally_verdict(VerdictTally *t, long tick, DcStatus s, DcVerdict v, const DcP
 void protective_scenarios(const HarnessOptions *options);
 
 /* One scenario with the protective verdict, every robot with stopping model `model` (warn_mm
- * 10), with or without each robot's programmed path ahead as its stop path, for n_ticks; the
- * stop simulated at the first STOP is checked every 0.1 ms for contact (protective.c).
- * Prints one line and returns the verdicts' tally. */
+ * 10), in exact mode (`table` NULL) or table mode on a clearance table, with or without each
+ * robot's programmed path ahead as its stop path, for n_ticks; the stop simulated at the
+ * first STOP is checked every 0.1 ms for contact (protective.c). Prints one line (and in
+ * table mode one more: the ticks answered by the lookup alone) and returns the tally. */
 VerdictTally run_protective(const char *cell_name, const char *case_name, const char *model_name,
-                            const DcStopConfig *model, int with_paths, long n_ticks);
+                            const DcStopConfig *model, const HarnessTable *table, int with_paths, long n_ticks);
 
 /* The four-robot line (line.c): both cases in exact mode through the POU, and with the
  * protective verdict and a simulated stop. --quick runs the collision case in exact mode

@@ -265,9 +265,9 @@ void line_scenarios(const HarnessOptions *options)
         if (options->protective_quick) {
             continue; /* under qemu the interval arithmetic of the verdict takes minutes */
         }
-        d = run_protective("line4", cases[k], "default", &standard, 0, MR_TICKS_PER_RUN);
-        t = run_protective("line4", cases[k], "stiff", &stiff, 0, MR_TICKS_PER_RUN);
-        p = run_protective("line4", cases[k], "stiff", &stiff, 1, MR_TICKS_PER_RUN);
+        d = run_protective("line4", cases[k], "default", &standard, NULL, 0, MR_TICKS_PER_RUN);
+        t = run_protective("line4", cases[k], "stiff", &stiff, NULL, 0, MR_TICKS_PER_RUN);
+        p = run_protective("line4", cases[k], "stiff", &stiff, NULL, 1, MR_TICKS_PER_RUN);
         if (exact_first >= 0) {
             check(d.first_stop >= 0 && d.first_stop <= exact_first && t.first_stop >= 0
                       && t.first_stop <= exact_first && p.first_stop >= 0 && p.first_stop <= exact_first,

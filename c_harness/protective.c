@@ -9,7 +9,10 @@
  * handle) must find no contact. Prints per scenario the first WARN and STOP ticks, the STOP
  * and WARN counts, the smallest clearance and the stop's length. --quick (valgrind) runs the
  * first 200 ticks of T1 collision with the default model, which hold its whole stop, with and
- * without paths.
+ * without paths. With a clearance table for a cell (--clearance-table), its scenarios run
+ * once more with the protective handle in table mode, where a tick the table's certified
+ * bound proves FREE is answered by one lookup: the same simulated stops must not touch, and
+ * the share of ticks answered by the lookup alone is printed.
  */
 #include "harness.h"
 
@@ -46,7 +49,7 @@ static DcStatus query_tick(DcCollider *h, const MrScenario *s, const MrStop stop
 }
 
 VerdictTally run_protective(const char *cell_name, const char *case_name, const char *model_name,
-                            const DcStopConfig *model, int with_paths, long n_ticks)
+                            const DcStopConfig *model, const HarnessTable *table, int with_paths, long n_ticks)
 {
     MrCell cell;
     MrScenario scenario;
@@ -59,7 +62,7 @@ VerdictTally run_protective(const char *cell_name, const char *case_name, const 
     size_t j;
     DcStatus s;
 
-    if (!open_protective("protective", cell_name, case_name, model, &cell, &scenario, stops, &h, &exact)) {
+    if (!open_protective("protective", cell_name, case_name, model, table, &cell, &scenario, stops, &h, &exact)) {
         return t;
     }
     for (tick = -1; tick < n_ticks; ++tick) {
@@ -100,14 +103,22 @@ VerdictTally run_protective(const char *cell_name, const char *case_name, const 
     check(st.contacts == 0, "protective %s %s: %lu of %lu samples of the stop touch", cell_name, case_name,
           st.contacts, st.samples);
     check(t.first_stop < 0 || st.samples > 0, "protective %s %s: the stop was not simulated", cell_name, case_name);
-    printf("protective %s %-9s %-7s%s: first WARN %ld, first STOP %ld", cell_name, case_name, model_name,
-           with_paths ? " with paths" : "", t.first_warn, t.first_stop);
+    printf("protective %s %-9s %-7s%s%s: first WARN %ld, first STOP %ld", cell_name, case_name, model_name,
+           with_paths ? " with paths" : "", table == NULL ? "" : " table mode", t.first_warn, t.first_stop);
     if (t.stop_robot_a != DC_BOX_NONE) {
         printf(" (robots %u-%u)", (unsigned)t.stop_robot_a, (unsigned)t.stop_robot_b);
     }
     printf(", STOP %lu WARN %lu of %ld ticks, statuses not OK %lu, smallest clearance %.1f mm, stop %.1f ms, "
            "%lu exact samples of the stop, contacts %lu\n",
            t.n_stop, t.n_warn, n_ticks, t.n_bad_status, t.min_clear, st.moving_ms, st.samples, st.contacts);
+    if (table != NULL) {
+        unsigned long lookups = (unsigned long)dc_table_protective_lookups(h);
+        printf("protective %s %-9s %-7s%s table mode: %lu of %ld ticks (%.1f %%) answered by the lookup alone\n",
+               cell_name, case_name, model_name, with_paths ? " with paths" : "", lookups, n_ticks,
+               100.0 * (double)lookups / (double)n_ticks);
+    } else {
+        check(dc_table_protective_lookups(h) == 0, "protective %s %s: lookups in exact mode", cell_name, case_name);
+    }
     dc_destroy(h);
     dc_destroy(exact);
     return t;
@@ -125,18 +136,24 @@ void protective_scenarios(const HarnessOptions *options)
     stiff.decel_mm_s2 = 120000.0;
     if (options->quick || options->protective_quick) {
         /* Valgrind: the default model stops at about tick 60 and stands still by tick 100. */
-        run_protective("T1", "collision", "default", &standard, 0, 200);
-        run_protective("T1", "collision", "default", &standard, 1, 200); /* the path entry point */
+        run_protective("T1", "collision", "default", &standard, NULL, 0, 200);
+        run_protective("T1", "collision", "default", &standard, NULL, 1, 200); /* the path entry point */
         return;
     }
     for (c = 0; c < 3; ++c) {
+        const HarnessTable *table = options->clearance_tables[c].path != NULL ? &options->clearance_tables[c] : NULL;
         for (k = 0; k < 2; ++k) {
-            run_protective(cells[c], cases[k], "default", &standard, 0, MR_TICKS_PER_RUN);
-            run_protective(cells[c], cases[k], "stiff", &stiff, 0, MR_TICKS_PER_RUN);
+            run_protective(cells[c], cases[k], "default", &standard, NULL, 0, MR_TICKS_PER_RUN);
+            run_protective(cells[c], cases[k], "stiff", &stiff, NULL, 0, MR_TICKS_PER_RUN);
             /* With the default model the first STOP comes in the first 100 ticks with or
              * without paths (tests/protective_paths.rs counts every tick); with the stiff one
              * the paths decide whether the practical runs stop at all. */
-            run_protective(cells[c], cases[k], "stiff", &stiff, 1, MR_TICKS_PER_RUN);
+            run_protective(cells[c], cases[k], "stiff", &stiff, NULL, 1, MR_TICKS_PER_RUN);
+            if (table != NULL) {
+                run_protective(cells[c], cases[k], "default", &standard, table, 0, MR_TICKS_PER_RUN);
+                run_protective(cells[c], cases[k], "stiff", &stiff, table, 0, MR_TICKS_PER_RUN);
+                run_protective(cells[c], cases[k], "stiff", &stiff, table, 1, MR_TICKS_PER_RUN);
+            }
         }
     }
 }

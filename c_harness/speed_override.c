@@ -120,7 +120,7 @@ static void run_override(const char *cell_name, const char *case_name)
     DcStatus s;
 
     DcStopConfig standard = dc_stop_config_default();
-    if (!open_protective("speed override", cell_name, case_name, &standard, &cell, &scenario, stops, &h, &exact)) {
+    if (!open_protective("speed override", cell_name, case_name, &standard, NULL, &cell, &scenario, stops, &h, &exact)) {
         return;
     }
     cycle = cycle_ticks(&scenario);

@@ -269,7 +269,7 @@ typedef struct DcProtectiveReport {
   /*
    Signed clearance of the cell now (mm, SPEC section 8): over the box pairs of robots that can
    meet, the smallest gap when apart, minus the penetration depth when boxes intersect,
-   0 when touching; NaN when not computed (status not OK).
+   0 when touching; NaN when not computed (status not OK). Exact in table mode too.
    */
   double clearance_mm;
   /*
@@ -694,7 +694,10 @@ void dc_protective_reset(struct DcCollider *handle);
  without any box touching a box of another robot? Robot j's TCP is `tcps_mcs[j]` (its
  MCS); its speed is estimated from the TCP of the previous call, so call it once per tick
  with the tick of `dc_set_stop_model` (works in exact and table mode: it reads the exact
- boxes).
+ boxes). In table mode with a clearance table, a tick whose certified clearance bound
+ exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup,
+ without the box-pair proof (`dc_table_protective_lookups`); every other tick takes the
+ exact protective check, as in exact mode. The report is filled alike in both modes.
 
  Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
  `DC_VERDICT_FREE` (proved: every stop the models allow keeps the boxes apart),
@@ -827,6 +830,18 @@ DcStatus dc_set_speed_limits(struct DcCollider *handle, uint32_t on);
  `handle` must be NULL or live.
  */
 uint64_t dc_table_confirmations(const struct DcCollider *handle);
+
+/*
+ Table mode with a clearance table (`build --variant clearance`): how many protective
+ queries so far (`dc_protective_query`, `dc_protective_query_with_paths`) were answered
+ FREE by the table's certified clearance bound alone, which exceeded both robots' motion
+ bounds over their stops plus `warn_mm` (docs/PROTECTIVE.md); every other protective query
+ took the exact protective proof. 0 in exact mode, with a boolean table and for NULL.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+uint64_t dc_table_protective_lookups(const struct DcCollider *handle);
 
 /*
  Number of robots of the handle's cell; 0 for NULL.

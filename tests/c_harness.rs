@@ -15,7 +15,7 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::cell::parse_cell;
 use delta_collide::table::bundle::build_bundle;
-use delta_collide::table::{build_tables, to_bytes, Labelling, Variant};
+use delta_collide::table::{build_tables, to_bytes, Labelling, Ladder, Variant};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
@@ -75,6 +75,38 @@ fn plain_harness() -> &'static Path {
 /// The table kinds the harness runs on: the thesis's 6-D linear quadtree and the shared 6-D
 /// quadtree, both built from one certified labelling.
 const KINDS: [(&str, Variant); 2] = [("6d", Variant::D6), ("shared", Variant::Shared)];
+
+/// Resolution of the clearance tables of the protective verdict in table mode: their
+/// labelling takes about 3 s per cell at k = 16 and a minute at k = 32.
+const CLEARANCE_K: u32 = 16;
+
+/// The certified clearance table (default levels) of `CELLS[c]` at [`CLEARANCE_K`]
+/// (`delta-collide build --cell T1 --k 16 --variant clearance`), kept and reused as
+/// [`table_files`] are.
+fn clearance_table_file(c: usize) -> &'static Path {
+    static FILES: [OnceLock<PathBuf>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    FILES[c].get_or_init(|| {
+        let name = CELLS[c];
+        let dir = scratch_dir("c_harness_tables");
+        let path = dir.join(format!("{name}_k{CLEARANCE_K}_clearance.dct"));
+        let stamp = dir.join(format!("{name}_k{CLEARANCE_K}_clearance.builder"));
+        let exe = std::fs::metadata(std::env::current_exe().expect("test executable")).expect("stat test executable");
+        let modified = exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+        let builder = format!("{} bytes, modified {:?}, k = {CLEARANCE_K}", exe.len(), modified.unwrap_or_default());
+        if path.is_file() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder) {
+            return path;
+        }
+        let cell = reference_cell(name).expect("reference cell");
+        let variant = Variant::Clearance(Ladder::default_ladder());
+        let (header, tables, _) =
+            build_tables(&cell, CLEARANCE_K, &Workspace::THESIS, &[variant], Labelling::Certified, Progress::Silent)
+                .unwrap_or_else(|e| panic!("building the {name} clearance table: {e}"));
+        let _ = std::fs::remove_file(&stamp);
+        std::fs::write(&path, to_bytes(&tables[0], &header)).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+        std::fs::write(&stamp, builder).unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
+        path
+    })
+}
 
 /// The table files of `CELLS[c]`, one per [`KINDS`] (the pipeline of `delta-collide build
 /// --cell T1 --k 32 --variant 6d|shared`). Labelling T1, T2, T3 takes about 3 s, 10 s and
@@ -186,6 +218,21 @@ fn number(line: &str, before: &str) -> f64 {
     field.parse().unwrap_or_else(|_| panic!("`{before}` is not followed by a number in: {line}"))
 }
 
+/// The protective runs in table mode on the clearance tables (`c_harness/protective.c`): for
+/// each cell, case and model as in exact mode, no simulated stop touches, and the share of
+/// ticks answered by the lookup alone is printed; the stiff model's runs have such ticks.
+fn assert_protective_table_mode(stdout: &str) {
+    let runs: Vec<&str> = stdout.lines().filter(|l| l.starts_with("protective T") && l.contains(" table mode: first")).collect();
+    assert_eq!(runs.len(), 18, "three table-mode protective runs per cell and case: {runs:?}");
+    for l in &runs {
+        assert_eq!(number(l, "contacts "), 0.0, "{l}");
+    }
+    let shares: Vec<&str> = stdout.lines().filter(|l| l.contains("answered by the lookup alone")).collect();
+    assert_eq!(shares.len(), 18, "{shares:?}");
+    let lookups: f64 = shares.iter().filter(|l| l.contains(" stiff ")).map(|l| number(l, "table mode: ")).sum();
+    assert!(lookups > 500.0, "the stiff runs in table mode answer few ticks by the lookup: {shares:?}");
+}
+
 /// The speed-override lines (`c_harness/speed_override.c`), one per practical scenario: the
 /// boxes never touch (every tick, and every 0.1 ms of each stop simulated at a STOP), the
 /// scaled run completes its cycle, no sooner than the unscaled one, with fewer STOP ticks.
@@ -273,14 +320,18 @@ fn c_harness_passes_on_the_shared_table() {
 fn harness_passes_with_tables(kind: usize) {
     let exe = plain_harness();
     let tmp = scratch_dir(&format!("c_harness_{}", KINDS[kind].0));
-    let out = run(Command::new(exe)
-        .arg("--tmp")
-        .arg(&tmp)
-        .args(table_args_of(&[0, 1, 2], kind))
-        .arg("--line-bundle")
-        .arg(line_bundle_file())
-        .current_dir(repo_root()));
+    let mut args = table_args_of(&[0, 1, 2], kind);
+    if kind == 0 {
+        for (c, cell) in CELLS.iter().enumerate() {
+            args.extend(["--clearance-table".to_string(), format!("{cell}={}", clearance_table_file(c).display())]);
+        }
+    }
+    args.extend(["--line-bundle".to_string(), line_bundle_file().display().to_string()]);
+    let out = run(Command::new(exe).arg("--tmp").arg(&tmp).args(&args).current_dir(repo_root()));
     let stdout = assert_harness_passed(&format!("c_harness (exact and {} table mode, T1 T2 T3)", KINDS[kind].0), &out);
+    if kind == 0 {
+        assert_protective_table_mode(&stdout);
+    }
     assert!(stdout.contains("bad input: done (exact and table mode)"), "table-mode bad inputs did not run");
     assert_speed_override(&stdout);
     assert_line(&stdout);

@@ -264,6 +264,38 @@ fn clearance_table_through_build_inspect_eval_and_check() {
         levelled += 1;
     }
     assert!(levelled > 10 && none > 0, "{levelled} rows with a level, {none} without:\n{text}");
+    // replay --table: T1 practical with a stiff stopping model on a table with the default
+    // levels; some ticks are answered by the lookup alone; statuses and the (exact) clearance
+    // agree with exact mode's.
+    let ladder_table = dir.join("t1d.dct");
+    let ladder_table = ladder_table.to_str().unwrap();
+    let out = cli(&["build", "--cell", "T1", "--k", "16", "--variant", "clearance", "--output", ladder_table]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let cell = dir.join("t1_stiff.toml");
+    let stop = "stop = { reaction_ms = 2.0, decel_mm_s2 = 120000.0, max_accel_mm_s2 = 130000.0, max_speed_mm_s = 4600.0 }";
+    let toml = format!(
+        "name = \"T1\"\ntick_ms = 1.0\n\n[[robot]]\nname = \"A\"\n{stop}\n\n[[robot]]\nname = \"B\"\n\
+         placement = {{ alpha_deg = 0.0, t = [450.0, 0.0, 0.0] }}\n{stop}\n"
+    );
+    std::fs::write(&cell, toml).unwrap();
+    let cell = cell.to_str().unwrap();
+    let rows = scenario_rows("T1", "practical", 6000);
+    let exact = cli_stdin(&["replay", "--cell", cell], &rows);
+    let table_mode = cli_stdin(&["replay", "--cell", cell, "--table", ladder_table], &rows);
+    assert!(exact.status.success() && table_mode.status.success(), "{}", stderr(&table_mode));
+    let lookups: u32 = stderr(&table_mode)
+        .split(" of 6000 ticks")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no lookup share: {}", stderr(&table_mode)));
+    assert!(lookups > 0 && stderr(&table_mode).contains("answered FREE by the lookup alone"), "{}", stderr(&table_mode));
+    let (exact, table_mode) = (stdout(&exact), stdout(&table_mode));
+    assert_eq!(exact.lines().count(), table_mode.lines().count());
+    for (e, t) in exact.lines().zip(table_mode.lines()).skip(1) {
+        let (e, t): (Vec<&str>, Vec<&str>) = (e.split(',').collect(), t.split(',').collect());
+        assert_eq!((e[0], e[2], e[3]), (t[0], t[2], t[3]), "tick, status and clearance");
+    }
     // quilt shades free cells by level: the middle levels' blues cover many cells.
     let png = dir.join("quilt.png");
     let out = cli(&["quilt", "--cell", "T1", "--table", table, "--axes", "zz", "--output", png.to_str().unwrap()]);

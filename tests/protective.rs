@@ -6,7 +6,7 @@
 
 use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveReport, ProtectiveStatus};
 use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
-use delta_collide::cell::{Cell, ExactChecker};
+use delta_collide::cell::ExactChecker;
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
 use rand::rngs::StdRng;
@@ -45,137 +45,7 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 mod protective_common;
-use protective_common::{cell, tcp_toward_other, unit, STIFF};
-
-/// A reachable TCP of robot `j` within 0 to 8 mm of its reach boundary (pushed out from
-/// [`tcp_toward_other`] along its radial direction), where elbows swing fastest.
-fn tcp_near_reach_boundary(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
-    let delta = &cell.robots[j].model.delta;
-    loop {
-        let p = tcp_toward_other(cell, j, rng);
-        let out = Vec3::new(p.x, p.y, 0.0).try_normalize(1e-9).unwrap_or(Vec3::x());
-        let mut step = 0.0;
-        while delta.is_reachable(&(p + out * (step + 1.0))) && step < 400.0 {
-            step += 1.0;
-        }
-        let q = p + out * (step - rng.random_range(0.0..8.0f64)).max(0.0);
-        if delta.is_reachable(&q) {
-            return q;
-        }
-    }
-}
-
-/// One robot's stopping motion, sampled every `DT`: reaction with random accelerations,
-/// then braking along a straight or curved path.
-struct Motion {
-    p: Vec3,
-    v: Vec3,
-    accel: Vec3,
-    braking: bool,
-    /// Braking: deceleration along the path and turn rate of the path (rad/s about `axis`).
-    decel: Real,
-    turn: Real,
-    axis: Vec3,
-    done: bool,
-}
-
-const DT: Real = 1e-4;
-
-impl Motion {
-    fn step(&mut self, t: Real, reaction_s: Real, model: &StopModel, rng: &mut StdRng, kind: usize, toward: &Vec3) {
-        if self.done {
-            return;
-        }
-        if t < reaction_s {
-            // New random acceleration every 0.5 ms (kind 0: always the hardest push toward the
-            // other robot).
-            if kind == 0 {
-                self.accel = toward * model.max_accel_mm_s2;
-            } else if (t / 5e-4).fract() < DT / 5e-4 + 1e-12 {
-                self.accel = unit(rng) * model.max_accel_mm_s2 * rng.random_range(0.0..1.0f64).sqrt();
-            }
-            self.v += self.accel * DT;
-            let speed = self.v.norm();
-            if speed > model.max_speed_mm_s {
-                self.v *= model.max_speed_mm_s / speed;
-            }
-            self.p += self.v * DT;
-            return;
-        }
-        if !self.braking {
-            self.braking = true;
-            let speed = self.v.norm();
-            // The path's direction at the start of braking: kind 0 toward the other robot,
-            // 1 straight on, 2 a random direction, 3 random and curving.
-            let dir = match kind {
-                0 => *toward,
-                1 if speed > 0.0 => self.v / speed,
-                _ => unit(rng),
-            };
-            self.v = dir * speed;
-            self.decel = if kind == 0 { model.decel_mm_s2 } else { model.decel_mm_s2 * rng.random_range(1.0..1.5) };
-            self.turn = if kind == 3 { rng.random_range(-40.0..40.0) } else { 0.0 };
-            self.axis = unit(rng);
-        }
-        let speed = self.v.norm();
-        let new_speed = (speed - self.decel * DT).max(0.0);
-        if new_speed == 0.0 || speed == 0.0 {
-            self.done = true;
-            return;
-        }
-        let mut dir = self.v / speed;
-        if self.turn != 0.0 {
-            let rot = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(self.axis), self.turn * DT);
-            dir = rot * dir;
-        }
-        self.v = dir * new_speed;
-        self.p += dir * (0.5 * (speed + new_speed) * DT);
-    }
-}
-
-/// Simulates `motions` random stops of both robots from TCPs `tcps` with true velocities
-/// `vel`; panics at the first contact.
-fn assert_stops_never_touch(cell: &Cell, tcps: &[Vec3; 2], vel: &[Vec3; 2], motions: usize, rng: &mut StdRng) -> usize {
-    let mut exact = ExactChecker::new(cell.clone());
-    let mut steps = 0;
-    for m in 0..motions {
-        let kind = m % 4;
-        let toward = |j: usize| {
-            // The other robot's TCP in robot j's MCS, roughly: its base direction.
-            let other = cell.robots[1 - j].placement.t - cell.robots[j].placement.t;
-            let (s, c) = cell.robots[j].placement.alpha.sin_cos();
-            Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize()
-        };
-        let mut robots: Vec<Motion> = (0..2)
-            .map(|j| Motion {
-                p: tcps[j],
-                v: vel[j],
-                accel: Vec3::zeros(),
-                braking: false,
-                decel: 0.0,
-                turn: 0.0,
-                axis: Vec3::z(),
-                done: false,
-            })
-            .collect();
-        let mut t = 0.0;
-        while !robots.iter().all(|r| r.done) {
-            for (j, r) in robots.iter_mut().enumerate() {
-                let stop = cell.stops[j];
-                r.step(t, (stop.reaction_ms + cell.tick_ms) * 1e-3, &stop, rng, kind, &toward(j));
-            }
-            t += DT;
-            let v = exact.check(&[robots[0].p, robots[1].p]).unwrap();
-            if !v.all_reachable() {
-                break; // the robot cannot go there: this motion is not physical
-            }
-            steps += 1;
-            assert!(!v.collides(), "contact at t = {t:.4} s in motion {m} from {tcps:?} with {vel:?}");
-            assert!(t < 1.0, "a stop lasted a second");
-        }
-    }
-    steps
-}
+use protective_common::{assert_stops_never_touch, cell, tcp_near_reach_boundary, tcp_toward_other, unit, STIFF};
 
 /// Random states near each other; for each FREE one, random stops are simulated.
 /// `precise`: the second tier's splits (0: the motor-angle table alone); `edge`: TCPs near the

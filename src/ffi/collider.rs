@@ -52,6 +52,9 @@ pub(crate) struct Collider {
     protective: ProtectiveChecker,
     /// Per robot, the points of its stop path of the current query, converted; sized once.
     path_points: Vec<[Vec3; DC_MAX_PATH_POINTS]>,
+    /// Table mode: protective queries so far answered FREE by the clearance table's bound
+    /// alone (kept across `dc_set_stop_model`).
+    protective_lookups: u64,
 }
 
 /// The protective checker of a handle until `dc_set_stop_model` sets one: without the motor-angle
@@ -70,6 +73,7 @@ impl Collider {
             tcps: vec![Vec3::zeros(); n],
             table_collides: false,
             path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; n],
+            protective_lookups: 0,
         }
     }
 
@@ -99,6 +103,7 @@ impl Collider {
             table_collides: false,
             protective,
             path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; 2],
+            protective_lookups: 0,
         })
     }
 
@@ -115,6 +120,7 @@ impl Collider {
             table_collides: false,
             protective,
             path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; n],
+            protective_lookups: 0,
         })
     }
 
@@ -169,6 +175,12 @@ impl Collider {
             Checker::Table(t) => t.confirmations(),
             Checker::Bundle(b) => b.confirmations(),
         }
+    }
+
+    /// Table mode: protective queries so far answered FREE by the clearance table's bound
+    /// alone, without the exact protective proof; 0 in exact mode and with a boolean table.
+    pub(crate) fn table_protective_lookups(&self) -> u64 {
+        self.protective_lookups
     }
 
     /// Table mode: chooses what a COLLISION lookup does from the next query on; exact mode
@@ -286,7 +298,14 @@ impl Collider {
         for (dst, src) in self.tcps.iter_mut().zip(tcps) {
             *dst = src.to_vec3();
         }
-        let Ok(r) = self.protective.check(&self.tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };
+        let r = match &self.checker {
+            Checker::Table(t) if t.table().as_clearance().is_some() => {
+                self.protective.check_with_table(&self.tcps, &|tcps| t.clearance_bound(tcps))
+            }
+            _ => self.protective.check(&self.tcps),
+        };
+        let Ok(r) = r else { return DC_STATUS_WRONG_ROBOT_COUNT };
+        self.protective_lookups += u64::from(r.table_lookup);
         write_protective(r, report)
     }
 
@@ -316,9 +335,15 @@ impl Collider {
                 stop_paths[j] = Some(StopPath { points: &self.path_points[j][..points.len()], tolerance_mm: *tolerance_mm });
             }
         }
-        let Ok(r) = self.protective.check_with_paths(&self.tcps, &stop_paths[..paths.len()]) else {
-            return DC_STATUS_WRONG_ROBOT_COUNT;
+        let stop_paths = &stop_paths[..paths.len()];
+        let r = match &self.checker {
+            Checker::Table(t) if t.table().as_clearance().is_some() => {
+                self.protective.check_with_paths_and_table(&self.tcps, stop_paths, &|tcps| t.clearance_bound(tcps))
+            }
+            _ => self.protective.check_with_paths(&self.tcps, stop_paths),
         };
+        let Ok(r) = r else { return DC_STATUS_WRONG_ROBOT_COUNT };
+        self.protective_lookups += u64::from(r.table_lookup);
         write_protective(r, report)
     }
 

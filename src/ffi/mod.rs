@@ -14,7 +14,9 @@
 //!   that can meet); `dc_query` is the same.
 //! - Table mode confirms a COLLISION lookup by the exact check unless
 //!   `dc_set_table_confirmation` (or the cell file's `table_confirm`) says otherwise, so it
-//!   answers as exact mode; `dc_table_confirmations` counts those ticks.
+//!   answers as exact mode; `dc_table_confirmations` counts those ticks. With a clearance
+//!   table the protective verdict is FREE by one lookup where the table's bound proves it
+//!   (`dc_table_protective_lookups`), else the exact protective check.
 //! - A handle is used by one thread at a time; distinct handles are independent.
 #![allow(unsafe_code)]
 
@@ -399,7 +401,10 @@ pub unsafe extern "C" fn dc_protective_reset(handle: *mut DcCollider) {
 /// without any box touching a box of another robot? Robot j's TCP is `tcps_mcs[j]` (its
 /// MCS); its speed is estimated from the TCP of the previous call, so call it once per tick
 /// with the tick of `dc_set_stop_model` (works in exact and table mode: it reads the exact
-/// boxes).
+/// boxes). In table mode with a clearance table, a tick whose certified clearance bound
+/// exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup,
+/// without the box-pair proof (`dc_table_protective_lookups`); every other tick takes the
+/// exact protective check, as in exact mode. The report is filled alike in both modes.
 ///
 /// Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
 /// `DC_VERDICT_FREE` (proved: every stop the models allow keeps the boxes apart),
@@ -729,6 +734,20 @@ pub unsafe extern "C" fn dc_set_speed_limits(handle: *mut DcCollider, on: u32) -
 pub unsafe extern "C" fn dc_table_confirmations(handle: *const DcCollider) -> u64 {
     // SAFETY: the caller guarantees `handle` is NULL or live.
     unsafe { handle.as_ref() }.map_or(0, |h| h.inner.table_confirmations())
+}
+
+/// Table mode with a clearance table (`build --variant clearance`): how many protective
+/// queries so far (`dc_protective_query`, `dc_protective_query_with_paths`) were answered
+/// FREE by the table's certified clearance bound alone, which exceeded both robots' motion
+/// bounds over their stops plus `warn_mm` (docs/PROTECTIVE.md); every other protective query
+/// took the exact protective proof. 0 in exact mode, with a boolean table and for NULL.
+///
+/// # Safety
+/// `handle` must be NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn dc_table_protective_lookups(handle: *const DcCollider) -> u64 {
+    // SAFETY: the caller guarantees `handle` is NULL or live.
+    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.table_protective_lookups())
 }
 
 /// Number of robots of the handle's cell; 0 for NULL.

@@ -299,7 +299,7 @@ pub struct DcProtectiveReport {
     pub unreachable_mask: u32,
     /// Signed clearance of the cell now (mm, SPEC section 8): over the box pairs of robots that can
     /// meet, the smallest gap when apart, minus the penetration depth when boxes intersect,
-    /// 0 when touching; NaN when not computed (status not OK).
+    /// 0 when touching; NaN when not computed (status not OK). Exact in table mode too.
     pub clearance_mm: f64,
     /// Closest box pair now: robots and boxes, or `DC_BOX_NONE`.
     pub closest_robot_a: u32,

@@ -199,6 +199,11 @@ pub struct ReplayArgs {
     /// names): that pair's exact signed clearance (mm), NA when the tick's status is not ok
     #[arg(long)]
     pub pairs: bool,
+    /// Table mode: a tick this clearance table (build --variant clearance, same cell) proves
+    /// FREE is answered by its lookup alone, the others by the exact protective check; the
+    /// share answered by the lookup goes to stderr [default: exact mode]
+    #[arg(long, value_name = "FILE.dct")]
+    pub table: Option<PathBuf>,
     /// Also draw the clearance, each robot's protective distance and the verdict per tick
     /// into this PNG file
     #[arg(long, value_name = "FILE.png")]

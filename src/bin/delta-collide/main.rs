@@ -328,7 +328,7 @@ impl Loaded {
     }
 }
 
-fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
+pub(crate) fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     TableChecker::new(cell.clone(), &bytes).map_err(|e| format!("{}: {e}", path.display()))
 }

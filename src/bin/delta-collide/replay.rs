@@ -8,17 +8,31 @@ use crate::replay_plot::{draw_replay, ReplayTrace};
 use crate::{open_input, write_output, Failure};
 use delta_collide::cell::protective::{path_through_samples, Protective, ProtectiveChecker, ProtectiveStatus, StopPath};
 use delta_collide::math::Vec3;
+use delta_collide::table::TableChecker;
 use std::io::{BufRead, Write};
 
 pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     let mut checker = ProtectiveChecker::new(args.cell.clone(), args.warn_mm).map_err(|e| e.to_string())?;
+    let table = args.table.as_ref().map(|p| crate::load_table(&args.cell, p)).transpose()?;
     let mut input = open_input(args.input.as_deref())?;
     let names = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
     let mut trace = args.plot.as_ref().map(|_| ReplayTrace::new(names));
     let paths = args.stop_path_mm.map(|length_mm| PathsAhead { length_mm, tolerance_mm: args.path_tolerance_mm });
+    let mut lookups = (0usize, 0usize);
     write_output(args.output.as_deref(), |out| {
-        replay_rows(&mut input, out, &mut checker, Columns { paths, pairs: args.pairs }, trace.as_mut())
+        lookups = replay_rows(&mut input, out, &mut checker, Columns { table: table.as_ref(), paths, pairs: args.pairs }, trace.as_mut())?;
+        Ok(())
     })?;
+    if let (Some(path), Some(t)) = (&args.table, &table) {
+        let (n, ticks) = lookups;
+        let share = if ticks > 0 { 100.0 * n as f64 / ticks as f64 } else { 0.0 };
+        let kind = if t.table().as_clearance().is_some() { "" } else { " (a boolean table proves no clearance)" };
+        // The verdicts may be on stdout: the summary goes to stderr.
+        eprintln!(
+            "table mode ({}): {n} of {ticks} ticks ({share:.1} %) answered FREE by the lookup alone{kind}",
+            path.display()
+        );
+    }
     if let (Some(path), Some(trace)) = (&args.plot, &trace) {
         let source = args.input.as_ref().map_or("stdin".to_string(), |p| p.display().to_string());
         let title = format!(
@@ -33,8 +47,10 @@ pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// What a replay adds to the verdicts: stop paths from the rows ahead, per-pair clearances.
-struct Columns {
+/// How a replay runs and what it adds to the verdicts: table mode, stop paths from the rows
+/// ahead, per-pair clearances.
+struct Columns<'a> {
+    table: Option<&'a TableChecker>,
     paths: Option<PathsAhead>,
     pairs: bool,
 }
@@ -50,8 +66,9 @@ struct PathsAhead {
 const PATH_POINTS: usize = delta_collide::ffi::DC_MAX_PATH_POINTS;
 
 /// Replays every row of `input` (one tick each) and writes one line per tick on `out`, with
-/// stop paths from the rows ahead and per-pair clearances as `columns` says; records each
-/// tick into `trace`.
+/// stop paths from the rows ahead, table mode and per-pair clearances as `columns` says;
+/// records each tick into `trace`. Returns the ticks answered by the table's lookup alone and
+/// all ticks.
 ///
 /// # Errors
 /// A row that is not `3 n` numbers (naming its line; the first line may be a header), or a
@@ -60,9 +77,11 @@ fn replay_rows(
     input: &mut dyn BufRead,
     out: &mut dyn Write,
     checker: &mut ProtectiveChecker,
-    Columns { paths, pairs }: Columns,
+    Columns { table, paths, pairs }: Columns<'_>,
     mut trace: Option<&mut ReplayTrace>,
-) -> Result<(), String> {
+) -> Result<(usize, usize), String> {
+    let bound = |tcps: &[Vec3]| table.and_then(|t| t.clearance_bound(tcps));
+    let mut lookups = 0;
     let names: Vec<String> = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
     let n = names.len();
     let write_err = |e: std::io::Error| format!("writing the verdicts: {e}");
@@ -85,6 +104,7 @@ fn replay_rows(
     let mut points = vec![[Vec3::zeros(); PATH_POINTS]; n];
     for (tick, tcps) in rows.iter().enumerate() {
         match paths {
+            None if table.is_some() => checker.check_with_table(tcps, &bound),
             None => checker.check(tcps),
             Some(p) => {
                 // Robot j's samples ahead: its TCP in this row and the rows that follow.
@@ -96,11 +116,15 @@ fn replay_rows(
                     .zip(&points)
                     .map(|(len, pts)| len.map(|len| StopPath { points: &pts[..len], tolerance_mm: p.tolerance_mm }))
                     .collect();
-                checker.check_with_paths(tcps, &stop_paths)
+                match table {
+                    Some(_) => checker.check_with_paths_and_table(tcps, &stop_paths, &bound),
+                    None => checker.check_with_paths(tcps, &stop_paths),
+                }
             }
         }
         .map_err(|e| format!("row {tick}: {e}"))?;
         let r = checker.report();
+        lookups += usize::from(r.table_lookup);
         if let Some(t) = trace.as_deref_mut() {
             // The exact check under the verdict ran only when the status is OK.
             let ok = r.status == ProtectiveStatus::Ok;
@@ -130,5 +154,5 @@ fn replay_rows(
         }
         writeln!(out, "{row}").map_err(write_err)?;
     }
-    Ok(())
+    Ok((lookups, rows.len()))
 }

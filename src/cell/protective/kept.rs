@@ -15,7 +15,9 @@
 //! # When a ball is kept
 //! - When the full proof proves FREE with the table's tier alone, every robot keeps the ball
 //!   and sweeps of that proof (nothing more to compute; they cover later stops that lie
-//!   inside, as when the robot stands or slows down).
+//!   inside, as when the robot stands or slows down). So does a FREE from a clearance
+//!   table's lookup (`protective/lookup.rs`): it proves FREE for every pair of TCPs of both
+//!   balls, the same claim.
 //! - On the tick after a FREE tick, a robot whose stop ball has left its kept ball gets a
 //!   wider one: its stop ball widened by [`KEPT_WIDEN`] and [`KEPT_MARGIN_MM`], with the
 //!   table's tier of sweeps, so that the ticks that follow at speed stay inside. Each pair is
@@ -160,8 +162,8 @@ impl ProtectiveChecker {
         free
     }
 
-    /// After the full proof proved every pair FREE with the sweeps of the table's tier about
-    /// each robot's reference: keeps those balls (of every robot that has sweeps: every robot
+    /// After the full proof (or a clearance table's lookup) proved every pair FREE with the
+    /// sweeps of the table's tier about each robot's reference: keeps those balls (of every robot that has sweeps: every robot
     /// of a pair that can meet) and marks every pair proved for them.
     pub(super) fn keep_references(&mut self) {
         for j in 0..self.kept.balls.len() {

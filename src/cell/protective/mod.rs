@@ -70,6 +70,13 @@
 //! tick's balls covers this tick too, so FREE ticks that follow FREE ticks mostly reuse one
 //! instead of computing sweeps ([`ProtectiveReport::kept_proof`]).
 //!
+//! **Table mode** (`protective/lookup.rs`): with a certified clearance table, a tick not
+//! settled by a kept proof or a certain STOP whose table bound exceeds both robots' motion
+//! bounds (the largest displacement of any box point under step 4's sweeps) plus `warn_mm`
+//! is FREE by the lookup, without the box-pair proof
+//! ([`ProtectiveChecker::check_with_table`], [`ProtectiveReport::table_lookup`]); every other
+//! tick takes the proof above, unchanged.
+//!
 //! Nothing here allocates after [`ProtectiveChecker::new`].
 
 use crate::cell::exact::PairVerdict;
@@ -85,8 +92,10 @@ use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
 use alloc::sync::Arc;
 
 mod kept;
+mod lookup;
 mod path;
 pub use kept::{KEPT_MARGIN_MM, KEPT_WIDEN};
+pub use lookup::{ClearanceBound, LOOKUP_SLACK_MM};
 pub use path::{path_through_samples, StopPath};
 
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`SPLITS^3` per
@@ -184,7 +193,8 @@ pub struct ProtectiveReport {
     pub status: ProtectiveStatus,
     /// The signed clearance of the cell now (mm, SPEC §8: the gap when apart, minus the
     /// penetration depth when boxes intersect, 0 when they touch; `INFINITY` when no pair can
-    /// meet, NaN when not computed).
+    /// meet, NaN when not computed). The exact clearance in table mode too: every tick with
+    /// status OK computes it before any proof, the table's lookup included.
     pub clearance_mm: Real,
     /// The box pair of the smallest clearance now.
     pub closest: Option<BoxPair>,
@@ -195,6 +205,9 @@ pub struct ProtectiveReport {
     /// Whether the verdict is FREE by a proof kept from an earlier tick or made for balls
     /// wider than this tick's (`protective/kept.rs`) rather than by this tick's own proof.
     pub kept_proof: bool,
+    /// Whether the verdict is FREE by the clearance table's bound alone, without a swept-box
+    /// proof (`protective/lookup.rs`; only with [`ProtectiveChecker::check_with_table`]).
+    pub table_lookup: bool,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -313,6 +326,7 @@ impl ProtectiveChecker {
                 limiting: None,
                 robots: alloc::vec![RobotProtection::UNKNOWN; n],
                 kept_proof: false,
+                table_lookup: false,
             },
         })
     }
@@ -381,6 +395,22 @@ impl ProtectiveChecker {
     /// # Errors
     /// [`QueryError::WrongRobotCount`] (the history is then left as it was).
     pub fn check(&mut self, tcps_mcs: &[Vec3]) -> Result<&ProtectiveReport, QueryError> {
+        self.check_bounded(tcps_mcs, None)
+    }
+
+    /// One tick like [`ProtectiveChecker::check`] in table mode: `bound` gives a certified
+    /// lower bound on the clearance at any TCPs (a clearance table's), and where it alone
+    /// proves FREE the tick is answered from it ([`ProtectiveReport::table_lookup`]; the
+    /// proof is in `protective/lookup.rs`); every other tick is [`ProtectiveChecker::check`]'s.
+    /// A bound that proves nothing (`None` everywhere: a boolean table) changes nothing.
+    ///
+    /// # Errors
+    /// As [`ProtectiveChecker::check`].
+    pub fn check_with_table(&mut self, tcps_mcs: &[Vec3], bound: ClearanceBound) -> Result<&ProtectiveReport, QueryError> {
+        self.check_bounded(tcps_mcs, Some(bound))
+    }
+
+    fn check_bounded(&mut self, tcps_mcs: &[Vec3], bound: Option<ClearanceBound>) -> Result<&ProtectiveReport, QueryError> {
         let n = self.cell().robots.len();
         if tcps_mcs.len() != n {
             return Err(QueryError::WrongRobotCount { expected: n, found: tcps_mcs.len() });
@@ -409,7 +439,7 @@ impl ProtectiveChecker {
             self.velocity[j] = velocity;
             self.history[j].velocity = Some(velocity);
         }
-        self.evaluate(tcps_mcs, status, true);
+        self.evaluate(tcps_mcs, status, true, bound);
         // Only a tick without error (unreachable included) becomes the next one's history.
         if self.report.status == ProtectiveStatus::Ok {
             for ((h, tcp), r) in self.history.iter_mut().zip(tcps_mcs).zip(&self.report.robots) {
@@ -436,11 +466,34 @@ impl ProtectiveChecker {
         tcps_mcs: &[Vec3],
         paths: &[Option<StopPath>],
     ) -> Result<&ProtectiveReport, QueryError> {
+        self.paths_bounded(tcps_mcs, paths, None)
+    }
+
+    /// [`ProtectiveChecker::check_with_paths`] in table mode: the tick without paths is
+    /// [`ProtectiveChecker::check_with_table`]'s (a FREE lookup needs no paths).
+    ///
+    /// # Errors
+    /// As [`ProtectiveChecker::check_with_paths`].
+    pub fn check_with_paths_and_table(
+        &mut self,
+        tcps_mcs: &[Vec3],
+        paths: &[Option<StopPath>],
+        bound: ClearanceBound,
+    ) -> Result<&ProtectiveReport, QueryError> {
+        self.paths_bounded(tcps_mcs, paths, Some(bound))
+    }
+
+    fn paths_bounded(
+        &mut self,
+        tcps_mcs: &[Vec3],
+        paths: &[Option<StopPath>],
+        bound: Option<ClearanceBound>,
+    ) -> Result<&ProtectiveReport, QueryError> {
         let n = self.cell().robots.len();
         if paths.len() != n {
             return Err(QueryError::WrongRobotCount { expected: n, found: paths.len() });
         }
-        self.check(tcps_mcs)?;
+        self.check_bounded(tcps_mcs, bound)?;
         if self.report.status != ProtectiveStatus::Ok {
             return Ok(&self.report);
         }
@@ -486,17 +539,18 @@ impl ProtectiveChecker {
                 status = worse(status, ProtectiveStatus::NonFinite(j));
             }
         }
-        self.evaluate(tcps_mcs, status, false);
+        self.evaluate(tcps_mcs, status, false, None);
         Ok(&self.report)
     }
 
     /// Fills the report from the TCPs and the measured speeds already in `report.robots`;
-    /// with `from_history`, each speed limit's search starts at the last tick's limit.
-    fn evaluate(&mut self, tcps_mcs: &[Vec3], status: ProtectiveStatus, from_history: bool) {
+    /// with `from_history`, each speed limit's search starts at the last tick's limit; with
+    /// `table`, a tick the table's bound proves FREE is answered from it.
+    fn evaluate(&mut self, tcps_mcs: &[Vec3], status: ProtectiveStatus, from_history: bool, table: Option<ClearanceBound>) {
         let was_free = self.report.verdict == Protective::Free;
         let report = &mut self.report;
         (report.verdict, report.status, report.clearance_mm) = (Protective::Stop, status, Real::NAN);
-        (report.closest, report.limiting, report.kept_proof) = (None, None, false);
+        (report.closest, report.limiting, report.kept_proof, report.table_lookup) = (None, None, false, false);
         if status != ProtectiveStatus::Ok {
             return;
         }
@@ -505,9 +559,6 @@ impl ProtectiveChecker {
             self.report.status = ProtectiveStatus::Unreachable(j);
             return;
         }
-        let memory = &mut self.clearances;
-        let (clearance, closest) = clearance_over_pairs(&self.exact, |k, a, b| memory[k].boxes_clearance(a, b));
-        (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let v = self.report.robots[j].speed_mm_s;
             let (s, ball) = self.stop_ball(j, tcp, v);
@@ -516,6 +567,9 @@ impl ProtectiveChecker {
             let r = &mut self.report.robots[j];
             (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
         }
+        let memory = &mut self.clearances;
+        let (clearance, closest) = clearance_over_pairs(&self.exact, |k, a, b| memory[k].boxes_clearance(a, b));
+        (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         let kept = self.kept_free(None);
         if kept && !self.speed_limits {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
@@ -525,10 +579,16 @@ impl ProtectiveChecker {
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
         }
+        // The cheaper answers first: a kept proof (no sweeps), a certain STOP (none either),
+        // then the table's bound (the table's tier of sweeps, which the proof below reuses).
         if kept {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else if let Some(pair) = self.certain_stop(None) {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
+        } else if table.is_some_and(|bound| self.lookup_free(bound)) {
+            (self.report.verdict, self.report.table_lookup) = (Protective::Free, true);
+            // The lookup proved FREE for every TCP of both stop balls: kept like a proof.
+            self.keep_references();
         } else if was_free && self.keep_and_prove() {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else {
@@ -557,10 +617,19 @@ impl ProtectiveChecker {
                 (self.report.verdict, self.report.limiting) = self.prove();
             }
         }
+        self.speed_limits_of(tcps_mcs, from_history);
+    }
+
+    /// Each robot's speed limit when they are asked for (else NaN), with this tick's stop
+    /// references of every robot already set (the limits search about them).
+    fn speed_limits_of(&mut self, tcps_mcs: &[Vec3], from_history: bool) {
+        if !self.speed_limits {
+            self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
+            return;
+        }
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let start = self.history[j].limit.filter(|_| from_history);
-            self.report.robots[j].speed_limit_mm_s =
-                if self.speed_limits { self.speed_limit(j, tcp, start) } else { Real::NAN };
+            self.report.robots[j].speed_limit_mm_s = self.speed_limit(j, tcp, start);
         }
     }
 

@@ -1,0 +1,81 @@
+//! The protective verdict from a certified clearance table (SPEC §8; clearance tables, SPEC
+//! §6): where the table's bound alone proves FREE, a tick costs one table lookup and one
+//! motion bound per robot instead of the swept-box proof of every box pair. It is tried
+//! after the cheaper answers (a kept proof, a certain STOP) and before the proof.
+//!
+//! # Why a lookup proves FREE
+//! Let robot `j`'s stop ball be `B(c_j, R_j)` (its stop reference, module doc of
+//! `protective`, step 3: the capsule's ball when the boxes at its centre exist, else the ball
+//! of radius `S` around the TCP now): every TCP of the whole stop lies in it. Its sweeps (step 4, the table's tier of
+//! motor angles, either form) bound the displacement of every box point, for every
+//! reachable TCP of that ball, from the same point of the boxes at `c_j`; so no box point of
+//! robot `j` moves further than `d_j`, the largest [`crate::geometry::Sweep::radius`] of its boxes, from
+//! where it is at `c_j`, until `j` stands still. A clearance table certifies `L`: every
+//! configuration of the table cell of `(c_A, c_B)` (both TCPs, each in its own MCS) has
+//! clearance at least `L`, in particular `(c_A, c_B)` itself. Any point `x` of a box of A
+//! and `y` of a box of B during the stop come from points `x0`, `y0` of those boxes at
+//! `(c_A, c_B)` with `|x - x0| <= d_A` and `|y - y0| <= d_B`, so
+//! `|x - y| >= |x0 - y0| - d_A - d_B >= L - d_A - d_B`. Hence `L > d_A + d_B + warn_mm`
+//! proves FREE with `warn_mm` to spare. The reference points `c_A`, `c_B` need not be
+//! where the robots are at the same time: the bound holds for the pair of configurations.
+//!
+//! Only FREE is answered this way. Where the bound does not prove FREE the tick takes the
+//! full proof, unchanged, so table mode never answers worse than exact mode, and better
+//! only where the lookup's proof holds. A WARN from the lookup (`L > d_A + d_B` alone) is
+//! not answered: the full proof may still prove FREE there.
+//!
+//! # The clearance reported
+//! Unchanged: every tick with status OK computes the exact clearance before any proof.
+//!
+//! # Numerics
+//! The proof asks `L` to exceed `d_A + d_B + warn_mm` by [`LOOKUP_SLACK_MM`], far above the
+//! rounding of the radii; sweeps that are not finite (a ball centre or cube out of reach of
+//! every bound) prove nothing.
+
+use super::ProtectiveChecker;
+use crate::math::{Real, Vec3};
+
+/// A certified lower bound on the clearance (SPEC §8, mm) of a two-robot cell at the given
+/// TCPs (each in its own robot's MCS), `None` when nothing is proved; for example
+/// [`crate::table::TableChecker::clearance_bound`] of a clearance table.
+pub type ClearanceBound<'a> = &'a dyn Fn(&[Vec3]) -> Option<Real>;
+
+/// How far (mm) the table's bound must exceed both motion bounds and `warn_mm` before a
+/// lookup proves FREE: far above the rounding of the radii (about 1e-13 of a metre).
+pub const LOOKUP_SLACK_MM: Real = 1e-6;
+
+impl ProtectiveChecker {
+    /// Robot `j`'s `d_j` about its stop reference (set for this tick): the farthest any of
+    /// its box points moves from its place at the reference over the stop, from the table's
+    /// tier of sweeps, which the full proof then reuses (module doc); `INFINITY` when no bound
+    /// is found.
+    fn motion_bound(&mut self, j: usize) -> Real {
+        self.sweeps_at(j, 0, 0);
+        let [cube, ball] = &self.sweeps[j];
+        // Either form holds every displacement: the smaller radius bounds it.
+        let d = cube.iter().zip(ball).map(|(c, b)| c.radius().min(b.radius())).fold(0.0, Real::max);
+        if d.is_nan() {
+            Real::INFINITY
+        } else {
+            d
+        }
+    }
+
+    /// Whether `bound` proves FREE with `warn_mm` to spare for two robots about this tick's
+    /// stop references (module doc); false for any other number of robots.
+    pub(super) fn lookup_free(&mut self, bound: ClearanceBound) -> bool {
+        if self.centres.len() != 2 {
+            return false;
+        }
+        let Some(at_centres) = bound(&[self.centres[0], self.centres[1]]) else { return false };
+        // Every sweep of a lower-link, platform or tool box holds the ball of the stop's radius
+        // (module doc of `protective`, step 6), so `d_j >= R_j`: where the bound cannot exceed
+        // that, the sweeps are not computed (the proof below may still need them).
+        let least = self.reach[0] + self.reach[1] + self.warn_mm;
+        if at_centres.partial_cmp(&least) != Some(core::cmp::Ordering::Greater) {
+            return false;
+        }
+        let motion = self.motion_bound(0) + self.motion_bound(1);
+        motion.is_finite() && at_centres > motion + self.warn_mm + LOOKUP_SLACK_MM
+    }
+}

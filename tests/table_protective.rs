@@ -1,0 +1,342 @@
+//! The protective verdict in table mode (SPEC §8; clearance tables, SPEC §6) against brute
+//! force: every tick answered FREE by the clearance table's lookup alone
+//! (`ProtectiveReport::table_lookup`) is followed by random stops within the stopping model,
+//! checked with the exact model every 0.1 ms (the oracle of `tests/protective.rs`), and none
+//! may bring two boxes into contact: random states in the open, next to the reach boundary
+//! and with TCPs on the table's grid-cell faces (where the level changes), and the reference
+//! runs. The reported clearance of a lookup tick never exceeds the exact one; a boolean table
+//! changes no verdict; a tick allocates nothing. The clearance tables are certified, at
+//! k = 16 (a few seconds per cell, built once per test process and shared by the tests; at
+//! k = 32 the clearance labelling takes a minute per cell).
+
+use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveStatus};
+use delta_collide::cell::reference::reference_cell;
+use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
+use delta_collide::cell::{Cell, ExactChecker};
+use delta_collide::cspace::{Progress, Workspace};
+use delta_collide::math::{Real, Vec3};
+use delta_collide::robot::StopModel;
+use delta_collide::table::{build_table, to_bytes, Labelling, Ladder, TableChecker, Variant};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::OnceLock;
+
+/// Counts allocations per thread (tests run in parallel threads of one process).
+struct Counting;
+thread_local! {
+    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+// SAFETY: forwards to the system allocator unchanged; only counts calls.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+mod protective_common;
+use protective_common::{assert_stops_never_touch, cell, tcp_toward_other, unit, STIFF};
+
+/// Resolution of the tables built here (SPEC §4: r = 33.125 mm).
+const K: u32 = 16;
+
+/// The bytes of the certified clearance table (default ladder of levels) and of the boolean
+/// shared 6-D table of reference cell `name` at [`K`], built once (the stopping models are
+/// no part of a table: one serves every model).
+fn table_bytes(name: &str) -> &'static [Vec<u8>; 2] {
+    static BYTES: [OnceLock<[Vec<u8>; 2]>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    let c = ["T1", "T2", "T3"].iter().position(|n| *n == name).unwrap();
+    BYTES[c].get_or_init(|| {
+        let cell = reference_cell(name).unwrap();
+        let build = |variant| {
+            let (header, table, _) =
+                build_table(&cell, K, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent).unwrap();
+            to_bytes(&table, &header)
+        };
+        [build(Variant::Clearance(Ladder::default_ladder())), build(Variant::Shared)]
+    })
+}
+
+/// The clearance table (or the boolean one) of `cell`, a reference cell with any stopping
+/// models, loaded.
+fn table(cell: &Cell, clearance: bool) -> TableChecker {
+    TableChecker::new(cell.clone(), &table_bytes(&cell.name)[usize::from(!clearance)]).unwrap()
+}
+
+/// A reachable TCP of robot `j` (MCS): half of them out toward the other robot, half
+/// anywhere in the working depth.
+fn tcp_anywhere(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
+    if rng.random::<bool>() {
+        return tcp_toward_other(cell, j, rng);
+    }
+    loop {
+        let p = Vec3::new(
+            rng.random_range(-320.0..320.0),
+            rng.random_range(-320.0..320.0),
+            rng.random_range(-560.0..-350.0),
+        );
+        if cell.robots[j].model.delta.is_reachable(&p) {
+            return p;
+        }
+    }
+}
+
+/// A reachable TCP of robot `j` within 0 to 8 mm of its reach boundary, pushed out radially
+/// from [`tcp_anywhere`] (elbows swing fastest there).
+fn tcp_at_reach_boundary(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
+    let delta = &cell.robots[j].model.delta;
+    loop {
+        let p = tcp_anywhere(cell, j, rng);
+        let out = Vec3::new(p.x, p.y, 0.0).try_normalize(1e-9).unwrap_or(Vec3::x());
+        let mut step = 0.0;
+        while delta.is_reachable(&(p + out * (step + 1.0))) && step < 400.0 {
+            step += 1.0;
+        }
+        let q = p + out * (step - rng.random_range(0.0..8.0f64)).max(0.0);
+        if delta.is_reachable(&q) {
+            return q;
+        }
+    }
+}
+
+/// Where the random states are drawn.
+#[derive(Clone, Copy, Debug)]
+enum Place {
+    /// Out toward the other robot or anywhere.
+    Open,
+    /// Within 8 mm of the reach boundary, where elbows swing fastest.
+    ReachBoundary,
+    /// As `Open`, every coordinate moved onto a face of its table grid cell (within 1e-7 mm
+    /// either side), where the stored level changes.
+    CellFaces,
+}
+
+/// Robot `j`'s TCP at `place`.
+fn sample(cell: &Cell, table: &TableChecker, j: usize, place: Place, rng: &mut StdRng) -> Vec3 {
+    match place {
+        Place::Open => tcp_anywhere(cell, j, rng),
+        Place::ReachBoundary => tcp_at_reach_boundary(cell, j, rng),
+        Place::CellFaces => loop {
+            let h = table.header();
+            let origin = if j == 0 { h.origin_a } else { h.origin_b };
+            let mut p = tcp_anywhere(cell, j, rng);
+            for a in 0..3 {
+                let u = ((p[a] - origin[a]) / h.r).round();
+                p[a] = origin[a] + u * h.r + rng.random_range(-1e-7..1e-7);
+            }
+            if cell.robots[j].model.delta.is_reachable(&p) {
+                return p;
+            }
+        },
+    }
+}
+
+/// Random states of `cell` at `place` (speeds mostly low, directions random), each checked
+/// in table mode after one tick that gives its speeds; from every state answered by the
+/// lookup alone, 8 random stops are simulated. Returns (lookup states, exact checks).
+fn brute_force(
+    cell: &Cell,
+    table: &TableChecker,
+    warn_mm: Real,
+    place: Place,
+    states: usize,
+    seed: u64,
+) -> (usize, usize) {
+    let bound = |t: &[Vec3]| table.clearance_bound(t);
+    let mut checker = ProtectiveChecker::new(cell.clone(), warn_mm).unwrap().with_speed_limits(false);
+    let mut exact = ExactChecker::new(cell.clone());
+    let mut rng = StdRng::seed_from_u64(seed);
+    let stop = cell.stops[0];
+    let tick = cell.tick_ms * 1e-3;
+    let (mut lookups, mut steps) = (0, 0);
+    for _ in 0..states {
+        let tcps = [sample(cell, table, 0, place, &mut rng), sample(cell, table, 1, place, &mut rng)];
+        let v_fd: [Vec3; 2] =
+            std::array::from_fn(|_| unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3));
+        let prev = [tcps[0] - v_fd[0] * tick, tcps[1] - v_fd[1] * tick];
+        checker.reset();
+        checker.check_with_table(&prev, &bound).unwrap();
+        let r = checker.check_with_table(&tcps, &bound).unwrap().clone();
+        if !r.table_lookup {
+            continue;
+        }
+        assert_eq!((r.verdict, r.status), (Protective::Free, ProtectiveStatus::Ok), "{tcps:?}");
+        let truth = protective_common_clearance(&mut exact, &tcps);
+        assert!(r.clearance_mm <= truth && r.clearance_mm > warn_mm, "{} vs exact {truth}: {tcps:?}", r.clearance_mm);
+        lookups += 1;
+        let vel = v_fd.map(|v| {
+            let w = v + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
+            w * (stop.max_speed_mm_s / w.norm()).min(1.0)
+        });
+        steps += assert_stops_never_touch(cell, &tcps, &vel, 8, &mut rng);
+    }
+    (lookups, steps)
+}
+
+/// The exact signed clearance of `cell` at `tcps` (SPEC §8).
+fn protective_common_clearance(exact: &mut ExactChecker, tcps: &[Vec3; 2]) -> Real {
+    exact.check(tcps).unwrap();
+    delta_collide::cell::protective::clearance_now(exact).0
+}
+
+#[test]
+fn lookup_free_verdicts_survive_simulated_stops() {
+    let mut total = [0usize; 3];
+    for (i, name) in ["T1", "T2", "T3"].iter().enumerate() {
+        for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
+            let cell = cell(name, stop);
+            let table = table(&cell, true);
+            // The reach boundary yields fewest lookups (elbows move far): more states there.
+            for (p, (place, states)) in
+                [(Place::Open, 1_000), (Place::ReachBoundary, 10_000), (Place::CellFaces, 1_000)]
+                    .into_iter()
+                    .enumerate()
+            {
+                // warn_mm 0: the lookup proves FREE with the least to spare.
+                let seed = 900 + 10 * i as u64 + k as u64 + 100 * p as u64;
+                let (lookups, steps) = brute_force(&cell, &table, 0.0, place, states, seed);
+                println!(
+                    "{name} model {k} {place:?}: {lookups} of {states} states FREE by the lookup, {steps} exact checks"
+                );
+                total[p] += lookups;
+            }
+        }
+    }
+    println!("FREE by the lookup (open, reach boundary, cell faces): {total:?}");
+    assert!(total[0] >= 50 && total[1] >= 5 && total[2] >= 50, "too few lookup states to test: {total:?}");
+}
+
+/// Per reference run (T1-T3, practical and collision) and model: exact and table mode side
+/// by side. Every lookup tick is FREE, reports a clearance at most the exact one (which the
+/// exact-mode checker reports on the same tick), and at every fifth one random stops from
+/// the true velocity (the finite difference moved within `a_max T`) never touch; so at every
+/// fifth tick FREE by a proof kept since a lookup (a lookup keeps its balls as a proof does).
+fn runs(stop: StopModel, label: &str) -> (u64, u64) {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let scenarios = parse_scenarios(&text).unwrap();
+    let mut rng = StdRng::seed_from_u64(11);
+    let (mut lookups_total, mut tested) = (0, 0);
+    for name in ["T1", "T2", "T3"] {
+        let cell = cell(name, stop);
+        let table = table(&cell, true);
+        let bound = |t: &[Vec3]| table.clearance_bound(t);
+        let tick = cell.tick_ms * 1e-3;
+        for s in scenarios.iter().filter(|s| s.cell == name) {
+            let mut exact = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let mut lookup = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let (mut tcps, mut prev) = ([Vec3::zeros(); 2], [Vec3::zeros(); 2]);
+            let (mut counts, mut lookups) = ([[0u32; 3]; 2], 0u64);
+            // Whether every tick since the last lookup was FREE (a kept proof may be its).
+            let (mut since_lookup, mut tested_ticks) = (false, 0u64);
+            for t in 0..RUN_TICKS {
+                s.tcps_at(t, &mut tcps);
+                let e = exact.check(&tcps).unwrap().clone();
+                let r = lookup.check_with_table(&tcps, &bound).unwrap();
+                counts[0][e.verdict as usize] += 1;
+                counts[1][r.verdict as usize] += 1;
+                since_lookup = (since_lookup || r.table_lookup) && r.verdict == Protective::Free;
+                if r.table_lookup || (since_lookup && r.kept_proof) {
+                    assert_eq!((r.verdict, r.status), (Protective::Free, ProtectiveStatus::Ok));
+                    assert!(
+                        r.clearance_mm <= e.clearance_mm,
+                        "{name} {} tick {t}: {} > {}",
+                        s.case,
+                        r.clearance_mm,
+                        e.clearance_mm
+                    );
+                    lookups += u64::from(r.table_lookup);
+                    tested_ticks += 1;
+                    if tested_ticks % 5 == 0 {
+                        let vel = std::array::from_fn(|j| {
+                            let w = (tcps[j] - prev[j]) / tick
+                                + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
+                            w * (stop.max_speed_mm_s / w.norm()).min(1.0)
+                        });
+                        assert_stops_never_touch(&cell, &tcps, &vel, 4, &mut rng);
+                        tested += 1;
+                    }
+                }
+                prev = tcps;
+            }
+            let share = 100.0 * lookups as f64 / RUN_TICKS as f64;
+            println!(
+                "{label} {name} {:<9}: exact mode STOP {} WARN {}; table mode STOP {} WARN {}, {lookups} ticks ({share:.1} %) by the lookup alone",
+                s.case, counts[0][2], counts[0][1], counts[1][2], counts[1][1]
+            );
+            lookups_total += lookups;
+        }
+    }
+    (lookups_total, tested)
+}
+
+#[test]
+fn lookup_ticks_of_the_reference_runs_are_sound() {
+    let (stiff, tested_stiff) = runs(STIFF, "stiff");
+    let (default, tested_default) = runs(StopModel::DEFAULT, "default");
+    println!("lookup ticks: stiff {stiff} ({tested_stiff} with simulated stops), default {default} ({tested_default})");
+    assert!(stiff >= 1_000, "the stiff model's runs have few lookup ticks: {stiff}");
+}
+
+/// A boolean table proves no clearance: table mode then gives every verdict of exact mode,
+/// with no lookup tick.
+#[test]
+fn a_boolean_table_changes_nothing() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let cell = cell("T1", STIFF);
+    let table = table(&cell, false);
+    let bound = |t: &[Vec3]| table.clearance_bound(t);
+    let mut exact = ProtectiveChecker::new(cell.clone(), 10.0).unwrap();
+    let mut lookup = ProtectiveChecker::new(cell.clone(), 10.0).unwrap();
+    let mut tcps = [Vec3::zeros(); 2];
+    for t in 0..1_500 {
+        s.tcps_at(t, &mut tcps);
+        let e = exact.check(&tcps).unwrap().clone();
+        assert_eq!(lookup.check_with_table(&tcps, &bound).unwrap(), &e, "tick {t}");
+    }
+}
+
+#[test]
+fn a_table_mode_tick_never_allocates() {
+    let cell = cell("T1", STIFF);
+    let table = table(&cell, true);
+    let bound = |t: &[Vec3]| table.clearance_bound(t);
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let mut c = ProtectiveChecker::new(cell, 10.0).unwrap();
+    let ticks: Vec<[Vec3; 2]> = (0..RUN_TICKS)
+        .map(|t| {
+            let mut tcps = [Vec3::zeros(); 2];
+            s.tcps_at(t, &mut tcps);
+            tcps
+        })
+        .collect();
+    let before = ALLOCATIONS.with(|a| a.get());
+    let mut lookups = 0;
+    for tcps in &ticks {
+        lookups += u32::from(c.check_with_table(tcps, &bound).unwrap().table_lookup);
+    }
+    assert_eq!(ALLOCATIONS.with(|a| a.get()), before);
+    assert!(lookups > 10, "{lookups} lookup ticks: the lookup path was not exercised");
+}
+
+#[test]
+fn the_c_counter_reads_zero_for_null() {
+    // SAFETY: NULL is a documented argument (the counter reads 0).
+    assert_eq!(unsafe { delta_collide::ffi::dc_table_protective_lookups(std::ptr::null()) }, 0);
+}
