@@ -11,41 +11,11 @@ use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use std::alloc::{GlobalAlloc, Layout, System};
-
-/// Counts allocations per thread (tests run in parallel threads of one process).
-struct Counting;
-thread_local! {
-    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-}
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
-
-// SAFETY: forwards to the system allocator unchanged; only counts calls.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 mod protective_common;
-use protective_common::{assert_stops_never_touch, cell, tcp_near_reach_boundary, tcp_toward_other, unit, STIFF};
+use protective_common::{
+    allocations, assert_stops_never_touch, cell, tcp_near_reach_boundary, tcp_toward_other, unit, STIFF,
+};
 
 /// Random states near each other; for each FREE one, random stops are simulated.
 /// `precise`: the second tier's splits (0: the motor-angle table alone); `edge`: TCPs near the

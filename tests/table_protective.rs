@@ -19,38 +19,10 @@ use delta_collide::robot::StopModel;
 use delta_collide::table::{build_table, to_bytes, Labelling, Ladder, TableChecker, Variant};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::OnceLock;
 
-/// Counts allocations per thread (tests run in parallel threads of one process).
-struct Counting;
-thread_local! {
-    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-}
-
-// SAFETY: forwards to the system allocator unchanged; only counts calls.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
-
 mod protective_common;
-use protective_common::{assert_stops_never_touch, cell, tcp_toward_other, unit, STIFF};
+use protective_common::{allocations, assert_stops_never_touch, cell, tcp_toward_other, unit, STIFF};
 
 /// Resolution of the tables built here (SPEC §4: r = 33.125 mm).
 const K: u32 = 16;
@@ -99,19 +71,7 @@ fn tcp_anywhere(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
 /// A reachable TCP of robot `j` within 0 to 8 mm of its reach boundary, pushed out radially
 /// from [`tcp_anywhere`] (elbows swing fastest there).
 fn tcp_at_reach_boundary(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
-    let delta = &cell.robots[j].model.delta;
-    loop {
-        let p = tcp_anywhere(cell, j, rng);
-        let out = Vec3::new(p.x, p.y, 0.0).try_normalize(1e-9).unwrap_or(Vec3::x());
-        let mut step = 0.0;
-        while delta.is_reachable(&(p + out * (step + 1.0))) && step < 400.0 {
-            step += 1.0;
-        }
-        let q = p + out * (step - rng.random_range(0.0..8.0f64)).max(0.0);
-        if delta.is_reachable(&q) {
-            return q;
-        }
-    }
+    protective_common::pushed_to_reach_boundary(cell, j, rng, tcp_anywhere)
 }
 
 /// Where the random states are drawn.
@@ -332,12 +292,12 @@ fn a_table_mode_tick_never_allocates() {
             tcps
         })
         .collect();
-    let before = ALLOCATIONS.with(|a| a.get());
+    let before = allocations();
     let mut lookups = 0;
     for tcps in &ticks {
         lookups += u32::from(c.check_with_table(tcps, &bound).unwrap().table_lookup);
     }
-    assert_eq!(ALLOCATIONS.with(|a| a.get()), before);
+    assert_eq!(allocations(), before);
     assert!(lookups > 10, "{lookups} lookup ticks: the lookup path was not exercised");
 }
 

@@ -1,6 +1,7 @@
 //! What the protective tests share: the stiff stopping model, the reference cells with one
 //! model for every robot, random directions and TCPs near the other robot, and the brute-force
-//! oracle (random stops within the model, checked with the exact model every 0.1 ms).
+//! oracle (random stops within the model, checked with the exact model every 0.1 ms), and an
+//! allocator that counts.
 #![allow(dead_code)] // each test file uses a subset
 
 use delta_collide::cell::reference::reference_cell;
@@ -9,6 +10,41 @@ use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
 use rand::rngs::StdRng;
 use rand::RngExt;
+use std::alloc::{GlobalAlloc, Layout, System};
+
+/// Counts allocations per thread (tests run in parallel threads of one process): every test
+/// binary that includes this module counts with it.
+struct Counting;
+thread_local! {
+    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+/// Allocations made so far by this thread.
+pub fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+// SAFETY: forwards to the system allocator unchanged; only counts calls.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
 
 /// A stiffer robot than the default (short reaction, hard braking): FREE then happens with
 /// the robots close, where a wrong bound would show.
@@ -170,9 +206,20 @@ pub fn assert_stops_never_touch(
 /// A reachable TCP of robot `j` within 0 to 8 mm of its reach boundary (pushed out from
 /// [`tcp_toward_other`] along its radial direction), where elbows swing fastest.
 pub fn tcp_near_reach_boundary(cell: &Cell, j: usize, rng: &mut StdRng) -> Vec3 {
+    pushed_to_reach_boundary(cell, j, rng, tcp_toward_other)
+}
+
+/// A reachable TCP of robot `j` within 0 to 8 mm of its reach boundary: a TCP from `start`
+/// pushed out along its radial direction.
+pub fn pushed_to_reach_boundary(
+    cell: &Cell,
+    j: usize,
+    rng: &mut StdRng,
+    start: impl Fn(&Cell, usize, &mut StdRng) -> Vec3,
+) -> Vec3 {
     let delta = &cell.robots[j].model.delta;
     loop {
-        let p = tcp_toward_other(cell, j, rng);
+        let p = start(cell, j, rng);
         let out = Vec3::new(p.x, p.y, 0.0).try_normalize(1e-9).unwrap_or(Vec3::x());
         let mut step = 0.0;
         while delta.is_reachable(&(p + out * (step + 1.0))) && step < 400.0 {
