@@ -26,7 +26,8 @@ typedef struct HarnessTable {
     size_t len;
 } HarnessTable;
 
-/* The command line: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]... [--clearance-table CELL=PATH]...
+/* The command line: c_harness [--quick] [--tmp DIR] [--table CELL=PATH]...
+ *                  [--clearance-table CELL=PATH]... [--line-bundle PATH]
  *   --quick  runs the T1 collision scenario only (exact and table mode), for valgrind;
  *            the kinematics grid, every bad-input scenario and the line's collision case
  *            in exact mode still run;
@@ -35,7 +36,7 @@ typedef struct HarnessTable {
  *   --tmp    a directory for scratch files (default ".");
  *   --table  the table file of reference cell CELL (T1, T2 or T3): enables table mode;
  *   --line-bundle  the bundle of cells/line4.toml (`delta-collide build --cell
- *            cells/line4.toml`): runs the line in table mode too. */
+ *            cells/line4.toml`): runs the line in table mode too;
  *   --clearance-table  a clearance table file (build --variant clearance) of CELL: the
  *            protective scenarios run once more in table mode on it. */
 typedef struct HarnessOptions {

@@ -79,13 +79,7 @@ impl CoherentClearance {
             return boxes_clearance(a, b);
         }
         let m = b.len().max(1);
-        let mut out = PairClearance {
-            distance: Real::INFINITY,
-            box_a: 0,
-            box_b: 0,
-            point_a: Vec3::zeros(),
-            point_b: Vec3::zeros(),
-        };
+        let mut out = PairClearance::NONE;
         let first = if self.closest < n { self.closest } else { 0 };
         for k in (0..n).map(|k| (k + first) % n) {
             let (ba, bb) = (&a[k / m], &b[k % m]);
@@ -96,13 +90,7 @@ impl CoherentClearance {
             }
             let c = pair_clearance(ba, bb, memory);
             if !(c.distance >= out.distance) {
-                out = PairClearance {
-                    distance: c.distance,
-                    box_a: k / m,
-                    box_b: k % m,
-                    point_a: c.point_a,
-                    point_b: c.point_b,
-                };
+                out = PairClearance::of(k / m, k % m, &c);
                 if c.distance.is_nan() {
                     break;
                 }

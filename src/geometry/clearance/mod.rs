@@ -66,6 +66,17 @@ pub struct PairClearance {
     pub point_b: Vec3,
 }
 
+impl PairClearance {
+    /// No pair yet: `+inf` with indices 0.
+    const NONE: PairClearance =
+        PairClearance { distance: Real::INFINITY, box_a: 0, box_b: 0, point_a: Vec3::new(0.0, 0.0, 0.0), point_b: Vec3::new(0.0, 0.0, 0.0) };
+
+    /// Box `box_a` of the first robot and `box_b` of the second at clearance `c`.
+    fn of(box_a: usize, box_b: usize, c: &Clearance) -> PairClearance {
+        PairClearance { distance: c.distance, box_a, box_b, point_a: c.point_a, point_b: c.point_b }
+    }
+}
+
 /// Relative error allowed for in the lower bound on top of the SAT guards: a few units in
 /// the last place of the largest term of an axis inequality.
 const BOUND_REL_SLACK: Real = 1e-14;
@@ -625,19 +636,12 @@ fn edge_pair(rel: &Rel, i: usize, j: usize, n2: Real, sg: [Real; 4], best: &mut 
 /// allocation.
 pub fn boxes_clearance(a: &[Obb], b: &[Obb]) -> PairClearance {
     let m = b.len().max(1);
-    let mut out =
-        PairClearance { distance: Real::INFINITY, box_a: 0, box_b: 0, point_a: Vec3::zeros(), point_b: Vec3::zeros() };
+    let mut out = PairClearance::NONE;
     pairs_by_bound(a, b, |k, cheap| {
         if !(cheap >= out.distance) && !out.distance.is_nan() {
             let c = obb_clearance(&a[k / m], &b[k % m]);
             if !(c.distance >= out.distance) {
-                out = PairClearance {
-                    distance: c.distance,
-                    box_a: k / m,
-                    box_b: k % m,
-                    point_a: c.point_a,
-                    point_b: c.point_b,
-                };
+                out = PairClearance::of(k / m, k % m, &c);
             }
         }
     });
