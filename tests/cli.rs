@@ -64,7 +64,8 @@ fn demo_runs_the_line_of_four_robots() {
     let rows: Vec<Vec<&str>> =
         text.lines().filter(|l| l.starts_with("line4")).map(|l| l.split_whitespace().collect()).collect();
     let firsts: Vec<_> = rows.iter().filter(|r| r[2].starts_with("SAT")).map(|r| (r[1], r[3])).collect();
-    assert_eq!(firsts, [("practical", "none"), ("practical", "none"), ("collision", "tick"), ("collision", "tick")], "{text}");
+    let expected = [("practical", "none"), ("practical", "none"), ("collision", "tick"), ("collision", "tick")];
+    assert_eq!(firsts, expected, "{text}");
     let at_3810 = text.lines().filter(|l| l.starts_with("line4 collision") && l.contains("tick 3810")).count();
     assert_eq!(at_3810, 2, "SAT and SAT-cache: R3-R4 meet at tick 3810\n{text}");
     let protective: Vec<&Vec<&str>> = rows.iter().filter(|r| r.len() == 10).collect();

@@ -20,7 +20,8 @@ pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     let paths = args.stop_path_mm.map(|length_mm| PathsAhead { length_mm, tolerance_mm: args.path_tolerance_mm });
     let mut lookups = (0usize, 0usize);
     write_output(args.output.as_deref(), |out| {
-        lookups = replay_rows(&mut input, out, &mut checker, Columns { table: table.as_ref(), paths, pairs: args.pairs }, trace.as_mut())?;
+        let columns = Columns { table: table.as_ref(), paths, pairs: args.pairs };
+        lookups = replay_rows(&mut input, out, &mut checker, columns, trace.as_mut())?;
         Ok(())
     })?;
     if let (Some(path), Some(t)) = (&args.table, &table) {
@@ -87,7 +88,10 @@ fn replay_rows(
     let write_err = |e: std::io::Error| format!("writing the verdicts: {e}");
     let columns = |prefix: &str| names.iter().map(|r| format!(",{prefix}_{r}")).collect::<String>();
     let pair_columns: String = match pairs {
-        true => checker.exact().verdict().pairs.iter().map(|p| format!(",clearance_mm_{}_{}", names[p.a], names[p.b])).collect(),
+        true => {
+            let pairs = &checker.exact().verdict().pairs;
+            pairs.iter().map(|p| format!(",clearance_mm_{}_{}", names[p.a], names[p.b])).collect()
+        }
         false => String::new(),
     };
     let (protective, limits) = (columns("protective_mm"), columns("speed_limit_mm_s"));

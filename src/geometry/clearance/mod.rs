@@ -68,8 +68,13 @@ pub struct PairClearance {
 
 impl PairClearance {
     /// No pair yet: `+inf` with indices 0.
-    const NONE: PairClearance =
-        PairClearance { distance: Real::INFINITY, box_a: 0, box_b: 0, point_a: Vec3::new(0.0, 0.0, 0.0), point_b: Vec3::new(0.0, 0.0, 0.0) };
+    const NONE: PairClearance = PairClearance {
+        distance: Real::INFINITY,
+        box_a: 0,
+        box_b: 0,
+        point_a: Vec3::new(0.0, 0.0, 0.0),
+        point_b: Vec3::new(0.0, 0.0, 0.0),
+    };
 
     /// Box `box_a` of the first robot and `box_b` of the second at clearance `c`.
     fn of(box_a: usize, box_b: usize, c: &Clearance) -> PairClearance {
@@ -507,7 +512,8 @@ fn supporting_features(rel: &Rel, k: usize, lhs: Real) -> Best {
             let q: [Real; 3] =
                 core::array::from_fn(|m| t[m] + sg[0] * b[0] * r[m][0] + sg[1] * b[1] * r[m][1] + sg[2] * b[2] * r[m][2]);
             let p: [Real; 3] = core::array::from_fn(|m| q[m].clamp(-a[m], a[m]));
-            Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q, feature: Feature::VertexOfB(signs(sg)) }
+            let feature = Feature::VertexOfB(signs(sg));
+            Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q, feature }
         }
         3..=5 => {
             // A's vertex highest along side * B_j, and its clamp into B, back in A's frame.
