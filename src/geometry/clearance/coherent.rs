@@ -38,6 +38,10 @@ use crate::math::{float, Real, Vec3};
 /// tolerances, as in [`obb_clearance`].
 pub const WARM_MIN_GAP: Real = 0.01;
 
+/// The shortest distance between the witness points (mm) from which a pair keeps their
+/// direction: far above the rounding of coordinates of a few metres (about 1e-12 mm).
+const DIRECTION_MIN_MM: Real = 1e-6;
+
 /// What one box pair's clearance was when last computed.
 #[derive(Clone, Copy, Debug, Default)]
 struct PairMemory {
@@ -123,8 +127,11 @@ fn pair_clearance(a: &Obb, b: &Obb, memory: &mut PairMemory) -> Clearance {
         Some(c) => (c, memory.feature),
         None => obb_clearance_with_feature(a, b),
     };
-    let n = (c.point_b - c.point_a) / c.distance;
-    memory.direction = if c.distance != 0.0 && n.iter().all(|x| x.is_finite()) { n } else { Vec3::zeros() };
+    // Unit by construction: a gap along a longer vector would not be a lower bound. Where the
+    // points are too close to give a direction (rounding of the coordinates), none is kept.
+    let d = (c.point_b - c.point_a) * c.distance.signum();
+    let length = d.norm();
+    memory.direction = if length > DIRECTION_MIN_MM && length.is_finite() { d / length } else { Vec3::zeros() };
     memory.feature = feature;
     c
 }
@@ -253,6 +260,20 @@ mod tests {
             let n = (rng.vec(1.0) + Vec3::new(1e-3, 0.0, 0.0)).normalize();
             let exact = obb_clearance(&a, &b).distance;
             assert!(gap_along(&a, &b, &n) <= exact, "{a:?} {b:?} {n}");
+        }
+    }
+
+    #[test]
+    fn kept_directions_are_unit_even_for_a_tiny_overlap_far_from_the_origin() {
+        let half = Vec3::new(150.0, 8.0, 8.0);
+        for overlap in [1e-12, 1e-10, 1e-7, 1e-3] {
+            let a = [Obb::new(Vec3::new(700.0, 300.0, -450.0), Mat3::identity(), half)];
+            let b = [Obb::new(Vec3::new(1000.0 - overlap, 300.5, -450.25), Mat3::identity(), half)];
+            let mut memory = CoherentClearance::new();
+            let c = memory.boxes_clearance(&a, &b);
+            let n = memory.pairs[0].direction;
+            assert!(n == Vec3::zeros() || (n.norm() - 1.0).abs() < 1e-12, "overlap {overlap}: {c:?}, direction {n}");
+            assert!(gap_along(&a[0], &b[0], &n) <= c.distance || n == Vec3::zeros());
         }
     }
 
