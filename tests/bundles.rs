@@ -278,3 +278,47 @@ fn build_inspect_and_check_a_line_with_its_bundle() {
     }
     assert!(count(&labels, "1,1") > count(&exact, "1,1"), "the labels alone stop early somewhere");
 }
+
+/// `eval --pairs` on the line: per scenario and for the random configurations, the whole
+/// tick's and each pair's counts; on the scenarios each pair's TP and FP as counted here from
+/// the library's labels and the exact model, and no FN anywhere.
+#[test]
+fn eval_counts_every_pair_of_a_line() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bundles_eval");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bundle = dir.join("line4.dcb");
+    std::fs::write(&bundle, line4_bundle()).unwrap();
+    let b = bundle.to_str().unwrap();
+    let out = cli(&["eval", "--cell", "cells/line4.toml", "--table", b, "--random", "3000", "--pairs"]);
+    assert!(out.contains("6 pairs that can meet, 3 tables"), "{out}");
+    let field = |line: &str, name: &str| -> u64 {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let at = words.iter().position(|w| *w == name).unwrap_or_else(|| panic!("{name} in {line}"));
+        words[at + 1].parse().unwrap()
+    };
+    let counted: Vec<&str> = out.lines().filter(|l| l.contains(" TP ")).collect();
+    assert_eq!(counted.len(), 3 * 7, "practical, collision, random: the tick and six pairs each\n{out}");
+    assert!(counted.iter().all(|l| field(l, "FN") == 0), "{out}");
+    let mut labels = BundleChecker::new(line4(), line4_bundle(), Confirmation::None).unwrap();
+    let mut exact = ExactChecker::new(line4());
+    let scenarios =
+        delta_collide::cell::trajectory::parse_scenarios(include_str!("../c_harness/line_scenarios.txt")).unwrap();
+    let mut tcps = vec![Vec3::zeros(); 4];
+    for (s, block) in scenarios.iter().zip(counted.chunks(7)) {
+        assert!(block[0].starts_with(&format!("line4 {}", s.case)), "{}", block[0]);
+        let (mut tp, mut fp) = ([0u64; 6], [0u64; 6]);
+        for tick in 0..delta_collide::cell::trajectory::RUN_TICKS {
+            s.tcps_at(tick, &mut tcps);
+            labels.check(&tcps).unwrap();
+            let v = exact.check(&tcps).unwrap();
+            for (k, (p, e)) in labels.pairs().iter().zip(&v.pairs).enumerate() {
+                let hit = matches!(e.state, PairState::Collides(..));
+                tp[k] += u64::from(p.answer == TableAnswer::Collision && hit);
+                fp[k] += u64::from(p.answer == TableAnswer::Collision && !hit);
+            }
+        }
+        for (k, line) in block[1..].iter().enumerate() {
+            assert_eq!((field(line, "TP"), field(line, "FP")), (tp[k], fp[k]), "{line}");
+        }
+    }
+}

@@ -52,3 +52,16 @@ fn a_nonzero_slice_axes_field_outside_4d_tables_is_corrupt() {
         }
     }
 }
+
+/// bundle_bytes, `relabelled_and_resealed.dcb`: the line's bundle with labels of its first
+/// table edited and, once sealed by the target, every checksum recomputed: it then loads and
+/// answers FREE where the robots collide, which the target had asserted could not happen. A
+/// label is not checked on loading (only a new build could); the checksum is what refuses an
+/// edited table, so the target asserts exact answers only for its input as given. Here: as
+/// given, the edit is refused by the table's checksum.
+#[test]
+fn an_edited_label_is_refused_by_the_checksum() {
+    let edited = data("bundle_bytes", "relabelled_and_resealed.dcb");
+    let e = bundle_from_bytes(&edited).unwrap_err();
+    assert!(matches!(&e, TableError::Corrupt { what } if what.contains("checksum")), "{e}");
+}

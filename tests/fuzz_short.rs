@@ -20,6 +20,8 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::{Progress, Symmetry, Workspace};
 use delta_collide::table::format::to_bytes;
 use delta_collide::table::synthetic::{space, Pattern};
+use delta_collide::cell::parse_cell;
+use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
@@ -111,6 +113,43 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
         }
     }
     out
+}
+
+/// The bundle of `cells/line4.toml` at k = 16 (three `shared` tables for six pairs), whole and
+/// with its tables cut to their first nodes; one without its last pair and table, which the
+/// line must refuse; a bundle of one table for T1.
+fn bundle_seeds() -> Vec<(String, Vec<u8>)> {
+    let line = parse_cell(&std::fs::read_to_string(root().join("cells/line4.toml")).unwrap()).unwrap();
+    let built = build_bundle(&line, 16, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
+        .expect("the line's bundle");
+    let (fingerprint, robots) = (line.fingerprint(), line.robots.len());
+    let cut_files: Vec<Vec<u8>> = built.tables.iter().map(|(h, t, _, _)| to_bytes(&cut(t, 24).unwrap(), h)).collect();
+    let bundle = |files: &[Vec<u8>], pairs: &[BundlePair]| bundle_to_bytes(fingerprint, robots, files, pairs).unwrap();
+    let short: Vec<BundlePair> = built.pairs.iter().copied().filter(|p| p.table < 2).collect();
+    let t1 = reference_cell("t1").unwrap();
+    let (t1_files, t1_pairs) = (vec![cut_files[0].clone()], vec![BundlePair { a: 0, b: 1, table: 0 }]);
+    let cut_bundle = bundle(&cut_files, &built.pairs);
+    vec![
+        ("line4_k16_shared_whole.dcb".into(), built.bytes.clone()),
+        ("line4_k16_shared_cut_truncated.dcb".into(), cut_bundle[..cut_bundle.len() / 2].to_vec()),
+        ("line4_k16_shared_cut.dcb".into(), cut_bundle),
+        ("line4_k16_shared_cut_short.dcb".into(), bundle(&cut_files[..2], &short)),
+        ("t1_spacing_one_table.dcb".into(), bundle_to_bytes(t1.fingerprint(), 2, &t1_files, &t1_pairs).unwrap()),
+    ]
+}
+
+/// The bundle seeds reach the checker: the whole and cut bundles load for the line, the one
+/// without its last table is refused for the line's farthest pairs.
+#[test]
+fn bundle_seeds_load_for_the_line() {
+    let line = parse_cell(&std::fs::read_to_string(root().join("cells/line4.toml")).unwrap()).unwrap();
+    let seed = |name: &str| std::fs::read(seed_dir("bundle_bytes").join(name)).unwrap();
+    for name in ["line4_k16_shared_whole.dcb", "line4_k16_shared_cut.dcb"] {
+        let checker = BundleChecker::new(line.clone(), &seed(name), Confirmation::Exact);
+        assert_eq!(checker.map(|c| c.table_count()).map_err(|e| e.to_string()), Ok(3), "{name}");
+    }
+    let short = BundleChecker::new(line, &seed("line4_k16_shared_cut_short.dcb"), Confirmation::Exact);
+    assert!(matches!(short, Err(TableError::MissingPair { .. })), "{:?}", short.map(|_| ()));
 }
 
 /// The table's first `n` codes with their data (the shared quadtree: `n` nodes per depth):
@@ -232,6 +271,7 @@ model = { tool = { half = [25.0, 25.0, 80.0] } }
 fn generated_seeds(target: &str) -> Vec<(String, Vec<u8>)> {
     match target {
         "table_bytes" => table_seeds(),
+        "bundle_bytes" => bundle_seeds(),
         "cell_toml" => cell_seeds(),
         "exact_oracle" => targets::exact_oracle::seeds(),
         _ => targets::c_abi::seeds().into_iter().map(|(n, b)| (format!("{n}.bin"), b)).collect(),

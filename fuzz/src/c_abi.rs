@@ -64,7 +64,7 @@ pub enum Op {
     /// empty, `cells/t1.toml`), NULL out flag (byte).
     InitFromFile = 8,
     /// `dc_init_with_table`: a config as for `Init` with n = byte % 4, then the table: source
-    /// (byte % 7: five T1 seed tables, one per variant, or u16 % 512 bytes of the input), up to 7 edits
+    /// (byte % 7: six T1 seed tables, one per variant, or u16 % 512 bytes of the input), up to 7 edits
     /// (byte % 8 of u16 offset, value), reseal flag (fingerprint of the config's cell,
     /// checksum), NULL table and NULL out flags.
     InitWithTable = 9,
@@ -74,8 +74,10 @@ pub enum Op {
     /// `dc_protective_query` or, with a flag, `dc_protective_query_with_paths`: handle, count
     /// and points as for `Query`; with paths, per robot a point count (byte % 40; above
     /// `DC_MAX_PATH_POINTS` is refused), its points and a tolerance, and a NULL flag for the
-    /// paths array; NULL flags (tcps, out_verdict, out_report). `dc_set_stop_model` is not
-    /// called: its motor-angle table takes about 0.3 s to build.
+    /// paths array; NULL flags (tcps, out_verdict, out_report); then
+    /// `dc_table_protective_lookups`. `dc_set_stop_model` is not called: its motor-angle
+    /// table takes about 0.3 s to build (so the default model's stops, too long for any
+    /// clearance level, never let a lookup answer).
     Protective = 11,
 }
 
@@ -264,6 +266,8 @@ fn protective(input: &mut Input, live: &[Live]) {
     report.verdict = 7;
     let tcps_ptr = if nulls & 1 != 0 { std::ptr::null() } else { tcps.as_ptr() };
     let (out_verdict, out_report) = (null_if(nulls & 2 != 0, &mut verdict), null_if(nulls & 4 != 0, &mut report));
+    // SAFETY: NULL or live.
+    let lookups_before = unsafe { dc_table_protective_lookups(handle_of(l)) };
     // SAFETY: the handle is NULL or live; `tcps` holds `count` points, `paths` one path per
     // TCP whose points it holds; outputs are NULL or writable.
     let status = unsafe {
@@ -275,6 +279,13 @@ fn protective(input: &mut Input, live: &[Live]) {
         }
     };
     assert_ne!(status, DC_STATUS_PANIC, "the protective query panicked");
+    // A query answered by the clearance table alone is one more lookup, and only a FREE one.
+    // SAFETY: NULL or live.
+    let (lookups, mode) = unsafe { (dc_table_protective_lookups(handle_of(l)), dc_mode(handle_of(l))) };
+    let looked_up = lookups.checked_sub(lookups_before).expect("the lookup count never falls");
+    assert!(looked_up <= 1 && (mode == DC_MODE_TABLE || lookups == 0), "{looked_up} lookups in one query, mode {mode}");
+    assert!(looked_up == 0 || status == DC_STATUS_OK, "a lookup answered a query with status {status}");
+    assert!(looked_up == 0 || nulls & 2 != 0 || verdict == DC_VERDICT_FREE, "a lookup answered verdict {verdict}");
     if nulls & 2 == 0 {
         assert!([DC_VERDICT_FREE, DC_VERDICT_WARN, DC_VERDICT_STOP].contains(&verdict), "verdict {verdict}");
         assert!(status == DC_STATUS_OK || verdict == DC_VERDICT_STOP, "status {status} with verdict {verdict}");
@@ -569,6 +580,7 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
         ("table_4d", TableKind::D4yy),
         ("table_shared", TableKind::Shared),
         ("table_shared_sub", TableKind::SharedSub),
+        ("table_clearance", TableKind::Clearance),
     ];
     for (name, kind) in tables {
         let source = init::table_source(kind).expect("a seed table of every kind listed");
@@ -579,6 +591,11 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
         query2(&mut e, [120.0, 0.0, -420.0], [-120.0, 0.0, -420.0]);
         query2(&mut e, [0.0, 0.0, -900.0], home);
         e.byte(Op::PairResults as u8).byte(0).byte(1).byte(0).byte(Op::Counts as u8).byte(0);
+        // The protective verdict in table mode, twice (speeds from the first).
+        for _ in 0..2 {
+            e.byte(Op::Protective as u8).byte(0).byte(0).point([-150.0, 0.0, -450.0]).point([150.0, 0.0, -450.0]);
+            e.byte(0).byte(0);
+        }
         out.push((name, e.bytes));
     }
     let mut e = Encoder::default();

@@ -19,12 +19,13 @@ const MAX_INIT_ROBOTS: u8 = 40;
 /// Seed tables of cell T1 (k = 16) that `dc_init_with_table` starts from, one per kind; a
 /// table's source byte is its index here ([`table_source`]), so committed inputs keep their
 /// meaning only while this order stays.
-const TABLES: [(TableKind, &[u8]); 5] = [
+const TABLES: [(TableKind, &[u8]); 6] = [
     (TableKind::D6, include_bytes!("../../seeds/table_bytes/t1_k16_6d_cut.dct")),
     (TableKind::D5, include_bytes!("../../seeds/table_bytes/t1_k16_5d_cut.dct")),
     (TableKind::D4yy, include_bytes!("../../seeds/table_bytes/t1_k16_4d_yy_cut.dct")),
     (TableKind::Shared, include_bytes!("../../seeds/table_bytes/t1_k16_shared_cut.dct")),
     (TableKind::SharedSub, include_bytes!("../../seeds/table_bytes/t1_k16_shared_sub_cut.dct")),
+    (TableKind::Clearance, include_bytes!("../../seeds/table_bytes/t1_k16_clearance_whole.dct")),
 ];
 
 /// The source byte of `Op::InitWithTable` that starts from the seed table of `kind`, if

@@ -289,7 +289,7 @@ pub struct EvalArgs {
     /// The cell: T1, T2, T3 or a .toml file
     #[arg(long, value_name = "CELL", value_parser = clipped(parse_cell))]
     pub cell: Cell,
-    /// The table file, built for the same cell
+    /// The table file, built for the same cell; or, for a line, its bundle
     #[arg(long, value_name = "FILE.dct")]
     pub table: PathBuf,
     /// Random reachable configurations to compare
@@ -298,7 +298,10 @@ pub struct EvalArgs {
     /// Seed of the random configurations (xorshift64*; not 0)
     #[arg(long, value_name = "S", default_value_t = 1, value_parser = clipped(parse_seed))]
     pub seed: u64,
-    /// Draw the scenarios' box distances and labels into this PNG file
+    /// A line (more than two robots, or a bundle): add one line per robot pair that can meet
+    #[arg(long)]
+    pub pairs: bool,
+    /// Draw the scenarios' box distances and labels into this PNG file (two robots)
     #[arg(long, value_name = "FILE.png")]
     pub plot: Option<PathBuf>,
     /// Width of the plot in pixels, 500 to 8192 (only with --plot)

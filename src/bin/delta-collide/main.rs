@@ -15,6 +15,7 @@ mod bundle;
 mod clearance;
 mod confirm;
 mod demo;
+mod eval;
 mod files;
 mod picture;
 mod plot;
@@ -27,11 +28,10 @@ mod rows;
 mod shard;
 mod stop;
 
-use args::{BuildArgs, CheckArgs, Cli, Command, EvalArgs, InspectArgs};
+use args::{BuildArgs, CheckArgs, Cli, Command, InspectArgs};
 use clap::CommandFactory;
-use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::exact::PairState;
-use delta_collide::cell::{Cell, ExactChecker, SatMethod};
+use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
@@ -40,7 +40,6 @@ use delta_collide::table::{
 };
 use std::io::{BufRead, Write};
 use std::path::Path;
-use std::time::Instant;
 
 /// The scenario file shared with the C harness.
 pub(crate) const SCENARIOS: &str = include_str!("../../../c_harness/scenarios.txt");
@@ -92,7 +91,7 @@ fn main() {
         },
         Command::Merge(a) => shard::merge(a),
         Command::Inspect(a) => inspect(a),
-        Command::Eval(a) => eval(a),
+        Command::Eval(a) => eval::eval(a),
         Command::Render(a) => render::render(a),
         Command::Quilt(a) => quilt::quilt(a),
         Command::Completions { shell } => completions(*shell),
@@ -142,7 +141,7 @@ fn man(dir: Option<&Path>) -> Result<(), Failure> {
 }
 
 /// `median .. ns, p99.9 .. ns, max .. ns over .. queries` of sorted, non-empty times (ns).
-fn spread(ns: &[u64]) -> String {
+pub(crate) fn spread(ns: &[u64]) -> String {
     let (median, p999, max) = (percentile(ns, 0.5), percentile(ns, 0.999), ns[ns.len() - 1]);
     format!("median {median} ns, p99.9 {p999} ns, max {max} ns over {} queries", ns.len())
 }
@@ -449,7 +448,7 @@ pub(crate) fn describe(table: &Table) -> String {
 }
 
 /// `counts` (index 0: no level, then one per level of `table`) as one line.
-fn levels_line(what: &str, table: &delta_collide::table::ClearanceTable, counts: &[u64]) -> String {
+pub(crate) fn levels_line(what: &str, table: &delta_collide::table::ClearanceTable, counts: &[u64]) -> String {
     let mut parts = vec![format!("no level {}", counts[0])];
     parts.extend(table.ladder().mm().iter().zip(&counts[1..]).map(|(mm, n)| format!(">= {mm} mm {n}")));
     format!("{what} per level: {}", parts.join(", "))
@@ -491,122 +490,3 @@ fn inspect(args: &InspectArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// True/false positives and negatives of the table against the exact model.
-#[derive(Default)]
-struct Confusion {
-    tp: u64,
-    tn: u64,
-    fp: u64,
-    false_neg: u64,
-}
-
-impl Confusion {
-    fn add(&mut self, table_hit: bool, exact_hit: bool) {
-        match (table_hit, exact_hit) {
-            (true, true) => self.tp += 1,
-            (false, false) => self.tn += 1,
-            (true, false) => self.fp += 1,
-            (false, true) => self.false_neg += 1,
-        }
-    }
-
-    fn line(&self, what: &str) -> String {
-        let n = (self.tp + self.tn + self.fp + self.false_neg).max(1);
-        let acc = 100.0 * (self.tp + self.tn) as f64 / n as f64;
-        format!(
-            "{what:<28} TP {:>9} TN {:>9} FP {:>9} FN {:>3} accuracy {acc:6.2} %",
-            self.tp, self.tn, self.fp, self.false_neg
-        )
-    }
-}
-
-fn eval(args: &EvalArgs) -> Result<(), Failure> {
-    let cell = &args.cell;
-    let mut table = load_table(cell, &args.table)?;
-    let (n, mut seed) = (args.random, args.seed);
-    let plot = args.plot.as_deref();
-    let plot_size = (args.width, args.height);
-    let table_name = format!("{} k = {}", table.table().name(), 1u32 << table.table().levels());
-    let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
-    let is_clearance = table.table().as_clearance().is_some();
-    let mut ns = Vec::new();
-    // The table's answer and the exact verdict; counted in `c` unless a TCP is unreachable.
-    let mut compare = |tcps: &[Vec3], c: &mut Confusion, ns: &mut Vec<u64>| -> Result<TableAnswer, String> {
-        let start = Instant::now();
-        let answer = table.check(tcps).map_err(|e| e.to_string())?;
-        ns.push(start.elapsed().as_nanos() as u64);
-        let v = exact.check(tcps).map_err(|e| e.to_string())?;
-        if !matches!(answer, TableAnswer::Unreachable(_)) {
-            c.add(answer == TableAnswer::Collision, v.collides());
-        }
-        Ok(answer)
-    };
-    let mut tcps = vec![Vec3::zeros(); 2];
-    let mut traces = Vec::new();
-    for scenario in parse_scenarios(SCENARIOS)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)) {
-        let mut c = Confusion::default();
-        let mut trace = plot.map(|_| plot::Trace::new(cell, format!("{} {}", scenario.cell, scenario.case)));
-        for tick in 0..RUN_TICKS {
-            scenario.tcps_at(tick, &mut tcps);
-            let answer = compare(&tcps, &mut c, &mut ns)?;
-            if let Some(t) = trace.as_mut() {
-                t.push(&tcps, answer)?;
-            }
-        }
-        println!("{}", c.line(&format!("{} {}", scenario.cell, scenario.case)));
-        traces.extend(trace);
-    }
-    if let Some(path) = plot {
-        let title = format!(
-            "cell {}, table {} ({table_name}): box distance and labels per tick",
-            cell.name,
-            args.table.display()
-        );
-        plot::draw_plot(path, plot_size, &title, &traces)?;
-        println!("{}: {} x {} pixels, {} scenarios", path.display(), plot_size.0, plot_size.1, traces.len());
-    }
-    // Random reachable configurations, uniform in the workspace box (xorshift64*, seeded).
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let ws = Workspace::THESIS;
-    let (rmax, dmax) = (ws.rcy, ws.zu + ws.hcy + ws.hco);
-    let mut c = Confusion::default();
-    let mut kept = 0;
-    // A clearance table's bound is timed on the same configurations afterwards.
-    let mut kept_tcps = Vec::new();
-    while kept < n {
-        for t in tcps.iter_mut() {
-            *t =
-                Vec3::new(rmax * (2.0 * next() - 1.0), rmax * (2.0 * next() - 1.0), -(ws.zu + (dmax - ws.zu) * next()));
-        }
-        if tcps.iter().all(|t| ws.contains(t))
-            && !matches!(compare(&tcps, &mut c, &mut ns)?, TableAnswer::Unreachable(_))
-        {
-            kept += 1;
-            if is_clearance {
-                kept_tcps.push([tcps[0], tcps[1]]);
-            }
-        }
-    }
-    println!("{}", c.line(&format!("{n} random configurations")));
-    ns.sort_unstable();
-    println!("table query incl. IK reachability: {}; {} exact fallbacks", spread(&ns), table.fallbacks());
-    if let Some(q) = table.table().as_clearance() {
-        let (mut ns, mut per_level) = (Vec::with_capacity(kept_tcps.len()), vec![0u64; q.ladder().len() + 1]);
-        for tcps in &kept_tcps {
-            let start = Instant::now();
-            let bound = table.clearance_bound(std::hint::black_box(tcps));
-            ns.push(start.elapsed().as_nanos() as u64);
-            per_level[bound.map_or(0, |b| 1 + q.ladder().mm().iter().position(|&l| l == b).unwrap_or(0))] += 1;
-        }
-        ns.sort_unstable();
-        println!("clearance bound incl. IK reachability: {}", spread(&ns));
-        println!("{}", levels_line("random configurations", q, &per_level));
-    }
-    confirm::report(cell, &table, SCENARIOS)?;
-    Ok(())
-}
