@@ -60,7 +60,7 @@ fn table_protective(c: &mut Criterion) {
 
 fn group(c: &mut Criterion, model: &str, cell: &Cell, bytes: &[u8], ticks: &[[Vec3; 2]]) {
     let lookup = TableChecker::new(cell.clone(), bytes).unwrap();
-    let bound = |t: &[Vec3]| lookup.clearance_bound(t);
+    let bound = |_: usize, _: usize, t: &[Vec3]| lookup.clearance_bound(t);
     let mut group = c.benchmark_group(format!("table_protective_T1_practical_{model}"));
     let mut table_mode = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
     let reports: Vec<(Protective, bool)> = ticks

@@ -322,3 +322,59 @@ fn eval_counts_every_pair_of_a_line() {
         }
     }
 }
+
+/// `replay --table` on the line with the bundle of its clearance tables (stiff stopping
+/// models, so that the lookups can prove far pairs): one row per tick with the verdicts of
+/// exact mode or better (never a STOP where exact mode has none), the exact clearance in both,
+/// and the pairs the lookups proved reported on stderr.
+#[test]
+fn replay_a_line_in_table_mode() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bundles_replay");
+    std::fs::create_dir_all(&dir).unwrap();
+    let variant = Variant::Clearance(delta_collide::table::Ladder::default_ladder());
+    let built = build_bundle(&line4(), K, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent).unwrap();
+    let bundle = dir.join("line4-clearance.dcb");
+    std::fs::write(&bundle, &built.bytes).unwrap();
+    let stop = "stop = { reaction_ms = 2.0, decel_mm_s2 = 120000.0, max_accel_mm_s2 = 130000.0, max_speed_mm_s = 4600.0 }";
+    let cell = LINE4.replace("\n[[robot]]", &format!("\n[[robot]]\n{stop}"));
+    let cell = format!("tick_ms = 1.0\n{cell}");
+    let cell_path = dir.join("line4-stiff.toml");
+    std::fs::write(&cell_path, &cell).unwrap();
+    let scenario = &delta_collide::cell::trajectory::parse_scenarios(include_str!("../c_harness/line_scenarios.txt"))
+        .unwrap()[0];
+    let mut rows = String::from("tick,x,y,z,x2,y2,z2,x3,y3,z3,x4,y4,z4\n");
+    let mut tcps = vec![Vec3::zeros(); 4];
+    for tick in 0..1_500 {
+        scenario.tcps_at(tick, &mut tcps);
+        rows += &format!("{tick},");
+        rows += &tcps.iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(",");
+        rows.push('\n');
+    }
+    let input = dir.join("line.csv");
+    std::fs::write(&input, rows).unwrap();
+    let (c, i, b) = (cell_path.to_str().unwrap(), input.to_str().unwrap(), bundle.to_str().unwrap());
+    let exact = cli(&["replay", "--cell", c, "--input", i]);
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_delta-collide"))
+        .args(["replay", "--cell", c, "--input", i, "--table", b])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let (table, note) = (String::from_utf8(run.stdout).unwrap(), String::from_utf8(run.stderr).unwrap());
+    assert_eq!(table.lines().count(), 1 + 1_500);
+    let mut stops = [0; 2];
+    for (e, t) in exact.lines().zip(table.lines()).skip(1) {
+        let (e, t): (Vec<&str>, Vec<&str>) = (e.split(',').collect(), t.split(',').collect());
+        assert_eq!((e[0], e[2]), (t[0], t[2]), "tick and exact clearance");
+        stops[0] += usize::from(e[1] == "stop");
+        stops[1] += usize::from(t[1] == "stop");
+        assert!(t[1] != "stop" || e[1] == "stop", "table mode stops at tick {} where exact mode does not", t[0]);
+    }
+    assert!(stops[0] > 0, "the line's neighbours come close enough to stop");
+    let pairs: usize = note
+        .split("answered FREE by the lookup alone, ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{note}"));
+    assert!(pairs > 500, "{note}");
+}

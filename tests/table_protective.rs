@@ -16,7 +16,11 @@ use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
-use delta_collide::table::{build_table, to_bytes, Labelling, Ladder, TableChecker, Variant};
+use delta_collide::cell::parse_cell;
+use delta_collide::table::bundle::build_bundle;
+use delta_collide::table::{
+    build_table, pair_cell, to_bytes, BundleChecker, Confirmation, Labelling, Ladder, TableChecker, Variant,
+};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use std::sync::OnceLock;
@@ -117,7 +121,7 @@ fn brute_force(
     states: usize,
     seed: u64,
 ) -> (usize, usize) {
-    let bound = |t: &[Vec3]| table.clearance_bound(t);
+    let bound = |_: usize, _: usize, t: &[Vec3]| table.clearance_bound(t);
     let mut checker = ProtectiveChecker::new(cell.clone(), warn_mm).unwrap().with_speed_limits(false);
     let mut exact = ExactChecker::new(cell.clone());
     let mut rng = StdRng::seed_from_u64(seed);
@@ -200,7 +204,7 @@ fn runs(stop: StopModel, label: &str) -> (u64, u64) {
     for name in ["T1", "T2", "T3"] {
         let cell = cell(name, stop);
         let table = table(&cell, true);
-        let bound = |t: &[Vec3]| table.clearance_bound(t);
+        let bound = |_: usize, _: usize, t: &[Vec3]| table.clearance_bound(t);
         let tick = cell.tick_ms * 1e-3;
         for s in scenarios.iter().filter(|s| s.cell == name) {
             let mut exact = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
@@ -266,7 +270,7 @@ fn a_boolean_table_changes_nothing() {
     let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
     let cell = cell("T1", STIFF);
     let table = table(&cell, false);
-    let bound = |t: &[Vec3]| table.clearance_bound(t);
+    let bound = |_: usize, _: usize, t: &[Vec3]| table.clearance_bound(t);
     let mut exact = ProtectiveChecker::new(cell.clone(), 10.0).unwrap();
     let mut lookup = ProtectiveChecker::new(cell.clone(), 10.0).unwrap();
     let mut tcps = [Vec3::zeros(); 2];
@@ -281,7 +285,7 @@ fn a_boolean_table_changes_nothing() {
 fn a_table_mode_tick_never_allocates() {
     let cell = cell("T1", STIFF);
     let table = table(&cell, true);
-    let bound = |t: &[Vec3]| table.clearance_bound(t);
+    let bound = |_: usize, _: usize, t: &[Vec3]| table.clearance_bound(t);
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
     let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
     let mut c = ProtectiveChecker::new(cell, 10.0).unwrap();
@@ -305,4 +309,69 @@ fn a_table_mode_tick_never_allocates() {
 fn the_c_counter_reads_zero_for_null() {
     // SAFETY: NULL is a documented argument (the counter reads 0).
     assert_eq!(unsafe { delta_collide::ffi::dc_table_protective_lookups(std::ptr::null()) }, 0);
+}
+
+/// The line of four (`cells/line4.toml`, stiff models) in table mode from the bundle of its
+/// clearance tables (one per spacing), beside exact mode, on both line cases. Every tick FREE
+/// by the lookups (every pair's table bound beats its robots' motion bounds), or by a proof
+/// kept since, reports a clearance at most the exact one; at every fifth such tick random
+/// stops of every pair that can meet never touch, each pair checked as its pair cell (the
+/// two robots where they stand relative to each other: the bundle's own reduction, whose
+/// soundness `tests/bundles.rs` checks against the whole line).
+#[test]
+fn a_line_in_table_mode_stops_in_time() {
+    let line = parse_cell(include_str!("../cells/line4.toml")).unwrap().with_stopping(1.0, vec![STIFF; 4]).unwrap();
+    let ladder = Variant::Clearance(Ladder::default_ladder());
+    let built = build_bundle(&line, K, &Workspace::THESIS, ladder, Labelling::Certified, Progress::Silent).unwrap();
+    let bundle = BundleChecker::new(line.clone(), &built.bytes, Confirmation::Exact).unwrap();
+    assert!(bundle.has_clearance());
+    let bound = |a: usize, b: usize, t: &[Vec3]| bundle.clearance_bound(a, b, t);
+    let scenarios = parse_scenarios(include_str!("../c_harness/line_scenarios.txt")).unwrap();
+    let mut rng = StdRng::seed_from_u64(23);
+    let tick = line.tick_ms * 1e-3;
+    let (mut lookups, mut tested) = (0u64, 0u64);
+    for s in &scenarios {
+        let mut exact = ProtectiveChecker::new(line.clone(), 10.0).unwrap().with_speed_limits(false);
+        let mut lookup = ProtectiveChecker::new(line.clone(), 10.0).unwrap().with_speed_limits(false);
+        let (mut tcps, mut prev) = (vec![Vec3::zeros(); 4], vec![Vec3::zeros(); 4]);
+        let (mut counts, mut since_lookup, mut run_lookups, mut pair_lookups) = ([[0u32; 3]; 2], false, 0u64, 0u64);
+        for t in 0..RUN_TICKS {
+            s.tcps_at(t, &mut tcps);
+            let e = exact.check(&tcps).unwrap().clone();
+            let r = lookup.check_with_table(&tcps, &bound).unwrap();
+            counts[0][e.verdict as usize] += 1;
+            counts[1][r.verdict as usize] += 1;
+            pair_lookups += u64::from(r.table_pairs);
+            let looked_up = r.table_pairs > 0 && r.verdict == Protective::Free;
+            since_lookup = (since_lookup || looked_up) && r.verdict == Protective::Free;
+            if looked_up || (since_lookup && r.kept_proof) {
+                assert_eq!((r.verdict, r.status), (Protective::Free, ProtectiveStatus::Ok));
+                assert!(r.clearance_mm <= e.clearance_mm, "{} tick {t}: {} > {}", s.case, r.clearance_mm, e.clearance_mm);
+                run_lookups += u64::from(r.table_lookup);
+                tested += 1;
+                if tested % 5 == 0 {
+                    let vel: Vec<Vec3> = (0..4)
+                        .map(|j| {
+                            let w = (tcps[j] - prev[j]) / tick
+                                + unit(&mut rng) * STIFF.max_accel_mm_s2 * tick * rng.random::<Real>();
+                            w * (STIFF.max_speed_mm_s / w.norm()).min(1.0)
+                        })
+                        .collect();
+                    for (a, b) in line.pairs_that_can_meet() {
+                        let pair = pair_cell(&line, a, b);
+                        assert_stops_never_touch(&pair, &[tcps[a], tcps[b]], &[vel[a], vel[b]], 4, &mut rng);
+                    }
+                }
+            }
+            prev.clone_from(&tcps);
+        }
+        println!(
+            "line4 {:<9}: exact mode STOP {} WARN {}; table mode STOP {} WARN {}, {run_lookups} ticks by the lookups alone, {pair_lookups} pairs proved by a lookup",
+            s.case, counts[0][2], counts[0][1], counts[1][2], counts[1][1]
+        );
+        assert!(counts[1][2] <= counts[0][2], "table mode stops more often than exact mode");
+        lookups += pair_lookups;
+    }
+    println!("{tested} FREE ticks that a lookup proved in part (or kept since), every fifth with simulated stops");
+    assert!(lookups >= 1_000, "the line's runs have few pairs proved by a lookup: {lookups}");
 }

@@ -300,7 +300,10 @@ impl Collider {
         }
         let r = match &self.checker {
             Checker::Table(t) if t.table().as_clearance().is_some() => {
-                self.protective.check_with_table(&self.tcps, &|tcps| t.clearance_bound(tcps))
+                self.protective.check_with_table(&self.tcps, &|_, _, tcps| t.clearance_bound(tcps))
+            }
+            Checker::Bundle(b) if b.has_clearance() => {
+                self.protective.check_with_table(&self.tcps, &|i, j, tcps| b.clearance_bound(i, j, tcps))
             }
             _ => self.protective.check(&self.tcps),
         };
@@ -338,8 +341,13 @@ impl Collider {
         let stop_paths = &stop_paths[..paths.len()];
         let r = match &self.checker {
             Checker::Table(t) if t.table().as_clearance().is_some() => {
-                self.protective.check_with_paths_and_table(&self.tcps, stop_paths, &|tcps| t.clearance_bound(tcps))
+                self.protective.check_with_paths_and_table(&self.tcps, stop_paths, &|_, _, tcps| t.clearance_bound(tcps))
             }
+            Checker::Bundle(b) if b.has_clearance() => self.protective.check_with_paths_and_table(
+                &self.tcps,
+                stop_paths,
+                &|i, j, tcps| b.clearance_bound(i, j, tcps),
+            ),
             _ => self.protective.check_with_paths(&self.tcps, stop_paths),
         };
         let Ok(r) = r else { return DC_STATUS_WRONG_ROBOT_COUNT };

@@ -109,6 +109,21 @@ impl BundleChecker {
         self.checkers.iter().map(TableChecker::confirmations).sum()
     }
 
+    /// Whether every table the pairs use is a clearance table (`build --variant clearance`),
+    /// so that [`BundleChecker::clearance_bound`] can prove something for every pair.
+    pub fn has_clearance(&self) -> bool {
+        !self.checkers.is_empty() && self.checkers.iter().all(|c| c.table().as_clearance().is_some())
+    }
+
+    /// The certified lower bound on the clearance (mm) of robots `a` and `b` (a pair that can
+    /// meet, `a < b`) with TCPs `[tcp_a, tcp_b]`, each in its own MCS: their table's
+    /// [`TableChecker::clearance_bound`]. `None` when nothing is proved, or for a pair that
+    /// has no table (it can never meet: no bound is needed).
+    pub fn clearance_bound(&self, a: usize, b: usize, tcps_mcs: &[Vec3]) -> Option<f64> {
+        let pair = self.pairs.iter().find(|p| (p.a, p.b) == (a, b))?;
+        self.checkers[pair.table].clearance_bound(tcps_mcs)
+    }
+
     /// How a COLLISION lookup is answered.
     pub fn confirmation(&self) -> Confirmation {
         self.checkers.first().map_or(Confirmation::Exact, TableChecker::confirmation)

@@ -199,9 +199,10 @@ pub struct ReplayArgs {
     /// names): that pair's exact signed clearance (mm), NA when the tick's status is not ok
     #[arg(long)]
     pub pairs: bool,
-    /// Table mode: a tick this clearance table (build --variant clearance, same cell) proves
-    /// FREE is answered by its lookup alone, the others by the exact protective check; the
-    /// share answered by the lookup goes to stderr [default: exact mode]
+    /// Table mode: a tick this clearance table (build --variant clearance, same cell; for a
+    /// line, its bundle) proves FREE is answered by its lookup alone; pairs it proves apart
+    /// skip the exact protective check, which decides the others; the share answered by the
+    /// lookups goes to stderr [default: exact mode]
     #[arg(long, value_name = "FILE.dct")]
     pub table: Option<PathBuf>,
     /// Also draw the clearance, each robot's protective distance and the verdict per tick

@@ -313,12 +313,29 @@ fn exact_answer(v: &delta_collide::cell::CellVerdict) -> TableAnswer {
 
 /// What `check --table` answers from: a two-robot cell's table, or a bundle (one table per
 /// pair that can meet) for a cell of any number of robots.
-enum Loaded {
+pub(crate) enum Loaded {
     Table(Box<TableChecker>),
     Bundle(BundleChecker),
 }
 
 impl Loaded {
+    /// The certified lower bound on the clearance of robots `a` and `b` at `[tcp_a, tcp_b]`
+    /// from a clearance table or bundle; `None` when nothing is proved.
+    pub(crate) fn clearance_bound(&self, a: usize, b: usize, tcps: &[Vec3]) -> Option<f64> {
+        match self {
+            Loaded::Table(t) => t.clearance_bound(tcps),
+            Loaded::Bundle(bundle) => bundle.clearance_bound(a, b, tcps),
+        }
+    }
+
+    /// Whether every table is a clearance table.
+    pub(crate) fn has_clearance(&self) -> bool {
+        match self {
+            Loaded::Table(t) => t.table().as_clearance().is_some(),
+            Loaded::Bundle(b) => b.has_clearance(),
+        }
+    }
+
     fn check(&mut self, tcps: &[Vec3]) -> Result<TableAnswer, delta_collide::cell::QueryError> {
         match self {
             Loaded::Table(t) => t.check(tcps),
@@ -333,7 +350,7 @@ pub(crate) fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, Strin
 }
 
 /// The table or bundle at `path` for `cell`, answering a COLLISION lookup as `confirmation` says.
-fn load_table_or_bundle(cell: &Cell, path: &Path, confirmation: Confirmation) -> Result<Loaded, String> {
+pub(crate) fn load_table_or_bundle(cell: &Cell, path: &Path, confirmation: Confirmation) -> Result<Loaded, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let at = |e: delta_collide::table::TableError| format!("{}: {e}", path.display());
     if cell.robots.len() == 2 && !is_bundle(&bytes) {

@@ -5,32 +5,33 @@
 use crate::args::ReplayArgs;
 use crate::clearance::{pair_clearances, signed_clearance};
 use crate::replay_plot::{draw_replay, ReplayTrace};
-use crate::{open_input, write_output, Failure};
+use crate::{load_table_or_bundle, open_input, write_output, Failure, Loaded};
 use delta_collide::cell::protective::{path_through_samples, Protective, ProtectiveChecker, ProtectiveStatus, StopPath};
 use delta_collide::math::Vec3;
-use delta_collide::table::TableChecker;
+use delta_collide::table::Confirmation;
 use std::io::{BufRead, Write};
 
 pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     let mut checker = ProtectiveChecker::new(args.cell.clone(), args.warn_mm).map_err(|e| e.to_string())?;
-    let table = args.table.as_ref().map(|p| crate::load_table(&args.cell, p)).transpose()?;
+    let table = args.table.as_ref().map(|p| load_table_or_bundle(&args.cell, p, Confirmation::Exact)).transpose()?;
     let mut input = open_input(args.input.as_deref())?;
     let names = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
     let mut trace = args.plot.as_ref().map(|_| ReplayTrace::new(names));
     let paths = args.stop_path_mm.map(|length_mm| PathsAhead { length_mm, tolerance_mm: args.path_tolerance_mm });
-    let mut lookups = (0usize, 0usize);
+    let mut lookups = Lookups::default();
     write_output(args.output.as_deref(), |out| {
         let columns = Columns { table: table.as_ref(), paths, pairs: args.pairs };
         lookups = replay_rows(&mut input, out, &mut checker, columns, trace.as_mut())?;
         Ok(())
     })?;
     if let (Some(path), Some(t)) = (&args.table, &table) {
-        let (n, ticks) = lookups;
+        let Lookups { ticks: n, pairs, of: ticks } = lookups;
         let share = if ticks > 0 { 100.0 * n as f64 / ticks as f64 } else { 0.0 };
-        let kind = if t.table().as_clearance().is_some() { "" } else { " (a boolean table proves no clearance)" };
+        let kind = if t.has_clearance() { "" } else { " (a boolean table proves no clearance)" };
         // The verdicts may be on stdout: the summary goes to stderr.
         eprintln!(
-            "table mode ({}): {n} of {ticks} ticks ({share:.1} %) answered FREE by the lookup alone{kind}",
+            "table mode ({}): {n} of {ticks} ticks ({share:.1} %) answered FREE by the lookup alone, \
+             {pairs} pairs proved apart by a lookup{kind}",
             path.display()
         );
     }
@@ -51,9 +52,17 @@ pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
 /// How a replay runs and what it adds to the verdicts: table mode, stop paths from the rows
 /// ahead, per-pair clearances.
 struct Columns<'a> {
-    table: Option<&'a TableChecker>,
+    table: Option<&'a Loaded>,
     paths: Option<PathsAhead>,
     pairs: bool,
+}
+
+/// What the table's lookups answered over a replay: whole ticks, pairs, of all ticks.
+#[derive(Default)]
+struct Lookups {
+    ticks: usize,
+    pairs: usize,
+    of: usize,
 }
 
 /// Each robot's stop path taken from the recorded rows ahead (`replay --stop-path-mm`).
@@ -68,8 +77,7 @@ const PATH_POINTS: usize = delta_collide::ffi::DC_MAX_PATH_POINTS;
 
 /// Replays every row of `input` (one tick each) and writes one line per tick on `out`, with
 /// stop paths from the rows ahead, table mode and per-pair clearances as `columns` says;
-/// records each tick into `trace`. Returns the ticks answered by the table's lookup alone and
-/// all ticks.
+/// records each tick into `trace`. Returns what the table's lookups answered.
 ///
 /// # Errors
 /// A row that is not `3 n` numbers (naming its line; the first line may be a header), or a
@@ -80,9 +88,9 @@ fn replay_rows(
     checker: &mut ProtectiveChecker,
     Columns { table, paths, pairs }: Columns<'_>,
     mut trace: Option<&mut ReplayTrace>,
-) -> Result<(usize, usize), String> {
-    let bound = |tcps: &[Vec3]| table.and_then(|t| t.clearance_bound(tcps));
-    let mut lookups = 0;
+) -> Result<Lookups, String> {
+    let bound = |a: usize, b: usize, tcps: &[Vec3]| table.and_then(|t| t.clearance_bound(a, b, tcps));
+    let mut lookups = Lookups::default();
     let names: Vec<String> = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
     let n = names.len();
     let write_err = |e: std::io::Error| format!("writing the verdicts: {e}");
@@ -128,7 +136,8 @@ fn replay_rows(
         }
         .map_err(|e| format!("row {tick}: {e}"))?;
         let r = checker.report();
-        lookups += usize::from(r.table_lookup);
+        lookups.ticks += usize::from(r.table_lookup);
+        lookups.pairs += r.table_pairs as usize;
         if let Some(t) = trace.as_deref_mut() {
             // The exact check under the verdict ran only when the status is OK.
             let ok = r.status == ProtectiveStatus::Ok;
@@ -158,5 +167,6 @@ fn replay_rows(
         }
         writeln!(out, "{row}").map_err(write_err)?;
     }
-    Ok((lookups, rows.len()))
+    lookups.of = rows.len();
+    Ok(lookups)
 }

@@ -1,6 +1,8 @@
 //! The protective verdict from a certified clearance table (SPEC §8; clearance tables, SPEC
-//! §6): where the table's bound alone proves FREE, a tick costs one table lookup and one
-//! motion bound per robot instead of the swept-box proof of every box pair. It is tried
+//! §6): where the table's bound alone proves FREE, a tick costs one table lookup per pair
+//! that can meet and one motion bound per robot instead of the swept-box proof of every box
+//! pair. A line's pairs each take their table's bound (a bundle's): the pairs it proves are
+//! skipped by the proof of the others, and the tick needs no proof when it proves them all. It is tried
 //! after the cheaper answers (a kept proof, a certain STOP) and before the proof.
 //!
 //! # Why a lookup proves FREE
@@ -19,9 +21,9 @@
 //! proves FREE with `warn_mm` to spare. The reference points `c_A`, `c_B` need not be
 //! where the robots are at the same time: the bound holds for the pair of configurations.
 //!
-//! Only FREE is answered this way. Where the bound does not prove FREE the tick takes the
-//! full proof, unchanged, so table mode never answers worse than exact mode, and better
-//! only where the lookup's proof holds. A WARN from the lookup (`L > d_A + d_B` alone) is
+//! Only FREE is answered this way, pair by pair. Where the bound does not prove a pair, the
+//! pair takes the full proof, unchanged, so table mode never answers worse than exact mode,
+//! and better only where the lookup's proof holds. A WARN from the lookup (`L > d_A + d_B` alone) is
 //! not answered: the full proof may still prove FREE there.
 //!
 //! # The clearance reported
@@ -35,10 +37,12 @@
 use super::ProtectiveChecker;
 use crate::math::{Real, Vec3};
 
-/// A certified lower bound on the clearance (SPEC §8, mm) of a two-robot cell at the given
-/// TCPs (each in its own robot's MCS), `None` when nothing is proved; for example
-/// [`crate::table::TableChecker::clearance_bound`] of a clearance table.
-pub type ClearanceBound<'a> = &'a dyn Fn(&[Vec3]) -> Option<Real>;
+/// A certified lower bound on the clearance (SPEC §8, mm) between robots `a` and `b` of the
+/// cell (the first two arguments, `a < b`) with their TCPs at `[tcp_a, tcp_b]` (each in its
+/// own robot's MCS), `None` when nothing is proved; for example
+/// [`crate::table::TableChecker::clearance_bound`] of a clearance table for two robots, or
+/// [`crate::table::BundleChecker::clearance_bound`] of a bundle of clearance tables for a line.
+pub type ClearanceBound<'a> = &'a dyn Fn(usize, usize, &[Vec3]) -> Option<Real>;
 
 /// How far (mm) the table's bound must exceed both motion bounds and `warn_mm` before a
 /// lookup proves FREE: far above the rounding of the radii (about 1e-13 of a metre).
@@ -61,21 +65,32 @@ impl ProtectiveChecker {
         }
     }
 
-    /// Whether `bound` proves FREE with `warn_mm` to spare for two robots about this tick's
-    /// stop references (module doc); false for any other number of robots.
-    pub(super) fn lookup_free(&mut self, bound: ClearanceBound) -> bool {
-        if self.centres.len() != 2 {
-            return false;
+    /// Marks each pair that can meet whose robots `bound` proves apart with `warn_mm` to spare
+    /// about this tick's stop references (module doc), counts them in the report, and says
+    /// whether that is every pair: the tick is then FREE. The swept-box proof skips the pairs
+    /// marked (a line's far pairs, while its neighbours come close).
+    pub(super) fn lookup_pairs(&mut self, bound: ClearanceBound) -> bool {
+        let mut proved = 0;
+        for k in 0..self.exact.verdict().pairs.len() {
+            let (a, b) = (self.exact.verdict().pairs[k].a, self.exact.verdict().pairs[k].b);
+            self.table_proved[k] = self.pair_proved(bound, a, b);
+            proved += u32::from(self.table_proved[k]);
         }
-        let Some(at_centres) = bound(&[self.centres[0], self.centres[1]]) else { return false };
+        self.report.table_pairs = proved;
+        proved as usize == self.table_proved.len()
+    }
+
+    /// Whether `bound` proves robots `a` and `b` apart with `warn_mm` to spare (module doc).
+    fn pair_proved(&mut self, bound: ClearanceBound, a: usize, b: usize) -> bool {
+        let Some(at_centres) = bound(a, b, &[self.centres[a], self.centres[b]]) else { return false };
         // Every sweep of a lower-link, platform or tool box holds the ball of the stop's radius
         // (module doc of `protective`, step 6), so `d_j >= R_j`: where the bound cannot exceed
-        // that, the sweeps are not computed (the proof below may still need them).
-        let least = self.reach[0] + self.reach[1] + self.warn_mm;
+        // that, the sweeps are not computed (the proof may still need them).
+        let least = self.reach[a] + self.reach[b] + self.warn_mm;
         if at_centres.partial_cmp(&least) != Some(core::cmp::Ordering::Greater) {
             return false;
         }
-        let motion = self.motion_bound(0) + self.motion_bound(1);
+        let motion = self.motion_bound(a) + self.motion_bound(b);
         motion.is_finite() && at_centres > motion + self.warn_mm + LOOKUP_SLACK_MM
     }
 }

@@ -208,6 +208,9 @@ pub struct ProtectiveReport {
     /// Whether the verdict is FREE by the clearance table's bound alone, without a swept-box
     /// proof (`protective/lookup.rs`; only with [`ProtectiveChecker::check_with_table`]).
     pub table_lookup: bool,
+    /// How many pairs that can meet the table's bound proved apart this tick, which the
+    /// swept-box proof then skipped (all of them when `table_lookup`).
+    pub table_pairs: u32,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -256,6 +259,9 @@ pub struct ProtectiveChecker {
     /// Per robot pair that can meet, what its clearance was at the last tick: where this
     /// tick's computation starts (same answer, a fraction of the time).
     clearances: alloc::vec::Vec<CoherentClearance>,
+    /// Per robot pair that can meet, whether the clearance table's bound proved it apart
+    /// over this tick's stop balls (`protective/lookup.rs`).
+    table_proved: alloc::vec::Vec<bool>,
     report: ProtectiveReport,
 }
 
@@ -317,6 +323,7 @@ impl ProtectiveChecker {
             sweep_tier: alloc::vec![None; n],
             no_faces,
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
+            table_proved: alloc::vec![false; n_pairs],
             kept,
             report: ProtectiveReport {
                 verdict: Protective::Stop,
@@ -327,6 +334,7 @@ impl ProtectiveChecker {
                 robots: alloc::vec![RobotProtection::UNKNOWN; n],
                 kept_proof: false,
                 table_lookup: false,
+                table_pairs: 0,
             },
         })
     }
@@ -551,6 +559,8 @@ impl ProtectiveChecker {
         let report = &mut self.report;
         (report.verdict, report.status, report.clearance_mm) = (Protective::Stop, status, Real::NAN);
         (report.closest, report.limiting, report.kept_proof, report.table_lookup) = (None, None, false, false);
+        report.table_pairs = 0;
+        self.table_proved.fill(false);
         if status != ProtectiveStatus::Ok {
             return;
         }
@@ -585,7 +595,7 @@ impl ProtectiveChecker {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else if let Some(pair) = self.certain_stop(None) {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
-        } else if table.is_some_and(|bound| self.lookup_free(bound)) {
+        } else if table.is_some_and(|bound| self.lookup_pairs(bound)) {
             (self.report.verdict, self.report.table_lookup) = (Protective::Free, true);
             // The lookup proved FREE for every TCP of both stop balls: kept like a proof.
             self.keep_references();
@@ -641,6 +651,9 @@ impl ProtectiveChecker {
         for (extra, verdict) in passes.into_iter().filter(|&(extra, v)| v == Protective::Stop || extra > 0.0) {
             for k in 0..self.exact.verdict().pairs.len() {
                 let p = self.exact.verdict().pairs[k];
+                if self.table_proved[k] {
+                    continue;
+                }
                 for j in [p.a, p.b] {
                     if self.sweep_tier[j].is_none() {
                         self.sweeps_at(j, 0, 0);
