@@ -9,9 +9,9 @@
 //! k = 16 (a few seconds per cell, built once per test process and shared by the tests; at
 //! k = 32 the clearance labelling takes a minute per cell).
 
-use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveStatus};
+use delta_collide::cell::protective::{ClearanceBound, Protective, ProtectiveChecker, ProtectiveStatus};
 use delta_collide::cell::reference::reference_cell;
-use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
+use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::{Real, Vec3};
@@ -191,67 +191,101 @@ fn lookup_free_verdicts_survive_simulated_stops() {
     assert!(total[0] >= 50 && total[1] >= 5 && total[2] >= 50, "too few lookup states to test: {total:?}");
 }
 
-/// Per reference run (T1-T3, practical and collision) and model: exact and table mode side
-/// by side. Every lookup tick is FREE, reports a clearance at most the exact one (which the
-/// exact-mode checker reports on the same tick), and at every fifth one random stops from
-/// the true velocity (the finite difference moved within `a_max T`) never touch; so at every
-/// fifth tick FREE by a proof kept since a lookup (a lookup keeps its balls as a proof does).
+/// One run in exact and table mode side by side: verdict counts of each, ticks FREE by the
+/// lookups alone, pairs proved by a lookup, and ticks tested with simulated stops.
+#[derive(Default)]
+struct SideBySide {
+    counts: [[u32; 3]; 2],
+    lookups: u64,
+    pairs: u64,
+    tested: u64,
+}
+
+impl SideBySide {
+    fn line(&self) -> String {
+        let c = &self.counts;
+        format!(
+            "exact mode STOP {} WARN {}; table mode STOP {} WARN {}, {} ticks ({:.1} %) by the lookups alone, {} pairs proved by a lookup",
+            c[0][2],
+            c[0][1],
+            c[1][2],
+            c[1][1],
+            self.lookups,
+            100.0 * self.lookups as f64 / RUN_TICKS as f64,
+            self.pairs
+        )
+    }
+}
+
+/// `scenario` on `cell` (every robot with stopping model `stop`) in exact and table mode side
+/// by side. Every FREE tick a lookup took part in (`table_pairs`: the pairs the table's
+/// bound proved; the proof took the others) reports a clearance at most the exact one (which
+/// the exact-mode checker reports on the same tick); at every fifth one, and at every fifth
+/// tick FREE by a proof kept since (a lookup keeps its balls as a proof does), random stops
+/// from the true velocities (the finite difference moved within `a_max T`) never touch, each
+/// pair that can meet checked as its pair cell (the two robots where they stand relative to
+/// each other: a two-robot cell's own pair, a line's as its bundle reduces it, whose soundness
+/// `tests/bundles.rs` checks against the whole line).
+fn side_by_side(cell: &Cell, bound: ClearanceBound, s: &Scenario, stop: StopModel, rng: &mut StdRng) -> SideBySide {
+    let n = cell.robots.len();
+    let tick = cell.tick_ms * 1e-3;
+    let mut exact = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+    let mut lookup = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+    let (mut tcps, mut prev) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
+    let mut out = SideBySide::default();
+    // Whether every tick since the last lookup was FREE (a kept proof may be its).
+    let (mut since_lookup, mut candidates) = (false, 0u64);
+    for t in 0..RUN_TICKS {
+        s.tcps_at(t, &mut tcps);
+        let e = exact.check(&tcps).unwrap().clone();
+        let r = lookup.check_with_table(&tcps, bound).unwrap();
+        out.counts[0][e.verdict as usize] += 1;
+        out.counts[1][r.verdict as usize] += 1;
+        out.pairs += u64::from(r.table_pairs);
+        let looked_up = r.table_pairs > 0 && r.verdict == Protective::Free;
+        since_lookup = (since_lookup || looked_up) && r.verdict == Protective::Free;
+        if looked_up || (since_lookup && r.kept_proof) {
+            assert_eq!((r.verdict, r.status), (Protective::Free, ProtectiveStatus::Ok));
+            let (case, got, want) = (&s.case, r.clearance_mm, e.clearance_mm);
+            assert!(got <= want, "{} {case} tick {t}: {got} > {want}", cell.name);
+            out.lookups += u64::from(r.table_lookup);
+            candidates += 1;
+            if candidates % 5 == 0 {
+                let vel: Vec<Vec3> = (0..n)
+                    .map(|j| {
+                        let w = (tcps[j] - prev[j]) / tick + unit(rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
+                        w * (stop.max_speed_mm_s / w.norm()).min(1.0)
+                    })
+                    .collect();
+                for (a, b) in cell.pairs_that_can_meet() {
+                    assert_stops_never_touch(&pair_cell(cell, a, b), &[tcps[a], tcps[b]], &[vel[a], vel[b]], 4, rng);
+                }
+                out.tested += 1;
+            }
+        }
+        prev.clone_from(&tcps);
+    }
+    out
+}
+
+/// Per reference run (T1-T3, practical and collision) and model: [`side_by_side`]. Returns
+/// the ticks FREE by the lookup alone and the ticks tested with simulated stops.
 fn runs(stop: StopModel, label: &str) -> (u64, u64) {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
     let scenarios = parse_scenarios(&text).unwrap();
     let mut rng = StdRng::seed_from_u64(11);
-    let (mut lookups_total, mut tested) = (0, 0);
+    let (mut lookups, mut tested) = (0, 0);
     for name in ["T1", "T2", "T3"] {
         let cell = cell(name, stop);
         let table = table(&cell, true);
         let bound = |_: usize, _: usize, t: &[Vec3]| table.clearance_bound(t);
-        let tick = cell.tick_ms * 1e-3;
         for s in scenarios.iter().filter(|s| s.cell == name) {
-            let mut exact = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
-            let mut lookup = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
-            let (mut tcps, mut prev) = ([Vec3::zeros(); 2], [Vec3::zeros(); 2]);
-            let (mut counts, mut lookups) = ([[0u32; 3]; 2], 0u64);
-            // Whether every tick since the last lookup was FREE (a kept proof may be its).
-            let (mut since_lookup, mut tested_ticks) = (false, 0u64);
-            for t in 0..RUN_TICKS {
-                s.tcps_at(t, &mut tcps);
-                let e = exact.check(&tcps).unwrap().clone();
-                let r = lookup.check_with_table(&tcps, &bound).unwrap();
-                counts[0][e.verdict as usize] += 1;
-                counts[1][r.verdict as usize] += 1;
-                since_lookup = (since_lookup || r.table_lookup) && r.verdict == Protective::Free;
-                if r.table_lookup || (since_lookup && r.kept_proof) {
-                    assert_eq!((r.verdict, r.status), (Protective::Free, ProtectiveStatus::Ok));
-                    assert!(
-                        r.clearance_mm <= e.clearance_mm,
-                        "{name} {} tick {t}: {} > {}",
-                        s.case,
-                        r.clearance_mm,
-                        e.clearance_mm
-                    );
-                    lookups += u64::from(r.table_lookup);
-                    tested_ticks += 1;
-                    if tested_ticks % 5 == 0 {
-                        let vel = std::array::from_fn(|j| {
-                            let w = (tcps[j] - prev[j]) / tick
-                                + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
-                            w * (stop.max_speed_mm_s / w.norm()).min(1.0)
-                        });
-                        assert_stops_never_touch(&cell, &tcps, &vel, 4, &mut rng);
-                        tested += 1;
-                    }
-                }
-                prev = tcps;
-            }
-            let share = 100.0 * lookups as f64 / RUN_TICKS as f64;
-            println!(
-                "{label} {name} {:<9}: exact mode STOP {} WARN {}; table mode STOP {} WARN {}, {lookups} ticks ({share:.1} %) by the lookup alone",
-                s.case, counts[0][2], counts[0][1], counts[1][2], counts[1][1]
-            );
-            lookups_total += lookups;
+            let run = side_by_side(&cell, &bound, s, stop, &mut rng);
+            println!("{label} {name} {:<9}: {}", s.case, run.line());
+            (lookups, tested) = (lookups + run.lookups, tested + run.tested);
         }
     }
-    (lookups_total, tested)
+    (lookups, tested)
 }
 
 #[test]
@@ -312,12 +346,9 @@ fn the_c_counter_reads_zero_for_null() {
 }
 
 /// The line of four (`cells/line4.toml`, stiff models) in table mode from the bundle of its
-/// clearance tables (one per spacing), beside exact mode, on both line cases. Every tick FREE
-/// by the lookups (every pair's table bound beats its robots' motion bounds), or by a proof
-/// kept since, reports a clearance at most the exact one; at every fifth such tick random
-/// stops of every pair that can meet never touch, each pair checked as its pair cell (the
-/// two robots where they stand relative to each other: the bundle's own reduction, whose
-/// soundness `tests/bundles.rs` checks against the whole line).
+/// clearance tables (one per spacing), beside exact mode, on both line cases
+/// ([`side_by_side`]). A neighbour pair is always close, so the lookups prove pairs, not
+/// whole ticks; table mode never stops more often than exact mode.
 #[test]
 fn a_line_in_table_mode_stops_in_time() {
     let line = parse_cell(include_str!("../cells/line4.toml")).unwrap().with_stopping(1.0, vec![STIFF; 4]).unwrap();
@@ -326,52 +357,14 @@ fn a_line_in_table_mode_stops_in_time() {
     let bundle = BundleChecker::new(line.clone(), &built.bytes, Confirmation::Exact).unwrap();
     assert!(bundle.has_clearance());
     let bound = |a: usize, b: usize, t: &[Vec3]| bundle.clearance_bound(a, b, t);
-    let scenarios = parse_scenarios(include_str!("../c_harness/line_scenarios.txt")).unwrap();
     let mut rng = StdRng::seed_from_u64(23);
-    let tick = line.tick_ms * 1e-3;
-    let (mut lookups, mut tested) = (0u64, 0u64);
-    for s in &scenarios {
-        let mut exact = ProtectiveChecker::new(line.clone(), 10.0).unwrap().with_speed_limits(false);
-        let mut lookup = ProtectiveChecker::new(line.clone(), 10.0).unwrap().with_speed_limits(false);
-        let (mut tcps, mut prev) = (vec![Vec3::zeros(); 4], vec![Vec3::zeros(); 4]);
-        let (mut counts, mut since_lookup, mut run_lookups, mut pair_lookups) = ([[0u32; 3]; 2], false, 0u64, 0u64);
-        for t in 0..RUN_TICKS {
-            s.tcps_at(t, &mut tcps);
-            let e = exact.check(&tcps).unwrap().clone();
-            let r = lookup.check_with_table(&tcps, &bound).unwrap();
-            counts[0][e.verdict as usize] += 1;
-            counts[1][r.verdict as usize] += 1;
-            pair_lookups += u64::from(r.table_pairs);
-            let looked_up = r.table_pairs > 0 && r.verdict == Protective::Free;
-            since_lookup = (since_lookup || looked_up) && r.verdict == Protective::Free;
-            if looked_up || (since_lookup && r.kept_proof) {
-                assert_eq!((r.verdict, r.status), (Protective::Free, ProtectiveStatus::Ok));
-                assert!(r.clearance_mm <= e.clearance_mm, "{} tick {t}: {} > {}", s.case, r.clearance_mm, e.clearance_mm);
-                run_lookups += u64::from(r.table_lookup);
-                tested += 1;
-                if tested % 5 == 0 {
-                    let vel: Vec<Vec3> = (0..4)
-                        .map(|j| {
-                            let w = (tcps[j] - prev[j]) / tick
-                                + unit(&mut rng) * STIFF.max_accel_mm_s2 * tick * rng.random::<Real>();
-                            w * (STIFF.max_speed_mm_s / w.norm()).min(1.0)
-                        })
-                        .collect();
-                    for (a, b) in line.pairs_that_can_meet() {
-                        let pair = pair_cell(&line, a, b);
-                        assert_stops_never_touch(&pair, &[tcps[a], tcps[b]], &[vel[a], vel[b]], 4, &mut rng);
-                    }
-                }
-            }
-            prev.clone_from(&tcps);
-        }
-        println!(
-            "line4 {:<9}: exact mode STOP {} WARN {}; table mode STOP {} WARN {}, {run_lookups} ticks by the lookups alone, {pair_lookups} pairs proved by a lookup",
-            s.case, counts[0][2], counts[0][1], counts[1][2], counts[1][1]
-        );
-        assert!(counts[1][2] <= counts[0][2], "table mode stops more often than exact mode");
-        lookups += pair_lookups;
+    let (mut pairs, mut tested) = (0, 0);
+    for s in &parse_scenarios(include_str!("../c_harness/line_scenarios.txt")).unwrap() {
+        let run = side_by_side(&line, &bound, s, STIFF, &mut rng);
+        println!("line4 {:<9}: {}", s.case, run.line());
+        assert!(run.counts[1][2] <= run.counts[0][2], "table mode stops more often than exact mode");
+        (pairs, tested) = (pairs + run.pairs, tested + run.tested);
     }
-    println!("{tested} FREE ticks that a lookup proved in part (or kept since), every fifth with simulated stops");
-    assert!(lookups >= 1_000, "the line's runs have few pairs proved by a lookup: {lookups}");
+    println!("{tested} ticks tested with simulated stops");
+    assert!(pairs >= 1_000, "the line's runs have few pairs proved by a lookup: {pairs}");
 }
