@@ -15,7 +15,8 @@
  *     (dc_init_with_table, exact confirmation of COLLISION lookups, the default), with the same
  *     checks as exact mode: FREE on every practical tick, the collision case stopped at the
  *     exact model's first colliding tick naming the same pairs; dc_init_from_files takes the
- *     cell file and the bundle file alike. T1's table alone is refused for the line: it has
+ *     cell file and the bundle file alike. With a bundle of clearance tables, the protective
+ *     verdict (stiff model) runs in table mode too, with the same stop checks. T1's table alone is refused for the line: it has
  *     no table for the robots 900 and 1350 mm apart.
  */
 #include "harness.h"
@@ -240,7 +241,7 @@ void line_scenarios(const HarnessOptions *options)
      * from then on; the stiff one (short reaction, hard braking) stops later and closer, where
      * a wrong bound would show. */
     DcStopConfig standard = dc_stop_config_default(), stiff = dc_stop_config_default();
-    VerdictTally d, t, p;
+    VerdictTally d, t, p, b;
     size_t k;
     stiff.reaction_ms = 2.0;
     stiff.decel_mm_s2 = 120000.0;
@@ -268,7 +269,15 @@ void line_scenarios(const HarnessOptions *options)
         d = run_protective("line4", cases[k], "default", &standard, NULL, 0, MR_TICKS_PER_RUN);
         t = run_protective("line4", cases[k], "stiff", &stiff, NULL, 0, MR_TICKS_PER_RUN);
         p = run_protective("line4", cases[k], "stiff", &stiff, NULL, 1, MR_TICKS_PER_RUN);
+        /* Table mode: with a bundle of clearance tables each pair's bound comes from its table,
+         * and the pairs it proves apart skip the box-pair proof of the others. */
+        b = options->line_bundle.bytes == NULL
+                ? p
+                : run_protective("line4", cases[k], "stiff", &stiff, &options->line_bundle, 0, MR_TICKS_PER_RUN);
         if (exact_first >= 0) {
+            check(b.first_stop >= 0 && b.first_stop <= exact_first,
+                  "line4 %s: first protective STOP in table mode %ld after the first exact collision tick %ld",
+                  cases[k], b.first_stop, exact_first);
             check(d.first_stop >= 0 && d.first_stop <= exact_first && t.first_stop >= 0
                       && t.first_stop <= exact_first && p.first_stop >= 0 && p.first_stop <= exact_first,
                   "line4 %s: first protective STOP %ld (stiff %ld, with paths %ld) after the first exact "

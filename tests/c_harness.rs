@@ -148,30 +148,32 @@ fn table_files(c: usize) -> &'static [PathBuf] {
 }
 
 /// The bundle file of `cells/line4.toml` (the pipeline of `delta-collide build --cell
-/// cells/line4.toml --k 32 --variant shared`: one table per spacing that can meet), kept and
+/// cells/line4.toml --k 16 --variant clearance`: one table per spacing that can meet), kept and
 /// reused as [`table_files`] are.
 fn line_bundle_file() -> &'static Path {
     static FILE: OnceLock<PathBuf> = OnceLock::new();
     FILE.get_or_init(|| {
         let dir = scratch_dir("c_harness_tables");
-        let path = dir.join(format!("line4_k{TABLE_K}_shared.dcb"));
-        let stamp = dir.join(format!("line4_k{TABLE_K}.builder"));
+        let path = dir.join(format!("line4_k{CLEARANCE_K}_clearance.dcb"));
+        let stamp = dir.join(format!("line4_k{CLEARANCE_K}.builder"));
         let exe = std::fs::metadata(std::env::current_exe().expect("test executable")).expect("stat test executable");
         let modified = exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
-        let builder = format!("{} bytes, modified {:?}, k = {TABLE_K}", exe.len(), modified.unwrap_or_default());
+        let builder = format!("{} bytes, modified {:?}, k = {CLEARANCE_K}", exe.len(), modified.unwrap_or_default());
         if path.is_file() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder) {
             return path;
         }
         let cell = parse_cell(&std::fs::read_to_string(repo_root().join("cells/line4.toml")).unwrap()).unwrap();
         let start = std::time::Instant::now();
+        // Clearance tables: the POU's lookups read their labels, the protective verdict their bounds.
+        let variant = Variant::Clearance(Ladder::default_ladder());
         let built =
-            build_bundle(&cell, TABLE_K, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
+            build_bundle(&cell, CLEARANCE_K, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent)
                 .unwrap_or_else(|e| panic!("building the line4 bundle: {e}"));
         let _ = std::fs::remove_file(&stamp);
         std::fs::write(&path, &built.bytes).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
         std::fs::write(&stamp, builder).unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
         println!(
-            "line4: bundle of {} tables k = {TABLE_K}, {} bytes, built in {:.1} s",
+            "line4: bundle of {} tables k = {CLEARANCE_K}, {} bytes, built in {:.1} s",
             built.tables.len(),
             built.bytes.len(),
             start.elapsed().as_secs_f64()
@@ -227,7 +229,8 @@ fn assert_protective_table_mode(stdout: &str) {
     for l in &runs {
         assert_eq!(number(l, "contacts "), 0.0, "{l}");
     }
-    let shares: Vec<&str> = stdout.lines().filter(|l| l.contains("answered by the lookup alone")).collect();
+    let shares: Vec<&str> =
+        stdout.lines().filter(|l| l.starts_with("protective T") && l.contains("answered by the lookup alone")).collect();
     assert_eq!(shares.len(), 18, "{shares:?}");
     let lookups: f64 = shares.iter().filter(|l| l.contains(" stiff ")).map(|l| number(l, "table mode: ")).sum();
     assert!(lookups > 500.0, "the stiff runs in table mode answer few ticks by the lookup: {shares:?}");
@@ -278,8 +281,12 @@ fn assert_line(stdout: &str) {
     assert!(table_collision.contains("colliding pairs at the stop 2-3,"), "{table_collision}");
     // The lookups said COLLISION near the contact and the exact check confirmed them.
     assert!(number(table_collision, "lookups confirmed ") > 0.0, "{table_collision}");
-    let protective: Vec<&str> = stdout.lines().filter(|l| l.starts_with("protective line4 ")).collect();
-    assert_eq!(protective.len(), 6, "three protective runs per case: {protective:?}");
+    let protective: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("protective line4 ") && !l.contains("answered by the lookup alone"))
+        .collect();
+    assert_eq!(protective.len(), 8, "four protective runs per case: {protective:?}");
+    assert_eq!(protective.iter().filter(|l| l.contains(" table mode:")).count(), 2, "{protective:?}");
     for l in protective {
         assert_eq!(number(l, "contacts "), 0.0, "{l}");
         assert_eq!(number(l, "statuses not OK "), 0.0, "{l}");
