@@ -282,18 +282,22 @@ fn runs(stop: StopModel, label: &str) -> (u64, u64) {
         for s in scenarios.iter().filter(|s| s.cell == name) {
             let run = side_by_side(&cell, &bound, s, stop, &mut rng);
             println!("{label} {name} {:<9}: {}", s.case, run.line());
+            assert!(run.counts[1][2] <= run.counts[0][2], "table mode stops more often than exact mode");
             (lookups, tested) = (lookups + run.lookups, tested + run.tested);
         }
     }
     (lookups, tested)
 }
 
+/// Table mode never stops a reference run more often than exact mode. Its lookups come after
+/// the proofs kept for wider balls, which settle almost every tick of these smooth runs, so
+/// the lookups rarely answer here: `lookup_free_verdicts_survive_simulated_stops` and the
+/// line's test are where they are tested hardest.
 #[test]
 fn lookup_ticks_of_the_reference_runs_are_sound() {
     let (stiff, tested_stiff) = runs(STIFF, "stiff");
     let (default, tested_default) = runs(StopModel::DEFAULT, "default");
     println!("lookup ticks: stiff {stiff} ({tested_stiff} with simulated stops), default {default} ({tested_default})");
-    assert!(stiff >= 1_000, "the stiff model's runs have few lookup ticks: {stiff}");
 }
 
 /// A boolean table proves no clearance: table mode then gives every verdict of exact mode,
@@ -315,28 +319,33 @@ fn a_boolean_table_changes_nothing() {
     }
 }
 
+/// Table-mode ticks allocate nothing: random states of T3 with TCPs on grid-cell faces, each
+/// a tick that gives the speeds and the tick checked (where lookups answer: see
+/// `lookup_free_verdicts_survive_simulated_stops`).
 #[test]
 fn a_table_mode_tick_never_allocates() {
-    let cell = cell("T1", STIFF);
+    let cell = cell("T3", STIFF);
     let table = table(&cell, true);
     let bound = |_: usize, _: usize, t: &[Vec3]| table.clearance_bound(t);
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
-    let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
-    let mut c = ProtectiveChecker::new(cell, 10.0).unwrap();
-    let ticks: Vec<[Vec3; 2]> = (0..RUN_TICKS)
-        .map(|t| {
-            let mut tcps = [Vec3::zeros(); 2];
-            s.tcps_at(t, &mut tcps);
-            tcps
+    let mut rng = StdRng::seed_from_u64(5);
+    let tick = cell.tick_ms * 1e-3;
+    let states: Vec<[[Vec3; 2]; 2]> = (0..2_000)
+        .map(|_| {
+            let tcps = [0, 1].map(|j| sample(&cell, &table, j, Place::CellFaces, &mut rng));
+            let v = [0, 1].map(|_| unit(&mut rng) * STIFF.max_speed_mm_s * rng.random::<Real>().powi(3) * tick);
+            [[tcps[0] - v[0], tcps[1] - v[1]], tcps]
         })
         .collect();
+    let mut c = ProtectiveChecker::new(cell, 10.0).unwrap().with_speed_limits(false);
     let before = allocations();
     let mut lookups = 0;
-    for tcps in &ticks {
-        lookups += u32::from(c.check_with_table(tcps, &bound).unwrap().table_lookup);
+    for [prev, tcps] in &states {
+        c.reset();
+        c.check_with_table(prev, &bound).unwrap();
+        lookups += u32::from(c.check_with_table(tcps, &bound).unwrap().table_pairs);
     }
     assert_eq!(allocations(), before);
-    assert!(lookups > 10, "{lookups} lookup ticks: the lookup path was not exercised");
+    assert!(lookups > 10, "{lookups} pairs proved by a lookup: the lookup path was not exercised");
 }
 
 #[test]

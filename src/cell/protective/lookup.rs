@@ -2,8 +2,9 @@
 //! §6): where the table's bound alone proves FREE, a tick costs one table lookup per pair
 //! that can meet and one motion bound per robot instead of the swept-box proof of every box
 //! pair. A line's pairs each take their table's bound (a bundle's): the pairs it proves are
-//! skipped by the proof of the others, and the tick needs no proof when it proves them all. It is tried
-//! after the cheaper answers (a kept proof, a certain STOP) and before the proof.
+//! skipped by the proof of the others, and the tick needs no proof when it proves them all. It
+//! is tried after the cheaper answers (a kept proof, a certain STOP, a proof kept for wider
+//! balls) and before the proof, which reuses the sweeps it computed.
 //!
 //! # Why a lookup proves FREE
 //! Let robot `j`'s stop ball be `B(c_j, R_j)` (its stop reference, module doc of

@@ -70,12 +70,13 @@
 //! tick's balls covers this tick too, so FREE ticks that follow FREE ticks mostly reuse one
 //! instead of computing sweeps ([`ProtectiveReport::kept_proof`]).
 //!
-//! **Table mode** (`protective/lookup.rs`): with a certified clearance table, a tick not
-//! settled by a kept proof or a certain STOP whose table bound exceeds both robots' motion
-//! bounds (the largest displacement of any box point under step 4's sweeps) plus `warn_mm`
-//! is FREE by the lookup, without the box-pair proof
-//! ([`ProtectiveChecker::check_with_table`], [`ProtectiveReport::table_lookup`]); every other
-//! tick takes the proof above, unchanged.
+//! **Table mode** (`protective/lookup.rs`): with certified clearance tables, in a tick not
+//! settled by a kept proof or a certain STOP, a pair whose table bound exceeds both robots'
+//! motion bounds (the largest displacement of any box point under step 4's sweeps) plus
+//! `warn_mm` is proved by the lookup, without its box-pair proof; the tick is FREE by the
+//! lookups when every pair is ([`ProtectiveChecker::check_with_table`],
+//! [`ProtectiveReport::table_lookup`], [`ProtectiveReport::table_pairs`]); the other pairs
+//! take the proof above, unchanged.
 //!
 //! Nothing here allocates after [`ProtectiveChecker::new`].
 
@@ -589,18 +590,19 @@ impl ProtectiveChecker {
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
         }
-        // The cheaper answers first: a kept proof (no sweeps), a certain STOP (none either),
-        // then the table's bound (the table's tier of sweeps, which the proof below reuses).
+        // The cheaper answers first: a kept proof (no sweeps), a certain STOP (none either), a
+        // proof kept for wider balls (sweeps only where the kept balls widen), then the
+        // table's bounds (this tick's sweeps of the table's tier, which the proof reuses).
         if kept {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
         } else if let Some(pair) = self.certain_stop(None) {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
-        } else if table.is_some_and(|bound| self.lookup_pairs(bound)) {
-            (self.report.verdict, self.report.table_lookup) = (Protective::Free, true);
-            // The lookup proved FREE for every TCP of both stop balls: kept like a proof.
-            self.keep_references();
         } else if was_free && self.keep_and_prove() {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
+        } else if table.is_some_and(|bound| self.lookup_pairs(bound)) {
+            (self.report.verdict, self.report.table_lookup) = (Protective::Free, true);
+            // The lookup proved FREE for every TCP of every stop ball: kept like a proof.
+            self.keep_references();
         } else {
             (self.report.verdict, self.report.limiting) = self.prove();
             if self.report.verdict == Protective::Free {
