@@ -85,19 +85,28 @@ impl CoherentClearance {
         let m = b.len().max(1);
         let mut out = PairClearance::NONE;
         let first = if self.closest < n { self.closest } else { 0 };
-        for k in (0..n).map(|k| (k + first) % n) {
-            let (ba, bb) = (&a[k / m], &b[k % m]);
+        // Box pair `k = i m + l` is `(a[i], b[l])`; counted from `first`, wrapping, with the
+        // two indices stepped along (an integer division per pair costs as much as its skip test).
+        let (mut i, mut l) = (first / m, first % m);
+        for _ in 0..n {
+            let k = i * m + l;
+            let (ba, bb) = (&a[i], &b[l]);
             let memory = &mut self.pairs[k];
             // NaN never skips: a box with a NaN is computed and shows as a NaN distance.
-            if memory.direction != Vec3::zeros() && gap_along(ba, bb, &memory.direction) >= out.distance {
-                continue;
-            }
-            let c = pair_clearance(ba, bb, memory);
-            if !(c.distance >= out.distance) {
-                out = PairClearance::of(k / m, k % m, &c);
-                if c.distance.is_nan() {
-                    break;
+            let skip = memory.direction != Vec3::zeros() && gap_along(ba, bb, &memory.direction) >= out.distance;
+            if !skip {
+                let c = pair_clearance(ba, bb, memory);
+                if !(c.distance >= out.distance) {
+                    out = PairClearance::of(i, l, &c);
+                    if c.distance.is_nan() {
+                        break;
+                    }
                 }
+            }
+            l += 1;
+            if l == m {
+                l = 0;
+                i = if i + 1 == a.len() { 0 } else { i + 1 };
             }
         }
         self.closest = out.box_a * m + out.box_b;
