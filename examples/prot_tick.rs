@@ -1,5 +1,7 @@
 //! Per-tick medians of the protective verdict and the exact query over the practical and
-//! collision runs, for profiling: `prot_tick [stiff|default] [verdict|limits] [repeats]`.
+//! collision runs, for profiling: `prot_tick [stiff|default] [verdict|limits] [repeats] [T1practical|...]`
+//! (the last argument keeps one run). With `COMPONENTS` set in the environment it times only the
+//! parts of a tick that reuses a kept proof: the boxes, the clearance, the closest box pair alone.
 
 use delta_collide::cell::protective::{Protective, ProtectiveChecker};
 use delta_collide::cell::reference::reference_cell;
