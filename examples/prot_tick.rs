@@ -89,7 +89,8 @@ fn main() {
         }
         let ((pm, p99, pmean), (em, _, _)) = (q(&mut tp), q(&mut te));
         println!(
-            "{} {}: STOP {stops} WARN {warns}; protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, exact median {em:.3} us",
+            "{} {}: STOP {stops} WARN {warns}; protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, \
+             exact median {em:.3} us",
             s.cell, s.case
         );
     }
