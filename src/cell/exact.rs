@@ -7,7 +7,7 @@
 
 use crate::cell::{Cell, SatMethod};
 use crate::geometry::{first_intersecting_pair, Obb, WitnessCache};
-use crate::math::{max_or_nan, min_or_nan, Vec3};
+use crate::math::{max_or_nan, min_or_nan, Mat3, Vec3};
 use crate::robot::{RobotBoxes, Unreachable};
 use alloc::{vec, vec::Vec};
 
@@ -96,6 +96,9 @@ pub struct ExactChecker {
     cell: Cell,
     /// Robots placed at the WCS origin without rotation skip the box transform.
     at_origin: Vec<bool>,
+    /// Per robot, the rotation of its placement (MCS to WCS): fixed, so its sine and cosine
+    /// are taken once here rather than every tick.
+    rotations: Vec<Mat3>,
     boxes: Vec<RobotBoxes>,
     /// Per robot: centre and half-extents of the AABB of all its boxes (WCS).
     aabb: Vec<(Vec3, Vec3)>,
@@ -114,6 +117,7 @@ impl ExactChecker {
             .collect();
         ExactChecker {
             at_origin: cell.robots.iter().map(|r| r.placement.alpha == 0.0 && r.placement.t == Vec3::zeros()).collect(),
+            rotations: cell.robots.iter().map(|r| r.placement.rotation()).collect(),
             boxes: vec![RobotBoxes::empty(); n],
             aabb: vec![(Vec3::zeros(), Vec3::zeros()); n],
             caches: vec![WitnessCache::new(); pairs.len()],
@@ -145,7 +149,8 @@ impl ExactChecker {
     /// # Errors
     /// [`QueryError::WrongRobotCount`] when `tcps_mcs.len()` differs from the robot count.
     pub fn check(&mut self, tcps_mcs: &[Vec3]) -> Result<&CellVerdict, QueryError> {
-        self.place_boxes(tcps_mcs)?;
+        // The loop below sets every pair's state: no need to mark them undecided first.
+        self.place(tcps_mcs, true)?;
         for (k, pair) in self.verdict.pairs.iter_mut().enumerate() {
             let (a, b) = (pair.a, pair.b);
             pair.state = if self.verdict.unreachable_mask & (1 << a | 1 << b) != 0 {
@@ -169,6 +174,15 @@ impl ExactChecker {
     /// # Errors
     /// [`QueryError::WrongRobotCount`] when `tcps_mcs.len()` differs from the robot count.
     pub fn place_boxes(&mut self, tcps_mcs: &[Vec3]) -> Result<&CellVerdict, QueryError> {
+        // The AABBs serve only the pair tests, which this leaves out.
+        self.place(tcps_mcs, false)?;
+        self.verdict.pairs.iter_mut().for_each(|p| p.state = PairState::Undecided);
+        Ok(&self.verdict)
+    }
+
+    /// Every robot's boxes in the WCS, which TCPs are unreachable, and with `aabbs` each
+    /// reachable robot's AABB; the pair states are left as they were.
+    fn place(&mut self, tcps_mcs: &[Vec3], aabbs: bool) -> Result<(), QueryError> {
         let n = self.cell.robots.len();
         if tcps_mcs.len() != n {
             return Err(QueryError::WrongRobotCount { expected: n, found: tcps_mcs.len() });
@@ -181,12 +195,14 @@ impl ExactChecker {
                 Ok(()) => {
                     let boxes = &mut self.boxes[j];
                     if !self.at_origin[j] {
-                        let (rot, t) = (robot.placement.rotation(), robot.placement.t);
+                        let (rot, t) = (&self.rotations[j], &robot.placement.t);
                         for b in &mut boxes.boxes[..boxes.len] {
-                            *b = b.transformed(&rot, &t);
+                            *b = b.transformed(rot, t);
                         }
                     }
-                    self.aabb[j] = aabb_of(boxes);
+                    if aabbs {
+                        self.aabb[j] = aabb_of(boxes);
+                    }
                 }
                 Err(why) => {
                     self.verdict.unreachable_mask |= 1 << j;
@@ -194,8 +210,7 @@ impl ExactChecker {
                 }
             }
         }
-        self.verdict.pairs.iter_mut().for_each(|p| p.state = PairState::Undecided);
-        Ok(&self.verdict)
+        Ok(())
     }
 }
 

@@ -218,8 +218,11 @@ impl RobotModel {
                 out.push(link_box(&d.motor_point(arm), g, inv_rf, &tangent(arm), upper_half));
             }
         }
-        for extra in [o.platform, o.tool].into_iter().flatten() {
-            out.push(Obb::new(tcp + extra.offset, Mat3::identity(), extra.half.add_scalar(m)));
+        // Each optional box read in place: an array of both options would copy them every call.
+        for extra in [&o.platform, &o.tool] {
+            if let Some(extra) = extra {
+                out.push(Obb::new(tcp + extra.offset, Mat3::identity(), extra.half.add_scalar(m)));
+            }
         }
     }
 

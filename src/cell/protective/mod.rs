@@ -248,6 +248,9 @@ pub struct ProtectiveChecker {
     precise_splits: u32,
     /// Whether the speed limits use the second tier too (else the table's alone).
     precise_limits: bool,
+    /// Per robot, `S` and the ball of [`ProtectiveChecker::stop_ball`] at this tick's measured
+    /// speed: computed once per tick, read again when the tick needs its references.
+    stop_balls: alloc::vec::Vec<(Real, (Vec3, Real))>,
     /// Per robot, the centre (MCS) and radius of the ball holding its TCP over the stop.
     centres: alloc::vec::Vec<Vec3>,
     reach: alloc::vec::Vec<Real>,
@@ -319,6 +322,7 @@ impl ProtectiveChecker {
             speed_limits: true,
             precise_splits: PRECISE_SPLITS,
             precise_limits: false,
+            stop_balls: alloc::vec![(0.0, (Vec3::zeros(), 0.0)); n],
             centres: alloc::vec![Vec3::zeros(); n],
             reach: alloc::vec![0.0; n],
             sweep_tier: alloc::vec![None; n],
@@ -573,6 +577,7 @@ impl ProtectiveChecker {
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let v = self.report.robots[j].speed_mm_s;
             let (s, ball) = self.stop_ball(j, tcp, v);
+            self.stop_balls[j] = (s, ball);
             self.kept.set_inside(j, &[ball, (*tcp, s)]);
             let bound = self.speed_bound(j, v);
             let r = &mut self.report.robots[j];
@@ -588,7 +593,7 @@ impl ProtectiveChecker {
             return;
         }
         for (j, tcp) in tcps_mcs.iter().enumerate() {
-            self.stop_reference(j, tcp, self.report.robots[j].speed_mm_s);
+            self.reference_at(j, tcp, self.stop_balls[j]);
         }
         // The cheaper answers first: a kept proof (no sweeps), a certain STOP (none either), a
         // proof kept for wider balls (sweeps only where the kept balls widen), then the
@@ -696,7 +701,13 @@ impl ProtectiveChecker {
     /// over the stop (module doc, step 3) for TCP `tcp_mcs` at measured speed `v`, and marks its
     /// sweeps as not computed; returns `S`.
     fn stop_reference(&mut self, j: usize, tcp_mcs: &Vec3, v: Real) -> Real {
-        let (s, (centre, radius)) = self.stop_ball(j, tcp_mcs, v);
+        let ball = self.stop_ball(j, tcp_mcs, v);
+        self.reference_at(j, tcp_mcs, ball)
+    }
+
+    /// [`ProtectiveChecker::stop_reference`] from `S` and the ball already computed by
+    /// [`ProtectiveChecker::stop_ball`] for this robot, TCP and speed.
+    fn reference_at(&mut self, j: usize, tcp_mcs: &Vec3, (s, (centre, radius)): (Real, (Vec3, Real))) -> Real {
         let robot = &self.exact.cell().robots[j];
         let (rot, t) = (robot.placement.rotation(), robot.placement.t);
         let (centre, radius) = match robot.model.boxes_into(&centre, &mut self.ref_boxes[j]) {

@@ -85,19 +85,28 @@ impl CoherentClearance {
         let m = b.len().max(1);
         let mut out = PairClearance::NONE;
         let first = if self.closest < n { self.closest } else { 0 };
-        for k in (0..n).map(|k| (k + first) % n) {
-            let (ba, bb) = (&a[k / m], &b[k % m]);
+        // Box pair `k = i m + l` is `(a[i], b[l])`; counted from `first`, wrapping, with the
+        // two indices stepped along (an integer division per pair costs as much as its skip test).
+        let (mut i, mut l) = (first / m, first % m);
+        for _ in 0..n {
+            let k = i * m + l;
+            let (ba, bb) = (&a[i], &b[l]);
             let memory = &mut self.pairs[k];
             // NaN never skips: a box with a NaN is computed and shows as a NaN distance.
-            if memory.direction != Vec3::zeros() && gap_along(ba, bb, &memory.direction) >= out.distance {
-                continue;
-            }
-            let c = pair_clearance(ba, bb, memory);
-            if !(c.distance >= out.distance) {
-                out = PairClearance::of(k / m, k % m, &c);
-                if c.distance.is_nan() {
-                    break;
+            let skip = memory.direction != Vec3::zeros() && gap_along(ba, bb, &memory.direction) >= out.distance;
+            if !skip {
+                let c = pair_clearance(ba, bb, memory);
+                if !(c.distance >= out.distance) {
+                    out = PairClearance::of(i, l, &c);
+                    if c.distance.is_nan() {
+                        break;
+                    }
                 }
+            }
+            l += 1;
+            if l == m {
+                l = 0;
+                i = if i + 1 == a.len() { 0 } else { i + 1 };
             }
         }
         self.closest = out.box_a * m + out.box_b;
@@ -123,10 +132,12 @@ fn gap_along(a: &Obb, b: &Obb, n: &Vec3) -> Real {
 /// scratch; the memory updated either way.
 #[inline(always)]
 fn pair_clearance(a: &Obb, b: &Obb, memory: &mut PairMemory) -> Clearance {
-    let (c, feature) = match warm(a, b, memory.feature) {
-        Some(c) => (c, memory.feature),
-        None => obb_clearance_with_feature(a, b),
-    };
+    if let Some((c, direction)) = warm(a, b, memory.feature) {
+        // The warm start's unit direction between its points, turned to the world frame.
+        memory.direction = direction;
+        return c;
+    }
+    let (c, feature) = obb_clearance_with_feature(a, b);
     // Unit by construction: a gap along a longer vector would not be a lower bound. Where the
     // points are too close to give a direction (rounding of the coordinates), none is kept.
     let d = (c.point_b - c.point_a) * c.distance.signum();
@@ -137,9 +148,11 @@ fn pair_clearance(a: &Obb, b: &Obb, memory: &mut PairMemory) -> Clearance {
 }
 
 /// The clearance from the features `feature` when the gap along the direction between their
-/// closest points certifies it (module doc, fact 2); `None` otherwise.
+/// closest points certifies it (module doc, fact 2), with that unit direction in the world
+/// frame (A's axes times the unit vector in A's frame: unit to rounding, and at least
+/// [`WARM_MIN_GAP`] between the points, far above [`DIRECTION_MIN_MM`]); `None` otherwise.
 #[inline(always)]
-fn warm(a: &Obb, b: &Obb, feature: Feature) -> Option<Clearance> {
+fn warm(a: &Obb, b: &Obb, feature: Feature) -> Option<(Clearance, Vec3)> {
     if feature == Feature::None || !finite(a, b) {
         return None;
     }
@@ -149,14 +162,15 @@ fn warm(a: &Obb, b: &Obb, feature: Feature) -> Option<Clearance> {
     if !(d >= WARM_MIN_GAP) {
         return None;
     }
-    let u: [Real; 3] = core::array::from_fn(|k| (best.q[k] - best.p[k]) / d);
+    let inv_d = 1.0 / d;
+    let u: [Real; 3] = core::array::from_fn(|k| (best.q[k] - best.p[k]) * inv_d);
     let (r, t) = (&rel.r, &rel.t);
     let centres = u[0] * t[0] + u[1] * t[1] + u[2] * t[2];
     let sa = rel.a[0] * u[0].abs() + rel.a[1] * u[1].abs() + rel.a[2] * u[2].abs();
     let sb: Real = (0..3).map(|l| rel.b[l] * (u[0] * r[0][l] + u[1] * r[1][l] + u[2] * r[2][l]).abs()).sum();
     // The same slack as `separated`'s shortcut: the size of the problem times 1e-13.
     let size = rel.t.iter().chain(&rel.a).chain(&rel.b).map(|x| x.abs()).sum::<Real>();
-    (d <= centres - sa - sb + 1e-13 * size).then(|| best.clearance(a))
+    (d <= centres - sa - sb + 1e-13 * size).then(|| (best.clearance(a), a.axes * Vec3::new(u[0], u[1], u[2])))
 }
 
 /// The closest points of the two features now (A's frame); `None` for edges now parallel.
