@@ -266,8 +266,10 @@ fn clearance_table_through_build_inspect_eval_and_check() {
     }
     assert!(levelled > 10 && none > 0, "{levelled} rows with a level, {none} without:\n{text}");
     // replay --table: T1 practical with a stiff stopping model on a table with the default
-    // levels; some ticks are answered by the lookup alone; statuses and the (exact) clearance
-    // agree with exact mode's.
+    // levels; the share of ticks answered by the lookup alone goes to stderr (on this smooth
+    // run, proofs kept from earlier ticks come first and leave the lookups almost nothing:
+    // `tests/bundles.rs` replays a line where they prove pairs); statuses and the (exact)
+    // clearance agree with exact mode's, and table mode never stops where exact mode does not.
     let ladder_table = dir.join("t1d.dct");
     let ladder_table = ladder_table.to_str().unwrap();
     let out = cli(&["build", "--cell", "T1", "--k", "16", "--variant", "clearance", "--output", ladder_table]);
@@ -284,18 +286,13 @@ fn clearance_table_through_build_inspect_eval_and_check() {
     let exact = cli_stdin(&["replay", "--cell", cell], &rows);
     let table_mode = cli_stdin(&["replay", "--cell", cell, "--table", ladder_table], &rows);
     assert!(exact.status.success() && table_mode.status.success(), "{}", stderr(&table_mode));
-    let lookups: u32 = stderr(&table_mode)
-        .split(" of 6000 ticks")
-        .next()
-        .and_then(|s| s.rsplit(' ').next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("no lookup share: {}", stderr(&table_mode)));
-    assert!(lookups > 0 && stderr(&table_mode).contains("answered FREE by the lookup alone"), "{}", stderr(&table_mode));
+    assert!(stderr(&table_mode).contains(" of 6000 ticks"), "no lookup share: {}", stderr(&table_mode));
     let (exact, table_mode) = (stdout(&exact), stdout(&table_mode));
     assert_eq!(exact.lines().count(), table_mode.lines().count());
     for (e, t) in exact.lines().zip(table_mode.lines()).skip(1) {
         let (e, t): (Vec<&str>, Vec<&str>) = (e.split(',').collect(), t.split(',').collect());
         assert_eq!((e[0], e[2], e[3]), (t[0], t[2], t[3]), "tick, status and clearance");
+        assert!(t[1] != "stop" || e[1] == "stop", "table mode stops at tick {} where exact mode does not", t[0]);
     }
     // quilt shades free cells by level: the middle levels' blues cover many cells.
     let png = dir.join("quilt.png");
