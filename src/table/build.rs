@@ -206,7 +206,13 @@ pub fn build_table_bounded(
 ///
 /// # Errors
 /// Not two robots, a bad `k`, or [`BuildError::Memory`].
-pub fn memory_plan(cell: &Cell, k: u32, ws: &Workspace, variant: Variant, max_memory: u64) -> Result<MemoryPlan, BuildError> {
+pub fn memory_plan(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    variant: Variant,
+    max_memory: u64,
+) -> Result<MemoryPlan, BuildError> {
     if cell.robots.len() != 2 {
         return Err(BuildError::NotTwoRobots { cell: cell.name.clone(), robots: cell.robots.len() });
     }
@@ -227,7 +233,8 @@ fn build_streamed(
     let symmetry = Symmetry::of(cell);
     let built = certify_rows_then(cell, k, ws, &config, Rows::ALL, true, |c, source| {
         let label_secs = start.elapsed().as_secs_f64();
-        let source = source.ok_or(BuildError::Table(TableError::BadInput { what: "no sub-cells were labelled".into() }))?;
+        let no_sub = || BuildError::Table(TableError::BadInput { what: "no sub-cells were labelled".into() });
+        let source = source.ok_or_else(no_sub)?;
         let space = &c.space;
         let header = Header::for_cell(space, cell, *ws, Certification::SweptBound);
         let mut blocks = Blocks { source, cache: plan.cache, secs: 0.0 };

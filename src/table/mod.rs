@@ -46,7 +46,9 @@ use alloc::{format, string::String};
 #[cfg(feature = "eval")]
 use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
-pub use build::{build_table, build_table_bounded, build_tables, memory_plan, BuildError, BuildReport, Labelling, Variant};
+pub use build::{
+    build_table, build_table_bounded, build_tables, memory_plan, BuildError, BuildReport, Labelling, Variant,
+};
 #[cfg(feature = "std")]
 pub use memory::{parse_bytes, MemoryPlan};
 pub use bundle::{bundle_from_bytes, bundle_to_bytes, is_bundle, pair_cell, Bundle, BundlePair};

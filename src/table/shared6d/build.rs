@@ -158,7 +158,8 @@ impl Builder<'_> {
     /// [`subdivided_cell`](Self::subdivided_cell) looks up inside the block.
     fn fetch_block(&mut self, d: u32, a: [usize; 3], b: [usize; 3]) {
         let side = self.k >> d;
-        let (in_a, in_b) = (block_samples(&self.dense_a, self.k, side, a), block_samples(&self.dense_b, self.k, side, b));
+        let in_a = block_samples(&self.dense_a, self.k, side, a);
+        let in_b = block_samples(&self.dense_b, self.k, side, b);
         let nb = self.view.space.grid_b.cells.len();
         let mut pairs = Vec::new();
         for &ia in &in_a {
@@ -299,7 +300,8 @@ fn block_samples(dense: &[u32], k: usize, side: usize, c: [usize; 3]) -> Vec<usi
     for x in c[0] * side..(c[0] + 1) * side {
         for y in c[1] * side..(c[1] + 1) * side {
             let row = (x * k + y) * k;
-            out.extend(dense[row + c[2] * side..row + (c[2] + 1) * side].iter().filter(|&&i| i != NONE).map(|&i| i as usize));
+            let line = &dense[row + c[2] * side..row + (c[2] + 1) * side];
+            out.extend(line.iter().filter(|&&i| i != NONE).map(|&i| i as usize));
         }
     }
     out
