@@ -1,5 +1,7 @@
 //! Building a table for a two-robot cell: sample, label, make the labels safe, build the
-//! chosen linear quadtree (thesis 3.2.1's pipeline, Figure 3.4; SPEC §4, §6).
+//! chosen linear quadtree (thesis 3.2.1's pipeline, Figure 3.4; SPEC §4, §6), in one go or,
+//! for the subdivided table, within a memory bound ([`build_table_bounded`]: the sub-cells
+//! found by blocks of the quadtree while it is built, [`crate::table::memory`]).
 //!
 //! # Safety of the labels
 //! The quadtrees treat `Unreachable` as "don't care" and may store it as free, which is safe
@@ -11,7 +13,7 @@
 //! cell), so for it the builder turns every `Unreachable` into `Collision` first.
 
 use crate::cell::Cell;
-use crate::cspace::certify::certify_rows;
+use crate::cspace::certify::{certify_rows, certify_rows_then, SubCellSource};
 use crate::cspace::certify::clearance::clearance_counts;
 use crate::cspace::label::label_space_thesis_rows;
 use crate::cspace::symmetry::Symmetry;
@@ -20,7 +22,10 @@ use crate::table::{
     Certification, ClearanceTable, Header, Ladder, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
     TableError,
 };
+use crate::table::memory::{plan_memory, MemoryPlan};
+use crate::table::shared6d::SubCellBlocks;
 use core::fmt;
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Why a table could not be built (apart from [`TableError`], which says why a table file
@@ -43,6 +48,16 @@ pub enum BuildError {
     ClearanceNeedsCertified,
     /// A builder refused the labels.
     Table(TableError),
+    /// A build bounded to `max` bytes ([`build_table_bounded`]) needs more for its fixed
+    /// part ([`crate::table::memory`]).
+    Memory {
+        /// Bytes of the fixed part (estimated).
+        needed: u64,
+        /// Of `needed`: the labels.
+        labels: u64,
+        /// The bound.
+        max: u64,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -57,11 +72,24 @@ impl fmt::Display for BuildError {
                 f.write_str("clearance levels are certified; use the certified labelling")
             }
             BuildError::Table(e) => write!(f, "{e}"),
+            BuildError::Memory { needed, labels, max } => write!(
+                f,
+                "the build needs about {} of memory whatever the block size (the robots' boxes and sweeps, \
+                 and {} of labels, one byte per sample pair), more than the {} allowed; allow more \
+                 memory, use a smaller k (each halving needs 64 times less for the labels) or shards",
+                gigabytes(*needed),
+                gigabytes(*labels),
+                gigabytes(*max)
+            ),
         }
     }
 }
 
 impl std::error::Error for BuildError {}
+
+fn gigabytes(bytes: u64) -> String {
+    format!("{:.2} GB", bytes as f64 / 1e9)
+}
 
 impl From<TableError> for BuildError {
     fn from(e: TableError) -> BuildError {
@@ -149,6 +177,106 @@ pub fn build_table(
     let (header, mut tables, report) = build_tables(cell, k, ws, &[variant], labelling, progress)?;
     let table = tables.pop().ok_or(BuildError::Table(TableError::BadInput { what: "no table built".into() }))?;
     Ok((header, table, report))
+}
+
+/// As [`build_table`] within about `max_memory` bytes ([`crate::table::memory`]): the same
+/// table; a subdivided table is built streaming its sub-cells by blocks of the quadtree,
+/// found as each block is built and dropped after it.
+///
+/// # Errors
+/// As [`build_table`], and [`BuildError::Memory`] when the fixed part of the build alone
+/// needs more than `max_memory`, before anything big is allocated.
+pub fn build_table_bounded(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    variant: Variant,
+    labelling: Labelling,
+    progress: Progress,
+    max_memory: u64,
+) -> Result<(Header, Table, BuildReport), BuildError> {
+    let plan = memory_plan(cell, k, ws, variant, max_memory)?;
+    if variant != Variant::SharedSubdivided || labelling != Labelling::Certified {
+        return build_table(cell, k, ws, variant, labelling, progress);
+    }
+    build_streamed(cell, k, ws, progress, &plan)
+}
+
+/// The memory plan of a build of `variant` of `cell` at `k` within `max_memory` bytes.
+///
+/// # Errors
+/// Not two robots, a bad `k`, or [`BuildError::Memory`].
+pub fn memory_plan(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    variant: Variant,
+    max_memory: u64,
+) -> Result<MemoryPlan, BuildError> {
+    if cell.robots.len() != 2 {
+        return Err(BuildError::NotTwoRobots { cell: cell.name.clone(), robots: cell.robots.len() });
+    }
+    let (ga, gb) = crate::cspace::label::two_robot_grids(cell, k, ws).map_err(BuildError::Labelling)?;
+    plan_memory(ga.cells.len() as u64, gb.cells.len() as u64, k, variant, max_memory)
+}
+
+/// The certified subdivided table, its sub-cells found block by block as `plan` says.
+fn build_streamed(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    progress: Progress,
+    plan: &MemoryPlan,
+) -> Result<(Header, Table, BuildReport), BuildError> {
+    let start = Instant::now();
+    let config = CertifyConfig { refinement: Refinement::SubCells, progress };
+    let symmetry = Symmetry::of(cell);
+    let built = certify_rows_then(cell, k, ws, &config, Rows::ALL, true, |c, source| {
+        let label_secs = start.elapsed().as_secs_f64();
+        let no_sub = || BuildError::Table(TableError::BadInput { what: "no sub-cells were labelled".into() });
+        let source = source.ok_or_else(no_sub)?;
+        let space = &c.space;
+        let header = Header::for_cell(space, cell, *ws, Certification::SweptBound);
+        let mut blocks = Blocks { source, cache: plan.cache, secs: 0.0 };
+        let built = Instant::now();
+        let table = SharedQuadtree6d::build_streamed(space, &mut blocks, plan.block_depth, symmetry)?;
+        let collisions = space.labels.iter().filter(|&&l| l == Label::Collision).count();
+        let report = BuildReport {
+            samples: (space.grid_a.cells.len(), space.grid_b.cells.len()),
+            pairs: space.labels.len(),
+            collisions,
+            unreachable: space.labels.iter().filter(|&&l| l == Label::Unreachable).count(),
+            symmetric: symmetry.is_mirrored(),
+            label_secs: label_secs + blocks.secs,
+            sub_cells: Some((collisions, blocks.secs)),
+            build_secs: built.elapsed().as_secs_f64() - blocks.secs,
+        };
+        Ok((header, Table::Shared(table), report))
+    });
+    built.map_err(BuildError::Labelling)?
+}
+
+/// The sub-cells of a streamed build's blocks, found in parallel; the sub-octant boxes made
+/// for them are dropped after a block once they hold more than `cache` bytes.
+struct Blocks<'s, 't> {
+    source: &'t mut SubCellSource<'s>,
+    cache: u64,
+    /// Seconds spent finding sub-cells.
+    secs: f64,
+}
+
+impl SubCellBlocks for Blocks<'_, '_> {
+    fn masks(&mut self, pairs: &[u64], nb: usize) -> Vec<(u64, u64)> {
+        let start = Instant::now();
+        let source = &*self.source;
+        let nb = nb as u64;
+        let masks = pairs.par_iter().map(|&p| source.masks((p / nb) as usize, (p % nb) as usize)).collect();
+        if source.cached_bytes() as u64 > self.cache {
+            self.source.clear_cache();
+        }
+        self.secs += start.elapsed().as_secs_f64();
+        masks
+    }
 }
 
 /// As [`build_table`] for several variants from one labelling (the tables in `variants`'

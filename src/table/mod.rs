@@ -25,6 +25,8 @@ pub mod code;
 pub(crate) mod error;
 pub mod format;
 mod kind;
+#[cfg(feature = "std")]
+pub mod memory;
 pub(crate) mod lookup;
 pub(crate) mod quadtree4d;
 pub(crate) mod quadtree5d;
@@ -44,7 +46,11 @@ use alloc::{format, string::String};
 #[cfg(feature = "eval")]
 use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
-pub use build::{build_table, build_tables, BuildError, BuildReport, Labelling, Variant};
+pub use build::{
+    build_table, build_table_bounded, build_tables, memory_plan, BuildError, BuildReport, Labelling, Variant,
+};
+#[cfg(feature = "std")]
+pub use memory::{parse_bytes, MemoryPlan};
 pub use bundle::{bundle_from_bytes, bundle_to_bytes, is_bundle, pair_cell, Bundle, BundlePair};
 pub use bundle_checker::{BundleChecker, PairAnswer};
 pub use clearance::{ClearanceTable, Ladder};

@@ -257,6 +257,13 @@ pub struct BuildArgs {
     /// the Job's completions) [default: env DELTA_COLLIDE_SHARDS]
     #[arg(long, value_name = "N", requires = "shard", value_parser = clipped(parse_number::<u32>))]
     pub shards: Option<u32>,
+    /// The memory the build may use, in bytes or with K, M, G or T (powers of 1024), e.g. 8G: a
+    /// shared-sub build finds its sub-cells by blocks of the quadtree sized to fit (the same
+    /// table); a build whose fixed part (boxes, one byte of label per sample pair) does not fit
+    /// is refused before it starts (one-shot builds; docs/CLUSTER.md) [default: the machine's
+    /// memory]
+    #[arg(long, value_name = "BYTES", conflicts_with = "shard", value_parser = clipped(parse_bytes))]
+    pub max_memory: Option<u64>,
 }
 
 /// Which part of a build `build --shard` does.
@@ -651,6 +658,10 @@ fn parse_cells(s: &str) -> Result<Cells, String> {
 }
 
 /// A number of type `T`.
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    delta_collide::table::parse_bytes(s)
+}
+
 fn parse_number<T: std::str::FromStr>(s: &str) -> Result<T, String>
 where
     T::Err: std::fmt::Display,

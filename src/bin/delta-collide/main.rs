@@ -35,7 +35,7 @@ use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
-    build_table, from_bytes, is_bundle, to_bytes, BundleChecker, Confirmation, Labelling, Table, TableAnswer,
+    build_table_bounded, from_bytes, is_bundle, to_bytes, BundleChecker, Confirmation, Labelling, Table, TableAnswer,
     TableChecker, TableKind, Variant,
 };
 use std::io::{BufRead, Write};
@@ -371,7 +371,9 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
         return bundle::write_bundle(cell, k, variant, labelling, output, progress);
     }
     check_memory(cell, k, &Workspace::THESIS, 1)?;
-    let (header, table, r) = build_table(cell, k, &Workspace::THESIS, variant, labelling, progress)?;
+    let max_memory = args.max_memory.or_else(total_memory).unwrap_or(u64::MAX);
+    let (header, table, r) =
+        build_table_bounded(cell, k, &Workspace::THESIS, variant, labelling, progress, max_memory)?;
     if let (Progress::Rows(_), Some((pairs, secs))) = (progress, r.sub_cells) {
         eprintln!("sub-cells of {pairs} collision pairs: {secs:.2} s");
     }

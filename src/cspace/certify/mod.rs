@@ -63,7 +63,7 @@ use crate::cspace::LabelledSpace;
 use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
-use refine::{octants_prove_free, refine_unknown_cells, sub_cells, Levels, SubOctants};
+use refine::{octants_prove_free, refine_unknown_cells, sub_cell_masks, sub_cells, Levels, SubOctants};
 use sweeps::{cell_sweeps, inflation, octants, references, unreachable_cells};
 
 
@@ -201,6 +201,53 @@ pub(crate) fn certify_rows(
     config: &CertifyConfig,
     rows: Rows,
 ) -> Result<CertifiedSpace, String> {
+    certify_rows_then(cell, k, ws, config, rows, false, |c, _| c)
+}
+
+/// The sub-cells of one pair at a time, found when asked ([`certify_rows_then`] with
+/// `defer_sub`): the same masks as [`CertifiedSpace::sub`] holds, so that a table build can
+/// find them block by block and drop them (and the sub-octant boxes they needed) in between.
+pub(crate) struct SubCellSource<'a> {
+    a: Levels<'a>,
+    b: Levels<'a>,
+}
+
+impl SubCellSource<'_> {
+    /// `(care, collision)` of pair `(ia, ib)`, as [`SubCells::get`] gives it for a pair labelled
+    /// collision.
+    pub(crate) fn masks(&self, ia: usize, ib: usize) -> (u64, u64) {
+        sub_cell_masks(&self.a, &self.b, ia, ib, false)
+    }
+
+    /// Bytes held by the sub-octant boxes made so far (both robots).
+    pub(crate) fn cached_bytes(&self) -> usize {
+        [&self.a.subs, &self.b.subs].into_iter().flatten().map(SubOctants::cached_bytes).sum()
+    }
+
+    /// Drops the sub-octant boxes made so far: they are made again when needed, with the same
+    /// answers.
+    pub(crate) fn clear_cache(&mut self) {
+        for subs in [&mut self.a.subs, &mut self.b.subs].into_iter().flatten() {
+            subs.clear();
+        }
+    }
+}
+
+/// As [`certify_rows`], handing the result to `then`; with `defer_sub` (and sub-cell
+/// refinement) the sub-cells are not found here: `then` gets a [`SubCellSource`] instead,
+/// alive while it runs (it borrows the robots' boxes of the labelling).
+///
+/// # Errors
+/// As [`crate::cspace::label_space`].
+pub(crate) fn certify_rows_then<R>(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    config: &CertifyConfig,
+    rows: Rows,
+    defer_sub: bool,
+    then: impl FnOnce(CertifiedSpace, Option<&mut SubCellSource<'_>>) -> R,
+) -> Result<R, String> {
     let refine = config.refinement != Refinement::WholeCells;
     let subdivide = config.refinement == Refinement::SubCells;
     let progress = config.progress;
@@ -211,35 +258,44 @@ pub(crate) fn certify_rows(
     let (refs_a, refs_b) = (references(&ra.model, &grid_a), references(&rb.model, &grid_b));
     let a0 = whole_cell_boxes(ra, &refs_a, &sweeps_a, &empty_a);
     let b0 = whole_cell_boxes(rb, &refs_b, &sweeps_b, &empty_b);
-    let labels = if refine {
-        let (a1, b1) = (octant_boxes(ra, &grid_a), octant_boxes(rb, &grid_b));
-        // The physical boxes at the reference points: a pair that collides there is a
-        // collision without refinement.
-        let none = |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]);
-        let (xa, xb) = (
-            SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
-            SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
-        );
-        let (mut la, mut lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
-        if subdivide {
-            (la.subs, lb.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
-        }
-        let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
-        let mut labels = label_pairs(&a0, &b0, collides, rows, progress);
-        refine_unknown_cells(&la, &lb, &mut labels, rows);
-        let start = std::time::Instant::now();
-        let sub = subdivide.then(|| sub_cells(&la, &lb, &labels, rows));
-        (labels, sub, start.elapsed().as_secs_f64())
-    } else {
-        (label_pairs(&a0, &b0, |_, _| true, rows, progress), None, 0.0)
-    };
-    let (labels, sub, sub_secs) = labels;
     let radii = |ss: &[[Sweep; MAX_BOXES]]| ss.iter().map(|s| s.map(|w| w.radius())).collect::<Vec<_>>();
     let (bounds_a, bounds_b) = (radii(&sweeps_a), radii(&sweeps_b));
     let used = |bs: &[[Real; MAX_BOXES]]| bs.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0, Real::max);
     let margin = used(&bounds_a).max(used(&bounds_b));
-    let space = LabelledSpace { grid_a, grid_b, labels, margin };
-    Ok(CertifiedSpace { space, bounds_a, bounds_b, refined: refine, sub, sub_secs: if subdivide { sub_secs } else { 0.0 } })
+    let certified = |labels, sub, sub_secs: f64, grid_a, grid_b| {
+        let space = LabelledSpace { grid_a, grid_b, labels, margin };
+        let sub_secs = if subdivide { sub_secs } else { 0.0 };
+        CertifiedSpace { space, bounds_a, bounds_b, refined: refine, sub, sub_secs }
+    };
+    if !refine {
+        let labels = label_pairs(&a0, &b0, |_, _| true, rows, progress);
+        return Ok(then(certified(labels, None, 0.0, grid_a, grid_b), None));
+    }
+    let (a1, b1) = (octant_boxes(ra, &grid_a), octant_boxes(rb, &grid_b));
+    // The physical boxes at the reference points: a pair that collides there is a
+    // collision without refinement.
+    let none = |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]);
+    let (xa, xb) = (
+        SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
+        SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
+    );
+    let (mut la, mut lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+    if subdivide {
+        (la.subs, lb.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+    }
+    let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
+    let mut labels = label_pairs(&a0, &b0, collides, rows, progress);
+    refine_unknown_cells(&la, &lb, &mut labels, rows);
+    drop((xa, xb));
+    let (ga, gb) = (grid_a.clone(), grid_b.clone());
+    if subdivide && defer_sub {
+        let mut source = SubCellSource { a: la, b: lb };
+        return Ok(then(certified(labels, None, 0.0, ga, gb), Some(&mut source)));
+    }
+    let start = std::time::Instant::now();
+    let sub = subdivide.then(|| sub_cells(&la, &lb, &labels, rows));
+    let sub_secs = start.elapsed().as_secs_f64();
+    Ok(then(certified(labels, sub, sub_secs, ga, gb), None))
 }
 
 /// One robot's level-1 boxes: at each sample's reference point `refs[s]`, swept by its

@@ -6,6 +6,7 @@ use crate::cell::RobotSpec;
 use crate::cspace::guarantee::reference_point;
 use crate::cspace::label::{
     aabbs_apart, all_box_pairs, boxes_may_touch, collision_mask, entries_apart, Inflation, Rows, SampleBoxes, Slot,
+    SweptBox,
 };
 use crate::cspace::sampler::SampleGrid;
 use crate::cspace::Label;
@@ -15,6 +16,7 @@ use crate::math::{max_or_nan, min_or_nan, Real, Vec3};
 use rayon::prelude::*;
 use super::sweeps::{inflation, octant_centre, octant_sweeps};
 use super::{sub_cell_index, SubCells};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;
 
 /// Rows of A whose sub-cells are found together ([`sub_cells`]; a cache blocking, any value
@@ -47,16 +49,33 @@ pub(super) struct SubOctants<'a> {
     /// Per octant entry `8 s + i`: its sub-octants, entry `u` offset by `+/- r/8` along x,
     /// y, z for bits 0, 1, 2 of `u`.
     boxes: Vec<OnceLock<SampleBoxes>>,
+    /// How many of `boxes` are made.
+    made: AtomicUsize,
 }
 
 impl<'a> SubOctants<'a> {
     pub(super) fn new(robot: &'a RobotSpec, grid: &'a SampleGrid) -> Self {
-        SubOctants { robot, grid, boxes: (0..8 * grid.cells.len()).map(|_| OnceLock::new()).collect() }
+        let boxes = (0..8 * grid.cells.len()).map(|_| OnceLock::new()).collect();
+        SubOctants { robot, grid, boxes, made: AtomicUsize::new(0) }
+    }
+
+    /// Bytes of the sub-octant boxes made so far (their boxes and per-entry arrays).
+    pub(super) fn cached_bytes(&self) -> usize {
+        self.made.load(Ordering::Relaxed) * sub_octant_bytes(self.robot.model.box_count())
+    }
+
+    /// Drops the sub-octant boxes made so far.
+    pub(super) fn clear(&mut self) {
+        if *self.made.get_mut() > 0 {
+            self.boxes.iter_mut().for_each(|b| drop(b.take()));
+            *self.made.get_mut() = 0;
+        }
     }
 
     /// The sub-octants of octant entry `e`.
     fn of(&self, e: usize) -> &SampleBoxes {
         self.boxes[e].get_or_init(|| {
+            self.made.fetch_add(1, Ordering::Relaxed);
             let (model, r) = (&self.robot.model, self.grid.r);
             let octant = octant_centre(&self.grid.sample_center(e / 8), e % 8, 0.25 * r);
             let h = 0.125 * r;
@@ -66,6 +85,12 @@ impl<'a> SubOctants<'a> {
             SampleBoxes::new(model, &self.robot.placement, &refs, inflate)
         })
     }
+}
+
+/// Bytes of one octant's 8 sub-octants with `boxes` boxes each ([`SubOctants::of`]): the
+/// boxes, the per-entry bounds and slots, and the vectors' headers.
+pub(crate) fn sub_octant_bytes(boxes: usize) -> usize {
+    8 * (boxes * size_of::<SweptBox>() + 2 * size_of::<[Real; 3]>() + size_of::<Slot>()) + 4 * size_of::<Vec<u8>>()
 }
 
 /// Whether level 3 proves octant pair (A's entry `sa`, B's entry `sb`) free: for each pair

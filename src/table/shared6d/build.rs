@@ -1,6 +1,8 @@
 //! The builder of the shared 6-D quadtree (module doc of `shared6d`): the 6-D quadtree of
 //! the labels built depth first, every subtree hash-consed so that equal subtrees are stored
-//! once, and, for a subdivided table, one more level from the sub-cell labels.
+//! once, and, for a subdivided table, one more level from the sub-cell labels: held whole, or
+//! fetched block by block (a block: the subtree of a node at a chosen depth) so that a build
+//! within bounded memory holds one block's sub-cells at a time.
 
 use super::SharedQuadtree6d;
 use crate::cspace::{Label, LabelledSpace, SubCells};
@@ -33,6 +35,23 @@ pub(crate) enum Fine<'a> {
     /// levels, `crate::table::clearance`), not 64 places: its mirror pair's word merges in
     /// unpermuted.
     Words(&'a (dyn Fn(usize) -> u64 + Sync)),
+    /// Sub-cells found block by block ([`SubCellBlocks`]), held one block at a time.
+    Streamed,
+}
+
+/// Where a subdivided build streamed by blocks finds the sub-cells: the masks of a block's
+/// pairs when the build enters the block, so that only one block's sub-cells are alive.
+pub(crate) trait SubCellBlocks {
+    /// `(care, collision)` of each pair of `pairs` (numbered `ia * nb + ib`, each labelled
+    /// collision), in order.
+    fn masks(&mut self, pairs: &[u64], nb: usize) -> Vec<(u64, u64)>;
+}
+
+/// The streamed sub-cells: the source, the depth of the blocks and the current block's.
+struct Stream<'a> {
+    source: &'a mut dyn SubCellBlocks,
+    depth: u32,
+    block: SubCells,
 }
 
 /// Hash-consing builder over a [`SpaceView`].
@@ -52,6 +71,8 @@ pub(super) struct Builder<'a> {
     inner_nodes: Vec<Vec<InnerNode>>,
     leaf_ids: HashMap<u64, u32>,
     leaves: Vec<u64>,
+    /// With [`Fine::Streamed`]: where the blocks' sub-cells come from.
+    stream: Option<Stream<'a>>,
 }
 
 pub(super) const NONE: u32 = u32::MAX;
@@ -96,6 +117,10 @@ impl Builder<'_> {
         if !self.occ_a[d as usize][at(a)] || !self.occ_b[d as usize][at(b)] {
             return Part::DontCare;
         }
+        let streamed_block = self.stream.as_ref().is_some_and(|s| s.depth == d);
+        if streamed_block {
+            self.fetch_block(d, a, b);
+        }
         let last = d == self.view.levels - 1;
         let mut kids = [Part::DontCare; 64];
         for (i, kid) in kids.iter_mut().enumerate() {
@@ -120,7 +145,40 @@ impl Builder<'_> {
             }
             return self.leaf(care, value);
         }
+        if streamed_block {
+            if let Some(s) = self.stream.as_mut() {
+                s.block = SubCells::default();
+            }
+        }
         self.node(d as usize, &kids)
+    }
+
+    /// Fetches the sub-cells of the block (depth `d`, block coordinates `a`, `b`) from the
+    /// stream: those of its pairs labelled collision and of their mirror pairs, the ones
+    /// [`subdivided_cell`](Self::subdivided_cell) looks up inside the block.
+    fn fetch_block(&mut self, d: u32, a: [usize; 3], b: [usize; 3]) {
+        let side = self.k >> d;
+        let in_a = block_samples(&self.dense_a, self.k, side, a);
+        let in_b = block_samples(&self.dense_b, self.k, side, b);
+        let nb = self.view.space.grid_b.cells.len();
+        let mut pairs = Vec::new();
+        for &ia in &in_a {
+            for &ib in &in_b {
+                let mirror = self.view.mirror_pair(ia, ib);
+                for (x, y) in core::iter::once((ia, ib)).chain(mirror) {
+                    if self.view.own_label(x, y) == Label::Collision {
+                        pairs.push((x * nb + y) as u64);
+                    }
+                }
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        if let Some(s) = self.stream.as_mut() {
+            let masks = s.source.masks(&pairs, nb);
+            let (care, collision) = masks.into_iter().unzip();
+            s.block = SubCells { pairs, care, collision };
+        }
     }
 
     /// The part of one cell pair without sub-cells, and its sample pair when both are sampled.
@@ -169,6 +227,10 @@ impl Builder<'_> {
                 match self.sub {
                     Some(Fine::SubCells(s)) => s.get(pair as u64).unwrap_or((u64::MAX, u64::MAX)),
                     Some(Fine::Words(word)) => (u64::MAX, word(pair)),
+                    Some(Fine::Streamed) => match &self.stream {
+                        Some(s) => s.block.get(pair as u64).unwrap_or((u64::MAX, u64::MAX)),
+                        None => (u64::MAX, u64::MAX),
+                    },
                     None => (u64::MAX, u64::MAX),
                 }
             }
@@ -231,6 +293,20 @@ impl Builder<'_> {
     }
 }
 
+/// The samples (dense map `dense` of side `k`) in the block of side `side` at block
+/// coordinates `c`, in the grid's order.
+fn block_samples(dense: &[u32], k: usize, side: usize, c: [usize; 3]) -> Vec<usize> {
+    let mut out = Vec::new();
+    for x in c[0] * side..(c[0] + 1) * side {
+        for y in c[1] * side..(c[1] + 1) * side {
+            let row = (x * k + y) * k;
+            let line = &dense[row + c[2] * side..row + (c[2] + 1) * side];
+            out.extend(line.iter().filter(|&&i| i != NONE).map(|&i| i as usize));
+        }
+    }
+    out
+}
+
 /// A sub-cell mask of a pair mapped to its mirror pair's (`y -> -y` flips the y octant bit of
 /// both robots: child index bits 4 and 1).
 pub(super) fn mirror_sub_cells(mask: u64) -> u64 {
@@ -245,7 +321,7 @@ impl SharedQuadtree6d {
     /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
     /// `2 <= levels <= MAX_LEVELS`, or the label count is wrong.
         pub fn build(space: &LabelledSpace, symmetry: Symmetry) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, None, symmetry.is_mirrored())
+        Self::build_with(space, None, symmetry.is_mirrored(), None)
     }
 
     /// As [`build`](Self::build) with every pair labelled collision cut into the sub-cells of
@@ -259,7 +335,7 @@ impl SharedQuadtree6d {
         sub: &SubCells,
         symmetry: Symmetry,
     ) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, Some(Fine::SubCells(sub)), symmetry.is_mirrored())
+        Self::build_with(space, Some(Fine::SubCells(sub)), symmetry.is_mirrored(), None)
     }
 
     /// As [`build`](Self::build) with one more level whose leaves hold, per pair labelled
@@ -274,13 +350,31 @@ impl SharedQuadtree6d {
         word: &(dyn Fn(usize) -> u64 + Sync),
         symmetry: Symmetry,
     ) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, Some(Fine::Words(word)), symmetry.is_mirrored())
+        Self::build_with(space, Some(Fine::Words(word)), symmetry.is_mirrored(), None)
     }
 
-        fn build_with(
+    /// As [`build_subdivided`](Self::build_subdivided) with the sub-cells fetched from `source`
+    /// block by block: a block is the subtree of a node at depth `block_depth` (clamped to
+    /// the grid cells' parents), one box of A's cells by one of B's, so that only one block's
+    /// sub-cells are held at a time. The same table, for every `block_depth`.
+    ///
+    /// # Errors
+    /// As [`build`](Self::build).
+    pub(crate) fn build_streamed(
         space: &LabelledSpace,
-        sub: Option<Fine<'_>>,
+        source: &mut dyn SubCellBlocks,
+        block_depth: u32,
+        symmetry: Symmetry,
+    ) -> Result<SharedQuadtree6d, TableError> {
+        let stream = Stream { source, depth: block_depth, block: SubCells::default() };
+        Self::build_with(space, Some(Fine::Streamed), symmetry.is_mirrored(), Some(stream))
+    }
+
+        fn build_with<'a>(
+        space: &'a LabelledSpace,
+        sub: Option<Fine<'a>>,
         symmetric: bool,
+        stream: Option<Stream<'a>>,
     ) -> Result<SharedQuadtree6d, TableError> {
         let view = SpaceView::new(space, symmetric)?;
         let levels = view.levels;
@@ -296,6 +390,7 @@ impl SharedQuadtree6d {
         let dense_b = dense_map(&space.grid_b.cells, k, |_| true);
         let (occ_a, occ_b) = (occupancy(&dense_a, k, levels), occupancy(&dense_b, k, levels));
         let inner_depths = (levels + sub_levels) as usize - 1;
+        let stream = stream.map(|s| Stream { depth: s.depth.min(levels - 1), ..s });
         let mut b = Builder {
             view,
             sub,
@@ -308,6 +403,7 @@ impl SharedQuadtree6d {
             inner_nodes: vec![Vec::new(); inner_depths],
             leaf_ids: HashMap::new(),
             leaves: Vec::new(),
+            stream,
         };
         let root = b.build(0, [0; 3], [0; 3]);
         let (mut masks, mut bases, mut depth_start, mut children) = (vec![], vec![], vec![], vec![]);

@@ -37,6 +37,9 @@
 mod build;
 mod pool;
 
+#[cfg(feature = "std")]
+pub(crate) use build::SubCellBlocks;
+
 use super::code::MAX_LEVELS;
 use super::error::{corrupt, TableError};
 use super::space::fold;

@@ -1,0 +1,133 @@
+//! How much memory a table build needs and how a build bounded by `max` bytes spends it:
+//! the fixed part (both robots' boxes and sweeps, one byte of label per sample pair, the tree
+//! builder's maps) must fit, and a subdivided build streams its sub-cells by blocks of the
+//! quadtree sized from what is left ([`MemoryPlan`]).
+//!
+//! The figures are estimates, not measurements of the running process: the per-sample bytes
+//! were measured (peak resident of a build labelling few rows: T1 at k = 64, 2.15 GB for
+//! 2 x 47,548 samples, `docs/record/2026-11-24-shards.md`) and rounded up.
+
+use super::build::{BuildError, Variant};
+use crate::cspace::Label;
+
+/// Bytes per sample of either robot that a labelling holds whatever the rows: boxes and
+/// sweeps of the whole cells and of their octants, with their cores (measured 22.6 KB).
+pub const FIXED_BYTES_PER_SAMPLE: u64 = 24_000;
+
+/// Bytes the process holds besides the labelling and the tree builder's maps: the program,
+/// the node pool of the table being built (the size of the output, megabytes) and slack.
+pub const RESERVE_BYTES: u64 = 256 << 20;
+
+/// Bytes per pair of a block of a streamed subdivided build, when every pair and its mirror
+/// pair are collisions (the worst case): the pair numbers while they are gathered, their
+/// masks and the block's [`crate::cspace::SubCells`].
+pub const BLOCK_BYTES_PER_PAIR: u64 = 2 * (8 + 16 + 24);
+
+/// How a build spends its memory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemoryPlan {
+    /// Bytes held whatever the blocks (boxes, labels, builder, reserve).
+    pub fixed: u64,
+    /// Of `fixed`: the labels (one byte per sample pair).
+    pub labels: u64,
+    /// Subdivided builds: the depth of the quadtree whose subtrees are the blocks (0: the
+    /// whole table is one block).
+    pub block_depth: u32,
+    /// Subdivided builds: the bytes of sub-octant boxes kept between blocks (made again
+    /// when needed beyond this).
+    pub cache: u64,
+}
+
+/// The plan of a build of `variant` at `k` (`2^levels`) for `na` x `nb` samples within
+/// `max` bytes.
+///
+/// # Errors
+/// [`BuildError::Memory`] when the fixed part alone needs more than `max`.
+pub fn plan_memory(na: u64, nb: u64, k: u32, variant: Variant, max: u64) -> Result<MemoryPlan, BuildError> {
+    let labels = na.saturating_mul(nb).saturating_mul(core::mem::size_of::<Label>() as u64);
+    let fixed = FIXED_BYTES_PER_SAMPLE
+        .saturating_mul(na + nb)
+        .saturating_add(labels)
+        .saturating_add(builder_bytes(k))
+        .saturating_add(RESERVE_BYTES);
+    if fixed > max {
+        return Err(BuildError::Memory { needed: fixed, labels, max });
+    }
+    let rest = max - fixed;
+    let (block_depth, cache) = match variant {
+        Variant::SharedSubdivided => (block_depth(k, rest / 2), rest / 2),
+        _ => (0, 0),
+    };
+    Ok(MemoryPlan { fixed, labels, block_depth, cache })
+}
+
+/// The tree builder's per-robot maps at `k`: a `u32` per grid cell and its occupancy per
+/// depth (a byte per block, `k^3 / 7` over the depths).
+fn builder_bytes(k: u32) -> u64 {
+    let cells = u64::from(k).pow(3);
+    2 * (4 * cells + cells.div_ceil(7) + 1)
+}
+
+/// The smallest depth (largest blocks) whose blocks, at worst, hold at most `bytes`: a block
+/// at depth `d` has `(k / 2^d)^6` pairs. Never past the grid cells' parents.
+fn block_depth(k: u32, bytes: u64) -> u32 {
+    let levels = k.max(2).trailing_zeros();
+    (0..levels.saturating_sub(1))
+        .find(|&d| u64::from(k >> d).saturating_pow(6).saturating_mul(BLOCK_BYTES_PER_PAIR) <= bytes)
+        .unwrap_or(levels.saturating_sub(1))
+}
+
+/// Parses a byte count: digits, optionally followed by `K`, `M`, `G` or `T` (powers of
+/// 1024, an optional trailing `B` or `iB`), e.g. `8G`, `512M`, `1073741824`.
+///
+/// # Errors
+/// A message naming the accepted forms.
+pub fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let t = t.strip_suffix("iB").or_else(|| t.strip_suffix('B')).unwrap_or(t);
+    let split = t.find(|c: char| !c.is_ascii_digit() && c != '.').unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let shift = match unit.to_ascii_uppercase().as_str() {
+        "" => 0,
+        "K" => 10,
+        "M" => 20,
+        "G" => 30,
+        "T" => 40,
+        _ => return Err(format!("'{s}': a byte count is digits with an optional K, M, G or T (e.g. 8G)")),
+    };
+    let value: f64 =
+        number.parse().map_err(|_| format!("'{s}': a byte count is digits with an optional K, M, G or T"))?;
+    let bytes = value * (1u64 << shift) as f64;
+    if !bytes.is_finite() || bytes < 1.0 || bytes >= u64::MAX as f64 {
+        return Err(format!("'{s}': a byte count from 1 byte to 16 EB"));
+    }
+    Ok(bytes as u64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn byte_counts_parse_with_binary_units() {
+        assert_eq!(parse_bytes("8G"), Ok(8 << 30));
+        assert_eq!(parse_bytes("512M"), Ok(512 << 20));
+        assert_eq!(parse_bytes("1.5GiB"), Ok(3 << 29));
+        assert_eq!(parse_bytes("4096"), Ok(4096));
+        assert!(parse_bytes("8X").is_err() && parse_bytes("").is_err() && parse_bytes("0").is_err());
+    }
+
+    /// Blocks shrink as the memory left shrinks, down to the grid cells' parents; a fixed
+    /// part that does not fit is refused.
+    #[test]
+    fn plans_choose_smaller_blocks_for_less_memory() {
+        let sub = Variant::SharedSubdivided;
+        let big = plan_memory(6_000, 6_000, 32, sub, 64 << 30).unwrap();
+        let small = plan_memory(6_000, 6_000, 32, sub, big.fixed + (1 << 20)).unwrap();
+        assert_eq!(big.block_depth, 1);
+        assert!(small.block_depth > 1 && small.block_depth <= 4, "{small:?}");
+        assert_eq!(plan_memory(6_000, 6_000, 32, sub, big.fixed).unwrap().block_depth, 4);
+        assert!(matches!(plan_memory(6_000, 6_000, 32, sub, big.fixed - 1), Err(BuildError::Memory { .. })));
+        assert_eq!(plan_memory(6_000, 6_000, 32, Variant::D6, 64 << 30).unwrap().cache, 0);
+    }
+}
