@@ -41,7 +41,7 @@
 //!    a narrower angle range gives a smaller sweep on every axis, so tier 2 proves whatever
 //!    the direct enclosure alone proved before the table existed).
 //! 5. **Apart.** Box `i` of robot `a` over the stop lies in `box_i(now) + sweep_i`, and
-//!    likewise for `b`; [`swept_boxes_apart`] proves the two sums disjoint on one of the 15
+//!    likewise for `b`; [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) proves the two sums disjoint on one of the 15
 //!    axes (with a positive gap). All box pairs of all pairs that can meet proved: FREE.
 //!    Proved again with `warn_mm` added to one sweep's ball: else WARN. Any unproved pair,
 //!    unreachable TCP, unbounded sweep or status other than OK: STOP.
@@ -50,7 +50,7 @@
 //!    is at least `(1 + mu) sum_a S' |w_a . n| >= S' |n|` (the cube term with weight
 //!    `max e_k >= 1`, the arc and ball terms are `>= 0`), form 1's at least
 //!    `(1 + mu) S' |n|`. So on every axis the swept box's projection holds that of the box
-//!    swept by the ball `S'` alone (upper links: by nothing). When [`swept_boxes_apart`] does
+//!    swept by the ball `S'` alone (upper links: by nothing). When [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) does
 //!    not separate the boxes swept by those balls (radii shrunk by a relative 1e-9, far above
 //!    rounding), it cannot separate them with the real sweeps of any tier: STOP at once,
 //!    without inverse kinematics.
@@ -61,7 +61,12 @@
 //! [`ProtectiveChecker::check`] start from the last tick's limit and step away from it by
 //! doubling steps to a bracket before bisecting: the same kind of answer (a grid speed proved,
 //! the next one up not) in a few tests where limits change little between ticks. 0 when not
-//! even standing still is proved; `v_max` when full speed is. By default the bisection uses
+//! even standing still is proved; `v_max` when full speed is. The tests of one robot and tick
+//! are capped ([`ProtectiveChecker::with_limit_tests`], [`DEFAULT_LIMIT_TESTS`]): at the cap
+//! the largest speed proved so far is the limit (a proved speed, lower than the search's end,
+//! which the next ticks approach from it), 0 when no test proved one. Never below that, the
+//! tick's measured speed when its verdict is not STOP: the verdict proved every pair with
+//! the ball of that speed and direction, the ball a test at that speed builds. By default the bisection uses
 //! tier 1 alone (a few us per robot): that limit is proved, and never above the limit of
 //! both tiers ([`ProtectiveChecker::with_precise_limits`] for that one: both tiers, the
 //! second only above the first's limit and below the speed where step 6 already fails).
@@ -86,7 +91,7 @@ use crate::cspace::guarantee::{cube_box_sweeps, cube_box_sweeps_with, theta_rang
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
 use crate::geometry::sweep::{swept_boxes_apart_with, FaceTerms};
 use crate::robot::MAX_BOXES;
-use crate::geometry::{swept_boxes_apart, Obb, Sweep};
+use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::motor_table::{intersect, MotorTable};
 use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
@@ -116,6 +121,11 @@ pub const PRECISE_SPLITS: u32 = 2;
 
 /// Bisection steps of a speed limit (after the checks at 0 and at `v_max`).
 pub const LIMIT_STEPS: u32 = 8;
+
+/// How many speeds the search of one robot's speed limit tests per tick at most
+/// ([`ProtectiveChecker::with_limit_tests`]); one test costs about as much as one robot's
+/// sweeps and their swept-box proof.
+pub const DEFAULT_LIMIT_TESTS: u32 = 2;
 
 /// Relative and absolute slack of the plausibility checks: rounding of the caller's own
 /// trajectory arithmetic must not read as an impossible motion.
@@ -248,6 +258,8 @@ pub struct ProtectiveChecker {
     precise_splits: u32,
     /// Whether the speed limits use the second tier too (else the table's alone).
     precise_limits: bool,
+    /// Speeds tested per robot and tick at most by the search of the table tier's limit.
+    limit_tests: u32,
     /// Per robot, `S` and the ball of [`ProtectiveChecker::stop_ball`] at this tick's measured
     /// speed: computed once per tick, read again when the tick needs its references.
     stop_balls: alloc::vec::Vec<(Real, (Vec3, Real))>,
@@ -322,6 +334,7 @@ impl ProtectiveChecker {
             speed_limits: true,
             precise_splits: PRECISE_SPLITS,
             precise_limits: false,
+            limit_tests: DEFAULT_LIMIT_TESTS,
             stop_balls: alloc::vec![(0.0, (Vec3::zeros(), 0.0)); n],
             centres: alloc::vec![Vec3::zeros(); n],
             reach: alloc::vec![0.0; n],
@@ -378,6 +391,23 @@ impl ProtectiveChecker {
     /// never above the precise limit, so FREE holds at it too).
     pub fn with_precise_limits(self, on: bool) -> Self {
         ProtectiveChecker { precise_limits: on, ..self }
+    }
+
+    /// This checker testing at most `tests` speeds per robot and tick in the search of the
+    /// speed limit of the table's tier ([`DEFAULT_LIMIT_TESTS`] by default; `u32::MAX`: the
+    /// search runs to its end). When the cap is reached the limit reported is the largest
+    /// speed proved so far: still a proved speed, possibly lower than the search would have
+    /// found; the next tick's search starts from it, so a limit that rose by more than the
+    /// tests of one tick reach is found over a few ticks. 0 tests report this tick's measured
+    /// speed when the verdict is not STOP, else 0 (module doc). The precise limits
+    /// ([`ProtectiveChecker::with_precise_limits`]) are not capped.
+    pub fn with_limit_tests(self, tests: u32) -> Self {
+        ProtectiveChecker { limit_tests: tests, ..self }
+    }
+
+    /// The cap on speeds tested per robot and tick ([`ProtectiveChecker::with_limit_tests`]).
+    pub fn limit_tests(&self) -> u32 {
+        self.limit_tests
     }
 
     /// The WARN threshold (mm).
@@ -644,9 +674,14 @@ impl ProtectiveChecker {
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
             return;
         }
+        // This tick's verdict, when not STOP, proved every pair at each robot's measured speed
+        // (with its measured direction, the ball the search's tests build at that speed too).
+        let proved_now = self.report.verdict != Protective::Stop;
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let start = self.history[j].limit.filter(|_| from_history);
-            self.report.robots[j].speed_limit_mm_s = self.speed_limit(j, tcp, start);
+            let v = self.report.robots[j].speed_mm_s;
+            let floor = if proved_now && v <= self.cell().stops[j].max_speed_mm_s { v } else { 0.0 };
+            self.report.robots[j].speed_limit_mm_s = self.speed_limit(j, tcp, start, floor);
         }
     }
 
@@ -748,7 +783,8 @@ impl ProtectiveChecker {
         let robot = &self.exact.cell().robots[j];
         let rot = robot.placement.rotation();
         let (centre, radius) = (self.centres[j], self.reach[j]);
-        self.sweeps[j] = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref(), tier, arms);
+        let table = self.tables[j].as_deref();
+        stop_sweeps_wcs_into(&mut self.sweeps[j], &robot.model, &rot, &centre, radius, table, tier, arms);
         let boxes = &self.ref_boxes[j];
         for (form, faces) in self.faces[j].iter_mut().enumerate() {
             for (k, b) in boxes.as_slice().iter().enumerate() {
@@ -767,10 +803,23 @@ impl ProtectiveChecker {
             let moves_with_tcp = !matches!(self.exact.cell().robots[j].model.box_kind(k), BoxKind::UpperLink(_));
             Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO }
         };
+        // Each box's sweep and face terms once per robot, not once per box pair: the same test
+        // as `swept_boxes_apart`, which builds both face terms for every pair it is given.
+        let swept = |j: usize| -> [(Sweep, FaceTerms); MAX_BOXES] {
+            let boxes = self.ref_boxes[j].as_slice();
+            core::array::from_fn(|k| match boxes.get(k) {
+                Some(b) => {
+                    let w = least(j, k);
+                    (w, FaceTerms::new(b, &w))
+                }
+                None => (Sweep::ZERO, self.no_faces),
+            })
+        };
         for p in self.exact.verdict().pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
-            for (i, box_a) in self.ref_boxes[p.a].as_slice().iter().enumerate() {
-                for (k, box_b) in self.ref_boxes[p.b].as_slice().iter().enumerate() {
-                    if !swept_boxes_apart(box_a, &least(p.a, i), box_b, &least(p.b, k)) {
+            let (swept_a, swept_b) = (swept(p.a), swept(p.b));
+            for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(&swept_a).enumerate() {
+                for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(&swept_b).enumerate() {
+                    if !swept_boxes_apart_with(box_a, sa, fa, box_b, sb, fb) {
                         return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
                     }
                 }
@@ -779,8 +828,10 @@ impl ProtectiveChecker {
         None
     }
 
-    /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are.
-    fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3, start: Option<Real>) -> Real {
+    /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are: the search
+    /// from `start` (the last tick's limit), never below `floor`, a speed this tick's verdict
+    /// proved for `j` (0 when none).
+    fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3, start: Option<Real>, floor: Real) -> Real {
         let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]);
         let inside = self.kept.inside(j);
         // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
@@ -846,10 +897,75 @@ impl ProtectiveChecker {
                 (from, step) = (to, 2.0 * step);
             }
         };
+        // `limit_of` or `limit_near` with tier 1 alone, at most `limit_tests` tests: the largest
+        // speed a test proved (0 when none did, or when every speed above `floor` that the
+        // search would still test is at most `floor`: `floor` is the answer then).
+        let capped = |me: &mut Self| -> Real {
+            let mut budget = me.limit_tests;
+            let mut test = |me: &mut Self, v: Real| {
+                let left = budget > 0;
+                budget = budget.saturating_sub(1);
+                left.then(|| proved(me, v, Some(0)))
+            };
+            // `lo` proved, `hi` not (`None`: no such speed tested yet).
+            let (mut lo, mut hi) = (None, None);
+            match start {
+                Some(h) => {
+                    let h = ((h / resolution).round() * resolution).clamp(0.0, vmax);
+                    match test(me, h) {
+                        None => return 0.0,
+                        Some(true) => lo = Some(h),
+                        Some(false) => hi = Some(h),
+                    }
+                }
+                None => {
+                    match test(me, vmax) {
+                        None => return 0.0,
+                        Some(true) => return vmax,
+                        Some(false) => hi = Some(vmax),
+                    }
+                    match test(me, 0.0) {
+                        Some(true) => lo = Some(0.0),
+                        _ => return 0.0,
+                    }
+                }
+            }
+            let mut step = resolution;
+            loop {
+                let (to, up) = match (lo, hi) {
+                    (Some(l), None) if l >= vmax => return vmax,
+                    (Some(l), None) => ((l + step).min(vmax), true),
+                    (None, Some(h)) if h <= floor || h <= 0.0 => return 0.0,
+                    (None, Some(h)) => ((h - step).max(0.0), false),
+                    _ => break,
+                };
+                match test(me, to) {
+                    None => return lo.unwrap_or(0.0),
+                    Some(true) => lo = Some(to),
+                    Some(false) => hi = Some(to),
+                }
+                // A bracket found going down from `hi` ends the steps; going up, so does `hi`.
+                if !up && lo.is_some() {
+                    break;
+                }
+                step *= 2.0;
+            }
+            let (Some(mut lo), Some(mut hi)) = (lo, hi) else { return lo.unwrap_or(0.0) };
+            while hi - lo > resolution && hi > floor {
+                let mid = 0.5 * (lo + hi);
+                match test(me, mid) {
+                    None => break,
+                    Some(true) => lo = mid,
+                    Some(false) => hi = mid,
+                }
+            }
+            lo
+        };
         let tier = if self.precise_limits { self.precise_splits } else { 0 };
-        // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit, and the floor
-        // of the precise one.
+        // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit (capped), and
+        // the floor of the precise one (not capped).
         let (lo, hi) = match start {
+            _ if tier == 0 => (capped(self), vmax),
             Some(h) => limit_near(self, h),
             None => limit_of(self, Some(0), vmax),
         };
@@ -873,7 +989,7 @@ impl ProtectiveChecker {
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
         self.kept.restore_inside(j, inside);
-        limit
+        limit.max(floor)
     }
 }
 
@@ -941,6 +1057,24 @@ pub fn stop_sweeps_wcs(
     precise: u32,
     arms: u8,
 ) -> SweepForms {
+    let mut out = [[Sweep::ZERO; MAX_BOXES]; 2];
+    stop_sweeps_wcs_into(&mut out, model, rot_wcs, tcp_mcs, s, table, precise, arms);
+    out
+}
+
+/// [`stop_sweeps_wcs`] written into `out`: the tick's sweeps are recomputed in place, many
+/// times per tick by the speed limits' tests, without whole sets copied on the way.
+#[allow(clippy::too_many_arguments)]
+fn stop_sweeps_wcs_into(
+    out: &mut SweepForms,
+    model: &RobotModel,
+    rot_wcs: &crate::math::Mat3,
+    tcp_mcs: &Vec3,
+    s: Real,
+    table: Option<&MotorTable>,
+    precise: u32,
+    arms: u8,
+) {
     let d = &model.delta;
     let direct = |lo: &Vec3, hi: &Vec3, splits: u32| -> [Enclosure; 3] {
         core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits))
@@ -976,9 +1110,12 @@ pub fn stop_sweeps_wcs(
                     ..*w
                 }
             };
-            [sweeps.map(|w| w.rotated(rot_wcs)), sweeps.map(|w| ball_form(&w).rotated(rot_wcs))]
+            let [cube_form, ball_forms] = out;
+            for ((w, c), b) in sweeps.iter().zip(cube_form.iter_mut()).zip(ball_forms.iter_mut()) {
+                (*c, *b) = (w.rotated(rot_wcs), ball_form(w).rotated(rot_wcs));
+            }
         }
-        None => [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2],
+        None => *out = [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2],
     }
 }
 
@@ -1018,16 +1155,19 @@ pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MA
 fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(usize, usize)> {
     const FORMS: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
     let ((boxes_a, sweeps_a, faces_a), (boxes_b, sweeps_b, faces_b)) = (a, b);
-    // With `extra`, the first robot's face terms under its widened sweeps.
-    let mut widened = *faces_a;
+    // With `extra`, the first robot's face terms under its widened sweeps (a copy only then:
+    // the tests of the speed limits call this with no `extra`, many times per tick).
+    let mut copy = None;
     if extra != 0.0 {
-        for (form, terms) in widened.iter_mut().enumerate() {
+        let terms = copy.insert(*faces_a);
+        for (form, terms) in terms.iter_mut().enumerate() {
             for (i, box_a) in boxes_a.iter().enumerate() {
                 let sa = &sweeps_a[form][i];
                 terms[i] = FaceTerms::new(box_a, &Sweep { ball: sa.ball + extra, ..*sa });
             }
         }
     }
+    let widened = copy.as_ref().unwrap_or(faces_a);
     for (i, box_a) in boxes_a.iter().enumerate() {
         for (k, box_b) in boxes_b.iter().enumerate() {
             let apart = |&(fa, fb): &(usize, usize)| {
