@@ -61,10 +61,11 @@
 //! [`ProtectiveChecker::check`] start from the last tick's limit and step away from it by
 //! doubling steps to a bracket before bisecting: the same kind of answer (a grid speed proved,
 //! the next one up not) in a few tests where limits change little between ticks. 0 when not
-//! even standing still is proved; `v_max` when full speed is. The tests of one robot and tick
-//! are capped ([`ProtectiveChecker::with_limit_tests`], [`DEFAULT_LIMIT_TESTS`]): at the cap
-//! the largest speed proved so far is the limit (a proved speed, lower than the search's end,
-//! which the next ticks approach from it), 0 when no test proved one. Never below that, the
+//! even standing still is proved; `v_max` when full speed is. The tests of a tick
+//! are capped, all robots together ([`ProtectiveChecker::with_limit_tests`],
+//! [`DEFAULT_EXTRA_LIMIT_TESTS`]): at the cap the largest speed proved so far is the limit (a
+//! proved speed, lower than the search's end, which the next ticks approach from it, with the
+//! step reached), 0 when no test proved one. Never below that, the
 //! tick's measured speed when its verdict is not STOP: the verdict proved every pair with
 //! the ball of that speed and direction, the ball a test at that speed builds. By default the bisection uses
 //! tier 1 alone (a few us per robot): that limit is proved, and never above the limit of
@@ -122,10 +123,10 @@ pub const PRECISE_SPLITS: u32 = 2;
 /// Bisection steps of a speed limit (after the checks at 0 and at `v_max`).
 pub const LIMIT_STEPS: u32 = 8;
 
-/// How many speeds the search of one robot's speed limit tests per tick at most
-/// ([`ProtectiveChecker::with_limit_tests`]); one test costs about as much as one robot's
-/// sweeps and their swept-box proof.
-pub const DEFAULT_LIMIT_TESTS: u32 = 2;
+/// How many speeds the searches of the robots' speed limits test per tick in all, beyond one
+/// per robot, by default ([`ProtectiveChecker::with_limit_tests`]); one test costs about as
+/// much as one robot's sweeps and their swept-box proof.
+pub const DEFAULT_EXTRA_LIMIT_TESTS: u32 = 1;
 
 /// Relative and absolute slack of the plausibility checks: rounding of the caller's own
 /// trajectory arithmetic must not read as an impossible motion.
@@ -229,8 +230,9 @@ struct History {
     tcp: Option<Vec3>,
     /// The last finite-difference velocity (mm/s).
     velocity: Option<Vec3>,
-    /// The last speed limit (mm/s): where this tick's search starts.
-    limit: Option<Real>,
+    /// The last speed limit (mm/s): where this tick's search starts; and the step of its
+    /// first test above that limit (mm/s; module doc).
+    limit: Option<(Real, Real)>,
 }
 
 const NO_HISTORY: History = History { tcp: None, velocity: None, limit: None };
@@ -258,8 +260,13 @@ pub struct ProtectiveChecker {
     precise_splits: u32,
     /// Whether the speed limits use the second tier too (else the table's alone).
     precise_limits: bool,
-    /// Speeds tested per robot and tick at most by the search of the table tier's limit.
+    /// Speeds tested per tick at most, all robots together, by the searches of the table
+    /// tier's limits.
     limit_tests: u32,
+    /// Per robot, the step of the next tick's first test above its limit.
+    limit_steps: alloc::vec::Vec<Real>,
+    /// Which robot's search comes first this tick (and may use the most tests).
+    limit_turn: usize,
     /// Per robot, `S` and the ball of [`ProtectiveChecker::stop_ball`] at this tick's measured
     /// speed: computed once per tick, read again when the tick needs its references.
     stop_balls: alloc::vec::Vec<(Real, (Vec3, Real))>,
@@ -334,7 +341,9 @@ impl ProtectiveChecker {
             speed_limits: true,
             precise_splits: PRECISE_SPLITS,
             precise_limits: false,
-            limit_tests: DEFAULT_LIMIT_TESTS,
+            limit_tests: n as u32 + DEFAULT_EXTRA_LIMIT_TESTS,
+            limit_steps: alloc::vec![0.0; n],
+            limit_turn: 0,
             stop_balls: alloc::vec![(0.0, (Vec3::zeros(), 0.0)); n],
             centres: alloc::vec![Vec3::zeros(); n],
             reach: alloc::vec![0.0; n],
@@ -393,19 +402,23 @@ impl ProtectiveChecker {
         ProtectiveChecker { precise_limits: on, ..self }
     }
 
-    /// This checker testing at most `tests` speeds per robot and tick in the search of the
-    /// speed limit of the table's tier ([`DEFAULT_LIMIT_TESTS`] by default; `u32::MAX`: the
-    /// search runs to its end). When the cap is reached the limit reported is the largest
-    /// speed proved so far: still a proved speed, possibly lower than the search would have
-    /// found; the next tick's search starts from it, so a limit that rose by more than the
-    /// tests of one tick reach is found over a few ticks. 0 tests report this tick's measured
-    /// speed when the verdict is not STOP, else 0 (module doc). The precise limits
+    /// This checker testing at most `tests` speeds per tick, all robots together, in the
+    /// searches of the speed limits of the table's tier (by default one per robot plus
+    /// [`DEFAULT_EXTRA_LIMIT_TESTS`]; `u32::MAX`: every search runs to its end). One test
+    /// costs about one robot's sweeps and their proof, so this bounds the time of a tick's
+    /// limits. The robots search in turn, the first one changing every tick; each may use
+    /// what is left but one test per robot after it. When a search runs out of tests the
+    /// limit reported is the largest speed it proved: still a proved speed, possibly lower
+    /// than the search would have found; the next tick's search starts from it, with the
+    /// step it had reached, so a limit that moved by more than one tick's tests reach is
+    /// found over a few ticks. A robot left no test reports this tick's measured speed when
+    /// the verdict is not STOP, else 0 (module doc). The precise limits
     /// ([`ProtectiveChecker::with_precise_limits`]) are not capped.
     pub fn with_limit_tests(self, tests: u32) -> Self {
         ProtectiveChecker { limit_tests: tests, ..self }
     }
 
-    /// The cap on speeds tested per robot and tick ([`ProtectiveChecker::with_limit_tests`]).
+    /// The cap on speeds tested per tick ([`ProtectiveChecker::with_limit_tests`]).
     pub fn limit_tests(&self) -> u32 {
         self.limit_tests
     }
@@ -485,9 +498,10 @@ impl ProtectiveChecker {
         self.evaluate(tcps_mcs, status, true, bound);
         // Only a tick without error (unreachable included) becomes the next one's history.
         if self.report.status == ProtectiveStatus::Ok {
-            for ((h, tcp), r) in self.history.iter_mut().zip(tcps_mcs).zip(&self.report.robots) {
+            let robots = self.history.iter_mut().zip(tcps_mcs).zip(&self.report.robots).zip(&self.limit_steps);
+            for (((h, tcp), r), step) in robots {
                 h.tcp = Some(*tcp);
-                h.limit = Some(r.speed_limit_mm_s).filter(|v| v.is_finite());
+                h.limit = Some(r.speed_limit_mm_s).filter(|v| v.is_finite()).map(|v| (v, *step));
             }
         } else {
             self.reset();
@@ -677,11 +691,21 @@ impl ProtectiveChecker {
         // This tick's verdict, when not STOP, proved every pair at each robot's measured speed
         // (with its measured direction, the ball the search's tests build at that speed too).
         let proved_now = self.report.verdict != Protective::Stop;
-        for (j, tcp) in tcps_mcs.iter().enumerate() {
+        let n = tcps_mcs.len();
+        let (first, mut left) = (self.limit_turn % n.max(1), self.limit_tests);
+        self.limit_turn = self.limit_turn.wrapping_add(1);
+        for i in 0..n {
+            let j = (first + i) % n;
+            let tcp = &tcps_mcs[j];
             let start = self.history[j].limit.filter(|_| from_history);
             let v = self.report.robots[j].speed_mm_s;
             let floor = if proved_now && v <= self.cell().stops[j].max_speed_mm_s { v } else { 0.0 };
-            self.report.robots[j].speed_limit_mm_s = self.speed_limit(j, tcp, start, floor);
+            // What is left, but one test for each robot after this one (while there are any).
+            let after = (n - 1 - i) as u32;
+            let budget = if left > after { left - after } else { left.min(1) };
+            let (limit, used, step) = self.speed_limit(j, tcp, start, floor, budget);
+            left -= used;
+            (self.report.robots[j].speed_limit_mm_s, self.limit_steps[j]) = (limit, step);
         }
     }
 
@@ -829,9 +853,18 @@ impl ProtectiveChecker {
     }
 
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are: the search
-    /// from `start` (the last tick's limit), never below `floor`, a speed this tick's verdict
-    /// proved for `j` (0 when none).
-    fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3, start: Option<Real>, floor: Real) -> Real {
+    /// from `start` (the last tick's limit and the step of the first test above it), never
+    /// below `floor`, a speed this tick's verdict proved for `j` (0 when none), with at most
+    /// `budget` tests of the table's tier. Returns the limit, the tests used, and the step of
+    /// the next tick's first test above the limit.
+    fn speed_limit(
+        &mut self,
+        j: usize,
+        tcp_mcs: &Vec3,
+        start: Option<(Real, Real)>,
+        floor: Real,
+        budget: u32,
+    ) -> (Real, u32, Real) {
         let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]);
         let inside = self.kept.inside(j);
         // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
@@ -844,12 +877,20 @@ impl ProtectiveChecker {
                 return false;
             }
             let Some(tier) = tier else { return true };
-            // The robots that can meet `j` as they are, with the motor angles of the same tier.
+            // The robots that can meet `j` as they are, with the motor angles of the same tier;
+            // with tier 1, another robot keeps the sweeps it has for this tick's reference,
+            // tier 1 or the verdict's second tier on some arms: each encloses every box of its
+            // stop (module doc, step 4), the second tier within the first, so a test proved
+            // with them is a proof, and tier 2 on every arm proves it too (the precise limit
+            // stays the higher); only a robot without sweeps gets tier 1's.
             for k in 0..me.exact.verdict().pairs.len() {
                 let p = me.exact.verdict().pairs[k];
                 if p.a == j || p.b == j {
-                    me.sweeps_at(p.a, tier, 0b111);
-                    me.sweeps_at(p.b, tier, 0b111);
+                    for i in [p.a, p.b] {
+                        if i == j || tier > 0 || me.sweep_tier[i].is_none() {
+                            me.sweeps_at(i, tier, 0b111);
+                        }
+                    }
                 }
             }
             let boxes = |i: usize| me.ref_boxes[i].as_slice();
@@ -897,50 +938,53 @@ impl ProtectiveChecker {
                 (from, step) = (to, 2.0 * step);
             }
         };
-        // `limit_of` or `limit_near` with tier 1 alone, at most `limit_tests` tests: the largest
-        // speed a test proved (0 when none did, or when every speed above `floor` that the
-        // search would still test is at most `floor`: `floor` is the answer then).
-        let capped = |me: &mut Self| -> Real {
-            let mut budget = me.limit_tests;
+        // `limit_of` or `limit_near` with tier 1 alone, at most `budget` tests: the largest speed
+        // a test proved (0 when none did, or when every speed above `floor` that the search
+        // would still test is at most `floor`: `floor` is the answer then), the tests used, and
+        // where the next tick's first step up starts: where this one's steps or bisection
+        // stopped for want of tests (`resolution` when the search ended).
+        let mut used = 0;
+        let mut capped = |me: &mut Self| -> (Real, Real) {
             let mut test = |me: &mut Self, v: Real| {
-                let left = budget > 0;
-                budget = budget.saturating_sub(1);
+                let left = used < budget;
+                used += u32::from(left);
                 left.then(|| proved(me, v, Some(0)))
             };
             // `lo` proved, `hi` not (`None`: no such speed tested yet).
             let (mut lo, mut hi) = (None, None);
+            let mut step = resolution;
             match start {
-                Some(h) => {
+                Some((h, carried)) => {
                     let h = ((h / resolution).round() * resolution).clamp(0.0, vmax);
                     match test(me, h) {
-                        None => return 0.0,
-                        Some(true) => lo = Some(h),
+                        None => return (0.0, resolution),
+                        Some(true) => (lo, step) = (Some(h), carried.max(resolution)),
                         Some(false) => hi = Some(h),
                     }
                 }
                 None => {
                     match test(me, vmax) {
-                        None => return 0.0,
-                        Some(true) => return vmax,
+                        None => return (0.0, resolution),
+                        Some(true) => return (vmax, resolution),
                         Some(false) => hi = Some(vmax),
                     }
                     match test(me, 0.0) {
                         Some(true) => lo = Some(0.0),
-                        _ => return 0.0,
+                        _ => return (0.0, resolution),
                     }
                 }
             }
-            let mut step = resolution;
             loop {
                 let (to, up) = match (lo, hi) {
-                    (Some(l), None) if l >= vmax => return vmax,
+                    (Some(l), None) if l >= vmax => return (vmax, resolution),
                     (Some(l), None) => ((l + step).min(vmax), true),
-                    (None, Some(h)) if h <= floor || h <= 0.0 => return 0.0,
+                    (None, Some(h)) if h <= floor || h <= 0.0 => return (0.0, resolution),
                     (None, Some(h)) => ((h - step).max(0.0), false),
                     _ => break,
                 };
                 match test(me, to) {
-                    None => return lo.unwrap_or(0.0),
+                    // Out of tests while going up: the next tick goes on with the next step.
+                    None => return (lo.unwrap_or(0.0), if up { step } else { resolution }),
                     Some(true) => lo = Some(to),
                     Some(false) => hi = Some(to),
                 }
@@ -950,23 +994,29 @@ impl ProtectiveChecker {
                 }
                 step *= 2.0;
             }
-            let (Some(mut lo), Some(mut hi)) = (lo, hi) else { return lo.unwrap_or(0.0) };
+            let (Some(mut lo), Some(mut hi)) = (lo, hi) else { return (lo.unwrap_or(0.0), resolution) };
             while hi - lo > resolution && hi > floor {
                 let mid = 0.5 * (lo + hi);
                 match test(me, mid) {
-                    None => break,
+                    // Out of tests: the next tick tries the middle of the bracket first.
+                    None => return (lo, mid - lo),
                     Some(true) => lo = mid,
                     Some(false) => hi = mid,
                 }
             }
-            lo
+            (lo, resolution)
         };
         let tier = if self.precise_limits { self.precise_splits } else { 0 };
         // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit (capped), and
         // the floor of the precise one (not capped).
+        let mut next_step = resolution;
         let (lo, hi) = match start {
-            _ if tier == 0 => (capped(self), vmax),
-            Some(h) => limit_near(self, h),
+            _ if tier == 0 => {
+                let (lo, step) = capped(self);
+                next_step = step;
+                (lo, vmax)
+            }
+            Some((h, _)) => limit_near(self, h),
             None => limit_of(self, Some(0), vmax),
         };
         let limit = if tier == 0 || lo == vmax {
@@ -989,7 +1039,9 @@ impl ProtectiveChecker {
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
         self.kept.restore_inside(j, inside);
-        limit.max(floor)
+        // The step is kept only when the limit is the one the steps were taken from.
+        let next_step = if limit >= floor { next_step } else { resolution };
+        (limit.max(floor), used, next_step)
     }
 }
 
