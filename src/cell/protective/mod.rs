@@ -412,8 +412,9 @@ impl ProtectiveChecker {
     /// than the search would have found; the next tick's search starts from it, with the
     /// step it had reached, so a limit that moved by more than one tick's tests reach is
     /// found over a few ticks. A robot left no test reports this tick's measured speed when
-    /// the verdict is not STOP, else 0 (module doc). The precise limits
-    /// ([`ProtectiveChecker::with_precise_limits`]) are not capped.
+    /// the verdict is not STOP, else 0 (module doc). Not capped: the precise limits
+    /// ([`ProtectiveChecker::with_precise_limits`]), and the searches of
+    /// [`ProtectiveChecker::check_at_speeds`], which has no last limit to start from.
     pub fn with_limit_tests(self, tests: u32) -> Self {
         ProtectiveChecker { limit_tests: tests, ..self }
     }
@@ -692,7 +693,10 @@ impl ProtectiveChecker {
         // (with its measured direction, the ball the search's tests build at that speed too).
         let proved_now = self.report.verdict != Protective::Stop;
         let n = tcps_mcs.len();
-        let (first, mut left) = (self.limit_turn % n.max(1), self.limit_tests);
+        // Without a history (`check_at_speeds`) no search has a last limit to start from, so
+        // none would get far with a few tests: those searches are not capped.
+        let cap = if from_history { self.limit_tests } else { u32::MAX };
+        let (first, mut left) = (self.limit_turn % n.max(1), cap);
         self.limit_turn = self.limit_turn.wrapping_add(1);
         for i in 0..n {
             let j = (first + i) % n;
