@@ -1283,11 +1283,18 @@ mod tests {
         let r = c.check(&[a, b]).unwrap().clone();
         assert_eq!(r.status, ProtectiveStatus::Ok);
         assert_eq!(r.robots[0].speed_bound_mm_s, 4_600.0);
-        // Standing still: the bound is the reaction only.
+        // Standing still: the bound is the reaction only. The search without a cap finds both
+        // limits at once; the capped one (a few tests per tick) reaches them a few ticks later.
+        let mut uncapped = c.clone().with_limit_tests(u32::MAX);
+        let r = uncapped.check(&[a, b]).unwrap();
+        assert!(r.robots.iter().all(|x| x.speed_limit_mm_s > 0.0), "{r:?}");
         let r = c.check(&[a, b]).unwrap().clone();
         assert_eq!(r.verdict, Protective::Free, "{r:?}");
         assert!(r.clearance_mm > 100.0);
-        assert!(r.robots.iter().all(|x| x.speed_limit_mm_s > 0.0));
+        for _ in 0..3 {
+            c.check(&[a, b]).unwrap();
+        }
+        assert!(c.report().robots.iter().all(|x| x.speed_limit_mm_s > 0.0), "{:?}", c.report());
         let close = [Vec3::new(60.0, 30.0, -420.0), Vec3::new(-60.0, -30.0, -430.0)];
         let r = c.check_at_speeds(&close, &[4_000.0, 4_000.0]).unwrap();
         assert_eq!(r.verdict, Protective::Stop);
