@@ -2,6 +2,8 @@
 //! collision runs, for profiling: `prot_tick [stiff|default] [verdict|limits] [repeats] [T1practical|...]`
 //! (the last argument keeps one run). With `COMPONENTS` set in the environment it times only the
 //! parts of a tick that reuses a kept proof: the boxes, the clearance, the closest box pair alone.
+//! `LIMIT_TESTS=n` caps the speeds tested per robot and tick by the speed-limit search
+//! (`ProtectiveChecker::with_limit_tests`; `4294967295`: not capped).
 
 use delta_collide::cell::protective::{Protective, ProtectiveChecker};
 use delta_collide::cell::reference::reference_cell;
@@ -32,6 +34,9 @@ fn main() {
         let n = base.robots.len();
         let cell = base.with_stopping(1.0, vec![stop; n]).unwrap();
         let mut c = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
+        if let Ok(tests) = std::env::var("LIMIT_TESTS") {
+            c = c.with_limit_tests(tests.parse().unwrap());
+        }
         let mut exact = ExactChecker::new(cell);
         let mut tcps = vec![Vec3::zeros(); n];
         let (mut tp, mut te) = (Vec::new(), Vec::new());

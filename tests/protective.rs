@@ -541,3 +541,78 @@ fn the_c_entry_point_with_paths_never_allocates_and_names_a_bad_path() {
     // SAFETY: live handle, destroyed once.
     unsafe { dc_destroy(h) };
 }
+
+/// The speed limits of a capped search (the default: a few tests per tick, all robots
+/// together) are proved speeds: over the runs of the C harness (T1-T3, practical and
+/// collision, both models), every fifth tick, each robot's reported limit is checked again by
+/// a separate checker that sees the robot arrive at its TCP at exactly that speed in its
+/// measured direction (the other robot as it moved): that verdict, a full proof of its own,
+/// must not be STOP. Also: a limit is never below the measured speed of a tick whose verdict
+/// is not STOP (that verdict proved it), and with no tests at all the limit is that speed (or
+/// 0 at a STOP). Prints how far below the uncapped search's limits the capped ones are.
+#[test]
+fn capped_speed_limits_are_proved_when_checked_again_by_another_checker() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let (mut rechecked, mut lower, mut compared) = (0, 0, 0);
+    for s in parse_scenarios(&text).unwrap() {
+        for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
+            let cell = cell(&s.cell, stop);
+            let tick = cell.tick_ms * 1e-3;
+            let mut capped = ProtectiveChecker::new(cell.clone(), 10.0).unwrap();
+            let mut full = capped.clone().with_limit_tests(u32::MAX);
+            let mut none = capped.clone().with_limit_tests(0);
+            let mut oracle = capped.clone().with_speed_limits(false);
+            let (mut tcps, mut prev) = ([Vec3::zeros(); 2], [Vec3::zeros(); 2]);
+            let (mut ratio, mut ratios) = (0.0, 0);
+            for t in 0..RUN_TICKS {
+                s.tcps_at(t, &mut tcps);
+                let r = capped.check(&tcps).unwrap().clone();
+                let f = full.check(&tcps).unwrap().clone();
+                let z = none.check(&tcps).unwrap().clone();
+                assert_eq!((f.verdict, z.verdict), (r.verdict, r.verdict), "tick {t}");
+                for j in 0..2 {
+                    let (limit, v) = (r.robots[j].speed_limit_mm_s, r.robots[j].speed_mm_s);
+                    assert!((0.0..=stop.max_speed_mm_s).contains(&limit), "tick {t}: {r:?}");
+                    let floor = if r.verdict != Protective::Stop && v <= stop.max_speed_mm_s { v } else { 0.0 };
+                    assert!(limit >= floor, "tick {t} robot {j}: limit {limit} below the proved {floor}");
+                    assert_eq!(z.robots[j].speed_limit_mm_s, floor, "tick {t} robot {j}: no tests, {z:?}");
+                    let uncapped = f.robots[j].speed_limit_mm_s;
+                    if uncapped > 0.0 {
+                        (ratio, ratios) = (ratio + limit / uncapped, ratios + 1);
+                        lower += usize::from(limit < uncapped);
+                        compared += 1;
+                    }
+                    // The check again: robot j arrives at `limit` along its measured direction.
+                    let dir = tcps[j] - prev[j];
+                    if t % 5 != 0 || t == 0 || limit == 0.0 || dir.norm() == 0.0 {
+                        continue;
+                    }
+                    let mut before = prev;
+                    before[j] = tcps[j] - dir * (limit * tick / dir.norm());
+                    oracle.reset();
+                    oracle.check(&before).unwrap();
+                    let again = oracle.check(&tcps).unwrap();
+                    assert_eq!(again.status, ProtectiveStatus::Ok, "tick {t} robot {j}");
+                    assert!((again.robots[j].speed_mm_s - limit).abs() <= 1e-6 * limit.max(1.0));
+                    assert_ne!(
+                        again.verdict,
+                        Protective::Stop,
+                        "{} {} model {k} tick {t} robot {j}: limit {limit} not proved: {again:?}",
+                        s.cell,
+                        s.case
+                    );
+                    rechecked += 1;
+                }
+                prev = tcps;
+            }
+            println!(
+                "{} {} model {k}: capped limit / uncapped limit {:.3} on average",
+                s.cell,
+                s.case,
+                ratio / ratios.max(1) as f64
+            );
+        }
+    }
+    println!("{rechecked} limits checked again; capped below uncapped at {lower} of {compared} robot ticks");
+    assert!(rechecked > 2_000, "too few limits checked again: {rechecked}");
+}

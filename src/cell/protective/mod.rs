@@ -41,7 +41,7 @@
 //!    a narrower angle range gives a smaller sweep on every axis, so tier 2 proves whatever
 //!    the direct enclosure alone proved before the table existed).
 //! 5. **Apart.** Box `i` of robot `a` over the stop lies in `box_i(now) + sweep_i`, and
-//!    likewise for `b`; [`swept_boxes_apart`] proves the two sums disjoint on one of the 15
+//!    likewise for `b`; [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) proves the two sums disjoint on one of the 15
 //!    axes (with a positive gap). All box pairs of all pairs that can meet proved: FREE.
 //!    Proved again with `warn_mm` added to one sweep's ball: else WARN. Any unproved pair,
 //!    unreachable TCP, unbounded sweep or status other than OK: STOP.
@@ -50,7 +50,7 @@
 //!    is at least `(1 + mu) sum_a S' |w_a . n| >= S' |n|` (the cube term with weight
 //!    `max e_k >= 1`, the arc and ball terms are `>= 0`), form 1's at least
 //!    `(1 + mu) S' |n|`. So on every axis the swept box's projection holds that of the box
-//!    swept by the ball `S'` alone (upper links: by nothing). When [`swept_boxes_apart`] does
+//!    swept by the ball `S'` alone (upper links: by nothing). When [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) does
 //!    not separate the boxes swept by those balls (radii shrunk by a relative 1e-9, far above
 //!    rounding), it cannot separate them with the real sweeps of any tier: STOP at once,
 //!    without inverse kinematics.
@@ -61,7 +61,13 @@
 //! [`ProtectiveChecker::check`] start from the last tick's limit and step away from it by
 //! doubling steps to a bracket before bisecting: the same kind of answer (a grid speed proved,
 //! the next one up not) in a few tests where limits change little between ticks. 0 when not
-//! even standing still is proved; `v_max` when full speed is. By default the bisection uses
+//! even standing still is proved; `v_max` when full speed is. The tests of a tick
+//! are capped, all robots together ([`ProtectiveChecker::with_limit_tests`],
+//! [`DEFAULT_EXTRA_LIMIT_TESTS`]): at the cap the largest speed proved so far is the limit (a
+//! proved speed, lower than the search's end, which the next ticks approach from it, with the
+//! step reached), 0 when no test proved one. Never below that, the
+//! tick's measured speed when its verdict is not STOP: the verdict proved every pair with
+//! the ball of that speed and direction, the ball a test at that speed builds. By default the bisection uses
 //! tier 1 alone (a few us per robot): that limit is proved, and never above the limit of
 //! both tiers ([`ProtectiveChecker::with_precise_limits`] for that one: both tiers, the
 //! second only above the first's limit and below the speed where step 6 already fails).
@@ -86,7 +92,7 @@ use crate::cspace::guarantee::{cube_box_sweeps, cube_box_sweeps_with, theta_rang
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
 use crate::geometry::sweep::{swept_boxes_apart_with, FaceTerms};
 use crate::robot::MAX_BOXES;
-use crate::geometry::{swept_boxes_apart, Obb, Sweep};
+use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::motor_table::{intersect, MotorTable};
 use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
@@ -116,6 +122,11 @@ pub const PRECISE_SPLITS: u32 = 2;
 
 /// Bisection steps of a speed limit (after the checks at 0 and at `v_max`).
 pub const LIMIT_STEPS: u32 = 8;
+
+/// How many speeds the searches of the robots' speed limits test per tick in all, beyond one
+/// per robot, by default ([`ProtectiveChecker::with_limit_tests`]); one test costs about as
+/// much as one robot's sweeps and their swept-box proof.
+pub const DEFAULT_EXTRA_LIMIT_TESTS: u32 = 1;
 
 /// Relative and absolute slack of the plausibility checks: rounding of the caller's own
 /// trajectory arithmetic must not read as an impossible motion.
@@ -219,8 +230,9 @@ struct History {
     tcp: Option<Vec3>,
     /// The last finite-difference velocity (mm/s).
     velocity: Option<Vec3>,
-    /// The last speed limit (mm/s): where this tick's search starts.
-    limit: Option<Real>,
+    /// The last speed limit (mm/s): where this tick's search starts; and the step of its
+    /// first test above that limit (mm/s; module doc).
+    limit: Option<(Real, Real)>,
 }
 
 const NO_HISTORY: History = History { tcp: None, velocity: None, limit: None };
@@ -248,6 +260,13 @@ pub struct ProtectiveChecker {
     precise_splits: u32,
     /// Whether the speed limits use the second tier too (else the table's alone).
     precise_limits: bool,
+    /// Speeds tested per tick at most, all robots together, by the searches of the table
+    /// tier's limits.
+    limit_tests: u32,
+    /// Per robot, the step of the next tick's first test above its limit.
+    limit_steps: alloc::vec::Vec<Real>,
+    /// Which robot's search comes first this tick (and may use the most tests).
+    limit_turn: usize,
     /// Per robot, `S` and the ball of [`ProtectiveChecker::stop_ball`] at this tick's measured
     /// speed: computed once per tick, read again when the tick needs its references.
     stop_balls: alloc::vec::Vec<(Real, (Vec3, Real))>,
@@ -322,6 +341,9 @@ impl ProtectiveChecker {
             speed_limits: true,
             precise_splits: PRECISE_SPLITS,
             precise_limits: false,
+            limit_tests: n as u32 + DEFAULT_EXTRA_LIMIT_TESTS,
+            limit_steps: alloc::vec![0.0; n],
+            limit_turn: 0,
             stop_balls: alloc::vec![(0.0, (Vec3::zeros(), 0.0)); n],
             centres: alloc::vec![Vec3::zeros(); n],
             reach: alloc::vec![0.0; n],
@@ -378,6 +400,28 @@ impl ProtectiveChecker {
     /// never above the precise limit, so FREE holds at it too).
     pub fn with_precise_limits(self, on: bool) -> Self {
         ProtectiveChecker { precise_limits: on, ..self }
+    }
+
+    /// This checker testing at most `tests` speeds per tick, all robots together, in the
+    /// searches of the speed limits of the table's tier (by default one per robot plus
+    /// [`DEFAULT_EXTRA_LIMIT_TESTS`]; `u32::MAX`: every search runs to its end). One test
+    /// costs about one robot's sweeps and their proof, so this bounds the time of a tick's
+    /// limits. The robots search in turn, the first one changing every tick; each may use
+    /// what is left but one test per robot after it. When a search runs out of tests the
+    /// limit reported is the largest speed it proved: still a proved speed, possibly lower
+    /// than the search would have found; the next tick's search starts from it, with the
+    /// step it had reached, so a limit that moved by more than one tick's tests reach is
+    /// found over a few ticks. A robot left no test reports this tick's measured speed when
+    /// the verdict is not STOP, else 0 (module doc). Not capped: the precise limits
+    /// ([`ProtectiveChecker::with_precise_limits`]), and the searches of
+    /// [`ProtectiveChecker::check_at_speeds`], which has no last limit to start from.
+    pub fn with_limit_tests(self, tests: u32) -> Self {
+        ProtectiveChecker { limit_tests: tests, ..self }
+    }
+
+    /// The cap on speeds tested per tick ([`ProtectiveChecker::with_limit_tests`]).
+    pub fn limit_tests(&self) -> u32 {
+        self.limit_tests
     }
 
     /// The WARN threshold (mm).
@@ -455,9 +499,10 @@ impl ProtectiveChecker {
         self.evaluate(tcps_mcs, status, true, bound);
         // Only a tick without error (unreachable included) becomes the next one's history.
         if self.report.status == ProtectiveStatus::Ok {
-            for ((h, tcp), r) in self.history.iter_mut().zip(tcps_mcs).zip(&self.report.robots) {
+            let robots = self.history.iter_mut().zip(tcps_mcs).zip(&self.report.robots).zip(&self.limit_steps);
+            for (((h, tcp), r), step) in robots {
                 h.tcp = Some(*tcp);
-                h.limit = Some(r.speed_limit_mm_s).filter(|v| v.is_finite());
+                h.limit = Some(r.speed_limit_mm_s).filter(|v| v.is_finite()).map(|v| (v, *step));
             }
         } else {
             self.reset();
@@ -644,9 +689,27 @@ impl ProtectiveChecker {
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
             return;
         }
-        for (j, tcp) in tcps_mcs.iter().enumerate() {
+        // This tick's verdict, when not STOP, proved every pair at each robot's measured speed
+        // (with its measured direction, the ball the search's tests build at that speed too).
+        let proved_now = self.report.verdict != Protective::Stop;
+        let n = tcps_mcs.len();
+        // Without a history (`check_at_speeds`) no search has a last limit to start from, so
+        // none would get far with a few tests: those searches are not capped.
+        let cap = if from_history { self.limit_tests } else { u32::MAX };
+        let (first, mut left) = (self.limit_turn % n.max(1), cap);
+        self.limit_turn = self.limit_turn.wrapping_add(1);
+        for i in 0..n {
+            let j = (first + i) % n;
+            let tcp = &tcps_mcs[j];
             let start = self.history[j].limit.filter(|_| from_history);
-            self.report.robots[j].speed_limit_mm_s = self.speed_limit(j, tcp, start);
+            let v = self.report.robots[j].speed_mm_s;
+            let floor = if proved_now && v <= self.cell().stops[j].max_speed_mm_s { v } else { 0.0 };
+            // What is left, but one test for each robot after this one (while there are any).
+            let after = (n - 1 - i) as u32;
+            let budget = if left > after { left - after } else { left.min(1) };
+            let (limit, used, step) = self.speed_limit(j, tcp, start, floor, budget);
+            left -= used;
+            (self.report.robots[j].speed_limit_mm_s, self.limit_steps[j]) = (limit, step);
         }
     }
 
@@ -748,7 +811,8 @@ impl ProtectiveChecker {
         let robot = &self.exact.cell().robots[j];
         let rot = robot.placement.rotation();
         let (centre, radius) = (self.centres[j], self.reach[j]);
-        self.sweeps[j] = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref(), tier, arms);
+        let table = self.tables[j].as_deref();
+        stop_sweeps_wcs_into(&mut self.sweeps[j], &robot.model, &rot, &centre, radius, table, tier, arms);
         let boxes = &self.ref_boxes[j];
         for (form, faces) in self.faces[j].iter_mut().enumerate() {
             for (k, b) in boxes.as_slice().iter().enumerate() {
@@ -767,10 +831,23 @@ impl ProtectiveChecker {
             let moves_with_tcp = !matches!(self.exact.cell().robots[j].model.box_kind(k), BoxKind::UpperLink(_));
             Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO }
         };
+        // Each box's sweep and face terms once per robot, not once per box pair: the same test
+        // as `swept_boxes_apart`, which builds both face terms for every pair it is given.
+        let swept = |j: usize| -> [(Sweep, FaceTerms); MAX_BOXES] {
+            let boxes = self.ref_boxes[j].as_slice();
+            core::array::from_fn(|k| match boxes.get(k) {
+                Some(b) => {
+                    let w = least(j, k);
+                    (w, FaceTerms::new(b, &w))
+                }
+                None => (Sweep::ZERO, self.no_faces),
+            })
+        };
         for p in self.exact.verdict().pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
-            for (i, box_a) in self.ref_boxes[p.a].as_slice().iter().enumerate() {
-                for (k, box_b) in self.ref_boxes[p.b].as_slice().iter().enumerate() {
-                    if !swept_boxes_apart(box_a, &least(p.a, i), box_b, &least(p.b, k)) {
+            let (swept_a, swept_b) = (swept(p.a), swept(p.b));
+            for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(&swept_a).enumerate() {
+                for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(&swept_b).enumerate() {
+                    if !swept_boxes_apart_with(box_a, sa, fa, box_b, sb, fb) {
                         return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
                     }
                 }
@@ -779,8 +856,19 @@ impl ProtectiveChecker {
         None
     }
 
-    /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are.
-    fn speed_limit(&mut self, j: usize, tcp_mcs: &Vec3, start: Option<Real>) -> Real {
+    /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are: the search
+    /// from `start` (the last tick's limit and the step of the first test above it), never
+    /// below `floor`, a speed this tick's verdict proved for `j` (0 when none), with at most
+    /// `budget` tests of the table's tier. Returns the limit, the tests used, and the step of
+    /// the next tick's first test above the limit.
+    fn speed_limit(
+        &mut self,
+        j: usize,
+        tcp_mcs: &Vec3,
+        start: Option<(Real, Real)>,
+        floor: Real,
+        budget: u32,
+    ) -> (Real, u32, Real) {
         let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]);
         let inside = self.kept.inside(j);
         // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
@@ -793,12 +881,20 @@ impl ProtectiveChecker {
                 return false;
             }
             let Some(tier) = tier else { return true };
-            // The robots that can meet `j` as they are, with the motor angles of the same tier.
+            // The robots that can meet `j` as they are, with the motor angles of the same tier;
+            // with tier 1, another robot keeps the sweeps it has for this tick's reference,
+            // tier 1 or the verdict's second tier on some arms: each encloses every box of its
+            // stop (module doc, step 4), the second tier within the first, so a test proved
+            // with them is a proof, and tier 2 on every arm proves it too (the precise limit
+            // stays the higher); only a robot without sweeps gets tier 1's.
             for k in 0..me.exact.verdict().pairs.len() {
                 let p = me.exact.verdict().pairs[k];
                 if p.a == j || p.b == j {
-                    me.sweeps_at(p.a, tier, 0b111);
-                    me.sweeps_at(p.b, tier, 0b111);
+                    for i in [p.a, p.b] {
+                        if i == j || tier > 0 || me.sweep_tier[i].is_none() {
+                            me.sweeps_at(i, tier, 0b111);
+                        }
+                    }
                 }
             }
             let boxes = |i: usize| me.ref_boxes[i].as_slice();
@@ -846,11 +942,85 @@ impl ProtectiveChecker {
                 (from, step) = (to, 2.0 * step);
             }
         };
+        // `limit_of` or `limit_near` with tier 1 alone, at most `budget` tests: the largest speed
+        // a test proved (0 when none did, or when every speed above `floor` that the search
+        // would still test is at most `floor`: `floor` is the answer then), the tests used, and
+        // where the next tick's first step up starts: where this one's steps or bisection
+        // stopped for want of tests (`resolution` when the search ended).
+        let mut used = 0;
+        let mut capped = |me: &mut Self| -> (Real, Real) {
+            let mut test = |me: &mut Self, v: Real| {
+                let left = used < budget;
+                used += u32::from(left);
+                left.then(|| proved(me, v, Some(0)))
+            };
+            // `lo` proved, `hi` not (`None`: no such speed tested yet).
+            let (mut lo, mut hi) = (None, None);
+            let mut step = resolution;
+            match start {
+                Some((h, carried)) => {
+                    let h = ((h / resolution).round() * resolution).clamp(0.0, vmax);
+                    match test(me, h) {
+                        None => return (0.0, resolution),
+                        Some(true) => (lo, step) = (Some(h), carried.max(resolution)),
+                        Some(false) => hi = Some(h),
+                    }
+                }
+                None => {
+                    match test(me, vmax) {
+                        None => return (0.0, resolution),
+                        Some(true) => return (vmax, resolution),
+                        Some(false) => hi = Some(vmax),
+                    }
+                    match test(me, 0.0) {
+                        Some(true) => lo = Some(0.0),
+                        _ => return (0.0, resolution),
+                    }
+                }
+            }
+            loop {
+                let (to, up) = match (lo, hi) {
+                    (Some(l), None) if l >= vmax => return (vmax, resolution),
+                    (Some(l), None) => ((l + step).min(vmax), true),
+                    (None, Some(h)) if h <= floor || h <= 0.0 => return (0.0, resolution),
+                    (None, Some(h)) => ((h - step).max(0.0), false),
+                    _ => break,
+                };
+                match test(me, to) {
+                    // Out of tests while going up: the next tick goes on with the next step.
+                    None => return (lo.unwrap_or(0.0), if up { step } else { resolution }),
+                    Some(true) => lo = Some(to),
+                    Some(false) => hi = Some(to),
+                }
+                // A bracket found going down from `hi` ends the steps; going up, so does `hi`.
+                if !up && lo.is_some() {
+                    break;
+                }
+                step *= 2.0;
+            }
+            let (Some(mut lo), Some(mut hi)) = (lo, hi) else { return (lo.unwrap_or(0.0), resolution) };
+            while hi - lo > resolution && hi > floor {
+                let mid = 0.5 * (lo + hi);
+                match test(me, mid) {
+                    // Out of tests: the next tick tries the middle of the bracket first.
+                    None => return (lo, mid - lo),
+                    Some(true) => lo = mid,
+                    Some(false) => hi = mid,
+                }
+            }
+            (lo, resolution)
+        };
         let tier = if self.precise_limits { self.precise_splits } else { 0 };
-        // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit, and the floor
-        // of the precise one.
+        // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit (capped), and
+        // the floor of the precise one (not capped).
+        let mut next_step = resolution;
         let (lo, hi) = match start {
-            Some(h) => limit_near(self, h),
+            _ if tier == 0 => {
+                let (lo, step) = capped(self);
+                next_step = step;
+                (lo, vmax)
+            }
+            Some((h, _)) => limit_near(self, h),
             None => limit_of(self, Some(0), vmax),
         };
         let limit = if tier == 0 || lo == vmax {
@@ -873,7 +1043,9 @@ impl ProtectiveChecker {
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
         self.kept.restore_inside(j, inside);
-        limit
+        // The step is kept only when the limit is the one the steps were taken from.
+        let next_step = if limit >= floor { next_step } else { resolution };
+        (limit.max(floor), used, next_step)
     }
 }
 
@@ -941,6 +1113,24 @@ pub fn stop_sweeps_wcs(
     precise: u32,
     arms: u8,
 ) -> SweepForms {
+    let mut out = [[Sweep::ZERO; MAX_BOXES]; 2];
+    stop_sweeps_wcs_into(&mut out, model, rot_wcs, tcp_mcs, s, table, precise, arms);
+    out
+}
+
+/// [`stop_sweeps_wcs`] written into `out`: the tick's sweeps are recomputed in place, many
+/// times per tick by the speed limits' tests, without whole sets copied on the way.
+#[allow(clippy::too_many_arguments)]
+fn stop_sweeps_wcs_into(
+    out: &mut SweepForms,
+    model: &RobotModel,
+    rot_wcs: &crate::math::Mat3,
+    tcp_mcs: &Vec3,
+    s: Real,
+    table: Option<&MotorTable>,
+    precise: u32,
+    arms: u8,
+) {
     let d = &model.delta;
     let direct = |lo: &Vec3, hi: &Vec3, splits: u32| -> [Enclosure; 3] {
         core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits))
@@ -976,9 +1166,12 @@ pub fn stop_sweeps_wcs(
                     ..*w
                 }
             };
-            [sweeps.map(|w| w.rotated(rot_wcs)), sweeps.map(|w| ball_form(&w).rotated(rot_wcs))]
+            let [cube_form, ball_forms] = out;
+            for ((w, c), b) in sweeps.iter().zip(cube_form.iter_mut()).zip(ball_forms.iter_mut()) {
+                (*c, *b) = (w.rotated(rot_wcs), ball_form(w).rotated(rot_wcs));
+            }
         }
-        None => [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2],
+        None => *out = [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2],
     }
 }
 
@@ -1018,16 +1211,19 @@ pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MA
 fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(usize, usize)> {
     const FORMS: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
     let ((boxes_a, sweeps_a, faces_a), (boxes_b, sweeps_b, faces_b)) = (a, b);
-    // With `extra`, the first robot's face terms under its widened sweeps.
-    let mut widened = *faces_a;
+    // With `extra`, the first robot's face terms under its widened sweeps (a copy only then:
+    // the tests of the speed limits call this with no `extra`, many times per tick).
+    let mut copy = None;
     if extra != 0.0 {
-        for (form, terms) in widened.iter_mut().enumerate() {
+        let terms = copy.insert(*faces_a);
+        for (form, terms) in terms.iter_mut().enumerate() {
             for (i, box_a) in boxes_a.iter().enumerate() {
                 let sa = &sweeps_a[form][i];
                 terms[i] = FaceTerms::new(box_a, &Sweep { ball: sa.ball + extra, ..*sa });
             }
         }
     }
+    let widened = copy.as_ref().unwrap_or(faces_a);
     for (i, box_a) in boxes_a.iter().enumerate() {
         for (k, box_b) in boxes_b.iter().enumerate() {
             let apart = |&(fa, fb): &(usize, usize)| {
@@ -1087,11 +1283,18 @@ mod tests {
         let r = c.check(&[a, b]).unwrap().clone();
         assert_eq!(r.status, ProtectiveStatus::Ok);
         assert_eq!(r.robots[0].speed_bound_mm_s, 4_600.0);
-        // Standing still: the bound is the reaction only.
+        // Standing still: the bound is the reaction only. The search without a cap finds both
+        // limits at once; the capped one (a few tests per tick) reaches them a few ticks later.
+        let mut uncapped = c.clone().with_limit_tests(u32::MAX);
+        let r = uncapped.check(&[a, b]).unwrap();
+        assert!(r.robots.iter().all(|x| x.speed_limit_mm_s > 0.0), "{r:?}");
         let r = c.check(&[a, b]).unwrap().clone();
         assert_eq!(r.verdict, Protective::Free, "{r:?}");
         assert!(r.clearance_mm > 100.0);
-        assert!(r.robots.iter().all(|x| x.speed_limit_mm_s > 0.0));
+        for _ in 0..3 {
+            c.check(&[a, b]).unwrap();
+        }
+        assert!(c.report().robots.iter().all(|x| x.speed_limit_mm_s > 0.0), "{:?}", c.report());
         let close = [Vec3::new(60.0, 30.0, -420.0), Vec3::new(-60.0, -30.0, -430.0)];
         let r = c.check_at_speeds(&close, &[4_000.0, 4_000.0]).unwrap();
         assert_eq!(r.verdict, Protective::Stop);
