@@ -228,6 +228,16 @@ impl Delta3 {
     /// (`z >= 0`), an arm cannot close its loop, or a motor would leave its limits; the first
     /// failing arm (0, 1, 2 in order) is reported.
     pub fn inverse_kinematics_cos_sin(&self, tcp: &Vec3) -> Result<MotorCosSin, Unreachable> {
+        let mut out = MotorCosSin { cos: [0.0; 3], sin: [0.0; 3] };
+        self.solve::<true>(tcp, &mut out)?;
+        Ok(out)
+    }
+
+    /// The inverse kinematics, arm by arm; with `OUT` the cosines and sines are written to
+    /// `out`, without it only reachability is decided, by the very same tests on the very same
+    /// values (the division by `R^2` is then taken only where the exact limit test needs it).
+    #[inline(always)]
+    fn solve<const OUT: bool>(&self, tcp: &Vec3, out: &mut MotorCosSin) -> Result<(), Unreachable> {
         if !(tcp.x.is_finite() && tcp.y.is_finite() && tcp.z.is_finite()) {
             return Err(Unreachable::NonFinite);
         }
@@ -238,7 +248,6 @@ impl Delta3 {
         let (re2, rf2, ef) = (self.re * self.re, self.rf * self.rf, self.e - self.f);
         let half_inv_rf = 0.5 / self.rf;
         let c = tcp.z;
-        let mut out = MotorCosSin { cos: [0.0; 3], sin: [0.0; 3] };
         for (arm, &[ux, uy]) in ARM_RADIAL.iter().enumerate() {
             // P = E_i - F_i = p + (e - f) u_i, in the arm's (u, t, z) frame: (a, b, c).
             let a = tcp.x * ux + tcp.y * uy + ef;
@@ -254,22 +263,26 @@ impl Delta3 {
             // sign that makes cos th larger, +/- = sign(c), and c = z < 0 here: minus.
             let s = -float::sqrt(r2 - k * k);
             let (cos_n, sin_n) = (a * k + c * s, a * s - c * k); // R^2 (cos th, sin th)
-                                                                 // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
+            // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
             let fast_ok = self.clearly_within_limits(approx_angle(cos_n, sin_n));
-            let inv_r2 = 1.0 / r2;
-            let (cos_th, sin_th) = (cos_n * inv_r2, sin_n * inv_r2);
-            if !fast_ok {
-                if let Err(theta) = self.motor_within_limits(cos_th, sin_th) {
-                    if theta.is_nan() {
-                        return Err(Unreachable::OutOfReach { arm: arm as u8 });
+            if OUT || !fast_ok {
+                let inv_r2 = 1.0 / r2;
+                let (cos_th, sin_th) = (cos_n * inv_r2, sin_n * inv_r2);
+                if !fast_ok {
+                    if let Err(theta) = self.motor_within_limits(cos_th, sin_th) {
+                        if theta.is_nan() {
+                            return Err(Unreachable::OutOfReach { arm: arm as u8 });
+                        }
+                        return Err(Unreachable::MotorLimit { arm: arm as u8, theta });
                     }
-                    return Err(Unreachable::MotorLimit { arm: arm as u8, theta });
+                }
+                if OUT {
+                    out.cos[arm] = cos_th;
+                    out.sin[arm] = sin_th;
                 }
             }
-            out.cos[arm] = cos_th;
-            out.sin[arm] = sin_th;
         }
-        Ok(out)
+        Ok(())
     }
 
     /// Elbow-out motor angles for a TCP in the MCS (SPEC §2), with their cosines and sines.
@@ -281,8 +294,12 @@ impl Delta3 {
     }
 
     /// Whether the TCP (MCS) is reachable: every loop closes and every motor is within limits.
+    ///
+    /// The same tests on the same values as [`Delta3::inverse_kinematics_cos_sin`], without
+    /// writing the cosines and sines (a table lookup needs only the verdict).
     pub fn is_reachable(&self, tcp: &Vec3) -> bool {
-        self.inverse_kinematics_cos_sin(tcp).is_ok()
+        let mut unused = MotorCosSin { cos: [0.0; 3], sin: [0.0; 3] };
+        self.solve::<false>(tcp, &mut unused).is_ok()
     }
 
     /// The TCP for motor angles `theta`: the lower intersection (smaller z) of the three

@@ -30,6 +30,15 @@ pub struct PairAnswer {
     pub boxes: Option<(usize, usize)>,
 }
 
+/// One robot's TCP on one grid: the robot, and the table checker and side (0 or 1) whose grid
+/// it is; every pair whose table has an equal grid on that robot's side reads the same cell.
+#[derive(Clone, Copy, Debug)]
+struct GridSlot {
+    robot: usize,
+    checker: usize,
+    side: usize,
+}
+
 /// The loaded tables of a bundle and the pairs of the controller's cell that use them.
 #[derive(Clone, Debug)]
 pub struct BundleChecker {
@@ -37,6 +46,13 @@ pub struct BundleChecker {
     models: Vec<RobotModel>,
     checkers: Vec<TableChecker>,
     pairs: Vec<PairAnswer>,
+    /// The distinct (robot, grid) cells a tick needs: a line's tables share one grid, so each
+    /// robot's cell is taken once per tick rather than once per pair it is in.
+    slots: Vec<GridSlot>,
+    /// Per pair, the slots of its robots `a` and `b`.
+    pair_slots: Vec<[usize; 2]>,
+    /// Per slot, the cell of the last tick (`None`: robot unreachable or outside the grid).
+    cells: Vec<Option<[u16; 3]>>,
 }
 
 impl BundleChecker {
@@ -73,8 +89,23 @@ impl BundleChecker {
             };
             pairs.push(PairAnswer { a, b, table, answer: TableAnswer::Unreachable(0), boxes: None });
         }
+        let mut slots: Vec<GridSlot> = Vec::new();
+        let mut pair_slots = Vec::with_capacity(pairs.len());
+        for p in &pairs {
+            let mut slot_of = |robot: usize, side: usize| {
+                let same = |s: &GridSlot| {
+                    s.robot == robot && checkers[s.checker].same_grid(s.side, &checkers[p.table], side)
+                };
+                slots.iter().position(same).unwrap_or_else(|| {
+                    slots.push(GridSlot { robot, checker: p.table, side });
+                    slots.len() - 1
+                })
+            };
+            pair_slots.push([slot_of(p.a, 0), slot_of(p.b, 1)]);
+        }
+        let cells = alloc::vec![None; slots.len()];
         let models = cell.robots.iter().map(|r| r.model).collect();
-        Ok(BundleChecker { cell, models, checkers, pairs })
+        Ok(BundleChecker { cell, models, checkers, pairs, slots, pair_slots, cells })
     }
 
     /// The cell.
@@ -153,13 +184,21 @@ impl BundleChecker {
         // is answered, and the tick's answer is unreachable.
         let mask = self.unreachable_mask(tcps_mcs);
         let mut answer = if mask != 0 { TableAnswer::Unreachable(mask) } else { TableAnswer::Free };
-        for p in &mut self.pairs {
+        // Each reachable robot's cell once per grid; an unreachable robot's pairs look nothing up.
+        for (cell, s) in self.cells.iter_mut().zip(&self.slots) {
+            *cell = match mask >> s.robot & 1 {
+                0 => self.checkers[s.checker].cell_of(s.side, &tcps_mcs[s.robot]),
+                _ => None,
+            };
+        }
+        for (p, [sa, sb]) in self.pairs.iter_mut().zip(&self.pair_slots) {
             (p.answer, p.boxes) = (TableAnswer::Unreachable(mask), None);
             if mask >> p.a & 1 == 1 || mask >> p.b & 1 == 1 {
                 continue;
             }
             let checker = &mut self.checkers[p.table];
-            p.answer = match checker.check_reachable(&[tcps_mcs[p.a], tcps_mcs[p.b]])? {
+            let cells = [self.cells[*sa], self.cells[*sb]];
+            p.answer = match checker.check_cells(cells, &[tcps_mcs[p.a], tcps_mcs[p.b]])? {
                 // The pair checker's bits name the pair's robots; fail closed on the cell's.
                 TableAnswer::Unreachable(m) => TableAnswer::Unreachable((m & 1) << p.a | (m >> 1 & 1) << p.b),
                 other => other,
