@@ -96,6 +96,11 @@ pub struct ExactChecker {
     cell: Cell,
     /// Robots placed at the WCS origin without rotation skip the box transform.
     at_origin: Vec<bool>,
+    /// Robots placed without rotation (`alpha == 0`, a line along a conveyor) only have their
+    /// boxes' centres moved: their rotation is the identity exactly (`sin 0 = 0`, `cos 0 = 1`),
+    /// so the product with it gives back every finite axis and centre as they are, and the
+    /// centre plus `t` is what the full transform computes.
+    translated_only: Vec<bool>,
     /// Per robot, the rotation of its placement (MCS to WCS): fixed, so its sine and cosine
     /// are taken once here rather than every tick.
     rotations: Vec<Mat3>,
@@ -117,6 +122,7 @@ impl ExactChecker {
             .collect();
         ExactChecker {
             at_origin: cell.robots.iter().map(|r| r.placement.alpha == 0.0 && r.placement.t == Vec3::zeros()).collect(),
+            translated_only: cell.robots.iter().map(|r| r.placement.alpha == 0.0).collect(),
             rotations: cell.robots.iter().map(|r| r.placement.rotation()).collect(),
             boxes: vec![RobotBoxes::empty(); n],
             aabb: vec![(Vec3::zeros(), Vec3::zeros()); n],
@@ -194,7 +200,17 @@ impl ExactChecker {
             match robot.model.boxes_into(tcp, &mut self.boxes[j]) {
                 Ok(()) => {
                     let boxes = &mut self.boxes[j];
-                    if !self.at_origin[j] {
+                    if self.at_origin[j] {
+                        // Already in the WCS.
+                    } else if self.translated_only[j] {
+                        // Non-finite boxes may differ here from the full transform (0 * inf is
+                        // NaN there), but either way they are non-finite, which the pair test
+                        // answers as colliding at the same first non-finite box.
+                        let t = &robot.placement.t;
+                        for b in &mut boxes.boxes[..boxes.len] {
+                            b.center += t;
+                        }
+                    } else {
                         let (rot, t) = (&self.rotations[j], &robot.placement.t);
                         for b in &mut boxes.boxes[..boxes.len] {
                             *b = b.transformed(rot, t);
