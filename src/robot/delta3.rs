@@ -339,6 +339,88 @@ impl Delta3 {
 mod tests {
     use super::*;
 
+    /// A small xorshift in [0, 1): the same TCPs on every run.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// `is_reachable` decides exactly as the inverse kinematics does, on random TCPs in and
+    /// around the workspace, on TCPs within an ulp of the reach boundary (bisection between a
+    /// reachable and an unreachable TCP), with a motor at or an ulp beyond either limit
+    /// (forward kinematics from a limit angle), and on non-finite or above-base TCPs; for the
+    /// thesis robot and for narrow limits that make the motor limits bind often.
+    #[test]
+    fn is_reachable_decides_as_the_inverse_kinematics() {
+        let narrow = Delta3 { theta_min: -0.3, theta_max: 0.9, ..Delta3::THESIS };
+        let wide = Delta3 { theta_min: -PI + 1e-3, theta_max: PI, ..Delta3::THESIS };
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let (mut reachable, mut unreachable, mut at_boundary) = (0, 0, 0);
+        for d in [Delta3::THESIS, narrow, wide] {
+            let agree = |p: &Vec3| {
+                let ik = d.inverse_kinematics_cos_sin(p).is_ok();
+                assert_eq!(d.is_reachable(p), ik, "{d:?} at {p:?}");
+                ik
+            };
+            let home = Vec3::new(0.0, 0.0, -450.0);
+            for _ in 0..50_000 {
+                let p = Vec3::new(700.0 * rng.next() - 350.0, 700.0 * rng.next() - 350.0, -700.0 * rng.next() + 50.0);
+                if agree(&p) {
+                    reachable += 1;
+                } else {
+                    unreachable += 1;
+                    // The boundary on the segment from home (reachable for all three) to p.
+                    if !agree(&home) {
+                        continue;
+                    }
+                    let (mut lo, mut hi) = (home, p);
+                    for _ in 0..80 {
+                        let mid = (lo + hi) * 0.5;
+                        if agree(&mid) {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    at_boundary += 1;
+                    for q in [lo, hi, lo.map(|v| v.next_up()), hi.map(|v| v.next_down())] {
+                        agree(&q);
+                    }
+                }
+            }
+            // A motor exactly at a limit and one ulp either side of it, the others random.
+            for i in 0..3000 {
+                let mut theta: [Real; 3] = core::array::from_fn(|_| d.theta_min + (d.theta_max - d.theta_min) * rng.next());
+                let limit = if i % 2 == 0 { d.theta_min } else { d.theta_max };
+                for th in [limit, limit.next_up(), limit.next_down()] {
+                    theta[i % 3] = th;
+                    if let Some(p) = d.forward_kinematics(&theta) {
+                        agree(&p);
+                        agree(&p.map(|v| v.next_up()));
+                        agree(&p.map(|v| v.next_down()));
+                    }
+                }
+            }
+            for p in [
+                Vec3::new(f64::NAN, 0.0, -400.0),
+                Vec3::new(0.0, f64::INFINITY, -400.0),
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, -0.0),
+                Vec3::new(0.0, 0.0, 1.0),
+                Vec3::new(1e300, 0.0, -1e300),
+                Vec3::new(0.0, 0.0, -f64::MIN_POSITIVE),
+            ] {
+                assert!(!agree(&p), "{p:?}");
+            }
+        }
+        assert!(reachable > 2_000 && at_boundary > 2_000, "{reachable} {unreachable} {at_boundary}");
+    }
+
     #[test]
     fn home_position_round_trips() {
         let d = Delta3::THESIS;

@@ -214,3 +214,82 @@ impl BundleChecker {
         Ok(answer)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::{Placement, RobotSpec, SatMethod};
+    use crate::cspace::{Progress, Workspace};
+    use crate::table::bundle::build_bundle;
+    use crate::table::{Labelling, Variant};
+    use alloc::{format, vec};
+
+    fn line(n: usize) -> Cell {
+        let robots = (0..n)
+            .map(|i| RobotSpec {
+                name: format!("R{i}"),
+                model: RobotModel::THESIS,
+                placement: Placement { alpha: 0.0, t: Vec3::new(450.0 * i as f64, 0.0, 0.0) },
+            })
+            .collect();
+        Cell::new("line".into(), robots, SatMethod::SatCache).unwrap()
+    }
+
+    /// In a line every robot's pairs share its grid, so each robot's cell is taken once per
+    /// tick; and every pair answers as its own table checker does alone (which takes both
+    /// cells and the reachability itself), labels compared (no confirmation), on random TCPs
+    /// inside, beyond and outside the grids and unreachable ones.
+    #[test]
+    fn a_lines_pairs_share_each_robots_cell_and_answer_as_their_own_checkers() {
+        let built = build_bundle(&line(4), 16, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
+            .unwrap();
+        let cell = line(8);
+        let mut bundle = BundleChecker::new(cell.clone(), &built.bytes, Confirmation::None).unwrap();
+        // Per robot, one cell per query resolution among its tables (the three tables may
+        // differ in sub-levels), against one per pair and side (36) taken pair by pair.
+        let mut resolutions = bundle.checkers.iter().map(|c| c.table().sub_levels()).collect::<Vec<_>>();
+        resolutions.sort_unstable();
+        resolutions.dedup();
+        let distinct = resolutions.len();
+        assert!(bundle.slots.len() <= 8 * distinct, "{} slots, sub-levels {resolutions:?}", bundle.slots.len());
+        assert!((0..8).all(|j| bundle.slots.iter().any(|s| s.robot == j)));
+        let loaded = bundle_from_bytes(&built.bytes).unwrap();
+        let mut alone: Vec<TableChecker> = bundle
+            .pairs()
+            .iter()
+            .map(|p| {
+                let (header, table) = loaded.tables[loaded.table_for(&cell, p.a, p.b).unwrap()].clone();
+                TableChecker::from_loaded(pair_cell(&cell, p.a, p.b), header, table, Confirmation::None).unwrap()
+            })
+            .collect();
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut seen = [0usize; 3]; // free, collision, unreachable
+        let mut tcps = vec![Vec3::zeros(); 8];
+        for _ in 0..20_000 {
+            for t in &mut tcps {
+                *t = Vec3::new(600.0 * next() - 300.0, 600.0 * next() - 300.0, -300.0 - 300.0 * next());
+            }
+            bundle.check(&tcps).unwrap();
+            let mask = bundle.unreachable_mask(&tcps);
+            for (p, checker) in bundle.pairs().iter().zip(&mut alone) {
+                let want = checker.check(&[tcps[p.a], tcps[p.b]]).unwrap();
+                if mask >> p.a & 1 == 1 || mask >> p.b & 1 == 1 {
+                    assert!(matches!(want, TableAnswer::Unreachable(_)));
+                    assert_eq!(p.answer, TableAnswer::Unreachable(mask));
+                    seen[2] += 1;
+                    continue;
+                }
+                assert_eq!(p.answer, want, "pair {}-{} at {:?} {:?}", p.a, p.b, tcps[p.a], tcps[p.b]);
+                seen[usize::from(want == TableAnswer::Collision)] += 1;
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 100), "free, collision, unreachable answers: {seen:?}");
+        assert!(bundle.fallbacks() > 0, "some TCPs lie outside the grid");
+    }
+}
