@@ -45,8 +45,9 @@ fn main() {
     let mut exact = ExactChecker::new(cell.clone());
     let hits: Vec<bool> = run.iter().map(|t| exact.check(t).unwrap().collides()).collect();
     let mut table = (mode == "table").then(|| {
-        let built = build_bundle(&line(4), k, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
-            .unwrap();
+        let built =
+            build_bundle(&line(4), k, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
+                .unwrap();
         BundleChecker::new(cell.clone(), &built.bytes, Confirmation::Exact).unwrap()
     });
     eprintln!("start");

@@ -329,8 +329,8 @@ mod tests {
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         for _ in 0..5_000 {
-            let tcps: Vec<Vec3> =
-                (0..4).map(|_| Vec3::new(500.0 * next() - 250.0, 500.0 * next() - 250.0, -350.0 - 200.0 * next())).collect();
+            let mut tcp = || Vec3::new(500.0 * next() - 250.0, 500.0 * next() - 250.0, -350.0 - 200.0 * next());
+            let tcps: Vec<Vec3> = (0..4).map(|_| tcp()).collect();
             let verdict = checker.check(&tcps).unwrap().clone();
             collisions += verdict.colliding_pairs();
             for (j, (tcp, robot)) in tcps.iter().zip(&cell.robots).enumerate() {

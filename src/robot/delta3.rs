@@ -395,7 +395,8 @@ mod tests {
             }
             // A motor exactly at a limit and one ulp either side of it, the others random.
             for i in 0..3000 {
-                let mut theta: [Real; 3] = core::array::from_fn(|_| d.theta_min + (d.theta_max - d.theta_min) * rng.next());
+                let span = d.theta_max - d.theta_min;
+                let mut theta: [Real; 3] = core::array::from_fn(|_| d.theta_min + span * rng.next());
                 let limit = if i % 2 == 0 { d.theta_min } else { d.theta_max };
                 for th in [limit, limit.next_up(), limit.next_down()] {
                     theta[i % 3] = th;

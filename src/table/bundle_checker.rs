@@ -241,8 +241,8 @@ mod tests {
     /// inside, beyond and outside the grids and unreachable ones.
     #[test]
     fn a_lines_pairs_share_each_robots_cell_and_answer_as_their_own_checkers() {
-        let built = build_bundle(&line(4), 16, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
-            .unwrap();
+        let (variant, labelling) = (Variant::Shared, Labelling::Certified);
+        let built = build_bundle(&line(4), 16, &Workspace::THESIS, variant, labelling, Progress::Silent).unwrap();
         let cell = line(8);
         let mut bundle = BundleChecker::new(cell.clone(), &built.bytes, Confirmation::None).unwrap();
         // Per robot, one cell per query resolution among its tables (the three tables may
