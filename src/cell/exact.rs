@@ -96,6 +96,11 @@ pub struct ExactChecker {
     cell: Cell,
     /// Robots placed at the WCS origin without rotation skip the box transform.
     at_origin: Vec<bool>,
+    /// Robots placed without rotation (`alpha == 0`, a line along a conveyor) only have their
+    /// boxes' centres moved: their rotation is the identity exactly (`sin 0 = 0`, `cos 0 = 1`),
+    /// so the product with it gives back every finite axis and centre as they are, and the
+    /// centre plus `t` is what the full transform computes.
+    translated_only: Vec<bool>,
     /// Per robot, the rotation of its placement (MCS to WCS): fixed, so its sine and cosine
     /// are taken once here rather than every tick.
     rotations: Vec<Mat3>,
@@ -117,6 +122,7 @@ impl ExactChecker {
             .collect();
         ExactChecker {
             at_origin: cell.robots.iter().map(|r| r.placement.alpha == 0.0 && r.placement.t == Vec3::zeros()).collect(),
+            translated_only: cell.robots.iter().map(|r| r.placement.alpha == 0.0).collect(),
             rotations: cell.robots.iter().map(|r| r.placement.rotation()).collect(),
             boxes: vec![RobotBoxes::empty(); n],
             aabb: vec![(Vec3::zeros(), Vec3::zeros()); n],
@@ -194,7 +200,17 @@ impl ExactChecker {
             match robot.model.boxes_into(tcp, &mut self.boxes[j]) {
                 Ok(()) => {
                     let boxes = &mut self.boxes[j];
-                    if !self.at_origin[j] {
+                    if self.at_origin[j] {
+                        // Already in the WCS.
+                    } else if self.translated_only[j] {
+                        // Non-finite boxes may differ here from the full transform (0 * inf is
+                        // NaN there), but either way they are non-finite, which the pair test
+                        // answers as colliding at the same first non-finite box.
+                        let t = &robot.placement.t;
+                        for b in &mut boxes.boxes[..boxes.len] {
+                            b.center += t;
+                        }
+                    } else {
                         let (rot, t) = (&self.rotations[j], &robot.placement.t);
                         for b in &mut boxes.boxes[..boxes.len] {
                             *b = b.transformed(rot, t);
@@ -289,6 +305,57 @@ mod tests {
             })
             .collect();
         Cell::new("row".into(), robots, method).unwrap()
+    }
+
+    /// Robots placed without rotation have their boxes' centres moved, nothing else: value for
+    /// value the boxes are those of the full rigid transform of the MCS boxes (rotation of the
+    /// placement, then its translation), and so are the verdicts.
+    #[test]
+    fn unrotated_placements_give_the_full_transforms_boxes() {
+        let robots = (0..4)
+            .map(|i| RobotSpec {
+                name: format!("R{i}"),
+                model: RobotModel::THESIS,
+                placement: Placement { alpha: 0.0, t: Vec3::new(450.0 * i as f64 + 0.37, -31.3 * i as f64, 0.0) },
+            })
+            .collect();
+        let cell = Cell::new("row".into(), robots, SatMethod::SatCache).unwrap();
+        let mut checker = ExactChecker::new(cell.clone());
+        let (mut state, mut collisions) = (0x2545_f491_4f6c_dd1du64, 0);
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..5_000 {
+            let mut tcp = || Vec3::new(500.0 * next() - 250.0, 500.0 * next() - 250.0, -350.0 - 200.0 * next());
+            let tcps: Vec<Vec3> = (0..4).map(|_| tcp()).collect();
+            let verdict = checker.check(&tcps).unwrap().clone();
+            collisions += verdict.colliding_pairs();
+            for (j, (tcp, robot)) in tcps.iter().zip(&cell.robots).enumerate() {
+                let Ok(mcs) = robot.model.boxes(tcp) else {
+                    assert!(verdict.unreachable_mask >> j & 1 == 1);
+                    continue;
+                };
+                let (rot, t) = (robot.placement.rotation(), robot.placement.t);
+                let want: Vec<Obb> = mcs.as_slice().iter().map(|b| b.transformed(&rot, &t)).collect();
+                assert_eq!(checker.boxes(j).as_slice(), &want[..], "robot {j} at {tcp:?}");
+            }
+            for p in &verdict.pairs {
+                if verdict.unreachable_mask & (1 << p.a | 1 << p.b) != 0 {
+                    continue;
+                }
+                let boxes = |j: usize| {
+                    let (rot, t) = (cell.robots[j].placement.rotation(), cell.robots[j].placement.t);
+                    let b = RobotModel::THESIS.boxes(&tcps[j]).unwrap();
+                    b.as_slice().iter().map(|b| b.transformed(&rot, &t)).collect::<Vec<Obb>>()
+                };
+                let hit = first_intersecting_pair(&boxes(p.a), &boxes(p.b)).is_some();
+                assert_eq!(matches!(p.state, PairState::Collides(..)), hit, "pair {}-{} at {tcps:?}", p.a, p.b);
+            }
+        }
+        assert!(collisions > 100, "{collisions} colliding pairs: the test must see some");
     }
 
     #[test]

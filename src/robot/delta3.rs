@@ -228,6 +228,16 @@ impl Delta3 {
     /// (`z >= 0`), an arm cannot close its loop, or a motor would leave its limits; the first
     /// failing arm (0, 1, 2 in order) is reported.
     pub fn inverse_kinematics_cos_sin(&self, tcp: &Vec3) -> Result<MotorCosSin, Unreachable> {
+        let mut out = MotorCosSin { cos: [0.0; 3], sin: [0.0; 3] };
+        self.solve::<true>(tcp, &mut out)?;
+        Ok(out)
+    }
+
+    /// The inverse kinematics, arm by arm; with `OUT` the cosines and sines are written to
+    /// `out`, without it only reachability is decided, by the very same tests on the very same
+    /// values (the division by `R^2` is then taken only where the exact limit test needs it).
+    #[inline(always)]
+    fn solve<const OUT: bool>(&self, tcp: &Vec3, out: &mut MotorCosSin) -> Result<(), Unreachable> {
         if !(tcp.x.is_finite() && tcp.y.is_finite() && tcp.z.is_finite()) {
             return Err(Unreachable::NonFinite);
         }
@@ -238,7 +248,6 @@ impl Delta3 {
         let (re2, rf2, ef) = (self.re * self.re, self.rf * self.rf, self.e - self.f);
         let half_inv_rf = 0.5 / self.rf;
         let c = tcp.z;
-        let mut out = MotorCosSin { cos: [0.0; 3], sin: [0.0; 3] };
         for (arm, &[ux, uy]) in ARM_RADIAL.iter().enumerate() {
             // P = E_i - F_i = p + (e - f) u_i, in the arm's (u, t, z) frame: (a, b, c).
             let a = tcp.x * ux + tcp.y * uy + ef;
@@ -254,22 +263,26 @@ impl Delta3 {
             // sign that makes cos th larger, +/- = sign(c), and c = z < 0 here: minus.
             let s = -float::sqrt(r2 - k * k);
             let (cos_n, sin_n) = (a * k + c * s, a * s - c * k); // R^2 (cos th, sin th)
-                                                                 // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
+            // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
             let fast_ok = self.clearly_within_limits(approx_angle(cos_n, sin_n));
-            let inv_r2 = 1.0 / r2;
-            let (cos_th, sin_th) = (cos_n * inv_r2, sin_n * inv_r2);
-            if !fast_ok {
-                if let Err(theta) = self.motor_within_limits(cos_th, sin_th) {
-                    if theta.is_nan() {
-                        return Err(Unreachable::OutOfReach { arm: arm as u8 });
+            if OUT || !fast_ok {
+                let inv_r2 = 1.0 / r2;
+                let (cos_th, sin_th) = (cos_n * inv_r2, sin_n * inv_r2);
+                if !fast_ok {
+                    if let Err(theta) = self.motor_within_limits(cos_th, sin_th) {
+                        if theta.is_nan() {
+                            return Err(Unreachable::OutOfReach { arm: arm as u8 });
+                        }
+                        return Err(Unreachable::MotorLimit { arm: arm as u8, theta });
                     }
-                    return Err(Unreachable::MotorLimit { arm: arm as u8, theta });
+                }
+                if OUT {
+                    out.cos[arm] = cos_th;
+                    out.sin[arm] = sin_th;
                 }
             }
-            out.cos[arm] = cos_th;
-            out.sin[arm] = sin_th;
         }
-        Ok(out)
+        Ok(())
     }
 
     /// Elbow-out motor angles for a TCP in the MCS (SPEC §2), with their cosines and sines.
@@ -281,8 +294,12 @@ impl Delta3 {
     }
 
     /// Whether the TCP (MCS) is reachable: every loop closes and every motor is within limits.
+    ///
+    /// The same tests on the same values as [`Delta3::inverse_kinematics_cos_sin`], without
+    /// writing the cosines and sines (a table lookup needs only the verdict).
     pub fn is_reachable(&self, tcp: &Vec3) -> bool {
-        self.inverse_kinematics_cos_sin(tcp).is_ok()
+        let mut unused = MotorCosSin { cos: [0.0; 3], sin: [0.0; 3] };
+        self.solve::<false>(tcp, &mut unused).is_ok()
     }
 
     /// The TCP for motor angles `theta`: the lower intersection (smaller z) of the three
@@ -321,6 +338,89 @@ impl Delta3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A small xorshift in [0, 1): the same TCPs on every run.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// `is_reachable` decides exactly as the inverse kinematics does, on random TCPs in and
+    /// around the workspace, on TCPs within an ulp of the reach boundary (bisection between a
+    /// reachable and an unreachable TCP), with a motor at or an ulp beyond either limit
+    /// (forward kinematics from a limit angle), and on non-finite or above-base TCPs; for the
+    /// thesis robot and for narrow limits that make the motor limits bind often.
+    #[test]
+    fn is_reachable_decides_as_the_inverse_kinematics() {
+        let narrow = Delta3 { theta_min: -0.3, theta_max: 0.9, ..Delta3::THESIS };
+        let wide = Delta3 { theta_min: -PI + 1e-3, theta_max: PI, ..Delta3::THESIS };
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let (mut reachable, mut unreachable, mut at_boundary) = (0, 0, 0);
+        for d in [Delta3::THESIS, narrow, wide] {
+            let agree = |p: &Vec3| {
+                let ik = d.inverse_kinematics_cos_sin(p).is_ok();
+                assert_eq!(d.is_reachable(p), ik, "{d:?} at {p:?}");
+                ik
+            };
+            let home = Vec3::new(0.0, 0.0, -450.0);
+            for _ in 0..50_000 {
+                let p = Vec3::new(700.0 * rng.next() - 350.0, 700.0 * rng.next() - 350.0, -700.0 * rng.next() + 50.0);
+                if agree(&p) {
+                    reachable += 1;
+                } else {
+                    unreachable += 1;
+                    // The boundary on the segment from home (reachable for all three) to p.
+                    if !agree(&home) {
+                        continue;
+                    }
+                    let (mut lo, mut hi) = (home, p);
+                    for _ in 0..80 {
+                        let mid = (lo + hi) * 0.5;
+                        if agree(&mid) {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    at_boundary += 1;
+                    for q in [lo, hi, lo.map(|v| v.next_up()), hi.map(|v| v.next_down())] {
+                        agree(&q);
+                    }
+                }
+            }
+            // A motor exactly at a limit and one ulp either side of it, the others random.
+            for i in 0..3000 {
+                let span = d.theta_max - d.theta_min;
+                let mut theta: [Real; 3] = core::array::from_fn(|_| d.theta_min + span * rng.next());
+                let limit = if i % 2 == 0 { d.theta_min } else { d.theta_max };
+                for th in [limit, limit.next_up(), limit.next_down()] {
+                    theta[i % 3] = th;
+                    if let Some(p) = d.forward_kinematics(&theta) {
+                        agree(&p);
+                        agree(&p.map(|v| v.next_up()));
+                        agree(&p.map(|v| v.next_down()));
+                    }
+                }
+            }
+            for p in [
+                Vec3::new(f64::NAN, 0.0, -400.0),
+                Vec3::new(0.0, f64::INFINITY, -400.0),
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, -0.0),
+                Vec3::new(0.0, 0.0, 1.0),
+                Vec3::new(1e300, 0.0, -1e300),
+                Vec3::new(0.0, 0.0, -f64::MIN_POSITIVE),
+            ] {
+                assert!(!agree(&p), "{p:?}");
+            }
+        }
+        assert!(reachable > 2_000 && at_boundary > 2_000, "{reachable} {unreachable} {at_boundary}");
+    }
 
     #[test]
     fn home_position_round_trips() {

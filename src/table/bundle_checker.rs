@@ -30,6 +30,15 @@ pub struct PairAnswer {
     pub boxes: Option<(usize, usize)>,
 }
 
+/// One robot's TCP on one grid: the robot, and the table checker and side (0 or 1) whose grid
+/// it is; every pair whose table has an equal grid on that robot's side reads the same cell.
+#[derive(Clone, Copy, Debug)]
+struct GridSlot {
+    robot: usize,
+    checker: usize,
+    side: usize,
+}
+
 /// The loaded tables of a bundle and the pairs of the controller's cell that use them.
 #[derive(Clone, Debug)]
 pub struct BundleChecker {
@@ -37,6 +46,13 @@ pub struct BundleChecker {
     models: Vec<RobotModel>,
     checkers: Vec<TableChecker>,
     pairs: Vec<PairAnswer>,
+    /// The distinct (robot, grid) cells a tick needs: a line's tables share one grid, so each
+    /// robot's cell is taken once per tick rather than once per pair it is in.
+    slots: Vec<GridSlot>,
+    /// Per pair, the slots of its robots `a` and `b`.
+    pair_slots: Vec<[usize; 2]>,
+    /// Per slot, the cell of the last tick (`None`: robot unreachable or outside the grid).
+    cells: Vec<Option<[u16; 3]>>,
 }
 
 impl BundleChecker {
@@ -73,8 +89,23 @@ impl BundleChecker {
             };
             pairs.push(PairAnswer { a, b, table, answer: TableAnswer::Unreachable(0), boxes: None });
         }
+        let mut slots: Vec<GridSlot> = Vec::new();
+        let mut pair_slots = Vec::with_capacity(pairs.len());
+        for p in &pairs {
+            let mut slot_of = |robot: usize, side: usize| {
+                let same = |s: &GridSlot| {
+                    s.robot == robot && checkers[s.checker].same_grid(s.side, &checkers[p.table], side)
+                };
+                slots.iter().position(same).unwrap_or_else(|| {
+                    slots.push(GridSlot { robot, checker: p.table, side });
+                    slots.len() - 1
+                })
+            };
+            pair_slots.push([slot_of(p.a, 0), slot_of(p.b, 1)]);
+        }
+        let cells = alloc::vec![None; slots.len()];
         let models = cell.robots.iter().map(|r| r.model).collect();
-        Ok(BundleChecker { cell, models, checkers, pairs })
+        Ok(BundleChecker { cell, models, checkers, pairs, slots, pair_slots, cells })
     }
 
     /// The cell.
@@ -153,13 +184,21 @@ impl BundleChecker {
         // is answered, and the tick's answer is unreachable.
         let mask = self.unreachable_mask(tcps_mcs);
         let mut answer = if mask != 0 { TableAnswer::Unreachable(mask) } else { TableAnswer::Free };
-        for p in &mut self.pairs {
+        // Each reachable robot's cell once per grid; an unreachable robot's pairs look nothing up.
+        for (cell, s) in self.cells.iter_mut().zip(&self.slots) {
+            *cell = match mask >> s.robot & 1 {
+                0 => self.checkers[s.checker].cell_of(s.side, &tcps_mcs[s.robot]),
+                _ => None,
+            };
+        }
+        for (p, [sa, sb]) in self.pairs.iter_mut().zip(&self.pair_slots) {
             (p.answer, p.boxes) = (TableAnswer::Unreachable(mask), None);
             if mask >> p.a & 1 == 1 || mask >> p.b & 1 == 1 {
                 continue;
             }
             let checker = &mut self.checkers[p.table];
-            p.answer = match checker.check_reachable(&[tcps_mcs[p.a], tcps_mcs[p.b]])? {
+            let cells = [self.cells[*sa], self.cells[*sb]];
+            p.answer = match checker.check_cells(cells, &[tcps_mcs[p.a], tcps_mcs[p.b]])? {
                 // The pair checker's bits name the pair's robots; fail closed on the cell's.
                 TableAnswer::Unreachable(m) => TableAnswer::Unreachable((m & 1) << p.a | (m >> 1 & 1) << p.b),
                 other => other,
@@ -173,5 +212,84 @@ impl BundleChecker {
             };
         }
         Ok(answer)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::{Placement, RobotSpec, SatMethod};
+    use crate::cspace::{Progress, Workspace};
+    use crate::table::bundle::build_bundle;
+    use crate::table::{Labelling, Variant};
+    use alloc::{format, vec};
+
+    fn line(n: usize) -> Cell {
+        let robots = (0..n)
+            .map(|i| RobotSpec {
+                name: format!("R{i}"),
+                model: RobotModel::THESIS,
+                placement: Placement { alpha: 0.0, t: Vec3::new(450.0 * i as f64, 0.0, 0.0) },
+            })
+            .collect();
+        Cell::new("line".into(), robots, SatMethod::SatCache).unwrap()
+    }
+
+    /// In a line every robot's pairs share its grid, so each robot's cell is taken once per
+    /// tick; and every pair answers as its own table checker does alone (which takes both
+    /// cells and the reachability itself), labels compared (no confirmation), on random TCPs
+    /// inside, beyond and outside the grids and unreachable ones.
+    #[test]
+    fn a_lines_pairs_share_each_robots_cell_and_answer_as_their_own_checkers() {
+        let (variant, labelling) = (Variant::Shared, Labelling::Certified);
+        let built = build_bundle(&line(4), 16, &Workspace::THESIS, variant, labelling, Progress::Silent).unwrap();
+        let cell = line(8);
+        let mut bundle = BundleChecker::new(cell.clone(), &built.bytes, Confirmation::None).unwrap();
+        // Per robot, one cell per query resolution among its tables (the three tables may
+        // differ in sub-levels), against one per pair and side (36) taken pair by pair.
+        let mut resolutions = bundle.checkers.iter().map(|c| c.table().sub_levels()).collect::<Vec<_>>();
+        resolutions.sort_unstable();
+        resolutions.dedup();
+        let distinct = resolutions.len();
+        assert!(bundle.slots.len() <= 8 * distinct, "{} slots, sub-levels {resolutions:?}", bundle.slots.len());
+        assert!((0..8).all(|j| bundle.slots.iter().any(|s| s.robot == j)));
+        let loaded = bundle_from_bytes(&built.bytes).unwrap();
+        let mut alone: Vec<TableChecker> = bundle
+            .pairs()
+            .iter()
+            .map(|p| {
+                let (header, table) = loaded.tables[loaded.table_for(&cell, p.a, p.b).unwrap()].clone();
+                TableChecker::from_loaded(pair_cell(&cell, p.a, p.b), header, table, Confirmation::None).unwrap()
+            })
+            .collect();
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut seen = [0usize; 3]; // free, collision, unreachable
+        let mut tcps = vec![Vec3::zeros(); 8];
+        for _ in 0..20_000 {
+            for t in &mut tcps {
+                *t = Vec3::new(600.0 * next() - 300.0, 600.0 * next() - 300.0, -300.0 - 300.0 * next());
+            }
+            bundle.check(&tcps).unwrap();
+            let mask = bundle.unreachable_mask(&tcps);
+            for (p, checker) in bundle.pairs().iter().zip(&mut alone) {
+                let want = checker.check(&[tcps[p.a], tcps[p.b]]).unwrap();
+                if mask >> p.a & 1 == 1 || mask >> p.b & 1 == 1 {
+                    assert!(matches!(want, TableAnswer::Unreachable(_)));
+                    assert_eq!(p.answer, TableAnswer::Unreachable(mask));
+                    seen[2] += 1;
+                    continue;
+                }
+                assert_eq!(p.answer, want, "pair {}-{} at {:?} {:?}", p.a, p.b, tcps[p.a], tcps[p.b]);
+                seen[usize::from(want == TableAnswer::Collision)] += 1;
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 100), "free, collision, unreachable answers: {seen:?}");
+        assert!(bundle.fallbacks() > 0, "some TCPs lie outside the grid");
     }
 }

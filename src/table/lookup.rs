@@ -15,7 +15,7 @@ use crate::cell::{Cell, ExactChecker, QueryError};
 use crate::cspace::symmetry::reflection_y;
 use crate::cspace::SampleGrid;
 use crate::cspace::Workspace;
-use crate::math::{float, Vec3};
+use crate::math::Vec3;
 use crate::robot::RobotModel;
 use crate::table::format::from_bytes;
 use crate::table::{Header, Table, TableError};
@@ -92,7 +92,7 @@ fn check_determined_by_cell(header: &Header, table: &Table, cell: &Cell) -> Resu
 }
 
 /// Which cells of one robot's grid were sampled: a dense bitmap over the `k^3` cells.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 struct SampledCells {
     k: usize,
     bits: Vec<u64>,
@@ -244,16 +244,30 @@ impl TableChecker {
 
     /// The cell of robot `j`'s TCP at the table's query resolution (`2^sub_levels` per grid
     /// cell and axis), or `None` when its grid cell is not sampled.
-    fn cell_of(&self, j: usize, tcp: &Vec3) -> Option<[u16; 3]> {
+    pub(crate) fn cell_of(&self, j: usize, tcp: &Vec3) -> Option<[u16; 3]> {
         let mut c = [0u16; 3];
         for (a, ci) in c.iter_mut().enumerate() {
-            let u = float::floor((tcp[a] - self.origins[j][a]) / self.query_r);
+            // The cell is floor(u); with query_k a whole number, floor(u) lies in [0, query_k)
+            // exactly when u does (NaN in neither), and for u >= 0 the cast truncates to floor(u):
+            // no call to floor, which is a library call on x86-64 without SSE4.1.
+            let u = (tcp[a] - self.origins[j][a]) / self.query_r;
             if !(u >= 0.0 && u < self.query_k) {
                 return None;
             }
             *ci = u as u16;
         }
         self.sampled[j].contains(c.map(|v| v >> self.sub_levels)).then_some(c)
+    }
+
+    /// Whether robot `j`'s grid here and robot `i`'s grid in `other` give every TCP the same
+    /// cell (origin, query resolution and sampled cells all equal), so that [`TableChecker::cell_of`]
+    /// of one serves the other (a bundle's pairs share their robots' cells).
+    pub(crate) fn same_grid(&self, j: usize, other: &TableChecker, i: usize) -> bool {
+        self.origins[j] == other.origins[i]
+            && self.query_r.to_bits() == other.query_r.to_bits()
+            && self.query_k.to_bits() == other.query_k.to_bits()
+            && self.sub_levels == other.sub_levels
+            && self.sampled[j] == other.sampled[i]
     }
 
     /// Answers one tick; `tcps_mcs[j]` is robot j's TCP in its own MCS.
@@ -275,8 +289,20 @@ impl TableChecker {
     /// [`TableChecker::check`] for two TCPs the caller has found reachable with this cell's
     /// models (a bundle checks each robot once per tick, not once per pair).
     pub(crate) fn check_reachable(&mut self, tcps_mcs: &[Vec3]) -> Result<TableAnswer, QueryError> {
+        let cells = [self.cell_of(0, &tcps_mcs[0]), self.cell_of(1, &tcps_mcs[1])];
+        self.check_cells(cells, tcps_mcs)
+    }
+
+    /// [`TableChecker::check_reachable`] with the two TCPs' cells already taken
+    /// (`cells[j]` must be [`TableChecker::cell_of`]`(j, &tcps_mcs[j])`, or that of a grid
+    /// [`TableChecker::same_grid`] finds equal).
+    pub(crate) fn check_cells(
+        &mut self,
+        cells: [Option<[u16; 3]>; 2],
+        tcps_mcs: &[Vec3],
+    ) -> Result<TableAnswer, QueryError> {
         self.exact_boxes = None;
-        match (self.cell_of(0, &tcps_mcs[0]), self.cell_of(1, &tcps_mcs[1])) {
+        match (cells[0], cells[1]) {
             (Some(a), Some(b)) => {
                 if !self.table.query([a[0], a[1], a[2], b[0], b[1], b[2]]) {
                     return Ok(TableAnswer::Free);
