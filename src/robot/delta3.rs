@@ -338,16 +338,11 @@ impl Delta3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_rng::TestRng;
 
-    /// A small xorshift in [0, 1): the same TCPs on every run.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
+    /// Uniform in [0, 1): the same TCPs on every run.
+    fn next(rng: &mut TestRng) -> Real {
+        0.5 * (rng.unit() + 1.0)
     }
 
     /// `is_reachable` decides exactly as the inverse kinematics does, on random TCPs in and
@@ -359,7 +354,7 @@ mod tests {
     fn is_reachable_decides_as_the_inverse_kinematics() {
         let narrow = Delta3 { theta_min: -0.3, theta_max: 0.9, ..Delta3::THESIS };
         let wide = Delta3 { theta_min: -PI + 1e-3, theta_max: PI, ..Delta3::THESIS };
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut rng = TestRng(0x9e37_79b9_7f4a_7c15);
         let (mut reachable, mut unreachable, mut at_boundary) = (0, 0, 0);
         for d in [Delta3::THESIS, narrow, wide] {
             let agree = |p: &Vec3| {
@@ -369,7 +364,7 @@ mod tests {
             };
             let home = Vec3::new(0.0, 0.0, -450.0);
             for _ in 0..50_000 {
-                let p = Vec3::new(700.0 * rng.next() - 350.0, 700.0 * rng.next() - 350.0, -700.0 * rng.next() + 50.0);
+                let p = Vec3::new(350.0 * rng.unit(), 350.0 * rng.unit(), -350.0 * rng.unit() - 300.0);
                 if agree(&p) {
                     reachable += 1;
                 } else {
@@ -396,7 +391,7 @@ mod tests {
             // A motor exactly at a limit and one ulp either side of it, the others random.
             for i in 0..3000 {
                 let span = d.theta_max - d.theta_min;
-                let mut theta: [Real; 3] = core::array::from_fn(|_| d.theta_min + span * rng.next());
+                let mut theta: [Real; 3] = core::array::from_fn(|_| d.theta_min + span * next(&mut rng));
                 let limit = if i % 2 == 0 { d.theta_min } else { d.theta_max };
                 for th in [limit, limit.next_up(), limit.next_down()] {
                     theta[i % 3] = th;
