@@ -9,8 +9,7 @@
 //! [`ClearanceTable::query`] answers exactly as the boolean `shared` table of the same labels.
 //!
 //! # Storage
-//! Two shared 6-D quadtrees ([`SharedQuadtree6d`]), looked up side by side (neither read
-//! depends on the other):
+//! Two shared 6-D quadtrees ([`SharedQuadtree6d`]), as the file holds them:
 //! - the *exact* tree: the boolean table of the certified labels, at `k` (free: level 0 or
 //!   more proved; collision: no level);
 //! - the *level* tree, at `k >> shift`: per coarse cell (a block of `2^shift` grid cells per
@@ -21,9 +20,24 @@
 //!   the words in between are at most `n - 1` distinct leaves, stored once. The mirror merge
 //!   of a symmetric table ORs a pair's word with its mirror's: the smaller level wins.
 //!
+//! # Lookup: one descent and one read
+//! The level tree is only the stored form. A table, built or loaded, expands it once into a
+//! *level grid*: one 4-bit count per coarse cell of the whole `(k >> shift)^6` grid (no
+//! symmetry fold: the mirror half holds what the level tree's folded lookup answers there),
+//! 16 counts to a `u64`. A lookup is the exact tree's descent (the boolean `shared` table's
+//! reads) and one read of the level grid at an address computed from the cell indices alone,
+//! so the two reads do not wait for each other: a fixed number of memory reads, one
+//! dependent chain.
+//!
+//! Why the grid answers what the level tree answers: its count at a coarse cell is
+//! `trailing_zeros` of the level tree's word there, read by the level tree's own lookup
+//! (`query_word`, folding as it folds), so for every grid cell the lookup gives the count
+//! the two-descent lookup of the same trees gives, except that a count of 16 (a ladder of
+//! [`MAX_RUNGS`] levels, all proved) is kept as 15: 4 bits, and a lower level is always safe.
+//!
 //! Storing a lower level than proved is always safe, so the builder takes the finest `shift`
-//! whose table is at most [`SIZE_BUDGET`] times the exact tree. A lookup is two descents of
-//! a fixed number of reads each; `trailing_zeros` of the word gives `m`.
+//! whose table in memory (both trees and the level grid) is at most [`SIZE_BUDGET`] times
+//! the exact tree, with the level grid at most `16^6` cells ([`GRID_MAX_LEVELS`]).
 
 #[cfg(feature = "std")]
 mod coarse;
@@ -111,6 +125,51 @@ fn count_of(word: u64, n: usize) -> usize {
 /// table at most this many times the exact (boolean) tree's bytes, or the coarsest.
 pub const SIZE_BUDGET: usize = 3;
 
+/// Most quadtree levels of the level grid: at most `16^6` coarse cells, 8 MiB of counts. A
+/// table whose level tree is finer (`levels - shift` above this) is refused on load and
+/// never built.
+pub const GRID_MAX_LEVELS: u32 = 4;
+
+/// The level grid (module doc): one 4-bit count per coarse cell, 16 to a word, the cell
+/// `(c0 .. c5)` (coarse indices of `bits` bits each) at index `c0 << 5 bits | .. | c5`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct LevelGrid {
+    /// Bits per coarse index (`levels - shift`).
+    bits: u32,
+    words: Vec<u64>,
+}
+
+impl LevelGrid {
+    /// The grid of `level_tree` (coarse grid of `2^bits` per axis), `n` ladder levels.
+    fn of(level_tree: &SharedQuadtree6d, bits: u32, n: usize) -> LevelGrid {
+        let cells = 1usize << (6 * bits);
+        let mut words = vec![0u64; cells.div_ceil(16)];
+        let mask = (1usize << bits) - 1;
+        for i in 0..cells {
+            let c: [u16; 6] = core::array::from_fn(|j| (i >> (bits as usize * (5 - j)) & mask) as u16);
+            let count = count_of(level_tree.query_word(c), n).min(15) as u64;
+            words[i / 16] |= count << (4 * (i % 16));
+        }
+        LevelGrid { bits, words }
+    }
+
+    /// Bytes of the grid's counts for a coarse grid of `2^bits` cells per axis.
+    fn bytes_for(bits: u32) -> usize {
+        (1usize << (6 * bits)).div_ceil(16) * 8
+    }
+
+    /// The count of the grid cell `cell` (indices at `k = 2^(bits + shift)`; an index beyond
+    /// reads some cell of the grid, never out of bounds: the exact tree answers such a cell
+    /// as collision, so the count is not used).
+    #[inline(always)]
+    fn count(&self, cell: [u16; 6], shift: u32) -> usize {
+        let mask = (1usize << self.bits) - 1;
+        let i = cell.iter().fold(0usize, |i, &v| i << self.bits | (usize::from(v) >> shift & mask));
+        // `i < 2^(6 bits)`, and `words` holds `2^(6 bits) / 16` words (rounded up).
+        (self.words[i / 16] >> (4 * (i % 16)) & 15) as usize
+    }
+}
+
 /// The stored arrays of one tree, as [`SharedQuadtree6d::from_parts`] takes them.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TreeParts {
@@ -144,6 +203,10 @@ impl TreeParts {
 pub struct ClearanceTable {
     exact: SharedQuadtree6d,
     level_tree: SharedQuadtree6d,
+    /// The level tree expanded for the lookup (module doc).
+    grid: LevelGrid,
+    /// 1 when the ladder starts at 0 mm (a free cell has level 0 proved), else 0.
+    floor: usize,
     shift: u32,
     ladder: Ladder,
 }
@@ -169,8 +232,14 @@ impl ClearanceTable {
         }
         let exact = SharedQuadtree6d::build(space, symmetry)?;
         let levels = exact.levels();
+        let budget = SIZE_BUDGET * exact.memory_bytes();
         let mut best = None;
-        for shift in 0..=levels.saturating_sub(2) {
+        for shift in levels.saturating_sub(GRID_MAX_LEVELS)..=levels.saturating_sub(2) {
+            // The level grid alone over the budget: a coarser shift (the last one is built
+            // whatever its size).
+            if LevelGrid::bytes_for(levels - shift) > budget && shift < levels.saturating_sub(2) {
+                continue;
+            }
             let t = Self::build_at(space, counts, ladder, symmetry, exact.clone(), shift)?;
             let fits = t.memory_bytes() <= SIZE_BUDGET * exact.memory_bytes();
             best = Some(t);
@@ -198,7 +267,14 @@ impl ClearanceTable {
         let (coarse, coarse_counts) = coarse::coarsen(space, counts, shift, n as u8);
         let word = |pair: usize| word_of(usize::from(coarse_counts[pair]), n);
         let level_tree = SharedQuadtree6d::build_words(&coarse, &word, symmetry)?;
-        Ok(ClearanceTable { exact, level_tree, shift, ladder })
+        Ok(Self::assemble(exact, level_tree, shift, ladder))
+    }
+
+    /// The table of two validated trees, with its level grid.
+    fn assemble(exact: SharedQuadtree6d, level_tree: SharedQuadtree6d, shift: u32, ladder: Ladder) -> ClearanceTable {
+        let grid = LevelGrid::of(&level_tree, exact.levels() - shift, ladder.len());
+        let floor = usize::from(ladder.mm[0] == 0.0);
+        ClearanceTable { exact, level_tree, grid, floor, shift, ladder }
     }
 
     /// A table from stored parts: both trees as [`SharedQuadtree6d::from_parts`] validates
@@ -217,9 +293,9 @@ impl ClearanceTable {
     ) -> Result<ClearanceTable, TableError> {
         let ladder = Ladder::new(ladder_mm).map_err(|e| corrupt(format!("clearance ladder: {e}")))?;
         let n = ladder.len();
-        if levels < 2 || shift > levels - 2 {
+        if levels < 2 || shift > levels - 2 || levels - shift > GRID_MAX_LEVELS {
             return Err(corrupt(format!(
-                "clearance level tree shift = {shift} with levels = {levels}: need levels - shift >= 2"
+                "clearance level tree shift = {shift} with levels = {levels}: need 2 <= levels - shift <= {GRID_MAX_LEVELS}"
             )));
         }
         let bad_leaf = |&w: &u64| !(1..n).contains(&count_of(w, n)) || word_of(count_of(w, n), n) != w;
@@ -228,21 +304,21 @@ impl ClearanceTable {
         }
         let exact = exact.tree(levels, 0, symmetric)?;
         let level_tree = level_tree.tree(levels - shift, 1, symmetric)?;
-        Ok(ClearanceTable { exact, level_tree, shift, ladder })
+        Ok(Self::assemble(exact, level_tree, shift, ladder))
     }
 
     /// How many levels are proved for the 6-D grid cell `cell` (indices at `k`; 0 for an
-    /// index beyond). Never allocates, never panics on a validated table.
+    /// index beyond): the exact tree's descent and one read of the level grid, independent
+    /// of each other. Never allocates, never panics on a validated table.
     #[inline]
     pub fn level_count(&self, cell: [u16; 6]) -> usize {
-        let word = self.level_tree.query_word(cell.map(|v| v >> self.shift));
+        let count = self.grid.count(cell, self.shift);
         let collision = self.exact.query(cell);
         // A free cell has level 0 proved when the ladder starts at 0 mm.
-        let floor = usize::from(self.ladder.mm[0] == 0.0);
         if collision {
             0
         } else {
-            count_of(word, self.ladder.len()).max(floor)
+            count.max(self.floor)
         }
     }
 
@@ -296,11 +372,20 @@ impl ClearanceTable {
         (TreeParts::of(&self.exact), TreeParts::of(&self.level_tree))
     }
 
-    /// Bytes this table occupies in memory.
+    /// The address and byte length of the level grid (the second array a lookup reads; the
+    /// first is the exact tree's [`SharedQuadtree6d::memory_region`]), for benchmarks that
+    /// flush it from the caches.
+    pub fn level_grid_region(&self) -> (usize, usize) {
+        (self.grid.words.as_ptr() as usize, core::mem::size_of_val(self.grid.words.as_slice()))
+    }
+
+    /// Bytes this table occupies in memory: both trees (the level tree is kept to write the
+    /// file) and the level grid.
     pub fn memory_bytes(&self) -> usize {
         core::mem::size_of::<Self>() - 2 * core::mem::size_of::<SharedQuadtree6d>()
             + self.exact.memory_bytes()
             + self.level_tree.memory_bytes()
+            + core::mem::size_of_val(self.grid.words.as_slice())
     }
 
     /// Grid cells per number of proved levels (index 0: no level), over every `k^6` grid
