@@ -21,13 +21,15 @@
 //!   of a symmetric table ORs a pair's word with its mirror's: the smaller level wins.
 //!
 //! # Lookup: one descent and one read
-//! The level tree is only the stored form. A table, built or loaded, expands it once into a
-//! *level grid*: one 4-bit count per coarse cell of the whole `(k >> shift)^6` grid (no
-//! symmetry fold: the mirror half holds what the level tree's folded lookup answers there),
-//! 16 counts to a `u64`. A lookup is the exact tree's descent (the boolean `shared` table's
-//! reads) and one read of the level grid at an address computed from the cell indices alone,
-//! so the two reads do not wait for each other: a fixed number of memory reads, one
-//! dependent chain.
+//! The level tree is the stored form. A table, built or loaded, expands it once into a
+//! *level grid* when the grid fits the size budget (below): one 4-bit count per coarse cell
+//! of the whole `(k >> shift)^6` grid (no symmetry fold: the mirror half holds what the level
+//! tree's folded lookup answers there), 16 counts to a `u64`. A lookup is then the exact
+//! tree's descent (the boolean `shared` table's reads) and one read of the level grid at an
+//! address computed from the cell indices alone, so the two reads do not wait for each
+//! other: a fixed number of memory reads, one dependent chain. A table whose grid does not
+//! fit (at k = 16 the `k / 2` grid is 128 KiB against an exact tree of 19-37 KB) keeps the
+//! two descents: the exact tree's and the level tree's, side by side.
 //!
 //! Why the grid answers what the level tree answers: its count at a coarse cell is
 //! `trailing_zeros` of the level tree's word there, read by the level tree's own lookup
@@ -36,8 +38,9 @@
 //! [`MAX_RUNGS`] levels, all proved) is kept as 15: 4 bits, and a lower level is always safe.
 //!
 //! Storing a lower level than proved is always safe, so the builder takes the finest `shift`
-//! whose table in memory (both trees and the level grid) is at most [`SIZE_BUDGET`] times
-//! the exact tree, with the level grid at most `16^6` cells ([`GRID_MAX_LEVELS`]).
+//! whose two trees are at most [`SIZE_BUDGET`] times the exact tree's bytes in memory; the
+//! grid is added when the table with it stays within that budget (the same rule on load, so
+//! a file gives the same lookup wherever it is loaded).
 
 #[cfg(feature = "std")]
 mod coarse;
@@ -125,11 +128,6 @@ fn count_of(word: u64, n: usize) -> usize {
 /// table at most this many times the exact (boolean) tree's bytes, or the coarsest.
 pub const SIZE_BUDGET: usize = 3;
 
-/// Most quadtree levels of the level grid: at most `16^6` coarse cells, 8 MiB of counts. A
-/// table whose level tree is finer (`levels - shift` above this) is refused on load and
-/// never built.
-pub const GRID_MAX_LEVELS: u32 = 4;
-
 /// The level grid (module doc): one 4-bit count per coarse cell, 16 to a word, the cell
 /// `(c0 .. c5)` (coarse indices of `bits` bits each) at index `c0 << 5 bits | .. | c5`.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -153,9 +151,11 @@ impl LevelGrid {
         LevelGrid { bits, words }
     }
 
-    /// Bytes of the grid's counts for a coarse grid of `2^bits` cells per axis.
-    fn bytes_for(bits: u32) -> usize {
-        (1usize << (6 * bits)).div_ceil(16) * 8
+    /// Bytes of the grid's counts for a coarse grid of `2^bits` cells per axis (`None`
+    /// beyond the address space).
+    fn bytes_for(bits: u32) -> Option<usize> {
+        let cells = 1usize.checked_shl(6 * bits).filter(|_| 6 * bits < usize::BITS - 1)?;
+        Some(cells.div_ceil(16) * 8)
     }
 
     /// The count of the grid cell `cell` (indices at `k = 2^(bits + shift)`; an index beyond
@@ -203,8 +203,8 @@ impl TreeParts {
 pub struct ClearanceTable {
     exact: SharedQuadtree6d,
     level_tree: SharedQuadtree6d,
-    /// The level tree expanded for the lookup (module doc).
-    grid: LevelGrid,
+    /// The level tree expanded for the lookup, when it fits the size budget (module doc).
+    grid: Option<LevelGrid>,
     /// 1 when the ladder starts at 0 mm (a free cell has level 0 proved), else 0.
     floor: usize,
     shift: u32,
@@ -232,14 +232,8 @@ impl ClearanceTable {
         }
         let exact = SharedQuadtree6d::build(space, symmetry)?;
         let levels = exact.levels();
-        let budget = SIZE_BUDGET * exact.memory_bytes();
         let mut best = None;
-        for shift in levels.saturating_sub(GRID_MAX_LEVELS)..=levels.saturating_sub(2) {
-            // The level grid alone over the budget: a coarser shift (the last one is built
-            // whatever its size).
-            if LevelGrid::bytes_for(levels - shift) > budget && shift < levels.saturating_sub(2) {
-                continue;
-            }
+        for shift in 0..=levels.saturating_sub(2) {
             let t = Self::build_at(space, counts, ladder, symmetry, exact.clone(), shift)?;
             let fits = t.memory_bytes() <= SIZE_BUDGET * exact.memory_bytes();
             best = Some(t);
@@ -270,11 +264,26 @@ impl ClearanceTable {
         Ok(Self::assemble(exact, level_tree, shift, ladder))
     }
 
-    /// The table of two validated trees, with its level grid.
+    /// The table of two validated trees, with its level grid when the table with it is at
+    /// most [`SIZE_BUDGET`] times the exact tree in memory.
     fn assemble(exact: SharedQuadtree6d, level_tree: SharedQuadtree6d, shift: u32, ladder: Ladder) -> ClearanceTable {
-        let grid = LevelGrid::of(&level_tree, exact.levels() - shift, ladder.len());
         let floor = usize::from(ladder.mm[0] == 0.0);
-        ClearanceTable { exact, level_tree, grid, floor, shift, ladder }
+        let mut t = ClearanceTable { exact, level_tree, grid: None, floor, shift, ladder };
+        let bits = t.levels() - shift;
+        let budget = SIZE_BUDGET.saturating_mul(t.exact.memory_bytes());
+        if LevelGrid::bytes_for(bits).is_some_and(|g| t.memory_bytes().saturating_add(g) <= budget) {
+            t.grid = Some(LevelGrid::of(&t.level_tree, bits, t.ladder.len()));
+        }
+        t
+    }
+
+    /// The table with its level grid whatever its size, or without (tests compare both
+    /// lookups).
+    #[cfg(test)]
+    fn with_grid(mut self, grid: bool) -> ClearanceTable {
+        let bits = self.levels() - self.shift;
+        self.grid = grid.then(|| LevelGrid::of(&self.level_tree, bits, self.ladder.len()));
+        self
     }
 
     /// A table from stored parts: both trees as [`SharedQuadtree6d::from_parts`] validates
@@ -293,9 +302,9 @@ impl ClearanceTable {
     ) -> Result<ClearanceTable, TableError> {
         let ladder = Ladder::new(ladder_mm).map_err(|e| corrupt(format!("clearance ladder: {e}")))?;
         let n = ladder.len();
-        if levels < 2 || shift > levels - 2 || levels - shift > GRID_MAX_LEVELS {
+        if levels < 2 || shift > levels - 2 {
             return Err(corrupt(format!(
-                "clearance level tree shift = {shift} with levels = {levels}: need 2 <= levels - shift <= {GRID_MAX_LEVELS}"
+                "clearance level tree shift = {shift} with levels = {levels}: need levels - shift >= 2"
             )));
         }
         let bad_leaf = |&w: &u64| !(1..n).contains(&count_of(w, n)) || word_of(count_of(w, n), n) != w;
@@ -309,10 +318,14 @@ impl ClearanceTable {
 
     /// How many levels are proved for the 6-D grid cell `cell` (indices at `k`; 0 for an
     /// index beyond): the exact tree's descent and one read of the level grid, independent
-    /// of each other. Never allocates, never panics on a validated table.
+    /// of each other (without a grid, the level tree's descent). Never allocates, never
+    /// panics on a validated table.
     #[inline]
     pub fn level_count(&self, cell: [u16; 6]) -> usize {
-        let count = self.grid.count(cell, self.shift);
+        let count = match &self.grid {
+            Some(grid) => grid.count(cell, self.shift),
+            None => count_of(self.level_tree.query_word(cell.map(|v| v >> self.shift)), self.ladder.len()),
+        };
         let collision = self.exact.query(cell);
         // A free cell has level 0 proved when the ladder starts at 0 mm.
         if collision {
@@ -372,11 +385,20 @@ impl ClearanceTable {
         (TreeParts::of(&self.exact), TreeParts::of(&self.level_tree))
     }
 
-    /// The address and byte length of the level grid (the second array a lookup reads; the
-    /// first is the exact tree's [`SharedQuadtree6d::memory_region`]), for benchmarks that
-    /// flush it from the caches.
-    pub fn level_grid_region(&self) -> (usize, usize) {
-        (self.grid.words.as_ptr() as usize, core::mem::size_of_val(self.grid.words.as_slice()))
+    /// Whether the lookup reads the level grid (one descent and one read) rather than the
+    /// level tree (two descents).
+    pub fn has_level_grid(&self) -> bool {
+        self.grid.is_some()
+    }
+
+    /// The address and byte length of the second array a lookup reads (the first is the exact
+    /// tree's [`SharedQuadtree6d::memory_region`]): the level grid, else the level tree's,
+    /// for benchmarks that flush it from the caches.
+    pub fn level_region(&self) -> (usize, usize) {
+        match &self.grid {
+            Some(g) => (g.words.as_ptr() as usize, core::mem::size_of_val(g.words.as_slice())),
+            None => self.level_tree.memory_region(),
+        }
     }
 
     /// Bytes this table occupies in memory: both trees (the level tree is kept to write the
@@ -385,7 +407,7 @@ impl ClearanceTable {
         core::mem::size_of::<Self>() - 2 * core::mem::size_of::<SharedQuadtree6d>()
             + self.exact.memory_bytes()
             + self.level_tree.memory_bytes()
-            + core::mem::size_of_val(self.grid.words.as_slice())
+            + self.grid.as_ref().map_or(0, |g| core::mem::size_of_val(g.words.as_slice()))
     }
 
     /// Grid cells per number of proved levels (index 0: no level), over every `k^6` grid
@@ -463,6 +485,8 @@ mod tests {
             let nb = s.grid_b.cells.len();
             for shift in 0..=levels - 2 {
                 let t = ClearanceTable::build_at(&s, &counts, ladder, symmetry, boolean.clone(), shift).unwrap();
+                let (gridded, treed) = (t.clone().with_grid(true), t.clone().with_grid(false));
+                assert!(gridded.has_level_grid() && !treed.has_level_grid());
                 let mut seen = vec![0usize; ladder.len() + 1];
                 for (ia, ca) in s.grid_a.cells.iter().enumerate() {
                     for (ib, cb) in s.grid_b.cells.iter().enumerate() {
@@ -477,6 +501,12 @@ mod tests {
                             }
                         }
                         let got = t.level_count(cell);
+                        // The two-descent lookup, spelled out: the reference of both layouts.
+                        let word = t.level_tree().query_word(cell.map(|v| v >> shift));
+                        let by_tree = if boolean.query(cell) { 0 } else { count_of(word, ladder.len()).max(1) };
+                        assert_eq!(gridded.level_count(cell), by_tree, "{pattern:?} {shift} {cell:?}: grid");
+                        assert_eq!(treed.level_count(cell), by_tree, "{pattern:?} {shift} {cell:?}: tree");
+                        assert_eq!(got, by_tree, "{pattern:?} {shift} {cell:?}");
                         assert_eq!(got == 0, boolean.query(cell), "{pattern:?} {shift} {cell:?}");
                         assert!(got <= own, "{pattern:?} {shift} {cell:?}: {got} > {own}");
                         if shift == 0 {
