@@ -7,8 +7,9 @@
 //! their collision pairs; for `clearance`, the ladder and each pair's proved level count),
 //! not parts of a tree, so the merge builds whichever variant the shards were labelled for.
 //! A pair's level count depends on the pair alone (its two cells' sweeps and its label), so
-//! the counts of the rows of all shards are the one-shot build's. The merge therefore needs the whole label set in memory (one byte
-//! per pair of samples), as a one-shot build does; the shards need `1/n` of it each.
+//! the counts of the rows of all shards are the one-shot build's. The merge therefore needs
+//! the whole label set in memory (one byte per pair of samples; a clearance table one more
+//! for the counts), as a one-shot build does; the shards need `1/n` of it each.
 //!
 //! A shard file (`format.rs`) records the cell, `k`, the variant, the labelling, `i` and `n`
 //! and a checksum; [`merge_shards`] refuses a missing, duplicated, truncated or corrupt shard
@@ -233,7 +234,8 @@ mod tests {
             let e = parse(&resealed(edited)).err().unwrap().to_string();
             assert!(e.contains("clearance count"), "{e}");
         }
-        let thesis = build_shard_of(&cell, 16, &Workspace::THESIS, variant, Labelling::ThesisMargin, shard, Progress::Silent);
+        let thesis = Labelling::ThesisMargin;
+        let thesis = build_shard_of(&cell, 16, &Workspace::THESIS, variant, thesis, shard, Progress::Silent);
         assert!(matches!(thesis, Err(BuildError::ClearanceNeedsCertified)));
     }
 
