@@ -104,7 +104,7 @@ fn kind_of(variant: Variant) -> (TableKind, u32) {
     match variant {
         Variant::D6 => (TableKind::D6, 0),
         Variant::D5 => (TableKind::D5, 0),
-        Variant::D4 { axes, t } if axes == SliceAxes::YY => (TableKind::D4yy, t),
+        Variant::D4 { axes: SliceAxes::YY, t } => (TableKind::D4yy, t),
         Variant::D4 { t, .. } => (TableKind::D4zz, t),
         Variant::Shared => (TableKind::Shared, 0),
         Variant::SharedSubdivided => (TableKind::SharedSub, 0),
