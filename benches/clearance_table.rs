@@ -79,11 +79,12 @@ fn report(name: &str, shared: &Table, clearance_table: &Table, cells: &[[u16; 6]
     }
     let clock = Clock::tsc().unwrap_or(Clock::Instant);
     println!(
-        "{name}: shared {} bytes, clearance {} bytes ({:.2}x; level tree at k / {}), levels {:?} mm; clock {}",
+        "{name}: shared {} bytes, clearance {} bytes ({:.2}x; level tree at k / {}, {}), levels {:?} mm; clock {}",
         shared.memory_bytes(),
         clearance_table.memory_bytes(),
         clearance_table.memory_bytes() as f64 / shared.memory_bytes() as f64,
         1u32 << clearance.shift(),
+        if clearance.has_level_grid() { "descent + level grid" } else { "two descents" },
         clearance.ladder().mm(),
         clock.name()
     );

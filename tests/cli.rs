@@ -505,7 +505,6 @@ fn usage_errors_exit_with_2_and_say_what_is_wrong() {
             &["build", "--cell", "T1", "--output", table, "--variant", "clearance", "--labelling", "thesis"],
             "certified",
         ),
-        (&["build", "--cell", "T1", "--output", table, "--variant", "clearance", "--shard", "0/2"], "drop --shard"),
         (&["build", "--cell", "T9", "--output", table], "T1, T2, T3"),
         (&["build", "--cell", "cells/nope.toml", "--output", table], "nope.toml"),
         (&["inspect", "A", "B"], "unexpected argument 'B'"),

@@ -1,6 +1,7 @@
 //! Tables built in shards, through the real command line: `build --shard I/N` for every `I`
 //! and `merge` write the one-shot `build`'s table byte for byte (T1, T2, T3 at k = 16, the
-//! smallest k the workspace allows, N = 1, 2, 3, 5; several variants and both labellings);
+//! smallest k the workspace allows, N = 1, 2, 3, 5; several variants, clearance tables with
+//! their ladders, and both labellings);
 //! a missing, duplicated, foreign, truncated or corrupt shard is refused with exit code 1 and
 //! a message naming the file.
 
@@ -110,6 +111,31 @@ fn every_kind_of_table_and_both_labellings_shard() {
     merged_equals_one_shot("T3", &["--variant", "shared"], &[2]);
     merged_equals_one_shot("T3", &["--variant", "4d-zz", "--t", "3"], &[2]);
     merged_equals_one_shot("T2", &["--variant", "5d", "--labelling", "thesis"], &[2]);
+}
+
+/// Clearance tables shard: the shards carry each pair's proved level count and the ladder,
+/// and the merge writes the one-shot table (default ladder, and one given with `--levels`).
+#[test]
+fn clearance_tables_shard() {
+    merged_equals_one_shot("T3", &["--variant", "clearance"], &[2, 3]);
+    merged_equals_one_shot("T1", &["--variant", "clearance", "--levels", "0,15,60"], &[2]);
+}
+
+/// A clearance shard of another ladder, or of another variant, belongs to another build.
+#[test]
+fn clearance_shards_of_another_ladder_are_refused() {
+    let dir = fresh_dir("ladders");
+    let out = dir.join("t.dct");
+    let o = s(&out);
+    let three = shards("T3", &["--variant", "clearance"], 3, &dir, "t3c");
+    let (a, b) = (s(&three[0]), s(&three[1]));
+    let other = shards("T3", &["--variant", "clearance", "--levels", "0,10"], 3, &dir, "t3l");
+    fails(&["merge", "--output", o, a, b, s(&other[2])], &["t3l-2-of-3.dcs", "clearance levels"]);
+    let shared = shards("T3", &["--variant", "shared"], 3, &dir, "t3s");
+    fails(&["merge", "--output", o, a, b, s(&shared[2])], &["t3s-2-of-3.dcs", "variant shared"]);
+    fails(&["merge", "--output", o, a, b], &["1 of 3 shards missing: 2"]);
+    assert!(!out.exists(), "no table is written when the merge fails");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

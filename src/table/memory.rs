@@ -45,9 +45,12 @@ pub struct MemoryPlan {
 /// [`BuildError::Memory`] when the fixed part alone needs more than `max`.
 pub fn plan_memory(na: u64, nb: u64, k: u32, variant: Variant, max: u64) -> Result<MemoryPlan, BuildError> {
     let labels = na.saturating_mul(nb).saturating_mul(core::mem::size_of::<Label>() as u64);
+    // A clearance build holds one more byte per pair: its proved level count.
+    let counts = if matches!(variant, Variant::Clearance(_)) { na.saturating_mul(nb) } else { 0 };
     let fixed = FIXED_BYTES_PER_SAMPLE
         .saturating_mul(na + nb)
         .saturating_add(labels)
+        .saturating_add(counts)
         .saturating_add(builder_bytes(k))
         .saturating_add(RESERVE_BYTES);
     if fixed > max {
@@ -129,5 +132,16 @@ mod tests {
         assert_eq!(plan_memory(6_000, 6_000, 32, sub, big.fixed).unwrap().block_depth, 4);
         assert!(matches!(plan_memory(6_000, 6_000, 32, sub, big.fixed - 1), Err(BuildError::Memory { .. })));
         assert_eq!(plan_memory(6_000, 6_000, 32, Variant::D6, 64 << 30).unwrap().cache, 0);
+    }
+
+    /// A clearance build holds a level count per pair besides the label: one byte more per
+    /// pair in the fixed part, so a limit that fits the boolean build exactly refuses it.
+    #[test]
+    fn clearance_builds_count_their_level_counts() {
+        let clearance = Variant::Clearance(crate::table::Ladder::default_ladder());
+        let shared = plan_memory(6_000, 5_000, 32, Variant::Shared, 64 << 30).unwrap();
+        let with_levels = plan_memory(6_000, 5_000, 32, clearance, 64 << 30).unwrap();
+        assert_eq!(with_levels.fixed, shared.fixed + 30_000_000);
+        assert!(matches!(plan_memory(6_000, 5_000, 32, clearance, shared.fixed), Err(BuildError::Memory { .. })));
     }
 }

@@ -174,7 +174,7 @@ impl Table {
                 vec![region(codes), region(slice_of), region(slices)]
             }
             Table::Shared(t) => vec![t.memory_region()],
-            Table::Clearance(t) => vec![t.exact_tree().memory_region(), t.level_tree().memory_region()],
+            Table::Clearance(t) => vec![t.exact_tree().memory_region(), t.level_region()],
         }
     }
 

@@ -486,13 +486,6 @@ impl Cli {
                         "--variant clearance proves its levels: it needs --labelling certified".into(),
                     ));
                 }
-                if b.variant.0 == TableKind::Clearance && b.shard.is_some() {
-                    return Err(usage_error(
-                        "build",
-                        ErrorKind::ArgumentConflict,
-                        "--variant clearance is built in one run: drop --shard".into(),
-                    ));
-                }
                 if b.variant.0 == TableKind::SharedSub && b.labelling == LabellingArg::Thesis {
                     return Err(usage_error(
                         "build",

@@ -6,8 +6,8 @@ use crate::args::{BuildArgs, MergeArgs, ShardArg};
 use crate::files;
 use crate::Failure;
 use delta_collide::cspace::{Progress, Workspace};
-use delta_collide::table::shard::{build_shard, merge_shards, read_shard_info, ShardIndex};
-use delta_collide::table::{to_bytes, Labelling};
+use delta_collide::table::shard::{build_shard_of, merge_shards, read_shard_info, ShardIndex};
+use delta_collide::table::{to_bytes, Labelling, TableKind, Variant};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -121,8 +121,12 @@ pub fn build(args: &BuildArgs, shard: &ShardArg, progress: Progress) -> Result<(
     let (cell, k) = (&args.cell, args.k);
     crate::check_memory(cell, k, &Workspace::THESIS, count)?;
     let kind = (args.variant.0, args.t.unwrap_or(0));
+    let variant = match (kind.0, args.levels) {
+        (TableKind::Clearance, Some(ladder)) => Variant::Clearance(ladder),
+        (kind, _) => kind.variant(args.t.unwrap_or(0)),
+    };
     let labelling = Labelling::from(args.labelling);
-    let (bytes, r) = build_shard(cell, k, &Workspace::THESIS, kind, labelling, shard, progress)?;
+    let (bytes, r) = build_shard_of(cell, k, &Workspace::THESIS, variant, labelling, shard, progress)?;
     let output = shard_path(&args.output, shard);
     files::write_file(&output, |w| w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display())))?;
     println!(

@@ -9,8 +9,7 @@
 //! [`ClearanceTable::query`] answers exactly as the boolean `shared` table of the same labels.
 //!
 //! # Storage
-//! Two shared 6-D quadtrees ([`SharedQuadtree6d`]), looked up side by side (neither read
-//! depends on the other):
+//! Two shared 6-D quadtrees ([`SharedQuadtree6d`]), as the file holds them:
 //! - the *exact* tree: the boolean table of the certified labels, at `k` (free: level 0 or
 //!   more proved; collision: no level);
 //! - the *level* tree, at `k >> shift`: per coarse cell (a block of `2^shift` grid cells per
@@ -21,9 +20,27 @@
 //!   the words in between are at most `n - 1` distinct leaves, stored once. The mirror merge
 //!   of a symmetric table ORs a pair's word with its mirror's: the smaller level wins.
 //!
+//! # Lookup: one descent and one read
+//! The level tree is the stored form. A table, built or loaded, expands it once into a
+//! *level grid* when the grid fits the size budget (below): one 4-bit count per coarse cell
+//! of the whole `(k >> shift)^6` grid (no symmetry fold: the mirror half holds what the level
+//! tree's folded lookup answers there), 16 counts to a `u64`. A lookup is then the exact
+//! tree's descent (the boolean `shared` table's reads) and one read of the level grid at an
+//! address computed from the cell indices alone, so the two reads do not wait for each
+//! other: a fixed number of memory reads, one dependent chain. A table whose grid does not
+//! fit (at k = 16 the `k / 2` grid is 128 KiB against an exact tree of 19-37 KB) keeps the
+//! two descents: the exact tree's and the level tree's, side by side.
+//!
+//! Why the grid answers what the level tree answers: its count at a coarse cell is
+//! `trailing_zeros` of the level tree's word there, read by the level tree's own lookup
+//! (`query_word`, folding as it folds), so for every grid cell the lookup gives the count
+//! the two-descent lookup of the same trees gives, except that a count of 16 (a ladder of
+//! [`MAX_RUNGS`] levels, all proved) is kept as 15: 4 bits, and a lower level is always safe.
+//!
 //! Storing a lower level than proved is always safe, so the builder takes the finest `shift`
-//! whose table is at most [`SIZE_BUDGET`] times the exact tree. A lookup is two descents of
-//! a fixed number of reads each; `trailing_zeros` of the word gives `m`.
+//! whose two trees are at most [`SIZE_BUDGET`] times the exact tree's bytes in memory; the
+//! grid is added when the table with it stays within that budget (the same rule on load, so
+//! a file gives the same lookup wherever it is loaded).
 
 #[cfg(feature = "std")]
 mod coarse;
@@ -111,6 +128,48 @@ fn count_of(word: u64, n: usize) -> usize {
 /// table at most this many times the exact (boolean) tree's bytes, or the coarsest.
 pub const SIZE_BUDGET: usize = 3;
 
+/// The level grid (module doc): one 4-bit count per coarse cell, 16 to a word, the cell
+/// `(c0 .. c5)` (coarse indices of `bits` bits each) at index `c0 << 5 bits | .. | c5`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct LevelGrid {
+    /// Bits per coarse index (`levels - shift`).
+    bits: u32,
+    words: Vec<u64>,
+}
+
+impl LevelGrid {
+    /// The grid of `level_tree` (coarse grid of `2^bits` per axis), `n` ladder levels.
+    fn of(level_tree: &SharedQuadtree6d, bits: u32, n: usize) -> LevelGrid {
+        let cells = 1usize << (6 * bits);
+        let mut words = vec![0u64; cells.div_ceil(16)];
+        let mask = (1usize << bits) - 1;
+        for i in 0..cells {
+            let c: [u16; 6] = core::array::from_fn(|j| (i >> (bits as usize * (5 - j)) & mask) as u16);
+            let count = count_of(level_tree.query_word(c), n).min(15) as u64;
+            words[i / 16] |= count << (4 * (i % 16));
+        }
+        LevelGrid { bits, words }
+    }
+
+    /// Bytes of the grid's counts for a coarse grid of `2^bits` cells per axis (`None`
+    /// beyond the address space).
+    fn bytes_for(bits: u32) -> Option<usize> {
+        let cells = 1usize.checked_shl(6 * bits).filter(|_| 6 * bits < usize::BITS - 1)?;
+        Some(cells.div_ceil(16) * 8)
+    }
+
+    /// The count of the grid cell `cell` (indices at `k = 2^(bits + shift)`; an index beyond
+    /// reads some cell of the grid, never out of bounds: the exact tree answers such a cell
+    /// as collision, so the count is not used).
+    #[inline(always)]
+    fn count(&self, cell: [u16; 6], shift: u32) -> usize {
+        let mask = (1usize << self.bits) - 1;
+        let i = cell.iter().fold(0usize, |i, &v| i << self.bits | (usize::from(v) >> shift & mask));
+        // `i < 2^(6 bits)`, and `words` holds `2^(6 bits) / 16` words (rounded up).
+        (self.words[i / 16] >> (4 * (i % 16)) & 15) as usize
+    }
+}
+
 /// The stored arrays of one tree, as [`SharedQuadtree6d::from_parts`] takes them.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TreeParts {
@@ -144,6 +203,10 @@ impl TreeParts {
 pub struct ClearanceTable {
     exact: SharedQuadtree6d,
     level_tree: SharedQuadtree6d,
+    /// The level tree expanded for the lookup, when it fits the size budget (module doc).
+    grid: Option<LevelGrid>,
+    /// 1 when the ladder starts at 0 mm (a free cell has level 0 proved), else 0.
+    floor: usize,
     shift: u32,
     ladder: Ladder,
 }
@@ -198,7 +261,29 @@ impl ClearanceTable {
         let (coarse, coarse_counts) = coarse::coarsen(space, counts, shift, n as u8);
         let word = |pair: usize| word_of(usize::from(coarse_counts[pair]), n);
         let level_tree = SharedQuadtree6d::build_words(&coarse, &word, symmetry)?;
-        Ok(ClearanceTable { exact, level_tree, shift, ladder })
+        Ok(Self::assemble(exact, level_tree, shift, ladder))
+    }
+
+    /// The table of two validated trees, with its level grid when the table with it is at
+    /// most [`SIZE_BUDGET`] times the exact tree in memory.
+    fn assemble(exact: SharedQuadtree6d, level_tree: SharedQuadtree6d, shift: u32, ladder: Ladder) -> ClearanceTable {
+        let floor = usize::from(ladder.mm[0] == 0.0);
+        let mut t = ClearanceTable { exact, level_tree, grid: None, floor, shift, ladder };
+        let bits = t.levels() - shift;
+        let budget = SIZE_BUDGET.saturating_mul(t.exact.memory_bytes());
+        if LevelGrid::bytes_for(bits).is_some_and(|g| t.memory_bytes().saturating_add(g) <= budget) {
+            t.grid = Some(LevelGrid::of(&t.level_tree, bits, t.ladder.len()));
+        }
+        t
+    }
+
+    /// The table with its level grid whatever its size, or without (tests compare both
+    /// lookups).
+    #[cfg(test)]
+    fn with_grid(mut self, grid: bool) -> ClearanceTable {
+        let bits = self.levels() - self.shift;
+        self.grid = grid.then(|| LevelGrid::of(&self.level_tree, bits, self.ladder.len()));
+        self
     }
 
     /// A table from stored parts: both trees as [`SharedQuadtree6d::from_parts`] validates
@@ -228,21 +313,25 @@ impl ClearanceTable {
         }
         let exact = exact.tree(levels, 0, symmetric)?;
         let level_tree = level_tree.tree(levels - shift, 1, symmetric)?;
-        Ok(ClearanceTable { exact, level_tree, shift, ladder })
+        Ok(Self::assemble(exact, level_tree, shift, ladder))
     }
 
     /// How many levels are proved for the 6-D grid cell `cell` (indices at `k`; 0 for an
-    /// index beyond). Never allocates, never panics on a validated table.
+    /// index beyond): the exact tree's descent and one read of the level grid, independent
+    /// of each other (without a grid, the level tree's descent). Never allocates, never
+    /// panics on a validated table.
     #[inline]
     pub fn level_count(&self, cell: [u16; 6]) -> usize {
-        let word = self.level_tree.query_word(cell.map(|v| v >> self.shift));
+        let count = match &self.grid {
+            Some(grid) => grid.count(cell, self.shift),
+            None => count_of(self.level_tree.query_word(cell.map(|v| v >> self.shift)), self.ladder.len()),
+        };
         let collision = self.exact.query(cell);
         // A free cell has level 0 proved when the ladder starts at 0 mm.
-        let floor = usize::from(self.ladder.mm[0] == 0.0);
         if collision {
             0
         } else {
-            count_of(word, self.ladder.len()).max(floor)
+            count.max(self.floor)
         }
     }
 
@@ -296,11 +385,29 @@ impl ClearanceTable {
         (TreeParts::of(&self.exact), TreeParts::of(&self.level_tree))
     }
 
-    /// Bytes this table occupies in memory.
+    /// Whether the lookup reads the level grid (one descent and one read) rather than the
+    /// level tree (two descents).
+    pub fn has_level_grid(&self) -> bool {
+        self.grid.is_some()
+    }
+
+    /// The address and byte length of the second array a lookup reads (the first is the exact
+    /// tree's [`SharedQuadtree6d::memory_region`]): the level grid, else the level tree's,
+    /// for benchmarks that flush it from the caches.
+    pub fn level_region(&self) -> (usize, usize) {
+        match &self.grid {
+            Some(g) => (g.words.as_ptr() as usize, core::mem::size_of_val(g.words.as_slice())),
+            None => self.level_tree.memory_region(),
+        }
+    }
+
+    /// Bytes this table occupies in memory: both trees (the level tree is kept to write the
+    /// file) and the level grid.
     pub fn memory_bytes(&self) -> usize {
         core::mem::size_of::<Self>() - 2 * core::mem::size_of::<SharedQuadtree6d>()
             + self.exact.memory_bytes()
             + self.level_tree.memory_bytes()
+            + self.grid.as_ref().map_or(0, |g| core::mem::size_of_val(g.words.as_slice()))
     }
 
     /// Grid cells per number of proved levels (index 0: no level), over every `k^6` grid
@@ -378,6 +485,8 @@ mod tests {
             let nb = s.grid_b.cells.len();
             for shift in 0..=levels - 2 {
                 let t = ClearanceTable::build_at(&s, &counts, ladder, symmetry, boolean.clone(), shift).unwrap();
+                let (gridded, treed) = (t.clone().with_grid(true), t.clone().with_grid(false));
+                assert!(gridded.has_level_grid() && !treed.has_level_grid());
                 let mut seen = vec![0usize; ladder.len() + 1];
                 for (ia, ca) in s.grid_a.cells.iter().enumerate() {
                     for (ib, cb) in s.grid_b.cells.iter().enumerate() {
@@ -392,6 +501,12 @@ mod tests {
                             }
                         }
                         let got = t.level_count(cell);
+                        // The two-descent lookup, spelled out: the reference of both layouts.
+                        let word = t.level_tree().query_word(cell.map(|v| v >> shift));
+                        let by_tree = if boolean.query(cell) { 0 } else { count_of(word, ladder.len()).max(1) };
+                        assert_eq!(gridded.level_count(cell), by_tree, "{pattern:?} {shift} {cell:?}: grid");
+                        assert_eq!(treed.level_count(cell), by_tree, "{pattern:?} {shift} {cell:?}: tree");
+                        assert_eq!(got, by_tree, "{pattern:?} {shift} {cell:?}");
                         assert_eq!(got == 0, boolean.query(cell), "{pattern:?} {shift} {cell:?}");
                         assert!(got <= own, "{pattern:?} {shift} {cell:?}: {got} > {own}");
                         if shift == 0 {

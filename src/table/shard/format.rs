@@ -1,5 +1,6 @@
 //! The shard file format: a fixed little-endian header, both robots' sampling grids, the
-//! shard's labels packed 2 bits each, its sub-cells, and a checksum, validated once when read.
+//! shard's labels packed 2 bits each, its sub-cells or its clearance levels, and a checksum,
+//! validated once when read.
 //!
 //! # Layout (all integers and floats little-endian)
 //! ```text
@@ -17,7 +18,8 @@
 //!     64    8  cell fingerprint     72  8  r (mm)
 //!     80   24  origin of A's grid  104 24  origin of B's grid (mm)
 //!    128   40  workspace Zu, Hcy, Rcy, Hco, Rco (mm)
-//!    168    8  margin (mm)         176  4  certification   180  4  reserved, 0
+//!    168    8  margin (mm)         176  4  certification
+//!    180    4  n, clearance levels (kind clearance: 1 to 16; else 0)
 //!    184    8  n_p, cell parameters     192  8  na, samples of A   200  8  nb, samples of B
 //!    208    8  rows labelled: those of Rows { first: i, step: n } below na
 //!    216    8  m, sub-cell entries
@@ -29,6 +31,9 @@
 //!                after row, label `j` at bits 2 (j mod 4) of byte j / 4; unused bits 0
 //!         24 m   sub-cells: pair ia nb + ib, care mask, collision mask (u64 each), pairs
 //!                increasing, each in a row of this shard
+//!          8 n   the clearance ladder (f64, mm, increasing)
+//!          rows nb (n > 0 only) per pair, how many of the n levels are proved (one byte,
+//!                at most n; 0 for a pair not labelled free), in the labels' order
 //!    end-8  8  FNV-1a 64 of every byte before it
 //! ```
 
@@ -39,12 +44,13 @@ use crate::cell::{fingerprint_of, fnv1a64};
 use crate::cspace::{CellIndex, Label, SampleGrid, Symmetry, Workspace};
 use crate::math::Vec3;
 use crate::table::build::{Labelling, RowLabels};
-use crate::table::{Certification, Header, TableKind};
+use crate::table::clearance::MAX_RUNGS;
+use crate::table::{Certification, Header, Ladder, TableKind};
 
 /// The first eight bytes of every shard file.
 pub const MAGIC: [u8; 8] = *b"DCSHARD\0";
 /// The shard format version written and read.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 const ENDIAN_MARK: u32 = 0x0102_0304;
 const FIXED_LEN: usize = 224;
 /// Most cell parameters a shard records (as a table file).
@@ -78,6 +84,8 @@ pub struct ShardInfo {
     pub rows: usize,
     /// Sub-cell entries.
     pub sub_entries: usize,
+    /// The clearance ladder (kind clearance only).
+    pub ladder: Option<Ladder>,
 }
 
 /// A shard file read and validated, its bulk left in place.
@@ -91,6 +99,8 @@ pub(super) struct Parsed<'a> {
     pub labels: &'a [u8],
     /// The sub-cell entries, 24 bytes each.
     pub sub: &'a [u8],
+    /// Per pair of the rows, its proved clearance level count (kind clearance; else empty).
+    pub counts: &'a [u8],
 }
 
 fn put(out: &mut Vec<u8>, v: &[u8]) {
@@ -128,7 +138,8 @@ pub(super) fn to_bytes(info: &ShardInfo, labels: &RowLabels) -> Vec<u8> {
         put(&mut out, &v.to_le_bytes());
     }
     put(&mut out, &(h.certification as u32).to_le_bytes());
-    put(&mut out, &0u32.to_le_bytes());
+    let clearance = labels.clearance.first().filter(|_| info.kind == TableKind::Clearance);
+    put(&mut out, &(clearance.map_or(0, |(l, _)| l.len()) as u32).to_le_bytes());
     let sub = labels.sub.as_ref();
     for v in [h.cell_parameters.len(), ga.cells.len(), gb.cells.len(), info.rows, sub.map_or(0, |s| s.pairs.len())] {
         put(&mut out, &(v as u64).to_le_bytes());
@@ -143,6 +154,10 @@ pub(super) fn to_bytes(info: &ShardInfo, labels: &RowLabels) -> Vec<u8> {
         for ((p, c), x) in s.pairs.iter().zip(&s.care).zip(&s.collision) {
             [p, c, x].iter().for_each(|v| put(&mut out, &v.to_le_bytes()));
         }
+    }
+    if let Some((ladder, counts)) = clearance {
+        ladder.mm().iter().for_each(|v| put(&mut out, &v.to_le_bytes()));
+        put(&mut out, counts);
     }
     let sum = fnv1a64(&out);
     put(&mut out, &sum.to_le_bytes());
@@ -204,7 +219,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     let kind_number = r.u32("table kind")?;
     let kind = *TableKind::ALL
         .get(kind_number as usize)
-        .ok_or_else(|| corrupt(format!("table kind = {kind_number}, expected 0 to 5")))?;
+        .ok_or_else(|| corrupt(format!("table kind = {kind_number}, expected 0 to {}", TableKind::ALL.len() - 1)))?;
     let t = r.u32("threshold t")?;
     let labelling = match r.u32("labelling")? {
         0 => Labelling::Certified,
@@ -232,8 +247,10 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
         2 => Certification::SweptBound,
         c => return Err(corrupt(format!("certification = {c}, expected 1 or 2"))),
     };
-    if r.u32("reserved")? != 0 {
-        return Err(corrupt("reserved field is not 0"));
+    let rungs = r.u32("clearance levels")?;
+    let clearance = kind == TableKind::Clearance;
+    if clearance != (1..=MAX_RUNGS as u32).contains(&rungs) || !clearance && rungs != 0 {
+        return Err(corrupt(format!("kind {kind} with {rungs} clearance levels (clearance: 1 to {MAX_RUNGS}, else 0)")));
     }
     let n_params = r.u64("cell parameter count")?;
     let (na, nb, rows, m) =
@@ -261,9 +278,16 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     let pairs = rows.checked_mul(nb).ok_or_else(|| corrupt("rows x samples of B overflows"))?;
     let labels = r.take(pairs.div_ceil(4), "labels")?;
     let sub = r.items(m, 24, "sub-cells")?;
+    let ladder_mm = (0..rungs).map(|_| r.f64("clearance level")).collect::<Result<Vec<_>, _>>()?;
+    let counts = if clearance { r.items(pairs, 1, "clearance counts")? } else { &[] };
     r.checksum()?;
     check_labels(labels, pairs)?;
     check_sub_cells(sub, shard, na, nb)?;
+    let ladder = match clearance {
+        true => Some(Ladder::new(&ladder_mm).map_err(|e| corrupt(format!("clearance ladder: {e}")))?),
+        false => None,
+    };
+    check_counts(counts, labels, rungs)?;
     let workspace = Workspace { zu: ws[0], hcy: ws[1], rcy: ws[2], hco: ws[3], rco: ws[4] };
     let header =
         Header { cell_fingerprint, r: spacing, origin_a, origin_b, workspace, margin, certification, cell_parameters };
@@ -280,8 +304,9 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
         samples: (na, nb),
         rows,
         sub_entries: m,
+        ladder,
     };
-    Ok(Parsed { info, grid_bytes, grid_a, grid_b, labels, sub })
+    Ok(Parsed { info, grid_bytes, grid_a, grid_b, labels, sub, counts })
 }
 
 /// What shard file `bytes` records, validated as [`merge_shards`](super::merge_shards)
@@ -302,6 +327,18 @@ fn check_labels(packed: &[u8], pairs: usize) -> Result<(), ShardError> {
     let used = pairs % 4;
     if used != 0 && packed.last().is_some_and(|&b| b >> (2 * used) != 0) {
         return Err(corrupt("bits after the last label are not 0"));
+    }
+    Ok(())
+}
+
+/// Every clearance count at most `n`, and 0 on a pair not labelled free (the counts of the
+/// one-shot build, `clearance_counts`, are).
+fn check_counts(counts: &[u8], packed: &[u8], n: u32) -> Result<(), ShardError> {
+    for (j, &c) in counts.iter().enumerate() {
+        let free = packed[j / 4] >> (2 * (j % 4)) & 3 == 0;
+        if u32::from(c) > n || c > 0 && !free {
+            return Err(corrupt(format!("clearance count {c} of pair {j}: above {n} levels, or on a pair not free")));
+        }
     }
     Ok(())
 }

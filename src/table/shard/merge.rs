@@ -5,7 +5,7 @@
 use super::error::ShardError;
 use super::format::{parse, unpack_row, Parsed, ShardInfo};
 use crate::cspace::{Label, LabelledSpace, SampleGrid, SubCells};
-use crate::table::build::{assemble, RowLabels};
+use crate::table::build::{assemble, RowLabels, Variant};
 use crate::table::{BuildReport, Header, Table, TableKind};
 
 /// Merges the shard files `files` (names, in any order; `read` gives a file's bytes) into
@@ -47,6 +47,9 @@ pub fn merge_shards(
         for j in 0..s.info.rows {
             let ia = rows.row(j);
             unpack_row(s.labels, j, &mut f.labels[ia * nb..(ia + 1) * nb]);
+            if !s.counts.is_empty() {
+                f.counts[ia * nb..(ia + 1) * nb].copy_from_slice(&s.counts[j * nb..(j + 1) * nb]);
+            }
         }
         sub.extend(s.sub.chunks_exact(24).map(|e| {
             let word = |w: usize| u64::from_le_bytes(core::array::from_fn(|i| e[8 * w + i]));
@@ -70,6 +73,11 @@ pub fn merge_shards(
     let info = f.info;
     let space = LabelledSpace { grid_a: f.grid_a, grid_b: f.grid_b, labels: f.labels, margin: info.header.margin };
     let sub = (info.kind == TableKind::SharedSub).then_some(cells);
+    let clearance: Vec<_> = info.ladder.map(|l| (l, f.counts)).into_iter().collect();
+    let variant = match info.ladder {
+        Some(ladder) => Variant::Clearance(ladder),
+        None => info.kind.variant(info.t),
+    };
     let labels =
         RowLabels {
             space,
@@ -77,9 +85,8 @@ pub fn merge_shards(
             sub_secs: secs.1,
             certification: info.header.certification,
             labelling: info.labelling,
-            clearance: vec![],
+            clearance,
         };
-    let variant = info.kind.variant(info.t);
     let (mut tables, report) = assemble(labels, info.symmetry, &[variant], secs.0).map_err(ShardError::Build)?;
     let table = tables.pop().ok_or(ShardError::NoShards)?;
     Ok((info.header, table, report))
@@ -96,6 +103,8 @@ struct First {
     holder: Vec<Option<String>>,
     /// Every pair's label.
     labels: Vec<Label>,
+    /// Every pair's clearance level count (clearance shards; else empty).
+    counts: Vec<u8>,
 }
 
 impl First {
@@ -109,6 +118,7 @@ impl First {
             grid_b: s.grid_b.clone(),
             holder: vec![None; s.info.shard.count() as usize],
             labels: vec![Label::Unreachable; na * nb],
+            counts: if s.info.ladder.is_some() { vec![0; na * nb] } else { vec![] },
         }
     }
 }
@@ -123,6 +133,8 @@ fn differs(a: &First, b: &Parsed) -> Option<String> {
         format!("k = {}, not {}", y.k, x.k)
     } else if (x.kind, x.t) != (y.kind, y.t) {
         format!("variant {} t = {}, not {} t = {}", y.kind, y.t, x.kind, x.t)
+    } else if x.ladder != y.ladder {
+        format!("clearance levels {:?}, not {:?}", y.ladder.map(|l| l.mm().to_vec()), x.ladder.map(|l| l.mm().to_vec()))
     } else if x.labelling != y.labelling {
         format!("labelling {:?}, not {:?}", y.labelling, x.labelling)
     } else if x.shard.count() != y.shard.count() {

@@ -4,9 +4,12 @@
 //! byte for byte the one a one-shot [`build_table`](super::build_table) writes (SPEC §6).
 //!
 //! Every variant shards: the shards carry labels (and, for `shared-sub`, the sub-cells of
-//! their collision pairs), not parts of a tree, so the merge builds whichever variant the
-//! shards were labelled for. The merge therefore needs the whole label set in memory (one byte
-//! per pair of samples), as a one-shot build does; the shards need `1/n` of it each.
+//! their collision pairs; for `clearance`, the ladder and each pair's proved level count),
+//! not parts of a tree, so the merge builds whichever variant the shards were labelled for.
+//! A pair's level count depends on the pair alone (its two cells' sweeps and its label), so
+//! the counts of the rows of all shards are the one-shot build's. The merge therefore needs
+//! the whole label set in memory (one byte per pair of samples; a clearance table one more
+//! for the counts), as a one-shot build does; the shards need `1/n` of it each.
 //!
 //! A shard file (`format.rs`) records the cell, `k`, the variant, the labelling, `i` and `n`
 //! and a checksum; [`merge_shards`] refuses a missing, duplicated, truncated or corrupt shard
@@ -22,8 +25,9 @@ pub use error::ShardError;
 pub use format::{read_shard_info, ShardInfo, MAGIC, VERSION};
 pub use merge::merge_shards;
 
-use super::build::{label_rows, BuildError, Labelling};
-use super::{Header, TableKind};
+use super::build::{label_rows, BuildError, Labelling, Variant};
+use super::{Header, SliceAxes, TableKind};
+use crate::cspace::certify::clearance::clearance_counts;
 use crate::cell::Cell;
 use crate::cspace::{Progress, Rows, Symmetry, Workspace};
 use std::time::Instant;
@@ -76,12 +80,13 @@ pub struct ShardReport {
     pub label_secs: f64,
 }
 
-/// Labels shard `shard` of the table `kind` (threshold `t` for the 4-D kinds, else 0) of the
-/// two-robot `cell` at `k` and returns the shard file's bytes.
+/// Labels shard `shard` of the table `kind` (threshold `t` for the 4-D kinds, else 0; the
+/// default ladder for clearance tables) of the two-robot `cell` at `k` and returns the shard
+/// file's bytes.
 ///
 /// # Errors
-/// As [`build_table`](super::build_table): not two robots, a bad `k`, sub-cells with the
-/// thesis labelling.
+/// As [`build_table`](super::build_table): not two robots, a bad `k`, sub-cells or
+/// clearance levels with the thesis labelling.
 pub fn build_shard(
     cell: &Cell,
     k: u32,
@@ -91,9 +96,47 @@ pub fn build_shard(
     shard: ShardIndex,
     progress: Progress,
 ) -> Result<(Vec<u8>, ShardReport), BuildError> {
+    build_shard_of(cell, k, ws, kind.variant(t), labelling, shard, progress)
+}
+
+/// The kind and threshold of `variant`.
+fn kind_of(variant: Variant) -> (TableKind, u32) {
+    match variant {
+        Variant::D6 => (TableKind::D6, 0),
+        Variant::D5 => (TableKind::D5, 0),
+        Variant::D4 { axes: SliceAxes::YY, t } => (TableKind::D4yy, t),
+        Variant::D4 { t, .. } => (TableKind::D4zz, t),
+        Variant::Shared => (TableKind::Shared, 0),
+        Variant::SharedSubdivided => (TableKind::SharedSub, 0),
+        Variant::Clearance(_) => (TableKind::Clearance, 0),
+    }
+}
+
+/// As [`build_shard`] for `variant` (a clearance table's own ladder).
+///
+/// # Errors
+/// As [`build_shard`].
+pub fn build_shard_of(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    variant: Variant,
+    labelling: Labelling,
+    shard: ShardIndex,
+    progress: Progress,
+) -> Result<(Vec<u8>, ShardReport), BuildError> {
     let start = Instant::now();
+    let (kind, t) = kind_of(variant);
     let subdivide = kind == TableKind::SharedSub;
-    let labels = label_rows(cell, k, ws, subdivide, labelling, shard.rows(), progress)?;
+    if matches!(variant, Variant::Clearance(_)) && labelling != Labelling::Certified {
+        return Err(BuildError::ClearanceNeedsCertified);
+    }
+    let mut labels = label_rows(cell, k, ws, subdivide, labelling, shard.rows(), progress)?;
+    if let Variant::Clearance(ladder) = variant {
+        let counts = clearance_counts(cell, k, ws, &labels.space.labels, ladder.mm(), shard.rows())
+            .map_err(BuildError::Labelling)?;
+        labels.clearance.push((ladder, counts));
+    }
     let label_secs = start.elapsed().as_secs_f64();
     let header = Header::for_cell(&labels.space, cell, *ws, labels.certification);
     let (na, nb) = (labels.space.grid_a.cells.len(), labels.space.grid_b.cells.len());
@@ -111,6 +154,7 @@ pub fn build_shard(
         samples: (na, nb),
         rows,
         sub_entries: labels.sub.as_ref().map_or(0, |s| s.pairs.len()),
+        ladder: labels.clearance.first().map(|(l, _)| *l),
     };
     let bytes = format::to_bytes(&info, &labels);
     Ok((bytes, ShardReport { rows, samples: (na, nb), pairs: rows * nb, label_secs }))
@@ -163,6 +207,36 @@ mod tests {
             flipped[i] ^= 0x20;
             assert!(parse(&flipped).is_err(), "byte {i} flipped was read");
         }
+    }
+
+    /// A clearance shard carries its ladder and a count per pair of its rows; a count above
+    /// the ladder or on a pair not free is refused, checksum or not.
+    #[test]
+    fn clearance_shards_carry_checked_counts() {
+        let cell = reference_cell("T3").unwrap();
+        let shard = ShardIndex::new(1, 200).unwrap();
+        let ladder = crate::table::Ladder::new(&[0.0, 20.0]).unwrap();
+        let variant = Variant::Clearance(ladder);
+        let bytes =
+            build_shard_of(&cell, 16, &Workspace::THESIS, variant, Labelling::Certified, shard, Progress::Silent)
+                .unwrap()
+                .0;
+        let p = parse(&bytes).unwrap();
+        assert_eq!(p.info.ladder, Some(ladder));
+        assert_eq!(p.counts.len(), p.info.rows * p.info.samples.1);
+        assert!(p.counts.iter().any(|&c| c == 2) && p.counts.iter().all(|&c| c <= 2), "levels proved in the rows");
+        let start = bytes.len() - 8 - p.counts.len();
+        let high = p.counts.iter().position(|&c| c > 0).unwrap();
+        let not_free = (0..p.counts.len()).find(|&j| p.labels[j / 4] >> (2 * (j % 4)) & 3 != 0).unwrap();
+        for (at, v) in [(high, 3u8), (not_free, 1)] {
+            let mut edited = bytes.clone();
+            edited[start + at] = v;
+            let e = parse(&resealed(edited)).err().unwrap().to_string();
+            assert!(e.contains("clearance count"), "{e}");
+        }
+        let thesis = Labelling::ThesisMargin;
+        let thesis = build_shard_of(&cell, 16, &Workspace::THESIS, variant, thesis, shard, Progress::Silent);
+        assert!(matches!(thesis, Err(BuildError::ClearanceNeedsCertified)));
     }
 
     #[test]
