@@ -41,19 +41,21 @@
 //!    a narrower angle range gives a smaller sweep on every axis, so tier 2 proves whatever
 //!    the direct enclosure alone proved before the table existed).
 //! 5. **Apart.** Box `i` of robot `a` over the stop lies in `box_i(now) + sweep_i`, and
-//!    likewise for `b`; [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) proves the two sums disjoint on one of the 15
-//!    axes (with a positive gap). All box pairs of all pairs that can meet proved: FREE.
-//!    Proved again with `warn_mm` added to one sweep's ball: else WARN. Any unproved pair,
-//!    unreachable TCP, unbounded sweep or status other than OK: STOP.
+//!    likewise for `b`; [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) proves the
+//!    two sums disjoint on one of the 15 axes (with a positive gap). All box pairs of all
+//!    pairs that can meet proved: FREE. Proved again with `warn_mm` added to one sweep's
+//!    ball: else WARN. Any unproved pair, unreachable TCP, unbounded sweep or status other
+//!    than OK: STOP.
 //! 6. **Certain STOP, before any sweep.** Every sweep of a lower-link, platform or tool box
 //!    holds the ball of radius `S'` (the radius of step 3's ball): form 0's support on any `n`
 //!    is at least `(1 + mu) sum_a S' |w_a . n| >= S' |n|` (the cube term with weight
 //!    `max e_k >= 1`, the arc and ball terms are `>= 0`), form 1's at least
 //!    `(1 + mu) S' |n|`. So on every axis the swept box's projection holds that of the box
-//!    swept by the ball `S'` alone (upper links: by nothing). When [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) does
-//!    not separate the boxes swept by those balls (radii shrunk by a relative 1e-9, far above
-//!    rounding), it cannot separate them with the real sweeps of any tier: STOP at once,
-//!    without inverse kinematics.
+//!    swept by the ball `S'` alone (upper links: by nothing). When
+//!    [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) does not separate the boxes
+//!    swept by those balls (radii shrunk by a relative 1e-9, far above rounding), it cannot
+//!    separate them with the real sweeps of any tier: STOP at once, without inverse
+//!    kinematics.
 //!
 //! The **speed limit** of a robot is the largest measured speed `|v_fd|` in `[0, v_max]` at
 //! which every pair involving it is still proved, the other robots as they are: bisection to
@@ -61,13 +63,13 @@
 //! [`ProtectiveChecker::check`] start from the last tick's limit and step away from it by
 //! doubling steps to a bracket before bisecting: the same kind of answer (a grid speed proved,
 //! the next one up not) in a few tests where limits change little between ticks. 0 when not
-//! even standing still is proved; `v_max` when full speed is. The tests of a tick
-//! are capped, all robots together ([`ProtectiveChecker::with_limit_tests`],
+//! even standing still is proved; `v_max` when full speed is. The tests of a tick are capped,
+//! all robots together ([`ProtectiveChecker::with_limit_tests`],
 //! [`DEFAULT_EXTRA_LIMIT_TESTS`]): at the cap the largest speed proved so far is the limit (a
 //! proved speed, lower than the search's end, which the next ticks approach from it, with the
-//! step reached), 0 when no test proved one. Never below that, the
-//! tick's measured speed when its verdict is not STOP: the verdict proved every pair with
-//! the ball of that speed and direction, the ball a test at that speed builds. By default the bisection uses
+//! step reached), 0 when no test proved one. Never below that, the tick's measured speed when
+//! its verdict is not STOP: the verdict proved every pair with the ball of that speed and
+//! direction, the ball a test at that speed builds. By default the bisection uses
 //! tier 1 alone (a few us per robot): that limit is proved, and never above the limit of
 //! both tiers ([`ProtectiveChecker::with_precise_limits`] for that one: both tiers, the
 //! second only above the first's limit and below the speed where step 6 already fails).
