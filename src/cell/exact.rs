@@ -295,6 +295,7 @@ mod tests {
     use super::*;
     use crate::cell::{Placement, RobotSpec};
     use crate::robot::RobotModel;
+    use crate::test_rng::TestRng;
 
     fn row_of_robots(n: usize, spacing: f64, method: SatMethod) -> Cell {
         let robots = (0..n)
@@ -321,15 +322,9 @@ mod tests {
             .collect();
         let cell = Cell::new("row".into(), robots, SatMethod::SatCache).unwrap();
         let mut checker = ExactChecker::new(cell.clone());
-        let (mut state, mut collisions) = (0x2545_f491_4f6c_dd1du64, 0);
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let (mut rng, mut collisions) = (TestRng(0x2545_f491_4f6c_dd1d), 0);
         for _ in 0..5_000 {
-            let mut tcp = || Vec3::new(500.0 * next() - 250.0, 500.0 * next() - 250.0, -350.0 - 200.0 * next());
+            let mut tcp = || Vec3::new(250.0 * rng.unit(), 250.0 * rng.unit(), -450.0 - 100.0 * rng.unit());
             let tcps: Vec<Vec3> = (0..4).map(|_| tcp()).collect();
             let verdict = checker.check(&tcps).unwrap().clone();
             collisions += verdict.colliding_pairs();
