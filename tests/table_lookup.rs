@@ -42,10 +42,11 @@ fn every_variant_has_no_false_negative_on_random_configurations() {
         let answers: Vec<TableAnswer> = checkers.iter_mut().map(|c| c.check(&tcps).unwrap()).collect();
         for (a, variant) in answers.iter().zip(&variants) {
             match a {
-                TableAnswer::Unreachable(_) => assert!(!reachable, "{variant:?}: reachable reported unreachable"),
+                TableAnswer::Unreachable(m) => assert_eq!(*m, v.unreachable_mask, "{variant:?} at {tcps:?}"),
                 TableAnswer::Free => assert!(reachable && !collides, "{variant:?}: false negative at {tcps:?}"),
                 TableAnswer::Collision => assert!(reachable),
             }
+            assert_eq!(matches!(a, TableAnswer::Unreachable(_)), !reachable, "{variant:?} at {tcps:?}");
         }
         // Lossless variants answer alike; sub-cells only turn collisions into free.
         assert!(answers[..4].windows(2).all(|w| w[0] == w[1]), "lossless variants disagree at {tcps:?}");
@@ -71,4 +72,58 @@ fn a_table_refuses_another_cell() {
     assert!(matches!(err, TableError::WrongCell { .. }), "{err}");
     assert!(err.to_string().contains("rebuild"), "{err}");
     assert!(TableChecker::new(t1, &bytes[..bytes.len() - 1]).is_err());
+}
+
+/// A lookup skips the inverse kinematics for a TCP in a grid cell proved wholly reachable:
+/// its reachability must still be exactly the inverse kinematics' own, hardest on the cells'
+/// corners, edges and faces (a TCP on a face belongs to one cell by rounding) and at the reach
+/// boundary (TCPs walked outward from the centre of the workspace until they fail).
+#[test]
+fn lookups_decide_reachability_as_the_inverse_kinematics_on_cell_faces_and_the_reach_boundary() {
+    let t1 = reference_cell("T1").unwrap();
+    let (header, table, _) =
+        build_table(&t1, 16, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent).unwrap();
+    let checker = TableChecker::new(t1.clone(), &to_bytes(&table, &header)).unwrap();
+    let delta = t1.robots[0].model.delta;
+    let home = Vec3::new(0.0, 0.0, -450.0);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+    let mut tried = [0usize; 2];
+    let mut check = |p: Vec3| {
+        let want = delta.is_reachable(&p);
+        tried[usize::from(want)] += 1;
+        assert_eq!(checker.unreachable_mask(&[p, home]) == 0, want, "robot A at {p:?}");
+    };
+    // The lattice of cell corners (and points an ulp either side) over the grid's cube.
+    let (o, r) = (Vec3::from(header.origin_a), header.r);
+    for i in 0..=16 {
+        for j in 0..=16 {
+            for l in 0..=16 {
+                let p = o + Vec3::new(i as f64, j as f64, l as f64) * r;
+                for q in [p, p.map(|v| v.next_up()), p.map(|v| v.next_down())] {
+                    check(q);
+                }
+                // Points on the faces and edges through this corner.
+                let f = rng.random_range(0.0..1.0) * r;
+                check(p + Vec3::new(f, 0.0, 0.0));
+                check(p + Vec3::new(0.0, f, f));
+            }
+        }
+    }
+    // The reach boundary: walk outward in random directions, in steps that shrink to an ulp.
+    for _ in 0..2000 {
+        let dir = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let (mut inside, mut step) = (home, 200.0);
+        while step > 1e-9 {
+            let next = inside + dir * step;
+            if delta.is_reachable(&next) {
+                inside = next;
+            } else {
+                step *= 0.5;
+            }
+            check(next);
+        }
+        check(inside);
+    }
+    println!("{} reachable and {} unreachable TCPs checked", tried[1], tried[0]);
+    assert!(tried[0] > 10_000 && tried[1] > 10_000, "{tried:?}");
 }

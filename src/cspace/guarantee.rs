@@ -171,34 +171,91 @@ fn outside_limits(delta: &Delta3, th: Interval) -> bool {
     start > 1e-12 && start + (th.hi - th.lo) < gap - 1e-12
 }
 
+/// Relative margin of [`cube_reachable`] on `b^2 <= re^2` and `|K / R| <= 1`, and absolute
+/// margin (rad) on the motor limits. [`Delta3::is_reachable`] decides the same inequalities on
+/// floating-point values whose error is near 1e-15 relative; the worst-conditioned of them,
+/// the angle near `|K / R| = 1` where `S = sqrt(R^2 - K^2)` loses digits, is still off by less
+/// than 1e-10 rad at this margin. So every TCP that the margins prove reachable passes
+/// `is_reachable` too.
+pub const REACH_MARGIN: Real = 1e-9;
+
+/// Whether every TCP of the closed cube of centre `c` and half-side `h` (widened by a
+/// relative 1e-12 and by [`REACH_SLACK`]) is reachable, proved by interval inverse kinematics
+/// with [`REACH_MARGIN`]: for each arm, over the whole cube, `z < 0`, `b^2 < re^2`,
+/// `|K / R| < 1` and the motor angle strictly inside its limits, each with the margin.
+/// `false` means "not proved", not "unreachable".
+///
+/// The widening covers the rounding of a TCP's grid cell (one subtraction and one division,
+/// far below 1e-6 mm): a TCP that a table maps to a proved cell lies in the widened cube, so
+/// [`Delta3::is_reachable`] accepts it and a lookup may skip the inverse kinematics.
+pub fn cube_reachable(delta: &Delta3, c: &Vec3, h: Real) -> bool {
+    let h = h * (1.0 + 1e-12) + REACH_SLACK;
+    let (lo, hi) = (c.add_scalar(-h), c.add_scalar(h));
+    let iv = |a: usize| Interval::new(lo[a], hi[a]);
+    (0..3).all(|arm| arm_reaches_box(delta, &radial(arm), &tangent(arm), iv(0), iv(1), iv(2)))
+}
+
+fn arm_reaches_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> bool {
+    // z < 0 everywhere also keeps R^2 >= z^2 > 0.
+    if !(z.hi < 0.0) {
+        return false;
+    }
+    let (a, b2, c) = arm_frame(d, u, t, x, y, z);
+    let m = 1.0 - REACH_MARGIN;
+    if !(b2.hi < d.re * d.re * m) {
+        return false;
+    }
+    let Some(q) = cos_ratio(d, a, b2, c) else { return false };
+    if !(q.lo > -m && q.hi < m) {
+        return false;
+    }
+    let (Some(psi), Some(phi)) = (q.acos(), Interval::atan2(c, a)) else { return false };
+    inside_limits(d, phi.neg().sub(psi))
+}
+
+/// Whether every angle of `th` lies in the motor's arc `[theta_min, theta_max]` (mod `2 pi`,
+/// as [`Delta3::motor_within_limits`]) with [`REACH_MARGIN`] to spare at both ends.
+fn inside_limits(delta: &Delta3, th: Interval) -> bool {
+    let start = (th.lo - delta.theta_min).rem_euclid(std::f64::consts::TAU);
+    start >= REACH_MARGIN && start + (th.hi - th.lo) <= delta.theta_max - delta.theta_min - REACH_MARGIN
+}
+
+/// The TCP box in arm `u, t`'s frame: `a = p.u + e - f`, `b^2 = (p.t)^2`, `c = p.z`.
+fn arm_frame(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> (Interval, Interval, Interval) {
+    let a = x.scale(u.x).add(y.scale(u.y)).shift(d.e - d.f);
+    let b = x.scale(t.x).add(y.scale(t.y));
+    (a, b.sqr(), z)
+}
+
+/// An enclosure of `K / R` over the box (`None`: no bound), with `R = hypot(a, c)`,
+/// `K = (R^2 + C) / (2 rf)`, `C = rf^2 - re^2 + b^2`.
+fn cos_ratio(d: &Delta3, a: Interval, b2: Interval, c: Interval) -> Option<Interval> {
+    let r2 = a.sqr().add(c.sqr());
+    let r = r2.sqrt()?;
+    let cc = b2.shift(d.rf * d.rf - d.re * d.re);
+    let two_rf = 2.0 * d.rf;
+    if cc.hi <= 0.0 {
+        // K/R = R/(2 rf) + C/(2 rf R): increasing in R (C <= 0) and in C (R > 0).
+        let g = |rv: Real, cv: Real| {
+            Some(Interval::point(rv / two_rf).add(Interval::point(cv).div(Interval::point(two_rf * rv))?))
+        };
+        let (glo, ghi) = (g(r.lo, cc.lo)?, g(r.hi, cc.hi)?);
+        Some(Interval::new(glo.lo, ghi.hi))
+    } else {
+        r2.add(cc).scale(1.0 / two_rf).div(r)
+    }
+}
+
 /// `th = -atan2(c, a) - acos(K / R)` over one sub-box (SPEC §2, elbow-out with `c < 0`).
 fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> Enclosure {
     if z.hi >= 0.0 {
         return Enclosure::Unbounded;
     }
-    let a = x.scale(u.x).add(y.scale(u.y)).shift(d.e - d.f);
-    let b = x.scale(t.x).add(y.scale(t.y));
-    let c = z;
-    let b2 = b.sqr();
+    let (a, b2, c) = arm_frame(d, u, t, x, y, z);
     if b2.lo > d.re * d.re {
         return Enclosure::Empty;
     }
-    let r2 = a.sqr().add(c.sqr());
-    let Some(r) = r2.sqrt() else { return Enclosure::Unbounded };
-    let cc = b2.shift(d.rf * d.rf - d.re * d.re);
-    let two_rf = 2.0 * d.rf;
-    let q = if cc.hi <= 0.0 {
-        // K/R = R/(2 rf) + C/(2 rf R): increasing in R (C <= 0) and in C (R > 0).
-        let g = |rv: Real, cv: Real| {
-            Interval::point(rv / two_rf).add(Interval::point(cv).div(Interval::point(two_rf * rv)).unwrap())
-        };
-        let (glo, ghi) = (g(r.lo, cc.lo), g(r.hi, cc.hi));
-        Interval::new(glo.lo, ghi.hi)
-    } else {
-        let k = r2.add(cc).scale(1.0 / two_rf);
-        let Some(q) = k.div(r) else { return Enclosure::Unbounded };
-        q
-    };
+    let Some(q) = cos_ratio(d, a, b2, c) else { return Enclosure::Unbounded };
     let Some(psi) = q.acos() else { return Enclosure::Empty };
     let Some(phi) = Interval::atan2(c, a) else { return Enclosure::Unbounded };
     Enclosure::Range(phi.neg().sub(psi))
@@ -476,6 +533,44 @@ mod tests {
         assert!(proved * 2 > tried, "{proved} of {tried}");
         // A cube around a reachable point is never proved unreachable.
         assert!(!cube_unreachable(&d, &Vec3::new(0.0, 0.0, -450.0), 1.0));
+    }
+
+    /// A cube proved wholly reachable holds no TCP that the inverse kinematics rejects: a
+    /// dense lattice with every corner, edge and face of the closed cell, and random points, on
+    /// every sampled cell of k = 16 and 32 (the thesis robot, and one whose motor limits cut
+    /// through its workspace); and the proof succeeds for most cells whose centre is reachable.
+    #[test]
+    fn cubes_proved_reachable_hold_only_reachable_tcps() {
+        let narrow = Delta3 { theta_min: -0.2, theta_max: 0.9, ..Delta3::THESIS };
+        let mut rng = StdRng::seed_from_u64(11);
+        for (d, k, points) in [(Delta3::THESIS, 16, 2000), (Delta3::THESIS, 32, 400), (narrow, 32, 400)] {
+            let grid = SampleGrid::new(&Workspace::THESIS, k, &d).unwrap();
+            let (mut proved, mut centred) = (0, 0);
+            for s in 0..grid.cells.len() {
+                let (c, h) = (grid.sample_center(s), 0.5 * grid.r);
+                centred += usize::from(grid.reachable[s]);
+                if !cube_reachable(&d, &c, h) {
+                    continue;
+                }
+                proved += 1;
+                assert!(grid.reachable[s], "a cell proved reachable has an unreachable centre");
+                for q in 0..points {
+                    let off = if q < 729 {
+                        Vec3::new((q % 9) as Real, (q / 9 % 9) as Real, (q / 81) as Real) / 4.0 - Vec3::repeat(1.0)
+                    } else {
+                        Vec3::new(rng.random::<Real>(), rng.random::<Real>(), rng.random::<Real>()) * 2.0
+                            - Vec3::repeat(1.0)
+                    };
+                    let p = c + off * h;
+                    assert!(d.is_reachable(&p), "k = {k}, sample {s}: {p:?} unreachable in a cube proved reachable");
+                }
+            }
+            println!("k = {k}: {proved} of {centred} cells with a reachable centre proved wholly reachable");
+            assert!(proved * 2 > centred, "{proved} of {centred}");
+        }
+        // A cube reaching the base plane, or beyond the reach, is never proved reachable.
+        assert!(!cube_reachable(&Delta3::THESIS, &Vec3::new(0.0, 0.0, -5.0), 10.0));
+        assert!(!cube_reachable(&Delta3::THESIS, &Vec3::new(0.0, 0.0, -1500.0), 10.0));
     }
 
     #[test]

@@ -5,7 +5,8 @@
 //! never meet has no table and no lookup. Each distinct table is loaded once into a
 //! [`TableChecker`] of its pair cell, which every pair using it shares: a pair's lookup is that
 //! checker's lookup on the pair's two TCPs, each in its own MCS, with the same exact fallback
-//! and confirmation as for two robots. Nothing allocates per tick.
+//! and confirmation as for two robots. A pair whose robots stay in the cells of its last FREE
+//! label keeps that answer without a lookup. Nothing allocates per tick.
 
 use crate::cell::{Cell, QueryError};
 use crate::math::Vec3;
@@ -53,6 +54,12 @@ pub struct BundleChecker {
     pair_slots: Vec<[usize; 2]>,
     /// Per slot, the cell of the last tick (`None`: robot unreachable or outside the grid).
     cells: Vec<Option<[u16; 3]>>,
+    /// The robots in no pair that can meet (no slot decides their reachability).
+    unpaired: Vec<usize>,
+    /// Robots `a < b`'s table at `a n + b` (`n` robots; `None`: the pair can never meet).
+    pair_tables: Vec<Option<usize>>,
+    /// Per pair, the robots' cells of its last lookup that the table labelled FREE.
+    free_cells: Vec<Option<[[u16; 3]; 2]>>,
 }
 
 impl BundleChecker {
@@ -105,7 +112,14 @@ impl BundleChecker {
         }
         let cells = alloc::vec![None; slots.len()];
         let models = cell.robots.iter().map(|r| r.model).collect();
-        Ok(BundleChecker { cell, models, checkers, pairs, slots, pair_slots, cells })
+        let unpaired = (0..cell.robots.len()).filter(|&j| !slots.iter().any(|s| s.robot == j)).collect();
+        let free_cells = alloc::vec![None; pairs.len()];
+        let n = cell.robots.len();
+        let mut pair_tables = alloc::vec![None; n * n];
+        for p in &pairs {
+            pair_tables[p.a * n + p.b] = Some(p.table);
+        }
+        Ok(BundleChecker { cell, models, checkers, pairs, slots, pair_slots, cells, unpaired, pair_tables, free_cells })
     }
 
     /// The cell.
@@ -151,8 +165,12 @@ impl BundleChecker {
     /// [`TableChecker::clearance_bound`]. `None` when nothing is proved, or for a pair that
     /// has no table (it can never meet: no bound is needed).
     pub fn clearance_bound(&self, a: usize, b: usize, tcps_mcs: &[Vec3]) -> Option<f64> {
-        let pair = self.pairs.iter().find(|p| (p.a, p.b) == (a, b))?;
-        self.checkers[pair.table].clearance_bound(tcps_mcs)
+        let n = self.models.len();
+        if !(a < b && b < n) {
+            return None;
+        }
+        let table = self.pair_tables[a * n + b]?;
+        self.checkers[table].clearance_bound(tcps_mcs)
     }
 
     /// How a COLLISION lookup is answered.
@@ -182,28 +200,40 @@ impl BundleChecker {
         }
         // As the exact check: a pair with an unreachable robot has no answer, every other pair
         // is answered, and the tick's answer is unreachable.
-        let mask = self.unreachable_mask(tcps_mcs);
-        let mut answer = if mask != 0 { TableAnswer::Unreachable(mask) } else { TableAnswer::Free };
-        // Each reachable robot's cell once per grid; an unreachable robot's pairs look nothing up.
+        // Each robot's cell once per grid, which also decides its reachability (the same answer
+        // on every grid: `TableChecker::locate`); an unreachable robot's pairs look nothing up.
+        let mut mask = 0u32;
         for (cell, s) in self.cells.iter_mut().zip(&self.slots) {
-            *cell = match mask >> s.robot & 1 {
-                0 => self.checkers[s.checker].cell_of(s.side, &tcps_mcs[s.robot]),
-                _ => None,
-            };
+            let located = self.checkers[s.checker].locate(s.side, &tcps_mcs[s.robot]);
+            mask |= u32::from(located.is_none()) << s.robot;
+            *cell = located.flatten();
         }
-        for (p, [sa, sb]) in self.pairs.iter_mut().zip(&self.pair_slots) {
+        for &j in &self.unpaired {
+            mask |= u32::from(!self.models[j].delta.is_reachable(&tcps_mcs[j])) << j;
+        }
+        let mut answer = if mask != 0 { TableAnswer::Unreachable(mask) } else { TableAnswer::Free };
+        for ((p, [sa, sb]), free) in self.pairs.iter_mut().zip(&self.pair_slots).zip(&mut self.free_cells) {
             (p.answer, p.boxes) = (TableAnswer::Unreachable(mask), None);
             if mask >> p.a & 1 == 1 || mask >> p.b & 1 == 1 {
                 continue;
             }
             let checker = &mut self.checkers[p.table];
-            let cells = [self.cells[*sa], self.cells[*sb]];
-            p.answer = match checker.check_cells(cells, &[tcps_mcs[p.a], tcps_mcs[p.b]])? {
-                // The pair checker's bits name the pair's robots; fail closed on the cell's.
-                TableAnswer::Unreachable(m) => TableAnswer::Unreachable((m & 1) << p.a | (m >> 1 & 1) << p.b),
-                other => other,
+            (p.answer, p.boxes) = match [self.cells[*sa], self.cells[*sb]] {
+                // The table's FREE is a function of the two cells alone, so while both robots stay
+                // in the cells of the pair's last such label the answer stands without a lookup
+                // (a confirmed answer depends on the TCPs and is not kept).
+                [Some(a), Some(b)] if *free == Some([a, b]) || checker.labelled_free(a, b) => {
+                    *free = Some([a, b]);
+                    (TableAnswer::Free, None)
+                }
+                cells => match checker.check_cells(cells, &[tcps_mcs[p.a], tcps_mcs[p.b]])? {
+                    // The pair checker's bits name the pair's robots; fail closed on the cell's.
+                    TableAnswer::Unreachable(m) => {
+                        (TableAnswer::Unreachable((m & 1) << p.a | (m >> 1 & 1) << p.b), None)
+                    }
+                    other => (other, checker.colliding_boxes()),
+                },
             };
-            p.boxes = checker.colliding_boxes();
             answer = match (answer, p.answer) {
                 (TableAnswer::Unreachable(m), TableAnswer::Unreachable(n)) => TableAnswer::Unreachable(m | n),
                 (TableAnswer::Unreachable(m), _) | (_, TableAnswer::Unreachable(m)) => TableAnswer::Unreachable(m),

@@ -1,8 +1,9 @@
 //! Table-backed queries for a two-robot cell: one lookup per tick (thesis 3.2.4-3.2.6 query
 //! phase; SPEC §6).
 //!
-//! Per tick: each TCP is checked for reachability (inverse kinematics, no box model), mapped
-//! to its grid cell, and the 6-D cell is looked up. A reachable TCP outside the sampled grid
+//! Per tick: each TCP is mapped to its grid cell and checked for reachability (the inverse
+//! kinematics, no box model; skipped in a cell proved wholly reachable when the table was
+//! loaded), and the 6-D cell is looked up. A reachable TCP outside the sampled grid
 //! has no table entry: that tick falls back to the exact check (counted in
 //! [`TableChecker::fallbacks`]), so the answer is never a guess. A cell labelled COLLISION may
 //! hold free configurations (only FREE labels are proofs); with [`Confirmation::Exact`] such a
@@ -12,11 +13,12 @@
 
 use crate::cell::exact::PairState;
 use crate::cell::{Cell, ExactChecker, QueryError};
+use crate::cspace::guarantee::cube_reachable;
 use crate::cspace::symmetry::reflection_y;
 use crate::cspace::SampleGrid;
 use crate::cspace::Workspace;
 use crate::math::Vec3;
-use crate::robot::RobotModel;
+use crate::robot::{Delta3, RobotModel};
 use crate::table::format::from_bytes;
 use crate::table::{Header, Table, TableError};
 use alloc::{format, string::String, vec, vec::Vec};
@@ -91,22 +93,34 @@ fn check_determined_by_cell(header: &Header, table: &Table, cell: &Cell) -> Resu
     Ok(())
 }
 
-/// Which cells of one robot's grid were sampled: a dense bitmap over the `k^3` cells.
+/// A set of one robot's grid cells: a dense bitmap over the `k^3` cells.
 #[derive(Clone, Debug, PartialEq)]
-struct SampledCells {
+struct CellSet {
     k: usize,
     bits: Vec<u64>,
 }
 
-impl SampledCells {
-    fn new(grid: &SampleGrid) -> Self {
-        let k = grid.k as usize;
+impl CellSet {
+    fn new<'a>(k: u32, cells: impl Iterator<Item = &'a [u16; 3]>) -> Self {
+        let k = k as usize;
         let mut bits = vec![0u64; (k * k * k).div_ceil(64)];
-        for c in &grid.cells {
+        for c in cells {
             let i = (c[0] as usize * k + c[1] as usize) * k + c[2] as usize;
             bits[i / 64] |= 1 << (i % 64);
         }
-        SampledCells { k, bits }
+        CellSet { k, bits }
+    }
+
+    /// The grid's sampled cells.
+    fn sampled(grid: &SampleGrid) -> Self {
+        CellSet::new(grid.k, grid.cells.iter())
+    }
+
+    /// The sampled cells of which every TCP is proved reachable by `delta`
+    /// ([`cube_reachable`]), so that a TCP found in one needs no inverse kinematics.
+    fn reachable(grid: &SampleGrid, delta: &Delta3) -> Self {
+        let h = 0.5 * grid.r;
+        CellSet::new(grid.k, grid.cells.iter().filter(|c| cube_reachable(delta, &grid.center(**c), h)))
     }
 
     fn contains(&self, c: [u16; 3]) -> bool {
@@ -122,7 +136,9 @@ pub struct TableChecker {
     table: Table,
     models: [RobotModel; 2],
     origins: [Vec3; 2],
-    sampled: [SampledCells; 2],
+    sampled: [CellSet; 2],
+    /// Per robot, the sampled cells proved wholly reachable.
+    reachable: [CellSet; 2],
     /// The query resolution, fixed by the table: `2^sub_levels` cells per grid cell and axis,
     /// cells per axis at it, and their side (mm).
     sub_levels: u32,
@@ -190,7 +206,11 @@ impl TableChecker {
         Ok(TableChecker {
             models: [cell.robots[0].model, cell.robots[1].model],
             origins: [grid_a.origin, grid_b.origin],
-            sampled: [SampledCells::new(&grid_a), SampledCells::new(&grid_b)],
+            sampled: [CellSet::sampled(&grid_a), CellSet::sampled(&grid_b)],
+            reachable: [
+                CellSet::reachable(&grid_a, &cell.robots[0].model.delta),
+                CellSet::reachable(&grid_b, &cell.robots[1].model.delta),
+            ],
             sub_levels,
             query_k: f64::from(k << sub_levels),
             query_r: header.r / f64::from(1u32 << sub_levels),
@@ -259,6 +279,16 @@ impl TableChecker {
         self.sampled[j].contains(c.map(|v| v >> self.sub_levels)).then_some(c)
     }
 
+    /// Robot `j`'s TCP (its own MCS) located: `None` when it is unreachable or not finite
+    /// ([`Delta3::is_reachable`]), else [`TableChecker::cell_of`]. A TCP in a grid cell proved
+    /// wholly reachable ([`cube_reachable`], whose margins make `is_reachable` accept every
+    /// TCP of the cell) skips the inverse kinematics.
+    pub(crate) fn locate(&self, j: usize, tcp: &Vec3) -> Option<Option<[u16; 3]>> {
+        let cell = self.cell_of(j, tcp);
+        let proved = cell.is_some_and(|c| self.reachable[j].contains(c.map(|v| v >> self.sub_levels)));
+        (proved || self.models[j].delta.is_reachable(tcp)).then_some(cell)
+    }
+
     /// Whether robot `j`'s grid here and robot `i`'s grid in `other` give every TCP the same
     /// cell (origin, query resolution and sampled cells all equal), so that [`TableChecker::cell_of`]
     /// of one serves the other (a bundle's pairs share their robots' cells).
@@ -279,21 +309,14 @@ impl TableChecker {
             return Err(QueryError::WrongRobotCount { expected: 2, found: tcps_mcs.len() });
         }
         self.exact_boxes = None;
-        let mask = self.unreachable_mask(tcps_mcs);
-        if mask != 0 {
-            return Ok(TableAnswer::Unreachable(mask));
+        let located = [self.locate(0, &tcps_mcs[0]), self.locate(1, &tcps_mcs[1])];
+        match located {
+            [Some(a), Some(b)] => self.check_cells([a, b], tcps_mcs),
+            _ => Ok(TableAnswer::Unreachable(u32::from(located[0].is_none()) | u32::from(located[1].is_none()) << 1)),
         }
-        self.check_reachable(tcps_mcs)
     }
 
-    /// [`TableChecker::check`] for two TCPs the caller has found reachable with this cell's
-    /// models (a bundle checks each robot once per tick, not once per pair).
-    pub(crate) fn check_reachable(&mut self, tcps_mcs: &[Vec3]) -> Result<TableAnswer, QueryError> {
-        let cells = [self.cell_of(0, &tcps_mcs[0]), self.cell_of(1, &tcps_mcs[1])];
-        self.check_cells(cells, tcps_mcs)
-    }
-
-    /// [`TableChecker::check_reachable`] with the two TCPs' cells already taken
+    /// [`TableChecker::check`] for two reachable TCPs with their cells already taken
     /// (`cells[j]` must be [`TableChecker::cell_of`]`(j, &tcps_mcs[j])`, or that of a grid
     /// [`TableChecker::same_grid`] finds equal).
     pub(crate) fn check_cells(
@@ -302,19 +325,15 @@ impl TableChecker {
         tcps_mcs: &[Vec3],
     ) -> Result<TableAnswer, QueryError> {
         self.exact_boxes = None;
-        match (cells[0], cells[1]) {
-            (Some(a), Some(b)) => {
-                if !self.table.query([a[0], a[1], a[2], b[0], b[1], b[2]]) {
-                    return Ok(TableAnswer::Free);
+        match cells {
+            [Some(a), Some(b)] if self.labelled_free(a, b) => Ok(TableAnswer::Free),
+            [Some(_), Some(_)] => match self.confirmation {
+                Confirmation::None => Ok(TableAnswer::Collision),
+                Confirmation::Exact => {
+                    self.confirmations += 1;
+                    self.exact_answer(tcps_mcs)
                 }
-                match self.confirmation {
-                    Confirmation::None => Ok(TableAnswer::Collision),
-                    Confirmation::Exact => {
-                        self.confirmations += 1;
-                        self.exact_answer(tcps_mcs)
-                    }
-                }
-            }
+            },
             _ => {
                 self.fallbacks += 1;
                 self.exact_answer(tcps_mcs)
@@ -322,10 +341,16 @@ impl TableChecker {
         }
     }
 
+    /// Whether the table labels the 6-D cell of robot cells `a` and `b` FREE: a proof for every
+    /// configuration of that cell, whatever TCPs in it a tick brings.
+    pub(crate) fn labelled_free(&self, a: [u16; 3], b: [u16; 3]) -> bool {
+        !self.table.query([a[0], a[1], a[2], b[0], b[1], b[2]])
+    }
+
     /// Bit j set: robot j's TCP (of the first two of `tcps_mcs`, each in its own MCS) is
     /// unreachable or not finite.
     pub fn unreachable_mask(&self, tcps_mcs: &[Vec3]) -> u32 {
-        let reachable = |j: usize| tcps_mcs.get(j).is_some_and(|t| self.models[j].delta.is_reachable(t));
+        let reachable = |j: usize| tcps_mcs.get(j).is_some_and(|t| self.locate(j, t).is_some());
         (0..2).fold(0u32, |m, j| m | u32::from(!reachable(j)) << j)
     }
 
@@ -337,10 +362,7 @@ impl TableChecker {
     pub fn clearance_bound(&self, tcps_mcs: &[Vec3]) -> Option<f64> {
         let table = self.table.as_clearance()?;
         let [ta, tb] = tcps_mcs else { return None };
-        if !(self.models[0].delta.is_reachable(ta) && self.models[1].delta.is_reachable(tb)) {
-            return None;
-        }
-        let (a, b) = (self.cell_of(0, ta)?, self.cell_of(1, tb)?);
+        let (a, b) = (self.locate(0, ta)??, self.locate(1, tb)??);
         table.bound_mm([a[0], a[1], a[2], b[0], b[1], b[2]])
     }
 
