@@ -268,7 +268,9 @@ mod tests {
     /// In a line every robot's pairs share its grid, so each robot's cell is taken once per
     /// tick; and every pair answers as its own table checker does alone (which takes both
     /// cells and the reachability itself), labels compared (no confirmation), on random TCPs
-    /// inside, beyond and outside the grids and unreachable ones.
+    /// inside, beyond and outside the grids and unreachable ones; the robots walk in steps of
+    /// a few mm with rare jumps, so pairs often keep their cells (and their last FREE label)
+    /// from one tick to the next and often leave them.
     #[test]
     fn a_lines_pairs_share_each_robots_cell_and_answer_as_their_own_checkers() {
         let (variant, labelling) = (Variant::Shared, Labelling::Certified);
@@ -300,12 +302,28 @@ mod tests {
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let mut seen = [0usize; 3]; // free, collision, unreachable
-        let mut tcps = vec![Vec3::zeros(); 8];
-        for _ in 0..20_000 {
+        let (mut kept, mut moved) = (0usize, 0usize); // FREE pairs that kept / left their cells
+        let mut tcps = vec![Vec3::new(0.0, 0.0, -450.0); 8];
+        for _ in 0..40_000 {
             for t in &mut tcps {
-                *t = Vec3::new(600.0 * next() - 300.0, 600.0 * next() - 300.0, -300.0 - 300.0 * next());
+                let jump = next() < 0.02;
+                let step = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 10.0;
+                *t = match jump {
+                    true => Vec3::new(600.0 * next() - 300.0, 600.0 * next() - 300.0, -300.0 - 300.0 * next()),
+                    false => *t + step,
+                };
             }
+            let cells_of = |b: &BundleChecker| -> Vec<_> {
+                b.pair_slots.iter().zip(&b.pairs).map(|(s, p)| (b.cells[s[0]], b.cells[s[1]], p.answer)).collect()
+            };
+            let before = cells_of(&bundle);
             bundle.check(&tcps).unwrap();
+            for ((ca, cb, was), (na, nb, now)) in before.iter().zip(&cells_of(&bundle)) {
+                if (*was, *now) == (TableAnswer::Free, TableAnswer::Free) && ca.is_some() && cb.is_some() {
+                    let same = (ca, cb) == (na, nb);
+                    (kept, moved) = (kept + usize::from(same), moved + usize::from(!same));
+                }
+            }
             let mask = bundle.unreachable_mask(&tcps);
             for (p, checker) in bundle.pairs().iter().zip(&mut alone) {
                 let want = checker.check(&[tcps[p.a], tcps[p.b]]).unwrap();
@@ -320,6 +338,7 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&n| n > 100), "free, collision, unreachable answers: {seen:?}");
+        assert!(kept > 10_000 && moved > 1_000, "FREE pairs that kept their cells {kept}, that left them {moved}");
         assert!(bundle.fallbacks() > 0, "some TCPs lie outside the grid");
     }
 }
