@@ -484,6 +484,56 @@ fn speed_limits_off_give_the_same_verdicts_and_nan_limits() {
     }
 }
 
+/// `dc_set_limit_tests`: the verdicts of T1's practical run are the same with no limit tests,
+/// the default budget and the full search; with none each limit is the tick's floor, at most
+/// the default budget's and below it on many ticks; the full search's limits are the highest on
+/// average; nothing allocates; the cap survives `dc_set_stop_model`; a NULL handle is a status.
+#[test]
+fn the_c_abi_caps_the_limit_tests_without_changing_the_verdicts() {
+    use delta_collide::ffi::*;
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let handles = [t1_handle_with_default_stops(), t1_handle_with_default_stops(), t1_handle_with_default_stops()];
+    // SAFETY: live handles (and NULL, rejected).
+    unsafe {
+        assert_eq!(dc_set_limit_tests(std::ptr::null_mut(), 0), DC_STATUS_NULL_POINTER);
+        assert_eq!(dc_set_limit_tests(handles[0], 0), DC_STATUS_OK);
+        assert_eq!(dc_set_limit_tests(handles[2], u32::MAX), DC_STATUS_OK);
+        let stops = [dc_stop_config_default(); 2];
+        assert_eq!(dc_set_stop_model(handles[0], 1.0, 10.0, stops.as_ptr(), 2), DC_STATUS_OK);
+    }
+    let mut tcps = [Vec3::zeros(); 2];
+    // SAFETY: the report holds numbers only, for which all-zero bytes are valid values.
+    let zeroed = || unsafe { std::mem::MaybeUninit::<DcProtectiveReport>::zeroed().assume_init() };
+    let mut reports = [zeroed(), zeroed(), zeroed()];
+    let mut verdicts = [DC_VERDICT_STOP; 3];
+    let (mut lower, mut sums, mut allocated) = (0, [0.0; 3], 0);
+    for tick in 0..RUN_TICKS {
+        s.tcps_at(tick, &mut tcps);
+        let c = tcps.map(|t| DcVec3 { x: t.x, y: t.y, z: t.z });
+        for ((h, v), r) in handles.iter().zip(&mut verdicts).zip(&mut reports) {
+            let before = allocations();
+            // SAFETY: live handles, two readable TCPs, writable outputs.
+            assert_eq!(unsafe { dc_protective_query(*h, c.as_ptr(), 2, v, r) }, DC_STATUS_OK);
+            allocated += allocations() - before;
+        }
+        assert!(verdicts.iter().all(|v| *v == verdicts[0]), "tick {tick}: {verdicts:?}");
+        for j in 0..2 {
+            let [none, default, full] = reports.map(|r| r.speed_limit_mm_s[j]);
+            assert!(none <= default * (1.0 + 1e-12), "tick {tick}, robot {j}: {none} > {default}");
+            lower += usize::from(none < default * 0.99);
+            for (sum, v) in sums.iter_mut().zip([none, default, full]) {
+                *sum += v;
+            }
+        }
+    }
+    assert_eq!(allocated, 0);
+    assert!(lower > 1_000, "the default budget finds higher limits than the floor on {lower} robot ticks");
+    assert!(sums[0] < sums[1] && sums[1] <= sums[2], "mean limits: none, default, full {sums:?}");
+    // SAFETY: live handles, destroyed once.
+    handles.iter().for_each(|&h| unsafe { dc_destroy(h) });
+}
+
 /// `dc_protective_query_with_paths` through the C ABI: no allocation per call while the
 /// robots move toward each other along their paths, and a status naming the robot for every
 /// kind of bad path.

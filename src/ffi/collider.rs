@@ -273,10 +273,17 @@ impl Collider {
             })
             .collect();
         let cell = self.protective.cell().clone().with_stopping(tick_ms, models).map_err(|e| invalid(e.to_string()))?;
-        let limits = self.protective.speed_limits();
-        self.protective =
-            ProtectiveChecker::new(cell, warn_mm).map_err(|e| invalid(e.to_string()))?.with_speed_limits(limits);
+        let (limits, tests) = (self.protective.speed_limits(), self.protective.limit_tests());
+        self.protective = ProtectiveChecker::new(cell, warn_mm)
+            .map_err(|e| invalid(e.to_string()))?
+            .with_speed_limits(limits)
+            .with_limit_tests(tests);
         Ok(())
+    }
+
+    /// Caps the speeds the speed-limit searches test per tick, all robots together.
+    pub(crate) fn set_limit_tests(&mut self, tests: u32) {
+        self.protective.set_limit_tests(tests);
     }
 
     /// Whether the protective queries to come find each robot's speed limit.

@@ -724,6 +724,30 @@ pub unsafe extern "C" fn dc_set_speed_limits(handle: *mut DcCollider, on: u32) -
     }
 }
 
+/// Caps the speeds that the speed-limit searches of `dc_protective_query` test per tick, all
+/// robots together: each test costs about one robot's stop sweeps and their proof, so this
+/// bounds the time a tick's limits take. The default is the robot count plus one; 0 reports
+/// each robot's measured speed when the verdict is not STOP (else 0); `UINT32_MAX` lets
+/// every search run to its end. Out of tests, a robot's limit is the largest speed its search
+/// proved: a proved speed, perhaps below what the full search would find; the next tick goes
+/// on from there. The verdict is the same whatever the cap. Setup only, like
+/// `dc_set_stop_model`, and kept by it.
+///
+/// Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_PANIC` (a poisoned handle).
+///
+/// # Safety
+/// `handle` must be NULL or a live handle not used by another thread.
+#[no_mangle]
+pub unsafe extern "C" fn dc_set_limit_tests(handle: *mut DcCollider, tests: u32) -> DcStatus {
+    // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+    unsafe {
+        set_on_handle(handle, |c| {
+            c.set_limit_tests(tests);
+            Ok(())
+        })
+    }
+}
+
 /// Table mode: how many queries so far the table's lookup said COLLISION and the exact check
 /// confirmed or refuted it (`DC_CONFIRMATION_EXACT`); ticks answered by the exact fallback
 /// are counted by `dc_table_fallbacks` instead. 0 in exact mode and for NULL.

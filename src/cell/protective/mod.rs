@@ -421,6 +421,12 @@ impl ProtectiveChecker {
         ProtectiveChecker { limit_tests: tests, ..self }
     }
 
+    /// Sets the cap on speeds tested per tick from the next tick on
+    /// ([`ProtectiveChecker::with_limit_tests`]).
+    pub fn set_limit_tests(&mut self, tests: u32) {
+        self.limit_tests = tests;
+    }
+
     /// The cap on speeds tested per tick ([`ProtectiveChecker::with_limit_tests`]).
     pub fn limit_tests(&self) -> u32 {
         self.limit_tests
