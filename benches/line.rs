@@ -1,9 +1,8 @@
 //! Lines of 2, 4, 8 and 16 thesis robots along one conveyor, bases 450 mm apart (as T1 and
 //! `cells/line4.toml`): the exact query and the protective verdict (alone, and with speed
-//! limits) per tick, against the number of pairs that can meet. Robot `j` runs T1 practical's
-//! trajectory of robot A (even `j`) or B (odd `j`), so every other neighbour pair works as
-//! T1's pair does; the 6,000 ticks are replayed in order (`check`, speeds from the history)
-//! and every answer is asserted against one computed before timing. The exact query of the
+//! limits) per tick, against the number of pairs that can meet, on the run of
+//! `support/line_run.rs`: its 6,000 ticks are replayed in order (`check`, speeds from the
+//! history) and every answer is asserted against one computed before timing. The exact query of the
 //! two-robot line is the peer of every other figure. Table mode (one lookup per pair, COLLISION
 //! confirmed by the exact check) runs on the bundle of `cells/line4.toml`'s spacing, which
 //! serves every line here: k = 32 `shared` when benchmarking, k = 16 in `cargo test`'s quick
@@ -11,12 +10,10 @@
 //! protective verdict in exact mode against table mode on the bundle of clearance tables
 //! (k = 16) of the same spacing.
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use delta_collide::cell::placement::Placement;
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, BenchmarkId, Criterion};
 use delta_collide::cell::protective::{Protective, ProtectiveChecker};
-use delta_collide::cell::reference::reference_cell;
-use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
-use delta_collide::cell::{Cell, ExactChecker, RobotSpec};
+use delta_collide::cell::ExactChecker;
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::bundle::build_bundle;
@@ -24,32 +21,9 @@ use delta_collide::robot::StopModel;
 use delta_collide::table::{BundleChecker, Confirmation, Labelling, Ladder, TableAnswer, Variant};
 use std::hint::black_box;
 
-const SCENARIOS: &str = include_str!("../c_harness/scenarios.txt");
-
-/// A line of `n` thesis robots, 450 mm apart along x.
-fn line(n: usize) -> Cell {
-    let t1 = reference_cell("T1").unwrap();
-    let robots = (0..n)
-        .map(|j| RobotSpec {
-            name: format!("R{}", j + 1),
-            placement: Placement { alpha: 0.0, t: Vec3::new(450.0 * j as f64, 0.0, 0.0) },
-            ..t1.robots[0].clone()
-        })
-        .collect();
-    Cell::new(format!("line{n}"), robots, t1.method).unwrap()
-}
-
-/// The ticks of the run for `n` robots.
-fn ticks(n: usize) -> Vec<Vec<Vec3>> {
-    let s = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
-    (0..RUN_TICKS)
-        .map(|tick| {
-            let mut pair = [Vec3::zeros(); 2];
-            s.tcps_at(tick, &mut pair);
-            (0..n).map(|j| pair[j % 2]).collect()
-        })
-        .collect()
-}
+#[path = "support/line_run.rs"]
+mod line_run;
+use line_run::{line, ticks};
 
 /// The stiff stopping model of the protective tests (2 ms reaction, 120 m/s^2 braking): stops
 /// short enough for a clearance table's levels to prove far pairs.
@@ -73,6 +47,17 @@ fn bundle() -> (u32, Vec<u8>) {
     (k, built.bytes)
 }
 
+/// Times `tick(k)` on ticks `k = 0, 1, ..., len - 1, 0, ...` in order, as a controller sends them.
+fn replay(group: &mut BenchmarkGroup<WallTime>, id: BenchmarkId, len: usize, mut tick: impl FnMut(usize)) {
+    let mut i = 0;
+    group.bench_function(id, |b| {
+        b.iter(|| {
+            tick(i % len);
+            i += 1;
+        })
+    });
+}
+
 fn lines(c: &mut Criterion) {
     let (k, bundle) = bundle();
     let clearance = clearance_bundle();
@@ -84,36 +69,22 @@ fn lines(c: &mut Criterion) {
         let mut exact = ExactChecker::new(cell.clone());
         let hits: Vec<bool> = run.iter().map(|t| exact.check(t).unwrap().collides()).collect();
         let label = format!("{n} robots, {pairs} pairs");
-        let mut i = 0;
-        group.bench_function(BenchmarkId::new("exact", &label), |b| {
-            b.iter(|| {
-                let k = i % run.len();
-                i += 1;
-                assert_eq!(exact.check(black_box(&run[k])).unwrap().collides(), hits[k]);
-            })
+        replay(&mut group, BenchmarkId::new("exact", &label), run.len(), |k| {
+            assert_eq!(exact.check(black_box(&run[k])).unwrap().collides(), hits[k]);
         });
         let mut table = BundleChecker::new(cell.clone(), &bundle, Confirmation::Exact).unwrap();
-        let mut i = 0;
-        group.bench_function(BenchmarkId::new(format!("table k{k}, exact confirmation"), &label), |b| {
-            b.iter(|| {
-                let k = i % run.len();
-                i += 1;
-                assert_eq!(table.check(black_box(&run[k])).unwrap() == TableAnswer::Collision, hits[k]);
-            })
+        let id = BenchmarkId::new(format!("table k{k}, exact confirmation"), &label);
+        replay(&mut group, id, run.len(), |k| {
+            assert_eq!(table.check(black_box(&run[k])).unwrap() == TableAnswer::Collision, hits[k]);
         });
         for (name, limits) in [("protective verdict", false), ("protective with speed limits", true)] {
             let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
             let verdicts: Vec<Protective> = run.iter().map(|t| checker.check(t).unwrap().verdict).collect();
-            let mut i = 0;
-            group.bench_function(BenchmarkId::new(name, &label), |b| {
-                b.iter(|| {
-                    let k = i % run.len();
-                    if k == 0 {
-                        checker.reset();
-                    }
-                    i += 1;
-                    assert_eq!(checker.check(black_box(&run[k])).unwrap().verdict, verdicts[k]);
-                })
+            replay(&mut group, BenchmarkId::new(name, &label), run.len(), |k| {
+                if k == 0 {
+                    checker.reset();
+                }
+                assert_eq!(checker.check(black_box(&run[k])).unwrap().verdict, verdicts[k]);
             });
         }
     }
@@ -134,21 +105,16 @@ fn lines(c: &mut Criterion) {
         println!("{label}, stiff: {pairs} pairs proved by a lookup over {} ticks", run.len());
         for (name, table_mode) in [("protective", false), ("protective, table mode", true)] {
             let checker = if table_mode { &mut lookup } else { &mut exact };
-            let mut i = 0;
-            group.bench_function(BenchmarkId::new(name, &label), |b| {
-                b.iter(|| {
-                    let k = i % run.len();
-                    if k == 0 {
-                        checker.reset();
-                    }
-                    i += 1;
-                    let r = match table_mode {
-                        true => checker.check_with_table(black_box(&run[k]), &bound).unwrap(),
-                        false => checker.check(black_box(&run[k])).unwrap(),
-                    };
-                    // Table mode proves some pairs another way: never a worse verdict.
-                    assert!(r.verdict <= verdicts[k]);
-                })
+            replay(&mut group, BenchmarkId::new(name, &label), run.len(), |k| {
+                if k == 0 {
+                    checker.reset();
+                }
+                let r = match table_mode {
+                    true => checker.check_with_table(black_box(&run[k]), &bound).unwrap(),
+                    false => checker.check(black_box(&run[k])).unwrap(),
+                };
+                // Table mode proves some pairs another way: never a worse verdict.
+                assert!(r.verdict <= verdicts[k]);
             });
         }
     }

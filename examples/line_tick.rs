@@ -2,30 +2,16 @@
 //! mode or in table mode (bundle of `cells/line4.toml`'s spacing), for `perf record`.
 //! `cargo run --release --example line_tick -- exact|table N SECONDS [K]`.
 
-use delta_collide::cell::placement::Placement;
-use delta_collide::cell::reference::reference_cell;
-use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
-use delta_collide::cell::{Cell, ExactChecker, RobotSpec};
+use delta_collide::cell::ExactChecker;
 use delta_collide::cspace::{Progress, Workspace};
-use delta_collide::math::Vec3;
 use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::{BundleChecker, Confirmation, Labelling, TableAnswer, Variant};
 use std::hint::black_box;
 use std::time::Instant;
 
-const SCENARIOS: &str = include_str!("../c_harness/scenarios.txt");
-
-fn line(n: usize) -> Cell {
-    let t1 = reference_cell("T1").unwrap();
-    let robots = (0..n)
-        .map(|j| RobotSpec {
-            name: format!("R{}", j + 1),
-            placement: Placement { alpha: 0.0, t: Vec3::new(450.0 * j as f64, 0.0, 0.0) },
-            ..t1.robots[0].clone()
-        })
-        .collect();
-    Cell::new(format!("line{n}"), robots, t1.method).unwrap()
-}
+#[path = "../benches/support/line_run.rs"]
+mod line_run;
+use line_run::{line, ticks};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -33,14 +19,7 @@ fn main() {
     let n: usize = args.get(2).map_or(8, |s| s.parse().unwrap());
     let secs: f64 = args.get(3).map_or(5.0, |s| s.parse().unwrap());
     let k: u32 = args.get(4).map_or(32, |s| s.parse().unwrap());
-    let s = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
-    let run: Vec<Vec<Vec3>> = (0..RUN_TICKS)
-        .map(|tick| {
-            let mut pair = [Vec3::zeros(); 2];
-            s.tcps_at(tick, &mut pair);
-            (0..n).map(|j| pair[j % 2]).collect()
-        })
-        .collect();
+    let run = ticks(n);
     let cell = line(n);
     let mut exact = ExactChecker::new(cell.clone());
     let hits: Vec<bool> = run.iter().map(|t| exact.check(t).unwrap().collides()).collect();
