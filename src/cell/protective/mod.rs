@@ -279,6 +279,12 @@ pub struct ProtectiveChecker {
     sweep_tier: alloc::vec::Vec<Option<(u32, u8)>>,
     /// Face terms of no box (fills the unused entries of a box list).
     no_faces: FaceTerms,
+    /// Per robot, each box's sweep by the stop ball alone and its face terms (module doc, step
+    /// 6), for [`ProtectiveChecker::certain_stop`]: built once per reference, not once per
+    /// test (another robot's stay the same through all the speed-limit tests of a tick).
+    least: alloc::vec::Vec<[(Sweep, FaceTerms); MAX_BOXES]>,
+    /// Per robot, whether `least` holds the terms of its current reference.
+    least_set: alloc::vec::Vec<bool>,
     /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
     kept: kept::Kept,
     /// Per robot pair that can meet, what its clearance was at the last tick: where this
@@ -351,6 +357,8 @@ impl ProtectiveChecker {
             reach: alloc::vec![0.0; n],
             sweep_tier: alloc::vec![None; n],
             no_faces,
+            least: alloc::vec![[(Sweep::ZERO, no_faces); MAX_BOXES]; n],
+            least_set: alloc::vec![false; n],
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
             kept,
@@ -788,7 +796,7 @@ impl ProtectiveChecker {
                 *b = b.transformed(&rot, &t);
             }
         }
-        (self.centres[j], self.reach[j], self.sweep_tier[j]) = (centre, radius, None);
+        (self.centres[j], self.reach[j], self.sweep_tier[j], self.least_set[j]) = (centre, radius, None, false);
         s
     }
 
@@ -828,27 +836,17 @@ impl ProtectiveChecker {
     /// prove apart: every sweep of a lower link, platform or tool box holds the ball of the
     /// TCP's stopping radius (module doc, step 6), so when the reference boxes swept by those
     /// balls alone are not proved apart, neither are they with the full sweeps.
-    fn certain_stop(&self, only: Option<usize>) -> Option<BoxPair> {
-        let least = |j: usize, k: usize| {
-            let moves_with_tcp = !matches!(self.exact.cell().robots[j].model.box_kind(k), BoxKind::UpperLink(_));
-            Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO }
-        };
-        // Each box's sweep and face terms once per robot, not once per box pair: the same test
-        // as `swept_boxes_apart`, which builds both face terms for every pair it is given.
-        let swept = |j: usize| -> [(Sweep, FaceTerms); MAX_BOXES] {
-            let boxes = self.ref_boxes[j].as_slice();
-            core::array::from_fn(|k| match boxes.get(k) {
-                Some(b) => {
-                    let w = least(j, k);
-                    (w, FaceTerms::new(b, &w))
-                }
-                None => (Sweep::ZERO, self.no_faces),
-            })
-        };
-        for p in self.exact.verdict().pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
-            let (swept_a, swept_b) = (swept(p.a), swept(p.b));
-            for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(&swept_a).enumerate() {
-                for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(&swept_b).enumerate() {
+    fn certain_stop(&mut self, only: Option<usize>) -> Option<BoxPair> {
+        for k in 0..self.exact.verdict().pairs.len() {
+            let p = self.exact.verdict().pairs[k];
+            if !only.is_none_or(|j| p.a == j || p.b == j) {
+                continue;
+            }
+            self.set_least(p.a);
+            self.set_least(p.b);
+            let (swept_a, swept_b) = (&self.least[p.a], &self.least[p.b]);
+            for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(swept_a).enumerate() {
+                for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(swept_b).enumerate() {
                     if !swept_boxes_apart_with(box_a, sa, fa, box_b, sb, fb) {
                         return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
                     }
@@ -856,6 +854,22 @@ impl ProtectiveChecker {
             }
         }
         None
+    }
+
+    /// Robot `j`'s terms of [`ProtectiveChecker::certain_stop`] for its current reference, when
+    /// not yet built: each box's sweep and face terms once per robot, not once per box pair
+    /// (the same test as `swept_boxes_apart`, which builds both face terms for every pair).
+    fn set_least(&mut self, j: usize) {
+        if self.least_set[j] {
+            return;
+        }
+        let model = &self.exact.cell().robots[j].model;
+        for (k, (b, slot)) in self.ref_boxes[j].as_slice().iter().zip(&mut self.least[j]).enumerate() {
+            let moves_with_tcp = !matches!(model.box_kind(k), BoxKind::UpperLink(_));
+            let w = Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO };
+            *slot = (w, FaceTerms::new(b, &w));
+        }
+        self.least_set[j] = true;
     }
 
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are: the search
@@ -1044,6 +1058,8 @@ impl ProtectiveChecker {
             }
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
+        // The certain-STOP terms are those of the last speed tested: built again when needed.
+        self.least_set[j] = false;
         self.kept.restore_inside(j, inside);
         // The step is kept only when the limit is the one the steps were taken from.
         let next_step = if limit >= floor { next_step } else { resolution };
