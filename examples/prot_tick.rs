@@ -41,6 +41,8 @@ fn main() {
         let mut tcps = vec![Vec3::zeros(); n];
         let (mut tp, mut te) = (Vec::new(), Vec::new());
         let (mut stops, mut warns) = (0, 0);
+        // The reported speed limits of the first pass (mm/s): their sum and count, for the mean.
+        let (mut limit_sum, mut limit_count) = (0.0, 0u32);
         for rep in 0..repeats * usize::from(std::env::var("COMPONENTS").is_err()) {
             c.reset();
             for tick in 0..RUN_TICKS {
@@ -48,6 +50,12 @@ fn main() {
                 let t0 = Instant::now();
                 let v = c.check(&tcps).unwrap().verdict;
                 let t1 = Instant::now();
+                if rep == 0 && limits {
+                    for r in &c.report().robots {
+                        limit_sum += r.speed_limit_mm_s;
+                        limit_count += 1;
+                    }
+                }
                 std::hint::black_box(exact.check(&tcps).unwrap().collides());
                 let t2 = Instant::now();
                 tp.push((t1 - t0).as_secs_f64() * 1e6);
@@ -93,9 +101,10 @@ fn main() {
             continue;
         }
         let ((pm, p99, pmean), (em, _, _)) = (q(&mut tp), q(&mut te));
+        let mean_limit = if limit_count > 0 { format!(", mean speed limit {:.1} mm/s", limit_sum / limit_count as f64) } else { String::new() };
         println!(
             "{} {}: STOP {stops} WARN {warns}; protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, \
-             exact median {em:.3} us",
+             exact median {em:.3} us{mean_limit}",
             s.cell, s.case
         );
     }
