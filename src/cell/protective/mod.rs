@@ -714,7 +714,8 @@ impl ProtectiveChecker {
                     (None, None)
                 };
                 if let (Some(la), Some(lb)) = least {
-                    let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
+                    let box_a = &self.ref_boxes[p.a].as_slice()[p.box_a];
+                    let box_b = &self.ref_boxes[p.b].as_slice()[p.box_b];
                     if !pair_apart_in_some_form(box_a, [&la[0], &la[1]], box_b, [&lb[0], &lb[1]], extra) {
                         break;
                     }
