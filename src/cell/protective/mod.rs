@@ -904,7 +904,9 @@ impl ProtectiveChecker {
             for corner in [centre + toward, centre - toward] {
                 let Ok(at) = d.inverse_kinematics_cos_sin(&corner) else { continue };
                 let theta = at.sin[i].atan2(at.cos[i]);
-                if !((theta - theta0).abs() <= core::f64::consts::FRAC_PI_2) {
+                // A NaN is not close either: nothing learned.
+                let close = (theta - theta0).abs() <= core::f64::consts::FRAC_PI_2;
+                if !close {
                     return None;
                 }
                 (lo, hi) = (lo.min(theta + ANGLE_SLACK), hi.max(theta - ANGLE_SLACK));
