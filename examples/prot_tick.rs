@@ -41,6 +41,12 @@ fn main() {
         let mut tcps = vec![Vec3::zeros(); n];
         let (mut tp, mut te) = (Vec::new(), Vec::new());
         let (mut stops, mut warns) = (0, 0);
+        // The reported speed limits of the first pass (mm/s): their sum and count, for the mean.
+        let (mut limit_sum, mut limit_count) = (0.0, 0u32);
+        // The first pass's verdicts and limiting pairs, tick by tick, hashed (FNV-1a): equal
+        // hashes say two builds gave the same answers; and the first WARN and STOP ticks.
+        let mut answers: u64 = 0xcbf2_9ce4_8422_2325;
+        let (mut first_warn, mut first_stop) = (None, None);
         for rep in 0..repeats * usize::from(std::env::var("COMPONENTS").is_err()) {
             c.reset();
             for tick in 0..RUN_TICKS {
@@ -48,11 +54,24 @@ fn main() {
                 let t0 = Instant::now();
                 let v = c.check(&tcps).unwrap().verdict;
                 let t1 = Instant::now();
+                if rep == 0 && limits {
+                    for r in &c.report().robots {
+                        limit_sum += r.speed_limit_mm_s;
+                        limit_count += 1;
+                    }
+                }
                 std::hint::black_box(exact.check(&tcps).unwrap().collides());
                 let t2 = Instant::now();
                 tp.push((t1 - t0).as_secs_f64() * 1e6);
                 te.push((t2 - t1).as_secs_f64() * 1e6);
                 if rep == 0 {
+                    let r = c.report();
+                    let limiting = r.limiting.map_or(0, |p| 1 + p.a * 1000 + p.b * 100 + p.box_a * 10 + p.box_b);
+                    for x in [v as u64, limiting as u64] {
+                        answers = (answers ^ x).wrapping_mul(0x0100_0000_01b3);
+                    }
+                    first_warn = first_warn.or((v == Protective::Warn).then_some(tick));
+                    first_stop = first_stop.or((v == Protective::Stop).then_some(tick));
                     stops += (v == Protective::Stop) as u32;
                     warns += (v == Protective::Warn) as u32;
                 }
@@ -93,9 +112,14 @@ fn main() {
             continue;
         }
         let ((pm, p99, pmean), (em, _, _)) = (q(&mut tp), q(&mut te));
+        let mean_limit = match limit_count {
+            0 => String::new(),
+            n => format!(", mean speed limit {:.1} mm/s", limit_sum / n as f64),
+        };
         println!(
             "{} {}: STOP {stops} WARN {warns}; protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, \
-             exact median {em:.3} us",
+             exact median {em:.3} us{mean_limit}; first WARN {first_warn:?} STOP {first_stop:?}, \
+             answers {answers:016x}",
             s.cell, s.case
         );
     }

@@ -56,6 +56,24 @@
 //!    swept by those balls (radii shrunk by a relative 1e-9, far above rounding), it cannot
 //!    separate them with the real sweeps of any tier: STOP at once, without inverse
 //!    kinematics.
+//! 7. **Certain STOP, before tier 2.** Every tier's enclosure of an arm's angle over the cube
+//!    holds the angle `th(p)` of every reachable TCP `p` of the cube, whichever points are
+//!    picked: here its centre `p0` and the two corners `p0 +- S sign(w)` (`w = E_i - G_i`, the
+//!    lower link of the box's arm at `p0`: the gradient of `th_i` is parallel to `w`, so
+//!    these corners are where the angle is largest and smallest to first order), those that
+//!    are reachable. Step 4's sweep of a box depends on the enclosure only through its arm's
+//!    `dth = max(th.hi - th(p0), th(p0) - th.lo)`, and grows with it on every axis (the
+//!    elbow's chord `2 rf sin(dth / 2)`, the arc's `sin dth` and `1 - cos dth`, all
+//!    increasing on `[0, pi]`; the TCP terms do not depend on it). So the sweeps built from
+//!    the hull of those angles alone ([`ProtectiveChecker::least_sweeps`]: each angle taken
+//!    `ANGLE_SLACK` toward `th(p0)`, far above the rounding of the inverse kinematics, and
+//!    each ball shrunk by `LEAST_SLACK`, far above the rounding of the supports, which stay
+//!    `>= 0`: every ball holds `BOUND_SLACK`) have, on every axis and in both forms, a support
+//!    at most that of the sweeps of any tier. When they do not prove the limiting box pair of
+//!    tier 1 apart (with `warn_mm` for a WARN), no refinement of tier 2 proves it: the pairs
+//!    before it stay proved (a narrower angle range, a smaller sweep), it stays the first
+//!    unproved one, and the verdict and limiting pair are final without tier 2's direct
+//!    enclosures. This test only ends a search for a proof; it never proves anything.
 //!
 //! The **speed limit** of a robot is the largest measured speed `|v_fd|` in `[0, v_max]` at
 //! which every pair involving it is still proved, the other robots as they are: bisection to
@@ -91,6 +109,7 @@
 use crate::cell::exact::PairVerdict;
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::cspace::guarantee::{cube_box_sweeps, cube_box_sweeps_with, theta_range, Enclosure};
+use crate::cspace::interval::Interval;
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
 use crate::geometry::sweep::{swept_boxes_apart_with, FaceTerms};
 use crate::robot::MAX_BOXES;
@@ -129,6 +148,15 @@ pub const LIMIT_STEPS: u32 = 8;
 /// per robot, by default ([`ProtectiveChecker::with_limit_tests`]); one test costs about as
 /// much as one robot's sweeps and their swept-box proof.
 pub const DEFAULT_EXTRA_LIMIT_TESTS: u32 = 1;
+
+/// How far (rad) each sampled motor angle of [`ProtectiveChecker::least_sweeps`] is taken
+/// toward the centre's: far above the rounding of the inverse kinematics, even near the edge of
+/// the workspace, where the angle's error is about the square root of the machine epsilon.
+const ANGLE_SLACK: Real = 1e-6;
+
+/// How much (mm) the balls of [`ProtectiveChecker::least_sweeps`] are shrunk: far above the
+/// rounding of a support (about `1e-13 |n|`), far below the `BOUND_SLACK` every ball holds.
+const LEAST_SLACK: Real = 1e-9;
 
 /// Relative and absolute slack of the plausibility checks: rounding of the caller's own
 /// trajectory arithmetic must not read as an impossible motion.
@@ -279,6 +307,12 @@ pub struct ProtectiveChecker {
     sweep_tier: alloc::vec::Vec<Option<(u32, u8)>>,
     /// Face terms of no box (fills the unused entries of a box list).
     no_faces: FaceTerms,
+    /// Per robot, each box's sweep by the stop ball alone and its face terms (module doc, step
+    /// 6), for [`ProtectiveChecker::certain_stop`]: built once per reference, not once per
+    /// test (another robot's stay the same through all the speed-limit tests of a tick).
+    least: alloc::vec::Vec<[(Sweep, FaceTerms); MAX_BOXES]>,
+    /// Per robot, whether `least` holds the terms of its current reference.
+    least_set: alloc::vec::Vec<bool>,
     /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
     kept: kept::Kept,
     /// Per robot pair that can meet, what its clearance was at the last tick: where this
@@ -351,6 +385,8 @@ impl ProtectiveChecker {
             reach: alloc::vec![0.0; n],
             sweep_tier: alloc::vec![None; n],
             no_faces,
+            least: alloc::vec![[(Sweep::ZERO, no_faces); MAX_BOXES]; n],
+            least_set: alloc::vec![false; n],
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
             kept,
@@ -670,8 +706,26 @@ impl ProtectiveChecker {
             // arms of the limiting pair are refined until it is proved or both are refined
             // (then the full tier 2 fails on it too: the same verdict and limiting pair, as a
             // pair proved with fewer arms refined stays proved with more).
+            // A limiting pair that the sweeps of the angles sampled in the cube cannot prove
+            // apart, no tier can (module doc, step 7): the verdict stands.
             let splits = self.precise_splits;
+            // Tried on tier 1's limiting pair only: a pair that tier 2 proved is followed by
+            // another mostly when tier 2 proves that one too.
+            let mut first = true;
             while let (Some(p), true) = (self.report.limiting, splits > 0) {
+                let extra = if self.report.verdict == Protective::Warn { self.warn_mm } else { 0.0 };
+                let least = if core::mem::take(&mut first) {
+                    (self.least_sweeps(p.a, p.box_a), self.least_sweeps(p.b, p.box_b))
+                } else {
+                    (None, None)
+                };
+                if let (Some(la), Some(lb)) = least {
+                    let box_a = &self.ref_boxes[p.a].as_slice()[p.box_a];
+                    let box_b = &self.ref_boxes[p.b].as_slice()[p.box_b];
+                    if !pair_apart_in_some_form(box_a, [&la[0], &la[1]], box_b, [&lb[0], &lb[1]], extra) {
+                        break;
+                    }
+                }
                 let (arms_a, arms_b) = (self.arm_bit(p.a, p.box_a), self.arm_bit(p.b, p.box_b));
                 let refined = |me: &Self, j: usize| match me.tables[j] {
                     None => 0b111,
@@ -794,7 +848,7 @@ impl ProtectiveChecker {
                 *b = b.transformed(&rot, &t);
             }
         }
-        (self.centres[j], self.reach[j], self.sweep_tier[j]) = (centre, radius, None);
+        (self.centres[j], self.reach[j], self.sweep_tier[j], self.least_set[j]) = (centre, radius, None, false);
         s
     }
 
@@ -830,31 +884,62 @@ impl ProtectiveChecker {
         self.sweep_tier[j] = Some((tier, arms));
     }
 
+    /// The sweep of robot `j`'s box `k` about its reference ball (both forms, WCS) from the
+    /// motor angles of the centre and of the two corners of the cube along the gradient of
+    /// its arm's angle alone, each angle `ANGLE_SLACK` toward the centre's and each ball
+    /// `LEAST_SLACK` smaller: on every axis no larger than the sweeps of any tier (module doc,
+    /// step 7). `None` when the centre is unreachable or a corner's angle lies more than a
+    /// right angle from the centre's (a range across the branch cut at `+-pi`, which no motor
+    /// limit of a Delta robot allows): nothing learned.
+    fn least_sweeps(&self, j: usize, k: usize) -> Option<[Sweep; 2]> {
+        let robot = &self.exact.cell().robots[j];
+        let d = &robot.model.delta;
+        let (centre, s) = (self.centres[j], self.reach[j]);
+        let at_centre = d.inverse_kinematics_cos_sin(&centre).ok()?;
+        // Box `k`'s sweep depends on its own arm's range alone; the others' are not read.
+        let mut th = [Enclosure::Range(Interval::point(0.0)); 3];
+        if let BoxKind::LowerLink(arm) | BoxKind::UpperLink(arm) = robot.model.box_kind(k) {
+            let i = arm as usize;
+            let theta0 = at_centre.sin[i].atan2(at_centre.cos[i]);
+            // `w = E_i - G_i`: the platform joint `p + e u_i` less the elbow
+            // `(f + rf cos th) u_i - rf sin th z`.
+            let u = crate::robot::delta3::radial(i);
+            let w = centre + u * (d.e - d.f - d.rf * at_centre.cos[i]) + Vec3::z() * (d.rf * at_centre.sin[i]);
+            let toward = w.map(|x| if x < 0.0 { -s } else { s });
+            let (mut lo, mut hi) = (theta0, theta0);
+            for corner in [centre + toward, centre - toward] {
+                let Ok(at) = d.inverse_kinematics_cos_sin(&corner) else { continue };
+                let theta = at.sin[i].atan2(at.cos[i]);
+                // A NaN is not close either: nothing learned.
+                let close = (theta - theta0).abs() <= core::f64::consts::FRAC_PI_2;
+                if !close {
+                    return None;
+                }
+                (lo, hi) = (lo.min(theta + ANGLE_SLACK), hi.max(theta - ANGLE_SLACK));
+            }
+            th[i] = Enclosure::Range(Interval::new(lo, hi));
+        }
+        let sweeps = cube_box_sweeps_with(&robot.model, &centre, s, &centre, |_, _| th)?;
+        let mut out = [[Sweep::ZERO; MAX_BOXES]; 2];
+        write_forms(&mut out, Some(sweeps), &robot.placement.rotation(), s);
+        Some(out.map(|form| Sweep { ball: (form[k].ball - LEAST_SLACK).max(0.0), ..form[k] }))
+    }
+
     /// A box pair (of the pairs involving `only`, or of all) that no sweeps of any tier can
     /// prove apart: every sweep of a lower link, platform or tool box holds the ball of the
     /// TCP's stopping radius (module doc, step 6), so when the reference boxes swept by those
     /// balls alone are not proved apart, neither are they with the full sweeps.
-    fn certain_stop(&self, only: Option<usize>) -> Option<BoxPair> {
-        let least = |j: usize, k: usize| {
-            let moves_with_tcp = !matches!(self.exact.cell().robots[j].model.box_kind(k), BoxKind::UpperLink(_));
-            Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO }
-        };
-        // Each box's sweep and face terms once per robot, not once per box pair: the same test
-        // as `swept_boxes_apart`, which builds both face terms for every pair it is given.
-        let swept = |j: usize| -> [(Sweep, FaceTerms); MAX_BOXES] {
-            let boxes = self.ref_boxes[j].as_slice();
-            core::array::from_fn(|k| match boxes.get(k) {
-                Some(b) => {
-                    let w = least(j, k);
-                    (w, FaceTerms::new(b, &w))
-                }
-                None => (Sweep::ZERO, self.no_faces),
-            })
-        };
-        for p in self.exact.verdict().pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
-            let (swept_a, swept_b) = (swept(p.a), swept(p.b));
-            for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(&swept_a).enumerate() {
-                for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(&swept_b).enumerate() {
+    fn certain_stop(&mut self, only: Option<usize>) -> Option<BoxPair> {
+        for k in 0..self.exact.verdict().pairs.len() {
+            let p = self.exact.verdict().pairs[k];
+            if !only.is_none_or(|j| p.a == j || p.b == j) {
+                continue;
+            }
+            self.set_least(p.a);
+            self.set_least(p.b);
+            let (swept_a, swept_b) = (&self.least[p.a], &self.least[p.b]);
+            for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(swept_a).enumerate() {
+                for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(swept_b).enumerate() {
                     if !swept_boxes_apart_with(box_a, sa, fa, box_b, sb, fb) {
                         return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
                     }
@@ -862,6 +947,22 @@ impl ProtectiveChecker {
             }
         }
         None
+    }
+
+    /// Robot `j`'s terms of [`ProtectiveChecker::certain_stop`] for its current reference, when
+    /// not yet built: each box's sweep and face terms once per robot, not once per box pair
+    /// (the same test as `swept_boxes_apart`, which builds both face terms for every pair).
+    fn set_least(&mut self, j: usize) {
+        if self.least_set[j] {
+            return;
+        }
+        let model = &self.exact.cell().robots[j].model;
+        for (k, (b, slot)) in self.ref_boxes[j].as_slice().iter().zip(&mut self.least[j]).enumerate() {
+            let moves_with_tcp = !matches!(model.box_kind(k), BoxKind::UpperLink(_));
+            let w = Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO };
+            *slot = (w, FaceTerms::new(b, &w));
+        }
+        self.least_set[j] = true;
     }
 
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are: the search
@@ -1050,6 +1151,8 @@ impl ProtectiveChecker {
             }
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
+        // The certain-STOP terms are those of the last speed tested: built again when needed.
+        self.least_set[j] = false;
         self.kept.restore_inside(j, inside);
         // The step is kept only when the limit is the one the steps were taken from.
         let next_step = if limit >= floor { next_step } else { resolution };
@@ -1160,6 +1263,12 @@ fn stop_sweeps_wcs_into(
         }),
         None => cube_box_sweeps(model, tcp_mcs, s, tcp_mcs, SPLITS),
     };
+    write_forms(out, sweeps, rot_wcs, s);
+}
+
+/// Both forms of `sweeps` (MCS) rotated to the WCS with `rot_wcs`, the TCP's cube term traded
+/// for the ball of radius `s` in the second; infinite balls when `None`.
+fn write_forms(out: &mut SweepForms, sweeps: Option<[Sweep; MAX_BOXES]>, rot_wcs: &crate::math::Mat3, s: Real) {
     match sweeps {
         Some(sweeps) => {
             // The TCP's own displacement lies in the ball of radius `s` (widened as the cube
@@ -1209,6 +1318,17 @@ fn first_unproved<'a>(
         }
     }
     None
+}
+
+/// Whether box `a` swept by `sa` (one per form, `extra` mm added to its ball) and box `b`
+/// swept by `sb` are proved apart in some combination of forms ([`first_unproved_between`]'s
+/// test for one box pair).
+fn pair_apart_in_some_form(a: &Obb, sa: [&Sweep; 2], b: &Obb, sb: [&Sweep; 2], extra: Real) -> bool {
+    let sa = sa.map(|w| Sweep { ball: w.ball + extra, ..*w });
+    let (fa, fb) = (sa.map(|w| FaceTerms::new(a, &w)), sb.map(|w| FaceTerms::new(b, w)));
+    [(0, 0), (1, 1), (0, 1), (1, 0)]
+        .iter()
+        .any(|&(i, k)| swept_boxes_apart_with(a, &sa[i], &fa[i], b, sb[k], &fb[k]))
 }
 
 /// One robot's boxes, their sweeps, and the face terms of each box under each sweep form.
