@@ -176,7 +176,7 @@ pub(super) fn sub_octants_prove_free(
 ///   sub-octant pair holding them is tried.
 ///
 /// It only skips tests whose answers it predicts; a "not free" is never a wrong answer.
-fn meet_at_references(x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize) -> bool {
+pub(super) fn meet_at_references(x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize) -> bool {
     let (i, j) = (ea * x.per_entry + bit / 8, eb * y.per_entry + bit % 8);
     separating_axis(&x.boxes[i].obb, &y.boxes[j].obb).is_none()
 }
