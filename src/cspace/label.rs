@@ -24,7 +24,8 @@ use crate::cspace::guarantee::thesis_margin;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::sat::separating_axis;
-use crate::geometry::sweep::{swept_aabb_half, swept_boxes_apart_with, FaceTerms, Sweep};
+use crate::cspace::swept_sat::{swept_apart, SweptFrame};
+use crate::geometry::sweep::{swept_aabb_half, Sweep};
 use crate::robot::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{max_or_nan, min_or_nan, Mat3, Real, Vec3};
@@ -119,8 +120,8 @@ pub struct SweptBox {
     pub sweep: Sweep,
     /// Whether `sweep` is [`Sweep::is_zero`] (an exact box: the separating axis test).
     pub exact: bool,
-    /// Its terms of the swept test on its own face axes.
-    pub faces: FaceTerms,
+    /// What the swept test reads of it ([`crate::cspace::swept_sat`]).
+    pub frame: SweptFrame,
 }
 
 impl SweptBox {
@@ -134,7 +135,7 @@ impl SweptBox {
             obb: b,
             sweep,
             exact: sweep.is_zero(),
-            faces: FaceTerms::new(&b, &sweep),
+            frame: SweptFrame::new(&b, &sweep),
         }
     }
 }
@@ -244,7 +245,8 @@ pub(crate) fn entries_apart(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usi
 
 /// Whether box `i` of A (index into `a.boxes`) and box `j` of B may intersect: not proved
 /// apart by their AABBs, nor by the separating axis test (exact boxes) or its swept form
-/// ([`crate::geometry::swept_boxes_apart`]).
+/// ([`crate::cspace::swept_sat::swept_apart`], the 15 axes of
+/// [`crate::geometry::swept_boxes_apart`] written in A's frame).
 #[inline]
 pub(crate) fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usize) -> bool {
     let (x, y) = (&a.boxes[i], &b.boxes[j]);
@@ -254,7 +256,7 @@ pub(crate) fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usi
     if x.exact && y.exact {
         separating_axis(&x.obb, &y.obb).is_none()
     } else {
-        !swept_boxes_apart_with(&x.obb, &x.sweep, &x.faces, &y.obb, &y.sweep, &y.faces)
+        !swept_apart(&x.obb, &x.frame, &x.sweep, &y.obb, &y.frame, &y.sweep)
     }
 }
 

@@ -179,22 +179,32 @@ pub fn build_table(
     Ok((header, table, report))
 }
 
-/// As [`build_table`] within about `max_memory` bytes ([`crate::table::memory`]): the same
-/// table; a subdivided table is built streaming its sub-cells by blocks of the quadtree,
+/// What [`build_table_bounded`] builds, and within how much memory.
+#[derive(Clone, Copy, Debug)]
+pub struct BoundedBuild {
+    /// Cells per axis of each robot's grid (a power of two).
+    pub k: u32,
+    /// The sampled workspace.
+    pub ws: Workspace,
+    /// The table built.
+    pub variant: Variant,
+    /// How the sample pairs are labelled.
+    pub labelling: Labelling,
+    /// Progress reports of the labelling.
+    pub progress: Progress,
+    /// About how many bytes the build may use ([`crate::table::memory`]).
+    pub max_memory: u64,
+}
+
+/// As [`build_table`] within about `build.max_memory` bytes ([`crate::table::memory`]): the
+/// same table; a subdivided table is built streaming its sub-cells by blocks of the quadtree,
 /// found as each block is built and dropped after it.
 ///
 /// # Errors
 /// As [`build_table`], and [`BuildError::Memory`] when the fixed part of the build alone
-/// needs more than `max_memory`, before anything big is allocated.
-pub fn build_table_bounded(
-    cell: &Cell,
-    k: u32,
-    ws: &Workspace,
-    variant: Variant,
-    labelling: Labelling,
-    progress: Progress,
-    max_memory: u64,
-) -> Result<(Header, Table, BuildReport), BuildError> {
+/// needs more than `build.max_memory`, before anything big is allocated.
+pub fn build_table_bounded(cell: &Cell, build: &BoundedBuild) -> Result<(Header, Table, BuildReport), BuildError> {
+    let BoundedBuild { k, ref ws, variant, labelling, progress, max_memory } = *build;
     let plan = memory_plan(cell, k, ws, variant, max_memory)?;
     if variant != Variant::SharedSubdivided || labelling != Labelling::Certified {
         return build_table(cell, k, ws, variant, labelling, progress);

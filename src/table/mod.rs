@@ -47,7 +47,8 @@ use alloc::{format, string::String};
 use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
 pub use build::{
-    build_table, build_table_bounded, build_tables, memory_plan, BuildError, BuildReport, Labelling, Variant,
+    build_table, build_table_bounded, build_tables, memory_plan, BoundedBuild, BuildError, BuildReport, Labelling,
+    Variant,
 };
 #[cfg(feature = "std")]
 pub use memory::{parse_bytes, MemoryPlan};

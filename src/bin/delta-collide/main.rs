@@ -35,8 +35,8 @@ use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
-    build_table_bounded, from_bytes, is_bundle, to_bytes, BundleChecker, Confirmation, Labelling, Table, TableAnswer,
-    TableChecker, TableKind, Variant,
+    build_table_bounded, from_bytes, is_bundle, to_bytes, BoundedBuild, BundleChecker, Confirmation, Labelling, Table,
+    TableAnswer, TableChecker, TableKind, Variant,
 };
 use std::io::{BufRead, Write};
 use std::path::Path;
@@ -372,8 +372,8 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
     }
     check_memory(cell, k, &Workspace::THESIS, 1)?;
     let max_memory = args.max_memory.or_else(total_memory).unwrap_or(u64::MAX);
-    let (header, table, r) =
-        build_table_bounded(cell, k, &Workspace::THESIS, variant, labelling, progress, max_memory)?;
+    let build = BoundedBuild { k, ws: Workspace::THESIS, variant, labelling, progress, max_memory };
+    let (header, table, r) = build_table_bounded(cell, &build)?;
     if let (Progress::Rows(_), Some((pairs, secs))) = (progress, r.sub_cells) {
         eprintln!("sub-cells of {pairs} collision pairs: {secs:.2} s");
     }

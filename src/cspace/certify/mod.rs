@@ -399,6 +399,50 @@ mod tests {
         }
     }
 
+    /// Boxes that meet at two octants' reference TCPs ([`meet_at_references`]) are never
+    /// proved disjoint by the swept tests of the octants or of the whole cells that hold
+    /// them: the premise of deciding a sub-cell by them. On T1, T2 and T3 at k = 16, every
+    /// box pair of a spread of pairs of octants.
+    #[test]
+    fn boxes_meeting_at_the_references_are_never_proved_apart() {
+        use crate::cspace::label::boxes_may_touch;
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let (na, nb) = (a0.per_entry, b0.per_entry);
+            let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
+            let (mut met, mut tried) = (0, 0);
+            for ia in (0..a0.len()).step_by(5).filter(|&ia| boxes(&a0, ia)) {
+                for ib in (ia % 7..b0.len()).step_by(7).filter(|&ib| boxes(&b0, ib)) {
+                    if !entries_collide(&a0, ia, &b0, ib) {
+                        continue;
+                    }
+                    for (i, j) in (0..8).flat_map(|i| (0..8).map(move |j| (i, j))) {
+                        let (sa, sb) = (8 * ia + i, 8 * ib + j);
+                        if !boxes(&a1, sa) || !boxes(&b1, sb) {
+                            continue;
+                        }
+                        for p in (0..na).flat_map(|x| (0..nb).map(move |y| 8 * x + y)) {
+                            tried += 1;
+                            if !meet_at_references(&a1, sa, &b1, sb, p) {
+                                continue;
+                            }
+                            met += 1;
+                            let (x, y) = (p / 8, p % 8);
+                            assert!(boxes_may_touch(&a1, sa * na + x, &b1, sb * nb + y), "{name} octants {sa} {sb}");
+                            let (i, j) = (sa * na + x, ib * nb + y);
+                            assert!(boxes_may_touch(&a1, i, &b0, j), "{name} octant {sa}, cell {ib}");
+                            let (i, j) = (ia * na + x, sb * nb + y);
+                            assert!(boxes_may_touch(&a0, i, &b1, j), "{name} cell {ia}, octant {sb}");
+                            assert!(boxes_may_touch(&a0, ia * na + x, &b0, ib * nb + y), "{name} cells {ia} {ib}");
+                        }
+                    }
+                }
+            }
+            assert!(met > 100, "{name}: {met} of {tried} box pairs meet at the references");
+        }
+    }
+
     /// At k = 32, where cores exist, the fast masks ([`sub_cell_masks`]) equal the plain ones on
     /// a spread of pairs whose boxes may meet, among them pairs where each certificate of a
     /// certain intersection (whole cells, A's octant with B's cell, A's cell with B's octant)

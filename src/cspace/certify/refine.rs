@@ -10,6 +10,7 @@ use crate::cspace::label::{
 };
 use crate::cspace::sampler::SampleGrid;
 use crate::cspace::Label;
+use crate::geometry::sat::separating_axis;
 use crate::geometry::sweep::{boxes_overlap_deeply, core};
 use crate::geometry::Obb;
 use crate::math::{max_or_nan, min_or_nan, Real, Vec3};
@@ -129,7 +130,7 @@ pub(super) fn sub_octants_prove_free(
         left != 0 && collision_mask(x, u0, b1, sb, left) & collision_mask(a1, sa, y, v0, left) != 0
     };
     let hinted = x.slot[u0] == Slot::Boxes && y.slot[v0] == Slot::Boxes;
-    if hinted && stays(1 << first) {
+    if hinted && (meet_at_references(x, u0, y, v0, first) || stays(1 << first)) {
         return false;
     }
     let open = open();
@@ -152,6 +153,32 @@ pub(super) fn sub_octants_prove_free(
         }
     }
     true
+}
+
+/// Whether box pair `bit` (as [`collision_mask`]) of A's entry `ea` of `x` and B's entry `eb`
+/// of `y` (both [`Slot::Boxes`]) meets at the entries' reference TCPs: the boxes without their
+/// sweeps, by the plain separating axis test. A cheap answer "may touch" for every test whose
+/// sweeps cover both reference configurations:
+///
+/// - an entry's reference TCP is reachable (a `Boxes` entry's boxes are built there) and lies
+///   in the entry's closed cube ([`reference_point`]), so every sweep made over a cube that
+///   holds it (the entry's own, or a coarser level's whose cube contains the entry's) holds the
+///   zero displacement or the displacement of that configuration: the swept box holds the
+///   box at the reference;
+/// - the plain test finds no axis only when every axis shows a gap of at most its touch
+///   tolerance (1e-9 mm, rounding far below it), so the two boxes at the references are that
+///   close or closer on all 15 axes; the swept test calls an axis separating only for a gap
+///   above [`crate::geometry::sweep::SWEEP_GAP`] = 1e-6 mm between two sets that contain
+///   them, so it finds none either;
+/// - so neither (sub-octant, sub-octant), (sub-octant, octant), (octant, sub-octant) nor
+///   (octant, octant) tests of those cubes prove the box pair disjoint: a sub-cell that holds
+///   both references is a collision whatever level 3 tries, and so is an octant pair whose
+///   sub-octant pair holding them is tried.
+///
+/// It only skips tests whose answers it predicts; a "not free" is never a wrong answer.
+pub(super) fn meet_at_references(x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize) -> bool {
+    let (i, j) = (ea * x.per_entry + bit / 8, eb * y.per_entry + bit % 8);
+    separating_axis(&x.boxes[i].obb, &y.boxes[j].obb).is_none()
 }
 
 /// Per box of `boxes`: its core under its sweep, when its entry has boxes and the core exists.
@@ -304,7 +331,9 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
                 Some(None) => continue,
                 Some(Some(p)) => {
                     hint = p;
-                    if !first_only {
+                    // Both octants' references lie in the sub-cell: their boxes meeting decides
+                        // it (`meet_at_references`), level 3 could not prove it free.
+                    if !first_only && !meet_at_references(a1, sa, b1, sb, p) {
                         let left = || hint_first(open0, p).filter(|&q| open(q)).fold(0u64, |m, q| m | 1 << q);
                         if sub_octants_prove_free(a, b, sa, sb, p, left, &mut hint3) {
                             continue;

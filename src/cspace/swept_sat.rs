@@ -1,0 +1,269 @@
+//! The swept-box separating axis test of the certified labelling, written in A's frame (as
+//! Coal/FCL's `obbDisjoint` writes the plain one): the same 15 axes and the same inequality as
+//! [`crate::geometry::sweep`] (module doc there, "The test"), with the boxes' terms read from
+//! `R = A^T B` and `t = A^T d` instead of from explicit cross products.
+//!
+//! # The terms
+//! For boxes with orthonormal axes `a_k`, `b_k` (columns), half-extents `ha`, `hb`,
+//! `R_ij = a_i . b_j`, `d = c_B - c_A` and `t_k = a_k . d`:
+//! - face axis `a_k`: `|d . a_k| = |t_k|`, A's radius `ha_k`, B's `sum_j hb_j |R_kj|`;
+//! - face axis `b_k`: `|d . b_k|`, A's radius `sum_i ha_i |R_ik|`, B's `hb_k`;
+//! - edge axis `n = a_i x b_j`, `(i, i1, i2)` and `(j, j1, j2)` cyclic: writing `n` in A's
+//!   frame, `a_k . n = b_j . (a_k x a_i)`, which is 0 for `k = i`, `-s R_i2j` for `k = i1` and
+//!   `s R_i1j` for `k = i2`, `s = det(a) = +/-1`. So `|d . n| = |t_i2 R_i1j - t_i1 R_i2j|`,
+//!   A's radius `sum_k ha_k |a_k . n| = ha_i1 |R_i2j| + ha_i2 |R_i1j|`, and likewise B's,
+//!   `hb_j1 |R_ij2| + hb_j2 |R_ij1|`; `|n|^2 = 1 - R_ij^2`. Only the absolute values enter,
+//!   so the handedness `s` of either frame does not matter.
+//!
+//! The sweeps' supports `h_S(n)` are computed from `n` itself (face axes: the axis; edge
+//! axes: the cross product), and only on the axes where the boxes alone come apart.
+//!
+//! # Numerics
+//! The identities above hold for exactly orthonormal frames; the boxes' frames are rotation
+//! matrices to a few units in the last place (about 1e-15), and every dot product rounds by
+//! about as much. Each `|R_ij|` is enlarged by [`R_GUARD`] = 1e-12 before it enters a radius,
+//! which adds at least `1e-12 (ha_i1 + ha_i2 + hb_j1 + hb_j2)` to the radii, and an axis
+//! separates only when its gap exceeds [`SWEEP_GAP`]` |n|` (1e-6 mm along the unit axis) as
+//! in the reference test; edge axes with `|n|^2 < 1e-10` are skipped as there. For boxes and
+//! distances below 1e4 mm the rounding of `|d . n|` and of the radii is below 1e-10 `|n|` mm
+//! (`|n| >= 1e-5` on a tested edge axis), far inside the 1e-6 `|n|` mm gap: an axis called
+//! separating separates the exact swept sets. Face axes use `|n| = 1` (the sweeps' ball term
+//! `c |n|` and the gap are off by `c` or 1e-6 times 1e-15 mm). All of it errs toward "not
+//! apart"; a value that is not finite (NaN) never separates.
+
+use crate::geometry::sweep::{Sweep, SWEEP_GAP};
+use crate::geometry::Obb;
+use crate::math::{float, Real, Vec3};
+
+/// Added to every `|R_ij|` entering a radius (module doc, "Numerics").
+pub const R_GUARD: Real = 1e-12;
+
+/// One swept box as [`swept_apart`] reads it: axes as rows, half-extents, and the sweep's
+/// support on the box's own axes (computed once per box, used by every pair).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SweptFrame {
+    /// `u[k]`: the box's axis `k` (column `k` of [`Obb::axes`]).
+    pub u: [[Real; 3]; 3],
+    /// Half-extents.
+    pub h: [Real; 3],
+    /// `h_S(u[k])`, the sweep's support on axis `k` (as a unit vector).
+    pub face_support: [Real; 3],
+}
+
+impl SweptFrame {
+    /// The frame of box `b` swept by `s`.
+    pub fn new(b: &Obb, s: &Sweep) -> SweptFrame {
+        let m = &b.axes;
+        let u: [[Real; 3]; 3] = core::array::from_fn(|k| [m[(0, k)], m[(1, k)], m[(2, k)]]);
+        SweptFrame { u, h: [b.half.x, b.half.y, b.half.z], face_support: u.map(|n| support(s, &n, 1.0)) }
+    }
+}
+
+#[inline(always)]
+fn dot(u: &[Real; 3], v: &[Real; 3]) -> Real {
+    u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+}
+
+/// `h_S(n)` of the sweep module doc for a vector `n` of length `norm`.
+#[inline(always)]
+fn support(s: &Sweep, n: &[Real; 3], norm: Real) -> Real {
+    let d = |w: &Vec3| (w.x * n[0] + w.y * n[1] + w.z * n[2]).abs();
+    let z = d(&s.cube[0]) + d(&s.cube[1]) + d(&s.cube[2]);
+    let a = d(&s.arc[0]) + d(&s.arc[1]);
+    let [(e1, d1), (e2, d2)] = s.ends;
+    s.ball * norm + (e1 * z + d1 * a).max(e2 * z + d2 * a)
+}
+
+/// Whether an axis with `|d . n| = dn`, boxes' radii summing to `boxes` and length `len`
+/// separates the swept boxes, the sweeps' supports `sweeps()` found only when the boxes
+/// alone come apart by the gap.
+#[inline(always)]
+fn separates(dn: Real, boxes: Real, len: impl Fn() -> Real, sweeps: impl FnOnce(Real) -> Real) -> bool {
+    let apart = dn - boxes;
+    // The boxes alone overlap along the axis (or a value is NaN): not apart.
+    if apart.is_nan() || apart <= 0.0 {
+        return false;
+    }
+    let l = len();
+    let gap = SWEEP_GAP * l;
+    apart > gap && dn - (boxes + sweeps(l)) > gap
+}
+
+/// Whether box `a` (frame `fa`) swept by `sa` and box `b` swept by `sb` are proved disjoint by
+/// one of their 15 axes (module doc); `false` means "not proved". Face axes of A first, then
+/// B's, then the edges, each stopping at the first that separates.
+#[inline]
+pub fn swept_apart(a: &Obb, fa: &SweptFrame, sa: &Sweep, b: &Obb, fb: &SweptFrame, sb: &Sweep) -> bool {
+    let dv = b.center - a.center;
+    let d = [dv.x, dv.y, dv.z];
+    let (ua, ub, ha, hb) = (&fa.u, &fb.u, &fa.h, &fb.h);
+    let mut r = [[0.0; 3]; 3];
+    let mut ar = [[0.0; 3]; 3];
+    let mut t = [0.0; 3];
+    for k in 0..3 {
+        r[k] = [dot(&ua[k], &ub[0]), dot(&ua[k], &ub[1]), dot(&ua[k], &ub[2])];
+        ar[k] = r[k].map(|x| x.abs() + R_GUARD);
+        t[k] = dot(&ua[k], &d);
+        let rb = hb[0] * ar[k][0] + hb[1] * ar[k][1] + hb[2] * ar[k][2];
+        let n = &ua[k];
+        if separates(t[k].abs(), ha[k] + rb, || 1.0, |l| fa.face_support[k] + support(sb, n, l)) {
+            return true;
+        }
+    }
+    for k in 0..3 {
+        let ra = ha[0] * ar[0][k] + ha[1] * ar[1][k] + ha[2] * ar[2][k];
+        let n = &ub[k];
+        if separates(dot(n, &d).abs(), ra + hb[k], || 1.0, |l| support(sa, n, l) + fb.face_support[k]) {
+            return true;
+        }
+    }
+    for i in 0..3 {
+        let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+        for j in 0..3 {
+            let len2 = 1.0 - r[i][j] * r[i][j];
+            // Nearly parallel edges (or a NaN): the axis's direction is not known well enough.
+            if !(len2 >= 1e-10) {
+                continue;
+            }
+            let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+            let dn = (t[i2] * r[i1][j] - t[i1] * r[i2][j]).abs();
+            let boxes = ha[i1] * ar[i2][j] + ha[i2] * ar[i1][j] + hb[j1] * ar[i][j2] + hb[j2] * ar[i][j1];
+            let sweeps = |l: Real| {
+                let (x, y) = (&ua[i], &ub[j]);
+                let n = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+                support(sa, &n, l) + support(sb, &n, l)
+            };
+            if separates(dn, boxes, || float::sqrt(len2), sweeps) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::sat::separating_axis;
+    use crate::geometry::sweep::swept_boxes_apart;
+    use crate::math::Mat3;
+    use proptest::prelude::*;
+
+    fn rot(e: (Real, Real, Real)) -> Mat3 {
+        *nalgebra::Rotation3::from_euler_angles(e.0, e.1, e.2).matrix()
+    }
+
+    fn apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
+        swept_apart(a, &SweptFrame::new(a, sa), sa, b, &SweptFrame::new(b, sb), sb)
+    }
+
+    prop_compose! {
+        fn any_box()(c in prop::array::uniform3(-200.0..200.0f64), e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64),
+                     h in prop::array::uniform3(1.0..120.0f64)) -> Obb {
+            Obb::new(Vec3::from(c), rot(e), Vec3::from(h))
+        }
+    }
+
+    prop_compose! {
+        fn any_sweep()(w in prop::array::uniform3(0.0..20.0f64), e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64),
+                       f in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64), v in prop::array::uniform2(0.0..30.0f64),
+                       ends in prop::array::uniform4(0.0..2.0f64), ball in 0.0..5.0f64) -> Sweep {
+            let (r, q) = (rot(e), rot(f));
+            Sweep {
+                cube: [r.column(0) * w[0], r.column(1) * w[1], r.column(2) * w[2]],
+                arc: [q.column(0) * v[0], q.column(1) * v[1]],
+                ends: [(ends[0], ends[1]), (ends[2], ends[3])],
+                ball,
+            }
+        }
+    }
+
+    /// A point of the displacement set `s` (module doc of `geometry::sweep`), from parameters
+    /// in `[-1, 1]`: one of the two hulled sets, a point of its cube and rectangle, plus a
+    /// point of the ball.
+    fn point_of(s: &Sweep, t: &[Real; 8]) -> Vec3 {
+        let (e, d) = s.ends[usize::from(t[0] >= 0.0)];
+        let z = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3];
+        let a = s.arc[0] * t[4] + s.arc[1] * t[5];
+        let any = Vec3::new(t[5], t[6], t[7]);
+        let ball = if any.norm() > 1.0 { any.normalize() } else { any } * s.ball;
+        z * e + a * d + ball
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// Boxes proved apart stay apart (plain separating axis test) when each is moved by
+        /// any displacement of its set; the proof is symmetric; and it agrees with the 15-axis
+        /// test of `geometry::sweep`, which computes every axis by explicit cross products.
+        #[test]
+        fn apart_boxes_stay_apart_and_agree_with_the_reference_test(a in any_box(), b in any_box(),
+                sa in any_sweep(), sb in any_sweep(),
+                ts in prop::collection::vec(
+                    (prop::array::uniform8(-1.0..1.0f64), prop::array::uniform8(-1.0..1.0f64)), 16)) {
+            let proved = apart(&a, &sa, &b, &sb);
+            prop_assert_eq!(proved, apart(&b, &sb, &a, &sa));
+            prop_assert_eq!(proved, swept_boxes_apart(&a, &sa, &b, &sb));
+            if proved {
+                for (ta, tb) in &ts {
+                    let ma = Obb { center: a.center + point_of(&sa, ta), ..a };
+                    let mb = Obb { center: b.center + point_of(&sb, tb), ..b };
+                    prop_assert!(separating_axis(&ma, &mb).is_some());
+                }
+            }
+        }
+
+        /// Close boxes (centres within 60 mm, so many touch or nearly do): the same answers as
+        /// the reference test, and never "apart" when the boxes at the references meet.
+        #[test]
+        fn close_boxes_agree_with_the_reference_test(a in any_box(), off in prop::array::uniform3(-60.0..60.0f64),
+                e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64), h in prop::array::uniform3(0.5..40.0f64),
+                sa in any_sweep(), sb in any_sweep(), zero in 0..4u8) {
+            let b = Obb::new(a.center + Vec3::from(off), rot(e), Vec3::from(h));
+            let (sa, sb) = match zero { 0 => (Sweep::ZERO, Sweep::ZERO), 1 => (sa, Sweep::ZERO), _ => (sa, sb) };
+            let proved = apart(&a, &sa, &b, &sb);
+            prop_assert_eq!(proved, swept_boxes_apart(&a, &sa, &b, &sb));
+            if separating_axis(&a, &b).is_none() {
+                prop_assert!(!proved);
+            }
+        }
+
+        /// Parallel and touching boxes (same axes up to quarter turns, so that every edge axis
+        /// is degenerate or exact): touching or overlapping boxes are never apart, whatever
+        /// the sweeps; a face gap wider than both sweeps' radii plus 1e-3 mm is.
+        #[test]
+        fn parallel_boxes(e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64), turn in 0..4u8, axis in 0..3usize,
+                ha in prop::array::uniform3(1.0..50.0f64), hb in prop::array::uniform3(1.0..50.0f64),
+                gap in -5.0..5.0f64, sa in any_sweep(), sb in any_sweep()) {
+            let ra = rot(e);
+            let quarter = rot((0.0, 0.0, Real::from(turn) * core::f64::consts::FRAC_PI_2));
+            let rb = ra * quarter;
+            let a = Obb::new(Vec3::new(10.0, -20.0, 30.0), ra, Vec3::from(ha));
+            let b_half = Vec3::from(hb);
+            // B's extent along A's axis `axis`: its half-extents through the quarter turn.
+            let u = ra.column(axis).into_owned();
+            let reach = (0..3).map(|k| b_half[k] * (rb.column(k).dot(&u)).abs()).sum::<Real>();
+            let b = Obb::new(a.center + u * (ha[axis] + reach + gap), rb, b_half);
+            for (sa, sb) in [(Sweep::ZERO, Sweep::ZERO), (sa, Sweep::ZERO), (sa, sb)] {
+                let proved = apart(&a, &sa, &b, &sb);
+                if gap <= 0.0 {
+                    prop_assert!(!proved, "gap {}", gap);
+                }
+                if gap > sa.radius() + sb.radius() + 1e-3 {
+                    prop_assert!(proved, "gap {} radii {} {}", gap, sa.radius(), sb.radius());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn face_touching_boxes_are_not_apart_and_a_gap_is() {
+        let a = Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::new(1.0, 1.0, 1.0));
+        let at = |x: Real| Obb::new(Vec3::new(x, 0.0, 0.0), Mat3::identity(), Vec3::new(1.0, 1.0, 1.0));
+        assert!(!apart(&a, &Sweep::ZERO, &at(2.0), &Sweep::ZERO));
+        assert!(apart(&a, &Sweep::ZERO, &at(2.001), &Sweep::ZERO));
+        let ball = Sweep { ball: 0.01, ..Sweep::ZERO };
+        assert!(!apart(&a, &ball, &at(2.001), &Sweep::ZERO));
+        assert!(apart(&a, &ball, &at(2.02), &Sweep::ZERO));
+    }
+}
