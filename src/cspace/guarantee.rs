@@ -195,6 +195,7 @@ pub fn cube_reachable(delta: &Delta3, c: &Vec3, h: Real) -> bool {
     (0..3).all(|arm| arm_reaches_box(delta, &radial(arm), &tangent(arm), iv(0), iv(1), iv(2)))
 }
 
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // written so that NaN fails the tests
 fn arm_reaches_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> bool {
     // z < 0 everywhere also keeps R^2 >= z^2 > 0.
     if !(z.hi < 0.0) {
@@ -502,6 +503,16 @@ mod tests {
         assert!(ratio <= 1.0);
     }
 
+    /// `n` points of the closed cube of centre `c` and half-side `h`: first the 9^3 lattice
+    /// of quarter steps (every corner, edge and face among them), then random points.
+    fn cube_points(c: &Vec3, h: Real, n: usize, rng: &mut StdRng) -> Vec<Vec3> {
+        let off = |q: usize, rng: &mut StdRng| match q < 729 {
+            true => Vec3::new((q % 9) as Real, (q / 9 % 9) as Real, (q / 81) as Real) / 4.0 - Vec3::repeat(1.0),
+            false => Vec3::from_fn(|_, _| rng.random::<Real>()) * 2.0 - Vec3::repeat(1.0),
+        };
+        (0..n).map(|q| c + off(q, rng) * h).collect()
+    }
+
     /// A cube proved unreachable holds no TCP that the inverse kinematics accepts (dense
     /// lattice and random points, on the cells of k = 32 whose centre is unreachable), and the
     /// proof succeeds for most such cells far from the reachable space.
@@ -518,14 +529,7 @@ mod tests {
                 continue;
             }
             proved += 1;
-            for q in 0..2000 {
-                let off = if q < 729 {
-                    Vec3::new((q % 9) as Real, (q / 9 % 9) as Real, (q / 81) as Real) / 4.0 - Vec3::repeat(1.0)
-                } else {
-                    Vec3::new(rng.random::<Real>(), rng.random::<Real>(), rng.random::<Real>()) * 2.0
-                        - Vec3::repeat(1.0)
-                };
-                let p = c + off * h;
+            for p in cube_points(&c, h, 2000, &mut rng) {
                 assert!(!d.is_reachable(&p), "sample {s}: {p:?} is reachable in a cube proved unreachable");
             }
         }
@@ -554,14 +558,7 @@ mod tests {
                 }
                 proved += 1;
                 assert!(grid.reachable[s], "a cell proved reachable has an unreachable centre");
-                for q in 0..points {
-                    let off = if q < 729 {
-                        Vec3::new((q % 9) as Real, (q / 9 % 9) as Real, (q / 81) as Real) / 4.0 - Vec3::repeat(1.0)
-                    } else {
-                        Vec3::new(rng.random::<Real>(), rng.random::<Real>(), rng.random::<Real>()) * 2.0
-                            - Vec3::repeat(1.0)
-                    };
-                    let p = c + off * h;
+                for p in cube_points(&c, h, points, &mut rng) {
                     assert!(d.is_reachable(&p), "k = {k}, sample {s}: {p:?} unreachable in a cube proved reachable");
                 }
             }

@@ -93,6 +93,7 @@ fn separates(dn: Real, boxes: Real, len: impl Fn() -> Real, sweeps: impl FnOnce(
 /// one of their 15 axes (module doc); `false` means "not proved". Face axes of A first, then
 /// B's, then the edges, each stopping at the first that separates.
 #[inline]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // written so that NaN fails the tests
 pub fn swept_apart(a: &Obb, fa: &SweptFrame, sa: &Sweep, b: &Obb, fb: &SweptFrame, sb: &Sweep) -> bool {
     let dv = b.center - a.center;
     let d = [dv.x, dv.y, dv.z];
@@ -146,48 +147,12 @@ mod tests {
     use super::*;
     use crate::geometry::sat::separating_axis;
     use crate::geometry::sweep::swept_boxes_apart;
+    use crate::geometry::sweep::tests::{any_box, any_sweep, point_of, rot};
     use crate::math::Mat3;
     use proptest::prelude::*;
 
-    fn rot(e: (Real, Real, Real)) -> Mat3 {
-        *nalgebra::Rotation3::from_euler_angles(e.0, e.1, e.2).matrix()
-    }
-
     fn apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
         swept_apart(a, &SweptFrame::new(a, sa), sa, b, &SweptFrame::new(b, sb), sb)
-    }
-
-    prop_compose! {
-        fn any_box()(c in prop::array::uniform3(-200.0..200.0f64), e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64),
-                     h in prop::array::uniform3(1.0..120.0f64)) -> Obb {
-            Obb::new(Vec3::from(c), rot(e), Vec3::from(h))
-        }
-    }
-
-    prop_compose! {
-        fn any_sweep()(w in prop::array::uniform3(0.0..20.0f64), e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64),
-                       f in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64), v in prop::array::uniform2(0.0..30.0f64),
-                       ends in prop::array::uniform4(0.0..2.0f64), ball in 0.0..5.0f64) -> Sweep {
-            let (r, q) = (rot(e), rot(f));
-            Sweep {
-                cube: [r.column(0) * w[0], r.column(1) * w[1], r.column(2) * w[2]],
-                arc: [q.column(0) * v[0], q.column(1) * v[1]],
-                ends: [(ends[0], ends[1]), (ends[2], ends[3])],
-                ball,
-            }
-        }
-    }
-
-    /// A point of the displacement set `s` (module doc of `geometry::sweep`), from parameters
-    /// in `[-1, 1]`: one of the two hulled sets, a point of its cube and rectangle, plus a
-    /// point of the ball.
-    fn point_of(s: &Sweep, t: &[Real; 8]) -> Vec3 {
-        let (e, d) = s.ends[usize::from(t[0] >= 0.0)];
-        let z = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3];
-        let a = s.arc[0] * t[4] + s.arc[1] * t[5];
-        let any = Vec3::new(t[5], t[6], t[7]);
-        let ball = if any.norm() > 1.0 { any.normalize() } else { any } * s.ball;
-        z * e + a * d + ball
     }
 
     proptest! {

@@ -268,7 +268,7 @@ pub fn swept_boxes_always_meet(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::geometry::sat::separating_axis;
     use proptest::prelude::*;
@@ -281,19 +281,19 @@ mod tests {
         }
     }
 
-    fn rot(e: (Real, Real, Real)) -> Mat3 {
+    pub(crate) fn rot(e: (Real, Real, Real)) -> Mat3 {
         *nalgebra::Rotation3::from_euler_angles(e.0, e.1, e.2).matrix()
     }
 
     prop_compose! {
-        fn any_box()(c in prop::array::uniform3(-300.0..300.0f64), e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64),
+        pub(crate) fn any_box()(c in prop::array::uniform3(-300.0..300.0f64), e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64),
                      h in prop::array::uniform3(1.0..150.0f64)) -> Obb {
             Obb::new(Vec3::from(c), rot(e), Vec3::from(h))
         }
     }
 
     prop_compose! {
-        fn any_sweep()(w in prop::array::uniform3(0.0..30.0f64), e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64),
+        pub(crate) fn any_sweep()(w in prop::array::uniform3(0.0..30.0f64), e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64),
                        f in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64), v in prop::array::uniform2(0.0..40.0f64),
                        ends in prop::array::uniform4(0.0..2.0f64), ball in 0.0..10.0f64) -> Sweep {
             let (r, q) = (rot(e), rot(f));
@@ -306,8 +306,9 @@ mod tests {
         }
     }
 
-    /// A point of the displacement set `s`, from parameters in `[-1, 1]`.
-    fn point_of(s: &Sweep, t: &[Real; 8]) -> Vec3 {
+    /// A point of the displacement set `s` (module doc), from parameters in `[-1, 1]`: one of
+    /// the two hulled sets, a point of its cube and rectangle, plus a point of the ball.
+    pub(crate) fn point_of(s: &Sweep, t: &[Real; 8]) -> Vec3 {
         let k = if t[0] < 0.0 { 0 } else { 1 };
         let (e, d) = s.ends[k];
         let z = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3];
