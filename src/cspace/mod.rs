@@ -17,6 +17,7 @@ pub(crate) mod interval;
 #[cfg(feature = "std")]
 pub(crate) mod label;
 pub mod sampler;
+#[cfg(feature = "std")]
 pub(crate) mod swept_sat;
 pub mod symmetry;
 

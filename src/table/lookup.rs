@@ -13,6 +13,7 @@
 
 use crate::cell::exact::PairState;
 use crate::cell::{Cell, ExactChecker, QueryError};
+#[cfg(feature = "std")]
 use crate::cspace::guarantee::cube_reachable;
 use crate::cspace::symmetry::reflection_y;
 use crate::cspace::SampleGrid;
@@ -117,10 +118,19 @@ impl CellSet {
     }
 
     /// The sampled cells of which every TCP is proved reachable by `delta`
-    /// ([`cube_reachable`]), so that a TCP found in one needs no inverse kinematics.
+    /// (`cspace::guarantee::cube_reachable`), so that a TCP found in one needs no inverse
+    /// kinematics.
+    #[cfg(feature = "std")]
     fn reachable(grid: &SampleGrid, delta: &Delta3) -> Self {
         let h = 0.5 * grid.r;
         CellSet::new(grid.k, grid.cells.iter().filter(|c| cube_reachable(delta, &grid.center(**c), h)))
+    }
+
+    /// Without `std` there is no interval arithmetic to prove a cell: none is, and every TCP
+    /// takes the inverse kinematics.
+    #[cfg(not(feature = "std"))]
+    fn reachable(grid: &SampleGrid, _delta: &Delta3) -> Self {
+        CellSet::new(grid.k, core::iter::empty())
     }
 
     fn contains(&self, c: [u16; 3]) -> bool {
@@ -281,8 +291,8 @@ impl TableChecker {
 
     /// Robot `j`'s TCP (its own MCS) located: `None` when it is unreachable or not finite
     /// ([`Delta3::is_reachable`]), else [`TableChecker::cell_of`]. A TCP in a grid cell proved
-    /// wholly reachable ([`cube_reachable`], whose margins make `is_reachable` accept every
-    /// TCP of the cell) skips the inverse kinematics.
+    /// wholly reachable (`cspace::guarantee::cube_reachable`, whose margins make
+    /// `is_reachable` accept every TCP of the cell) skips the inverse kinematics.
     pub(crate) fn locate(&self, j: usize, tcp: &Vec3) -> Option<Option<[u16; 3]>> {
         let cell = self.cell_of(j, tcp);
         let proved = cell.is_some_and(|c| self.reachable[j].contains(c.map(|v| v >> self.sub_levels)));

@@ -332,7 +332,7 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
                 Some(Some(p)) => {
                     hint = p;
                     // Both octants' references lie in the sub-cell: their boxes meeting decides
-                        // it (`meet_at_references`), level 3 could not prove it free.
+                    // it (`meet_at_references`), level 3 could not prove it free.
                     if !first_only && !meet_at_references(a1, sa, b1, sb, p) {
                         let left = || hint_first(open0, p).filter(|&q| open(q)).fold(0u64, |m, q| m | 1 << q);
                         if sub_octants_prove_free(a, b, sa, sb, p, left, &mut hint3) {
