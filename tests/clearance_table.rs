@@ -105,14 +105,18 @@ impl Tally {
 }
 
 /// Both tables of `cell` at [`K`] from one labelling, loaded through their file bytes:
-/// the clearance table and the boolean shared table.
+/// the clearance table and the boolean shared table. The clearance file is at most 3x the
+/// boolean one (the size target of clearance tables).
 fn checkers(cell: &Cell, ladder: Ladder) -> (TableChecker, TableChecker) {
     let variants = [Variant::Clearance(ladder), Variant::Shared];
     let (header, tables, _) =
         build_tables(cell, K, &Workspace::THESIS, &variants, Labelling::Certified, Progress::Silent).unwrap();
     assert_eq!(TableKind::of(&tables[0]), TableKind::Clearance);
-    let load = |t: &Table| TableChecker::new(cell.clone(), &to_bytes(t, &header)).unwrap();
-    (load(&tables[0]), load(&tables[1]))
+    let files: Vec<Vec<u8>> = tables.iter().map(|t: &Table| to_bytes(t, &header)).collect();
+    let (clearance, boolean) = (files[0].len(), files[1].len());
+    assert!(clearance <= 3 * boolean, "clearance file {clearance} bytes, boolean {boolean}");
+    let load = |bytes: &[u8]| TableChecker::new(cell.clone(), bytes).unwrap();
+    (load(&files[0]), load(&files[1]))
 }
 
 /// Runs configurations from seed `seed` until `n` have both TCPs reachable, the `i`-th drawn

@@ -3,7 +3,7 @@
 //! `tests/data/` are described in `tests/data/README.md`.
 
 use delta_collide::cspace::{LabelledSpace, Progress, Symmetry, Workspace};
-use delta_collide::table::format::{fnv1a64, from_bytes_for_cell};
+use delta_collide::table::format::{fnv1a64, from_bytes, from_bytes_for_cell};
 use delta_collide::table::synthetic::{space, Pattern};
 use delta_collide::table::*;
 
@@ -167,7 +167,59 @@ fn corrupted_files(s: &LabelledSpace) -> Vec<(&'static str, Vec<u8>, &'static st
     b[at..at + 8].copy_from_slice(&0b1010u64.to_le_bytes());
     reseal(&mut b);
     out.push(("leaf_not_a_level_clearance.dctable", b, "clearance leaf"));
+    // Clearance: packed child indices, the section cut short by one byte (its count too).
+    let mut b = to_bytes(&ts[7], &header(s));
+    let n2 = u64::from_le_bytes(b[176..184].try_into().unwrap());
+    b[176..184].copy_from_slice(&(n2 - 1).to_le_bytes());
+    b.remove(b.len() - 9);
+    reseal(&mut b);
+    out.push(("packed_children_short_clearance.dctable", b, "child indices of"));
     out
+}
+
+/// `bytes` of a clearance table rewritten as files without flag bit 2 hold it: section 2 the
+/// trees' child indices as u32 each.
+fn with_wide_children(bytes: &[u8], t: &ClearanceTable) -> Vec<u8> {
+    let count = |i: usize| u64::from_le_bytes(bytes[160 + 8 * i..168 + 8 * i].try_into().unwrap()) as usize;
+    let start = SECTIONS + 8 * count(0) + 4 * count(1);
+    let (e, l) = t.parts();
+    let mut out = bytes[..start].to_vec();
+    out.extend(e.children.iter().chain(&l.children).flat_map(|c| c.to_le_bytes()));
+    out[176..184].copy_from_slice(&((e.children.len() + l.children.len()) as u64).to_le_bytes());
+    let flags = u32::from_le_bytes(out[28..32].try_into().unwrap());
+    assert_eq!(flags & 4, 4, "the writer packs child indices");
+    out[28..32].copy_from_slice(&(flags & !4).to_le_bytes());
+    out.extend_from_slice(&[0; 8]);
+    reseal(&mut out);
+    out
+}
+
+/// Clearance files pack their child indices (flag bit 2) into fewer bytes; a file holding
+/// them as u32 each (flag clear, as files were first written) loads as the same table, and
+/// so does the kept file `tests/data/clearance_wide_children.dct` written that way, which
+/// the packed writer then writes smaller.
+#[test]
+fn clearance_files_with_packed_or_wide_child_indices_load_alike() {
+    let s = small_space();
+    let t = tables(&s).pop().unwrap();
+    let Table::Clearance(c) = &t else { unreachable!("tables() ends with the clearance table") };
+    let packed = to_bytes(&t, &header(&s));
+    let wide = with_wide_children(&packed, c);
+    assert!(packed.len() < wide.len(), "packed {} bytes, wide {}", packed.len(), wide.len());
+    assert_eq!(from_bytes(&wide).unwrap().1, t);
+    assert_eq!(from_bytes(&packed).unwrap().1, t);
+    let kept_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/clearance_wide_children.dct");
+    let kept = std::fs::read(kept_path).unwrap();
+    let (h, old) = from_bytes(&kept).unwrap();
+    assert_eq!(u32::from_le_bytes(kept[28..32].try_into().unwrap()) & 4, 0, "the kept file is of the wide form");
+    let again = to_bytes(&old, &h);
+    assert!(again.len() < kept.len());
+    assert_eq!(from_bytes(&again).unwrap().1, old);
+    // A wide file whose flags claim packed indices is refused, not misread.
+    let mut claimed = wide.clone();
+    claimed[28] |= 4;
+    reseal(&mut claimed);
+    assert!(matches!(from_bytes(&claimed), Err(TableError::Corrupt { .. })));
 }
 
 #[test]

@@ -10,7 +10,8 @@
 //!     16    4  variant: 6, 5, 4, 7 (the shared 6-D quadtree) or 8 (clearance levels)
 //!     20    4  levels        24  4  k = 2^levels
 //!     28    4  flags: bit 0 = symmetric (reflection, thesis 3.2.8); bit 1 = sub-cells (one
-//!              extra level, variant 7 only); other bits 0
+//!              extra level, variant 7 only); bit 2 = packed child indices (variant 8
+//!              only, set by every writer; files without it hold them as u32); other bits 0
 //!     32    4  slice axes: 0 (6D, 5D), 1 = yy', 2 = zz' (4D)
 //!     36    4  similarity threshold t (0 unless 4D); variant 8: the number n of clearance levels
 //!     40    8  fingerprint of the cell (`Cell::fingerprint`)
@@ -33,7 +34,11 @@
 //!              shift, nodes and leaves of the exact tree, nodes and leaves of the level
 //!              tree (u64 each), then per tree masks then leaves; section 1 = per tree depth
 //!              starts (levels, then levels - shift + 1 entries) then bases; section 2 = per
-//!              tree child indices (the exact tree's: its masks' non-uniform count)
+//!              tree child indices (the exact tree's: its masks' non-uniform count), packed
+//!              (bit 2; section 2's count is then in bytes): each inner depth's indices in
+//!              1, 2 or 4 bytes as what they point into (the next depth's nodes, the leaves
+//!              after the last inner depth) has at most 256, 65,536 or more entries
+//!              (`clearance::child_width`)
 //!    end-8  8  FNV-1a 64 of every byte before it
 //! ```
 //! Loading checks magic, endianness and version first (so those errors are specific), then
@@ -58,6 +63,8 @@ pub const MAGIC: [u8; 8] = *b"DCTABLE\0";
 /// The format version written and read.
 pub const VERSION: u32 = 2;
 const ENDIAN_MARK: u32 = 0x0102_0304;
+/// Flag bit 2: a clearance table's child indices packed (module doc).
+const PACKED_CHILDREN: u32 = 4;
 const HEADER_LEN: usize = 184;
 
 /// How the margin the table was labelled with was obtained (SPEC §6).
@@ -194,19 +201,21 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
             head.extend([u64::from(q.shift()), len(e.masks.len()), len(e.leaves.len()), len(l.masks.len()), len(l.leaves.len())]);
             owned = head.into_iter().chain(tree_words(&e)).chain(tree_words(&l)).collect();
             let aux = e.depth_start.iter().chain(&e.bases).chain(&l.depth_start).chain(&l.bases).copied().collect();
-            let children = e.children.iter().chain(&l.children).flat_map(|c| c.to_le_bytes()).collect();
+            let children = [e.packed_children(), l.packed_children()].concat();
             (0, q.ladder().len() as u32, &owned[..], aux, children)
         }
     };
     let n2 = match variant {
         5 => s2.len() / 2,
-        7 | 8 => s2.len() / 4,
+        7 => s2.len() / 4,
+        8 => s2.len(),
         _ => s2.len() / 8,
     };
     let mut out = Vec::with_capacity(HEADER_LEN + 8 * s0.len() + 4 * s1.len() + s2.len() + 8);
     out.extend_from_slice(&MAGIC);
     let levels = table.levels();
-    let flags = u32::from(table.symmetric()) | table.sub_levels() << 1;
+    let packed = if variant == 8 { PACKED_CHILDREN } else { 0 };
+    let flags = u32::from(table.symmetric()) | table.sub_levels() << 1 | packed;
     for v in [ENDIAN_MARK, VERSION, variant, levels, 1 << levels, flags, axes, t] {
         out.extend_from_slice(&v.to_le_bytes());
     }
@@ -249,6 +258,8 @@ struct Shape {
     levels: u32,
     sub_levels: u32,
     symmetric: bool,
+    /// Variant 8 only: child indices packed (flag bit 2).
+    packed: bool,
     axes: u32,
     t: u32,
 }
@@ -279,9 +290,10 @@ fn read_prefix(r: &mut Reader<TableError>) -> Result<Shape, TableError> {
     if levels == 0 || levels > super::code::MAX_LEVELS || k != 1 << levels {
         return Err(corrupt(format!("levels = {levels}, k = {k}: k must be 2^levels, levels in 1..=8")));
     }
-    if flags > 3 || (flags & 2 != 0 && variant != 7) {
+    if flags > 7 || (flags & 2 != 0 && variant != 7) || (flags & PACKED_CHILDREN != 0 && variant != 8) {
         return Err(corrupt(format!(
-            "flags = {flags:#x}: only bit 0 (symmetric) and, for variant 7, bit 1 (sub-cells) are defined"
+            "flags = {flags:#x}: only bit 0 (symmetric), for variant 7 bit 1 (sub-cells) and for variant 8 bit 2 \
+             (packed child indices) are defined"
         )));
     }
     let rungs = super::clearance::MAX_RUNGS as u32;
@@ -291,7 +303,8 @@ fn read_prefix(r: &mut Reader<TableError>) -> Result<Shape, TableError> {
     if (variant == 4 && !matches!(axes, 1 | 2)) || (!matches!(variant, 4 | 8) && (axes != 0 || t != 0)) {
         return Err(corrupt(format!("variant {variant} with slice axes = {axes}, t = {t}")));
     }
-    Ok(Shape { variant, levels, sub_levels: flags >> 1, symmetric: flags & 1 == 1, axes, t })
+    let (sub_levels, symmetric, packed) = (flags >> 1 & 1, flags & 1 == 1, flags & PACKED_CHILDREN != 0);
+    Ok(Shape { variant, levels, sub_levels, symmetric, packed, axes, t })
 }
 
 fn read_header(r: &mut Reader<TableError>) -> Result<Header, TableError> {
@@ -390,6 +403,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
     let sizes: [usize; 3] = match shape.variant {
         6 => [8, 4, 0],
         5 => [8, 4, 2],
+        8 if shape.packed => [8, 4, 1],
         7 | 8 => [8, 4, 4],
         _ => [8, 4, 8],
     };
@@ -416,7 +430,10 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
         if shape.symmetric {
             check_unstored_half(&shape, &codes)?;
         }
-        let children = words(sections[2], u32::from_le_bytes);
+        let children = match shape.packed {
+            true => Children::Packed(sections[2]),
+            false => Children::Wide(words(sections[2], u32::from_le_bytes)),
+        };
         let table = clearance_from_sections(&shape, &ladder, &counts, codes, aux, children)?;
         return Ok((header, Table::Clearance(alloc::boxed::Box::new(table))));
     }
@@ -476,6 +493,12 @@ fn split_front<T>(v: &mut Vec<T>, n: u64, what: &str) -> Result<Vec<T>, TableErr
     }
 }
 
+/// A clearance table's section 2: child indices packed (flag bit 2) or u32 each.
+enum Children<'a> {
+    Packed(&'a [u8]),
+    Wide(Vec<u32>),
+}
+
 /// The two trees of a clearance table from its sections (module doc: variant 8), `counts`
 /// being shift, nodes and leaves of the exact tree, nodes and leaves of the level tree.
 fn clearance_from_sections(
@@ -484,7 +507,7 @@ fn clearance_from_sections(
     counts: &[u64],
     mut words: Vec<u64>,
     mut aux: Vec<u32>,
-    mut children: Vec<u32>,
+    mut children: Children,
 ) -> Result<ClearanceTable, TableError> {
     let &[shift, nodes_e, leaves_e, nodes_l, leaves_l] = counts else {
         return Err(corrupt("clearance table counts"));
@@ -498,13 +521,22 @@ fn clearance_from_sections(
         let leaves = split_front(&mut words, leaves, what)?;
         let depth_start = split_front(&mut aux, u64::from(depths), what)?;
         let bases = split_front(&mut aux, nodes, what)?;
-        let n_children: u64 = masks.iter().map(|m| u64::from(m[0].count_ones())).sum();
-        let children = split_front(&mut children, n_children, what)?;
+        let children = match &mut children {
+            Children::Packed(bytes) => TreeParts::unpack_children(&masks, &depth_start, leaves.len(), bytes, what)?,
+            Children::Wide(all) => {
+                let n_children: u64 = masks.iter().map(|m| u64::from(m[0].count_ones())).sum();
+                split_front(all, n_children, what)?
+            }
+        };
         Ok(TreeParts { masks, bases, depth_start, children, leaves })
     };
     let exact = tree(nodes_e, leaves_e, shape.levels, "clearance exact tree")?;
     let levels = tree(nodes_l, leaves_l, shape.levels - shift + 1, "clearance level tree")?;
-    if !(words.is_empty() && aux.is_empty() && children.is_empty()) {
+    let children_left = match &children {
+        Children::Packed(bytes) => bytes.len(),
+        Children::Wide(all) => all.len(),
+    };
+    if !(words.is_empty() && aux.is_empty() && children_left == 0) {
         return Err(corrupt("clearance table sections hold more than their two trees"));
     }
     ClearanceTable::from_parts(shape.levels, shape.symmetric, ladder, shift, exact, levels)

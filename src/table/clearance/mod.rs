@@ -38,7 +38,8 @@
 //! [`MAX_RUNGS`] levels, all proved) is kept as 15: 4 bits, and a lower level is always safe.
 //!
 //! Storing a lower level than proved is always safe, so the builder takes the finest `shift`
-//! whose two trees are at most [`SIZE_BUDGET`] times the exact tree's bytes in memory; the
+//! whose two trees are at most [`SIZE_BUDGET`] times the exact tree's bytes, both in memory
+//! and in the file (against the `shared` table's file of the same labels); the
 //! grid is added when the table with it stays within that budget (the same rule on load, so
 //! a file gives the same lookup wherever it is loaded).
 
@@ -196,6 +197,93 @@ impl TreeParts {
         let TreeParts { masks, bases, depth_start, children, leaves } = self;
         SharedQuadtree6d::from_parts(levels, sub_levels, symmetric, masks, bases, depth_start, children, leaves)
     }
+
+    /// The child indices as the file packs them (`format.rs`, variant 8): each inner depth's
+    /// in [`child_width`] of what they point into, little-endian. A level tree's children
+    /// mostly point at its few leaves, one byte each instead of four.
+    pub(crate) fn packed_children(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut children = self.children.iter();
+        for (range, targets) in depth_runs(&self.masks, &self.depth_start, self.leaves.len()).into_iter().flatten() {
+            let width = child_width(targets);
+            for _ in 0..range {
+                let c = children.next().copied().unwrap_or(0);
+                out.extend_from_slice(&c.to_le_bytes()[..width]);
+            }
+        }
+        out
+    }
+
+    /// The inverse of [`packed_children`](Self::packed_children) for a tree whose masks,
+    /// depth starts and leaf count are read: the indices taken from the front of `bytes`.
+    ///
+    /// # Errors
+    /// [`TableError::Corrupt`] when the depth starts do not cover the nodes in order, or
+    /// `bytes` is too short.
+    pub(crate) fn unpack_children(
+        masks: &[[u64; 2]],
+        depth_start: &[u32],
+        leaves: usize,
+        bytes: &mut &[u8],
+        what: &str,
+    ) -> Result<Vec<u32>, TableError> {
+        let runs = depth_runs(masks, depth_start, leaves).ok_or_else(|| {
+            corrupt(format!("{what}: depth starts {depth_start:?} do not cover its {} nodes", masks.len()))
+        })?;
+        let mut out = Vec::new();
+        for (count, targets) in runs {
+            let width = child_width(targets);
+            let n = count.checked_mul(width).filter(|&n| n <= bytes.len()).ok_or_else(|| {
+                let left = bytes.len();
+                corrupt(format!("{what}: {count} child indices of {width} bytes, the section has {left} bytes left"))
+            })?;
+            let (run, rest) = bytes.split_at(n);
+            out.extend(run.chunks_exact(width).map(|c| c.iter().rev().fold(0u32, |v, &b| v << 8 | u32::from(b))));
+            *bytes = rest;
+        }
+        Ok(out)
+    }
+}
+
+/// Bytes of a packed child index that points into `targets` entries: 1 up to 256, 2 up to
+/// 65,536, else 4.
+pub(crate) fn child_width(targets: usize) -> usize {
+    match targets {
+        0..=0x100 => 1,
+        0x101..=0x1_0000 => 2,
+        _ => 4,
+    }
+}
+
+/// Per inner depth: how many child indices its nodes hold (their non-uniform children) and
+/// how many entries those point into (the next depth's nodes; the leaves, for the last inner
+/// depth). `None` when `depth_start` is not `0`, non-decreasing, ending at the node count.
+fn depth_runs(masks: &[[u64; 2]], depth_start: &[u32], leaves: usize) -> Option<Vec<(usize, usize)>> {
+    let starts: Vec<usize> = depth_start.iter().map(|&d| d as usize).collect();
+    let ordered = starts.windows(2).all(|w| w[0] <= w[1]);
+    if starts.len() < 2 || starts[0] != 0 || !ordered || starts[starts.len() - 1] != masks.len() {
+        return None;
+    }
+    let depths = starts.len() - 1;
+    let runs = (0..depths).map(|d| {
+        let count = masks[starts[d]..starts[d + 1]].iter().map(|m| m[0].count_ones() as usize).sum();
+        let targets = if d + 1 < depths { starts[d + 2] - starts[d + 1] } else { leaves };
+        (count, targets)
+    });
+    Some(runs.collect())
+}
+
+/// Bytes a `shared` table file holds for `tree` (`format::to_bytes`): two words per inner
+/// node's masks, a word per leaf, four bytes per depth start, base and child index.
+fn stored_bytes(tree: &SharedQuadtree6d) -> usize {
+    let p = tree.parts();
+    16 * p.masks.len() + 8 * p.leaves.len() + 4 * (p.depth_start.len() + p.bases.len() + p.children.len())
+}
+
+/// As [`stored_bytes`], the child indices packed as a clearance table file holds them.
+fn packed_bytes(tree: &SharedQuadtree6d) -> usize {
+    let p = TreeParts::of(tree);
+    16 * p.masks.len() + 8 * p.leaves.len() + 4 * (p.depth_start.len() + p.bases.len()) + p.packed_children().len()
 }
 
 /// A clearance table (module doc).
@@ -235,7 +323,8 @@ impl ClearanceTable {
         let mut best = None;
         for shift in 0..=levels.saturating_sub(2) {
             let t = Self::build_at(space, counts, ladder, symmetry, exact.clone(), shift)?;
-            let fits = t.memory_bytes() <= SIZE_BUDGET * exact.memory_bytes();
+            let fits = t.memory_bytes() <= SIZE_BUDGET * exact.memory_bytes()
+                && t.stored_bytes() <= SIZE_BUDGET * stored_bytes(&exact);
             best = Some(t);
             if fits {
                 break;
@@ -410,6 +499,12 @@ impl ClearanceTable {
             + self.grid.as_ref().map_or(0, |g| core::mem::size_of_val(g.words.as_slice()))
     }
 
+    /// Bytes the file holds for this table: both trees and the ladder words ahead of them
+    /// (`format::to_bytes`), without the header every table file has.
+    pub fn stored_bytes(&self) -> usize {
+        8 * (self.ladder.len() + 5) + packed_bytes(&self.exact) + packed_bytes(&self.level_tree)
+    }
+
     /// Grid cells per number of proved levels (index 0: no level), over every `k^6` grid
     /// cell (a "don't care" cell counts as what is stored there). Queries every cell: for
     /// reports at small `k`; allocates.
@@ -524,6 +619,40 @@ mod tests {
                 assert_eq!(back, t);
                 let k6 = (1u64 << levels).pow(6);
                 assert_eq!(t.cells_per_level().iter().sum::<u64>(), k6);
+            }
+        }
+    }
+
+    /// The builder takes the finest shift whose table fits the size budget in memory and in
+    /// the file; `stored_bytes` is what the file holds beyond its header and checksum.
+    #[test]
+    fn builds_take_the_finest_shift_that_fits_memory_and_file() {
+        let ladder = Ladder::default_ladder();
+        use crate::table::format::{to_bytes, Certification, Header};
+        use crate::table::Table;
+        // The file less its 192-byte header (no cell parameters) and 8-byte checksum.
+        let sections = |t: Table, s: &crate::cspace::LabelledSpace| {
+            let header = Header::for_space(s, 0, crate::cspace::Workspace::THESIS, Certification::SweptBound);
+            to_bytes(&t, &header).len() - 192 - 8
+        };
+        for (pattern, levels, symmetric) in
+            [(Pattern::Blobs, 4, true), (Pattern::Noise { p: 0.3, seed: 1 }, 4, false), (Pattern::Blobs, 3, false)]
+        {
+            let s = space(levels, pattern);
+            let counts = counts_for(&s, ladder.len());
+            let symmetry = Symmetry::from_flag(symmetric);
+            let exact = SharedQuadtree6d::build(&s, symmetry).unwrap();
+            let fits = |t: &ClearanceTable| {
+                t.memory_bytes() <= SIZE_BUDGET * exact.memory_bytes()
+                    && t.stored_bytes() <= SIZE_BUDGET * stored_bytes(&exact)
+            };
+            let t = ClearanceTable::build(&s, &counts, ladder, symmetry).unwrap();
+            assert_eq!(sections(Table::Clearance(alloc::boxed::Box::new(t.clone())), &s), t.stored_bytes());
+            assert_eq!(sections(Table::Shared(exact.clone()), &s), stored_bytes(&exact));
+            assert!(fits(&t) || t.shift() == levels - 2, "{pattern:?}: shift {} does not fit", t.shift());
+            for finer in 0..t.shift() {
+                let f = ClearanceTable::build_at(&s, &counts, ladder, symmetry, exact.clone(), finer).unwrap();
+                assert!(!fits(&f), "{pattern:?}: shift {finer} fits, finer than {}", t.shift());
             }
         }
     }
