@@ -241,8 +241,10 @@ impl Collider {
                 (DC_STATUS_UNREACHABLE, none)
             }
             Checker::Exact(_) => (DC_STATUS_OK, none),
-            Checker::Table(t) if t.unreachable_mask(&self.tcps) != 0 => (DC_STATUS_UNREACHABLE, none),
-            Checker::Table(t) => (DC_STATUS_OK, t.clearance_bound(&self.tcps).unwrap_or(none)),
+            Checker::Table(t) => match t.located_clearance_bound(&self.tcps) {
+                Ok(bound) => (DC_STATUS_OK, bound.unwrap_or(none)),
+                Err(_) => (DC_STATUS_UNREACHABLE, none),
+            },
             Checker::Bundle(b) if b.unreachable_mask(&self.tcps) != 0 => (DC_STATUS_UNREACHABLE, none),
             Checker::Bundle(_) => (DC_STATUS_OK, none),
         }

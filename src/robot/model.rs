@@ -219,10 +219,8 @@ impl RobotModel {
             }
         }
         // Each optional box read in place: an array of both options would copy them every call.
-        for extra in [&o.platform, &o.tool] {
-            if let Some(extra) = extra {
-                out.push(Obb::new(tcp + extra.offset, Mat3::identity(), extra.half.add_scalar(m)));
-            }
+        for extra in [&o.platform, &o.tool].into_iter().flatten() {
+            out.push(Obb::new(tcp + extra.offset, Mat3::identity(), extra.half.add_scalar(m)));
         }
     }
 

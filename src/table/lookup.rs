@@ -370,10 +370,22 @@ impl TableChecker {
     /// nothing is proved: no level for the cell (it may collide), a TCP unreachable or outside
     /// the table's grid, not two TCPs, or not a clearance table. One lookup, no allocation.
     pub fn clearance_bound(&self, tcps_mcs: &[Vec3]) -> Option<f64> {
-        let table = self.table.as_clearance()?;
-        let [ta, tb] = tcps_mcs else { return None };
-        let (a, b) = (self.locate(0, ta)??, self.locate(1, tb)??);
-        table.bound_mm([a[0], a[1], a[2], b[0], b[1], b[2]])
+        self.table.as_clearance()?;
+        self.located_clearance_bound(tcps_mcs).ok().flatten()
+    }
+
+    /// As [`clearance_bound`](Self::clearance_bound), each TCP located once, with an
+    /// unreachable one told apart: `Err` of [`unreachable_mask`](Self::unreachable_mask)'s
+    /// bits when that is not 0.
+    pub fn located_clearance_bound(&self, tcps_mcs: &[Vec3]) -> Result<Option<f64>, u32> {
+        let cells = [0, 1].map(|j| tcps_mcs.get(j).and_then(|t| self.locate(j, t)));
+        match cells {
+            [Some(a), Some(b)] => {
+                let (Some(a), Some(b), Some(table)) = (a, b, self.table.as_clearance()) else { return Ok(None) };
+                Ok(table.bound_mm([a[0], a[1], a[2], b[0], b[1], b[2]]))
+            }
+            _ => Err(cells.iter().enumerate().fold(0u32, |m, (j, c)| m | u32::from(c.is_none()) << j)),
+        }
     }
 
     /// The exact check's verdict in the table's terms.
