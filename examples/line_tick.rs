@@ -1,7 +1,9 @@
 //! Profiling aid: replays T1 practical on a line of `n` thesis robots 450 mm apart, in exact
-//! mode or in table mode (bundle of `cells/line4.toml`'s spacing), for `perf record`.
-//! `cargo run --release --example line_tick -- exact|table N SECONDS [K]`.
+//! mode, in table mode (bundle of `cells/line4.toml`'s spacing) or through the protective
+//! verdict (default stopping model, no speed limits), for `perf record`.
+//! `cargo run --release --example line_tick -- exact|table|protective N SECONDS [K]`.
 
+use delta_collide::cell::protective::ProtectiveChecker;
 use delta_collide::cell::ExactChecker;
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::table::bundle::build_bundle;
@@ -29,11 +31,20 @@ fn main() {
                 .unwrap();
         BundleChecker::new(cell.clone(), &built.bytes, Confirmation::Exact).unwrap()
     });
+    let mut protective =
+        (mode == "protective").then(|| ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false));
+    // Ticks per protective verdict (FREE, WARN, STOP), over every pass.
+    let mut verdicts = [0u64; 3];
     eprintln!("start");
     let start = Instant::now();
     let mut ticks = 0u64;
     while start.elapsed().as_secs_f64() < secs {
         for (t, hit) in run.iter().zip(&hits) {
+            if let Some(p) = &mut protective {
+                let v = p.check(black_box(t)).unwrap().verdict;
+                verdicts[v as usize] += 1;
+                continue;
+            }
             let c = match &mut table {
                 Some(table) => table.check(black_box(t)).unwrap() == TableAnswer::Collision,
                 None => exact.check(black_box(t)).unwrap().collides(),
@@ -44,6 +55,9 @@ fn main() {
     }
     let ns = start.elapsed().as_secs_f64() * 1e9 / ticks as f64;
     println!("{mode} n={n}: {ns:.0} ns per tick over {ticks} ticks");
+    if protective.is_some() {
+        println!("FREE, WARN, STOP ticks {verdicts:?}");
+    }
     if let Some(t) = &table {
         println!("confirmations {} fallbacks {}", t.confirmations(), t.fallbacks());
     }
