@@ -204,9 +204,10 @@ impl TreeParts {
     pub(crate) fn packed_children(&self) -> Vec<u8> {
         let mut out = Vec::new();
         let mut children = self.children.iter();
-        for (range, targets) in depth_runs(&self.masks, &self.depth_start, self.leaves.len()).into_iter().flatten() {
+        // A valid tree's depth runs hold exactly its child indices.
+        for (count, targets) in depth_runs(&self.masks, &self.depth_start, self.leaves.len()).into_iter().flatten() {
             let width = child_width(targets);
-            for _ in 0..range {
+            for _ in 0..count {
                 let c = children.next().copied().unwrap_or(0);
                 out.extend_from_slice(&c.to_le_bytes()[..width]);
             }
@@ -627,9 +628,9 @@ mod tests {
     /// the file; `stored_bytes` is what the file holds beyond its header and checksum.
     #[test]
     fn builds_take_the_finest_shift_that_fits_memory_and_file() {
-        let ladder = Ladder::default_ladder();
         use crate::table::format::{to_bytes, Certification, Header};
         use crate::table::Table;
+        let ladder = Ladder::default_ladder();
         // The file less its 192-byte header (no cell parameters) and 8-byte checksum.
         let sections = |t: Table, s: &crate::cspace::LabelledSpace| {
             let header = Header::for_space(s, 0, crate::cspace::Workspace::THESIS, Certification::SweptBound);
