@@ -117,14 +117,32 @@ impl Interval {
     /// The range of `atan2(y, x)` over the box `y x x`; `None` (no useful bound) when the box
     /// meets the origin or the branch cut (`x <= 0`, `y = 0`). Otherwise the box lies in an
     /// open half-plane cut-free wedge and the angle is extreme at a corner.
+    ///
+    /// Which corners, when the box lies wholly below or above the x axis: the partial
+    /// derivatives are `d/dx = -y / r^2` and `d/dy = x / r^2`. Below (`y < 0`) the angle grows
+    /// with `x`, so it is least on the side `x = x.lo` and greatest on `x = x.hi`; along a side
+    /// it grows with `y` where that side's `x >= 0` and falls where `x < 0`. Above (`y > 0`)
+    /// it falls with `x`: least on `x = x.hi`, greatest on `x = x.lo`, with `y` as before.
+    /// So two `atan2` give both ends there (the inverse kinematics' boxes have `y = z < 0`);
+    /// other boxes take all four corners. The ends are widened by 1e-15, more than the
+    /// rounding of `atan2` near `pi` (4.4e-16), so they hold the exact extremes.
     pub fn atan2(y: Interval, x: Interval) -> Option<Interval> {
         let meets_cut = x.lo <= 0.0 && y.lo <= 0.0 && y.hi >= 0.0;
         if meets_cut {
             return None;
         }
-        let corners = [y.lo.atan2(x.lo), y.lo.atan2(x.hi), y.hi.atan2(x.lo), y.hi.atan2(x.hi)];
-        let lo = corners.iter().copied().fold(Real::INFINITY, Real::min);
-        let hi = corners.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+        // `y` at which the angle is extreme on the side at `side_x`: `larger` picks the end
+        // that makes it grow (`d/dy` has the sign of `x`).
+        let end_y = |side_x: Real, larger: bool| if (side_x >= 0.0) == larger { y.hi } else { y.lo };
+        let (lo, hi) = if y.hi < 0.0 {
+            (end_y(x.lo, false).atan2(x.lo), end_y(x.hi, true).atan2(x.hi))
+        } else if y.lo > 0.0 {
+            (end_y(x.hi, false).atan2(x.hi), end_y(x.lo, true).atan2(x.lo))
+        } else {
+            let corners = [y.lo.atan2(x.lo), y.lo.atan2(x.hi), y.hi.atan2(x.lo), y.hi.atan2(x.hi)];
+            let lo = corners.iter().copied().fold(Real::INFINITY, Real::min);
+            (lo, corners.iter().copied().fold(Real::NEG_INFINITY, Real::max))
+        };
         Some(Interval { lo: lo - 1e-15, hi: hi + 1e-15 })
     }
 
@@ -175,5 +193,41 @@ mod tests {
         assert_eq!(Interval::new(1.5, 3.0).acos(), None);
         assert!(Interval::atan2(Interval::new(-1.0, 1.0), Interval::new(-2.0, -1.0)).is_none(), "branch cut");
         assert!(Interval::atan2(Interval::new(-1.0, 1.0), Interval::new(1.0, 2.0)).is_some());
+    }
+
+    /// Boxes wholly below or above the x axis (where two corners give the ends), on both sides
+    /// of `x = 0`, touching it, and thin: the enclosure holds `atan2` at all four corners and at
+    /// a grid of interior points, and its ends are corner values (no wider than the rounding).
+    #[test]
+    fn atan2_of_half_plane_boxes_holds_every_corner() {
+        let mut rng = crate::test_rng::TestRng(7);
+        let mut pick = |scale: f64| rng.unit() * scale;
+        for i in 0..20_000 {
+            let scale = [1e-3, 1.0, 300.0][i % 3];
+            let (x0, x1) = (pick(scale), pick(scale));
+            let (mut y0, mut y1) = (pick(scale).abs(), pick(scale).abs());
+            if i % 7 == 0 {
+                y0 = 0.0; // touching the axis from one side
+            }
+            if i % 2 == 0 {
+                (y0, y1) = (-y0, -y1);
+            }
+            let (x, y) = (Interval::new(x0, x1), Interval::new(y0, y1));
+            let Some(t) = Interval::atan2(y, x) else { continue };
+            let corners = [y.lo.atan2(x.lo), y.lo.atan2(x.hi), y.hi.atan2(x.lo), y.hi.atan2(x.hi)];
+            for c in corners {
+                assert!(t.contains(c), "atan2 over {y:?} x {x:?}: corner {c} not in {t:?}");
+            }
+            let least = corners.iter().copied().fold(f64::INFINITY, f64::min);
+            assert!(t.lo >= least - 2e-15, "{y:?} x {x:?}: {t:?} wider than the corners' {least}");
+            for s in 0..=4 {
+                for u in 0..=4 {
+                    // Clamped: the rounded sum may step past the far end.
+                    let at = |i: &Interval, f: usize| (i.lo + (i.hi - i.lo) * f as f64 / 4.0).clamp(i.lo, i.hi);
+                    let (px, py) = (at(&x, s), at(&y, u));
+                    assert!(t.contains(py.atan2(px)), "atan2({py}, {px}) not in {t:?}, box {y:?} x {x:?}");
+                }
+            }
+        }
     }
 }
