@@ -32,6 +32,14 @@
 //! intersects for every configuration of a (sub)cell pair holding it (the boxes' *cores*
 //! overlap, [`crate::geometry::sweep`], "Certain intersection"); whole cells decide all 64
 //! at once, an octant with the other robot's whole cell decides a row or column of 8.
+//! Boxes that meet at two configurations decide the same way, with plain separating axis
+//! tests instead of swept ones: every swept test whose cubes hold both configurations keeps
+//! the box pair open. So a pair whose boxes meet at the whole cells' reference TCPs (cell
+//! centres, each held by all 8 octants) has all its octant pairs collisions at levels 2 and 3
+//! (`held_by_references`), and at level 3 a sub-octant's reference meeting the other robot's
+//! octant reference decides the octant pair (`mixed_references_meet`), as the octants'
+//! references meeting already did. Which octants hold a reference is counted as the sweeps
+//! cover their cubes (`sweeps::octants_holding`).
 //!
 //! A sample is labelled [`Label::Unreachable`](crate::cspace::Label) ("don't care") only
 //! when no TCP of its whole cell is reachable ([`cube_unreachable`]); a cell whose centre is
@@ -64,7 +72,7 @@ use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use refine::{octants_prove_free, refine_unknown_cells, sub_cell_masks, sub_cells, Levels, SubOctants};
-use sweeps::{cell_sweeps, inflation, octants, references, unreachable_cells};
+use sweeps::{cell_sweeps, inflation, octants, reference_octants, references, unreachable_cells};
 
 
 /// Sub-boxes per axis when enclosing the motor angles over an octant (an octant is half as
@@ -279,7 +287,10 @@ pub(crate) fn certify_rows_then<R>(
         SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
         SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
     );
-    let (mut la, mut lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+    let (mut la, mut lb) = (
+        Levels::with_references(&a0, &a1, reference_octants(&grid_a, &refs_a)),
+        Levels::with_references(&b0, &b1, reference_octants(&grid_b, &refs_b)),
+    );
     if subdivide {
         (la.subs, lb.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
     }
@@ -440,6 +451,40 @@ mod tests {
                 }
             }
             assert!(met > 100, "{name}: {met} of {tried} box pairs meet at the references");
+        }
+    }
+
+    /// The exits that use where the reference TCPs lie ([`held_by_references`], level 3's
+    /// mixed references) change no sub-cell: on T1, T2 and T3 at k = 16, every collision
+    /// pair's sub-cells, levels 2 and 3, are those found without them, and the whole cells'
+    /// references decide the octant pairs of many pairs.
+    #[test]
+    fn reference_exits_change_no_sub_cell() {
+        let ws = Workspace::THESIS;
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let labels = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap().space.labels;
+            let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
+            let held = |r: &RobotSpec, g: &SampleGrid| reference_octants(g, &references(&r.model, g));
+            let levels = |fast: bool| {
+                let (mut a, mut b) = if fast {
+                    let a = Levels::with_references(&a0, &a1, held(ra, &grid_a));
+                    (a, Levels::with_references(&b0, &b1, held(rb, &grid_b)))
+                } else {
+                    (Levels::new(&a0, &a1), Levels::new(&b0, &b1))
+                };
+                (a.subs, b.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+                (a, b)
+            };
+            let ((fa, fb), (pa, pb)) = (levels(true), levels(false));
+            let nb = b0.len();
+            let collisions = labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision);
+            let decided = collisions.filter(|&(p, _)| held_by_references(&fa, &fb, p / nb, p % nb) != 0).count();
+            let (fast, plain) = (sub_cells(&fa, &fb, &labels, Rows::ALL), sub_cells(&pa, &pb, &labels, Rows::ALL));
+            assert!(fast == plain, "{name}: the references' exits changed sub-cells");
+            assert!(decided > 1000, "{name}: {decided} of {} pairs decided by the references", fast.pairs.len());
         }
     }
 

@@ -15,7 +15,7 @@ use crate::geometry::sweep::{boxes_overlap_deeply, core};
 use crate::geometry::Obb;
 use crate::math::{max_or_nan, min_or_nan, Real, Vec3};
 use rayon::prelude::*;
-use super::sweeps::{inflation, octant_centre, octant_sweeps};
+use super::sweeps::{inflation, octant_centre, octant_sweeps, octants_holding};
 use super::{sub_cell_index, SubCells};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;
@@ -32,13 +32,22 @@ pub(super) struct Levels<'a> {
     pub(super) octs: &'a SampleBoxes,
     pub(super) whole_cores: Vec<Option<Obb>>,
     pub(super) oct_cores: Vec<Option<Obb>>,
+    /// Per sample: its octants that hold its reference TCP ([`octants_holding`]). `None`
+    /// turns off the exits that use where the references lie ([`held_by_references`], and
+    /// level 3's mixed references), to test them against the levels without them.
+    pub(super) ref_octants: Option<Vec<u8>>,
     /// Level 3, for the sub-cells only.
     pub(super) subs: Option<SubOctants<'a>>,
 }
 
 impl<'a> Levels<'a> {
     pub(super) fn new(whole: &'a SampleBoxes, octs: &'a SampleBoxes) -> Self {
-        Levels { whole, octs, whole_cores: cores(whole), oct_cores: cores(octs), subs: None }
+        Levels { whole, octs, whole_cores: cores(whole), oct_cores: cores(octs), ref_octants: None, subs: None }
+    }
+
+    /// As [`Levels::new`], with the octants holding each sample's reference TCP.
+    pub(super) fn with_references(whole: &'a SampleBoxes, octs: &'a SampleBoxes, ref_octants: Vec<u8>) -> Self {
+        Levels { ref_octants: Some(ref_octants), ..Levels::new(whole, octs) }
     }
 }
 
@@ -48,8 +57,9 @@ pub(super) struct SubOctants<'a> {
     robot: &'a RobotSpec,
     grid: &'a SampleGrid,
     /// Per octant entry `8 s + i`: its sub-octants, entry `u` offset by `+/- r/8` along x,
-    /// y, z for bits 0, 1, 2 of `u`.
-    boxes: Vec<OnceLock<SampleBoxes>>,
+    /// y, z for bits 0, 1, 2 of `u`, and those that hold the octant's reference TCP
+    /// ([`octants_holding`]).
+    boxes: Vec<OnceLock<(SampleBoxes, u8)>>,
     /// How many of `boxes` are made.
     made: AtomicUsize,
 }
@@ -73,9 +83,10 @@ impl<'a> SubOctants<'a> {
         }
     }
 
-    /// The sub-octants of octant entry `e`.
-    fn of(&self, e: usize) -> &SampleBoxes {
-        self.boxes[e].get_or_init(|| {
+    /// The sub-octants of octant entry `e`, and those holding the octant's reference TCP (the
+    /// one `super::sweeps::octants` gives it).
+    fn of(&self, e: usize) -> (&SampleBoxes, u8) {
+        let (boxes, held) = self.boxes[e].get_or_init(|| {
             self.made.fetch_add(1, Ordering::Relaxed);
             let (model, r) = (&self.robot.model, self.grid.r);
             let octant = octant_centre(&self.grid.sample_center(e / 8), e % 8, 0.25 * r);
@@ -83,8 +94,10 @@ impl<'a> SubOctants<'a> {
             let cs: Vec<Vec3> = (0..8).map(|u| octant_centre(&octant, u, h)).collect();
             let refs: Vec<Vec3> = cs.iter().map(|c| reference_point(&model.delta, c, h).unwrap_or(*c)).collect();
             let inflate = |u: usize| octant_sweeps(model, &cs[u], h, &refs[u]).map_or(Inflation::Vacuous, inflation);
-            SampleBoxes::new(model, &self.robot.placement, &refs, inflate)
-        })
+            let own = reference_point(&model.delta, &octant, 0.25 * r).unwrap_or(octant);
+            (SampleBoxes::new(model, &self.robot.placement, &refs, inflate), octants_holding(&octant, h, &own))
+        });
+        (boxes, *held)
     }
 }
 
@@ -110,7 +123,7 @@ pub(super) fn sub_octants_prove_free(
 ) -> bool {
     let (Some(sub_a), Some(sub_b)) = (&a.subs, &b.subs) else { return false };
     let (a1, b1, na, nb) = (a.octs, b.octs, a.octs.per_entry, b.octs.per_entry);
-    let (x, y) = (sub_a.of(sa), sub_b.of(sb));
+    let ((x, held_a), (y, held_b)) = (sub_a.of(sa), sub_b.of(sb));
     let usable = |slot: Slot| slot == Slot::Boxes || slot == Slot::Vacuous;
     if !x.slot[..8].iter().chain(&y.slot[..8]).all(|&s| usable(s)) {
         return false;
@@ -130,7 +143,13 @@ pub(super) fn sub_octants_prove_free(
         left != 0 && collision_mask(x, u0, b1, sb, left) & collision_mask(a1, sa, y, v0, left) != 0
     };
     let hinted = x.slot[u0] == Slot::Boxes && y.slot[v0] == Slot::Boxes;
-    if hinted && (meet_at_references(x, u0, y, v0, first) || stays(1 << first)) {
+    // One sub-octant's reference against the other robot's octant reference, held by one of
+    // that robot's sub-octants with boxes ([`mixed_references_meet`]).
+    let mixed = || {
+        let known = a.ref_octants.is_some() && b.ref_octants.is_some();
+        known && mixed_references_meet((a1, sa, x, held_a, u0), (b1, sb, y, held_b, v0), first)
+    };
+    if hinted && (meet_at_references(x, u0, y, v0, first) || mixed() || stays(1 << first)) {
         return false;
     }
     let open = open();
@@ -179,6 +198,78 @@ pub(super) fn sub_octants_prove_free(
 pub(super) fn meet_at_references(x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize) -> bool {
     let (i, j) = (ea * x.per_entry + bit / 8, eb * y.per_entry + bit % 8);
     separating_axis(&x.boxes[i].obb, &y.boxes[j].obb).is_none()
+}
+
+/// Whether box pair `bit` meets with A at its sub-octant `u`'s reference TCP and B at its
+/// octant's, B's octant reference being held by one of B's sub-octants with boxes; or the same
+/// with the robots' roles swapped (A at its octant's reference, B at sub-octant `v`'s). Each
+/// robot is given as (octant boxes, octant entry, its sub-octants, those holding the octant's
+/// reference, the sub-octant).
+///
+/// A "yes" decides level 3 of an octant pair whose level 2 left `bit` open. Say A's
+/// sub-octant `u` (with boxes) meets B's octant reference, held by B's sub-octant `w` (with
+/// boxes, [`octants_holding`]). A's reference TCP of `u` lies in `u`'s cube, so in A's
+/// octant's; B's octant reference lies in B's octant's cube and within what `w`'s sweeps
+/// cover. So each of the three tests of sub-octant pair `(u, w)`, (sub-octant `u`, B's octant)
+/// and (A's octant, sub-octant `w`) sweeps over both configurations, and none proves `bit`
+/// disjoint (the argument of [`meet_at_references`]): the octant pair stays a collision, as
+/// its full level 3 would find at `(u, w)`.
+fn mixed_references_meet(
+    (a1, sa, x, held_a, u): (&SampleBoxes, usize, &SampleBoxes, u8, usize),
+    (b1, sb, y, held_b, v): (&SampleBoxes, usize, &SampleBoxes, u8, usize),
+    bit: usize,
+) -> bool {
+    let (na, nb) = (a1.per_entry, b1.per_entry);
+    let holds = |s: &SampleBoxes, held: u8| (0..8).any(|w| held >> w & 1 == 1 && s.slot[w] == Slot::Boxes);
+    let (i, j) = (bit / 8, bit % 8);
+    x.slot[u] == Slot::Boxes && holds(y, held_b) && meet(&x.boxes[u * na + i].obb, &b1.boxes[sb * nb + j].obb)
+        || y.slot[v] == Slot::Boxes && holds(x, held_a) && meet(&a1.boxes[sa * na + i].obb, &y.boxes[v * nb + j].obb)
+}
+
+/// Whether two boxes at reference TCPs meet: the plain separating axis test finds no axis
+/// (the premise of [`meet_at_references`]).
+fn meet(a: &Obb, b: &Obb) -> bool {
+    separating_axis(a, b).is_none()
+}
+
+/// The octant pairs of `(ia, ib)` (bits as [`sub_cell_index`]) that level 2 and level 3 leave
+/// collisions because the boxes meet at the whole cells' reference TCPs: those of A's octants
+/// holding A's reference (`a.ref_octants`) with B's octants holding B's; 0 when the boxes do
+/// not meet there or a cell has no boxes.
+///
+/// A box pair meeting at both references is open after every test whose cubes hold the two
+/// references ([`meet_at_references`], first two points): the whole cells' test, each of
+/// those octants' with the other cell ([`sub_cell_masks`]' rows and columns) and the octant
+/// pair's own, so level 2 leaves such an octant pair a collision on it. At level 3 the
+/// octant's sub-octants cover its cube, so a sub-octant of each holds the reference
+/// ([`octants_holding`] counts the point within the widened cubes the sweeps cover, so a point
+/// held by an octant lies within the cover of one of its sub-octants), and the three tests of
+/// that sub-octant pair keep the box pair open too. The cell centres, when reachable (the usual
+/// reference), are held by all 8 octants: the 64 octant pairs are decided by a few plain tests.
+pub(super) fn held_by_references(a: &Levels, b: &Levels, ia: usize, ib: usize) -> u64 {
+    let (a0, b0) = (a.whole, b.whole);
+    let (Some(in_a), Some(in_b)) = (&a.ref_octants, &b.ref_octants) else { return 0 };
+    let (in_a, in_b) = (in_a[ia], in_b[ib]);
+    if in_a == 0 || in_b == 0 || a0.slot[ia] != Slot::Boxes || b0.slot[ib] != Slot::Boxes {
+        return 0;
+    }
+    let (na, nb) = (a0.per_entry, b0.per_entry);
+    let mut pairs = all_box_pairs(na, nb);
+    let met = loop {
+        if pairs == 0 {
+            break false;
+        }
+        let p = pairs.trailing_zeros() as usize;
+        pairs &= pairs - 1;
+        if meet_at_references(a0, ia, b0, ib, p) {
+            break true;
+        }
+    };
+    if !met {
+        return 0;
+    }
+    let column = (0..8).filter(|&j| in_b >> j & 1 == 1).fold(0u64, |m, j| m | 1 << sub_cell_index(0, j));
+    (0..8).filter(|&i| in_a >> i & 1 == 1).fold(0, |m, i| m | column << sub_cell_index(i, 0))
 }
 
 /// Per box of `boxes`: its core under its sweep, when its entry has boxes and the core exists.
@@ -269,6 +360,8 @@ pub(super) fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize
 ///   octant (its column). Such an octant pair is never proved free by [`octant_pairs`]: its
 ///   octants are [`Slot::Boxes`] only with reachable reference TCPs, a configuration of the
 ///   pair that collides, and its tests are sound; other octants it calls collisions anyway.
+/// - an octant pair is a collision without its tests when a box pair meets at the whole
+///   cells' reference TCPs and its octants hold them ([`held_by_references`]).
 /// - a box pair of an octant pair is proved disjoint when one of the tests (A octant, B
 ///   cell), (A cell, B octant), (A octant, B octant) proves it (after the whole cells left it
 ///   open); an octant pair is free when all its box pairs are. The octant-cell tests are
@@ -283,6 +376,12 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
     let care = care_mask(a1, ia, b1, ib);
     let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
     let all = all_box_pairs(na, nb);
+    // Octant pairs left collisions by the boxes at the cells' references (the labelling found
+    // them meeting there and skipped level 2).
+    let held = if first_only { 0 } else { held_by_references(a, b, ia, ib) };
+    if care & !held == 0 {
+        return (care, care);
+    }
     // A box pair whose cores meet is never proved disjoint: no need to look for it among
     // those the whole cells leave open.
     if whole_a && whole_b && cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) {
@@ -313,7 +412,7 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
                 continue;
             }
             let (sa, sb) = (8 * ia + i, 8 * ib + j);
-            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meet || column_meet;
+            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meet || column_meet || held & bit != 0;
             // Whether box pair `p` stays open: no test of the octant pair proves it.
             let mut open = |p: usize| {
                 rows.open(i, p, || !whole_b || touch(a1, sa, b0, ib, p))
