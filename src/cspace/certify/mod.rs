@@ -36,10 +36,9 @@
 //! tests instead of swept ones: every swept test whose cubes hold both configurations keeps
 //! the box pair open. So a pair whose boxes meet at the whole cells' reference TCPs (cell
 //! centres, each held by all 8 octants) has all its octant pairs collisions at levels 2 and 3
-//! (`held_by_references`), and at level 3 a sub-octant's reference meeting the other robot's
-//! octant reference decides the octant pair (`mixed_references_meet`), as the octants'
-//! references meeting already did. Which octants hold a reference is counted as the sweeps
-//! cover their cubes (`sweeps::octants_holding`).
+//! (`held_by_references`; which octants hold a reference is counted as the sweeps cover their
+//! cubes, `sweeps::octants_holding`), as the octants' references meeting already decided
+//! level 3 of an octant pair.
 //!
 //! A sample is labelled [`Label::Unreachable`](crate::cspace::Label) ("don't care") only
 //! when no TCP of its whole cell is reachable ([`cube_unreachable`]); a cell whose centre is
@@ -454,10 +453,9 @@ mod tests {
         }
     }
 
-    /// The exits that use where the reference TCPs lie ([`held_by_references`], level 3's
-    /// mixed references) change no sub-cell: on T1, T2 and T3 at k = 16, every collision
-    /// pair's sub-cells, levels 2 and 3, are those found without them, and the whole cells'
-    /// references decide the octant pairs of many pairs.
+    /// The octant pairs held by the whole cells' meeting references ([`held_by_references`])
+    /// change no sub-cell: on T1, T2 and T3 at k = 16, every collision pair's sub-cells,
+    /// levels 2 and 3, are those found without that exit, which decides many pairs.
     #[test]
     fn reference_exits_change_no_sub_cell() {
         let ws = Workspace::THESIS;
@@ -483,8 +481,54 @@ mod tests {
             let collisions = labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision);
             let decided = collisions.filter(|&(p, _)| held_by_references(&fa, &fb, p / nb, p % nb) != 0).count();
             let (fast, plain) = (sub_cells(&fa, &fb, &labels, Rows::ALL), sub_cells(&pa, &pb, &labels, Rows::ALL));
-            assert!(fast == plain, "{name}: the references' exits changed sub-cells");
+            assert!(fast == plain, "{name}: the references' exit changed sub-cells");
             assert!(decided > 1000, "{name}: {decided} of {} pairs decided by the references", fast.pairs.len());
+        }
+    }
+
+    /// Level 3 ([`sub_octants_prove_free`], with its hint, its reference test and its columns
+    /// tested only where a row leaves a box pair open) answers as its plain statement
+    /// ([`sub_octants_prove_free_plainly`]) on every octant pair that level 2 leaves open, of
+    /// a spread of collision pairs of T1, T2 and T3 at k = 16.
+    #[test]
+    fn level_3_answers_as_its_plain_statement() {
+        use crate::cspace::label::collision_mask;
+        let ws = Workspace::THESIS;
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let (mut a, mut b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+            let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
+            (a.subs, b.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+            let (na, nb) = (a0.per_entry, b0.per_entry);
+            let all = all_box_pairs(na, nb);
+            let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
+            let (mut hint, mut tried, mut freed) = (0, 0, 0);
+            for ia in (0..a0.len()).step_by(3).filter(|&ia| boxes(&a0, ia)) {
+                for ib in (ia % 5..b0.len()).step_by(5).filter(|&ib| boxes(&b0, ib)) {
+                    let open0 = collision_mask(&a0, ia, &b0, ib, all);
+                    if open0 == 0 {
+                        continue;
+                    }
+                    for (sa, sb) in (0..8).flat_map(|i| (0..8).map(move |j| (8 * ia + i, 8 * ib + j))) {
+                        if !boxes(&a1, sa) || !boxes(&b1, sb) {
+                            continue;
+                        }
+                        let open = collision_mask(&a1, sa, &b0, ib, open0)
+                            & collision_mask(&a0, ia, &b1, sb, open0)
+                            & collision_mask(&a1, sa, &b1, sb, open0);
+                        if open == 0 {
+                            continue;
+                        }
+                        let first = open.trailing_zeros() as usize;
+                        let fast = sub_octants_prove_free(&a, &b, sa, sb, first, || open, &mut hint);
+                        assert_eq!(fast, sub_octants_prove_free_plainly(&a, &b, sa, sb, open), "{name} {sa} {sb}");
+                        (tried, freed) = (tried + 1, freed + fast as usize);
+                    }
+                }
+            }
+            assert!(freed > 100 && tried > freed, "{name}: {freed} of {tried} octant pairs freed");
         }
     }
 

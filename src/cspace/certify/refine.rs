@@ -15,7 +15,7 @@ use crate::geometry::sweep::{boxes_overlap_deeply, core};
 use crate::geometry::Obb;
 use crate::math::{max_or_nan, min_or_nan, Real, Vec3};
 use rayon::prelude::*;
-use super::sweeps::{inflation, octant_centre, octant_sweeps, octants_holding};
+use super::sweeps::{inflation, octant_centre, octant_sweeps};
 use super::{sub_cell_index, SubCells};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;
@@ -32,9 +32,9 @@ pub(super) struct Levels<'a> {
     pub(super) octs: &'a SampleBoxes,
     pub(super) whole_cores: Vec<Option<Obb>>,
     pub(super) oct_cores: Vec<Option<Obb>>,
-    /// Per sample: its octants that hold its reference TCP ([`octants_holding`]). `None`
-    /// turns off the exits that use where the references lie ([`held_by_references`], and
-    /// level 3's mixed references), to test them against the levels without them.
+    /// Per sample: its octants that hold its reference TCP
+    /// ([`octants_holding`](super::sweeps::octants_holding)). `None` turns off
+    /// [`held_by_references`], to test it against the levels without it.
     pub(super) ref_octants: Option<Vec<u8>>,
     /// Level 3, for the sub-cells only.
     pub(super) subs: Option<SubOctants<'a>>,
@@ -57,9 +57,8 @@ pub(super) struct SubOctants<'a> {
     robot: &'a RobotSpec,
     grid: &'a SampleGrid,
     /// Per octant entry `8 s + i`: its sub-octants, entry `u` offset by `+/- r/8` along x,
-    /// y, z for bits 0, 1, 2 of `u`, and those that hold the octant's reference TCP
-    /// ([`octants_holding`]).
-    boxes: Vec<OnceLock<(SampleBoxes, u8)>>,
+    /// y, z for bits 0, 1, 2 of `u`.
+    boxes: Vec<OnceLock<SampleBoxes>>,
     /// How many of `boxes` are made.
     made: AtomicUsize,
 }
@@ -83,10 +82,9 @@ impl<'a> SubOctants<'a> {
         }
     }
 
-    /// The sub-octants of octant entry `e`, and those holding the octant's reference TCP (the
-    /// one `super::sweeps::octants` gives it).
-    fn of(&self, e: usize) -> (&SampleBoxes, u8) {
-        let (boxes, held) = self.boxes[e].get_or_init(|| {
+    /// The sub-octants of octant entry `e`.
+    fn of(&self, e: usize) -> &SampleBoxes {
+        self.boxes[e].get_or_init(|| {
             self.made.fetch_add(1, Ordering::Relaxed);
             let (model, r) = (&self.robot.model, self.grid.r);
             let octant = octant_centre(&self.grid.sample_center(e / 8), e % 8, 0.25 * r);
@@ -94,10 +92,8 @@ impl<'a> SubOctants<'a> {
             let cs: Vec<Vec3> = (0..8).map(|u| octant_centre(&octant, u, h)).collect();
             let refs: Vec<Vec3> = cs.iter().map(|c| reference_point(&model.delta, c, h).unwrap_or(*c)).collect();
             let inflate = |u: usize| octant_sweeps(model, &cs[u], h, &refs[u]).map_or(Inflation::Vacuous, inflation);
-            let own = reference_point(&model.delta, &octant, 0.25 * r).unwrap_or(octant);
-            (SampleBoxes::new(model, &self.robot.placement, &refs, inflate), octants_holding(&octant, h, &own))
-        });
-        (boxes, *held)
+            SampleBoxes::new(model, &self.robot.placement, &refs, inflate)
+        })
     }
 }
 
@@ -123,7 +119,7 @@ pub(super) fn sub_octants_prove_free(
 ) -> bool {
     let (Some(sub_a), Some(sub_b)) = (&a.subs, &b.subs) else { return false };
     let (a1, b1, na, nb) = (a.octs, b.octs, a.octs.per_entry, b.octs.per_entry);
-    let ((x, held_a), (y, held_b)) = (sub_a.of(sa), sub_b.of(sb));
+    let (x, y) = (sub_a.of(sa), sub_b.of(sb));
     let usable = |slot: Slot| slot == Slot::Boxes || slot == Slot::Vacuous;
     if !x.slot[..8].iter().chain(&y.slot[..8]).all(|&s| usable(s)) {
         return false;
@@ -143,29 +139,29 @@ pub(super) fn sub_octants_prove_free(
         left != 0 && collision_mask(x, u0, b1, sb, left) & collision_mask(a1, sa, y, v0, left) != 0
     };
     let hinted = x.slot[u0] == Slot::Boxes && y.slot[v0] == Slot::Boxes;
-    // One sub-octant's reference against the other robot's octant reference, held by one of
-    // that robot's sub-octants with boxes ([`mixed_references_meet`]).
-    let mixed = || {
-        let known = a.ref_octants.is_some() && b.ref_octants.is_some();
-        known && mixed_references_meet((a1, sa, x, held_a, u0), (b1, sb, y, held_b, v0), first)
-    };
-    if hinted && (meet_at_references(x, u0, y, v0, first) || mixed() || stays(1 << first)) {
+    if hinted && (meet_at_references(x, u0, y, v0, first) || stays(1 << first)) {
         return false;
     }
     let open = open();
     if cores_meet(&a.oct_cores, sa, na, &b.oct_cores, sb, nb, open) || hinted && stays(open & !(1 << first)) {
         return false;
     }
-    // Then each sub-octant against the other octant, and the finest test for what is left.
-    let mut columns = [None; 8];
+    // Then each sub-octant against the other octant, and the finest test for what is left. A
+    // column (A's octant against sub-octant `v`) is tested only on the box pairs that some row
+    // left open, each once: only those enter `row & column`.
+    let (mut tested, mut columns) = ([0u64; 8], [0u64; 8]);
     for u in (0..8).filter(|&u| x.slot[u] == Slot::Boxes) {
         let row = collision_mask(x, u, b1, sb, open);
         if row == 0 {
             continue;
         }
         for v in (0..8).filter(|&v| y.slot[v] == Slot::Boxes) {
-            let column = *columns[v].get_or_insert_with(|| collision_mask(a1, sa, y, v, open));
-            if fine(u, v, row & column) != 0 {
+            let untested = row & !tested[v];
+            if untested != 0 {
+                columns[v] |= collision_mask(a1, sa, y, v, untested);
+                tested[v] |= untested;
+            }
+            if fine(u, v, row & columns[v]) != 0 {
                 *hint = 8 * u + v;
                 return false;
             }
@@ -197,39 +193,17 @@ pub(super) fn sub_octants_prove_free(
 /// It only skips tests whose answers it predicts; a "not free" is never a wrong answer.
 pub(super) fn meet_at_references(x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize) -> bool {
     let (i, j) = (ea * x.per_entry + bit / 8, eb * y.per_entry + bit % 8);
-    separating_axis(&x.boxes[i].obb, &y.boxes[j].obb).is_none()
+    meet(&x.boxes[i], &y.boxes[j])
 }
 
-/// Whether box pair `bit` meets with A at its sub-octant `u`'s reference TCP and B at its
-/// octant's, B's octant reference being held by one of B's sub-octants with boxes; or the same
-/// with the robots' roles swapped (A at its octant's reference, B at sub-octant `v`'s). Each
-/// robot is given as (octant boxes, octant entry, its sub-octants, those holding the octant's
-/// reference, the sub-octant).
-///
-/// A "yes" decides level 3 of an octant pair whose level 2 left `bit` open. Say A's
-/// sub-octant `u` (with boxes) meets B's octant reference, held by B's sub-octant `w` (with
-/// boxes, [`octants_holding`]). A's reference TCP of `u` lies in `u`'s cube, so in A's
-/// octant's; B's octant reference lies in B's octant's cube and within what `w`'s sweeps
-/// cover. So each of the three tests of sub-octant pair `(u, w)`, (sub-octant `u`, B's octant)
-/// and (A's octant, sub-octant `w`) sweeps over both configurations, and none proves `bit`
-/// disjoint (the argument of [`meet_at_references`]): the octant pair stays a collision, as
-/// its full level 3 would find at `(u, w)`.
-fn mixed_references_meet(
-    (a1, sa, x, held_a, u): (&SampleBoxes, usize, &SampleBoxes, u8, usize),
-    (b1, sb, y, held_b, v): (&SampleBoxes, usize, &SampleBoxes, u8, usize),
-    bit: usize,
-) -> bool {
-    let (na, nb) = (a1.per_entry, b1.per_entry);
-    let holds = |s: &SampleBoxes, held: u8| (0..8).any(|w| held >> w & 1 == 1 && s.slot[w] == Slot::Boxes);
-    let (i, j) = (bit / 8, bit % 8);
-    x.slot[u] == Slot::Boxes && holds(y, held_b) && meet(&x.boxes[u * na + i].obb, &b1.boxes[sb * nb + j].obb)
-        || y.slot[v] == Slot::Boxes && holds(x, held_a) && meet(&a1.boxes[sa * na + i].obb, &y.boxes[v * nb + j].obb)
-}
-
-/// Whether two boxes at reference TCPs meet: the plain separating axis test finds no axis
-/// (the premise of [`meet_at_references`]).
-fn meet(a: &Obb, b: &Obb) -> bool {
-    separating_axis(a, b).is_none()
+/// Whether two boxes at their entries' reference TCPs (`.obb`) meet: the plain separating axis
+/// test finds no axis (the premise of [`meet_at_references`]). Boxes whose swept AABBs are apart
+/// (by the slack, 1e-6 mm, along a world axis) are not tried: each swept box holds its box, so
+/// such boxes are apart by more than 1e-6 mm, and boxes on which the plain test finds no axis
+/// are within its touch tolerance (1e-9 mm) on each of their 15 axes, so a few times that
+/// apart at most: the answer is the plain test's, found without it.
+fn meet(a: &SweptBox, b: &SweptBox) -> bool {
+    !aabbs_apart(&a.lo, &a.hi, &b.lo, &b.hi) && separating_axis(&a.obb, &b.obb).is_none()
 }
 
 /// The octant pairs of `(ia, ib)` (bits as [`sub_cell_index`]) that level 2 and level 3 leave
@@ -241,11 +215,16 @@ fn meet(a: &Obb, b: &Obb) -> bool {
 /// references ([`meet_at_references`], first two points): the whole cells' test, each of
 /// those octants' with the other cell ([`sub_cell_masks`]' rows and columns) and the octant
 /// pair's own, so level 2 leaves such an octant pair a collision on it. At level 3 the
-/// octant's sub-octants cover its cube, so a sub-octant of each holds the reference
-/// ([`octants_holding`] counts the point within the widened cubes the sweeps cover, so a point
-/// held by an octant lies within the cover of one of its sub-octants), and the three tests of
-/// that sub-octant pair keep the box pair open too. The cell centres, when reachable (the usual
-/// reference), are held by all 8 octants: the 64 octant pairs are decided by a few plain tests.
+/// octant's sub-octants cover its cube, so a sub-octant of each holds the reference (a point
+/// counted in an octant lies within `HOLD_SLACK` of its cube, so within as much of one of its
+/// sub-octants' cubes, inside what their sweeps cover:
+/// [`octants_holding`](super::sweeps::octants_holding)), and the three tests of that sub-octant
+/// pair keep the box pair open too; a sub-octant with no reachable TCP cannot hold a reachable
+/// reference. The cell centres, when reachable (the usual reference), are held by all 8
+/// octants: the 64 octant pairs are decided by a few plain tests.
+///
+/// Like [`meet_at_references`], it only skips tests whose answers it predicts; a test checks
+/// that the sub-cells are those found without it.
 pub(super) fn held_by_references(a: &Levels, b: &Levels, ia: usize, ib: usize) -> u64 {
     let (a0, b0) = (a.whole, b.whole);
     let (Some(in_a), Some(in_b)) = (&a.ref_octants, &b.ref_octants) else { return 0 };
@@ -531,6 +510,31 @@ pub(super) fn octant_pairs(
         }
     }
     (care, collision)
+}
+
+/// Level 3 of octant pair (A's entry `sa`, B's entry `sb`) as the module doc of `certify`
+/// states it, to test [`sub_octants_prove_free`]: free when no box pair of `open` has its
+/// octant cores meet, every sub-octant is [`Slot::Boxes`] or [`Slot::Vacuous`], and for
+/// every pair of sub-octants with boxes each box pair of `open` is proved disjoint by
+/// (A sub-octant, B sub-octant), (A sub-octant, B octant) or (A octant, B sub-octant).
+#[cfg(test)]
+pub(super) fn sub_octants_prove_free_plainly(a: &Levels, b: &Levels, sa: usize, sb: usize, open: u64) -> bool {
+    let (Some(sub_a), Some(sub_b)) = (&a.subs, &b.subs) else { return false };
+    let (a1, b1, na, nb) = (a.octs, b.octs, a.octs.per_entry, b.octs.per_entry);
+    let (x, y) = (sub_a.of(sa), sub_b.of(sb));
+    let usable = |slot: Slot| slot == Slot::Boxes || slot == Slot::Vacuous;
+    if !x.slot[..8].iter().chain(&y.slot[..8]).all(|&s| usable(s))
+        || cores_meet(&a.oct_cores, sa, na, &b.oct_cores, sb, nb, open)
+    {
+        return false;
+    }
+    let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
+    (0..8).filter(|&u| boxes(x, u)).all(|u| {
+        (0..8).filter(|&v| boxes(y, v)).all(|v| {
+            let left = collision_mask(x, u, b1, sb, open) & collision_mask(a1, sa, y, v, open);
+            collision_mask(x, u, y, v, left) == 0
+        })
+    })
 }
 
 /// Level 2 for a pair whose whole-cell test failed or could not run (a sample without a
