@@ -32,6 +32,13 @@
 //! intersects for every configuration of a (sub)cell pair holding it (the boxes' *cores*
 //! overlap, [`crate::geometry::sweep`], "Certain intersection"); whole cells decide all 64
 //! at once, an octant with the other robot's whole cell decides a row or column of 8.
+//! Boxes that meet at two configurations decide the same way, with plain separating axis
+//! tests instead of swept ones: every swept test whose cubes hold both configurations keeps
+//! the box pair open. So a pair whose boxes meet at the whole cells' reference TCPs (cell
+//! centres, each held by all 8 octants) has all its octant pairs collisions at levels 2 and 3
+//! (`held_by_references`; which octants hold a reference is counted as the sweeps cover their
+//! cubes, `sweeps::octants_holding`), as the octants' references meeting already decided
+//! level 3 of an octant pair.
 //!
 //! A sample is labelled [`Label::Unreachable`](crate::cspace::Label) ("don't care") only
 //! when no TCP of its whole cell is reachable ([`cube_unreachable`]); a cell whose centre is
@@ -64,7 +71,7 @@ use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use refine::{octants_prove_free, refine_unknown_cells, sub_cell_masks, sub_cells, Levels, SubOctants};
-use sweeps::{cell_sweeps, inflation, octants, references, unreachable_cells};
+use sweeps::{cell_sweeps, inflation, octants, reference_octants, references, unreachable_cells};
 
 
 /// Sub-boxes per axis when enclosing the motor angles over an octant (an octant is half as
@@ -279,7 +286,10 @@ pub(crate) fn certify_rows_then<R>(
         SampleBoxes::new(&ra.model, &ra.placement, &refs_a, none),
         SampleBoxes::new(&rb.model, &rb.placement, &refs_b, none),
     );
-    let (mut la, mut lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+    let (mut la, mut lb) = (
+        Levels::with_references(&a0, &a1, reference_octants(&grid_a, &refs_a)),
+        Levels::with_references(&b0, &b1, reference_octants(&grid_b, &refs_b)),
+    );
     if subdivide {
         (la.subs, lb.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
     }
@@ -440,6 +450,85 @@ mod tests {
                 }
             }
             assert!(met > 100, "{name}: {met} of {tried} box pairs meet at the references");
+        }
+    }
+
+    /// The octant pairs held by the whole cells' meeting references ([`held_by_references`])
+    /// change no sub-cell: on T1, T2 and T3 at k = 16, every collision pair's sub-cells,
+    /// levels 2 and 3, are those found without that exit, which decides many pairs.
+    #[test]
+    fn reference_exits_change_no_sub_cell() {
+        let ws = Workspace::THESIS;
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let labels = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap().space.labels;
+            let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
+            let held = |r: &RobotSpec, g: &SampleGrid| reference_octants(g, &references(&r.model, g));
+            let levels = |fast: bool| {
+                let (mut a, mut b) = if fast {
+                    let a = Levels::with_references(&a0, &a1, held(ra, &grid_a));
+                    (a, Levels::with_references(&b0, &b1, held(rb, &grid_b)))
+                } else {
+                    (Levels::new(&a0, &a1), Levels::new(&b0, &b1))
+                };
+                (a.subs, b.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+                (a, b)
+            };
+            let ((fa, fb), (pa, pb)) = (levels(true), levels(false));
+            let nb = b0.len();
+            let collisions = labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision);
+            let decided = collisions.filter(|&(p, _)| held_by_references(&fa, &fb, p / nb, p % nb) != 0).count();
+            let (fast, plain) = (sub_cells(&fa, &fb, &labels, Rows::ALL), sub_cells(&pa, &pb, &labels, Rows::ALL));
+            assert!(fast == plain, "{name}: the references' exit changed sub-cells");
+            assert!(decided > 1000, "{name}: {decided} of {} pairs decided by the references", fast.pairs.len());
+        }
+    }
+
+    /// Level 3 ([`sub_octants_prove_free`], with its hint, its reference test and its columns
+    /// tested only where a row leaves a box pair open) answers as its plain statement
+    /// ([`sub_octants_prove_free_plainly`]) on every octant pair that level 2 leaves open, of
+    /// a spread of collision pairs of T1, T2 and T3 at k = 16.
+    #[test]
+    fn level_3_answers_as_its_plain_statement() {
+        use crate::cspace::label::collision_mask;
+        let ws = Workspace::THESIS;
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let (mut a, mut b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+            let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
+            (a.subs, b.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+            let (na, nb) = (a0.per_entry, b0.per_entry);
+            let all = all_box_pairs(na, nb);
+            let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
+            let (mut hint, mut tried, mut freed) = (0, 0, 0);
+            for ia in (0..a0.len()).step_by(3).filter(|&ia| boxes(&a0, ia)) {
+                for ib in (ia % 5..b0.len()).step_by(5).filter(|&ib| boxes(&b0, ib)) {
+                    let open0 = collision_mask(&a0, ia, &b0, ib, all);
+                    if open0 == 0 {
+                        continue;
+                    }
+                    for (sa, sb) in (0..8).flat_map(|i| (0..8).map(move |j| (8 * ia + i, 8 * ib + j))) {
+                        if !boxes(&a1, sa) || !boxes(&b1, sb) {
+                            continue;
+                        }
+                        let open = collision_mask(&a1, sa, &b0, ib, open0)
+                            & collision_mask(&a0, ia, &b1, sb, open0)
+                            & collision_mask(&a1, sa, &b1, sb, open0);
+                        if open == 0 {
+                            continue;
+                        }
+                        let first = open.trailing_zeros() as usize;
+                        let fast = sub_octants_prove_free(&a, &b, sa, sb, first, || open, &mut hint);
+                        assert_eq!(fast, sub_octants_prove_free_plainly(&a, &b, sa, sb, open), "{name} {sa} {sb}");
+                        (tried, freed) = (tried + 1, freed + fast as usize);
+                    }
+                }
+            }
+            assert!(freed > 100 && tried > freed, "{name}: {freed} of {tried} octant pairs freed");
         }
     }
 

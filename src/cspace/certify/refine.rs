@@ -32,13 +32,22 @@ pub(super) struct Levels<'a> {
     pub(super) octs: &'a SampleBoxes,
     pub(super) whole_cores: Vec<Option<Obb>>,
     pub(super) oct_cores: Vec<Option<Obb>>,
+    /// Per sample: its octants that hold its reference TCP
+    /// ([`octants_holding`](super::sweeps::octants_holding)). `None` turns off
+    /// [`held_by_references`], to test it against the levels without it.
+    pub(super) ref_octants: Option<Vec<u8>>,
     /// Level 3, for the sub-cells only.
     pub(super) subs: Option<SubOctants<'a>>,
 }
 
 impl<'a> Levels<'a> {
     pub(super) fn new(whole: &'a SampleBoxes, octs: &'a SampleBoxes) -> Self {
-        Levels { whole, octs, whole_cores: cores(whole), oct_cores: cores(octs), subs: None }
+        Levels { whole, octs, whole_cores: cores(whole), oct_cores: cores(octs), ref_octants: None, subs: None }
+    }
+
+    /// As [`Levels::new`], with the octants holding each sample's reference TCP.
+    pub(super) fn with_references(whole: &'a SampleBoxes, octs: &'a SampleBoxes, ref_octants: Vec<u8>) -> Self {
+        Levels { ref_octants: Some(ref_octants), ..Levels::new(whole, octs) }
     }
 }
 
@@ -137,16 +146,22 @@ pub(super) fn sub_octants_prove_free(
     if cores_meet(&a.oct_cores, sa, na, &b.oct_cores, sb, nb, open) || hinted && stays(open & !(1 << first)) {
         return false;
     }
-    // Then each sub-octant against the other octant, and the finest test for what is left.
-    let mut columns = [None; 8];
+    // Then each sub-octant against the other octant, and the finest test for what is left. A
+    // column (A's octant against sub-octant `v`) is tested only on the box pairs that some row
+    // left open, each once: only those enter `row & column`.
+    let (mut tested, mut columns) = ([0u64; 8], [0u64; 8]);
     for u in (0..8).filter(|&u| x.slot[u] == Slot::Boxes) {
         let row = collision_mask(x, u, b1, sb, open);
         if row == 0 {
             continue;
         }
         for v in (0..8).filter(|&v| y.slot[v] == Slot::Boxes) {
-            let column = *columns[v].get_or_insert_with(|| collision_mask(a1, sa, y, v, open));
-            if fine(u, v, row & column) != 0 {
+            let untested = row & !tested[v];
+            if untested != 0 {
+                columns[v] |= collision_mask(a1, sa, y, v, untested);
+                tested[v] |= untested;
+            }
+            if fine(u, v, row & columns[v]) != 0 {
                 *hint = 8 * u + v;
                 return false;
             }
@@ -178,7 +193,62 @@ pub(super) fn sub_octants_prove_free(
 /// It only skips tests whose answers it predicts; a "not free" is never a wrong answer.
 pub(super) fn meet_at_references(x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize) -> bool {
     let (i, j) = (ea * x.per_entry + bit / 8, eb * y.per_entry + bit % 8);
-    separating_axis(&x.boxes[i].obb, &y.boxes[j].obb).is_none()
+    meet(&x.boxes[i], &y.boxes[j])
+}
+
+/// Whether two boxes at their entries' reference TCPs (`.obb`) meet: the plain separating axis
+/// test finds no axis (the premise of [`meet_at_references`]). Boxes whose swept AABBs are apart
+/// (by the slack, 1e-6 mm, along a world axis) are not tried: each swept box holds its box, so
+/// such boxes are apart by more than 1e-6 mm, and boxes on which the plain test finds no axis
+/// are within its touch tolerance (1e-9 mm) on each of their 15 axes, so a few times that
+/// apart at most: the answer is the plain test's, found without it.
+fn meet(a: &SweptBox, b: &SweptBox) -> bool {
+    !aabbs_apart(&a.lo, &a.hi, &b.lo, &b.hi) && separating_axis(&a.obb, &b.obb).is_none()
+}
+
+/// The octant pairs of `(ia, ib)` (bits as [`sub_cell_index`]) that level 2 and level 3 leave
+/// collisions because the boxes meet at the whole cells' reference TCPs: those of A's octants
+/// holding A's reference (`a.ref_octants`) with B's octants holding B's; 0 when the boxes do
+/// not meet there or a cell has no boxes.
+///
+/// A box pair meeting at both references is open after every test whose cubes hold the two
+/// references ([`meet_at_references`], first two points): the whole cells' test, each of
+/// those octants' with the other cell ([`sub_cell_masks`]' rows and columns) and the octant
+/// pair's own, so level 2 leaves such an octant pair a collision on it. At level 3 the
+/// octant's sub-octants cover its cube, so a sub-octant of each holds the reference (a point
+/// counted in an octant lies within `HOLD_SLACK` of its cube, so within as much of one of its
+/// sub-octants' cubes, inside what their sweeps cover:
+/// [`octants_holding`](super::sweeps::octants_holding)), and the three tests of that sub-octant
+/// pair keep the box pair open too; a sub-octant with no reachable TCP cannot hold a reachable
+/// reference. The cell centres, when reachable (the usual reference), are held by all 8
+/// octants: the 64 octant pairs are decided by a few plain tests.
+///
+/// Like [`meet_at_references`], it only skips tests whose answers it predicts; a test checks
+/// that the sub-cells are those found without it.
+pub(super) fn held_by_references(a: &Levels, b: &Levels, ia: usize, ib: usize) -> u64 {
+    let (a0, b0) = (a.whole, b.whole);
+    let (Some(in_a), Some(in_b)) = (&a.ref_octants, &b.ref_octants) else { return 0 };
+    let (in_a, in_b) = (in_a[ia], in_b[ib]);
+    if in_a == 0 || in_b == 0 || a0.slot[ia] != Slot::Boxes || b0.slot[ib] != Slot::Boxes {
+        return 0;
+    }
+    let (na, nb) = (a0.per_entry, b0.per_entry);
+    let mut pairs = all_box_pairs(na, nb);
+    let met = loop {
+        if pairs == 0 {
+            break false;
+        }
+        let p = pairs.trailing_zeros() as usize;
+        pairs &= pairs - 1;
+        if meet_at_references(a0, ia, b0, ib, p) {
+            break true;
+        }
+    };
+    if !met {
+        return 0;
+    }
+    let column = (0..8).filter(|&j| in_b >> j & 1 == 1).fold(0u64, |m, j| m | 1 << sub_cell_index(0, j));
+    (0..8).filter(|&i| in_a >> i & 1 == 1).fold(0, |m, i| m | column << sub_cell_index(i, 0))
 }
 
 /// Per box of `boxes`: its core under its sweep, when its entry has boxes and the core exists.
@@ -269,6 +339,8 @@ pub(super) fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize
 ///   octant (its column). Such an octant pair is never proved free by [`octant_pairs`]: its
 ///   octants are [`Slot::Boxes`] only with reachable reference TCPs, a configuration of the
 ///   pair that collides, and its tests are sound; other octants it calls collisions anyway.
+/// - an octant pair is a collision without its tests when a box pair meets at the whole
+///   cells' reference TCPs and its octants hold them ([`held_by_references`]).
 /// - a box pair of an octant pair is proved disjoint when one of the tests (A octant, B
 ///   cell), (A cell, B octant), (A octant, B octant) proves it (after the whole cells left it
 ///   open); an octant pair is free when all its box pairs are. The octant-cell tests are
@@ -283,6 +355,12 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
     let care = care_mask(a1, ia, b1, ib);
     let (whole_a, whole_b) = (a0.slot[ia] == Slot::Boxes, b0.slot[ib] == Slot::Boxes);
     let all = all_box_pairs(na, nb);
+    // Octant pairs left collisions by the boxes at the cells' references (the labelling found
+    // them meeting there and skipped level 2).
+    let held = if first_only { 0 } else { held_by_references(a, b, ia, ib) };
+    if care & !held == 0 {
+        return (care, care);
+    }
     // A box pair whose cores meet is never proved disjoint: no need to look for it among
     // those the whole cells leave open.
     if whole_a && whole_b && cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) {
@@ -313,7 +391,7 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
                 continue;
             }
             let (sa, sb) = (8 * ia + i, 8 * ib + j);
-            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meet || column_meet;
+            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meet || column_meet || held & bit != 0;
             // Whether box pair `p` stays open: no test of the octant pair proves it.
             let mut open = |p: usize| {
                 rows.open(i, p, || !whole_b || touch(a1, sa, b0, ib, p))
@@ -432,6 +510,31 @@ pub(super) fn octant_pairs(
         }
     }
     (care, collision)
+}
+
+/// Level 3 of octant pair (A's entry `sa`, B's entry `sb`) as the module doc of `certify`
+/// states it, to test [`sub_octants_prove_free`]: free when no box pair of `open` has its
+/// octant cores meet, every sub-octant is [`Slot::Boxes`] or [`Slot::Vacuous`], and for
+/// every pair of sub-octants with boxes each box pair of `open` is proved disjoint by
+/// (A sub-octant, B sub-octant), (A sub-octant, B octant) or (A octant, B sub-octant).
+#[cfg(test)]
+pub(super) fn sub_octants_prove_free_plainly(a: &Levels, b: &Levels, sa: usize, sb: usize, open: u64) -> bool {
+    let (Some(sub_a), Some(sub_b)) = (&a.subs, &b.subs) else { return false };
+    let (a1, b1, na, nb) = (a.octs, b.octs, a.octs.per_entry, b.octs.per_entry);
+    let (x, y) = (sub_a.of(sa), sub_b.of(sb));
+    let usable = |slot: Slot| slot == Slot::Boxes || slot == Slot::Vacuous;
+    if !x.slot[..8].iter().chain(&y.slot[..8]).all(|&s| usable(s))
+        || cores_meet(&a.oct_cores, sa, na, &b.oct_cores, sb, nb, open)
+    {
+        return false;
+    }
+    let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
+    (0..8).filter(|&u| boxes(x, u)).all(|u| {
+        (0..8).filter(|&v| boxes(y, v)).all(|v| {
+            let left = collision_mask(x, u, b1, sb, open) & collision_mask(a1, sa, y, v, open);
+            collision_mask(x, u, y, v, left) == 0
+        })
+    })
 }
 
 /// Level 2 for a pair whose whole-cell test failed or could not run (a sample without a

@@ -85,6 +85,38 @@ pub(super) fn octant_centre(c: &Vec3, o: usize, d: Real) -> Vec3 {
     c + Vec3::from_fn(|a, _| if o >> a & 1 == 1 { d } else { -d })
 }
 
+/// How far (mm) a point may lie outside an octant's cube, as computed, and still be counted
+/// in it by [`octants_holding`].
+///
+/// An octant's displacement sets cover every reachable TCP of its cube widened by at least
+/// 1e-12 mm (`cube_box_sweeps_with`: half-side `h (1 + 1e-12) + 1e-12`, about the computed
+/// centre). For coordinates below [`HOLD_RANGE`] mm the cube's computed bounds are within
+/// 6e-14 mm of the widened ones (half a unit in the last place below 1024), and the difference
+/// of two coordinates is within 1.2e-13 mm of its exact value: a point whose computed distance
+/// from the centre is within `h + HOLD_SLACK` on every axis lies within `h + 6.2e-13` mm, inside
+/// the covered cube (`h + 9.4e-13` or more) with 3e-13 mm to spare. A cell's centre, a corner of
+/// each of its octants (their centres are `c +/- h`, each rounded by at most 6e-14 mm), passes
+/// for all 8; so does an octant's centre for its sub-octants.
+pub(super) const HOLD_SLACK: Real = 5e-13;
+
+/// Coordinates (mm, MCS) below which [`HOLD_SLACK`] holds; the workspace lies well within.
+pub(super) const HOLD_RANGE: Real = 1024.0;
+
+/// Which octants (bit `o`: centre [`octant_centre`]`(c, o, h)`, half-side `h`) of the cube
+/// of centre `c` and half-side `2 h` hold `p`, counted as their displacement sets count it
+/// ([`HOLD_SLACK`]); none when a coordinate is outside [`HOLD_RANGE`].
+pub(super) fn octants_holding(c: &Vec3, h: Real, p: &Vec3) -> u8 {
+    if !(c.amax() < HOLD_RANGE && p.amax() < HOLD_RANGE) {
+        return 0;
+    }
+    (0..8).filter(|&o| (p - octant_centre(c, o, h)).amax() <= h + HOLD_SLACK).fold(0, |m, o| m | 1 << o)
+}
+
+/// Per sample: the octants holding its reference point `refs[s]` ([`octants_holding`]).
+pub(super) fn reference_octants(grid: &SampleGrid, refs: &[Vec3]) -> Vec<u8> {
+    refs.iter().enumerate().map(|(s, p)| octants_holding(&grid.sample_center(s), 0.25 * grid.r, p)).collect()
+}
+
 /// The box sweeps over the cube of centre `c` and half-side `h` (about `reference`, with
 /// [`OCTANT_SPLITS`]), or `None` when the cube is proved to hold no reachable TCP or has no
 /// bound: the octants and sub-octants of levels 2 and 3.
@@ -148,4 +180,46 @@ pub(super) fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<
         })
         .collect();
     (refs, inflation)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::TestRng;
+
+    /// A cube's centre is held by all 8 octants; a point inside an octant, away from the
+    /// others, by that one only; a point farther out than the slack by none. Random points of
+    /// the cube (and of its faces and edges) are held by at least one octant, and every holding
+    /// octant has them within `h + 1e-12` mm of its centre on each axis, inside the cube its
+    /// displacement sets cover.
+    #[test]
+    fn octants_holding_counts_what_the_sweeps_cover() {
+        let mut rng = TestRng(0x9e37_79b9_7f4a_7c15);
+        for _ in 0..20_000 {
+            let c = rng.vec(600.0);
+            let h = 0.5 + 40.0 * (rng.unit() + 1.0);
+            assert_eq!(octants_holding(&c, h, &c), 0xff, "centre {c:?} h {h}");
+            let o = (rng.next_u64() % 8) as usize;
+            let inside = octant_centre(&c, o, h) + rng.vec(0.9 * h);
+            assert_eq!(octants_holding(&c, h, &inside), 1 << o);
+            let mut out = c;
+            out[(rng.next_u64() % 3) as usize] += 2.0 * h * (1.0 + 1e-9);
+            assert_eq!(octants_holding(&c, h, &out), 0);
+            // A point of the cube, snapped to a face, edge or the centre's planes at random.
+            let mut p = c + rng.vec(2.0 * h);
+            for a in 0..3 {
+                match rng.next_u64() % 4 {
+                    0 => p[a] = c[a],
+                    1 => p[a] = c[a] + 2.0 * h,
+                    _ => {}
+                }
+            }
+            let held = octants_holding(&c, h, &p);
+            assert_ne!(held, 0, "{p:?} in the cube of {c:?}, h {h}");
+            for o in (0..8).filter(|o| held >> o & 1 == 1) {
+                assert!((p - octant_centre(&c, o, h)).amax() <= h + 1e-12, "octant {o} of {c:?} holds {p:?}");
+            }
+        }
+        assert_eq!(octants_holding(&Vec3::new(2000.0, 0.0, 0.0), 1.0, &Vec3::new(2000.0, 0.0, 0.0)), 0);
+    }
 }
