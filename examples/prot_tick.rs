@@ -40,12 +40,16 @@ fn main() {
         let mut exact = ExactChecker::new(cell);
         let mut tcps = vec![Vec3::zeros(); n];
         let (mut tp, mut te) = (Vec::new(), Vec::new());
+        // The protective times again, by the tick's verdict (FREE, WARN, STOP).
+        let mut by_verdict: [Vec<f64>; 3] = Default::default();
         let (mut stops, mut warns) = (0, 0);
         // The reported speed limits of the first pass (mm/s): their sum and count, for the mean.
         let (mut limit_sum, mut limit_count) = (0.0, 0u32);
         // The first pass's verdicts and limiting pairs, tick by tick, hashed (FNV-1a): equal
-        // hashes say two builds gave the same answers; and the first WARN and STOP ticks.
-        let mut answers: u64 = 0xcbf2_9ce4_8422_2325;
+        // hashes say two builds gave the same answers; the verdicts alone, likewise (the
+        // limiting pair is any pair not proved, and may change with the order of the tests);
+        // and the first WARN and STOP ticks.
+        let (mut answers, mut verdicts): (u64, u64) = (0xcbf2_9ce4_8422_2325, 0xcbf2_9ce4_8422_2325);
         let (mut first_warn, mut first_stop) = (None, None);
         for rep in 0..repeats * usize::from(std::env::var("COMPONENTS").is_err()) {
             c.reset();
@@ -63,6 +67,7 @@ fn main() {
                 std::hint::black_box(exact.check(&tcps).unwrap().collides());
                 let t2 = Instant::now();
                 tp.push((t1 - t0).as_secs_f64() * 1e6);
+                by_verdict[v as usize].push((t1 - t0).as_secs_f64() * 1e6);
                 te.push((t2 - t1).as_secs_f64() * 1e6);
                 if rep == 0 {
                     let r = c.report();
@@ -70,6 +75,7 @@ fn main() {
                     for x in [v as u64, limiting as u64] {
                         answers = (answers ^ x).wrapping_mul(0x0100_0000_01b3);
                     }
+                    verdicts = (verdicts ^ v as u64).wrapping_mul(0x0100_0000_01b3);
                     first_warn = first_warn.or((v == Protective::Warn).then_some(tick));
                     first_stop = first_stop.or((v == Protective::Stop).then_some(tick));
                     stops += (v == Protective::Stop) as u32;
@@ -112,6 +118,10 @@ fn main() {
             continue;
         }
         let ((pm, p99, pmean), (em, _, _)) = (q(&mut tp), q(&mut te));
+        for (name, t) in ["FREE", "WARN", "STOP"].iter().zip(&mut by_verdict).filter(|(_, t)| !t.is_empty()) {
+            let (m, p, _) = q(t);
+            println!("  {name} ticks: median {m:.3} us, p99 {p:.1} us");
+        }
         let mean_limit = match limit_count {
             0 => String::new(),
             n => format!(", mean speed limit {:.1} mm/s", limit_sum / n as f64),
@@ -119,7 +129,7 @@ fn main() {
         println!(
             "{} {}: STOP {stops} WARN {warns}; protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, \
              exact median {em:.3} us{mean_limit}; first WARN {first_warn:?} STOP {first_stop:?}, \
-             answers {answers:016x}",
+             answers {answers:016x}, verdicts {verdicts:016x}",
             s.cell, s.case
         );
     }

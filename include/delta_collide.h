@@ -289,8 +289,9 @@ typedef struct DcProtectiveReport {
    */
   uint32_t closest_box_b;
   /*
-   The first box pair not proved apart over a stop (STOP) or not with `warn_mm` to spare
-   (WARN): robots and boxes, or `DC_BOX_NONE`.
+   A box pair not proved apart over a stop (STOP) or not with `warn_mm` to spare (WARN):
+   robots and boxes, or `DC_BOX_NONE`. The closest pair now when that one is certain to
+   stay unproved, else the first such pair in the order of the robots and boxes.
    */
   uint32_t limiting_robot_a;
   /*

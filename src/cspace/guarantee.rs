@@ -73,7 +73,7 @@ use crate::cspace::sampler::SampleGrid;
 use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
-use crate::robot::delta3::{radial, tangent};
+use crate::robot::delta3::{radial, tangent, ArmSolution};
 use crate::robot::{BoxKind, Delta3, RobotModel};
 
 /// Sub-boxes per axis when enclosing the motor angles over a cell (`SPLITS^3` per arm).
@@ -330,7 +330,7 @@ pub fn cube_box_sweeps_with(
     p0: &Vec3,
     enclose: impl FnOnce(&Vec3, &Vec3) -> [Enclosure; 3],
 ) -> Option<[Sweep; MAX_BOXES]> {
-    let (d, o) = (&model.delta, &model.options);
+    let d = &model.delta;
     let n = model.box_count();
     let h = h * (1.0 + 1e-12) + 1e-12;
     let (lo, hi) = (c.add_scalar(-h), c.add_scalar(h));
@@ -344,30 +344,75 @@ pub fn cube_box_sweeps_with(
         }
     }
     let Ok(sol) = d.inverse_kinematics(p0) else { return Some(unknown(model)) };
-    // Per axis, the farthest any TCP of the cube lies from p0 (h at the centre).
-    let reach = (p0 - c).abs().add_scalar(h);
-    let dp = reach.norm();
-    let cube = [Vec3::x() * reach.x, Vec3::y() * reach.y, Vec3::z() * reach.z];
-    let dth: [Real; 3] = std::array::from_fn(|arm| {
-        (th[arm].hi - sol.theta[arm]).max(sol.theta[arm] - th[arm].lo).clamp(0.0, std::f64::consts::PI)
-    });
-    let dg = dth.map(|a| 2.0 * d.rf * (0.5 * a).sin());
-    // The elbow's arc: `G - G0 = rf (sin D tau0 + (cos D - 1) nu0)` for `|D| <= dth`.
-    let arc = |arm: usize| {
-        let (s, c) = (sol.theta[arm].sin(), sol.theta[arm].cos());
-        let u = radial(arm);
-        let (nu0, tau0) = (u * c - Vec3::z() * s, -u * s - Vec3::z() * c);
-        let (along, inward) = (dth[arm].min(std::f64::consts::FRAC_PI_2).sin(), 1.0 - dth[arm].cos());
-        (tau0, nu0, along, inward)
-    };
-    let m = o.margin;
+    let swing = CubeSwing::new(model, c, h, p0, &sol, &th, 0b111);
     let mut out = [Sweep::ZERO; MAX_BOXES];
     for (j, slot) in out[..n].iter_mut().enumerate() {
+        *slot = swing.box_sweep(model, p0, j);
+    }
+    Some(out)
+}
+
+/// The sweep of box `j` alone of [`cube_box_sweeps_with`], for the cube of centre `c` and
+/// half-side `h` (widened as there), measured from the reachable `p0` with its inverse
+/// kinematics `sol`, the motor angles over the cube enclosed by `th`: the same operations, so
+/// the same sweep to the bit, without the other boxes'. Only box `j`'s arm's entries of `sol`
+/// and `th` are read.
+pub fn cube_box_sweep(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, sol: &ArmSolution, th: &[Interval; 3], j: usize) -> Sweep {
+    let h = h * (1.0 + 1e-12) + 1e-12;
+    let arms = match model.box_kind(j) {
+        BoxKind::LowerLink(arm) | BoxKind::UpperLink(arm) => 1 << arm,
+        BoxKind::Platform | BoxKind::Tool => 0,
+    };
+    CubeSwing::new(model, c, h, p0, sol, th, arms).box_sweep(model, p0, j)
+}
+
+/// What every box's sweep over a cube shares: the TCP's reach per axis and in all, and each
+/// arm's largest turn `dth`, the elbow's chord `dG` and its arc (module doc, steps 1-3);
+/// the arm terms only for the arms asked for (the others stay 0 and are not to be read).
+struct CubeSwing {
+    reach: Vec3,
+    dp: Real,
+    cube: [Vec3; 3],
+    dth: [Real; 3],
+    dg: [Real; 3],
+    theta0: [Real; 3],
+}
+
+impl CubeSwing {
+    /// The terms for the (already widened) half-side `h`.
+    fn new(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, sol: &ArmSolution, th: &[Interval; 3], arms: u8) -> CubeSwing {
+        let d = &model.delta;
+        // Per axis, the farthest any TCP of the cube lies from p0 (h at the centre).
+        let reach = (p0 - c).abs().add_scalar(h);
+        let dp = reach.norm();
+        let cube = [Vec3::x() * reach.x, Vec3::y() * reach.y, Vec3::z() * reach.z];
+        let (mut dth, mut dg) = ([0.0; 3], [0.0; 3]);
+        for arm in (0..3).filter(|arm| arms >> arm & 1 == 1) {
+            dth[arm] = (th[arm].hi - sol.theta[arm]).max(sol.theta[arm] - th[arm].lo).clamp(0.0, std::f64::consts::PI);
+            dg[arm] = 2.0 * d.rf * (0.5 * dth[arm]).sin();
+        }
+        CubeSwing { reach, dp, cube, dth, dg, theta0: sol.theta }
+    }
+
+    /// The elbow's arc: `G - G0 = rf (sin D tau0 + (cos D - 1) nu0)` for `|D| <= dth`.
+    fn arc(&self, arm: usize) -> (Vec3, Vec3, Real, Real) {
+        let (s, c) = (self.theta0[arm].sin(), self.theta0[arm].cos());
+        let u = radial(arm);
+        let (nu0, tau0) = (u * c - Vec3::z() * s, -u * s - Vec3::z() * c);
+        let (along, inward) = (self.dth[arm].min(std::f64::consts::FRAC_PI_2).sin(), 1.0 - self.dth[arm].cos());
+        (tau0, nu0, along, inward)
+    }
+
+    /// Box `j`'s sweep (module doc, per box kind).
+    fn box_sweep(&self, model: &RobotModel, p0: &Vec3, j: usize) -> Sweep {
+        let (d, o) = (&model.delta, &model.options);
+        let (reach, dp, cube) = (&self.reach, self.dp, self.cube);
+        let m = o.margin;
         let sweep = match model.box_kind(j) {
             BoxKind::LowerLink(arm) => {
                 let (arm, t) = (arm as usize, tangent(arm as usize));
                 let mu = m / d.re;
-                let dx = ((dp + dg[arm]) / d.re).min(2.0);
+                let dx = ((dp + self.dg[arm]) / d.re).min(2.0);
                 let tt = (reach.x * t.x.abs() + reach.y * t.y.abs()) / d.re;
                 let beta = p0.dot(&t).abs() / d.re + tt;
                 if beta >= 1.0 {
@@ -377,7 +422,7 @@ pub fn cube_box_sweeps_with(
                     let dz = (dx / w0).min(2.0);
                     let dy = ((beta * dx + tt) / w0).min(2.0);
                     let ball = (o.half_height + m) * dy + (o.half_depth + m) * dz;
-                    let (tau0, nu0, along, inward) = arc(arm);
+                    let (tau0, nu0, along, inward) = self.arc(arm);
                     let arc = [tau0 * (d.rf * along), nu0 * (d.rf * inward)];
                     Sweep { cube, arc, ends: [(mu, 1.0 + mu), (1.0 + mu, mu)], ball }
                 }
@@ -386,16 +431,15 @@ pub fn cube_box_sweeps_with(
                 // `lambda (G - G0) + s_z (z - z0)`, `|lambda| <= 1 + m/rf`, `|s_z| <= d_u + m`,
                 // with `z - z0` the link axis's turn: `sin D` along nu0, `1 - cos D` along tau0.
                 let (_, du) = o.upper_links.expect("upper link boxes exist");
-                let (tau0, nu0, along, inward) = arc(arm as usize);
+                let (tau0, nu0, along, inward) = self.arc(arm as usize);
                 let (l, w) = (d.rf + m, du + m);
                 let arc = [tau0 * (l * along + w * inward), nu0 * (l * inward + w * along)];
                 Sweep { cube, arc, ends: [(0.0, 1.0); 2], ball: 0.0 }
             }
             BoxKind::Platform | BoxKind::Tool => Sweep { cube, ends: [(1.0, 0.0); 2], ..Sweep::ZERO },
         };
-        *slot = Sweep { ball: sweep.ball + BOUND_SLACK, ..sweep };
+        Sweep { ball: sweep.ball + BOUND_SLACK, ..sweep }
     }
-    Some(out)
 }
 
 /// The thesis's global blow-up margin for spacing `r`: `r / sqrt(2)` (thesis 3.2.7; not a

@@ -309,8 +309,9 @@ pub struct DcProtectiveReport {
     pub closest_box_a: u32,
     /// See `closest_robot_a`.
     pub closest_box_b: u32,
-    /// The first box pair not proved apart over a stop (STOP) or not with `warn_mm` to spare
-    /// (WARN): robots and boxes, or `DC_BOX_NONE`.
+    /// A box pair not proved apart over a stop (STOP) or not with `warn_mm` to spare (WARN):
+    /// robots and boxes, or `DC_BOX_NONE`. The closest pair now when that one is certain to
+    /// stay unproved, else the first such pair in the order of the robots and boxes.
     pub limiting_robot_a: u32,
     /// See `limiting_robot_a`.
     pub limiting_robot_b: u32,

@@ -74,6 +74,12 @@
 //!    before it stay proved (a narrower angle range, a smaller sweep), it stays the first
 //!    unproved one, and the verdict and limiting pair are final without tier 2's direct
 //!    enclosures. This test only ends a search for a proof; it never proves anything.
+//! 8. **Certain STOP, first.** Any box pair that steps 6 or 7 show no tier can prove apart
+//!    makes the tick STOP, whatever the other pairs give: the verdict does not depend on the
+//!    order in which pairs are tried, only the limiting pair reported (then that pair: one
+//!    the proof cannot separate). So both tests are tried first on the closest box pair now,
+//!    the likeliest to fail (step 7 only after a STOP tick, when another STOP is likely),
+//!    before step 6 on every pair and before any sweep of a tier.
 //!
 //! The **speed limit** of a robot is the largest measured speed `|v_fd|` in `[0, v_max]` at
 //! which every pair involving it is still proved, the other robots as they are: bisection to
@@ -108,13 +114,14 @@
 
 use crate::cell::exact::PairVerdict;
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
-use crate::cspace::guarantee::{cube_box_sweeps, cube_box_sweeps_with, theta_range, Enclosure};
+use crate::cspace::guarantee::{cube_box_sweep, cube_box_sweeps, cube_box_sweeps_with, theta_range, Enclosure};
 use crate::cspace::interval::Interval;
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
-use crate::geometry::sweep::{swept_boxes_apart_with, FaceTerms};
+use crate::geometry::sweep::{swept_boxes_apart_either, swept_boxes_apart_with, FaceTerms};
 use crate::robot::MAX_BOXES;
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
+use crate::robot::delta3::ArmSolution;
 use crate::robot::motor_table::{intersect, MotorTable};
 use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
 use alloc::sync::Arc;
@@ -240,7 +247,9 @@ pub struct ProtectiveReport {
     pub clearance_mm: Real,
     /// The box pair of the smallest clearance now.
     pub closest: Option<BoxPair>,
-    /// The first box pair not proved apart (STOP) or not with `warn_mm` to spare (WARN).
+    /// A box pair not proved apart (STOP) or not with `warn_mm` to spare (WARN): the closest
+    /// pair now when that one is certain to stay unproved (module doc, step 8), else the first
+    /// such pair in the order of the robots and boxes.
     pub limiting: Option<BoxPair>,
     /// One entry per robot.
     pub robots: alloc::vec::Vec<RobotProtection>,
@@ -311,8 +320,9 @@ pub struct ProtectiveChecker {
     /// 6), for [`ProtectiveChecker::certain_stop`]: built once per reference, not once per
     /// test (another robot's stay the same through all the speed-limit tests of a tick).
     least: alloc::vec::Vec<[(Sweep, FaceTerms); MAX_BOXES]>,
-    /// Per robot, whether `least` holds the terms of its current reference.
-    least_set: alloc::vec::Vec<bool>,
+    /// Per robot, which boxes' terms `least` holds for its current reference (bit `k`: box
+    /// `k`).
+    least_set: alloc::vec::Vec<u8>,
     /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
     kept: kept::Kept,
     /// Per robot pair that can meet, what its clearance was at the last tick: where this
@@ -386,7 +396,7 @@ impl ProtectiveChecker {
             sweep_tier: alloc::vec![None; n],
             no_faces,
             least: alloc::vec![[(Sweep::ZERO, no_faces); MAX_BOXES]; n],
-            least_set: alloc::vec![false; n],
+            least_set: alloc::vec![0; n],
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
             kept,
@@ -649,7 +659,7 @@ impl ProtectiveChecker {
     /// with `from_history`, each speed limit's search starts at the last tick's limit; with
     /// `table`, a tick the table's bound proves FREE is answered from it.
     fn evaluate(&mut self, tcps_mcs: &[Vec3], status: ProtectiveStatus, from_history: bool, table: Option<ClearanceBound>) {
-        let was_free = self.report.verdict == Protective::Free;
+        let (was_free, was_stop) = (self.report.verdict == Protective::Free, self.report.verdict == Protective::Stop);
         let report = &mut self.report;
         (report.verdict, report.status, report.clearance_mm) = (Protective::Stop, status, Real::NAN);
         (report.closest, report.limiting, report.kept_proof, report.table_lookup) = (None, None, false, false);
@@ -689,7 +699,7 @@ impl ProtectiveChecker {
         // table's bounds (this tick's sweeps of the table's tier, which the proof reuses).
         if kept {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
-        } else if let Some(pair) = self.certain_stop(None) {
+        } else if let Some(pair) = self.certain_stop_now(was_stop) {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
         } else if was_free && self.keep_and_prove() {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
@@ -714,17 +724,8 @@ impl ProtectiveChecker {
             let mut first = true;
             while let (Some(p), true) = (self.report.limiting, splits > 0) {
                 let extra = if self.report.verdict == Protective::Warn { self.warn_mm } else { 0.0 };
-                let least = if core::mem::take(&mut first) {
-                    (self.least_sweeps(p.a, p.box_a), self.least_sweeps(p.b, p.box_b))
-                } else {
-                    (None, None)
-                };
-                if let (Some(la), Some(lb)) = least {
-                    let box_a = &self.ref_boxes[p.a].as_slice()[p.box_a];
-                    let box_b = &self.ref_boxes[p.b].as_slice()[p.box_b];
-                    if !pair_apart_in_some_form(box_a, [&la[0], &la[1]], box_b, [&lb[0], &lb[1]], extra) {
-                        break;
-                    }
+                if core::mem::take(&mut first) && self.beyond_every_tier(p, extra) {
+                    break;
                 }
                 let (arms_a, arms_b) = (self.arm_bit(p.a, p.box_a), self.arm_bit(p.b, p.box_b));
                 let refined = |me: &Self, j: usize| match me.tables[j] {
@@ -848,7 +849,7 @@ impl ProtectiveChecker {
                 *b = b.transformed(&rot, &t);
             }
         }
-        (self.centres[j], self.reach[j], self.sweep_tier[j], self.least_set[j]) = (centre, radius, None, false);
+        (self.centres[j], self.reach[j], self.sweep_tier[j], self.least_set[j]) = (centre, radius, None, 0);
         s
     }
 
@@ -897,10 +898,12 @@ impl ProtectiveChecker {
         let (centre, s) = (self.centres[j], self.reach[j]);
         let at_centre = d.inverse_kinematics_cos_sin(&centre).ok()?;
         // Box `k`'s sweep depends on its own arm's range alone; the others' are not read.
-        let mut th = [Enclosure::Range(Interval::point(0.0)); 3];
+        let mut th = [Interval::point(0.0); 3];
+        let mut sol = ArmSolution { theta: [0.0; 3], cos: at_centre.cos, sin: at_centre.sin };
         if let BoxKind::LowerLink(arm) | BoxKind::UpperLink(arm) = robot.model.box_kind(k) {
             let i = arm as usize;
-            let theta0 = at_centre.sin[i].atan2(at_centre.cos[i]);
+            let theta0 = at_centre.theta(i);
+            sol.theta[i] = theta0;
             // `w = E_i - G_i`: the platform joint `p + e u_i` less the elbow
             // `(f + rf cos th) u_i - rf sin th z`.
             let u = crate::robot::delta3::radial(i);
@@ -909,7 +912,7 @@ impl ProtectiveChecker {
             let (mut lo, mut hi) = (theta0, theta0);
             for corner in [centre + toward, centre - toward] {
                 let Ok(at) = d.inverse_kinematics_cos_sin(&corner) else { continue };
-                let theta = at.sin[i].atan2(at.cos[i]);
+                let theta = at.theta(i);
                 // A NaN is not close either: nothing learned.
                 let close = (theta - theta0).abs() <= core::f64::consts::FRAC_PI_2;
                 if !close {
@@ -917,26 +920,40 @@ impl ProtectiveChecker {
                 }
                 (lo, hi) = (lo.min(theta + ANGLE_SLACK), hi.max(theta - ANGLE_SLACK));
             }
-            th[i] = Enclosure::Range(Interval::new(lo, hi));
+            th[i] = Interval::new(lo, hi);
         }
-        let sweeps = cube_box_sweeps_with(&robot.model, &centre, s, &centre, |_, _| th)?;
-        let mut out = [[Sweep::ZERO; MAX_BOXES]; 2];
-        write_forms(&mut out, Some(sweeps), &robot.placement.rotation(), s);
-        Some(out.map(|form| Sweep { ball: (form[k].ball - LEAST_SLACK).max(0.0), ..form[k] }))
+        let sweep = cube_box_sweep(&robot.model, &centre, s, &centre, &sol, &th, k);
+        let forms = sweep_forms(&sweep, &robot.placement.rotation(), s);
+        Some(forms.map(|form| Sweep { ball: (form.ball - LEAST_SLACK).max(0.0), ..form }))
+    }
+
+    /// Whether box pair `p` is certain not to be proved apart (with `extra` mm added to the
+    /// first robot's sweeps) by the sweeps of any tier (module doc, step 7); `false` when that
+    /// is not known.
+    fn beyond_every_tier(&self, p: BoxPair, extra: Real) -> bool {
+        let (Some(la), Some(lb)) = (self.least_sweeps(p.a, p.box_a), self.least_sweeps(p.b, p.box_b)) else {
+            return false;
+        };
+        let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
+        !pair_apart_in_some_form(box_a, [&la[0], &la[1]], box_b, [&lb[0], &lb[1]], extra)
     }
 
     /// A box pair (of the pairs involving `only`, or of all) that no sweeps of any tier can
     /// prove apart: every sweep of a lower link, platform or tool box holds the ball of the
     /// TCP's stopping radius (module doc, step 6), so when the reference boxes swept by those
     /// balls alone are not proved apart, neither are they with the full sweeps.
-    fn certain_stop(&mut self, only: Option<usize>) -> Option<BoxPair> {
+    fn certain_stop(&mut self, only: Option<usize>, hint: Option<BoxPair>) -> Option<BoxPair> {
+        // The closest box pair now is the likeliest to fail: tested first.
+        if let Some(h) = hint.filter(|h| only.is_none_or(|j| h.a == j || h.b == j) && self.ball_swept_meet(*h)) {
+            return Some(h);
+        }
         for k in 0..self.exact.verdict().pairs.len() {
             let p = self.exact.verdict().pairs[k];
             if !only.is_none_or(|j| p.a == j || p.b == j) {
                 continue;
             }
-            self.set_least(p.a);
-            self.set_least(p.b);
+            self.set_least_all(p.a);
+            self.set_least_all(p.b);
             let (swept_a, swept_b) = (&self.least[p.a], &self.least[p.b]);
             for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(swept_a).enumerate() {
                 for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(swept_b).enumerate() {
@@ -949,20 +966,47 @@ impl ProtectiveChecker {
         None
     }
 
-    /// Robot `j`'s terms of [`ProtectiveChecker::certain_stop`] for its current reference, when
-    /// not yet built: each box's sweep and face terms once per robot, not once per box pair
-    /// (the same test as `swept_boxes_apart`, which builds both face terms for every pair).
-    fn set_least(&mut self, j: usize) {
-        if self.least_set[j] {
+    /// Whether box pair `p`'s reference boxes swept by their stop balls alone are not proved
+    /// apart: step 6 for one pair.
+    fn ball_swept_meet(&mut self, p: BoxPair) -> bool {
+        self.set_least(p.a, p.box_a);
+        self.set_least(p.b, p.box_b);
+        let ((sa, fa), (sb, fb)) = (&self.least[p.a][p.box_a], &self.least[p.b][p.box_b]);
+        let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
+        !swept_boxes_apart_with(box_a, sa, fa, box_b, sb, fb)
+    }
+
+    /// The tick's certain STOP before any sweep of a tier (module doc, steps 6 and 7): step 6
+    /// on the closest box pair now, the likeliest to fail, and, after a STOP (when another is
+    /// likely), step 7 on it too; then step 6 on every pair.
+    fn certain_stop_now(&mut self, after_stop: bool) -> Option<BoxPair> {
+        if let Some(h) = self.report.closest {
+            if self.ball_swept_meet(h) || (after_stop && self.beyond_every_tier(h, 0.0)) {
+                return Some(h);
+            }
+        }
+        self.certain_stop(None, None)
+    }
+
+    /// Box `k` of robot `j`'s terms of [`ProtectiveChecker::certain_stop`] for its current
+    /// reference, when not yet built: each box's sweep and face terms once per reference, not
+    /// once per box pair (the same test as `swept_boxes_apart`, which builds both face terms for
+    /// every pair), and only for the boxes tested.
+    fn set_least(&mut self, j: usize, k: usize) {
+        if self.least_set[j] >> k & 1 == 1 {
             return;
         }
-        let model = &self.exact.cell().robots[j].model;
-        for (k, (b, slot)) in self.ref_boxes[j].as_slice().iter().zip(&mut self.least[j]).enumerate() {
-            let moves_with_tcp = !matches!(model.box_kind(k), BoxKind::UpperLink(_));
-            let w = Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO };
-            *slot = (w, FaceTerms::new(b, &w));
+        let moves_with_tcp = !matches!(self.exact.cell().robots[j].model.box_kind(k), BoxKind::UpperLink(_));
+        let w = Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO };
+        self.least[j][k] = (w, FaceTerms::new(&self.ref_boxes[j].as_slice()[k], &w));
+        self.least_set[j] |= 1 << k;
+    }
+
+    /// [`ProtectiveChecker::set_least`] for every box of robot `j`.
+    fn set_least_all(&mut self, j: usize) {
+        for k in 0..self.ref_boxes[j].len {
+            self.set_least(j, k);
         }
-        self.least_set[j] = true;
     }
 
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are: the search
@@ -986,7 +1030,7 @@ impl ProtectiveChecker {
             if me.kept.set_inside(j, &[(me.centres[j], me.reach[j]), (*tcp_mcs, s)]) && me.kept_free(Some(j)) {
                 return true;
             }
-            if me.certain_stop(Some(j)).is_some() {
+            if me.certain_stop(Some(j), me.report.closest).is_some() {
                 return false;
             }
             let Some(tier) = tier else { return true };
@@ -1152,7 +1196,7 @@ impl ProtectiveChecker {
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
         // The certain-STOP terms are those of the last speed tested: built again when needed.
-        self.least_set[j] = false;
+        self.least_set[j] = 0;
         self.kept.restore_inside(j, inside);
         // The step is kept only when the limit is the one the steps were taken from.
         let next_step = if limit >= floor { next_step } else { resolution };
@@ -1271,25 +1315,24 @@ fn stop_sweeps_wcs_into(
 fn write_forms(out: &mut SweepForms, sweeps: Option<[Sweep; MAX_BOXES]>, rot_wcs: &crate::math::Mat3, s: Real) {
     match sweeps {
         Some(sweeps) => {
-            // The TCP's own displacement lies in the ball of radius `s` (widened as the cube
-            // is in `cube_box_sweeps`), so its cube term may be traded for that ball.
-            let reach = s * (1.0 + 1e-12) + 1e-12;
-            let ball_form = |w: &Sweep| {
-                let [(e1, d1), (e2, d2)] = w.ends;
-                Sweep {
-                    cube: [Vec3::zeros(); 3],
-                    ends: [(0.0, d1), (0.0, d2)],
-                    ball: w.ball + e1.max(e2) * reach,
-                    ..*w
-                }
-            };
             let [cube_form, ball_forms] = out;
             for ((w, c), b) in sweeps.iter().zip(cube_form.iter_mut()).zip(ball_forms.iter_mut()) {
-                (*c, *b) = (w.rotated(rot_wcs), ball_form(w).rotated(rot_wcs));
+                [*c, *b] = sweep_forms(w, rot_wcs, s);
             }
         }
         None => *out = [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2],
     }
+}
+
+/// Both forms of one box's sweep `w` (MCS) rotated to the WCS with `rot_wcs`: as it is, and
+/// with the TCP's cube term traded for the ball of radius `s`.
+fn sweep_forms(w: &Sweep, rot_wcs: &crate::math::Mat3, s: Real) -> [Sweep; 2] {
+    // The TCP's own displacement lies in the ball of radius `s` (widened as the cube is in
+    // `cube_box_sweeps`), so its cube term may be traded for that ball.
+    let reach = s * (1.0 + 1e-12) + 1e-12;
+    let [(e1, d1), (e2, d2)] = w.ends;
+    let ball_form = Sweep { cube: [Vec3::zeros(); 3], ends: [(0.0, d1), (0.0, d2)], ball: w.ball + e1.max(e2) * reach, ..*w };
+    [w.rotated(rot_wcs), ball_form.rotated(rot_wcs)]
 }
 
 /// Two forms of the same bound on each box's displacements (module doc, step 4): `[0]` with
@@ -1326,9 +1369,7 @@ fn first_unproved<'a>(
 fn pair_apart_in_some_form(a: &Obb, sa: [&Sweep; 2], b: &Obb, sb: [&Sweep; 2], extra: Real) -> bool {
     let sa = sa.map(|w| Sweep { ball: w.ball + extra, ..*w });
     let (fa, fb) = (sa.map(|w| FaceTerms::new(a, &w)), sb.map(|w| FaceTerms::new(b, w)));
-    [(0, 0), (1, 1), (0, 1), (1, 0)]
-        .iter()
-        .any(|&(i, k)| swept_boxes_apart_with(a, &sa[i], &fa[i], b, sb[k], &fb[k]))
+    swept_boxes_apart_either(a, [&sa[0], &sa[1]], [&fa[0], &fa[1]], b, sb, [&fb[0], &fb[1]])
 }
 
 /// One robot's boxes, their sweeps, and the face terms of each box under each sweep form.
@@ -1337,7 +1378,6 @@ pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MA
 /// The first box pair `(i, k)` of two robots' swept boxes not proved apart with `extra` mm
 /// added to the first robot's sweeps, any combination of sweep forms allowed.
 fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(usize, usize)> {
-    const FORMS: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
     let ((boxes_a, sweeps_a, faces_a), (boxes_b, sweeps_b, faces_b)) = (a, b);
     // With `extra`, the first robot's face terms under its widened sweeps (a copy only then:
     // the tests of the speed limits call this with no `extra`, many times per tick).
@@ -1353,13 +1393,10 @@ fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(
     }
     let widened = copy.as_ref().unwrap_or(faces_a);
     for (i, box_a) in boxes_a.iter().enumerate() {
+        let sa = sweeps_a.map(|form| Sweep { ball: form[i].ball + extra, ..form[i] });
         for (k, box_b) in boxes_b.iter().enumerate() {
-            let apart = |&(fa, fb): &(usize, usize)| {
-                let (sa, sb) = (&sweeps_a[fa][i], &sweeps_b[fb][k]);
-                let sa = Sweep { ball: sa.ball + extra, ..*sa };
-                swept_boxes_apart_with(box_a, &sa, &widened[fa][i], box_b, sb, &faces_b[fb][k])
-            };
-            if !FORMS.iter().any(apart) {
+            let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
+            if !swept_boxes_apart_either(box_a, [&sa[0], &sa[1]], fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb) {
                 return Some((i, k));
             }
         }
