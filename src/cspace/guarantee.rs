@@ -330,8 +330,53 @@ pub fn cube_box_sweeps_with(
     p0: &Vec3,
     enclose: impl FnOnce(&Vec3, &Vec3) -> [Enclosure; 3],
 ) -> Option<[Sweep; MAX_BOXES]> {
+    let (swing, h) = swing_over_cube(model, c, h, p0, enclose)?;
+    let Some(swing) = swing else { return Some(unknown(model)) };
+    let mut out = [Sweep::ZERO; MAX_BOXES];
+    for (j, slot) in out[..model.box_count()].iter_mut().enumerate() {
+        *slot = swing.box_sweep(model, p0, j, &TcpMotion::cube(c, h, p0));
+    }
+    Some(out)
+}
+
+/// Both forms of the sweeps of a stop: `[0]` as [`cube_box_sweeps_with`] (every reachable TCP
+/// of the cube of centre `c` and half-side `h`), `[1]` for every reachable TCP of the ball of
+/// radius `h` around `c` (within the cube, so the same angle enclosures hold): the TCP's own
+/// displacement `D` then lies in the ball of radius `|p0 - c| + h` (widened as the cube),
+/// which takes the place of the box `Z` inside the hull of each lower link (the sweep's
+/// `round`), and the link's turn is bounded with `|D|` at most that radius and `|D . t|` at
+/// most that radius times `|t|` (module doc, steps 1, 6). Both are sound for the ball; on an
+/// axis either may be the smaller.
+pub fn box_sweep_forms_with(
+    model: &RobotModel,
+    c: &Vec3,
+    h: Real,
+    p0: &Vec3,
+    enclose: impl FnOnce(&Vec3, &Vec3) -> [Enclosure; 3],
+) -> Option<[[Sweep; MAX_BOXES]; 2]> {
+    let (swing, h) = swing_over_cube(model, c, h, p0, enclose)?;
+    let Some(swing) = swing else { return Some([unknown(model); 2]) };
+    let mut out = [[Sweep::ZERO; MAX_BOXES]; 2];
+    let motions = [TcpMotion::cube(c, h, p0), TcpMotion::ball(c, h, p0)];
+    for (form, motion) in out.iter_mut().zip(&motions) {
+        for (j, slot) in form[..model.box_count()].iter_mut().enumerate() {
+            *slot = swing.box_sweep(model, p0, j, motion);
+        }
+    }
+    Some(out)
+}
+
+/// The shared terms of the sweeps over the cube of centre `c` and half-side `h`, with that
+/// half-side widened: `None` when no TCP of the cube is reachable, `Some(None)` when `p0` is
+/// unreachable or the angles cannot be enclosed.
+fn swing_over_cube(
+    model: &RobotModel,
+    c: &Vec3,
+    h: Real,
+    p0: &Vec3,
+    enclose: impl FnOnce(&Vec3, &Vec3) -> [Enclosure; 3],
+) -> Option<(Option<CubeSwing>, Real)> {
     let d = &model.delta;
-    let n = model.box_count();
     let h = h * (1.0 + 1e-12) + 1e-12;
     let (lo, hi) = (c.add_scalar(-h), c.add_scalar(h));
     let mut th = [Interval::point(0.0); 3];
@@ -339,59 +384,98 @@ pub fn cube_box_sweeps_with(
     for (arm, slot) in th.iter_mut().enumerate() {
         match enclosures[arm] {
             Enclosure::Empty => return None,
-            Enclosure::Unbounded => return Some(unknown(model)),
+            Enclosure::Unbounded => return Some((None, h)),
             Enclosure::Range(r) => *slot = r,
         }
     }
-    let Ok(sol) = d.inverse_kinematics(p0) else { return Some(unknown(model)) };
-    let swing = CubeSwing::new(model, c, h, p0, &sol, &th, 0b111);
-    let mut out = [Sweep::ZERO; MAX_BOXES];
-    for (j, slot) in out[..n].iter_mut().enumerate() {
-        *slot = swing.box_sweep(model, p0, j);
-    }
-    Some(out)
+    let Ok(sol) = d.inverse_kinematics(p0) else { return Some((None, h)) };
+    Some((Some(CubeSwing::new(model, &sol, &th, 0b111)), h))
 }
 
-/// The sweep of box `j` alone of [`cube_box_sweeps_with`], for the cube of centre `c` and
-/// half-side `h` (widened as there), measured from the reachable `p0` with its inverse
-/// kinematics `sol`, the motor angles over the cube enclosed by `th`: the same operations, so
-/// the same sweep to the bit, without the other boxes'. Only box `j`'s arm's entries of `sol`
-/// and `th` are read.
-pub fn cube_box_sweep(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, sol: &ArmSolution, th: &[Interval; 3], j: usize) -> Sweep {
+/// Both forms of [`box_sweep_forms_with`] for box `j` alone, measured from the reachable `p0`
+/// with its inverse kinematics `sol`, the motor angles over the cube enclosed by `th`: the
+/// same operations, so the same sweeps to the bit, without the other boxes'. Only box `j`'s
+/// arm's entries of `sol` and `th` are read.
+pub fn box_sweep_forms(
+    model: &RobotModel,
+    c: &Vec3,
+    h: Real,
+    p0: &Vec3,
+    sol: &ArmSolution,
+    th: &[Interval; 3],
+    j: usize,
+) -> [Sweep; 2] {
     let h = h * (1.0 + 1e-12) + 1e-12;
     let arms = match model.box_kind(j) {
         BoxKind::LowerLink(arm) | BoxKind::UpperLink(arm) => 1 << arm,
         BoxKind::Platform | BoxKind::Tool => 0,
     };
-    CubeSwing::new(model, c, h, p0, sol, th, arms).box_sweep(model, p0, j)
+    let swing = CubeSwing::new(model, sol, th, arms);
+    [TcpMotion::cube(c, h, p0), TcpMotion::ball(c, h, p0)].map(|motion| swing.box_sweep(model, p0, j, &motion))
 }
 
-/// What every box's sweep over a cube shares: the TCP's reach per axis and in all, and each
-/// arm's largest turn `dth`, the elbow's chord `dG` and its arc (module doc, steps 1-3);
-/// the arm terms only for the arms asked for (the others stay 0 and are not to be read).
+/// Where the TCP's displacement `D = p - p0` lies: in the box of half-edges `reach` (per
+/// axis) or in the ball of radius `radius`.
+enum TcpMotion {
+    Cube(Vec3),
+    Ball(Real),
+}
+
+impl TcpMotion {
+    /// Every `p` of the cube of centre `c` and half-side `h`: per axis, at most
+    /// `|p0_a - c_a| + h` from `p0` (`h` at the centre).
+    fn cube(c: &Vec3, h: Real, p0: &Vec3) -> TcpMotion {
+        TcpMotion::Cube((p0 - c).abs().add_scalar(h))
+    }
+
+    /// Every `p` of the ball of radius `h` around `c`: at most `|p0 - c| + h` from `p0`.
+    fn ball(c: &Vec3, h: Real, p0: &Vec3) -> TcpMotion {
+        TcpMotion::Ball((p0 - c).norm() + h)
+    }
+
+    /// `dp >= |D|`.
+    fn length(&self) -> Real {
+        match self {
+            TcpMotion::Cube(reach) => reach.norm(),
+            TcpMotion::Ball(r) => *r,
+        }
+    }
+
+    /// A bound on `|D . t|` (module doc, step 6).
+    fn along(&self, t: &Vec3) -> Real {
+        match self {
+            TcpMotion::Cube(reach) => reach.x * t.x.abs() + reach.y * t.y.abs(),
+            TcpMotion::Ball(r) => r * t.norm(),
+        }
+    }
+
+    /// The set of `D` as a sweep's `Z`: its box and its rounding ball.
+    fn as_z(&self) -> ([Vec3; 3], Real) {
+        match self {
+            TcpMotion::Cube(reach) => ([Vec3::x() * reach.x, Vec3::y() * reach.y, Vec3::z() * reach.z], 0.0),
+            TcpMotion::Ball(r) => ([Vec3::zeros(); 3], *r),
+        }
+    }
+}
+
+/// What every box's sweep over a cube shares: each arm's largest turn `dth`, the elbow's chord
+/// `dG` and its arc (module doc, step 3); only for the arms asked for (the others stay 0 and
+/// are not to be read).
 struct CubeSwing {
-    reach: Vec3,
-    dp: Real,
-    cube: [Vec3; 3],
     dth: [Real; 3],
     dg: [Real; 3],
     theta0: [Real; 3],
 }
 
 impl CubeSwing {
-    /// The terms for the (already widened) half-side `h`.
-    fn new(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, sol: &ArmSolution, th: &[Interval; 3], arms: u8) -> CubeSwing {
+    fn new(model: &RobotModel, sol: &ArmSolution, th: &[Interval; 3], arms: u8) -> CubeSwing {
         let d = &model.delta;
-        // Per axis, the farthest any TCP of the cube lies from p0 (h at the centre).
-        let reach = (p0 - c).abs().add_scalar(h);
-        let dp = reach.norm();
-        let cube = [Vec3::x() * reach.x, Vec3::y() * reach.y, Vec3::z() * reach.z];
         let (mut dth, mut dg) = ([0.0; 3], [0.0; 3]);
         for arm in (0..3).filter(|arm| arms >> arm & 1 == 1) {
             dth[arm] = (th[arm].hi - sol.theta[arm]).max(sol.theta[arm] - th[arm].lo).clamp(0.0, std::f64::consts::PI);
             dg[arm] = 2.0 * d.rf * (0.5 * dth[arm]).sin();
         }
-        CubeSwing { reach, dp, cube, dth, dg, theta0: sol.theta }
+        CubeSwing { dth, dg, theta0: sol.theta }
     }
 
     /// The elbow's arc: `G - G0 = rf (sin D tau0 + (cos D - 1) nu0)` for `|D| <= dth`.
@@ -403,17 +487,17 @@ impl CubeSwing {
         (tau0, nu0, along, inward)
     }
 
-    /// Box `j`'s sweep (module doc, per box kind).
-    fn box_sweep(&self, model: &RobotModel, p0: &Vec3, j: usize) -> Sweep {
+    /// Box `j`'s sweep for the TCP's displacements `motion` (module doc, per box kind).
+    fn box_sweep(&self, model: &RobotModel, p0: &Vec3, j: usize, motion: &TcpMotion) -> Sweep {
         let (d, o) = (&model.delta, &model.options);
-        let (reach, dp, cube) = (&self.reach, self.dp, self.cube);
+        let (dp, (cube, round)) = (motion.length(), motion.as_z());
         let m = o.margin;
         let sweep = match model.box_kind(j) {
             BoxKind::LowerLink(arm) => {
                 let (arm, t) = (arm as usize, tangent(arm as usize));
                 let mu = m / d.re;
                 let dx = ((dp + self.dg[arm]) / d.re).min(2.0);
-                let tt = (reach.x * t.x.abs() + reach.y * t.y.abs()) / d.re;
+                let tt = motion.along(&t) / d.re;
                 let beta = p0.dot(&t).abs() / d.re + tt;
                 if beta >= 1.0 {
                     Sweep { ball: Real::INFINITY, ..Sweep::ZERO }
@@ -424,7 +508,7 @@ impl CubeSwing {
                     let ball = (o.half_height + m) * dy + (o.half_depth + m) * dz;
                     let (tau0, nu0, along, inward) = self.arc(arm);
                     let arc = [tau0 * (d.rf * along), nu0 * (d.rf * inward)];
-                    Sweep { cube, arc, ends: [(mu, 1.0 + mu), (1.0 + mu, mu)], ball }
+                    Sweep { cube, round, arc, ends: [(mu, 1.0 + mu), (1.0 + mu, mu)], ball }
                 }
             }
             BoxKind::UpperLink(arm) => {
@@ -434,9 +518,9 @@ impl CubeSwing {
                 let (tau0, nu0, along, inward) = self.arc(arm as usize);
                 let (l, w) = (d.rf + m, du + m);
                 let arc = [tau0 * (l * along + w * inward), nu0 * (l * inward + w * along)];
-                Sweep { cube, arc, ends: [(0.0, 1.0); 2], ball: 0.0 }
+                Sweep { cube, round, arc, ends: [(0.0, 1.0); 2], ball: 0.0 }
             }
-            BoxKind::Platform | BoxKind::Tool => Sweep { cube, ends: [(1.0, 0.0); 2], ..Sweep::ZERO },
+            BoxKind::Platform | BoxKind::Tool => Sweep { cube, round, ends: [(1.0, 0.0); 2], ..Sweep::ZERO },
         };
         Sweep { ball: sweep.ball + BOUND_SLACK, ..sweep }
     }
@@ -545,6 +629,70 @@ mod tests {
         let model = RobotModel { options, ..RobotModel::THESIS };
         let ratio = check_bounds_against_brute_force(model, 32, 150, 40, 4);
         assert!(ratio <= 1.0);
+    }
+
+    /// Both forms of [`box_sweep_forms_with`] bound the displacement of every box corner for
+    /// every TCP of the ball: on random balls of 2 to 150 mm across the reachable space (the
+    /// reference at the centre, or off it), with a margin and every kind of box, for TCPs on
+    /// the sphere in the 26 axis, edge and corner directions and at random, then inside it; on
+    /// those directions, on the displacement's own and on each form's radius.
+    #[test]
+    fn ball_and_cube_forms_hold_every_tcp_of_the_ball() {
+        let options = ModelOptions {
+            margin: 5.0,
+            upper_links: Some((30.0, 15.0)),
+            platform: Some(crate::robot::ToolBox { offset: Vec3::zeros(), half: Vec3::new(50.0, 50.0, 10.0) }),
+            tool: Some(crate::robot::ToolBox { offset: Vec3::new(0.0, 0.0, -30.0), half: Vec3::new(20.0, 20.0, 30.0) }),
+            ..ModelOptions::THESIS
+        };
+        let model = RobotModel { options, ..RobotModel::THESIS };
+        let d = &model.delta;
+        let mut rng = StdRng::seed_from_u64(11);
+        let dirs: Vec<Vec3> = (0..27)
+            .map(|i: i32| Vec3::new((i % 3 - 1) as Real, (i / 3 % 3 - 1) as Real, (i / 9 - 1) as Real))
+            .filter(|d| *d != Vec3::zeros())
+            .map(|d| d.normalize())
+            .collect();
+        let unit = |rng: &mut StdRng| loop {
+            let v = Vec3::from_fn(|_, _| rng.random::<Real>() * 2.0 - 1.0);
+            if v.norm() > 0.1 && v.norm() <= 1.0 {
+                break v.normalize();
+            }
+        };
+        let (mut balls, mut tighter) = (0, 0);
+        while balls < 400 {
+            let c = Vec3::new(rng.random_range(-500.0..500.0), rng.random_range(-500.0..500.0), rng.random_range(-1100.0..-300.0));
+            let h = rng.random_range(2.0..150.0);
+            let p0 = if balls % 2 == 0 { c } else { c + unit(&mut rng) * (h * rng.random::<Real>()) };
+            if !d.is_reachable(&c) || !d.is_reachable(&p0) {
+                continue;
+            }
+            balls += 1;
+            let enclose = |lo: &Vec3, hi: &Vec3| core::array::from_fn(|arm| theta_range(d, arm, lo, hi, SPLITS));
+            let forms = box_sweep_forms_with(&model, &c, h, &p0, enclose).unwrap();
+            assert_eq!(forms[0], cube_box_sweeps_with(&model, &c, h, &p0, enclose).unwrap(), "form 0 is the cube's");
+            for q in 0..120 {
+                let dir = if q < dirs.len() { dirs[q] } else { unit(&mut rng) };
+                let depth = if q < 60 { 1.0 } else { rng.random::<Real>().cbrt() };
+                let Some(m) = measured(&model, &p0, &(c + dir * (h * depth))) else { continue };
+                for (j, corners) in m.iter().enumerate() {
+                    for v in corners {
+                        let along = v.try_normalize(0.0).unwrap_or(Vec3::z());
+                        for (f, w) in forms.iter().map(|form| &form[j]).enumerate() {
+                            assert!(v.norm() <= w.radius() + 1e-9, "form {f} box {j}: moved {} > {}", v.norm(), w.radius());
+                            for n in dirs.iter().chain([&along]) {
+                                let support = w.support(n);
+                                assert!(v.dot(n) <= support + 1e-9, "form {f} box {j}: {v:?} . {n:?} > {support}");
+                            }
+                        }
+                    }
+                }
+            }
+            // The ball form is the smaller on some axis of a lower link (else it adds nothing).
+            let n = unit(&mut rng);
+            tighter += usize::from(forms[1][0].support(&n) < forms[0][0].support(&n));
+        }
+        assert!(tighter > 100, "the ball form is tighter on only {tighter} of 400 random axes");
     }
 
     /// `n` points of the closed cube of centre `c` and half-side `h`: first the 9^3 lattice

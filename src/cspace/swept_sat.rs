@@ -68,7 +68,7 @@ fn dot(u: &[Real; 3], v: &[Real; 3]) -> Real {
 #[inline(always)]
 fn support(s: &Sweep, n: &[Real; 3], norm: Real) -> Real {
     let d = |w: &Vec3| (w.x * n[0] + w.y * n[1] + w.z * n[2]).abs();
-    let z = d(&s.cube[0]) + d(&s.cube[1]) + d(&s.cube[2]);
+    let z = d(&s.cube[0]) + d(&s.cube[1]) + d(&s.cube[2]) + s.round * norm;
     let a = d(&s.arc[0]) + d(&s.arc[1]);
     let [(e1, d1), (e2, d2)] = s.ends;
     s.ball * norm + (e1 * z + d1 * a).max(e2 * z + d2 * a)

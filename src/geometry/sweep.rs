@@ -5,12 +5,13 @@
 //! # The displacement set
 //! A [`Sweep`] is the convex, centrally symmetric set
 //! `S = ball(c) + hull(E_1 u E_2)`, `E_k = e_k Z + d_k A`, where `Z` is the box
-//! `[-w_0, w_0] + [-w_1, w_1] + [-w_2, w_2]` (the TCP's cell: `w_a` is its half-edge along axis
-//! `a`) and `A` the rectangle `[-v_0, v_0] + [-v_1, v_1]` (around the arc an elbow moves on:
+//! `[-w_0, w_0] + [-w_1, w_1] + [-w_2, w_2]` plus the ball of radius `r` (the TCP's cell: `w_a`
+//! is its half-edge along axis `a`, `r = 0`; or the TCP's ball: `w = 0`, `r` its radius) and
+//! `A` the rectangle `[-v_0, v_0] + [-v_1, v_1]` (around the arc an elbow moves on:
 //! `v_0` along the arc's tangent, `v_1` toward its centre). Its support function, for any
 //! vector `n` (not only unit ones), is
 //!
-//! `h_S(n) = c |n| + max_k ( e_k sum_a |w_a . n| + d_k sum_b |v_b . n| )`.
+//! `h_S(n) = c |n| + max_k ( e_k (sum_a |w_a . n| + r |n|) + d_k sum_b |v_b . n| )`.
 //!
 //! # The test
 //! If every point of a box at some configuration lies within `S` of the point with the same
@@ -68,6 +69,8 @@ pub const MEET_DEPTH: Real = 1e-6;
 pub struct Sweep {
     /// Half-edges of the box `Z` (orthogonal).
     pub cube: [Vec3; 3],
+    /// Radius `r` of the ball that rounds `Z` (`Z` is the box plus this ball).
+    pub round: Real,
     /// Half-edges of the rectangle `A` (orthogonal).
     pub arc: [Vec3; 2],
     /// `(e_k, d_k)` of the two hulled sets `E_k = e_k Z + d_k A`.
@@ -80,6 +83,7 @@ impl Sweep {
     /// No displacement at all.
     pub const ZERO: Sweep = Sweep {
         cube: [Vec3::new(0.0, 0.0, 0.0); 3],
+        round: 0.0,
         arc: [Vec3::new(0.0, 0.0, 0.0); 2],
         ends: [(0.0, 0.0); 2],
         ball: 0.0,
@@ -88,7 +92,7 @@ impl Sweep {
     /// Whether this is no displacement at all.
     pub fn is_zero(&self) -> bool {
         let point = |v: &[Vec3]| v.iter().all(|w| *w == Vec3::zeros());
-        let (z, a) = (point(&self.cube), point(&self.arc));
+        let (z, a) = (point(&self.cube) && self.round == 0.0, point(&self.arc));
         self.ball == 0.0 && self.ends.iter().all(|&(e, d)| (e == 0.0 || z) && (d == 0.0 || a))
     }
 
@@ -102,7 +106,7 @@ impl Sweep {
     /// same value).
     #[inline(always)]
     fn support_with_norm(&self, n: &Vec3, norm: Real) -> Real {
-        let z = self.cube[0].dot(n).abs() + self.cube[1].dot(n).abs() + self.cube[2].dot(n).abs();
+        let z = self.cube[0].dot(n).abs() + self.cube[1].dot(n).abs() + self.cube[2].dot(n).abs() + self.round * norm;
         let a = self.arc[0].dot(n).abs() + self.arc[1].dot(n).abs();
         let [(e1, d1), (e2, d2)] = self.ends;
         self.ball * norm + (e1 * z + d1 * a).max(e2 * z + d2 * a)
@@ -110,7 +114,7 @@ impl Sweep {
 
     /// The largest displacement in the set: `h_S` over unit vectors is at most this.
     pub fn radius(&self) -> Real {
-        let z = float::sqrt(self.cube.iter().map(|w| w.norm_squared()).sum::<Real>());
+        let z = float::sqrt(self.cube.iter().map(|w| w.norm_squared()).sum::<Real>()) + self.round;
         let a = float::sqrt(self.arc.iter().map(|v| v.norm_squared()).sum::<Real>());
         let [(e1, d1), (e2, d2)] = self.ends;
         self.ball + (e1 * z + d1 * a).max(e2 * z + d2 * a)
@@ -350,10 +354,12 @@ pub(crate) mod tests {
     prop_compose! {
         pub(crate) fn any_sweep()(w in prop::array::uniform3(0.0..30.0f64), e in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64),
                        f in (-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64), v in prop::array::uniform2(0.0..40.0f64),
-                       ends in prop::array::uniform4(0.0..2.0f64), ball in 0.0..10.0f64) -> Sweep {
+                       ends in prop::array::uniform4(0.0..2.0f64), ball in 0.0..10.0f64,
+                       round in prop_oneof![Just(0.0), 0.0..20.0f64]) -> Sweep {
             let (r, q) = (rot(e), rot(f));
             Sweep {
                 cube: [r.column(0) * w[0], r.column(1) * w[1], r.column(2) * w[2]],
+                round,
                 arc: [q.column(0) * v[0], q.column(1) * v[1]],
                 ends: [(ends[0], ends[1]), (ends[2], ends[3])],
                 ball,
@@ -366,7 +372,10 @@ pub(crate) mod tests {
     pub(crate) fn point_of(s: &Sweep, t: &[Real; 8]) -> Vec3 {
         let k = if t[0] < 0.0 { 0 } else { 1 };
         let (e, d) = s.ends[k];
-        let z = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3];
+        // A point of the box `Z` and one of its rounding ball (from the same parameters).
+        let u = Vec3::new(t[1], t[2], t[3]);
+        let z = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3]
+            + if u.norm() > 1.0 { u.normalize() } else { u } * s.round;
         let a = s.arc[0] * t[4] + s.arc[1] * t[5];
         let any = Vec3::new(t[5], t[6], t[7]);
         let ball = if any.norm() > 1.0 { any.normalize() } else { any } * s.ball;
@@ -407,10 +416,11 @@ pub(crate) mod tests {
             half.x * u[0].dot(n).abs() + half.y * u[1].dot(n).abs() + half.z * u[2].dot(n).abs()
         };
         let support = |s: &Sweep, n: &Vec3| {
-            let z = s.cube[0].dot(n).abs() + s.cube[1].dot(n).abs() + s.cube[2].dot(n).abs();
+            let norm = float::sqrt(n.norm_squared());
+            let z = s.cube[0].dot(n).abs() + s.cube[1].dot(n).abs() + s.cube[2].dot(n).abs() + s.round * norm;
             let a = s.arc[0].dot(n).abs() + s.arc[1].dot(n).abs();
             let [(e1, d1), (e2, d2)] = s.ends;
-            s.ball * float::sqrt(n.norm_squared()) + (e1 * z + d1 * a).max(e2 * z + d2 * a)
+            s.ball * norm + (e1 * z + d1 * a).max(e2 * z + d2 * a)
         };
         let separates = |n: &Vec3| {
             let len2 = n.norm_squared();

@@ -23,14 +23,17 @@
 //!    radius `S - |v_fd| T_r`, and in the ball around its middle of radius
 //!    `S - |v_fd| T_r / 2` ([`capsule_ball`]); that ball is used, with the boxes built at its
 //!    centre, when the centre is reachable.
-//! 4. **Where the boxes can be.** [`cube_box_sweeps`] bounds, per box, the displacement of
-//!    every box point for every reachable TCP of that cube, measured from its centre (interval
-//!    inverse kinematics: elbows may swing far more than the TCP moves, SPEC §8); the
-//!    displacement set is a [`Sweep`] (MCS, rotated to the WCS with the robot's placement).
-//!    Its TCP term (the cube of half-side `S`, weighted `e_k`) may equally be replaced by the
-//!    ball of radius `S` that holds the TCP (weight `max e_k`): two sound forms of one bound
-//!    ([`SweepForms`]); a box pair is proved apart when any combination of forms proves it
-//!    (the cube is tighter where the separating axis is a world axis, the ball elsewhere).
+//! 4. **Where the boxes can be.** [`box_sweep_forms_with`] bounds, per box, the displacement
+//!    of every box point for every reachable TCP of that cube, measured from its centre
+//!    (interval inverse kinematics: elbows may swing far more than the TCP moves, SPEC §8);
+//!    the displacement set is a [`Sweep`] (MCS, rotated to the WCS with the robot's
+//!    placement). It gives two sound forms of one bound ([`SweepForms`]): `[0]` with the
+//!    TCP's displacement in the cube of half-side `S`, `[1]` in the ball of radius `S` that
+//!    holds the TCP (the ball takes the cube's place inside each lower link's hull, and the
+//!    link's turn is bounded with `|D| <= S`, not the cube's half-diagonal). A box pair is
+//!    proved apart when, on one axis, the smaller support of either form of each box
+//!    separates them ([`swept_boxes_apart_either`]: the cube is tighter where the separating
+//!    axis is a world axis, the ball elsewhere).
 //!    The motor angles over the cube come in **tiers**, each a sound enclosure of the angle
 //!    of every reachable TCP of the cube (the only input of the bound that needs inverse
 //!    kinematics): tier 1 reads them from the robot's [`MotorTable`] (certified interval
@@ -50,7 +53,7 @@
 //!    holds the ball of radius `S'` (the radius of step 3's ball): form 0's support on any `n`
 //!    is at least `(1 + mu) sum_a S' |w_a . n| >= S' |n|` (the cube term with weight
 //!    `max e_k >= 1`, the arc and ball terms are `>= 0`), form 1's at least
-//!    `(1 + mu) S' |n|`. So on every axis the swept box's projection holds that of the box
+//!    `max e_k S' |n| >= S' |n|` (its rounding ball in the hull). So on every axis the swept box's projection holds that of the box
 //!    swept by the ball `S'` alone (upper links: by nothing). When
 //!    [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) does not separate the boxes
 //!    swept by those balls (radii shrunk by a relative 1e-9, far above rounding), it cannot
@@ -114,7 +117,7 @@
 
 use crate::cell::exact::PairVerdict;
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
-use crate::cspace::guarantee::{cube_box_sweep, cube_box_sweeps, cube_box_sweeps_with, theta_range, Enclosure};
+use crate::cspace::guarantee::{box_sweep_forms, box_sweep_forms_with, theta_range, Enclosure};
 use crate::cspace::interval::Interval;
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
 use crate::geometry::sweep::{swept_boxes_apart_either, swept_boxes_apart_with, FaceTerms};
@@ -922,9 +925,9 @@ impl ProtectiveChecker {
             }
             th[i] = Interval::new(lo, hi);
         }
-        let sweep = cube_box_sweep(&robot.model, &centre, s, &centre, &sol, &th, k);
-        let forms = sweep_forms(&sweep, &robot.placement.rotation(), s);
-        Some(forms.map(|form| Sweep { ball: (form.ball - LEAST_SLACK).max(0.0), ..form }))
+        let rot = robot.placement.rotation();
+        let forms = box_sweep_forms(&robot.model, &centre, s, &centre, &sol, &th, k);
+        Some(forms.map(|form| Sweep { ball: (form.ball - LEAST_SLACK).max(0.0), ..form.rotated(&rot) }))
     }
 
     /// Whether box pair `p` is certain not to be proved apart (with `extra` mm added to the
@@ -1055,10 +1058,15 @@ impl ProtectiveChecker {
         };
         let vmax = self.cell().stops[j].max_speed_mm_s;
         let resolution = vmax / (1u32 << LIMIT_STEPS) as Real;
+        // The speed on the grid of `resolution` nearest the middle of `lo` and `hi` (grid
+        // speeds, at least two steps apart), strictly between them: every search tests grid
+        // speeds only, so that searches of the same proof end at the same bracket (`v_max` is
+        // `2^LIMIT_STEPS` steps exactly; so is every grid speed a whole number of steps).
+        let middle = |lo: Real, hi: Real| lo + (0.5 * (hi - lo) / resolution).floor().max(1.0) * resolution;
         // From `lo` (proved) and `hi` (not), halves until they are `resolution` apart.
         let bisect = |me: &mut Self, (mut lo, mut hi): (Real, Real), tier: Option<u32>| {
             while hi - lo > resolution {
-                let mid = 0.5 * (lo + hi);
+                let mid = middle(lo, hi);
                 if proved(me, mid, tier) {
                     lo = mid
                 } else {
@@ -1153,7 +1161,7 @@ impl ProtectiveChecker {
             }
             let (Some(mut lo), Some(mut hi)) = (lo, hi) else { return (lo.unwrap_or(0.0), resolution) };
             while hi - lo > resolution && hi > floor {
-                let mid = 0.5 * (lo + hi);
+                let mid = middle(lo, hi);
                 match test(me, mid) {
                     // Out of tests: the next tick tries the middle of the bracket first.
                     None => return (lo, mid - lo),
@@ -1291,7 +1299,7 @@ fn stop_sweeps_wcs_into(
         core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits))
     };
     let sweeps = match table.filter(|t| t.delta() == d) {
-        Some(t) => cube_box_sweeps_with(model, tcp_mcs, s, tcp_mcs, |lo, hi| match t.enclose(lo, hi) {
+        Some(t) => box_sweep_forms_with(model, tcp_mcs, s, tcp_mcs, |lo, hi| match t.enclose(lo, hi) {
             Some(th) if precise > 0 => {
                 let refine = |arm: usize| arms >> arm & 1 == 1;
                 core::array::from_fn(|arm| {
@@ -1305,34 +1313,23 @@ fn stop_sweeps_wcs_into(
             Some(th) => th,
             None => direct(lo, hi, SPLITS),
         }),
-        None => cube_box_sweeps(model, tcp_mcs, s, tcp_mcs, SPLITS),
+        None => box_sweep_forms_with(model, tcp_mcs, s, tcp_mcs, |lo, hi| direct(lo, hi, SPLITS)),
     };
-    write_forms(out, sweeps, rot_wcs, s);
+    write_forms(out, sweeps, rot_wcs);
 }
 
-/// Both forms of `sweeps` (MCS) rotated to the WCS with `rot_wcs`, the TCP's cube term traded
-/// for the ball of radius `s` in the second; infinite balls when `None`.
-fn write_forms(out: &mut SweepForms, sweeps: Option<[Sweep; MAX_BOXES]>, rot_wcs: &crate::math::Mat3, s: Real) {
+/// Both forms of `sweeps` (MCS) rotated to the WCS with `rot_wcs`; infinite balls when `None`.
+fn write_forms(out: &mut SweepForms, sweeps: Option<[[Sweep; MAX_BOXES]; 2]>, rot_wcs: &crate::math::Mat3) {
     match sweeps {
-        Some(sweeps) => {
-            let [cube_form, ball_forms] = out;
-            for ((w, c), b) in sweeps.iter().zip(cube_form.iter_mut()).zip(ball_forms.iter_mut()) {
-                [*c, *b] = sweep_forms(w, rot_wcs, s);
+        Some(forms) => {
+            for (form, slots) in forms.iter().zip(out.iter_mut()) {
+                for (w, slot) in form.iter().zip(slots.iter_mut()) {
+                    *slot = w.rotated(rot_wcs);
+                }
             }
         }
         None => *out = [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2],
     }
-}
-
-/// Both forms of one box's sweep `w` (MCS) rotated to the WCS with `rot_wcs`: as it is, and
-/// with the TCP's cube term traded for the ball of radius `s`.
-fn sweep_forms(w: &Sweep, rot_wcs: &crate::math::Mat3, s: Real) -> [Sweep; 2] {
-    // The TCP's own displacement lies in the ball of radius `s` (widened as the cube is in
-    // `cube_box_sweeps`), so its cube term may be traded for that ball.
-    let reach = s * (1.0 + 1e-12) + 1e-12;
-    let [(e1, d1), (e2, d2)] = w.ends;
-    let ball_form = Sweep { cube: [Vec3::zeros(); 3], ends: [(0.0, d1), (0.0, d2)], ball: w.ball + e1.max(e2) * reach, ..*w };
-    [w.rotated(rot_wcs), ball_form.rotated(rot_wcs)]
 }
 
 /// Two forms of the same bound on each box's displacements (module doc, step 4): `[0]` with

@@ -61,7 +61,7 @@ pub(super) fn larger(a: &Sweep, b: &Sweep) -> Sweep {
         }
     });
     let ends = std::array::from_fn(|k| (a.ends[k].0.max(b.ends[k].0), a.ends[k].1.max(b.ends[k].1)));
-    Sweep { cube, arc, ends, ball: a.ball.max(b.ball) }
+    Sweep { cube, round: a.round.max(b.round), arc, ends, ball: a.ball.max(b.ball) }
 }
 
 /// The mirror image of `s` under `y -> -y` (the MCS cube maps to itself).
