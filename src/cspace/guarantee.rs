@@ -458,33 +458,30 @@ impl TcpMotion {
     }
 }
 
-/// What every box's sweep over a cube shares: each arm's largest turn `dth`, the elbow's chord
-/// `dG` and its arc (module doc, step 3); only for the arms asked for (the others stay 0 and
-/// are not to be read).
+/// What every box's sweep over a cube shares, per arm: the largest turn `dth`, the elbow's
+/// chord `dG` and its arc (module doc, step 3); only for the arms asked for (the others stay 0
+/// and are not to be read).
 struct CubeSwing {
-    dth: [Real; 3],
     dg: [Real; 3],
-    theta0: [Real; 3],
+    /// The elbow's arc: `G - G0 = rf (sin D tau0 + (cos D - 1) nu0)` for `|D| <= dth`, as
+    /// `(tau0, nu0, sin min(dth, pi/2), 1 - cos dth)`.
+    arcs: [(Vec3, Vec3, Real, Real); 3],
 }
 
 impl CubeSwing {
     fn new(model: &RobotModel, sol: &ArmSolution, th: &[Interval; 3], arms: u8) -> CubeSwing {
         let d = &model.delta;
-        let (mut dth, mut dg) = ([0.0; 3], [0.0; 3]);
+        let (mut dg, mut arcs) = ([0.0; 3], [(Vec3::zeros(), Vec3::zeros(), 0.0, 0.0); 3]);
         for arm in (0..3).filter(|arm| arms >> arm & 1 == 1) {
-            dth[arm] = (th[arm].hi - sol.theta[arm]).max(sol.theta[arm] - th[arm].lo).clamp(0.0, std::f64::consts::PI);
-            dg[arm] = 2.0 * d.rf * (0.5 * dth[arm]).sin();
+            let theta0 = sol.theta[arm];
+            let dth = (th[arm].hi - theta0).max(theta0 - th[arm].lo).clamp(0.0, std::f64::consts::PI);
+            dg[arm] = 2.0 * d.rf * (0.5 * dth).sin();
+            let (s, c) = (theta0.sin(), theta0.cos());
+            let u = radial(arm);
+            let (nu0, tau0) = (u * c - Vec3::z() * s, -u * s - Vec3::z() * c);
+            arcs[arm] = (tau0, nu0, dth.min(std::f64::consts::FRAC_PI_2).sin(), 1.0 - dth.cos());
         }
-        CubeSwing { dth, dg, theta0: sol.theta }
-    }
-
-    /// The elbow's arc: `G - G0 = rf (sin D tau0 + (cos D - 1) nu0)` for `|D| <= dth`.
-    fn arc(&self, arm: usize) -> (Vec3, Vec3, Real, Real) {
-        let (s, c) = (self.theta0[arm].sin(), self.theta0[arm].cos());
-        let u = radial(arm);
-        let (nu0, tau0) = (u * c - Vec3::z() * s, -u * s - Vec3::z() * c);
-        let (along, inward) = (self.dth[arm].min(std::f64::consts::FRAC_PI_2).sin(), 1.0 - self.dth[arm].cos());
-        (tau0, nu0, along, inward)
+        CubeSwing { dg, arcs }
     }
 
     /// Box `j`'s sweep for the TCP's displacements `motion` (module doc, per box kind).
@@ -506,7 +503,7 @@ impl CubeSwing {
                     let dz = (dx / w0).min(2.0);
                     let dy = ((beta * dx + tt) / w0).min(2.0);
                     let ball = (o.half_height + m) * dy + (o.half_depth + m) * dz;
-                    let (tau0, nu0, along, inward) = self.arc(arm);
+                    let (tau0, nu0, along, inward) = self.arcs[arm];
                     let arc = [tau0 * (d.rf * along), nu0 * (d.rf * inward)];
                     Sweep { cube, round, arc, ends: [(mu, 1.0 + mu), (1.0 + mu, mu)], ball }
                 }
@@ -515,7 +512,7 @@ impl CubeSwing {
                 // `lambda (G - G0) + s_z (z - z0)`, `|lambda| <= 1 + m/rf`, `|s_z| <= d_u + m`,
                 // with `z - z0` the link axis's turn: `sin D` along nu0, `1 - cos D` along tau0.
                 let (_, du) = o.upper_links.expect("upper link boxes exist");
-                let (tau0, nu0, along, inward) = self.arc(arm as usize);
+                let (tau0, nu0, along, inward) = self.arcs[arm as usize];
                 let (l, w) = (d.rf + m, du + m);
                 let arc = [tau0 * (l * along + w * inward), nu0 * (l * inward + w * along)];
                 Sweep { cube, round, arc, ends: [(0.0, 1.0); 2], ball: 0.0 }

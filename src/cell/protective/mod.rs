@@ -1390,7 +1390,7 @@ fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(
     }
     let widened = copy.as_ref().unwrap_or(faces_a);
     for (i, box_a) in boxes_a.iter().enumerate() {
-        let sa = sweeps_a.map(|form| Sweep { ball: form[i].ball + extra, ..form[i] });
+        let sa = [0, 1].map(|form| Sweep { ball: sweeps_a[form][i].ball + extra, ..sweeps_a[form][i] });
         for (k, box_b) in boxes_b.iter().enumerate() {
             let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
             if !swept_boxes_apart_either(box_a, [&sa[0], &sa[1]], fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb) {
