@@ -120,7 +120,8 @@ fn main() {
         let ((pm, p99, pmean), (em, _, _)) = (q(&mut tp), q(&mut te));
         for (name, t) in ["FREE", "WARN", "STOP"].iter().zip(&mut by_verdict).filter(|(_, t)| !t.is_empty()) {
             let (m, p, _) = q(t);
-            println!("  {name} ticks: median {m:.3} us, p99 {p:.1} us");
+            let under = t.iter().filter(|&&x| x < 1.0).count();
+            println!("  {name} ticks: {} ({under} under 1 us), median {m:.3} us, p99 {p:.1} us", t.len() / repeats.max(1));
         }
         let mean_limit = match limit_count {
             0 => String::new(),
