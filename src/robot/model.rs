@@ -201,6 +201,34 @@ impl RobotModel {
         out
     }
 
+    /// Box `k` alone of [`RobotModel::boxes`] (the same operations, so the same box), in the
+    /// MCS: one box of a configuration without building the others.
+    ///
+    /// # Errors
+    /// [`Unreachable`] from the inverse kinematics.
+    pub fn box_at(&self, tcp: &Vec3, k: usize) -> Result<Obb, Unreachable> {
+        let sol = self.delta.inverse_kinematics_cos_sin(tcp)?;
+        let (d, o) = (&self.delta, &self.options);
+        let m = o.margin;
+        let elbow = |arm: usize| d.elbow(arm, sol.cos[arm], sol.sin[arm]);
+        Ok(match self.box_kind(k) {
+            BoxKind::LowerLink(arm) => {
+                let (arm, lower_half) = (arm as usize, Vec3::new(0.5 * d.re + m, o.half_height + m, o.half_depth + m));
+                link_box(&elbow(arm), &d.platform_joint(arm, tcp), 1.0 / d.re, &tangent(arm), lower_half)
+            }
+            BoxKind::UpperLink(arm) => {
+                let (h, dz) = o.upper_links.expect("upper link boxes exist");
+                let (arm, upper_half) = (arm as usize, Vec3::new(0.5 * d.rf + m, h + m, dz + m));
+                link_box(&d.motor_point(arm), &elbow(arm), 1.0 / d.rf, &tangent(arm), upper_half)
+            }
+            BoxKind::Platform | BoxKind::Tool => {
+                let extra = if self.box_kind(k) == BoxKind::Platform { o.platform } else { o.tool };
+                let extra = extra.expect("the box exists");
+                Obb::new(tcp + extra.offset, Mat3::identity(), extra.half.add_scalar(m))
+            }
+        })
+    }
+
     fn write_boxes(&self, tcp: &Vec3, sol: &MotorCosSin, out: &mut RobotBoxes) {
         let (d, o) = (&self.delta, &self.options);
         let m = o.margin;
@@ -340,6 +368,26 @@ fn link_box(p: &Vec3, q: &Vec3, inv_len: Real, t: &Vec3, half: Vec3) -> Obb {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One box alone is the same box, to the bit, as among all of them, for every box kind.
+    #[test]
+    fn one_box_is_that_box_of_all() {
+        let mut rng = crate::test_rng::TestRng(7);
+        for model in [RobotModel::THESIS, full_options(5.0)] {
+            let mut tried = 0;
+            while tried < 500 {
+                let tcp = Vec3::new(400.0 * rng.unit(), 400.0 * rng.unit(), -650.0 + 350.0 * rng.unit());
+                let Ok(all) = model.boxes(&tcp) else {
+                    assert!(model.box_at(&tcp, 0).is_err());
+                    continue;
+                };
+                for (k, b) in all.as_slice().iter().enumerate() {
+                    assert_eq!(model.box_at(&tcp, k).unwrap(), *b, "box {k} at {tcp:?}");
+                }
+                tried += 1;
+            }
+        }
+    }
 
     #[test]
     fn lower_link_box_spans_elbow_to_platform_joint() {

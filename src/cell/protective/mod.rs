@@ -334,6 +334,10 @@ pub struct ProtectiveChecker {
     /// Per robot pair that can meet, whether the clearance table's bound proved it apart
     /// over this tick's stop balls (`protective/lookup.rs`).
     table_proved: alloc::vec::Vec<bool>,
+    /// Whether the last tick ended before setting the references of its stop balls (a kept
+    /// proof or a certain STOP without speed limits): `centres`, `reach`, `ref_boxes` and
+    /// the sweeps are then an earlier tick's.
+    references_stale: bool,
     report: ProtectiveReport,
 }
 
@@ -402,6 +406,7 @@ impl ProtectiveChecker {
             least_set: alloc::vec![0; n],
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
+            references_stale: true,
             kept,
             report: ProtectiveReport {
                 verdict: Protective::Stop,
@@ -621,6 +626,11 @@ impl ProtectiveChecker {
             return Ok(&self.report);
         }
         if self.report.verdict != Protective::Free && paths.iter().any(Option::is_some) {
+            // The proof along the paths reads this tick's references (a robot without a path
+            // keeps its stop ball's), which a tick settled early has not set.
+            if self.references_stale {
+                self.set_references(tcps_mcs);
+            }
             let (verdict, limiting) = self.prove_with_paths(tcps_mcs, paths);
             if verdict < self.report.verdict {
                 (self.report.verdict, self.report.limiting) = (verdict, limiting);
@@ -689,20 +699,25 @@ impl ProtectiveChecker {
         let (clearance, closest) = clearance_over_pairs(&self.exact, |k, a, b| memory[k].boxes_clearance(a, b));
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         let kept = self.kept_free(None);
-        if kept && !self.speed_limits {
-            (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
+        // Steps 6 and 7 on the closest pair need two reference boxes, not every robot's (step 8).
+        let early = if kept { None } else { closest.filter(|&p| self.reference_pair_stops(tcps_mcs, p, was_stop)) };
+        if (kept || early.is_some()) && !self.speed_limits {
+            if kept {
+                (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
+            } else {
+                (self.report.verdict, self.report.limiting) = (Protective::Stop, early);
+            }
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
+            self.references_stale = true;
             return;
         }
-        for (j, tcp) in tcps_mcs.iter().enumerate() {
-            self.reference_at(j, tcp, self.stop_balls[j]);
-        }
+        self.set_references(tcps_mcs);
         // The cheaper answers first: a kept proof (no sweeps), a certain STOP (none either), a
         // proof kept for wider balls (sweeps only where the kept balls widen), then the
         // table's bounds (this tick's sweeps of the table's tier, which the proof reuses).
         if kept {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
-        } else if let Some(pair) = self.certain_stop_now(was_stop) {
+        } else if let Some(pair) = early.or_else(|| self.certain_stop(None, None)) {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
         } else if was_free && self.keep_and_prove() {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
@@ -826,6 +841,15 @@ impl ProtectiveChecker {
         (s, capsule_ball(&stop, cell.tick_ms * 1e-3, reaction_s, tcp_mcs, &self.velocity[j], v, s))
     }
 
+    /// Every robot's reference for this tick's stop ball ([`ProtectiveChecker::reference_at`]),
+    /// from the stop balls [`ProtectiveChecker::evaluate`] computed for `tcps_mcs`.
+    fn set_references(&mut self, tcps_mcs: &[Vec3]) {
+        for (j, tcp) in tcps_mcs.iter().enumerate() {
+            self.reference_at(j, tcp, self.stop_balls[j]);
+        }
+        self.references_stale = false;
+    }
+
     /// Sets robot `j`'s reference boxes, the centre and radius of the ball that holds its TCP
     /// over the stop (module doc, step 3) for TCP `tcp_mcs` at measured speed `v`, and marks its
     /// sweeps as not computed; returns `S`.
@@ -888,17 +912,17 @@ impl ProtectiveChecker {
         self.sweep_tier[j] = Some((tier, arms));
     }
 
-    /// The sweep of robot `j`'s box `k` about its reference ball (both forms, WCS) from the
+    /// The sweep of robot `j`'s box `k` about the reference ball `(centre, s)` (centre MCS;
+    /// both forms, WCS) from the
     /// motor angles of the centre and of the two corners of the cube along the gradient of
     /// its arm's angle alone, each angle `ANGLE_SLACK` toward the centre's and each ball
     /// `LEAST_SLACK` smaller: on every axis no larger than the sweeps of any tier (module doc,
     /// step 7). `None` when the centre is unreachable or a corner's angle lies more than a
     /// right angle from the centre's (a range across the branch cut at `+-pi`, which no motor
     /// limit of a Delta robot allows): nothing learned.
-    fn least_sweeps(&self, j: usize, k: usize) -> Option<[Sweep; 2]> {
+    fn least_sweeps(&self, j: usize, k: usize, centre: Vec3, s: Real) -> Option<[Sweep; 2]> {
         let robot = &self.exact.cell().robots[j];
         let d = &robot.model.delta;
-        let (centre, s) = (self.centres[j], self.reach[j]);
         let at_centre = d.inverse_kinematics_cos_sin(&centre).ok()?;
         // Box `k`'s sweep depends on its own arm's range alone; the others' are not read.
         let mut th = [Interval::point(0.0); 3];
@@ -934,11 +958,18 @@ impl ProtectiveChecker {
     /// first robot's sweeps) by the sweeps of any tier (module doc, step 7); `false` when that
     /// is not known.
     fn beyond_every_tier(&self, p: BoxPair, extra: Real) -> bool {
-        let (Some(la), Some(lb)) = (self.least_sweeps(p.a, p.box_a), self.least_sweeps(p.b, p.box_b)) else {
+        let reference = |j: usize, k: usize| (self.ref_boxes[j].as_slice()[k], self.centres[j], self.reach[j]);
+        self.beyond_every_tier_at(p, [reference(p.a, p.box_a), reference(p.b, p.box_b)], extra)
+    }
+
+    /// [`ProtectiveChecker::beyond_every_tier`] with the pair's two reference boxes (WCS) and
+    /// each robot's reference ball (centre MCS, radius) given.
+    fn beyond_every_tier_at(&self, p: BoxPair, [(box_a, ca, sa), (box_b, cb, sb)]: [(Obb, Vec3, Real); 2], extra: Real) -> bool {
+        let (Some(la), Some(lb)) = (self.least_sweeps(p.a, p.box_a, ca, sa), self.least_sweeps(p.b, p.box_b, cb, sb))
+        else {
             return false;
         };
-        let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
-        !pair_apart_in_some_form(box_a, [&la[0], &la[1]], box_b, [&lb[0], &lb[1]], extra)
+        !pair_apart_in_some_form(&box_a, [&la[0], &la[1]], &box_b, [&lb[0], &lb[1]], extra)
     }
 
     /// A box pair (of the pairs involving `only`, or of all) that no sweeps of any tier can
@@ -969,6 +1000,28 @@ impl ProtectiveChecker {
         None
     }
 
+    /// The certain STOPs of steps 6 and 7 on box pair `p` before the references are set
+    /// (step 8): its two reference boxes built as [`ProtectiveChecker::reference_at`] builds
+    /// them (the same operations, so the same answers), from this tick's stop balls; step 7
+    /// only when `also_least`.
+    fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool) -> bool {
+        let reference = |j: usize, k: usize| {
+            let robot = &self.exact.cell().robots[j];
+            let (tcp, (s, (centre, radius))) = (&tcps_mcs[j], self.stop_balls[j]);
+            match robot.model.box_at(&centre, k) {
+                Ok(b) if centre != *tcp => (b.transformed(&robot.placement.rotation(), &robot.placement.t), centre, radius),
+                _ => (self.exact.boxes(j).as_slice()[k], *tcp, s),
+            }
+        };
+        let refs = [reference(p.a, p.box_a), reference(p.b, p.box_b)];
+        let swept = |j: usize, k: usize, (b, _, reach): &(Obb, Vec3, Real)| {
+            let w = least_ball(&self.exact.cell().robots[j].model, k, *reach);
+            (w, FaceTerms::new(b, &w))
+        };
+        let ((wa, fa), (wb, fb)) = (swept(p.a, p.box_a, &refs[0]), swept(p.b, p.box_b, &refs[1]));
+        !swept_boxes_apart_with(&refs[0].0, &wa, &fa, &refs[1].0, &wb, &fb) || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
+    }
+
     /// Whether box pair `p`'s reference boxes swept by their stop balls alone are not proved
     /// apart: step 6 for one pair.
     fn ball_swept_meet(&mut self, p: BoxPair) -> bool {
@@ -979,18 +1032,6 @@ impl ProtectiveChecker {
         !swept_boxes_apart_with(box_a, sa, fa, box_b, sb, fb)
     }
 
-    /// The tick's certain STOP before any sweep of a tier (module doc, steps 6 and 7): step 6
-    /// on the closest box pair now, the likeliest to fail, and, after a STOP (when another is
-    /// likely), step 7 on it too; then step 6 on every pair.
-    fn certain_stop_now(&mut self, after_stop: bool) -> Option<BoxPair> {
-        if let Some(h) = self.report.closest {
-            if self.ball_swept_meet(h) || (after_stop && self.beyond_every_tier(h, 0.0)) {
-                return Some(h);
-            }
-        }
-        self.certain_stop(None, None)
-    }
-
     /// Box `k` of robot `j`'s terms of [`ProtectiveChecker::certain_stop`] for its current
     /// reference, when not yet built: each box's sweep and face terms once per reference, not
     /// once per box pair (the same test as `swept_boxes_apart`, which builds both face terms for
@@ -999,8 +1040,7 @@ impl ProtectiveChecker {
         if self.least_set[j] >> k & 1 == 1 {
             return;
         }
-        let moves_with_tcp = !matches!(self.exact.cell().robots[j].model.box_kind(k), BoxKind::UpperLink(_));
-        let w = Sweep { ball: if moves_with_tcp { self.reach[j] * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO };
+        let w = least_ball(&self.exact.cell().robots[j].model, k, self.reach[j]);
         self.least[j][k] = (w, FaceTerms::new(&self.ref_boxes[j].as_slice()[k], &w));
         self.least_set[j] |= 1 << k;
     }
@@ -1242,6 +1282,13 @@ fn capsule_ball(
     } else {
         (*p, s)
     }
+}
+
+/// Box `k`'s sweep of step 6: the ball of the stop's radius `reach` (shrunk by a relative
+/// 1e-9) for a box that moves with the TCP, nothing for an upper link.
+fn least_ball(model: &RobotModel, k: usize, reach: Real) -> Sweep {
+    let moves_with_tcp = !matches!(model.box_kind(k), BoxKind::UpperLink(_));
+    Sweep { ball: if moves_with_tcp { reach * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO }
 }
 
 /// The status that wins when several robots fail: non-finite, then implausible, then an
