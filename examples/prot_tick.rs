@@ -121,7 +121,10 @@ fn main() {
         for (name, t) in ["FREE", "WARN", "STOP"].iter().zip(&mut by_verdict).filter(|(_, t)| !t.is_empty()) {
             let (m, p, _) = q(t);
             let under = t.iter().filter(|&&x| x < 1.0).count();
-            println!("  {name} ticks: {} ({under} under 1 us), median {m:.3} us, p99 {p:.1} us", t.len() / repeats.max(1));
+            println!(
+                "  {name} ticks: {} ({under} under 1 us), median {m:.3} us, p99 {p:.1} us",
+                t.len() / repeats.max(1)
+            );
         }
         let mean_limit = match limit_count {
             0 => String::new(),

@@ -70,10 +70,10 @@
 
 use crate::cspace::interval::Interval;
 use crate::cspace::sampler::SampleGrid;
-use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use crate::robot::delta3::{radial, tangent, ArmSolution};
+use crate::robot::MAX_BOXES;
 use crate::robot::{BoxKind, Delta3, RobotModel};
 
 /// Sub-boxes per axis when enclosing the motor angles over a cell (`SPLITS^3` per arm).
@@ -658,7 +658,11 @@ mod tests {
         };
         let (mut balls, mut tighter) = (0, 0);
         while balls < 400 {
-            let c = Vec3::new(rng.random_range(-500.0..500.0), rng.random_range(-500.0..500.0), rng.random_range(-1100.0..-300.0));
+            let c = Vec3::new(
+                rng.random_range(-500.0..500.0),
+                rng.random_range(-500.0..500.0),
+                rng.random_range(-1100.0..-300.0),
+            );
             let h = rng.random_range(2.0..150.0);
             let p0 = if balls % 2 == 0 { c } else { c + unit(&mut rng) * (h * rng.random::<Real>()) };
             if !d.is_reachable(&c) || !d.is_reachable(&p0) {
@@ -676,7 +680,12 @@ mod tests {
                     for v in corners {
                         let along = v.try_normalize(0.0).unwrap_or(Vec3::z());
                         for (f, w) in forms.iter().map(|form| &form[j]).enumerate() {
-                            assert!(v.norm() <= w.radius() + 1e-9, "form {f} box {j}: moved {} > {}", v.norm(), w.radius());
+                            assert!(
+                                v.norm() <= w.radius() + 1e-9,
+                                "form {f} box {j}: moved {} > {}",
+                                v.norm(),
+                                w.radius()
+                            );
                             for n in dirs.iter().chain([&along]) {
                                 let support = w.support(n);
                                 assert!(v.dot(n) <= support + 1e-9, "form {f} box {j}: {v:?} . {n:?} > {support}");

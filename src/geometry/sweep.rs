@@ -261,7 +261,14 @@ pub fn swept_boxes_apart_either(
     let (ta, tb) = (fa[0], fb[0]);
     let (ua, ub) = (&ta.u, &tb.u);
     #[inline(always)]
-    fn separates(d: &Vec3, n: &Vec3, len: impl Fn() -> Real, boxes: Real, ha: impl Fn() -> Real, hb: impl Fn() -> Real) -> bool {
+    fn separates(
+        d: &Vec3,
+        n: &Vec3,
+        len: impl Fn() -> Real,
+        boxes: Real,
+        ha: impl Fn() -> Real,
+        hb: impl Fn() -> Real,
+    ) -> bool {
         let dn = d.dot(n).abs();
         if (dn - boxes).is_nan() || dn - boxes <= 0.0 {
             return false;
@@ -269,7 +276,8 @@ pub fn swept_boxes_apart_either(
         let gap = SWEEP_GAP * len();
         dn - boxes > gap && dn - (boxes + ha() + hb()) > gap
     }
-    let least = |w: [&Sweep; 2], n: &Vec3, len: Real| w[0].support_with_norm(n, len).min(w[1].support_with_norm(n, len));
+    let least =
+        |w: [&Sweep; 2], n: &Vec3, len: Real| w[0].support_with_norm(n, len).min(w[1].support_with_norm(n, len));
     let face_a = |k: usize| {
         let (n, len) = (&ua[k], ta.norm[k]);
         let boxes = ta.radius[k] + radius(ub, &b.half, n);
@@ -374,7 +382,9 @@ pub(crate) mod tests {
         let (e, d) = s.ends[k];
         // A point of the box `Z` and one of its rounding ball (from the same parameters).
         let u = Vec3::new(t[1], t[2], t[3]);
-        let z = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3]
+        let z = s.cube[0] * t[1]
+            + s.cube[1] * t[2]
+            + s.cube[2] * t[3]
             + if u.norm() > 1.0 { u.normalize() } else { u } * s.round;
         let a = s.arc[0] * t[4] + s.arc[1] * t[5];
         let any = Vec3::new(t[5], t[6], t[7]);

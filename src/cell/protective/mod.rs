@@ -964,7 +964,12 @@ impl ProtectiveChecker {
 
     /// [`ProtectiveChecker::beyond_every_tier`] with the pair's two reference boxes (WCS) and
     /// each robot's reference ball (centre MCS, radius) given.
-    fn beyond_every_tier_at(&self, p: BoxPair, [(box_a, ca, sa), (box_b, cb, sb)]: [(Obb, Vec3, Real); 2], extra: Real) -> bool {
+    fn beyond_every_tier_at(
+        &self,
+        p: BoxPair,
+        [(box_a, ca, sa), (box_b, cb, sb)]: [(Obb, Vec3, Real); 2],
+        extra: Real,
+    ) -> bool {
         let (Some(la), Some(lb)) = (self.least_sweeps(p.a, p.box_a, ca, sa), self.least_sweeps(p.b, p.box_b, cb, sb))
         else {
             return false;
@@ -1009,7 +1014,9 @@ impl ProtectiveChecker {
             let robot = &self.exact.cell().robots[j];
             let (tcp, (s, (centre, radius))) = (&tcps_mcs[j], self.stop_balls[j]);
             match robot.model.box_at(&centre, k) {
-                Ok(b) if centre != *tcp => (b.transformed(&robot.placement.rotation(), &robot.placement.t), centre, radius),
+                Ok(b) if centre != *tcp => {
+                    (b.transformed(&robot.placement.rotation(), &robot.placement.t), centre, radius)
+                }
                 _ => (self.exact.boxes(j).as_slice()[k], *tcp, s),
             }
         };
@@ -1019,7 +1026,8 @@ impl ProtectiveChecker {
             (w, FaceTerms::new(b, &w))
         };
         let ((wa, fa), (wb, fb)) = (swept(p.a, p.box_a, &refs[0]), swept(p.b, p.box_b, &refs[1]));
-        !swept_boxes_apart_with(&refs[0].0, &wa, &fa, &refs[1].0, &wb, &fb) || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
+        !swept_boxes_apart_with(&refs[0].0, &wa, &fa, &refs[1].0, &wb, &fb)
+            || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
     }
 
     /// Whether box pair `p`'s reference boxes swept by their stop balls alone are not proved
