@@ -191,14 +191,53 @@ pub fn swept_boxes_apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
 /// a box meets many others.
 #[inline]
 pub fn swept_boxes_apart_with(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: &Sweep, fb: &FaceTerms) -> bool {
+    let (ha, hb) = (|k: usize| fa.support[k], |k: usize| fb.support[k]);
+    apart_on_an_axis(
+        (a, fa, ha, |n: &Vec3, len| sa.support_with_norm(n, len)),
+        (b, fb, hb, |n: &Vec3, len| sb.support_with_norm(n, len)),
+    )
+}
+
+/// Whether `a` and `b` are proved apart by [`swept_boxes_apart_with`] with some pair of their
+/// sweeps, when each box has two sound bounds on its displacements (`sa[0]` or `sa[1]`, with
+/// face terms `fa[f] = FaceTerms::new(a, sa[f])`; likewise `b`): one pass over the 15 axes
+/// instead of four. The same answer, to the bit, as trying the four pairs: on an axis, a pair
+/// separates when `dn - (ra + rb) > gap` (the same for all pairs) and
+/// `dn - ((ra + rb + ha) + hb) > gap`; a rounded sum never decreases when an addend grows, so
+/// the smaller support of each box gives the smallest sum, and some pair separates exactly
+/// when that one does. A NaN support fails its pairs, and `min` takes the other form's.
+pub fn swept_boxes_apart_either(
+    a: &Obb,
+    sa: [&Sweep; 2],
+    fa: [&FaceTerms; 2],
+    b: &Obb,
+    sb: [&Sweep; 2],
+    fb: [&FaceTerms; 2],
+) -> bool {
+    let least_a = |n: &Vec3, len| sa[0].support_with_norm(n, len).min(sa[1].support_with_norm(n, len));
+    let least_b = |n: &Vec3, len| sb[0].support_with_norm(n, len).min(sb[1].support_with_norm(n, len));
+    let (ha, hb) =
+        (|k: usize| fa[0].support[k].min(fa[1].support[k]), |k: usize| fb[0].support[k].min(fb[1].support[k]));
+    // The axes, radii and norms depend on the boxes alone: the same in both forms.
+    apart_on_an_axis((a, fa[0], ha, least_a), (b, fb[0], hb, least_b))
+}
+
+/// The 15 axes of [`swept_boxes_apart_with`] for each box's terms `(box, face terms, its
+/// support on its own face axis k, its support on any vector of the given norm)`.
+///
+/// Axis `n` of norm `len` separates when `|n . d|` exceeds the four radii by the gap: `ra`,
+/// `rb` the boxes', `ha`, `hb` the sweeps' supports, `(ra + rb + ha) + hb`. The supports are
+/// never negative (a sweep's sizes are not), so a rounded sum with them is never below the
+/// rounded `ra + rb`: when the boxes alone do not clear the gap (or do not even come apart,
+/// then the norm is not needed either), the swept ones do not, and what is left is not
+/// computed. The same answer, to the bit, as computing everything.
+#[inline(always)]
+fn apart_on_an_axis(
+    (a, fa, face_a_support, a_support): (&Obb, &FaceTerms, impl Fn(usize) -> Real, impl Fn(&Vec3, Real) -> Real),
+    (b, fb, face_b_support, b_support): (&Obb, &FaceTerms, impl Fn(usize) -> Real, impl Fn(&Vec3, Real) -> Real),
+) -> bool {
     let d = b.center - a.center;
     let (ua, ub) = (&fa.u, &fb.u);
-    // Axis `n` of norm `len` separates when `|n . d|` exceeds the four radii by the gap:
-    // `ra`, `rb` the boxes', `ha`, `hb` the sweeps' supports, `(ra + rb + ha) + hb`. The
-    // supports are never negative (a sweep's sizes are not), so a rounded sum with them is
-    // never below the rounded `ra + rb`: when the boxes alone do not clear the gap (or do not
-    // even come apart, then the norm is not needed either), the swept ones do not, and what
-    // is left is not computed. The same answer, to the bit, as computing everything.
     #[inline(always)]
     fn separates(
         d: &Vec3,
@@ -220,12 +259,12 @@ pub fn swept_boxes_apart_with(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: 
     let face_a = |k: usize| {
         let (n, len) = (&ua[k], fa.norm[k]);
         let rb = radius(ub, &b.half, n);
-        !fa.short[k] && separates(&d, n, || len, fa.radius[k], rb, || fa.support[k], || sb.support_with_norm(n, len))
+        !fa.short[k] && separates(&d, n, || len, fa.radius[k], rb, || face_a_support(k), || b_support(n, len))
     };
     let face_b = |k: usize| {
         let (n, len) = (&ub[k], fb.norm[k]);
         let ra = radius(ua, &a.half, n);
-        !fb.short[k] && separates(&d, n, || len, ra, fb.radius[k], || sa.support_with_norm(n, len), || fb.support[k])
+        !fb.short[k] && separates(&d, n, || len, ra, fb.radius[k], || a_support(n, len), || face_b_support(k))
     };
     let edge = |i: usize, j: usize| {
         let n = ua[i].cross(&ub[j]);
@@ -235,70 +274,7 @@ pub fn swept_boxes_apart_with(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: 
         }
         let len = || float::sqrt(len2);
         let (ra, rb) = (radius(ua, &a.half, &n), radius(ub, &b.half, &n));
-        separates(&d, &n, len, ra, rb, || sa.support_with_norm(&n, len()), || sb.support_with_norm(&n, len()))
-    };
-    (0..3).any(face_a) || (0..3).any(face_b) || (0..3).any(|i| (0..3).any(|j| edge(i, j)))
-}
-
-/// Whether `a` and `b` are proved apart by [`swept_boxes_apart_with`] with some pair of their
-/// sweeps, when each box has two sound bounds on its displacements (`sa[0]` or `sa[1]`, with
-/// face terms `fa[f] = FaceTerms::new(a, sa[f])`; likewise `b`): one pass over the 15 axes
-/// instead of four. The same answer, to the bit, as trying the four pairs: on an axis, a pair
-/// separates when `dn - (ra + rb) > gap` (the same for all pairs) and
-/// `dn - ((ra + rb + ha) + hb) > gap`; a rounded sum never decreases when an addend grows, so
-/// the smaller support of each box gives the smallest sum, and some pair separates exactly
-/// when that one does. A NaN support fails its pairs, and `min` takes the other form's.
-pub fn swept_boxes_apart_either(
-    a: &Obb,
-    sa: [&Sweep; 2],
-    fa: [&FaceTerms; 2],
-    b: &Obb,
-    sb: [&Sweep; 2],
-    fb: [&FaceTerms; 2],
-) -> bool {
-    let d = b.center - a.center;
-    // The axes, radii and norms depend on the boxes alone: the same in both forms.
-    let (ta, tb) = (fa[0], fb[0]);
-    let (ua, ub) = (&ta.u, &tb.u);
-    #[inline(always)]
-    fn separates(
-        d: &Vec3,
-        n: &Vec3,
-        len: impl Fn() -> Real,
-        boxes: Real,
-        ha: impl Fn() -> Real,
-        hb: impl Fn() -> Real,
-    ) -> bool {
-        let dn = d.dot(n).abs();
-        if (dn - boxes).is_nan() || dn - boxes <= 0.0 {
-            return false;
-        }
-        let gap = SWEEP_GAP * len();
-        dn - boxes > gap && dn - (boxes + ha() + hb()) > gap
-    }
-    let least =
-        |w: [&Sweep; 2], n: &Vec3, len: Real| w[0].support_with_norm(n, len).min(w[1].support_with_norm(n, len));
-    let face_a = |k: usize| {
-        let (n, len) = (&ua[k], ta.norm[k]);
-        let boxes = ta.radius[k] + radius(ub, &b.half, n);
-        let ha = || fa[0].support[k].min(fa[1].support[k]);
-        !ta.short[k] && separates(&d, n, || len, boxes, ha, || least(sb, n, len))
-    };
-    let face_b = |k: usize| {
-        let (n, len) = (&ub[k], tb.norm[k]);
-        let boxes = radius(ua, &a.half, n) + tb.radius[k];
-        let hb = || fb[0].support[k].min(fb[1].support[k]);
-        !tb.short[k] && separates(&d, n, || len, boxes, || least(sa, n, len), hb)
-    };
-    let edge = |i: usize, j: usize| {
-        let n = ua[i].cross(&ub[j]);
-        let len2 = n.norm_squared();
-        if len2 < 1e-10 {
-            return false;
-        }
-        let len = || float::sqrt(len2);
-        let boxes = radius(ua, &a.half, &n) + radius(ub, &b.half, &n);
-        separates(&d, &n, len, boxes, || least(sa, &n, len()), || least(sb, &n, len()))
+        separates(&d, &n, len, ra, rb, || a_support(&n, len()), || b_support(&n, len()))
     };
     (0..3).any(face_a) || (0..3).any(face_b) || (0..3).any(|i| (0..3).any(|j| edge(i, j)))
 }
