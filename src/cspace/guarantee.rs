@@ -346,24 +346,29 @@ pub fn cube_box_sweeps_with(
 /// which takes the place of the box `Z` inside the hull of each lower link (the sweep's
 /// `round`), and the link's turn is bounded with `|D|` at most that radius and `|D . t|` at
 /// most that radius times `|t|` (module doc, steps 1, 6). Both are sound for the ball; on an
-/// axis either may be the smaller.
-pub fn box_sweep_forms_with(
+/// axis either may be the smaller. Written into `out` (the per-tick path: no copy of the
+/// 2.5 KB set); `false`, with nothing written, when no TCP of the cube is reachable.
+pub fn box_sweep_forms_into(
+    out: &mut [[Sweep; MAX_BOXES]; 2],
     model: &RobotModel,
     c: &Vec3,
     h: Real,
     p0: &Vec3,
     enclose: impl FnOnce(&Vec3, &Vec3) -> [Enclosure; 3],
-) -> Option<[[Sweep; MAX_BOXES]; 2]> {
-    let (swing, h) = swing_over_cube(model, c, h, p0, enclose)?;
-    let Some(swing) = swing else { return Some([unknown(model); 2]) };
-    let mut out = [[Sweep::ZERO; MAX_BOXES]; 2];
+) -> bool {
+    let Some((swing, h)) = swing_over_cube(model, c, h, p0, enclose) else { return false };
     let motions = [TcpMotion::cube(c, h, p0), TcpMotion::ball(c, h, p0)];
+    let n = model.box_count();
     for (form, motion) in out.iter_mut().zip(&motions) {
-        for (j, slot) in form[..model.box_count()].iter_mut().enumerate() {
-            *slot = swing.box_sweep(model, p0, j, motion);
+        for (j, slot) in form.iter_mut().enumerate() {
+            *slot = match &swing {
+                _ if j >= n => Sweep::ZERO,
+                Some(swing) => swing.box_sweep(model, p0, j, motion),
+                None => Sweep { ball: Real::INFINITY, ..Sweep::ZERO },
+            };
         }
     }
-    Some(out)
+    true
 }
 
 /// The shared terms of the sweeps over the cube of centre `c` and half-side `h`, with that
@@ -392,7 +397,7 @@ fn swing_over_cube(
     Some((Some(CubeSwing::new(model, &sol, &th, 0b111)), h))
 }
 
-/// Both forms of [`box_sweep_forms_with`] for box `j` alone, measured from the reachable `p0`
+/// Both forms of [`box_sweep_forms_into`] for box `j` alone, measured from the reachable `p0`
 /// with its inverse kinematics `sol`, the motor angles over the cube enclosed by `th`: the
 /// same operations, so the same sweeps to the bit, without the other boxes'. Only box `j`'s
 /// arm's entries of `sol` and `th` are read.
@@ -628,7 +633,7 @@ mod tests {
         assert!(ratio <= 1.0);
     }
 
-    /// Both forms of [`box_sweep_forms_with`] bound the displacement of every box corner for
+    /// Both forms of [`box_sweep_forms_into`] bound the displacement of every box corner for
     /// every TCP of the ball: on random balls of 2 to 150 mm across the reachable space (the
     /// reference at the centre, or off it), with a margin and every kind of box, for TCPs on
     /// the sphere in the 26 axis, edge and corner directions and at random, then inside it; on
@@ -670,7 +675,8 @@ mod tests {
             }
             balls += 1;
             let enclose = |lo: &Vec3, hi: &Vec3| core::array::from_fn(|arm| theta_range(d, arm, lo, hi, SPLITS));
-            let forms = box_sweep_forms_with(&model, &c, h, &p0, enclose).unwrap();
+            let mut forms = [[Sweep { ball: Real::NAN, ..Sweep::ZERO }; MAX_BOXES]; 2];
+            assert!(box_sweep_forms_into(&mut forms, &model, &c, h, &p0, enclose));
             assert_eq!(forms[0], cube_box_sweeps_with(&model, &c, h, &p0, enclose).unwrap(), "form 0 is the cube's");
             for q in 0..120 {
                 let dir = if q < dirs.len() { dirs[q] } else { unit(&mut rng) };

@@ -23,7 +23,7 @@
 //!    radius `S - |v_fd| T_r`, and in the ball around its middle of radius
 //!    `S - |v_fd| T_r / 2` ([`capsule_ball`]); that ball is used, with the boxes built at its
 //!    centre, when the centre is reachable.
-//! 4. **Where the boxes can be.** [`box_sweep_forms_with`] bounds, per box, the displacement
+//! 4. **Where the boxes can be.** [`box_sweep_forms_into`] bounds, per box, the displacement
 //!    of every box point for every reachable TCP of that cube, measured from its centre
 //!    (interval inverse kinematics: elbows may swing far more than the TCP moves, SPEC §8);
 //!    the displacement set is a [`Sweep`] (MCS, rotated to the WCS with the robot's
@@ -117,7 +117,7 @@
 
 use crate::cell::exact::PairVerdict;
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
-use crate::cspace::guarantee::{box_sweep_forms, box_sweep_forms_with, theta_range, Enclosure};
+use crate::cspace::guarantee::{box_sweep_forms, box_sweep_forms_into, theta_range, Enclosure};
 use crate::cspace::interval::Interval;
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
 use crate::geometry::sweep::{swept_boxes_apart_either, swept_boxes_apart_with, FaceTerms};
@@ -1353,8 +1353,8 @@ fn stop_sweeps_wcs_into(
     let direct = |lo: &Vec3, hi: &Vec3, splits: u32| -> [Enclosure; 3] {
         core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits))
     };
-    let sweeps = match table.filter(|t| t.delta() == d) {
-        Some(t) => box_sweep_forms_with(model, tcp_mcs, s, tcp_mcs, |lo, hi| match t.enclose(lo, hi) {
+    let filled = match table.filter(|t| t.delta() == d) {
+        Some(t) => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| match t.enclose(lo, hi) {
             Some(th) if precise > 0 => {
                 let refine = |arm: usize| arms >> arm & 1 == 1;
                 core::array::from_fn(|arm| {
@@ -1368,22 +1368,20 @@ fn stop_sweeps_wcs_into(
             Some(th) => th,
             None => direct(lo, hi, SPLITS),
         }),
-        None => box_sweep_forms_with(model, tcp_mcs, s, tcp_mcs, |lo, hi| direct(lo, hi, SPLITS)),
+        None => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| direct(lo, hi, SPLITS)),
     };
-    write_forms(out, sweeps, rot_wcs);
+    write_forms(out, filled, rot_wcs);
 }
 
-/// Both forms of `sweeps` (MCS) rotated to the WCS with `rot_wcs`; infinite balls when `None`.
-fn write_forms(out: &mut SweepForms, sweeps: Option<[[Sweep; MAX_BOXES]; 2]>, rot_wcs: &crate::math::Mat3) {
-    match sweeps {
-        Some(forms) => {
-            for (form, slots) in forms.iter().zip(out.iter_mut()) {
-                for (w, slot) in form.iter().zip(slots.iter_mut()) {
-                    *slot = w.rotated(rot_wcs);
-                }
-            }
+/// Both forms of the sweeps in `out` (MCS, when `filled`) rotated to the WCS with `rot_wcs`
+/// in place; infinite balls when not `filled`.
+fn write_forms(out: &mut SweepForms, filled: bool, rot_wcs: &crate::math::Mat3) {
+    if filled {
+        for w in out.iter_mut().flatten() {
+            *w = w.rotated(rot_wcs);
         }
-        None => *out = [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2],
+    } else {
+        *out = [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2];
     }
 }
 
@@ -1445,10 +1443,18 @@ fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(
     }
     let widened = copy.as_ref().unwrap_or(faces_a);
     for (i, box_a) in boxes_a.iter().enumerate() {
-        let sa = [0, 1].map(|form| Sweep { ball: sweeps_a[form][i].ball + extra, ..sweeps_a[form][i] });
+        // Copies only for `extra` (the sweeps as they are otherwise: `ball + 0` is `ball`).
+        let wider;
+        let sa = match extra {
+            0.0 => [&sweeps_a[0][i], &sweeps_a[1][i]],
+            _ => {
+                wider = [0, 1].map(|form| Sweep { ball: sweeps_a[form][i].ball + extra, ..sweeps_a[form][i] });
+                [&wider[0], &wider[1]]
+            }
+        };
         for (k, box_b) in boxes_b.iter().enumerate() {
             let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
-            if !swept_boxes_apart_either(box_a, [&sa[0], &sa[1]], fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb) {
+            if !swept_boxes_apart_either(box_a, sa, fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb) {
                 return Some((i, k));
             }
         }
