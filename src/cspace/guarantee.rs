@@ -21,7 +21,10 @@
 //! [`crate::geometry::sweep`] tests box(p0) plus the set by its support function on the 15
 //! axes of the two boxes. On every axis the support is at most the length `rho` above (its
 //! [`Sweep::radius`]), and on most axes less: a face axis along `t` sees no elbow motion at
-//! all, and a world axis sees `h`, not `h sqrt(3)`, of the TCP's.
+//! all, and a world axis sees `h`, not `h sqrt(3)`, of the TCP's. Where the TCP stays in the
+//! ball of radius `h` (the protective verdict's stop, SPEC §8), [`box_sweep_forms_into`] also
+//! gives the same derivation with `D` in that ball: the ball takes `Z`'s place (the sweep's
+//! `round`) and steps 1 and 6 below read `|D| <= h` and `|D . t| <= h |t|`.
 //!
 //! # Reference point
 //! Displacements are measured from a reachable TCP `p0` of the cell: its centre when that is

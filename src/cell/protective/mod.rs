@@ -913,11 +913,10 @@ impl ProtectiveChecker {
     }
 
     /// The sweep of robot `j`'s box `k` about the reference ball `(centre, s)` (centre MCS;
-    /// both forms, WCS) from the
-    /// motor angles of the centre and of the two corners of the cube along the gradient of
-    /// its arm's angle alone, each angle `ANGLE_SLACK` toward the centre's and each ball
-    /// `LEAST_SLACK` smaller: on every axis no larger than the sweeps of any tier (module doc,
-    /// step 7). `None` when the centre is unreachable or a corner's angle lies more than a
+    /// both forms, WCS) from the motor angles of the centre and of the two corners of the
+    /// cube along the gradient of its arm's angle alone, each angle `ANGLE_SLACK` toward the
+    /// centre's and each ball `LEAST_SLACK` smaller: on every axis no larger than the sweeps
+    /// of any tier (module doc, step 7). `None` when the centre is unreachable or a corner's angle lies more than a
     /// right angle from the centre's (a range across the branch cut at `+-pi`, which no motor
     /// limit of a Delta robot allows): nothing learned.
     fn least_sweeps(&self, j: usize, k: usize, centre: Vec3, s: Real) -> Option<[Sweep; 2]> {
