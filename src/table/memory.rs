@@ -23,6 +23,30 @@ pub const RESERVE_BYTES: u64 = 256 << 20;
 /// masks and the block's [`crate::cspace::SubCells`].
 pub const BLOCK_BYTES_PER_PAIR: u64 = 2 * (8 + 16 + 24);
 
+/// The bound of a build not given one ([`default_max_memory`]): 7 GiB. A `shared-sub` build
+/// spends what its fixed part leaves on blocks and on the sub-octant cache, so the machine's
+/// whole memory as the bound lets the cache grow past 8 GB at k = 64 (T3: 8.06 GB peak
+/// resident on a 24 GB machine). The reference cells' fixed part at k = 64 is estimated at
+/// 4.81 GB; 7 GiB (7.5 GB) leaves 2.7 GB for the blocks and the cache, and about half a
+/// gigabyte below 8 GB for what the estimate leaves out (a block's sub-octant boxes made
+/// beyond the cache before it is dropped, the allocator's slack).
+pub const DEFAULT_MAX_MEMORY: u64 = 7 << 30;
+
+/// The bound of a build not given one, whose fixed part needs `fixed` bytes
+/// ([`MemoryPlan::fixed`]) on a machine with `total` bytes (when known):
+/// [`DEFAULT_MAX_MEMORY`] when the fixed part fits in it, never more than the machine has;
+/// otherwise the machine's memory, so that a build that cannot fit in the default is bounded
+/// only by what the machine has. The bound changes where the sub-cells are found and when
+/// the cache is dropped, never the table.
+pub fn default_max_memory(fixed: u64, total: Option<u64>) -> u64 {
+    let total = total.unwrap_or(u64::MAX);
+    if fixed <= DEFAULT_MAX_MEMORY {
+        DEFAULT_MAX_MEMORY.min(total)
+    } else {
+        total
+    }
+}
+
 /// How a build spends its memory.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MemoryPlan {
@@ -132,6 +156,25 @@ mod tests {
         assert_eq!(plan_memory(6_000, 6_000, 32, sub, big.fixed).unwrap().block_depth, 4);
         assert!(matches!(plan_memory(6_000, 6_000, 32, sub, big.fixed - 1), Err(BuildError::Memory { .. })));
         assert_eq!(plan_memory(6_000, 6_000, 32, Variant::D6, 64 << 30).unwrap().cache, 0);
+    }
+
+    /// The default bound is 7 GiB where the fixed part fits in it (and the machine has as
+    /// much), the machine's memory otherwise; at k = 64 it leaves a reference cell's
+    /// `shared-sub` build blocks and a cache, at k = 32 the blocks of the machine-wide bound.
+    #[test]
+    fn default_bound_is_7_gib_where_the_fixed_part_fits() {
+        let sub = Variant::SharedSubdivided;
+        assert_eq!(default_max_memory(1 << 30, Some(24 << 30)), DEFAULT_MAX_MEMORY);
+        assert_eq!(default_max_memory(1 << 30, None), DEFAULT_MAX_MEMORY);
+        assert_eq!(default_max_memory(1 << 30, Some(4 << 30)), 4 << 30);
+        assert_eq!(default_max_memory(DEFAULT_MAX_MEMORY + 1, Some(24 << 30)), 24 << 30);
+        // T1 at k = 64 (47,548 samples per robot).
+        let k64 = plan_memory(47_548, 47_548, 64, sub, u64::MAX).unwrap();
+        let plan = plan_memory(47_548, 47_548, 64, sub, default_max_memory(k64.fixed, Some(24 << 30))).unwrap();
+        assert!(plan.cache > 1 << 30 && plan.block_depth == 3, "{plan:?}");
+        let k32 = plan_memory(6_284, 6_284, 32, sub, u64::MAX).unwrap();
+        let at_32 = |max| plan_memory(6_284, 6_284, 32, sub, max).unwrap().block_depth;
+        assert_eq!(at_32(default_max_memory(k32.fixed, Some(24 << 30))), at_32(24 << 30));
     }
 
     /// A clearance build holds a level count per pair besides the label: one byte more per

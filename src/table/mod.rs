@@ -51,7 +51,7 @@ pub use build::{
     Variant,
 };
 #[cfg(feature = "std")]
-pub use memory::{parse_bytes, MemoryPlan};
+pub use memory::{default_max_memory, parse_bytes, MemoryPlan, DEFAULT_MAX_MEMORY};
 pub use bundle::{bundle_from_bytes, bundle_to_bytes, is_bundle, pair_cell, Bundle, BundlePair};
 pub use bundle_checker::{BundleChecker, PairAnswer};
 pub use clearance::{ClearanceTable, Ladder};

@@ -260,8 +260,8 @@ pub struct BuildArgs {
     /// The memory the build may use, in bytes or with K, M, G or T (powers of 1024), e.g. 8G: a
     /// shared-sub build finds its sub-cells by blocks of the quadtree sized to fit (the same
     /// table); a build whose fixed part (boxes, one byte of label per sample pair) does not fit
-    /// is refused before it starts (one-shot builds; docs/CLUSTER.md) [default: the machine's
-    /// memory]
+    /// is refused before it starts (one-shot builds; docs/CLUSTER.md) [default: 7G, or the
+    /// machine's memory when it has less or when the fixed part alone needs more]
     #[arg(long, value_name = "BYTES", conflicts_with = "shard", value_parser = clipped(parse_bytes))]
     pub max_memory: Option<u64>,
 }

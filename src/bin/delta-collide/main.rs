@@ -35,7 +35,7 @@ use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
-    build_table_bounded, from_bytes, is_bundle, to_bytes, BoundedBuild, BundleChecker, Confirmation, Labelling, Table,
+    build_table_bounded, default_max_memory, from_bytes, memory_plan, is_bundle, to_bytes, BoundedBuild, BundleChecker, Confirmation, Labelling, Table,
     TableAnswer, TableChecker, TableKind, Variant,
 };
 use std::io::{BufRead, Write};
@@ -371,7 +371,11 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
         return bundle::write_bundle(cell, k, variant, labelling, output, progress);
     }
     check_memory(cell, k, &Workspace::THESIS, 1)?;
-    let max_memory = args.max_memory.or_else(total_memory).unwrap_or(u64::MAX);
+    let max_memory = args.max_memory.unwrap_or_else(|| {
+        // An error of the plan is the build's to report.
+        let fixed = memory_plan(cell, k, &Workspace::THESIS, variant, u64::MAX).map_or(0, |p| p.fixed);
+        default_max_memory(fixed, total_memory())
+    });
     let build = BoundedBuild { k, ws: Workspace::THESIS, variant, labelling, progress, max_memory };
     let (header, table, r) = build_table_bounded(cell, &build)?;
     if let (Progress::Rows(_), Some((pairs, secs))) = (progress, r.sub_cells) {
