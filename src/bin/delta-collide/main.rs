@@ -35,8 +35,8 @@ use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
-    build_table_bounded, default_max_memory, from_bytes, memory_plan, is_bundle, to_bytes, BoundedBuild, BundleChecker, Confirmation, Labelling, Table,
-    TableAnswer, TableChecker, TableKind, Variant,
+    build_table_bounded, default_max_memory, from_bytes, is_bundle, memory_plan, to_bytes, BoundedBuild, BundleChecker,
+    Confirmation, Labelling, Table, TableAnswer, TableChecker, TableKind, Variant,
 };
 use std::io::{BufRead, Write};
 use std::path::Path;
