@@ -201,21 +201,6 @@ mod tests {
     use crate::math::Mat3;
     use proptest::prelude::*;
 
-    /// Whether an axis with `|d . n| = dn`, boxes' radii summing to `boxes` and length `len`
-    /// separates the swept boxes, the sweeps' supports `sweeps()` found only when the boxes
-    /// alone come apart by the gap.
-    #[inline(always)]
-    fn separates_one(dn: Real, boxes: Real, len: impl Fn() -> Real, sweeps: impl FnOnce(Real) -> Real) -> bool {
-        let apart = dn - boxes;
-        // The boxes alone overlap along the axis (or a value is NaN): not apart.
-        if apart.is_nan() || apart <= 0.0 {
-            return false;
-        }
-        let l = len();
-        let gap = SWEEP_GAP * l;
-        apart > gap && dn - (boxes + sweeps(l)) > gap
-    }
-
     /// [`swept_apart`] as first written: face axes of A first, then B's, then the edges, each
     /// axis's terms computed when it is reached, stopping at the first that separates. The
     /// statement the reordered form must answer as, to the bit.
@@ -233,14 +218,14 @@ mod tests {
             t[k] = dot(&ua[k], &d);
             let rb = hb[0] * ar[k][0] + hb[1] * ar[k][1] + hb[2] * ar[k][2];
             let n = &ua[k];
-            if separates_one(t[k].abs(), ha[k] + rb, || 1.0, |l| fa.face_support[k] + support(sb, n, l)) {
+            if separates(t[k].abs(), ha[k] + rb, || 1.0, |l| fa.face_support[k] + support(sb, n, l)) {
                 return true;
             }
         }
         for k in 0..3 {
             let ra = ha[0] * ar[0][k] + ha[1] * ar[1][k] + ha[2] * ar[2][k];
             let n = &ub[k];
-            if separates_one(dot(n, &d).abs(), ra + hb[k], || 1.0, |l| support(sa, n, l) + fb.face_support[k]) {
+            if separates(dot(n, &d).abs(), ra + hb[k], || 1.0, |l| support(sa, n, l) + fb.face_support[k]) {
                 return true;
             }
         }
@@ -260,7 +245,7 @@ mod tests {
                     let n = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
                     support(sa, &n, l) + support(sb, &n, l)
                 };
-                if separates_one(dn, boxes, || float::sqrt(len2), sweeps) {
+                if separates(dn, boxes, || float::sqrt(len2), sweeps) {
                     return true;
                 }
             }
