@@ -334,6 +334,9 @@ pub struct ProtectiveChecker {
     /// Per robot pair that can meet, whether the clearance table's bound proved it apart
     /// over this tick's stop balls (`protective/lookup.rs`).
     table_proved: alloc::vec::Vec<bool>,
+    /// Whether the certain STOPs are tried on the closest pair before any reference is set
+    /// (module doc, step 8; off only in the test that checks it changes no verdict).
+    certain_stops_first: bool,
     /// Whether the last tick ended before setting the references of its stop balls (a kept
     /// proof or a certain STOP without speed limits): `centres`, `reach`, `ref_boxes` and
     /// the sweeps are then an earlier tick's.
@@ -407,6 +410,7 @@ impl ProtectiveChecker {
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
             references_stale: true,
+            certain_stops_first: true,
             kept,
             report: ProtectiveReport {
                 verdict: Protective::Stop,
@@ -700,7 +704,8 @@ impl ProtectiveChecker {
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         let kept = self.kept_free(None);
         // Steps 6 and 7 on the closest pair need two reference boxes, not every robot's (step 8).
-        let early = if kept { None } else { closest.filter(|&p| self.reference_pair_stops(tcps_mcs, p, was_stop)) };
+        let first = !kept && self.certain_stops_first;
+        let early = if first { closest.filter(|&p| self.reference_pair_stops(tcps_mcs, p, was_stop)) } else { None };
         if (kept || early.is_some()) && !self.speed_limits {
             if kept {
                 (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
@@ -1495,6 +1500,27 @@ mod tests {
 
     fn checker(name: &str) -> ProtectiveChecker {
         ProtectiveChecker::new(reference_cell(name).unwrap(), 10.0).unwrap()
+    }
+
+    /// Step 8 changes no verdict: every tick of the default model's practical and collision
+    /// runs of T1 and T3 (where most STOPs are settled by it) gets the same verdict with the
+    /// certain STOPs tried first and without, and many ticks are settled by it.
+    #[test]
+    fn certain_stops_first_change_no_verdict() {
+        let text = include_str!("../../../c_harness/scenarios.txt");
+        for s in crate::cell::trajectory::parse_scenarios(text).unwrap().iter().filter(|s| s.cell != "T2") {
+            let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, vec![StopModel::DEFAULT; 2]).unwrap();
+            let mut first = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let mut plain = ProtectiveChecker { certain_stops_first: false, ..first.clone() };
+            let (mut tcps, mut early) = ([Vec3::zeros(); 2], 0);
+            for tick in 0..crate::cell::trajectory::RUN_TICKS {
+                s.tcps_at(tick, &mut tcps);
+                let v = first.check(&tcps).unwrap().verdict;
+                early += usize::from(v == Protective::Stop && first.references_stale);
+                assert_eq!(plain.check(&tcps).unwrap().verdict, v, "{} {} tick {tick}", s.cell, s.case);
+            }
+            assert!(early > 500, "{} {}: {early} ticks settled by step 8", s.cell, s.case);
+        }
     }
 
     #[test]
