@@ -561,11 +561,7 @@ mod tests {
         let grid = SampleGrid::new(&Workspace::THESIS, k, &model.delta).unwrap();
         let mut rng = StdRng::seed_from_u64(seed);
         let mut worst_ratio: Real = 0.0;
-        let dirs: Vec<Vec3> = (1..27)
-            .map(|i: i32| Vec3::new((i % 3 - 1) as Real, (i / 3 % 3 - 1) as Real, (i / 9 - 1) as Real))
-            .filter(|d| *d != Vec3::zeros())
-            .map(|d| d.normalize())
-            .collect();
+        let dirs = lattice_directions();
         // Half of the cells are drawn from those with an unreachable centre (the boundary of
         // the reachable space), where the bound is measured from an off-centre reference.
         let boundary: Vec<usize> = (0..grid.cells.len()).filter(|&s| !grid.reachable[s]).collect();
@@ -623,15 +619,30 @@ mod tests {
         }
     }
 
-    #[test]
-    fn bounds_hold_with_margin_and_extra_boxes() {
+    /// The 26 unit directions to the neighbours of a cube lattice point: axes, edges, corners.
+    fn lattice_directions() -> Vec<Vec3> {
+        (0..27)
+            .map(|i: i32| Vec3::new((i % 3 - 1) as Real, (i / 3 % 3 - 1) as Real, (i / 9 - 1) as Real))
+            .filter(|d| *d != Vec3::zeros())
+            .map(|d| d.normalize())
+            .collect()
+    }
+
+    /// The thesis robot with a 5 mm margin, upper link boxes, a platform box and `tool`.
+    fn with_extra_boxes(tool: Option<crate::robot::ToolBox>) -> RobotModel {
         let options = ModelOptions {
             margin: 5.0,
             upper_links: Some((30.0, 15.0)),
             platform: Some(crate::robot::ToolBox { offset: Vec3::zeros(), half: Vec3::new(50.0, 50.0, 10.0) }),
+            tool,
             ..ModelOptions::THESIS
         };
-        let model = RobotModel { options, ..RobotModel::THESIS };
+        RobotModel { options, ..RobotModel::THESIS }
+    }
+
+    #[test]
+    fn bounds_hold_with_margin_and_extra_boxes() {
+        let model = with_extra_boxes(None);
         let ratio = check_bounds_against_brute_force(model, 32, 150, 40, 4);
         assert!(ratio <= 1.0);
     }
@@ -643,21 +654,11 @@ mod tests {
     /// those directions, on the displacement's own and on each form's radius.
     #[test]
     fn ball_and_cube_forms_hold_every_tcp_of_the_ball() {
-        let options = ModelOptions {
-            margin: 5.0,
-            upper_links: Some((30.0, 15.0)),
-            platform: Some(crate::robot::ToolBox { offset: Vec3::zeros(), half: Vec3::new(50.0, 50.0, 10.0) }),
-            tool: Some(crate::robot::ToolBox { offset: Vec3::new(0.0, 0.0, -30.0), half: Vec3::new(20.0, 20.0, 30.0) }),
-            ..ModelOptions::THESIS
-        };
-        let model = RobotModel { options, ..RobotModel::THESIS };
+        let tool = crate::robot::ToolBox { offset: Vec3::new(0.0, 0.0, -30.0), half: Vec3::new(20.0, 20.0, 30.0) };
+        let model = with_extra_boxes(Some(tool));
         let d = &model.delta;
         let mut rng = StdRng::seed_from_u64(11);
-        let dirs: Vec<Vec3> = (0..27)
-            .map(|i: i32| Vec3::new((i % 3 - 1) as Real, (i / 3 % 3 - 1) as Real, (i / 9 - 1) as Real))
-            .filter(|d| *d != Vec3::zeros())
-            .map(|d| d.normalize())
-            .collect();
+        let dirs = lattice_directions();
         let unit = |rng: &mut StdRng| loop {
             let v = Vec3::from_fn(|_, _| rng.random::<Real>() * 2.0 - 1.0);
             if v.norm() > 0.1 && v.norm() <= 1.0 {
