@@ -201,17 +201,13 @@ impl RobotModel {
         out
     }
 
-    /// Box `k` alone of [`RobotModel::boxes`] (the same operations, so the same box), in the
-    /// MCS: one box of a configuration without building the others.
-    ///
-    /// # Errors
-    /// [`Unreachable`] from the inverse kinematics.
-    pub fn box_at(&self, tcp: &Vec3, k: usize) -> Result<Obb, Unreachable> {
-        let sol = self.delta.inverse_kinematics_cos_sin(tcp)?;
+    /// Box `k` alone of [`RobotModel::boxes_from_cos_sin`] (the same operations, so the same
+    /// box), in the MCS: one box of a configuration without building the others.
+    pub fn box_from_cos_sin(&self, tcp: &Vec3, sol: &MotorCosSin, k: usize) -> Obb {
         let (d, o) = (&self.delta, &self.options);
         let m = o.margin;
         let elbow = |arm: usize| d.elbow(arm, sol.cos[arm], sol.sin[arm]);
-        Ok(match self.box_kind(k) {
+        match self.box_kind(k) {
             BoxKind::LowerLink(arm) => {
                 let (arm, lower_half) = (arm as usize, Vec3::new(0.5 * d.re + m, o.half_height + m, o.half_depth + m));
                 link_box(&elbow(arm), &d.platform_joint(arm, tcp), 1.0 / d.re, &tangent(arm), lower_half)
@@ -226,7 +222,7 @@ impl RobotModel {
                 let extra = extra.expect("the box exists");
                 Obb::new(tcp + extra.offset, Mat3::identity(), extra.half.add_scalar(m))
             }
-        })
+        }
     }
 
     fn write_boxes(&self, tcp: &Vec3, sol: &MotorCosSin, out: &mut RobotBoxes) {
@@ -377,12 +373,13 @@ mod tests {
             let mut tried = 0;
             while tried < 500 {
                 let tcp = Vec3::new(400.0 * rng.unit(), 400.0 * rng.unit(), -650.0 + 350.0 * rng.unit());
-                let Ok(all) = model.boxes(&tcp) else {
-                    assert!(model.box_at(&tcp, 0).is_err());
+                let Ok(sol) = model.delta.inverse_kinematics_cos_sin(&tcp) else {
+                    assert!(model.boxes(&tcp).is_err());
                     continue;
                 };
+                let all = model.boxes(&tcp).unwrap();
                 for (k, b) in all.as_slice().iter().enumerate() {
-                    assert_eq!(model.box_at(&tcp, k).unwrap(), *b, "box {k} at {tcp:?}");
+                    assert_eq!(model.box_from_cos_sin(&tcp, &sol, k), *b, "box {k} at {tcp:?}");
                 }
                 tried += 1;
             }

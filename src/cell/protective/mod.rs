@@ -124,7 +124,7 @@ use crate::geometry::sweep::{swept_boxes_apart_either, swept_boxes_apart_with, F
 use crate::robot::MAX_BOXES;
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
-use crate::robot::delta3::ArmSolution;
+use crate::robot::delta3::{ArmSolution, MotorCosSin};
 use crate::robot::motor_table::{intersect, MotorTable};
 use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
 use alloc::sync::Arc;
@@ -923,11 +923,22 @@ impl ProtectiveChecker {
     /// centre's and each ball `LEAST_SLACK` smaller: on every axis no larger than the sweeps
     /// of any tier (module doc, step 7). `None` when the centre is unreachable or a corner's angle lies more than a
     /// right angle from the centre's (a range across the branch cut at `+-pi`, which no motor
-    /// limit of a Delta robot allows): nothing learned.
-    fn least_sweeps(&self, j: usize, k: usize, centre: Vec3, s: Real) -> Option<[Sweep; 2]> {
+    /// limit of a Delta robot allows): nothing learned. `at_centre`: the centre's inverse
+    /// kinematics, when the caller has it.
+    fn least_sweeps(
+        &self,
+        j: usize,
+        k: usize,
+        centre: Vec3,
+        s: Real,
+        at_centre: Option<MotorCosSin>,
+    ) -> Option<[Sweep; 2]> {
         let robot = &self.exact.cell().robots[j];
         let d = &robot.model.delta;
-        let at_centre = d.inverse_kinematics_cos_sin(&centre).ok()?;
+        let at_centre = match at_centre {
+            Some(sol) => sol,
+            None => d.inverse_kinematics_cos_sin(&centre).ok()?,
+        };
         // Box `k`'s sweep depends on its own arm's range alone; the others' are not read.
         let mut th = [Interval::point(0.0); 3];
         let mut sol = ArmSolution { theta: [0.0; 3], cos: at_centre.cos, sin: at_centre.sin };
@@ -962,19 +973,21 @@ impl ProtectiveChecker {
     /// first robot's sweeps) by the sweeps of any tier (module doc, step 7); `false` when that
     /// is not known.
     fn beyond_every_tier(&self, p: BoxPair, extra: Real) -> bool {
-        let reference = |j: usize, k: usize| (self.ref_boxes[j].as_slice()[k], self.centres[j], self.reach[j]);
+        let reference = |j: usize, k: usize| (self.ref_boxes[j].as_slice()[k], self.centres[j], self.reach[j], None);
         self.beyond_every_tier_at(p, [reference(p.a, p.box_a), reference(p.b, p.box_b)], extra)
     }
 
-    /// [`ProtectiveChecker::beyond_every_tier`] with the pair's two reference boxes (WCS) and
-    /// each robot's reference ball (centre MCS, radius) given.
+    /// [`ProtectiveChecker::beyond_every_tier`] with the pair's two reference boxes (WCS),
+    /// each robot's reference ball (centre MCS, radius) and, when at hand, its centre's inverse
+    /// kinematics given.
     fn beyond_every_tier_at(
         &self,
         p: BoxPair,
-        [(box_a, ca, sa), (box_b, cb, sb)]: [(Obb, Vec3, Real); 2],
+        [(box_a, ca, sa, ika), (box_b, cb, sb, ikb)]: [(Obb, Vec3, Real, Option<MotorCosSin>); 2],
         extra: Real,
     ) -> bool {
-        let (Some(la), Some(lb)) = (self.least_sweeps(p.a, p.box_a, ca, sa), self.least_sweeps(p.b, p.box_b, cb, sb))
+        let (Some(la), Some(lb)) =
+            (self.least_sweeps(p.a, p.box_a, ca, sa, ika), self.least_sweeps(p.b, p.box_b, cb, sb, ikb))
         else {
             return false;
         };
@@ -1017,15 +1030,16 @@ impl ProtectiveChecker {
         let reference = |j: usize, k: usize| {
             let robot = &self.exact.cell().robots[j];
             let (tcp, (s, (centre, radius))) = (&tcps_mcs[j], self.stop_balls[j]);
-            match robot.model.box_at(&centre, k) {
-                Ok(b) if centre != *tcp => {
-                    (b.transformed(&robot.placement.rotation(), &robot.placement.t), centre, radius)
+            match robot.model.delta.inverse_kinematics_cos_sin(&centre) {
+                Ok(sol) if centre != *tcp => {
+                    let b = robot.model.box_from_cos_sin(&centre, &sol, k);
+                    (b.transformed(&robot.placement.rotation(), &robot.placement.t), centre, radius, Some(sol))
                 }
-                _ => (self.exact.boxes(j).as_slice()[k], *tcp, s),
+                _ => (self.exact.boxes(j).as_slice()[k], *tcp, s, None),
             }
         };
         let refs = [reference(p.a, p.box_a), reference(p.b, p.box_b)];
-        let swept = |j: usize, k: usize, (b, _, reach): &(Obb, Vec3, Real)| {
+        let swept = |j: usize, k: usize, (b, _, reach, _): &(Obb, Vec3, Real, Option<MotorCosSin>)| {
             let w = least_ball(&self.exact.cell().robots[j].model, k, *reach);
             (w, FaceTerms::new(b, &w))
         };
