@@ -60,6 +60,21 @@
 //!    `|(x - x0) cross t| <= dx`, so `|z - z0| <= dx / w0`.
 //! 9. `y = z cross x = (t - (x.t) x) / sqrt(1 - (x.t)^2)`; the numerator changes by
 //!    `(x.t) (x - x0) + ((x - x0).t) x0`, so `|y - y0| <= (beta dx + (h_x |t_x| + h_y |t_y|) / re) / w0`.
+//! 10. (Stops only, [`box_sweep_forms_into`].) The same `y`, written exactly: with `s = x.t`,
+//!    `w = sqrt(1 - s^2)` and `s0, w'` at `p0`, `t - s x = (t - s0 x0) - (s - s0) x0 - s (x - x0)`,
+//!    so `y - y0 = (w'/w - 1) y0 - ((s - s0) / w) x0 - (s / w)(x - x0)`. With `|s| <= beta`
+//!    (`w >= w0`) and `|s - s0| <= (h_x |t_x| + h_y |t_y|) / re =: tt` (step 6): a segment
+//!    along the link's own axis `x0` of half-length `tt / w0`, plus a ball of radius
+//!    `beta dx / w0 + max(1 - w', w'/w0 - 1)`. Step 9's ball becomes that ball and segment
+//!    (each times `H + m`): the sum of their lengths exceeds step 9's bound by the last term
+//!    only, and on the axes across the link, such as the cross product of two links' axes,
+//!    the segment adds nothing.
+//!
+//! # Motor angles over a ball
+//! Where the TCP stays in a ball, its motor angles are also enclosed over the ball itself
+//! ([`ball_theta_range`], in the arm's polar coordinates) and intersected with the cube's:
+//! both hold every angle of the ball. Over a world cube the same ranges are wider (its
+//! corners reach `sqrt 3` times as far as the ball).
 //!
 //! Upper links (`F` to `G`, fixed `F`): `x.t = 0` so `y = t` never turns, `|z - z0| = dG / rf`,
 //! and points move at most `(1 + m/rf) dG + (d_u + m) dG / rf`. Platform and tool boxes
@@ -77,6 +92,7 @@ use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use crate::robot::delta3::{radial, tangent, ArmSolution};
 use crate::robot::MAX_BOXES;
+use crate::robot::motor_table::intersect;
 use crate::robot::{BoxKind, Delta3, RobotModel};
 
 /// Sub-boxes per axis when enclosing the motor angles over a cell (`SPLITS^3` per arm).
@@ -235,7 +251,11 @@ fn arm_frame(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interv
 /// `K = (R^2 + C) / (2 rf)`, `C = rf^2 - re^2 + b^2`.
 fn cos_ratio(d: &Delta3, a: Interval, b2: Interval, c: Interval) -> Option<Interval> {
     let r2 = a.sqr().add(c.sqr());
-    let r = r2.sqrt()?;
+    cos_ratio_of(d, r2, r2.sqrt()?, b2)
+}
+
+/// [`cos_ratio`] from enclosures of `R^2` and `R`.
+fn cos_ratio_of(d: &Delta3, r2: Interval, r: Interval, b2: Interval) -> Option<Interval> {
     let cc = b2.shift(d.rf * d.rf - d.re * d.re);
     let two_rf = 2.0 * d.rf;
     if cc.hi <= 0.0 {
@@ -263,6 +283,72 @@ fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: I
     let Some(psi) = q.acos() else { return Enclosure::Empty };
     let Some(phi) = Interval::atan2(c, a) else { return Enclosure::Unbounded };
     Enclosure::Range(phi.neg().sub(psi))
+}
+
+/// An enclosure of the elbow-out motor angle of `arm` over the reachable TCPs of the closed
+/// ball of centre `c` (MCS) and radius `rho`, in the arm's polar coordinates: the frame
+/// `(a, b, z) = (p.u + e - f, p.t, p.z)` is `p`'s orthonormal coordinates shifted, so the
+/// ball stays a ball of radius `rho` there and its shadow on the `(a, z)` plane is the disc
+/// of radius `rho` around `(a0, z0)`. Over that disc `R = hypot(a, z)` lies within `rho` of
+/// `R0` (triangle inequality) and, when `rho < R0`, `phi = atan2(z, a)` within
+/// `asin(rho / R0)` of `phi0` (the disc's tangents from the origin); `b` lies within `rho` of
+/// `b0`. Then `th = -phi - acos(K / R)` is enclosed as [`theta_over_box`] does, with `R`
+/// and `C` in those ranges (`K / R` is monotone in each, or bounded by interval arithmetic).
+/// Over a world-aligned cube of half-side `rho` the same ranges are wider: the square's
+/// shadow reaches `rho sqrt 2` from its centre, `rho (|u_x| + |u_y|)` along `a` for an arm
+/// not along a world axis.
+pub fn ball_theta_range(delta: &Delta3, arm: usize, c: &Vec3, rho: Real) -> Enclosure {
+    let (u, t) = (radial(arm), tangent(arm));
+    let (x, y, z0) = (Interval::point(c.x), Interval::point(c.y), Interval::point(c.z));
+    let spread = Interval::new(-rho, rho);
+    if z0.add(spread).hi >= 0.0 {
+        return Enclosure::Unbounded;
+    }
+    let a0 = x.scale(u.x).add(y.scale(u.y)).shift(delta.e - delta.f);
+    let b2 = x.scale(t.x).add(y.scale(t.y)).add(spread).sqr();
+    if b2.lo > delta.re * delta.re {
+        return Enclosure::Empty;
+    }
+    let Some(r0) = a0.sqr().add(z0.sqr()).sqrt() else { return Enclosure::Unbounded };
+    // `rho / R0` rounded up, its arcsine widened far beyond the rounding of `asin`.
+    let ratio = rho / r0.lo * (1.0 + 4.0 * Real::EPSILON);
+    let Some(phi0) = Interval::atan2(z0, a0) else { return Enclosure::Unbounded };
+    if !(ratio < 1.0 && r0.lo > rho) {
+        return Enclosure::Unbounded;
+    }
+    let turn = ratio.asin() * (1.0 + 1e-12) + 1e-15;
+    let mut out = Enclosure::Empty;
+    for w in 0..BALL_WEDGES {
+        // Wedge `w` of `phi - phi0` in `[-turn, turn]`, and its angle nearest 0.
+        let end = |i: u32| if i == BALL_WEDGES { turn } else { -turn + 2.0 * turn * i as Real / BALL_WEDGES as Real };
+        let (d0, d1) = (end(w), end(w + 1));
+        let nearest = if d0 <= 0.0 && d1 >= 0.0 { 0.0 } else { d0.abs().min(d1.abs()) };
+        let phi = phi0.add(Interval::new(d0, d1));
+        let r = wedge_radii(r0, rho, nearest);
+        let Some(q) = cos_ratio_of(delta, r.sqr(), r, b2) else { return Enclosure::Unbounded };
+        match (q.acos(), out) {
+            (None, _) => {}
+            (Some(psi), Enclosure::Range(o)) => out = Enclosure::Range(o.hull(&phi.neg().sub(psi))),
+            (Some(psi), _) => out = Enclosure::Range(phi.neg().sub(psi)),
+        }
+    }
+    out
+}
+
+/// Wedges of the polar angle in [`ball_theta_range`].
+pub const BALL_WEDGES: u32 = 5;
+
+/// `R` over the part of the disc of radius `rho` whose centre lies at distance `r0` from the
+/// origin, within the wedge of directions at least `nearest` from the centre's direction: a
+/// ray at angle `delta` meets the disc at `R = r0 cos delta -+ sqrt(rho^2 - r0^2 sin^2 delta)`,
+/// the nearer root increasing and the farther decreasing in `|delta|` (for `rho < r0`), so
+/// both are widest at `|delta| = nearest`.
+fn wedge_radii(r0: Interval, rho: Real, nearest: Real) -> Interval {
+    let (sin, cos) = nearest.sin_cos();
+    let along = r0.scale(cos);
+    let across = Interval::point(rho).sqr().sub(r0.sqr().scale(sin * sin));
+    let half = Interval::new(across.lo.max(0.0), across.hi.max(0.0)).sqrt().unwrap_or(Interval::point(0.0));
+    Interval::new(along.sub(half).lo, along.add(half).hi)
 }
 
 /// Lattice points per half-axis searched by [`reference_point`] (`(2 n + 1)^3` in all).
@@ -333,8 +419,9 @@ pub fn cube_box_sweeps_with(
     p0: &Vec3,
     enclose: impl FnOnce(&Vec3, &Vec3) -> [Enclosure; 3],
 ) -> Option<[Sweep; MAX_BOXES]> {
-    let (swing, h) = swing_over_cube(model, c, h, p0, enclose)?;
-    let Some(swing) = swing else { return Some(unknown(model)) };
+    let (angles, h) = angles_over_cube(model, c, h, p0, enclose)?;
+    let Some((sol, th)) = angles else { return Some(unknown(model)) };
+    let swing = CubeSwing::new(model, &sol, &th, 0b111, LinkTurn::Ball);
     let mut out = [Sweep::ZERO; MAX_BOXES];
     for (j, slot) in out[..model.box_count()].iter_mut().enumerate() {
         *slot = swing.box_sweep(model, p0, j, &TcpMotion::cube(c, h, p0));
@@ -342,14 +429,14 @@ pub fn cube_box_sweeps_with(
     Some(out)
 }
 
-/// Both forms of the sweeps of a stop: `[0]` as [`cube_box_sweeps_with`] (every reachable TCP
-/// of the cube of centre `c` and half-side `h`), `[1]` for every reachable TCP of the ball of
-/// radius `h` around `c` (within the cube, so the same angle enclosures hold): the TCP's own
-/// displacement `D` then lies in the ball of radius `|p0 - c| + h` (widened as the cube),
-/// which takes the place of the box `Z` inside the hull of each lower link (the sweep's
-/// `round`), and the link's turn is bounded with `|D|` at most that radius and `|D . t|` at
-/// most that radius times `|t|` (module doc, steps 1, 6). Both are sound for the ball; on an
-/// axis either may be the smaller. Written into `out` (the per-tick path: no copy of the
+/// Both forms of the sweeps of a stop, for every reachable TCP of the ball of radius `h` around
+/// `c`: the motor angles `enclose` gives over the cube of centre `c` and half-side `h`
+/// intersected with [`ball_theta_range`], and each lower link's turn split as in step 10.
+/// `[0]` takes the TCP's own displacement `D` in the cube (as [`cube_box_sweeps_with`]); `[1]`
+/// in the ball of radius `|p0 - c| + h` (widened as the cube), which takes the place of the
+/// box `Z` inside the hull of each lower link (the sweep's `round`), and the link's turn is
+/// bounded with `|D|` at most that radius and `|D . t|` at most that radius times `|t|`
+/// (module doc, steps 1, 6). On an axis either form may be the smaller. Written into `out` (the per-tick path: no copy of the
 /// 2.5 KB set); `false`, with nothing written, when no TCP of the cube is reachable.
 pub fn box_sweep_forms_into(
     out: &mut [[Sweep; MAX_BOXES]; 2],
@@ -359,8 +446,11 @@ pub fn box_sweep_forms_into(
     p0: &Vec3,
     enclose: impl FnOnce(&Vec3, &Vec3) -> [Enclosure; 3],
 ) -> bool {
-    let Some((swing, h)) = swing_over_cube(model, c, h, p0, enclose) else { return false };
+    let Some((angles, h)) = angles_over_cube(model, c, h, p0, enclose) else { return false };
     let motions = [TcpMotion::cube(c, h, p0), TcpMotion::ball(c, h, p0)];
+    let swing = angles.map(|(sol, th)| {
+        CubeSwing::new(model, &sol, &narrowed_to_ball(&model.delta, c, h, &th), 0b111, LinkTurn::AlongLink)
+    });
     let n = model.box_count();
     for (form, motion) in out.iter_mut().zip(&motions) {
         for (j, slot) in form.iter_mut().enumerate() {
@@ -374,16 +464,28 @@ pub fn box_sweep_forms_into(
     true
 }
 
-/// The shared terms of the sweeps over the cube of centre `c` and half-side `h`, with that
-/// half-side widened: `None` when no TCP of the cube is reachable, `Some(None)` when `p0` is
-/// unreachable or the angles cannot be enclosed.
-fn swing_over_cube(
+/// The motor angles `th` over the cube of centre `c` and half-side `h`, each intersected with
+/// [`ball_theta_range`] over the ball of radius `h` around `c` (both hold the angle of every
+/// reachable TCP of the ball, so does their intersection); `th` as it is where the ball's
+/// enclosure gives nothing.
+fn narrowed_to_ball(delta: &Delta3, c: &Vec3, h: Real, th: &[Interval; 3]) -> [Interval; 3] {
+    core::array::from_fn(|arm| match intersect(Enclosure::Range(th[arm]), ball_theta_range(delta, arm, c, h)) {
+        Enclosure::Range(r) => r,
+        Enclosure::Empty | Enclosure::Unbounded => th[arm],
+    })
+}
+
+/// The inverse kinematics at `p0` and the motor angles over the cube of centre `c` and
+/// half-side `h`, with that half-side widened: `None` when no TCP of the cube is reachable,
+/// `Some(None)` when `p0` is unreachable or the angles cannot be enclosed.
+#[allow(clippy::type_complexity)]
+fn angles_over_cube(
     model: &RobotModel,
     c: &Vec3,
     h: Real,
     p0: &Vec3,
     enclose: impl FnOnce(&Vec3, &Vec3) -> [Enclosure; 3],
-) -> Option<(Option<CubeSwing>, Real)> {
+) -> Option<(Option<(ArmSolution, [Interval; 3])>, Real)> {
     let d = &model.delta;
     let h = h * (1.0 + 1e-12) + 1e-12;
     let (lo, hi) = (c.add_scalar(-h), c.add_scalar(h));
@@ -397,7 +499,7 @@ fn swing_over_cube(
         }
     }
     let Ok(sol) = d.inverse_kinematics(p0) else { return Some((None, h)) };
-    Some((Some(CubeSwing::new(model, &sol, &th, 0b111)), h))
+    Some((Some((sol, th)), h))
 }
 
 /// Both forms of [`box_sweep_forms_into`] for box `j` alone, measured from the reachable `p0`
@@ -418,7 +520,7 @@ pub fn box_sweep_forms(
         BoxKind::LowerLink(arm) | BoxKind::UpperLink(arm) => 1 << arm,
         BoxKind::Platform | BoxKind::Tool => 0,
     };
-    let swing = CubeSwing::new(model, sol, th, arms);
+    let swing = CubeSwing::new(model, sol, th, arms, LinkTurn::AlongLink);
     [TcpMotion::cube(c, h, p0), TcpMotion::ball(c, h, p0)].map(|motion| swing.box_sweep(model, p0, j, &motion))
 }
 
@@ -466,18 +568,28 @@ impl TcpMotion {
     }
 }
 
+/// How a lower link's sweep holds the turn of the box's `y` axis (module doc, steps 9, 10).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LinkTurn {
+    /// All of it in the sweep's ball (step 9): the tables' sweeps.
+    Ball,
+    /// Its part along the link's own axis as the sweep's segment (step 10): the stops'.
+    AlongLink,
+}
+
 /// What every box's sweep over a cube shares, per arm: the largest turn `dth`, the elbow's
 /// chord `dG` and its arc (module doc, step 3); only for the arms asked for (the others stay 0
 /// and are not to be read).
 struct CubeSwing {
     dg: [Real; 3],
+    turn: LinkTurn,
     /// The elbow's arc: `G - G0 = rf (sin D tau0 + (cos D - 1) nu0)` for `|D| <= dth`, as
     /// `(tau0, nu0, sin min(dth, pi/2), 1 - cos dth)`.
     arcs: [(Vec3, Vec3, Real, Real); 3],
 }
 
 impl CubeSwing {
-    fn new(model: &RobotModel, sol: &ArmSolution, th: &[Interval; 3], arms: u8) -> CubeSwing {
+    fn new(model: &RobotModel, sol: &ArmSolution, th: &[Interval; 3], arms: u8, turn: LinkTurn) -> CubeSwing {
         let d = &model.delta;
         let (mut dg, mut arcs) = ([0.0; 3], [(Vec3::zeros(), Vec3::zeros(), 0.0, 0.0); 3]);
         for arm in (0..3).filter(|arm| arms >> arm & 1 == 1) {
@@ -489,7 +601,7 @@ impl CubeSwing {
             let (nu0, tau0) = (u * c - Vec3::z() * s, -u * s - Vec3::z() * c);
             arcs[arm] = (tau0, nu0, dth.min(std::f64::consts::FRAC_PI_2).sin(), 1.0 - dth.cos());
         }
-        CubeSwing { dg, arcs }
+        CubeSwing { dg, arcs, turn }
     }
 
     /// Box `j`'s sweep for the TCP's displacements `motion` (module doc, per box kind).
@@ -510,10 +622,21 @@ impl CubeSwing {
                     let w0 = (1.0 - beta * beta).sqrt();
                     let dz = (dx / w0).min(2.0);
                     let dy = ((beta * dx + tt) / w0).min(2.0);
-                    let ball = (o.half_height + m) * dy + (o.half_depth + m) * dz;
+                    let (h, depth) = (o.half_height + m, o.half_depth + m);
                     let (tau0, nu0, along, inward) = self.arcs[arm];
+                    let (ball, line) = match self.turn {
+                        // Step 10: the turn of `y` as a segment along `x0` and a ball, `x0` the
+                        // link's axis `(E0 - G0) / re` with `G0 - F = rf nu0`.
+                        LinkTurn::AlongLink if dy < 2.0 => {
+                            let x0 = (p0 + radial(arm) * (d.e - d.f) - nu0 * d.rf) / d.re;
+                            let w = (1.0 - (p0.dot(&t) / d.re).powi(2)).max(0.0).sqrt();
+                            let stretch = (1.0 - w).max(w / w0 - 1.0);
+                            (h * (beta * dx / w0 + stretch) + depth * dz, x0 * (h * tt / w0))
+                        }
+                        _ => (h * dy + depth * dz, Vec3::zeros()),
+                    };
                     let arc = [tau0 * (d.rf * along), nu0 * (d.rf * inward)];
-                    Sweep { cube, round, arc, ends: [(mu, 1.0 + mu), (1.0 + mu, mu)], ball }
+                    Sweep { cube, round, arc, ends: [(mu, 1.0 + mu), (1.0 + mu, mu)], ball, line }
                 }
             }
             BoxKind::UpperLink(arm) => {
@@ -523,7 +646,7 @@ impl CubeSwing {
                 let (tau0, nu0, along, inward) = self.arcs[arm as usize];
                 let (l, w) = (d.rf + m, du + m);
                 let arc = [tau0 * (l * along + w * inward), nu0 * (l * inward + w * along)];
-                Sweep { cube, round, arc, ends: [(0.0, 1.0); 2], ball: 0.0 }
+                Sweep { cube, round, arc, ends: [(0.0, 1.0); 2], ..Sweep::ZERO }
             }
             BoxKind::Platform | BoxKind::Tool => Sweep { cube, round, ends: [(1.0, 0.0); 2], ..Sweep::ZERO },
         };
@@ -651,11 +774,19 @@ mod tests {
     /// every TCP of the ball: on random balls of 2 to 150 mm across the reachable space (the
     /// reference at the centre, or off it), with a margin and every kind of box, for TCPs on
     /// the sphere in the 26 axis, edge and corner directions and at random, then inside it; on
-    /// those directions, on the displacement's own and on each form's radius.
+    /// those directions, on the axes of every box at the reference, on the displacement's own
+    /// and on each form's radius; also for lower links four times as wide, where the turn of
+    /// their `y` axis is most of their motion.
     #[test]
     fn ball_and_cube_forms_hold_every_tcp_of_the_ball() {
         let tool = crate::robot::ToolBox { offset: Vec3::new(0.0, 0.0, -30.0), half: Vec3::new(20.0, 20.0, 30.0) };
-        let model = with_extra_boxes(Some(tool));
+        let wide = RobotModel { options: ModelOptions { half_height: 280.0, ..ModelOptions::THESIS }, ..RobotModel::THESIS };
+        for model in [with_extra_boxes(Some(tool)), wide] {
+            forms_hold_every_tcp_of_the_ball(&model);
+        }
+    }
+
+    fn forms_hold_every_tcp_of_the_ball(model: &RobotModel) {
         let d = &model.delta;
         let mut rng = StdRng::seed_from_u64(11);
         let dirs = lattice_directions();
@@ -680,12 +811,13 @@ mod tests {
             balls += 1;
             let enclose = |lo: &Vec3, hi: &Vec3| core::array::from_fn(|arm| theta_range(d, arm, lo, hi, SPLITS));
             let mut forms = [[Sweep { ball: Real::NAN, ..Sweep::ZERO }; MAX_BOXES]; 2];
-            assert!(box_sweep_forms_into(&mut forms, &model, &c, h, &p0, enclose));
-            assert_eq!(forms[0], cube_box_sweeps_with(&model, &c, h, &p0, enclose).unwrap(), "form 0 is the cube's");
+            assert!(box_sweep_forms_into(&mut forms, model, &c, h, &p0, enclose));
+            let reference = model.boxes(&p0).unwrap();
+            let axes: Vec<Vec3> = reference.as_slice().iter().flat_map(|b| [0, 1, 2].map(|k| b.axes.column(k).into())).collect();
             for q in 0..120 {
                 let dir = if q < dirs.len() { dirs[q] } else { unit(&mut rng) };
                 let depth = if q < 60 { 1.0 } else { rng.random::<Real>().cbrt() };
-                let Some(m) = measured(&model, &p0, &(c + dir * (h * depth))) else { continue };
+                let Some(m) = measured(model, &p0, &(c + dir * (h * depth))) else { continue };
                 for (j, corners) in m.iter().enumerate() {
                     for v in corners {
                         let along = v.try_normalize(0.0).unwrap_or(Vec3::z());
@@ -696,7 +828,7 @@ mod tests {
                                 v.norm(),
                                 w.radius()
                             );
-                            for n in dirs.iter().chain([&along]) {
+                            for n in dirs.iter().chain(&axes).chain([&along]) {
                                 let support = w.support(n);
                                 assert!(v.dot(n) <= support + 1e-9, "form {f} box {j}: {v:?} . {n:?} > {support}");
                             }
@@ -811,6 +943,50 @@ mod tests {
         }
         assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -10.0), &Vec3::new(1.0, 1.0, 1.0), 2), Enclosure::Unbounded);
         assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -990.0), &Vec3::new(1.0, 1.0, -980.0), 2), Enclosure::Empty);
+    }
+
+    /// [`ball_theta_range`] holds the angle of every reachable TCP of the ball: on 3,000 random
+    /// balls of 1 to 250 mm (many reaching past the workspace's edge), for TCPs on the sphere
+    /// where the angle is largest and smallest to first order (along `E - G`, its gradient), in
+    /// random directions and inside; it is `Empty` only where none is reachable. On balls
+    /// within reach it is narrower than [`theta_range`] over the cube around the ball.
+    #[test]
+    fn ball_enclosure_holds_every_angle_of_the_ball() {
+        let d = Delta3::THESIS;
+        let mut rng = StdRng::seed_from_u64(5);
+        let (mut narrower, mut compared) = (0, 0);
+        for _ in 0..3000 {
+            let c = Vec3::new(rng.random_range(-600.0..600.0), rng.random_range(-600.0..600.0), rng.random_range(-1200.0..-150.0));
+            let rho = rng.random_range(1.0..250.0);
+            for arm in 0..3 {
+                let e = ball_theta_range(&d, arm, &c, rho);
+                let mut points = Vec::new();
+                if let Ok(sol) = d.inverse_kinematics(&c) {
+                    let u = radial(arm);
+                    let w = c + u * (d.e - d.f - d.rf * sol.cos[arm]) + Vec3::z() * (d.rf * sol.sin[arm]);
+                    points.extend([c, c + w.normalize() * rho, c - w.normalize() * rho]);
+                }
+                for q in 0..200 {
+                    let v = Vec3::from_fn(|_, _| rng.random::<Real>() * 2.0 - 1.0);
+                    let depth = if q < 100 { 1.0 } else { rng.random::<Real>().cbrt() };
+                    points.push(c + v.try_normalize(1e-9).unwrap_or(Vec3::z()) * (rho * depth));
+                }
+                for p in &points {
+                    let Ok(sol) = d.inverse_kinematics(p) else { continue };
+                    match e {
+                        Enclosure::Range(th) => assert!(th.contains(sol.theta[arm]), "arm {arm} ball {c:?} {rho}: {p:?}"),
+                        Enclosure::Empty => panic!("arm {arm} ball {c:?} {rho}: {p:?} reachable"),
+                        Enclosure::Unbounded => {}
+                    }
+                }
+                let (lo, hi) = (c.add_scalar(-rho), c.add_scalar(rho));
+                if let (Enclosure::Range(b), Enclosure::Range(q)) = (e, theta_range(&d, arm, &lo, &hi, 2)) {
+                    compared += 1;
+                    narrower += usize::from(b.hi - b.lo < q.hi - q.lo);
+                }
+            }
+        }
+        assert!(compared > 1000 && narrower * 10 > compared * 9, "{narrower} of {compared} narrower");
     }
 
     /// The largest [`Sweep::radius`] of [`box_sweeps`]: no point of the robot's model moves

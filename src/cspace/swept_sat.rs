@@ -67,6 +67,9 @@ pub struct SweptFrame {
 impl SweptFrame {
     /// The frame of box `b` swept by `s`.
     pub fn new(b: &Obb, s: &Sweep) -> SweptFrame {
+        // The tables' sweeps ([`crate::cspace::guarantee::cube_box_sweeps`]) have no segment,
+        // so [`support`] leaves it out.
+        debug_assert!(s.line == Vec3::zeros(), "a table's sweep has no segment");
         let m = &b.axes;
         let u: [[Real; 3]; 3] = core::array::from_fn(|k| [m[(0, k)], m[(1, k)], m[(2, k)]]);
         SweptFrame { u, h: [b.half.x, b.half.y, b.half.z], face_support: u.map(|n| support(s, &n, 1.0)) }

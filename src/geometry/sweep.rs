@@ -4,14 +4,15 @@
 //!
 //! # The displacement set
 //! A [`Sweep`] is the convex, centrally symmetric set
-//! `S = ball(c) + hull(E_1 u E_2)`, `E_k = e_k Z + d_k A`, where `Z` is the box
+//! `S = ball(c) + [-l, l] + hull(E_1 u E_2)`, `E_k = e_k Z + d_k A`, where `[-l, l]` is a
+//! segment (a lower link's turn along its own axis, `cspace::guarantee` step 9), `Z` is the box
 //! `[-w_0, w_0] + [-w_1, w_1] + [-w_2, w_2]` plus the ball of radius `r` (the TCP's cell: `w_a`
 //! is its half-edge along axis `a`, `r = 0`; or the TCP's ball: `w = 0`, `r` its radius) and
 //! `A` the rectangle `[-v_0, v_0] + [-v_1, v_1]` (around the arc an elbow moves on:
 //! `v_0` along the arc's tangent, `v_1` toward its centre). Its support function, for any
 //! vector `n` (not only unit ones), is
 //!
-//! `h_S(n) = c |n| + max_k ( e_k (sum_a |w_a . n| + r |n|) + d_k sum_b |v_b . n| )`.
+//! `h_S(n) = c |n| + |l . n| + max_k ( e_k (sum_a |w_a . n| + r |n|) + d_k sum_b |v_b . n| )`.
 //!
 //! # The test
 //! If every point of a box at some configuration lies within `S` of the point with the same
@@ -77,6 +78,8 @@ pub struct Sweep {
     pub ends: [(Real, Real); 2],
     /// Radius `c` of the ball added to everything.
     pub ball: Real,
+    /// Half-edge `l` of the segment added to everything.
+    pub line: Vec3,
 }
 
 impl Sweep {
@@ -87,13 +90,14 @@ impl Sweep {
         arc: [Vec3::new(0.0, 0.0, 0.0); 2],
         ends: [(0.0, 0.0); 2],
         ball: 0.0,
+        line: Vec3::new(0.0, 0.0, 0.0),
     };
 
     /// Whether this is no displacement at all.
     pub fn is_zero(&self) -> bool {
         let point = |v: &[Vec3]| v.iter().all(|w| *w == Vec3::zeros());
         let (z, a) = (point(&self.cube) && self.round == 0.0, point(&self.arc));
-        self.ball == 0.0 && self.ends.iter().all(|&(e, d)| (e == 0.0 || z) && (d == 0.0 || a))
+        self.ball == 0.0 && self.line == Vec3::zeros() && self.ends.iter().all(|&(e, d)| (e == 0.0 || z) && (d == 0.0 || a))
     }
 
     /// `h_S(n)`, the support function (module doc); `n` need not be unit.
@@ -109,7 +113,7 @@ impl Sweep {
         let z = self.cube[0].dot(n).abs() + self.cube[1].dot(n).abs() + self.cube[2].dot(n).abs() + self.round * norm;
         let a = self.arc[0].dot(n).abs() + self.arc[1].dot(n).abs();
         let [(e1, d1), (e2, d2)] = self.ends;
-        self.ball * norm + (e1 * z + d1 * a).max(e2 * z + d2 * a)
+        self.ball * norm + self.line.dot(n).abs() + (e1 * z + d1 * a).max(e2 * z + d2 * a)
     }
 
     /// The largest displacement in the set: `h_S` over unit vectors is at most this.
@@ -117,12 +121,12 @@ impl Sweep {
         let z = float::sqrt(self.cube.iter().map(|w| w.norm_squared()).sum::<Real>()) + self.round;
         let a = float::sqrt(self.arc.iter().map(|v| v.norm_squared()).sum::<Real>());
         let [(e1, d1), (e2, d2)] = self.ends;
-        self.ball + (e1 * z + d1 * a).max(e2 * z + d2 * a)
+        self.ball + self.line.norm() + (e1 * z + d1 * a).max(e2 * z + d2 * a)
     }
 
     /// The set rotated by `rot` (a rotation matrix).
     pub fn rotated(&self, rot: &Mat3) -> Sweep {
-        Sweep { cube: self.cube.map(|w| rot * w), arc: self.arc.map(|v| rot * v), ..*self }
+        Sweep { cube: self.cube.map(|w| rot * w), arc: self.arc.map(|v| rot * v), line: rot * self.line, ..*self }
     }
 }
 
@@ -347,12 +351,22 @@ pub(crate) mod tests {
                 arc: [q.column(0) * v[0], q.column(1) * v[1]],
                 ends: [(ends[0], ends[1]), (ends[2], ends[3])],
                 ball,
+                line: Vec3::zeros(),
             }
         }
     }
 
+    prop_compose! {
+        /// [`any_sweep`], half of them with a segment.
+        pub(crate) fn any_sweep_with_line()(s in any_sweep(), l in prop::array::uniform3(-25.0..25.0f64),
+                                            on in any::<bool>()) -> Sweep {
+            Sweep { line: if on { Vec3::from(l) } else { Vec3::zeros() }, ..s }
+        }
+    }
+
     /// A point of the displacement set `s` (module doc), from parameters in `[-1, 1]`: one of
-    /// the two hulled sets, a point of its cube and rectangle, plus a point of the ball.
+    /// the two hulled sets, a point of its cube and rectangle, plus a point of the ball and
+    /// one of the segment.
     pub(crate) fn point_of(s: &Sweep, t: &[Real; 8]) -> Vec3 {
         let k = if t[0] < 0.0 { 0 } else { 1 };
         let (e, d) = s.ends[k];
@@ -365,7 +379,7 @@ pub(crate) mod tests {
         let a = s.arc[0] * t[4] + s.arc[1] * t[5];
         let any = Vec3::new(t[5], t[6], t[7]);
         let ball = if any.norm() > 1.0 { any.normalize() } else { any } * s.ball;
-        z * e + a * d + ball
+        z * e + a * d + ball + s.line * (2.0 * t[0].abs() - 1.0)
     }
 
     /// Displacement parameters for [`point_of`], one per robot box, as the property tests draw them.
@@ -406,7 +420,7 @@ pub(crate) mod tests {
             let z = s.cube[0].dot(n).abs() + s.cube[1].dot(n).abs() + s.cube[2].dot(n).abs() + s.round * norm;
             let a = s.arc[0].dot(n).abs() + s.arc[1].dot(n).abs();
             let [(e1, d1), (e2, d2)] = s.ends;
-            s.ball * norm + (e1 * z + d1 * a).max(e2 * z + d2 * a)
+            s.ball * norm + s.line.dot(n).abs() + (e1 * z + d1 * a).max(e2 * z + d2 * a)
         };
         let separates = |n: &Vec3| {
             let len2 = n.norm_squared();
@@ -423,7 +437,8 @@ pub(crate) mod tests {
         /// The test with prepared face terms answers as the test as first written, also right at
         /// the threshold (B moved along `v` by bisection to where the answer flips, both sides).
         #[test]
-        fn prepared_swept_test_answers_as_written(a in any_box(), b in any_box(), sa in any_sweep(), sb in any_sweep(),
+        fn prepared_swept_test_answers_as_written(a in any_box(), b in any_box(), sa in any_sweep_with_line(),
+                sb in any_sweep_with_line(),
                 v in prop::array::uniform3(-1.0..1.0f64)) {
             let v = unit(Vec3::from(v));
             let at = |t: Real| Obb { center: a.center + v * t, ..b };
@@ -449,8 +464,8 @@ pub(crate) mod tests {
         /// to where that pair's answer flips, both sides), with parallel boxes (`b` turned like
         /// `a`) and with sweeps that are NaN or infinite in one form.
         #[test]
-        fn either_form_test_answers_as_the_four_pairs(a in any_box(), b in any_box(), sa in any_sweep(),
-                sa1 in any_sweep(), sb in any_sweep(), sb1 in any_sweep(), v in prop::array::uniform3(-1.0..1.0f64),
+        fn either_form_test_answers_as_the_four_pairs(a in any_box(), b in any_box(), sa in any_sweep_with_line(),
+                sa1 in any_sweep_with_line(), sb in any_sweep_with_line(), sb1 in any_sweep_with_line(), v in prop::array::uniform3(-1.0..1.0f64),
                 parallel in any::<bool>(), odd in 0..4usize) {
             let v = unit(Vec3::from(v));
             let b = if parallel { Obb { axes: a.axes, ..b } } else { b };
@@ -484,7 +499,7 @@ pub(crate) mod tests {
         /// are proved apart; and the proof is symmetric.
         #[test]
         fn apart_swept_boxes_stay_apart_under_every_displacement(a in any_box(), b in any_box(),
-                sa in any_sweep(), sb in any_sweep(),
+                sa in any_sweep_with_line(), sb in any_sweep_with_line(),
                 ts in prop::collection::vec((prop::array::uniform8(-1.0..1.0f64), prop::array::uniform8(-1.0..1.0f64)), 32)) {
             proved_and_stay_apart(swept_boxes_apart, (&a, &sa), (&b, &sb), &ts)?;
         }
@@ -492,7 +507,7 @@ pub(crate) mod tests {
         /// With no displacement the test is the separating-axis test (up to its tolerances), and
         /// the support never exceeds the radius on unit vectors.
         #[test]
-        fn zero_sweeps_agree_with_the_separating_axis_test(a in any_box(), b in any_box(), s in any_sweep(),
+        fn zero_sweeps_agree_with_the_separating_axis_test(a in any_box(), b in any_box(), s in any_sweep_with_line(),
                 n in prop::array::uniform3(-1.0..1.0f64)) {
             let apart = swept_boxes_apart(&a, &Sweep::ZERO, &b, &Sweep::ZERO);
             if apart {

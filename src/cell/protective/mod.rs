@@ -42,7 +42,12 @@
 //!    unproved (STOP or WARN), intersects that with the direct enclosure over the cube in
 //!    [`PRECISE_SPLITS`]`^3` sub-boxes (two sound enclosures: so is their intersection, and
 //!    a narrower angle range gives a smaller sweep on every axis, so tier 2 proves whatever
-//!    the direct enclosure alone proved before the table existed).
+//!    the direct enclosure alone proved before the table existed). Each tier's angles are
+//!    then intersected with
+//!    [`ball_theta_range`](crate::cspace::guarantee::ball_theta_range), an enclosure over
+//!    the ball itself in the arm's polar coordinates (the TCP never leaves the ball; the cube
+//!    only writes it as a box), and a lower link's turn is split between a ball and a
+//!    segment along its own axis (`cspace::guarantee`, step 10).
 //! 5. **Apart.** Box `i` of robot `a` over the stop lies in `box_i(now) + sweep_i`, and
 //!    likewise for `b`; [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) proves the
 //!    two sums disjoint on one of the 15 axes (with a positive gap). All box pairs of all
@@ -52,19 +57,19 @@
 //! 6. **Certain STOP, before any sweep.** Every sweep of a lower-link, platform or tool box
 //!    holds the ball of radius `S'` (the radius of step 3's ball): form 0's support on any `n`
 //!    is at least `(1 + mu) sum_a S' |w_a . n| >= S' |n|` (the cube term with weight
-//!    `max e_k >= 1`, the arc and ball terms are `>= 0`), form 1's at least
+//!    `max e_k >= 1`, the arc, ball and segment terms are `>= 0`), form 1's at least
 //!    `max e_k S' |n| >= S' |n|` (its rounding ball in the hull). So on every axis the swept box's projection holds that of the box
 //!    swept by the ball `S'` alone (upper links: by nothing). When
 //!    [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) does not separate the boxes
 //!    swept by those balls (radii shrunk by a relative 1e-9, far above rounding), it cannot
 //!    separate them with the real sweeps of any tier: STOP at once, without inverse
 //!    kinematics.
-//! 7. **Certain STOP, before tier 2.** Every tier's enclosure of an arm's angle over the cube
-//!    holds the angle `th(p)` of every reachable TCP `p` of the cube, whichever points are
-//!    picked: here its centre `p0` and the two corners `p0 +- S sign(w)` (`w = E_i - G_i`, the
-//!    lower link of the box's arm at `p0`: the gradient of `th_i` is parallel to `w`, so
-//!    these corners are where the angle is largest and smallest to first order), those that
-//!    are reachable. Step 4's sweep of a box depends on the enclosure only through its arm's
+//! 7. **Certain STOP, before tier 2.** Every tier's enclosure of an arm's angle over the ball
+//!    holds the angle `th(p)` of every reachable TCP `p` of the ball, whichever points are
+//!    picked: here its centre `p0` and the two points `p0 +- S w / |w|` of the ball
+//!    (`w = E_i - G_i`, the lower link of the box's arm at `p0`: the gradient of `th_i` is
+//!    parallel to `w`, so these are where the angle is largest and smallest to first order),
+//!    those that are reachable. Step 4's sweep of a box depends on the enclosure only through its arm's
 //!    `dth = max(th.hi - th(p0), th(p0) - th.lo)`, and grows with it on every axis (the
 //!    elbow's chord `2 rf sin(dth / 2)`, the arc's `sin dth` and `1 - cos dth`, all
 //!    increasing on `[0, pi]`; the TCP terms do not depend on it). So the sweeps built from
@@ -918,10 +923,10 @@ impl ProtectiveChecker {
     }
 
     /// The sweep of robot `j`'s box `k` about the reference ball `(centre, s)` (centre MCS;
-    /// both forms, WCS) from the motor angles of the centre and of the two corners of the
-    /// cube along the gradient of its arm's angle alone, each angle `ANGLE_SLACK` toward the
+    /// both forms, WCS) from the motor angles of the centre and of the two points of the
+    /// ball along the gradient of its arm's angle alone, each angle `ANGLE_SLACK` toward the
     /// centre's and each ball `LEAST_SLACK` smaller: on every axis no larger than the sweeps
-    /// of any tier (module doc, step 7). `None` when the centre is unreachable or a corner's angle lies more than a
+    /// of any tier (module doc, step 7). `None` when the centre is unreachable or a point's angle lies more than a
     /// right angle from the centre's (a range across the branch cut at `+-pi`, which no motor
     /// limit of a Delta robot allows): nothing learned. `at_centre`: the centre's inverse
     /// kinematics, when the caller has it.
@@ -950,10 +955,10 @@ impl ProtectiveChecker {
             // `(f + rf cos th) u_i - rf sin th z`.
             let u = crate::robot::delta3::radial(i);
             let w = centre + u * (d.e - d.f - d.rf * at_centre.cos[i]) + Vec3::z() * (d.rf * at_centre.sin[i]);
-            let toward = w.map(|x| if x < 0.0 { -s } else { s });
+            let toward = w * (s / w.norm());
             let (mut lo, mut hi) = (theta0, theta0);
-            for corner in [centre + toward, centre - toward] {
-                let Ok(at) = d.inverse_kinematics_cos_sin(&corner) else { continue };
+            for point in [centre + toward, centre - toward] {
+                let Ok(at) = d.inverse_kinematics_cos_sin(&point) else { continue };
                 let theta = at.theta(i);
                 // A NaN is not close either: nothing learned.
                 let close = (theta - theta0).abs() <= core::f64::consts::FRAC_PI_2;
@@ -1533,7 +1538,7 @@ mod tests {
                 early += usize::from(v == Protective::Stop && first.references_stale);
                 assert_eq!(plain.check(&tcps).unwrap().verdict, v, "{} {} tick {tick}", s.cell, s.case);
             }
-            assert!(early > 500, "{} {}: {early} ticks settled by step 8", s.cell, s.case);
+            assert!(early > 300, "{} {}: {early} ticks settled by step 8", s.cell, s.case);
         }
     }
 

@@ -61,13 +61,15 @@ pub(super) fn larger(a: &Sweep, b: &Sweep) -> Sweep {
         }
     });
     let ends = std::array::from_fn(|k| (a.ends[k].0.max(b.ends[k].0), a.ends[k].1.max(b.ends[k].1)));
-    Sweep { cube, round: a.round.max(b.round), arc, ends, ball: a.ball.max(b.ball) }
+    // A segment of either is held by the ball of its length (the table's sweeps have none).
+    let ball = a.ball.max(b.ball) + a.line.norm().max(b.line.norm());
+    Sweep { cube, round: a.round.max(b.round), arc, ends, ball, line: Vec3::zeros() }
 }
 
 /// The mirror image of `s` under `y -> -y` (the MCS cube maps to itself).
 pub(super) fn mirrored(s: &Sweep) -> Sweep {
     let flip = |v: Vec3| Vec3::new(v.x, -v.y, v.z);
-    Sweep { cube: s.cube.map(flip), arc: s.arc.map(flip), ..*s }
+    Sweep { cube: s.cube.map(flip), arc: s.arc.map(flip), line: flip(s.line), ..*s }
 }
 
 /// How to build an entry's boxes from its displacement sets: unknown when one is unbounded.
