@@ -289,54 +289,64 @@ fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: I
 /// ball of centre `c` (MCS) and radius `rho`, in the arm's polar coordinates: the frame
 /// `(a, b, z) = (p.u + e - f, p.t, p.z)` is `p`'s orthonormal coordinates shifted, so the
 /// ball stays a ball of radius `rho` there and its shadow on the `(a, z)` plane is the disc
-/// of radius `rho` around `(a0, z0)`. Over that disc `R = hypot(a, z)` lies within `rho` of
-/// `R0` (triangle inequality) and, when `rho < R0`, `phi = atan2(z, a)` within
-/// `asin(rho / R0)` of `phi0` (the disc's tangents from the origin); `b` lies within `rho` of
-/// `b0`. Then `th = -phi - acos(K / R)` is enclosed as [`theta_over_box`] does, with `R`
-/// and `C` in those ranges (`K / R` is monotone in each, or bounded by interval arithmetic).
-/// Over a world-aligned cube of half-side `rho` the same ranges are wider: the square's
-/// shadow reaches `rho sqrt 2` from its centre, `rho (|u_x| + |u_y|)` along `a` for an arm
-/// not along a world axis.
+/// of radius `rho` around `(a0, z0)`. Over that disc, when `rho < R0`, the polar angle
+/// `phi = atan2(z, a)` lies within `T = asin(rho / R0)` of `phi0` (the disc's tangents from
+/// the origin), and `b` within `rho` of `b0`. The angles `phi - phi0` are cut into
+/// [`BALL_WEDGES`] wedges; over each, `R = hypot(a, z)` lies in [`wedge_radii`] (within `rho`
+/// of `R0` on the middle one, closer on the others). Then `th = -phi - acos(K / R)` is
+/// enclosed as [`theta_over_box`] does, with `R` and `C` in those ranges, and the wedges'
+/// enclosures united (the two wedges at the same distance from the middle share their `R`
+/// range, so one enclosure of `acos(K / R)` serves both). Over a world-aligned cube of
+/// half-side `rho` the ranges are wider: the square's shadow reaches `rho sqrt 2` from its
+/// centre, and `rho (|u_x| + |u_y|)` along `a` for an arm not along a world axis.
+///
+/// Rounding: `a0`, `b0`, `R0` and `phi0` are computed in floating point, off by far less
+/// than [`POLAR_SLACK`] (mm, and rad), which widens each range.
 pub fn ball_theta_range(delta: &Delta3, arm: usize, c: &Vec3, rho: Real) -> Enclosure {
     let (u, t) = (radial(arm), tangent(arm));
-    let (x, y, z0) = (Interval::point(c.x), Interval::point(c.y), Interval::point(c.z));
-    let spread = Interval::new(-rho, rho);
-    if z0.add(spread).hi >= 0.0 {
+    let slack = Interval::new(-POLAR_SLACK, POLAR_SLACK);
+    let spread = Interval::new(-rho, rho).add(slack);
+    if Interval::point(c.z).add(spread).hi >= 0.0 {
         return Enclosure::Unbounded;
     }
-    let a0 = x.scale(u.x).add(y.scale(u.y)).shift(delta.e - delta.f);
-    let b2 = x.scale(t.x).add(y.scale(t.y)).add(spread).sqr();
+    let a0 = c.x * u.x + c.y * u.y + (delta.e - delta.f);
+    let b2 = Interval::point(c.x * t.x + c.y * t.y).add(spread).sqr();
     if b2.lo > delta.re * delta.re {
         return Enclosure::Empty;
     }
-    let Some(r0) = a0.sqr().add(z0.sqr()).sqrt() else { return Enclosure::Unbounded };
+    let r0 = Interval::point(a0.hypot(c.z)).add(slack);
     // `rho / R0` rounded up, its arcsine widened far beyond the rounding of `asin`.
     let ratio = rho / r0.lo * (1.0 + 4.0 * Real::EPSILON);
-    let Some(phi0) = Interval::atan2(z0, a0) else { return Enclosure::Unbounded };
     if !(ratio < 1.0 && r0.lo > rho) {
         return Enclosure::Unbounded;
     }
-    let turn = ratio.asin() * (1.0 + 1e-12) + 1e-15;
+    let turn = ratio.asin() * (1.0 + 1e-12) + POLAR_SLACK;
+    let minus_phi0 = Interval::point(-c.z.atan2(a0));
+    let step = 2.0 * turn / BALL_WEDGES as Real;
     let mut out = Enclosure::Empty;
-    for w in 0..BALL_WEDGES {
-        // Wedge `w` of `phi - phi0` in `[-turn, turn]`, and its angle nearest 0.
-        let end = |i: u32| if i == BALL_WEDGES { turn } else { -turn + 2.0 * turn * i as Real / BALL_WEDGES as Real };
-        let (d0, d1) = (end(w), end(w + 1));
-        let nearest = if d0 <= 0.0 && d1 >= 0.0 { 0.0 } else { d0.abs().min(d1.abs()) };
-        let phi = phi0.add(Interval::new(d0, d1));
+    for k in 0..=BALL_WEDGES / 2 {
+        // The wedges `|phi - phi0|` in `[(k - 1/2) step, (k + 1/2) step]`, or within `step / 2`
+        // for `k = 0`.
+        let nearest = (k as Real - 0.5).max(0.0) * step;
+        let farthest = if k == BALL_WEDGES / 2 { turn } else { (k as Real + 0.5) * step };
         let r = wedge_radii(r0, rho, nearest);
         let Some(q) = cos_ratio_of(delta, r.sqr(), r, b2) else { return Enclosure::Unbounded };
-        match (q.acos(), out) {
-            (None, _) => {}
-            (Some(psi), Enclosure::Range(o)) => out = Enclosure::Range(o.hull(&phi.neg().sub(psi))),
-            (Some(psi), _) => out = Enclosure::Range(phi.neg().sub(psi)),
-        }
+        let Some(psi) = q.acos() else { continue };
+        let th = minus_phi0.add(Interval::new(-farthest, farthest)).sub(psi);
+        out = match out {
+            Enclosure::Range(o) => Enclosure::Range(o.hull(&th)),
+            _ => Enclosure::Range(th),
+        };
     }
     out
 }
 
-/// Wedges of the polar angle in [`ball_theta_range`].
-pub const BALL_WEDGES: u32 = 5;
+/// Wedges of the polar angle in [`ball_theta_range`] (odd: one in the middle).
+pub const BALL_WEDGES: u32 = 3;
+
+/// Absolute widening (mm, and rad for angles) of the ranges of [`ball_theta_range`]: far
+/// above the rounding of the few operations before them.
+const POLAR_SLACK: Real = 1e-9;
 
 /// `R` over the part of the disc of radius `rho` whose centre lies at distance `r0` from the
 /// origin, within the wedge of directions at least `nearest` from the centre's direction: a
@@ -344,6 +354,9 @@ pub const BALL_WEDGES: u32 = 5;
 /// the nearer root increasing and the farther decreasing in `|delta|` (for `rho < r0`), so
 /// both are widest at `|delta| = nearest`.
 fn wedge_radii(r0: Interval, rho: Real, nearest: Real) -> Interval {
+    if nearest == 0.0 {
+        return r0.add(Interval::new(-rho, rho));
+    }
     let (sin, cos) = nearest.sin_cos();
     let along = r0.scale(cos);
     let across = Interval::point(rho).sqr().sub(r0.sqr().scale(sin * sin));
