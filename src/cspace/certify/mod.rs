@@ -486,6 +486,26 @@ mod tests {
         }
     }
 
+    /// [`Known`] answers as asking the test about the whole mask every time, and asks it about
+    /// each box pair once: random masks over random answers.
+    #[test]
+    fn known_answers_as_testing_every_time() {
+        let mut rng = crate::test_rng::TestRng(0x5eed);
+        for _ in 0..500 {
+            let truth = rng.next_u64();
+            let (mut known, mut asked) = (Known::default(), 0u64);
+            for _ in 0..20 {
+                let mask = rng.next_u64() & rng.next_u64();
+                let got = known.open(mask, |m| {
+                    assert_eq!(m & asked, 0, "a box pair asked twice");
+                    asked |= m;
+                    truth & m
+                });
+                assert_eq!(got, truth & mask);
+            }
+        }
+    }
+
     /// The sub-cells of [`sub_cell_masks`] with level 3 and every exit (the whole cells' and
     /// the octants' references, the cores, level 3's hinted exit and its columns tested only
     /// where a row leaves a box pair open) are those of the plain statement: level 2 as
