@@ -486,6 +486,76 @@ mod tests {
         }
     }
 
+    /// [`Known`] answers as asking the test about the whole mask every time, and asks it about
+    /// each box pair once: random masks over random answers.
+    #[test]
+    fn known_answers_as_testing_every_time() {
+        let mut rng = crate::test_rng::TestRng(0x5eed);
+        for _ in 0..500 {
+            let truth = rng.next_u64();
+            let (mut known, mut asked) = (Known::default(), 0u64);
+            for _ in 0..20 {
+                let mask = rng.next_u64() & rng.next_u64();
+                let got = known.open(mask, |m| {
+                    assert_eq!(m & asked, 0, "a box pair asked twice");
+                    asked |= m;
+                    truth & m
+                });
+                assert_eq!(got, truth & mask);
+            }
+        }
+    }
+
+    /// The sub-cells of [`sub_cell_masks`] with level 3 and every exit (the whole cells' and
+    /// the octants' references, the cores, level 3's hinted exit and its columns tested only
+    /// where a row leaves a box pair open) are those of the plain statement: level 2 as
+    /// [`octant_pairs`], then level 3 as [`sub_octants_prove_free_plainly`] on the box pairs
+    /// the three tests of the octant pair leave open. A third of the collision pairs of T1, T2
+    /// and T3 at k = 16.
+    #[test]
+    fn sub_cells_with_level_3_answer_as_their_plain_statement() {
+        use crate::cspace::label::collision_mask;
+        let ws = Workspace::THESIS;
+        for name in ["T1", "T2", "T3"] {
+            let cell = reference_cell(name).unwrap();
+            let labels = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap().space.labels;
+            let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
+            let held = |r: &RobotSpec, g: &SampleGrid| reference_octants(g, &references(&r.model, g));
+            let mut a = Levels::with_references(&a0, &a1, held(ra, &grid_a));
+            let mut b = Levels::with_references(&b0, &b1, held(rb, &grid_b));
+            (a.subs, b.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+            let nb = b0.len();
+            let all = all_box_pairs(a0.per_entry, b0.per_entry);
+            let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
+            let (mut pairs, mut freed) = (0, 0);
+            for (p, _) in labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision).step_by(3) {
+                let (ia, ib) = (p / nb, p % nb);
+                let (care, level_2) = octant_pairs(&a0, &a1, &b0, &b1, ia, ib, false);
+                let (whole_a, whole_b) = (boxes(&a0, ia), boxes(&b0, ib));
+                let open0 = if whole_a && whole_b { collision_mask(&a0, ia, &b0, ib, all) } else { all };
+                let mut want = level_2;
+                for (i, j) in (0..8).flat_map(|i| (0..8).map(move |j| (i, j))) {
+                    let (sa, sb, bit) = (8 * ia + i, 8 * ib + j, 1u64 << sub_cell_index(i, j));
+                    if level_2 & bit == 0 || !boxes(&a1, sa) || !boxes(&b1, sb) {
+                        continue;
+                    }
+                    let row = if whole_b { collision_mask(&a1, sa, &b0, ib, open0) } else { open0 };
+                    let column = if whole_a { collision_mask(&a0, ia, &b1, sb, open0) } else { open0 };
+                    let open = collision_mask(&a1, sa, &b1, sb, row & column);
+                    if sub_octants_prove_free_plainly(&a, &b, sa, sb, open) {
+                        want &= !bit;
+                        freed += 1;
+                    }
+                }
+                assert_eq!(sub_cell_masks(&a, &b, ia, ib, false), (care, want), "{name} pair ({ia}, {ib})");
+                pairs += 1;
+            }
+            assert!(freed > 1000, "{name}: {freed} octant pairs freed by level 3 in {pairs} pairs");
+        }
+    }
+
     /// Level 3 ([`sub_octants_prove_free`], with its hint, its reference test and its columns
     /// tested only where a row leaves a box pair open) answers as its plain statement
     /// ([`sub_octants_prove_free_plainly`]) on every octant pair that level 2 leaves open, of

@@ -131,12 +131,18 @@ pub(super) fn sub_octants_prove_free(
             collision_mask(x, u, y, v, open)
         }
     };
+    // Each test's answers on each box pair, kept from the first time it is asked: the rows
+    // (sub-octant `u` against B's octant), the columns (A's octant against sub-octant `v`)
+    // and the hinted sub-octant pair, which the hinted exit and the full loop both ask.
+    let (mut rows, mut columns, mut hinted_pair) = ([Known::default(); 8], [Known::default(); 8], Known::default());
+    let row = |known: &mut Known, u: usize, mask: u64| known.open(mask, |m| collision_mask(x, u, b1, sb, m));
+    let column = |known: &mut Known, v: usize, mask: u64| known.open(mask, |m| collision_mask(a1, sa, y, v, m));
     // The pair that failed last first, on box pair `first`, finest test first: a collision
     // usually fails there.
     let (u0, v0) = (*hint / 8, *hint % 8);
-    let stays = |open: u64| {
-        let left = fine(u0, v0, open);
-        left != 0 && collision_mask(x, u0, b1, sb, left) & collision_mask(a1, sa, y, v0, left) != 0
+    let mut stays = |open: u64| {
+        let left = hinted_pair.open(open, |m| fine(u0, v0, m));
+        left != 0 && row(&mut rows[u0], u0, left) & column(&mut columns[v0], v0, left) != 0
     };
     let hinted = x.slot[u0] == Slot::Boxes && y.slot[v0] == Slot::Boxes;
     if hinted && (meet_at_references(x, u0, y, v0, first) || stays(1 << first)) {
@@ -147,27 +153,46 @@ pub(super) fn sub_octants_prove_free(
         return false;
     }
     // Then each sub-octant against the other octant, and the finest test for what is left. A
-    // column (A's octant against sub-octant `v`) is tested only on the box pairs that some row
-    // left open, each once: only those enter `row & column`.
-    let (mut tested, mut columns) = ([0u64; 8], [0u64; 8]);
+    // column is tested only on the box pairs that some row left open, each once: only those
+    // enter `row & column`.
     for u in (0..8).filter(|&u| x.slot[u] == Slot::Boxes) {
-        let row = collision_mask(x, u, b1, sb, open);
-        if row == 0 {
+        let left = row(&mut rows[u], u, open);
+        if left == 0 {
             continue;
         }
         for v in (0..8).filter(|&v| y.slot[v] == Slot::Boxes) {
-            let untested = row & !tested[v];
-            if untested != 0 {
-                columns[v] |= collision_mask(a1, sa, y, v, untested);
-                tested[v] |= untested;
-            }
-            if fine(u, v, row & columns[v]) != 0 {
+            let both = left & column(&mut columns[v], v, left);
+            let met = if (u, v) == (u0, v0) { hinted_pair.open(both, |m| fine(u, v, m)) } else { fine(u, v, both) };
+            if met != 0 {
                 *hint = 8 * u + v;
                 return false;
             }
         }
     }
     true
+}
+
+/// The answers of one test over the box pairs asked so far: bit `p` of `tested` says whether
+/// box pair `p` (as [`collision_mask`]) was tested, of `open` whether it stayed open. A test
+/// answers each box pair alone (its two boxes decide it), so asking only the untested ones
+/// and keeping the answers gives what testing the whole mask again would.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Known {
+    tested: u64,
+    open: u64,
+}
+
+impl Known {
+    /// The box pairs of `mask` left open; `test(m)` gives those of `m` left open, and is asked
+    /// only about the box pairs not tested before.
+    pub(super) fn open(&mut self, mask: u64, test: impl FnOnce(u64) -> u64) -> u64 {
+        let new = mask & !self.tested;
+        if new != 0 {
+            self.open |= test(new) & new;
+            self.tested |= new;
+        }
+        self.open & mask
+    }
 }
 
 /// Whether box pair `bit` (as [`collision_mask`]) of A's entry `ea` of `x` and B's entry `eb`
@@ -398,12 +423,20 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
                     && columns.open(j, p, || !whole_a || touch(a0, ia, b1, sb, p))
                     && touch(a1, sa, b1, sb, p)
             };
+            // The box pairs found closed before the stopper: `left` below does not test them again.
+            let mut closed = 0u64;
             let stopper = if decided {
                 None
             } else if entries_apart(a1, sa, b1, sb) {
                 Some(None)
             } else {
-                Some(hint_first(open0, hint).find(|&p| open(p)))
+                Some(hint_first(open0, hint).find(|&p| {
+                    let o = open(p);
+                    if !o {
+                        closed |= 1 << p;
+                    }
+                    o
+                }))
             };
             match stopper {
                 Some(None) => continue,
@@ -412,7 +445,13 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
                     // Both octants' references lie in the sub-cell: their boxes meeting decides
                     // it (`meet_at_references`), level 3 could not prove it free.
                     if !first_only && !meet_at_references(a1, sa, b1, sb, p) {
-                        let left = || hint_first(open0, p).filter(|&q| open(q)).fold(0u64, |m, q| m | 1 << q);
+                        // The box pairs the octant pair leaves open: the stopper `p`, and those
+                        // the search above did not reach, each tested once (every test is a
+                        // function of its boxes, so the answers are those of testing all again).
+                        let left = || {
+                            let rest = hint_first(open0 & !closed & !(1 << p), p).filter(|&q| open(q));
+                            rest.fold(1u64 << p, |m, q| m | 1 << q)
+                        };
                         if sub_octants_prove_free(a, b, sa, sb, p, left, &mut hint3) {
                             continue;
                         }
