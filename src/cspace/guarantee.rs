@@ -69,6 +69,13 @@
 //!    (each times `H + m`): the sum of their lengths exceeds step 9's bound by the last term
 //!    only, and on the axes across the link, such as the cross product of two links' axes,
 //!    the segment adds nothing.
+//! 11. (Stops only.) `z` and `z0` are unit vectors orthogonal to `t`, so `z` is `z0` turned
+//!    about `t` by an angle `phi` with `2 sin(|phi| / 2) = |z - z0| <= dz` (step 8):
+//!    `z - z0 = (cos phi - 1) z0 + sin phi (t x z0)`, and `t x z0 = (x0 - s0 t) / w'`
+//!    (`z0 = x0 x t / w'`). So `z - z0` is a segment along `x0` of half-length
+//!    `sin phi_max / w'` (`phi_max = 2 asin(dz / 2)`, `sin` taken at `min(phi_max, pi/2)`)
+//!    plus a ball of radius `sin phi_max |s0| / w' + 1 - cos phi_max`; times `D + m`. Both
+//!    segments lie along `x0`, so they add into one.
 //!
 //! # Motor angles over a ball
 //! Where the TCP stays in a ball, its motor angles are also enclosed over the ball itself
@@ -638,15 +645,22 @@ impl CubeSwing {
                     let (h, depth) = (o.half_height + m, o.half_depth + m);
                     let (tau0, nu0, along, inward) = self.arcs[arm];
                     let (ball, line) = match self.turn {
-                        // Step 10: the turn of `y` as a segment along `x0` and a ball, `x0` the
-                        // link's axis `(E0 - G0) / re` with `G0 - F = rf nu0`.
-                        LinkTurn::AlongLink if dy < 2.0 => {
+                        // Steps 10 and 11: the turns of `y` and `z`, each as a segment along `x0`
+                        // and a ball; `x0` is the link's axis `(E0 - G0) / re`, `G0 - F = rf nu0`.
+                        LinkTurn::AlongLink => {
                             let x0 = (p0 + radial(arm) * (d.e - d.f) - nu0 * d.rf) / d.re;
-                            let w = (1.0 - (p0.dot(&t) / d.re).powi(2)).max(0.0).sqrt();
-                            let stretch = (1.0 - w).max(w / w0 - 1.0);
-                            (h * (beta * dx / w0 + stretch) + depth * dz, x0 * (h * tt / w0))
+                            let s0 = p0.dot(&t) / d.re;
+                            let w = (1.0 - s0 * s0).max(0.0).sqrt();
+                            let (y_ball, y_line) = match dy < 2.0 {
+                                true => (h * (beta * dx / w0 + (1.0 - w).max(w / w0 - 1.0)), h * tt / w0),
+                                false => (h * dy, 0.0),
+                            };
+                            let phi = if dz < 2.0 { 2.0 * (0.5 * dz).asin() } else { std::f64::consts::PI };
+                            let sin = phi.min(std::f64::consts::FRAC_PI_2).sin();
+                            let z_ball = depth * (sin * s0.abs() / w + (1.0 - phi.cos()));
+                            (y_ball + z_ball, x0 * (y_line + depth * sin / w))
                         }
-                        _ => (h * dy + depth * dz, Vec3::zeros()),
+                        LinkTurn::Ball => (h * dy + depth * dz, Vec3::zeros()),
                     };
                     let arc = [tau0 * (d.rf * along), nu0 * (d.rf * inward)];
                     Sweep { cube, round, arc, ends: [(mu, 1.0 + mu), (1.0 + mu, mu)], ball, line }
@@ -788,13 +802,17 @@ mod tests {
     /// reference at the centre, or off it), with a margin and every kind of box, for TCPs on
     /// the sphere in the 26 axis, edge and corner directions and at random, then inside it; on
     /// those directions, on the axes of every box at the reference, on the displacement's own
-    /// and on each form's radius; also for lower links four times as wide, where the turn of
-    /// their `y` axis is most of their motion.
+    /// and on each form's radius; also for lower links four times as wide or 16 times as deep,
+    /// where the turn of their `y` or `z` axis is most of their motion.
     #[test]
     fn ball_and_cube_forms_hold_every_tcp_of_the_ball() {
         let tool = crate::robot::ToolBox { offset: Vec3::new(0.0, 0.0, -30.0), half: Vec3::new(20.0, 20.0, 30.0) };
         let wide = RobotModel { options: ModelOptions { half_height: 280.0, ..ModelOptions::THESIS }, ..RobotModel::THESIS };
-        for model in [with_extra_boxes(Some(tool)), wide] {
+        let deep = RobotModel {
+            options: ModelOptions { half_height: 10.0, half_depth: 280.0, ..ModelOptions::THESIS },
+            ..RobotModel::THESIS
+        };
+        for model in [with_extra_boxes(Some(tool)), wide, deep] {
             forms_hold_every_tcp_of_the_ball(&model);
         }
     }
