@@ -451,7 +451,7 @@ pub fn cube_box_sweeps_with(
 
 /// Both forms of the sweeps of a stop, for every reachable TCP of the ball of radius `h` around
 /// `c`: the motor angles `enclose` gives over the cube of centre `c` and half-side `h`
-/// intersected with [`ball_theta_range`], and each lower link's turn split as in step 10.
+/// intersected with [`ball_theta_range`], and each lower link's turn split as in steps 10 and 11.
 /// `[0]` takes the TCP's own displacement `D` in the cube (as [`cube_box_sweeps_with`]); `[1]`
 /// in the ball of radius `|p0 - c| + h` (widened as the cube), which takes the place of the
 /// box `Z` inside the hull of each lower link (the sweep's `round`), and the link's turn is
@@ -588,12 +588,12 @@ impl TcpMotion {
     }
 }
 
-/// How a lower link's sweep holds the turn of the box's `y` axis (module doc, steps 9, 10).
+/// How a lower link's sweep holds the turn of the box's `y` and `z` axes (module doc, steps 8-11).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum LinkTurn {
-    /// All of it in the sweep's ball (step 9): the tables' sweeps.
+    /// All of it in the sweep's ball (steps 8, 9): the tables' sweeps.
     Ball,
-    /// Its part along the link's own axis as the sweep's segment (step 10): the stops'.
+    /// Its part along the link's own axis as the sweep's segment (steps 10 and 11): the stops'.
     AlongLink,
 }
 

@@ -5,7 +5,7 @@
 //! # The displacement set
 //! A [`Sweep`] is the convex, centrally symmetric set
 //! `S = ball(c) + [-l, l] + hull(E_1 u E_2)`, `E_k = e_k Z + d_k A`, where `[-l, l]` is a
-//! segment (a lower link's turn along its own axis, `cspace::guarantee` step 9), `Z` is the box
+//! segment (a lower link's turn along its own axis, `cspace::guarantee` steps 10-11), `Z` is the box
 //! `[-w_0, w_0] + [-w_1, w_1] + [-w_2, w_2]` plus the ball of radius `r` (the TCP's cell: `w_a`
 //! is its half-edge along axis `a`, `r = 0`; or the TCP's ball: `w = 0`, `r` its radius) and
 //! `A` the rectangle `[-v_0, v_0] + [-v_1, v_1]` (around the arc an elbow moves on:
