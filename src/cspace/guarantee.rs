@@ -61,21 +61,21 @@
 //! 9. `y = z cross x = (t - (x.t) x) / sqrt(1 - (x.t)^2)`; the numerator changes by
 //!    `(x.t) (x - x0) + ((x - x0).t) x0`, so `|y - y0| <= (beta dx + (h_x |t_x| + h_y |t_y|) / re) / w0`.
 //! 10. (Stops only, [`box_sweep_forms_into`].) The same `y`, written exactly: with `s = x.t`,
-//!    `w = sqrt(1 - s^2)` and `s0, w'` at `p0`, `t - s x = (t - s0 x0) - (s - s0) x0 - s (x - x0)`,
-//!    so `y - y0 = (w'/w - 1) y0 - ((s - s0) / w) x0 - (s / w)(x - x0)`. With `|s| <= beta`
-//!    (`w >= w0`) and `|s - s0| <= (h_x |t_x| + h_y |t_y|) / re =: tt` (step 6): a segment
-//!    along the link's own axis `x0` of half-length `tt / w0`, plus a ball of radius
-//!    `beta dx / w0 + max(1 - w', w'/w0 - 1)`. Step 9's ball becomes that ball and segment
-//!    (each times `H + m`): the sum of their lengths exceeds step 9's bound by the last term
-//!    only, and on the axes across the link, such as the cross product of two links' axes,
-//!    the segment adds nothing.
+//!     `w = sqrt(1 - s^2)` and `s0, w'` at `p0`, `t - s x = (t - s0 x0) - (s - s0) x0 - s (x - x0)`,
+//!     so `y - y0 = (w'/w - 1) y0 - ((s - s0) / w) x0 - (s / w)(x - x0)`. With `|s| <= beta`
+//!     (`w >= w0`) and `|s - s0| <= (h_x |t_x| + h_y |t_y|) / re =: tt` (step 6): a segment
+//!     along the link's own axis `x0` of half-length `tt / w0`, plus a ball of radius
+//!     `beta dx / w0 + max(1 - w', w'/w0 - 1)`. Step 9's ball becomes that ball and segment
+//!     (each times `H + m`): the sum of their lengths exceeds step 9's bound by the last term
+//!     only, and on the axes across the link, such as the cross product of two links' axes,
+//!     the segment adds nothing.
 //! 11. (Stops only.) `z` and `z0` are unit vectors orthogonal to `t`, so `z` is `z0` turned
-//!    about `t` by an angle `phi` with `2 sin(|phi| / 2) = |z - z0| <= dz` (step 8):
-//!    `z - z0 = (cos phi - 1) z0 + sin phi (t x z0)`, and `t x z0 = (x0 - s0 t) / w'`
-//!    (`z0 = x0 x t / w'`). So `z - z0` is a segment along `x0` of half-length
-//!    `sin phi_max / w'` (`phi_max = 2 asin(dz / 2)`, `sin` taken at `min(phi_max, pi/2)`)
-//!    plus a ball of radius `sin phi_max |s0| / w' + 1 - cos phi_max`; times `D + m`. Both
-//!    segments lie along `x0`, so they add into one.
+//!     about `t` by an angle `phi` with `2 sin(|phi| / 2) = |z - z0| <= dz` (step 8):
+//!     `z - z0 = (cos phi - 1) z0 + sin phi (t x z0)`, and `t x z0 = (x0 - s0 t) / w'`
+//!     (`z0 = x0 x t / w'`). So `z - z0` is a segment along `x0` of half-length
+//!     `sin phi_max / w'` (`phi_max = 2 asin(dz / 2)`, `sin` taken at `min(phi_max, pi/2)`)
+//!     plus a ball of radius `sin phi_max |s0| / w' + 1 - cos phi_max`; times `D + m`. Both
+//!     segments lie along `x0`, so they add into one.
 //!
 //! # Motor angles over a ball
 //! Where the TCP stays in a ball, its motor angles are also enclosed over the ball itself
