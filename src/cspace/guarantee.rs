@@ -98,8 +98,8 @@ use crate::cspace::sampler::SampleGrid;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
 use crate::robot::delta3::{radial, tangent, ArmSolution};
-use crate::robot::MAX_BOXES;
 use crate::robot::motor_table::intersect;
+use crate::robot::MAX_BOXES;
 use crate::robot::{BoxKind, Delta3, RobotModel};
 
 /// Sub-boxes per axis when enclosing the motor angles over a cell (`SPLITS^3` per arm).
@@ -456,8 +456,9 @@ pub fn cube_box_sweeps_with(
 /// in the ball of radius `|p0 - c| + h` (widened as the cube), which takes the place of the
 /// box `Z` inside the hull of each lower link (the sweep's `round`), and the link's turn is
 /// bounded with `|D|` at most that radius and `|D . t|` at most that radius times `|t|`
-/// (module doc, steps 1, 6). On an axis either form may be the smaller. Written into `out` (the per-tick path: no copy of the
-/// 2.5 KB set); `false`, with nothing written, when no TCP of the cube is reachable.
+/// (module doc, steps 1, 6). On an axis either form may be the smaller. Written into `out`
+/// (the per-tick path: no copy of the 2.5 KB set); `false`, with nothing written, when no TCP
+/// of the cube is reachable.
 pub fn box_sweep_forms_into(
     out: &mut [[Sweep; MAX_BOXES]; 2],
     model: &RobotModel,
@@ -523,9 +524,10 @@ fn angles_over_cube(
 }
 
 /// Both forms of [`box_sweep_forms_into`] for box `j` alone, measured from the reachable `p0`
-/// with its inverse kinematics `sol`, the motor angles over the cube enclosed by `th`: the
-/// same operations, so the same sweeps to the bit, without the other boxes'. Only box `j`'s
-/// arm's entries of `sol` and `th` are read.
+/// with its inverse kinematics `sol`, with the motor angles `th` as given (not narrowed
+/// further): for angles that hold every reachable TCP of the ball, a sound bound, and the
+/// same operations as [`box_sweep_forms_into`] after it narrows. Only box `j`'s arm's entries
+/// of `sol` and `th` are read.
 pub fn box_sweep_forms(
     model: &RobotModel,
     c: &Vec3,
@@ -807,7 +809,8 @@ mod tests {
     #[test]
     fn ball_and_cube_forms_hold_every_tcp_of_the_ball() {
         let tool = crate::robot::ToolBox { offset: Vec3::new(0.0, 0.0, -30.0), half: Vec3::new(20.0, 20.0, 30.0) };
-        let wide = RobotModel { options: ModelOptions { half_height: 280.0, ..ModelOptions::THESIS }, ..RobotModel::THESIS };
+        let wide =
+            RobotModel { options: ModelOptions { half_height: 280.0, ..ModelOptions::THESIS }, ..RobotModel::THESIS };
         let deep = RobotModel {
             options: ModelOptions { half_height: 10.0, half_depth: 280.0, ..ModelOptions::THESIS },
             ..RobotModel::THESIS
@@ -844,7 +847,8 @@ mod tests {
             let mut forms = [[Sweep { ball: Real::NAN, ..Sweep::ZERO }; MAX_BOXES]; 2];
             assert!(box_sweep_forms_into(&mut forms, model, &c, h, &p0, enclose));
             let reference = model.boxes(&p0).unwrap();
-            let axes: Vec<Vec3> = reference.as_slice().iter().flat_map(|b| [0, 1, 2].map(|k| b.axes.column(k).into())).collect();
+            let axes: Vec<Vec3> =
+                reference.as_slice().iter().flat_map(|b| [0, 1, 2].map(|k| b.axes.column(k).into())).collect();
             for q in 0..120 {
                 let dir = if q < dirs.len() { dirs[q] } else { unit(&mut rng) };
                 let depth = if q < 60 { 1.0 } else { rng.random::<Real>().cbrt() };
@@ -987,7 +991,11 @@ mod tests {
         let mut rng = StdRng::seed_from_u64(5);
         let (mut narrower, mut compared) = (0, 0);
         for _ in 0..3000 {
-            let c = Vec3::new(rng.random_range(-600.0..600.0), rng.random_range(-600.0..600.0), rng.random_range(-1200.0..-150.0));
+            let c = Vec3::new(
+                rng.random_range(-600.0..600.0),
+                rng.random_range(-600.0..600.0),
+                rng.random_range(-1200.0..-150.0),
+            );
             let rho = rng.random_range(1.0..250.0);
             for arm in 0..3 {
                 let e = ball_theta_range(&d, arm, &c, rho);
@@ -1005,7 +1013,9 @@ mod tests {
                 for p in &points {
                     let Ok(sol) = d.inverse_kinematics(p) else { continue };
                     match e {
-                        Enclosure::Range(th) => assert!(th.contains(sol.theta[arm]), "arm {arm} ball {c:?} {rho}: {p:?}"),
+                        Enclosure::Range(th) => {
+                            assert!(th.contains(sol.theta[arm]), "arm {arm} ball {c:?} {rho}: {p:?}")
+                        }
                         Enclosure::Empty => panic!("arm {arm} ball {c:?} {rho}: {p:?} reachable"),
                         Enclosure::Unbounded => {}
                     }

@@ -97,7 +97,9 @@ impl Sweep {
     pub fn is_zero(&self) -> bool {
         let point = |v: &[Vec3]| v.iter().all(|w| *w == Vec3::zeros());
         let (z, a) = (point(&self.cube) && self.round == 0.0, point(&self.arc));
-        self.ball == 0.0 && self.line == Vec3::zeros() && self.ends.iter().all(|&(e, d)| (e == 0.0 || z) && (d == 0.0 || a))
+        self.ball == 0.0
+            && self.line == Vec3::zeros()
+            && self.ends.iter().all(|&(e, d)| (e == 0.0 || z) && (d == 0.0 || a))
     }
 
     /// `h_S(n)`, the support function (module doc); `n` need not be unit.

@@ -1539,7 +1539,8 @@ mod tests {
                 stops += usize::from(v == Protective::Stop);
                 assert_eq!(plain.check(&tcps).unwrap().verdict, v, "{} {} tick {tick}", s.cell, s.case);
             }
-            assert!(early > 100 && 2 * early > stops, "{} {}: {early} of {stops} STOPs settled by step 8", s.cell, s.case);
+            let (cell, case) = (&s.cell, &s.case);
+            assert!(early > 100 && 2 * early > stops, "{cell} {case}: {early} of {stops} STOPs settled by step 8");
         }
     }
 
