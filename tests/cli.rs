@@ -103,6 +103,7 @@ fn demo_reports_no_collision_when_practical_the_same_first_tick_for_both_methods
             assert!(stop > 0 && warn + stop <= 6000, "{r:?}");
             assert_eq!(r[6], "clear", "{cell} {}: the simulated stop never touches", r[1]);
             assert!(r[7].parse::<f64>().unwrap() > 0.0 && r[8].parse::<f64>().unwrap() > 0.0, "{r:?}");
+            assert!(r[9].parse::<f64>().unwrap() > 0.0, "{cell} {}: a tick takes some time: {r:?}", r[1]);
         }
     }
 }

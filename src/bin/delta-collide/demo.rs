@@ -105,7 +105,8 @@ struct ProtectiveRun {
     first_stop: Option<u32>,
     warn_ticks: u32,
     stop_ticks: u32,
-    us: Vec<u64>,
+    /// Each tick's time (ns), sorted once the run ends.
+    ns: Vec<u64>,
 }
 
 fn protective_run(cell: &Cell, scenario: &Scenario) -> Result<ProtectiveRun, String> {
@@ -117,12 +118,12 @@ fn protective_run(cell: &Cell, scenario: &Scenario) -> Result<ProtectiveRun, Str
     // first tick a measured speed instead of the full speed assumed without history.
     scenario.tcps_at(0, &mut tcps);
     checker.check(&tcps).map_err(|e| e.to_string())?;
-    let mut r = ProtectiveRun { first_warn: None, first_stop: None, warn_ticks: 0, stop_ticks: 0, us: Vec::new() };
+    let mut r = ProtectiveRun { first_warn: None, first_stop: None, warn_ticks: 0, stop_ticks: 0, ns: Vec::new() };
     for tick in 0..RUN_TICKS {
         scenario.tcps_at(tick, &mut tcps);
         let start = Instant::now();
         let verdict = checker.check(&tcps).map_err(|e| e.to_string())?.verdict;
-        r.us.push(start.elapsed().as_micros() as u64);
+        r.ns.push(start.elapsed().as_nanos() as u64);
         match verdict {
             Protective::Free => {}
             Protective::Warn => {
@@ -135,7 +136,7 @@ fn protective_run(cell: &Cell, scenario: &Scenario) -> Result<ProtectiveRun, Str
             }
         }
     }
-    r.us.sort_unstable();
+    r.ns.sort_unstable();
     Ok(r)
 }
 
@@ -183,7 +184,7 @@ fn protective_table(cells: &[Cell], scenarios: &[Scenario]) -> Result<(), Failur
                 outcome,
                 stop_ms,
                 closest,
-                percentile(&r.us, 0.5)
+                format!("{:.2}", percentile(&r.ns, 0.5) as f64 * 1e-3)
             );
         }
     }
