@@ -137,6 +137,12 @@ impl ExactChecker {
         &self.cell
     }
 
+    /// Robot `i`'s placement rotation (MCS to WCS), computed once: the same matrix as
+    /// `placement.rotation()`.
+    pub fn rotation(&self, i: usize) -> &Mat3 {
+        &self.rotations[i]
+    }
+
     /// Robot `i`'s boxes in the WCS as of the last check (meaningless if it was unreachable).
     pub fn boxes(&self, i: usize) -> &RobotBoxes {
         &self.boxes[i]

@@ -186,8 +186,8 @@ impl ProtectiveChecker {
     fn keep_wider(&mut self, j: usize) {
         let robot = &self.exact.cell().robots[j];
         let (centre, radius) = (self.centres[j], self.reach[j] * (1.0 + KEPT_WIDEN) + KEPT_MARGIN_MM);
-        let rot = robot.placement.rotation();
-        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref(), 0, 0);
+        let rot = self.exact.rotation(j);
+        let sweeps = stop_sweeps_wcs(&robot.model, rot, &centre, radius, self.tables[j].as_deref(), 0, 0);
         let faces = core::array::from_fn(|form| {
             core::array::from_fn(|k| match self.ref_boxes[j].as_slice().get(k) {
                 Some(b) => FaceTerms::new(b, &sweeps[form][k]),

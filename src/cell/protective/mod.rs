@@ -872,7 +872,7 @@ impl ProtectiveChecker {
     /// [`ProtectiveChecker::stop_ball`] for this robot, TCP and speed.
     fn reference_at(&mut self, j: usize, tcp_mcs: &Vec3, (s, (centre, radius)): (Real, (Vec3, Real))) -> Real {
         let robot = &self.exact.cell().robots[j];
-        let (rot, t) = (robot.placement.rotation(), robot.placement.t);
+        let (rot, t) = (*self.exact.rotation(j), robot.placement.t);
         let (centre, radius) = match robot.model.boxes_into(&centre, &mut self.ref_boxes[j]) {
             Ok(()) if centre != *tcp_mcs => (centre, radius),
             _ => {
@@ -909,10 +909,10 @@ impl ProtectiveChecker {
             return;
         }
         let robot = &self.exact.cell().robots[j];
-        let rot = robot.placement.rotation();
+        let rot = self.exact.rotation(j);
         let (centre, radius) = (self.centres[j], self.reach[j]);
         let table = self.tables[j].as_deref();
-        stop_sweeps_wcs_into(&mut self.sweeps[j], &robot.model, &rot, &centre, radius, table, tier, arms);
+        stop_sweeps_wcs_into(&mut self.sweeps[j], &robot.model, rot, &centre, radius, table, tier, arms);
         let boxes = &self.ref_boxes[j];
         for (form, faces) in self.faces[j].iter_mut().enumerate() {
             for (k, b) in boxes.as_slice().iter().enumerate() {
@@ -969,9 +969,9 @@ impl ProtectiveChecker {
             }
             th[i] = Interval::new(lo, hi);
         }
-        let rot = robot.placement.rotation();
+        let rot = self.exact.rotation(j);
         let forms = box_sweep_forms(&robot.model, &centre, s, &centre, &sol, &th, k);
-        Some(forms.map(|form| Sweep { ball: (form.ball - LEAST_SLACK).max(0.0), ..form.rotated(&rot) }))
+        Some(forms.map(|form| Sweep { ball: (form.ball - LEAST_SLACK).max(0.0), ..form.rotated(rot) }))
     }
 
     /// Whether box pair `p` is certain not to be proved apart (with `extra` mm added to the
@@ -1038,7 +1038,7 @@ impl ProtectiveChecker {
             match robot.model.delta.inverse_kinematics_cos_sin(&centre) {
                 Ok(sol) if centre != *tcp => {
                     let b = robot.model.box_from_cos_sin(&centre, &sol, k);
-                    (b.transformed(&robot.placement.rotation(), &robot.placement.t), centre, radius, Some(sol))
+                    (b.transformed(self.exact.rotation(j), &robot.placement.t), centre, radius, Some(sol))
                 }
                 _ => (self.exact.boxes(j).as_slice()[k], *tcp, s, None),
             }
@@ -1440,9 +1440,18 @@ fn first_unproved<'a>(
 /// swept by `sb` are proved apart in some combination of forms ([`first_unproved_between`]'s
 /// test for one box pair).
 fn pair_apart_in_some_form(a: &Obb, sa: [&Sweep; 2], b: &Obb, sb: [&Sweep; 2], extra: Real) -> bool {
-    let sa = sa.map(|w| Sweep { ball: w.ball + extra, ..*w });
-    let (fa, fb) = (sa.map(|w| FaceTerms::new(a, &w)), sb.map(|w| FaceTerms::new(b, w)));
-    swept_boxes_apart_either(a, [&sa[0], &sa[1]], [&fa[0], &fa[1]], b, sb, [&fb[0], &fb[1]])
+    // Copies only for `extra` (`ball + 0` is `ball`).
+    let wider;
+    let sa = match extra {
+        0.0 => sa,
+        _ => {
+            wider = sa.map(|w| Sweep { ball: w.ball + extra, ..*w });
+            [&wider[0], &wider[1]]
+        }
+    };
+    let (fa0, fa1) = (FaceTerms::new(a, sa[0]), FaceTerms::new(a, sa[1]));
+    let (fb0, fb1) = (FaceTerms::new(b, sb[0]), FaceTerms::new(b, sb[1]));
+    swept_boxes_apart_either(a, sa, [&fa0, &fa1], b, sb, [&fb0, &fb1])
 }
 
 /// One robot's boxes, their sweeps, and the face terms of each box under each sweep form.
