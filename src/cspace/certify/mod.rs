@@ -367,6 +367,22 @@ mod tests {
         (whole(ra, &grid_a), octant_boxes(ra, &grid_a), whole(rb, &grid_b), octant_boxes(rb, &grid_b))
     }
 
+    /// Robot `r`'s levels over `whole` and `octs` with its sub-octants, and with its whole
+    /// cells' meeting references when `held` (as [`label_space_subdivided`] builds them).
+    fn levels_with_subs<'a>(
+        (whole, octs): (&'a SampleBoxes, &'a SampleBoxes),
+        r: &'a RobotSpec,
+        g: &'a SampleGrid,
+        held: bool,
+    ) -> Levels<'a> {
+        let mut levels = match held {
+            true => Levels::with_references(whole, octs, reference_octants(g, &references(&r.model, g))),
+            false => Levels::new(whole, octs),
+        };
+        levels.subs = Some(SubOctants::new(r, g));
+        levels
+    }
+
     /// Without level 3, the sub-cells are exactly those of the plain octant tests
     /// ([`octant_pairs`]), pair by pair, on every collision pair at k = 16; a subdivided
     /// labelling has the same pairs and care masks, and level 3 only frees sub-cells.
@@ -465,16 +481,8 @@ mod tests {
             let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
-            let held = |r: &RobotSpec, g: &SampleGrid| reference_octants(g, &references(&r.model, g));
             let levels = |fast: bool| {
-                let (mut a, mut b) = if fast {
-                    let a = Levels::with_references(&a0, &a1, held(ra, &grid_a));
-                    (a, Levels::with_references(&b0, &b1, held(rb, &grid_b)))
-                } else {
-                    (Levels::new(&a0, &a1), Levels::new(&b0, &b1))
-                };
-                (a.subs, b.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
-                (a, b)
+                (levels_with_subs((&a0, &a1), ra, &grid_a, fast), levels_with_subs((&b0, &b1), rb, &grid_b, fast))
             };
             let ((fa, fb), (pa, pb)) = (levels(true), levels(false));
             let nb = b0.len();
@@ -522,10 +530,8 @@ mod tests {
             let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
-            let held = |r: &RobotSpec, g: &SampleGrid| reference_octants(g, &references(&r.model, g));
-            let mut a = Levels::with_references(&a0, &a1, held(ra, &grid_a));
-            let mut b = Levels::with_references(&b0, &b1, held(rb, &grid_b));
-            (a.subs, b.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+            let a = levels_with_subs((&a0, &a1), ra, &grid_a, true);
+            let b = levels_with_subs((&b0, &b1), rb, &grid_b, true);
             let nb = b0.len();
             let all = all_box_pairs(a0.per_entry, b0.per_entry);
             let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
@@ -568,9 +574,9 @@ mod tests {
             let cell = reference_cell(name).unwrap();
             let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
-            let (mut a, mut b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
             let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
-            (a.subs, b.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+            let a = levels_with_subs((&a0, &a1), ra, &grid_a, false);
+            let b = levels_with_subs((&b0, &b1), rb, &grid_b, false);
             let (na, nb) = (a0.per_entry, b0.per_entry);
             let all = all_box_pairs(na, nb);
             let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
