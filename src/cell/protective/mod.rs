@@ -1440,18 +1440,22 @@ fn first_unproved<'a>(
 /// swept by `sb` are proved apart in some combination of forms ([`first_unproved_between`]'s
 /// test for one box pair).
 fn pair_apart_in_some_form(a: &Obb, sa: [&Sweep; 2], b: &Obb, sb: [&Sweep; 2], extra: Real) -> bool {
-    // Copies only for `extra` (`ball + 0` is `ball`).
-    let wider;
-    let sa = match extra {
-        0.0 => sa,
-        _ => {
-            wider = sa.map(|w| Sweep { ball: w.ball + extra, ..*w });
-            [&wider[0], &wider[1]]
-        }
-    };
+    let mut wider = None;
+    let sa = with_extra(sa, extra, &mut wider);
     let (fa0, fa1) = (FaceTerms::new(a, sa[0]), FaceTerms::new(a, sa[1]));
     let (fb0, fb1) = (FaceTerms::new(b, sb[0]), FaceTerms::new(b, sb[1]));
     swept_boxes_apart_either(a, sa, [&fa0, &fa1], b, sb, [&fb0, &fb1])
+}
+
+/// Both forms of a sweep with `extra` mm added to their balls: the forms themselves for 0
+/// (`ball + 0` is `ball`: the tests of the speed limits ask this many times per tick), else
+/// copies kept in `wider`.
+fn with_extra<'a>(forms: [&'a Sweep; 2], extra: Real, wider: &'a mut Option<[Sweep; 2]>) -> [&'a Sweep; 2] {
+    if extra == 0.0 {
+        return forms;
+    }
+    let copies: &'a [Sweep; 2] = wider.insert(forms.map(|w| Sweep { ball: w.ball + extra, ..*w }));
+    [&copies[0], &copies[1]]
 }
 
 /// One robot's boxes, their sweeps, and the face terms of each box under each sweep form.
@@ -1475,15 +1479,8 @@ fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(
     }
     let widened = copy.as_ref().unwrap_or(faces_a);
     for (i, box_a) in boxes_a.iter().enumerate() {
-        // Copies only for `extra` (the sweeps as they are otherwise: `ball + 0` is `ball`).
-        let wider;
-        let sa = match extra {
-            0.0 => [&sweeps_a[0][i], &sweeps_a[1][i]],
-            _ => {
-                wider = [0, 1].map(|form| Sweep { ball: sweeps_a[form][i].ball + extra, ..sweeps_a[form][i] });
-                [&wider[0], &wider[1]]
-            }
-        };
+        let mut wider = None;
+        let sa = with_extra([&sweeps_a[0][i], &sweeps_a[1][i]], extra, &mut wider);
         for (k, box_b) in boxes_b.iter().enumerate() {
             let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
             if !swept_boxes_apart_either(box_a, sa, fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb) {
