@@ -88,6 +88,10 @@
 //!    the proof cannot separate). So both tests are tried first on the closest box pair now,
 //!    the likeliest to fail (step 7 only after a STOP tick, when another STOP is likely),
 //!    before step 6 on every pair and before any sweep of a tier.
+//! 9. **Certain STOP, kept.** Two reachable TCPs, one in each robot's stop ball, whose boxes
+//!    overlap, make every tick whose balls still hold them STOP (`protective/witness.rs`:
+//!    every sweep holds the boxes of every TCP of its ball). After a STOP the checker seeks
+//!    such a witness; a tick that it settles needs neither references nor sweeps.
 //!
 //! The **speed limit** of a robot is the largest measured speed `|v_fd|` in `[0, v_max]` at
 //! which every pair involving it is still proved, the other robots as they are: bisection to
@@ -137,6 +141,7 @@ use alloc::sync::Arc;
 mod kept;
 mod lookup;
 mod path;
+mod witness;
 pub use kept::{KEPT_MARGIN_MM, KEPT_WIDEN};
 pub use lookup::{ClearanceBound, LOOKUP_SLACK_MM};
 pub use path::{path_through_samples, StopPath};
@@ -346,6 +351,9 @@ pub struct ProtectiveChecker {
     /// proof or a certain STOP without speed limits): `centres`, `reach`, `ref_boxes` and
     /// the sweeps are then an earlier tick's.
     references_stale: bool,
+    /// Two TCPs in earlier stop balls whose boxes overlap, which make every tick whose stop
+    /// balls still hold them STOP (`protective/witness.rs`).
+    witness: witness::KeptWitness,
     report: ProtectiveReport,
 }
 
@@ -416,6 +424,7 @@ impl ProtectiveChecker {
             table_proved: alloc::vec![false; n_pairs],
             references_stale: true,
             certain_stops_first: true,
+            witness: witness::KeptWitness::default(),
             kept,
             report: ProtectiveReport {
                 verdict: Protective::Stop,
@@ -515,6 +524,7 @@ impl ProtectiveChecker {
     /// Forgets every previous TCP: the next tick assumes full speed (module doc, step 1).
     pub fn reset(&mut self) {
         self.history.fill(NO_HISTORY);
+        self.witness = witness::KeptWitness::default();
     }
 
     /// One tick: `tcps_mcs[j]` is robot `j`'s TCP now, in its own MCS; the speeds come from
@@ -705,17 +715,28 @@ impl ProtectiveChecker {
             (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
         }
         let memory = &mut self.clearances;
-        let (clearance, closest) = clearance_over_pairs(&self.exact, |k, a, b| memory[k].boxes_clearance(a, b));
+        let (clearance, closest, points) = clearance_over_pairs(&self.exact, |k, a, b| memory[k].boxes_clearance(a, b));
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         let kept = self.kept_free(None);
-        // Steps 6 and 7 on the closest pair need two reference boxes, not every robot's (step 8).
+        // A witness kept from an earlier STOP tick (no inverse kinematics at all), then steps 6
+        // and 7 on the closest pair, which need two reference boxes, not every robot's (step 8).
         let first = !kept && self.certain_stops_first;
-        let early = if first { closest.filter(|&p| self.reference_pair_stops(tcps_mcs, p, was_stop)) } else { None };
+        let witnessed = if first { self.witness_holds(tcps_mcs) } else { None };
+        let early = match witnessed {
+            Some(p) => Some(p),
+            None if first => closest.filter(|&p| self.reference_pair_stops(tcps_mcs, p, was_stop)),
+            None => None,
+        };
+        // A STOP not settled by a witness seeks one for the ticks that follow.
+        let seek = first && witnessed.is_none();
         if (kept || early.is_some()) && !self.speed_limits {
             if kept {
                 (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
             } else {
                 (self.report.verdict, self.report.limiting) = (Protective::Stop, early);
+                if let (true, Some(p)) = (seek, closest) {
+                    self.seek_witness(p, points);
+                }
             }
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
             self.references_stale = true;
@@ -769,6 +790,9 @@ impl ProtectiveChecker {
                 self.sweeps_at(p.b, splits, rb | arms_b);
                 (self.report.verdict, self.report.limiting) = self.prove();
             }
+        }
+        if let (true, Protective::Stop, Some(p)) = (seek, self.report.verdict, closest) {
+            self.seek_witness(p, points);
         }
         self.speed_limits_of(tcps_mcs, from_history);
     }
@@ -1495,21 +1519,23 @@ fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(
 /// when apart, minus the penetration depth when intersecting, 0 when touching) and its
 /// closest box pair (mm).
 pub fn clearance_now(exact: &ExactChecker) -> (Real, Option<BoxPair>) {
-    clearance_over_pairs(exact, |_, a, b| boxes_clearance(a, b))
+    let (clearance, closest, _) = clearance_over_pairs(exact, |_, a, b| boxes_clearance(a, b));
+    (clearance, closest)
 }
 
 /// [`clearance_now`] with each robot pair's clearance from `pair_clearance(pair index, boxes
-/// of a, boxes of b)`.
+/// of a, boxes of b)`, and the closest pair's witness points (WCS).
 fn clearance_over_pairs(
     exact: &ExactChecker,
     mut pair_clearance: impl FnMut(usize, &[Obb], &[Obb]) -> PairClearance,
-) -> (Real, Option<BoxPair>) {
-    let mut best = (Real::INFINITY, None);
+) -> (Real, Option<BoxPair>, [Vec3; 2]) {
+    let mut best = (Real::INFINITY, None, [Vec3::zeros(); 2]);
     for (k, p) in exact.verdict().pairs.iter().enumerate() {
         let c = pair_clearance(k, exact.boxes(p.a).as_slice(), exact.boxes(p.b).as_slice());
         // A NaN distance (a non-finite box) wins, so it shows in the report.
         if c.distance.is_nan() || c.distance < best.0 {
-            best = (c.distance, Some(BoxPair { a: p.a, b: p.b, box_a: c.box_a, box_b: c.box_b }));
+            let pair = BoxPair { a: p.a, b: p.b, box_a: c.box_a, box_b: c.box_b };
+            best = (c.distance, Some(pair), [c.point_a, c.point_b]);
             if c.distance.is_nan() {
                 break;
             }
