@@ -176,6 +176,32 @@ impl FaceTerms {
     }
 }
 
+impl FaceTerms {
+    /// [`FaceTerms::new`] for the sweep that is the ball of radius `r >= 0` alone: the same
+    /// values to the bit (that sweep's support on `n` is `r |n|` plus exact zeros), without
+    /// evaluating the other terms of a sweep.
+    pub fn ball(b: &Obb, r: Real) -> FaceTerms {
+        let u = axes(b);
+        let norm = u.map(|n| float::sqrt(n.norm_squared()));
+        FaceTerms {
+            short: u.map(|n| n.norm_squared() < 1e-10),
+            u,
+            radius: core::array::from_fn(|k| radius(&u, &b.half, &u[k])),
+            support: norm.map(|len| r * len),
+            norm,
+        }
+    }
+}
+
+/// [`swept_boxes_apart_with`] where `a` is swept by the ball of radius `ra` alone and `b` by
+/// that of radius `rb` (`fa = FaceTerms::ball(a, ra)`, `fb = FaceTerms::ball(b, rb)`): the
+/// same answer to the bit, the supports on the cross axes taken as `r |n|` directly.
+#[inline]
+pub fn balls_swept_apart_with(a: &Obb, ra: Real, fa: &FaceTerms, b: &Obb, rb: Real, fb: &FaceTerms) -> bool {
+    let (ha, hb) = (|k: usize| fa.support[k], |k: usize| fb.support[k]);
+    apart_on_an_axis((a, fa, ha, |_: &Vec3, len| ra * len), (b, fb, hb, |_: &Vec3, len| rb * len))
+}
+
 fn axes(b: &Obb) -> [Vec3; 3] {
     [b.axes.column(0).into_owned(), b.axes.column(1).into_owned(), b.axes.column(2).into_owned()]
 }
@@ -448,6 +474,34 @@ pub(crate) mod tests {
                 let b = at(t);
                 let fast = swept_boxes_apart_with(&a, &sa, &FaceTerms::new(&a, &sa), &b, &sb, &FaceTerms::new(&b, &sb));
                 (fast == swept_boxes_apart_as_written(&a, &sa, &b, &sb), fast)
+            };
+            let (mut lo, mut hi) = (0.0, 2000.0);
+            prop_assert_eq!(same(lo).0 && same(hi).0, true);
+            if !same(lo).1 && same(hi).1 {
+                for _ in 0..80 {
+                    let mid = 0.5 * (lo + hi);
+                    let (ok, apart) = same(mid);
+                    prop_assert!(ok, "differs at {}", mid);
+                    if apart { hi = mid } else { lo = mid }
+                }
+            }
+        }
+
+        /// The test of boxes swept by balls alone answers as the general test with those balls
+        /// as sweeps, also right at the threshold (B moved along `v` by bisection to where the
+        /// answer flips), with parallel boxes and with a zero radius.
+        #[test]
+        fn ball_swept_test_answers_as_the_general_one(a in any_box(), b in any_box(), ra in 0.0..60.0f64,
+                rb in prop_oneof![Just(0.0), 0.0..60.0f64], v in prop::array::uniform3(-1.0..1.0f64), parallel in any::<bool>()) {
+            let v = unit(Vec3::from(v));
+            let b = if parallel { Obb { axes: a.axes, ..b } } else { b };
+            let (sa, sb) = (Sweep { ball: ra, ..Sweep::ZERO }, Sweep { ball: rb, ..Sweep::ZERO });
+            prop_assert_eq!(FaceTerms::ball(&a, ra), FaceTerms::new(&a, &sa));
+            let same = |t: Real| {
+                let b = Obb { center: a.center + v * t, ..b };
+                let general = swept_boxes_apart(&a, &sa, &b, &sb);
+                let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
+                (balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb) == general, general)
             };
             let (mut lo, mut hi) = (0.0, 2000.0);
             prop_assert_eq!(same(lo).0 && same(hi).0, true);

@@ -129,7 +129,7 @@ use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::cspace::guarantee::{box_sweep_forms, box_sweep_forms_into, theta_range, Enclosure};
 use crate::cspace::interval::Interval;
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
-use crate::geometry::sweep::{swept_boxes_apart_either, swept_boxes_apart_with, FaceTerms};
+use crate::geometry::sweep::{balls_swept_apart_with, swept_boxes_apart_either, FaceTerms};
 use crate::robot::MAX_BOXES;
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
@@ -332,7 +332,7 @@ pub struct ProtectiveChecker {
     /// Per robot, each box's sweep by the stop ball alone and its face terms (module doc, step
     /// 6), for [`ProtectiveChecker::certain_stop`]: built once per reference, not once per
     /// test (another robot's stay the same through all the speed-limit tests of a tick).
-    least: alloc::vec::Vec<[(Sweep, FaceTerms); MAX_BOXES]>,
+    least: alloc::vec::Vec<[(Real, FaceTerms); MAX_BOXES]>,
     /// Per robot, which boxes' terms `least` holds for its current reference (bit `k`: box
     /// `k`).
     least_set: alloc::vec::Vec<u8>,
@@ -418,7 +418,7 @@ impl ProtectiveChecker {
             reach: alloc::vec![0.0; n],
             sweep_tier: alloc::vec![None; n],
             no_faces,
-            least: alloc::vec![[(Sweep::ZERO, no_faces); MAX_BOXES]; n],
+            least: alloc::vec![[(0.0, no_faces); MAX_BOXES]; n],
             least_set: alloc::vec![0; n],
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
@@ -1042,7 +1042,7 @@ impl ProtectiveChecker {
             let (swept_a, swept_b) = (&self.least[p.a], &self.least[p.b]);
             for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(swept_a).enumerate() {
                 for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(swept_b).enumerate() {
-                    if !swept_boxes_apart_with(box_a, sa, fa, box_b, sb, fb) {
+                    if !balls_swept_apart_with(box_a, *sa, fa, box_b, *sb, fb) {
                         return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
                     }
                 }
@@ -1069,11 +1069,11 @@ impl ProtectiveChecker {
         };
         let refs = [reference(p.a, p.box_a), reference(p.b, p.box_b)];
         let swept = |j: usize, k: usize, (b, _, reach, _): &(Obb, Vec3, Real, Option<MotorCosSin>)| {
-            let w = least_ball(&self.exact.cell().robots[j].model, k, *reach);
-            (w, FaceTerms::new(b, &w))
+            let r = least_radius(&self.exact.cell().robots[j].model, k, *reach);
+            (r, FaceTerms::ball(b, r))
         };
-        let ((wa, fa), (wb, fb)) = (swept(p.a, p.box_a, &refs[0]), swept(p.b, p.box_b, &refs[1]));
-        !swept_boxes_apart_with(&refs[0].0, &wa, &fa, &refs[1].0, &wb, &fb)
+        let ((ra, fa), (rb, fb)) = (swept(p.a, p.box_a, &refs[0]), swept(p.b, p.box_b, &refs[1]));
+        !balls_swept_apart_with(&refs[0].0, ra, &fa, &refs[1].0, rb, &fb)
             || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
     }
 
@@ -1084,7 +1084,7 @@ impl ProtectiveChecker {
         self.set_least(p.b, p.box_b);
         let ((sa, fa), (sb, fb)) = (&self.least[p.a][p.box_a], &self.least[p.b][p.box_b]);
         let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
-        !swept_boxes_apart_with(box_a, sa, fa, box_b, sb, fb)
+        !balls_swept_apart_with(box_a, *sa, fa, box_b, *sb, fb)
     }
 
     /// Box `k` of robot `j`'s terms of [`ProtectiveChecker::certain_stop`] for its current
@@ -1095,8 +1095,8 @@ impl ProtectiveChecker {
         if self.least_set[j] >> k & 1 == 1 {
             return;
         }
-        let w = least_ball(&self.exact.cell().robots[j].model, k, self.reach[j]);
-        self.least[j][k] = (w, FaceTerms::new(&self.ref_boxes[j].as_slice()[k], &w));
+        let r = least_radius(&self.exact.cell().robots[j].model, k, self.reach[j]);
+        self.least[j][k] = (r, FaceTerms::ball(&self.ref_boxes[j].as_slice()[k], r));
         self.least_set[j] |= 1 << k;
     }
 
@@ -1339,11 +1339,15 @@ fn capsule_ball(
     }
 }
 
-/// Box `k`'s sweep of step 6: the ball of the stop's radius `reach` (shrunk by a relative
-/// 1e-9) for a box that moves with the TCP, nothing for an upper link.
-fn least_ball(model: &RobotModel, k: usize, reach: Real) -> Sweep {
+/// The radius of box `k`'s sweep of step 6, a ball: the stop's radius `reach` (shrunk by a
+/// relative 1e-9) for a box that moves with the TCP, 0 for an upper link.
+fn least_radius(model: &RobotModel, k: usize, reach: Real) -> Real {
     let moves_with_tcp = !matches!(model.box_kind(k), BoxKind::UpperLink(_));
-    Sweep { ball: if moves_with_tcp { reach * (1.0 - 1e-9) } else { 0.0 }, ..Sweep::ZERO }
+    if moves_with_tcp {
+        reach * (1.0 - 1e-9)
+    } else {
+        0.0
+    }
 }
 
 /// The status that wins when several robots fail: non-finite, then implausible, then an
