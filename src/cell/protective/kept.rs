@@ -19,7 +19,8 @@
 //!   table's lookup (`protective/lookup.rs`): it proves FREE for every pair of TCPs of both
 //!   balls, the same claim.
 //! - On the tick after a FREE tick, a robot whose stop ball has left its kept ball gets a
-//!   wider one: its stop ball widened by [`KEPT_WIDEN`] and [`KEPT_MARGIN_MM`], with the
+//!   wider one: its stop ball widened by [`KEPT_WIDEN`] and [`KEPT_MARGIN_MM`] and moved
+//!   ahead along the measured velocity by half the widening, with its own boxes and the
 //!   table's tier of sweeps, so that the ticks that follow at speed stay inside. Each pair is
 //!   proved once per pair of kept balls (a generation number per ball). Where the wider balls
 //!   are not proved apart (robots close for their speed), the tick takes the full proof, and
@@ -171,7 +172,7 @@ impl ProtectiveChecker {
     pub(super) fn keep_references(&mut self) {
         for j in 0..self.kept.balls.len() {
             if self.sweep_tier[j] == Some((0, 0)) {
-                let ball = (self.centres[j], self.reach[j], self.sweeps[j], self.faces[j]);
+                let ball = (self.centres[j], self.reach[j], self.ref_boxes[j], self.sweeps[j], self.faces[j]);
                 self.keep(j, ball);
             }
         }
@@ -182,32 +183,102 @@ impl ProtectiveChecker {
         }
     }
 
-    /// A wider kept ball for robot `j` around its reference centre (module doc).
+    /// A wider kept ball for robot `j` (module doc): its stop ball widened, and moved ahead
+    /// along the measured velocity by half the widening (so it still holds this tick's ball,
+    /// and the balls of the ticks that follow at that velocity for twice as long as a ball
+    /// around this tick's centre would), with its own boxes; around the reference centre when
+    /// the robot stands or the centre ahead is unreachable.
     fn keep_wider(&mut self, j: usize) {
         let robot = &self.exact.cell().robots[j];
-        let (centre, radius) = (self.centres[j], self.reach[j] * (1.0 + KEPT_WIDEN) + KEPT_MARGIN_MM);
+        let (reference, reach) = (self.centres[j], self.reach[j]);
+        let radius = reach * (1.0 + KEPT_WIDEN) + KEPT_MARGIN_MM;
         let rot = self.exact.rotation(j);
+        let mut boxes = self.ref_boxes[j];
+        let ahead = self.velocity[j].try_normalize(0.0).map(|u| reference + u * (0.5 * (radius - reach)));
+        let centre = match ahead {
+            Some(c) if robot.model.boxes_into(&c, &mut boxes).is_ok() => {
+                for b in &mut boxes.boxes[..boxes.len] {
+                    *b = b.transformed(rot, &robot.placement.t);
+                }
+                c
+            }
+            _ => {
+                boxes = self.ref_boxes[j];
+                reference
+            }
+        };
         let sweeps = stop_sweeps_wcs(&robot.model, rot, &centre, radius, self.tables[j].as_deref(), 0, 0);
         let faces = core::array::from_fn(|form| {
-            core::array::from_fn(|k| match self.ref_boxes[j].as_slice().get(k) {
+            core::array::from_fn(|k| match boxes.as_slice().get(k) {
                 Some(b) => FaceTerms::new(b, &sweeps[form][k]),
                 None => self.no_faces,
             })
         });
-        self.keep(j, (centre, radius, sweeps, faces));
+        self.keep(j, (centre, radius, boxes, sweeps, faces));
     }
 
-    /// Keeps, for robot `j`, the ball `(centre, radius)` with its sweeps and face terms about
-    /// the reference boxes, under a new generation.
+    /// Keeps, for robot `j`, the ball `(centre, radius)` with its boxes at the centre (WCS),
+    /// their sweeps and face terms, under a new generation.
     fn keep(
         &mut self,
         j: usize,
-        (centre, radius, sweeps, faces): (Vec3, Real, SweepForms, [[FaceTerms; MAX_BOXES]; 2]),
+        (centre, radius, boxes, sweeps, faces): (Vec3, Real, RobotBoxes, SweepForms, [[FaceTerms; MAX_BOXES]; 2]),
     ) {
         let generation = self.kept.next_generation;
         self.kept.next_generation += 1;
-        let boxes = self.ref_boxes[j];
         self.kept.balls[j] = Some(KeptBall { centre, radius, boxes, sweeps, faces, generation });
         self.kept.inside[j] = true;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::protective::ProtectiveChecker;
+    use crate::cell::reference::reference_cell;
+    use crate::cell::trajectory::{parse_scenarios, RUN_TICKS};
+    use crate::cell::ExactChecker;
+    use crate::robot::StopModel;
+
+    /// Every kept ball holds its boxes at its own centre (the exact query's boxes there, its
+    /// own inverse kinematics and placement), and the stop ball of the tick that kept it; and
+    /// balls moved ahead of the reference are kept on the practical runs.
+    #[test]
+    fn kept_balls_hold_their_own_boxes_and_the_stop() {
+        let text = include_str!("../../../c_harness/scenarios.txt");
+        for s in parse_scenarios(text).unwrap().iter().filter(|s| s.case == "practical") {
+            let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, alloc::vec![StopModel::DEFAULT; 2]).unwrap();
+            let mut c = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let mut exact = ExactChecker::new(cell);
+            let (mut tcps, mut moved, mut last) = ([Vec3::zeros(); 2], 0, [None; 2]);
+            for tick in 0..RUN_TICKS {
+                s.tcps_at(tick, &mut tcps);
+                c.check(&tcps).unwrap();
+                for j in 0..2 {
+                    let Some(k) = &c.kept.balls[j] else { continue };
+                    if last[j] == Some(k.generation) {
+                        continue;
+                    }
+                    last[j] = Some(k.generation);
+                    let mut at = tcps;
+                    at[j] = k.centre;
+                    exact.place_boxes(&at).unwrap();
+                    for (x, y) in k.boxes.as_slice().iter().zip(exact.boxes(j).as_slice()) {
+                        let close = (x.center - y.center).norm() < 1e-9 && (x.axes - y.axes).norm() < 1e-12;
+                        assert!(close && x.half == y.half, "{} tick {tick} robot {j}: {x:?} {y:?}", s.cell);
+                    }
+                    let (_, (centre, radius)) = c.stop_balls[j];
+                    let inside = (centre - k.centre).norm() + radius <= k.radius * (1.0 + 1e-12);
+                    let (sc, ss) = (tcps[j], c.stop_balls[j].0);
+                    assert!(
+                        inside || (sc - k.centre).norm() + ss <= k.radius * (1.0 + 1e-12),
+                        "{} tick {tick}",
+                        s.cell
+                    );
+                    moved += usize::from(k.centre != c.centres[j]);
+                }
+            }
+            assert!(moved > 50, "{}: {moved} balls kept ahead", s.cell);
+        }
     }
 }
