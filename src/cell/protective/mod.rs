@@ -329,8 +329,8 @@ pub struct ProtectiveChecker {
     sweep_tier: alloc::vec::Vec<Option<(u32, u8)>>,
     /// Face terms of no box (fills the unused entries of a box list).
     no_faces: FaceTerms,
-    /// Per robot, each box's sweep by the stop ball alone and its face terms (module doc, step
-    /// 6), for [`ProtectiveChecker::certain_stop`]: built once per reference, not once per
+    /// Per robot, the radius of each box's sweep of step 6 (a ball: module doc) and its face
+    /// terms, for [`ProtectiveChecker::certain_stop`]: built once per reference, not once per
     /// test (another robot's stay the same through all the speed-limit tests of a tick).
     least: alloc::vec::Vec<[(Real, FaceTerms); MAX_BOXES]>,
     /// Per robot, which boxes' terms `least` holds for its current reference (bit `k`: box
@@ -722,11 +722,7 @@ impl ProtectiveChecker {
         // and 7 on the closest pair, which need two reference boxes, not every robot's (step 8).
         let first = !kept && self.certain_stops_first;
         let witnessed = if first { self.witness_holds(tcps_mcs) } else { None };
-        let early = match witnessed {
-            Some(p) => Some(p),
-            None if first => closest.filter(|&p| self.reference_pair_stops(tcps_mcs, p, was_stop)),
-            None => None,
-        };
+        let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop)));
         // A STOP not settled by a witness seeks one for the ticks that follow.
         let seek = first && witnessed.is_none();
         if (kept || early.is_some()) && !self.speed_limits {
