@@ -351,7 +351,8 @@ fn scenario_counts(stop: StopModel, label: &str) {
                     (limit_ratio, limited) = (limit_ratio + fast.speed_limit_mm_s / slow.speed_limit_mm_s, limited + 1);
                 }
             }
-            (t_verdict.push((t1 - t0).as_secs_f64() * 1e6), t_exact.push((t2 - t1).as_secs_f64() * 1e6));
+            t_verdict.push((t1 - t0).as_secs_f64() * 1e6);
+            t_exact.push((t2 - t1).as_secs_f64() * 1e6);
             assert_eq!(v, r.verdict, "tick {tick}: the verdict does not depend on the speed limits");
             min_clear = min_clear.min(r.clearance_mm);
             implausible += matches!(r.status, ProtectiveStatus::ImplausibleMotion(_)) as u32;

@@ -342,7 +342,7 @@ fn a_table_mode_tick_never_allocates() {
     for [prev, tcps] in &states {
         c.reset();
         c.check_with_table(prev, &bound).unwrap();
-        lookups += u32::from(c.check_with_table(tcps, &bound).unwrap().table_pairs);
+        lookups += c.check_with_table(tcps, &bound).unwrap().table_pairs;
     }
     assert_eq!(allocations(), before);
     assert!(lookups > 10, "{lookups} pairs proved by a lookup: the lookup path was not exercised");

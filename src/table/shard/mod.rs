@@ -224,7 +224,7 @@ mod tests {
         let p = parse(&bytes).unwrap();
         assert_eq!(p.info.ladder, Some(ladder));
         assert_eq!(p.counts.len(), p.info.rows * p.info.samples.1);
-        assert!(p.counts.iter().any(|&c| c == 2) && p.counts.iter().all(|&c| c <= 2), "levels proved in the rows");
+        assert!(p.counts.contains(&2) && p.counts.iter().all(|&c| c <= 2), "levels proved in the rows");
         let start = bytes.len() - 8 - p.counts.len();
         let high = p.counts.iter().position(|&c| c > 0).unwrap();
         let not_free = (0..p.counts.len()).find(|&j| p.labels[j / 4] >> (2 * (j % 4)) & 3 != 0).unwrap();
