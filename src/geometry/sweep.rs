@@ -461,6 +461,27 @@ pub(crate) mod tests {
         ua.iter().chain(&ub).any(separates) || ua.iter().any(|x| ub.iter().any(|y| separates(&x.cross(y))))
     }
 
+    /// Checks `same(t)` (whether two tests agree with B moved by `t` mm, and the reference
+    /// test's answer there) at 0 and 2,000 mm and, where the answer flips from "not apart" to
+    /// "apart" between them, at each of 80 bisection steps toward the flip.
+    fn agree_through_the_flip(same: impl Fn(Real) -> (bool, bool)) -> Result<(), TestCaseError> {
+        let (mut lo, mut hi) = (0.0, 2000.0);
+        prop_assert!(same(lo).0 && same(hi).0);
+        if !same(lo).1 && same(hi).1 {
+            for _ in 0..80 {
+                let mid = 0.5 * (lo + hi);
+                let (ok, apart) = same(mid);
+                prop_assert!(ok, "differs at {}", mid);
+                if apart {
+                    hi = mid
+                } else {
+                    lo = mid
+                }
+            }
+        }
+        Ok(())
+    }
+
     proptest! {
         /// The test with prepared face terms answers as the test as first written, also right at
         /// the threshold (B moved along `v` by bisection to where the answer flips, both sides).
@@ -475,16 +496,7 @@ pub(crate) mod tests {
                 let fast = swept_boxes_apart_with(&a, &sa, &FaceTerms::new(&a, &sa), &b, &sb, &FaceTerms::new(&b, &sb));
                 (fast == swept_boxes_apart_as_written(&a, &sa, &b, &sb), fast)
             };
-            let (mut lo, mut hi) = (0.0, 2000.0);
-            prop_assert_eq!(same(lo).0 && same(hi).0, true);
-            if !same(lo).1 && same(hi).1 {
-                for _ in 0..80 {
-                    let mid = 0.5 * (lo + hi);
-                    let (ok, apart) = same(mid);
-                    prop_assert!(ok, "differs at {}", mid);
-                    if apart { hi = mid } else { lo = mid }
-                }
-            }
+            agree_through_the_flip(same)?;
         }
 
         /// The test of boxes swept by balls alone answers as the general test with those balls
@@ -503,16 +515,7 @@ pub(crate) mod tests {
                 let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
                 (balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb) == general, general)
             };
-            let (mut lo, mut hi) = (0.0, 2000.0);
-            prop_assert_eq!(same(lo).0 && same(hi).0, true);
-            if !same(lo).1 && same(hi).1 {
-                for _ in 0..80 {
-                    let mid = 0.5 * (lo + hi);
-                    let (ok, apart) = same(mid);
-                    prop_assert!(ok, "differs at {}", mid);
-                    if apart { hi = mid } else { lo = mid }
-                }
-            }
+            agree_through_the_flip(same)?;
         }
 
         /// The one-pass test over two forms per box answers as the four pairs of forms tried
