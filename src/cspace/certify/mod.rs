@@ -367,6 +367,18 @@ mod tests {
         (whole(ra, &grid_a), octant_boxes(ra, &grid_a), whole(rb, &grid_b), octant_boxes(rb, &grid_b))
     }
 
+    /// Reference cell `name` at k = 16 with both robots' sample grids and their whole-cell and
+    /// octant boxes ([`level_boxes`]): where the sub-cell tests start.
+    #[allow(clippy::type_complexity)]
+    fn cell_at_16(
+        name: &str,
+    ) -> (Cell, (SampleGrid, SampleGrid), (SampleBoxes, SampleBoxes, SampleBoxes, SampleBoxes)) {
+        let cell = reference_cell(name).unwrap();
+        let grids = two_robot_grids(&cell, 16, &Workspace::THESIS).unwrap();
+        let boxes = level_boxes(&cell, 16);
+        (cell, grids, boxes)
+    }
+
     /// Robot `r`'s levels over `whole` and `octs` with its sub-octants, and with its whole
     /// cells' meeting references when `held` (as [`label_space_subdivided`] builds them).
     fn levels_with_subs<'a>(
@@ -476,10 +488,8 @@ mod tests {
     fn reference_exits_change_no_sub_cell() {
         let ws = Workspace::THESIS;
         for name in ["T1", "T2", "T3"] {
-            let cell = reference_cell(name).unwrap();
+            let (cell, (grid_a, grid_b), (a0, a1, b0, b1)) = cell_at_16(name);
             let labels = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap().space.labels;
-            let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
-            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
             let levels = |fast: bool| {
                 (levels_with_subs((&a0, &a1), ra, &grid_a, fast), levels_with_subs((&b0, &b1), rb, &grid_b, fast))
@@ -525,10 +535,8 @@ mod tests {
         use crate::cspace::label::collision_mask;
         let ws = Workspace::THESIS;
         for name in ["T1", "T2", "T3"] {
-            let cell = reference_cell(name).unwrap();
+            let (cell, (grid_a, grid_b), (a0, a1, b0, b1)) = cell_at_16(name);
             let labels = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap().space.labels;
-            let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
-            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
             let a = levels_with_subs((&a0, &a1), ra, &grid_a, true);
             let b = levels_with_subs((&b0, &b1), rb, &grid_b, true);
@@ -569,11 +577,8 @@ mod tests {
     #[test]
     fn level_3_answers_as_its_plain_statement() {
         use crate::cspace::label::collision_mask;
-        let ws = Workspace::THESIS;
         for name in ["T1", "T2", "T3"] {
-            let cell = reference_cell(name).unwrap();
-            let (grid_a, grid_b) = two_robot_grids(&cell, 16, &ws).unwrap();
-            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let (cell, (grid_a, grid_b), (a0, a1, b0, b1)) = cell_at_16(name);
             let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
             let a = levels_with_subs((&a0, &a1), ra, &grid_a, false);
             let b = levels_with_subs((&b0, &b1), rb, &grid_b, false);
