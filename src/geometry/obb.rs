@@ -34,6 +34,13 @@ impl Obb {
         Obb { center: rot * self.center + t, axes: rot * self.axes, half: self.half }
     }
 
+    /// The point of the box nearest to `p`: `p`'s box coordinates clamped to the
+    /// half-extents (Ericson, *Real-Time Collision Detection*, 5.1.4).
+    pub fn closest_point(&self, p: &Vec3) -> Vec3 {
+        let local = self.axes.tr_mul(&(p - self.center));
+        self.center + self.axes * Vec3::from_fn(|k, _| local[k].clamp(-self.half[k], self.half[k]))
+    }
+
     /// Half-extents of the axis-aligned box that encloses this box.
     pub fn aabb_half(&self) -> Vec3 {
         self.axes.abs() * self.half

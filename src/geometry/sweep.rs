@@ -202,6 +202,20 @@ pub fn balls_swept_apart_with(a: &Obb, ra: Real, fa: &FaceTerms, b: &Obb, rb: Re
     apart_on_an_axis((a, fa, ha, |_: &Vec3, len| ra * len), (b, fb, hb, |_: &Vec3, len| rb * len))
 }
 
+/// Whether `a` swept by the ball of radius `ra` and `b` swept by that of radius `rb` certainly
+/// share a point, so that [`balls_swept_apart_with`] (and the test of any sweeps holding those
+/// balls) finds no separating axis: a point `y_a` of `a` and a point `y_b` of `b` lie within
+/// `ra + rb - 2 MEET_DEPTH` of each other. Then the point of segment `y_a y_b` at `ra / (ra + rb)`
+/// of the way lies in both swept sets, more than `MEET_DEPTH` inside one of them, so on every
+/// axis `n` their projections overlap by more than `MEET_DEPTH |n|`: far above the rounding of
+/// the separating test, which asks for a gap above `SWEEP_GAP |n|` besides. The points are
+/// found from `near` by projecting onto `a`, `b`, `a` again (alternating projections, each no
+/// farther from the other box than the last); a false answer means "not known".
+pub fn balls_swept_meet_near(a: &Obb, ra: Real, b: &Obb, rb: Real, near: &Vec3) -> bool {
+    let yb = b.closest_point(&a.closest_point(near));
+    (a.closest_point(&yb) - yb).norm() <= ra + rb - 2.0 * MEET_DEPTH
+}
+
 fn axes(b: &Obb) -> [Vec3; 3] {
     [b.axes.column(0).into_owned(), b.axes.column(1).into_owned(), b.axes.column(2).into_owned()]
 }
@@ -516,6 +530,29 @@ pub(crate) mod tests {
                 (balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb) == general, general)
             };
             agree_through_the_flip(same)?;
+        }
+
+        /// Boxes swept by balls that the point certificate finds meeting are never proved apart,
+        /// also right where either answer flips (B moved along `v` by bisection), with parallel
+        /// boxes and a zero radius; started at a point both boxes hold, it finds them meeting.
+        #[test]
+        fn balls_found_meeting_are_not_apart(a in any_box(), b in any_box(), ra in 0.0..60.0f64,
+                rb in prop_oneof![Just(0.0), 0.0..60.0f64], v in prop::array::uniform3(-1.0..1.0f64),
+                parallel in any::<bool>(), near in prop::array::uniform3(-300.0..300.0f64)) {
+            let v = unit(Vec3::from(v));
+            let b = if parallel { Obb { axes: a.axes, ..b } } else { b };
+            let (fa, near) = (FaceTerms::ball(&a, ra), Vec3::from(near));
+            let answers = |t: Real| {
+                let b = Obb { center: a.center + v * t, ..b };
+                let apart = balls_swept_apart_with(&a, ra, &fa, &b, rb, &FaceTerms::ball(&b, rb));
+                (balls_swept_meet_near(&a, ra, &b, rb, &near), apart)
+            };
+            // Through the flip of each answer: the swept test's, then the certificate's.
+            agree_through_the_flip(|t| { let (found, apart) = answers(t); (!(found && apart), apart) })?;
+            agree_through_the_flip(|t| { let (found, apart) = answers(t); (!(found && apart), !found) })?;
+            // Started at a point the boxes share, it finds them meeting.
+            let inside = Obb { center: a.center, ..b };
+            prop_assert_eq!(balls_swept_meet_near(&a, ra, &inside, rb, &a.center), ra + rb >= 2.0 * MEET_DEPTH);
         }
 
         /// The one-pass test over two forms per box answers as the four pairs of forms tried

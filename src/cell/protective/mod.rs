@@ -63,7 +63,9 @@
 //!    [`swept_boxes_apart`](crate::geometry::swept_boxes_apart) does not separate the boxes
 //!    swept by those balls (radii shrunk by a relative 1e-9, far above rounding), it cannot
 //!    separate them with the real sweeps of any tier: STOP at once, without inverse
-//!    kinematics.
+//!    kinematics. Two points, one of each box, closer than the two radii (sought from the
+//!    closest points now: [`balls_swept_meet_near`]) show the swept boxes share a point, so
+//!    that no axis separates them: the same answer without reading the 15 axes.
 //! 7. **Certain STOP, before tier 2.** Every tier's enclosure of an arm's angle over the ball
 //!    holds the angle `th(p)` of every reachable TCP `p` of the ball, whichever points are
 //!    picked: here its centre `p0` and the two points `p0 +- S w / |w|` of the ball
@@ -129,7 +131,7 @@ use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::cspace::guarantee::{box_sweep_forms, box_sweep_forms_into, theta_range, Enclosure};
 use crate::cspace::interval::Interval;
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
-use crate::geometry::sweep::{balls_swept_apart_with, swept_boxes_apart_either, FaceTerms};
+use crate::geometry::sweep::{balls_swept_apart_with, balls_swept_meet_near, swept_boxes_apart_either, FaceTerms};
 use crate::robot::MAX_BOXES;
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
@@ -722,7 +724,7 @@ impl ProtectiveChecker {
         // and 7 on the closest pair, which need two reference boxes, not every robot's (step 8).
         let first = !kept && self.certain_stops_first;
         let witnessed = if first { self.witness_holds(tcps_mcs) } else { None };
-        let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop)));
+        let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop, (points[0] + points[1]) * 0.5)));
         // A STOP not settled by a witness seeks one for the ticks that follow.
         let seek = first && witnessed.is_none();
         if (kept || early.is_some()) && !self.speed_limits {
@@ -1051,7 +1053,7 @@ impl ProtectiveChecker {
     /// (step 8): its two reference boxes built as [`ProtectiveChecker::reference_at`] builds
     /// them (the same operations, so the same answers), from this tick's stop balls; step 7
     /// only when `also_least`.
-    fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool) -> bool {
+    fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool, near: Vec3) -> bool {
         let reference = |j: usize, k: usize| {
             let robot = &self.exact.cell().robots[j];
             let (tcp, (s, (centre, radius))) = (&tcps_mcs[j], self.stop_balls[j]);
@@ -1064,11 +1066,14 @@ impl ProtectiveChecker {
             }
         };
         let refs = [reference(p.a, p.box_a), reference(p.b, p.box_b)];
-        let swept = |j: usize, k: usize, (b, _, reach, _): &(Obb, Vec3, Real, Option<MotorCosSin>)| {
-            let r = least_radius(&self.exact.cell().robots[j].model, k, *reach);
-            (r, FaceTerms::ball(b, r))
-        };
-        let ((ra, fa), (rb, fb)) = (swept(p.a, p.box_a, &refs[0]), swept(p.b, p.box_b, &refs[1]));
+        let radius = |j: usize, k: usize, reach: Real| least_radius(&self.exact.cell().robots[j].model, k, reach);
+        let (ra, rb) = (radius(p.a, p.box_a, refs[0].2), radius(p.b, p.box_b, refs[1].2));
+        // Swept boxes found sharing a point near the boxes' closest points now have no
+        // separating axis: the same answer without the 15 axes (`balls_swept_meet_near`).
+        if balls_swept_meet_near(&refs[0].0, ra, &refs[1].0, rb, &near) {
+            return true;
+        }
+        let (fa, fb) = (FaceTerms::ball(&refs[0].0, ra), FaceTerms::ball(&refs[1].0, rb));
         !balls_swept_apart_with(&refs[0].0, ra, &fa, &refs[1].0, rb, &fb)
             || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
     }
