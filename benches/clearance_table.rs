@@ -57,7 +57,9 @@ fn random_cells(cell: &delta_collide::cell::Cell, k: u32, n: usize) -> Vec<[u16;
     out
 }
 
-/// One lookup of each table, checked against the other.
+/// One lookup of each table, checked against the other (closures, not boxed: the benchmark
+/// times them).
+#[allow(clippy::type_complexity)]
 fn lookups<'a>(
     shared: &'a Table,
     clearance: &'a ClearanceTable,

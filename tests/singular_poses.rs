@@ -188,7 +188,7 @@ fn b_tcps() -> Vec<Vec3> {
 fn the_reported_singular_pose_collides() {
     let mut checker = ExactChecker::new(reference_cell("T1").unwrap());
     let a = Vec3::new(60.0, 400.0, -150.0);
-    let b = Vec3::new(-258.41263562619667, 256.22158467793497, -152.07408585805371);
+    let b = Vec3::new(-258.412_635_626_196_7, 256.22158467793497, -152.074_085_858_053_7);
     let v = checker.check(&[a, b]).unwrap();
     assert!(v.all_reachable(), "the pose is reachable: {:?}", v.first_unreachable);
     assert!(v.collides(), "lower link 0 along its motor axis must still collide");

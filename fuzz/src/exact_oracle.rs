@@ -171,7 +171,7 @@ pub fn seeds() -> Vec<(String, Vec<u8>)> {
     let mut e = Encoder::default();
     e.byte(0).byte(2).byte(0).u16(32_767).u16(0).byte(1);
     e.byte(0).byte(0);
-    for v in [-258.412_635_626_196_67f64, 256.221_584_677_934_97, -152.074_085_853_705_71] {
+    for v in [-258.412_635_626_196_7_f64, 256.221_584_677_934_97, -152.074_085_853_705_7] {
         e.byte(1).bytes.extend_from_slice(&v.to_bits().to_le_bytes());
     }
     out.push(("t1_reported_singular_pose.bin".into(), e.bytes));

@@ -315,7 +315,7 @@ fn exact_answer(v: &delta_collide::cell::CellVerdict) -> TableAnswer {
 /// pair that can meet) for a cell of any number of robots.
 pub(crate) enum Loaded {
     Table(Box<TableChecker>),
-    Bundle(BundleChecker),
+    Bundle(Box<BundleChecker>),
 }
 
 impl Loaded {
@@ -356,7 +356,7 @@ pub(crate) fn load_table_or_bundle(cell: &Cell, path: &Path, confirmation: Confi
     if cell.robots.len() == 2 && !is_bundle(&bytes) {
         TableChecker::with_confirmation(cell.clone(), &bytes, confirmation).map(|t| Loaded::Table(Box::new(t))).map_err(at)
     } else {
-        BundleChecker::new(cell.clone(), &bytes, confirmation).map(Loaded::Bundle).map_err(at)
+        BundleChecker::new(cell.clone(), &bytes, confirmation).map(|b| Loaded::Bundle(Box::new(b))).map_err(at)
     }
 }
 
