@@ -724,7 +724,8 @@ impl ProtectiveChecker {
         // and 7 on the closest pair, which need two reference boxes, not every robot's (step 8).
         let first = !kept && self.certain_stops_first;
         let witnessed = if first { self.witness_holds(tcps_mcs) } else { None };
-        let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop, (points[0] + points[1]) * 0.5)));
+        let near = (points[0] + points[1]) * 0.5;
+        let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop, near)));
         // A STOP not settled by a witness seeks one for the ticks that follow.
         let seek = first && witnessed.is_none();
         if (kept || early.is_some()) && !self.speed_limits {
@@ -1054,6 +1055,22 @@ impl ProtectiveChecker {
     /// them (the same operations, so the same answers), from this tick's stop balls; step 7
     /// only when `also_least`.
     fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool, near: Vec3) -> bool {
+        let refs = self.reference_pair(tcps_mcs, p);
+        let (ra, rb) = (self.step_6_radius(p.a, p.box_a, refs[0].2), self.step_6_radius(p.b, p.box_b, refs[1].2));
+        // Swept boxes found sharing a point near the boxes' closest points now have no
+        // separating axis: the same answer without the 15 axes (`balls_swept_meet_near`).
+        if balls_swept_meet_near(&refs[0].0, ra, &refs[1].0, rb, &near) {
+            return true;
+        }
+        let (fa, fb) = (FaceTerms::ball(&refs[0].0, ra), FaceTerms::ball(&refs[1].0, rb));
+        !balls_swept_apart_with(&refs[0].0, ra, &fa, &refs[1].0, rb, &fb)
+            || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
+    }
+
+    /// Box pair `p`'s reference boxes (WCS) as [`ProtectiveChecker::reference_at`] builds them
+    /// (the same operations, so the same values) from this tick's stop balls, each with its
+    /// reference centre (MCS), radius and, at a ball's centre, the inverse kinematics there.
+    fn reference_pair(&self, tcps_mcs: &[Vec3], p: BoxPair) -> [(Obb, Vec3, Real, Option<MotorCosSin>); 2] {
         let reference = |j: usize, k: usize| {
             let robot = &self.exact.cell().robots[j];
             let (tcp, (s, (centre, radius))) = (&tcps_mcs[j], self.stop_balls[j]);
@@ -1065,17 +1082,12 @@ impl ProtectiveChecker {
                 _ => (self.exact.boxes(j).as_slice()[k], *tcp, s, None),
             }
         };
-        let refs = [reference(p.a, p.box_a), reference(p.b, p.box_b)];
-        let radius = |j: usize, k: usize, reach: Real| least_radius(&self.exact.cell().robots[j].model, k, reach);
-        let (ra, rb) = (radius(p.a, p.box_a, refs[0].2), radius(p.b, p.box_b, refs[1].2));
-        // Swept boxes found sharing a point near the boxes' closest points now have no
-        // separating axis: the same answer without the 15 axes (`balls_swept_meet_near`).
-        if balls_swept_meet_near(&refs[0].0, ra, &refs[1].0, rb, &near) {
-            return true;
-        }
-        let (fa, fb) = (FaceTerms::ball(&refs[0].0, ra), FaceTerms::ball(&refs[1].0, rb));
-        !balls_swept_apart_with(&refs[0].0, ra, &fa, &refs[1].0, rb, &fb)
-            || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
+        [reference(p.a, p.box_a), reference(p.b, p.box_b)]
+    }
+
+    /// [`least_radius`] of robot `j`'s box `k` for reference radius `reach`.
+    fn step_6_radius(&self, j: usize, k: usize, reach: Real) -> Real {
+        least_radius(&self.exact.cell().robots[j].model, k, reach)
     }
 
     /// Whether box pair `p`'s reference boxes swept by their stop balls alone are not proved
@@ -1578,6 +1590,35 @@ mod tests {
             }
             let (cell, case) = (&s.cell, &s.case);
             assert!(early > 100 && 2 * early > stops, "{cell} {case}: {early} of {stops} STOPs settled by step 8");
+        }
+    }
+
+    /// Step 6's points answer as its separating axis test on every closest pair of the default
+    /// model's runs of T1 and T2 (points closer than the radii: no axis separates), and they
+    /// settle most of the tests that find no axis: `cargo test --release --lib step_6_points --
+    /// --nocapture` prints how many.
+    #[test]
+    fn step_6_points_answer_as_the_axes() {
+        let text = include_str!("../../../c_harness/scenarios.txt");
+        for s in crate::cell::trajectory::parse_scenarios(text).unwrap().iter().filter(|s| s.cell != "T3") {
+            let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, vec![StopModel::DEFAULT; 2]).unwrap();
+            let mut c = ProtectiveChecker::new(cell, 10.0).unwrap().with_speed_limits(false);
+            let (mut tcps, mut meet, mut found) = ([Vec3::zeros(); 2], 0, 0);
+            for tick in 0..crate::cell::trajectory::RUN_TICKS {
+                s.tcps_at(tick, &mut tcps);
+                c.check(&tcps).unwrap();
+                let Some(p) = c.report.closest else { continue };
+                let memory = &mut c.clearances.clone();
+                let (_, _, points) = clearance_over_pairs(&c.exact, |k, a, b| memory[k].boxes_clearance(a, b));
+                let [(a, _, reach_a, _), (b, _, reach_b, _)] = c.reference_pair(&tcps, p);
+                let (ra, rb) = (c.step_6_radius(p.a, p.box_a, reach_a), c.step_6_radius(p.b, p.box_b, reach_b));
+                let apart = balls_swept_apart_with(&a, ra, &FaceTerms::ball(&a, ra), &b, rb, &FaceTerms::ball(&b, rb));
+                let points_meet = balls_swept_meet_near(&a, ra, &b, rb, &((points[0] + points[1]) * 0.5));
+                assert!(!(points_meet && apart), "{} {} tick {tick}", s.cell, s.case);
+                (meet, found) = (meet + usize::from(!apart), found + usize::from(points_meet));
+            }
+            println!("{} {}: {found} of the {meet} closest pairs no axis separates are settled by the points", s.cell, s.case);
+            assert!(10 * found > 9 * meet && meet > 300, "{} {}: {found} of {meet}", s.cell, s.case);
         }
     }
 
