@@ -338,6 +338,9 @@ pub struct ProtectiveChecker {
     /// Per robot, which boxes' terms `least` holds for its current reference (bit `k`: box
     /// `k`).
     least_set: alloc::vec::Vec<u8>,
+    /// The midpoint of this tick's closest points (WCS), where step 6's points are sought from
+    /// ([`balls_swept_meet_near`]).
+    near: Vec3,
     /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
     kept: kept::Kept,
     /// Per robot pair that can meet, what its clearance was at the last tick: where this
@@ -422,6 +425,7 @@ impl ProtectiveChecker {
             no_faces,
             least: alloc::vec![[(0.0, no_faces); MAX_BOXES]; n],
             least_set: alloc::vec![0; n],
+            near: Vec3::zeros(),
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
             references_stale: true,
@@ -724,8 +728,8 @@ impl ProtectiveChecker {
         // and 7 on the closest pair, which need two reference boxes, not every robot's (step 8).
         let first = !kept && self.certain_stops_first;
         let witnessed = if first { self.witness_holds(tcps_mcs) } else { None };
-        let near = (points[0] + points[1]) * 0.5;
-        let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop, near)));
+        self.near = (points[0] + points[1]) * 0.5;
+        let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop)));
         // A STOP not settled by a witness seeks one for the ticks that follow.
         let seek = first && witnessed.is_none();
         if (kept || early.is_some()) && !self.speed_limits {
@@ -1054,12 +1058,12 @@ impl ProtectiveChecker {
     /// (step 8): its two reference boxes built as [`ProtectiveChecker::reference_at`] builds
     /// them (the same operations, so the same answers), from this tick's stop balls; step 7
     /// only when `also_least`.
-    fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool, near: Vec3) -> bool {
+    fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool) -> bool {
         let refs = self.reference_pair(tcps_mcs, p);
         let (ra, rb) = (self.step_6_radius(p.a, p.box_a, refs[0].2), self.step_6_radius(p.b, p.box_b, refs[1].2));
         // Swept boxes found sharing a point near the boxes' closest points now have no
         // separating axis: the same answer without the 15 axes (`balls_swept_meet_near`).
-        if balls_swept_meet_near(&refs[0].0, ra, &refs[1].0, rb, &near) {
+        if balls_swept_meet_near(&refs[0].0, ra, &refs[1].0, rb, &self.near) {
             return true;
         }
         let (fa, fb) = (FaceTerms::ball(&refs[0].0, ra), FaceTerms::ball(&refs[1].0, rb));
@@ -1093,6 +1097,12 @@ impl ProtectiveChecker {
     /// Whether box pair `p`'s reference boxes swept by their stop balls alone are not proved
     /// apart: step 6 for one pair.
     fn ball_swept_meet(&mut self, p: BoxPair) -> bool {
+        let (ra, rb) = (self.step_6_radius(p.a, p.box_a, self.reach[p.a]), self.step_6_radius(p.b, p.box_b, self.reach[p.b]));
+        let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
+        // Points closer than the radii: no axis separates (as in `reference_pair_stops`).
+        if balls_swept_meet_near(box_a, ra, box_b, rb, &self.near) {
+            return true;
+        }
         self.set_least(p.a, p.box_a);
         self.set_least(p.b, p.box_b);
         let ((sa, fa), (sb, fb)) = (&self.least[p.a][p.box_a], &self.least[p.b][p.box_b]);
@@ -1608,12 +1618,10 @@ mod tests {
                 s.tcps_at(tick, &mut tcps);
                 c.check(&tcps).unwrap();
                 let Some(p) = c.report.closest else { continue };
-                let memory = &mut c.clearances.clone();
-                let (_, _, points) = clearance_over_pairs(&c.exact, |k, a, b| memory[k].boxes_clearance(a, b));
                 let [(a, _, reach_a, _), (b, _, reach_b, _)] = c.reference_pair(&tcps, p);
                 let (ra, rb) = (c.step_6_radius(p.a, p.box_a, reach_a), c.step_6_radius(p.b, p.box_b, reach_b));
                 let apart = balls_swept_apart_with(&a, ra, &FaceTerms::ball(&a, ra), &b, rb, &FaceTerms::ball(&b, rb));
-                let points_meet = balls_swept_meet_near(&a, ra, &b, rb, &((points[0] + points[1]) * 0.5));
+                let points_meet = balls_swept_meet_near(&a, ra, &b, rb, &c.near);
                 assert!(!(points_meet && apart), "{} {} tick {tick}", s.cell, s.case);
                 (meet, found) = (meet + usize::from(!apart), found + usize::from(points_meet));
             }
