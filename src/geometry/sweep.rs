@@ -496,6 +496,31 @@ pub(crate) mod tests {
         Ok(())
     }
 
+    /// Round numbers where the points' answer flips: two boxes 10 mm apart face to face (and
+    /// edge to edge, turned by 45 degrees), swept by balls of 4 and 6 mm, at the origin and
+    /// 10 m away. At exactly 10 mm the points say "not known" (the slack), 1e-5 mm closer
+    /// they say "meet", and the axes agree that no axis separates them.
+    #[test]
+    fn balls_meeting_at_round_numbers() {
+        let turned = rot((0.0, 0.0, core::f64::consts::FRAC_PI_4));
+        for origin in [Vec3::zeros(), Vec3::new(1e4, -1e4, 1e4)] {
+            for (axes, gap_scale) in [(Mat3::identity(), 1.0), (turned, core::f64::consts::SQRT_2)] {
+                let a = Obb::new(origin, axes, Vec3::new(20.0, 20.0, 20.0));
+                let at = |gap: Real| {
+                    // B's nearest face (or edge) `gap` from A's along x.
+                    let c = origin + Vec3::new(2.0 * 20.0 * gap_scale + gap, 0.0, 0.0);
+                    Obb::new(c, axes, Vec3::new(20.0, 20.0, 20.0))
+                };
+                let near = origin + Vec3::new(20.0 * gap_scale, 0.0, 0.0);
+                assert!(!balls_swept_meet_near(&a, 4.0, &at(10.0), 6.0, &near), "{origin} {gap_scale}");
+                let b = at(10.0 - 1e-5);
+                assert!(balls_swept_meet_near(&a, 4.0, &b, 6.0, &near), "{origin} {gap_scale}");
+                let (fa, fb) = (FaceTerms::ball(&a, 4.0), FaceTerms::ball(&b, 6.0));
+                assert!(!balls_swept_apart_with(&a, 4.0, &fa, &b, 6.0, &fb));
+            }
+        }
+    }
+
     proptest! {
         /// The test with prepared face terms answers as the test as first written, also right at
         /// the threshold (B moved along `v` by bisection to where the answer flips, both sides).
