@@ -143,6 +143,21 @@ impl ExactChecker {
         &self.rotations[i]
     }
 
+    /// Robot `i`'s boxes for the TCP `tcp_mcs` (its MCS) moved to the WCS by the full placement
+    /// transform, into `out`: what the protective check measures its sweeps from, at points
+    /// other than the TCP now (ball centres, kept balls, path pieces).
+    ///
+    /// # Errors
+    /// Why the TCP is unreachable (`out` then holds no usable boxes).
+    pub fn boxes_in_wcs(&self, i: usize, tcp_mcs: &Vec3, out: &mut RobotBoxes) -> Result<(), Unreachable> {
+        let robot = &self.cell.robots[i];
+        robot.model.boxes_into(tcp_mcs, out)?;
+        for b in &mut out.boxes[..out.len] {
+            *b = b.transformed(&self.rotations[i], &robot.placement.t);
+        }
+        Ok(())
+    }
+
     /// Robot `i`'s boxes in the WCS as of the last check (meaningless if it was unreachable).
     pub fn boxes(&self, i: usize) -> &RobotBoxes {
         &self.boxes[i]

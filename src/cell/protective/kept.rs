@@ -196,12 +196,7 @@ impl ProtectiveChecker {
         let mut boxes = self.ref_boxes[j];
         let ahead = self.velocity[j].try_normalize(0.0).map(|u| reference + u * (0.5 * (radius - reach)));
         let centre = match ahead {
-            Some(c) if robot.model.boxes_into(&c, &mut boxes).is_ok() => {
-                for b in &mut boxes.boxes[..boxes.len] {
-                    *b = b.transformed(rot, &robot.placement.t);
-                }
-                c
-            }
+            Some(c) if self.exact.boxes_in_wcs(j, &c, &mut boxes).is_ok() => c,
             _ => {
                 boxes = self.ref_boxes[j];
                 reference

@@ -898,21 +898,13 @@ impl ProtectiveChecker {
     /// [`ProtectiveChecker::stop_reference`] from `S` and the ball already computed by
     /// [`ProtectiveChecker::stop_ball`] for this robot, TCP and speed.
     fn reference_at(&mut self, j: usize, tcp_mcs: &Vec3, (s, (centre, radius)): (Real, (Vec3, Real))) -> Real {
-        let robot = &self.exact.cell().robots[j];
-        let (rot, t) = (*self.exact.rotation(j), robot.placement.t);
-        let (centre, radius) = match robot.model.boxes_into(&centre, &mut self.ref_boxes[j]) {
+        let (centre, radius) = match self.exact.boxes_in_wcs(j, &centre, &mut self.ref_boxes[j]) {
             Ok(()) if centre != *tcp_mcs => (centre, radius),
             _ => {
                 self.ref_boxes[j] = *self.exact.boxes(j);
                 (*tcp_mcs, s)
             }
         };
-        if centre != *tcp_mcs {
-            let boxes = &mut self.ref_boxes[j];
-            for b in &mut boxes.boxes[..boxes.len] {
-                *b = b.transformed(&rot, &t);
-            }
-        }
         (self.centres[j], self.reach[j], self.sweep_tier[j], self.least_set[j]) = (centre, radius, None, 0);
         s
     }

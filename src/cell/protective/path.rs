@@ -176,20 +176,15 @@ impl ProtectiveChecker {
     /// The piece of robot `j` for the arc range `arc` of its path (module doc, steps 1, 3).
     fn piece(&self, j: usize, path: Option<&StopPath>, arc: Option<(Real, Real)>) -> Piece {
         let robot = &self.cell().robots[j];
-        let (rot, t) = (robot.placement.rotation(), robot.placement.t);
+        let rot = *self.exact.rotation(j);
         let mut boxes = RobotBoxes::empty();
         let ball = match (path, arc) {
             (Some(p), Some(range)) => Some(piece_ball(p.points, range, p.tolerance_mm)),
             _ => None,
         };
-        let ball = ball.filter(|&(c, r)| r < self.reach[j] && robot.model.boxes_into(&c, &mut boxes).is_ok());
+        let ball = ball.filter(|&(c, r)| r < self.reach[j] && self.exact.boxes_in_wcs(j, &c, &mut boxes).is_ok());
         let (centre, radius, arc) = match ball {
-            Some((c, r)) => {
-                for b in &mut boxes.boxes[..boxes.len] {
-                    *b = b.transformed(&rot, &t);
-                }
-                (c, r, arc)
-            }
+            Some((c, r)) => (c, r, arc),
             None => {
                 boxes = self.ref_boxes[j];
                 (self.centres[j], self.reach[j], None)
