@@ -65,7 +65,11 @@
 //!    separate them with the real sweeps of any tier: STOP at once, without inverse
 //!    kinematics. Two points, one of each box, closer than the two radii (sought from the
 //!    closest points now: [`balls_swept_meet_near`]) show the swept boxes share a point, so
-//!    that no axis separates them: the same answer without reading the 15 axes.
+//!    that no axis separates them: the same answer without reading the 15 axes. Before the
+//!    reference boxes are built, the closest points now are moved to them as points of their
+//!    boxes' bodies, as far as [`RobotModel::point_travel`] bounds the move of the TCP to the
+//!    ball's centre ([`ProtectiveChecker::travel_meets`]): places that close settle it without
+//!    inverse kinematics.
 //! 7. **Certain STOP, before tier 2.** Every tier's enclosure of an arm's angle over the ball
 //!    holds the angle `th(p)` of every reachable TCP `p` of the ball, whichever points are
 //!    picked: here its centre `p0` and the two points `p0 +- S w / |w|` of the ball
@@ -131,7 +135,9 @@ use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::cspace::guarantee::{box_sweep_forms, box_sweep_forms_into, theta_range, Enclosure};
 use crate::cspace::interval::Interval;
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
-use crate::geometry::sweep::{balls_swept_apart_with, balls_swept_meet_near, swept_boxes_apart_either, FaceTerms};
+use crate::geometry::sweep::{
+    balls_swept_apart_with, balls_swept_meet_near, swept_boxes_apart_either, FaceTerms, MEET_DEPTH,
+};
 use crate::robot::MAX_BOXES;
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
@@ -179,6 +185,11 @@ const ANGLE_SLACK: Real = 1e-6;
 /// How much (mm) the balls of [`ProtectiveChecker::least_sweeps`] are shrunk: far above the
 /// rounding of a support (about `1e-13 |n|`), far below the `BOUND_SLACK` every ball holds.
 const LEAST_SLACK: Real = 1e-9;
+
+/// How much closer (mm) than step 6's bound [`ProtectiveChecker::travel_meets`] asks its
+/// points to be: far above the rounding of the reference boxes that the inverse kinematics
+/// builds where [`RobotModel::point_travel`] bounds (about `1e-13 re / k0` with `k0 >= 1e-3`).
+const TRAVEL_SLACK: Real = 1e-5;
 
 /// Relative and absolute slack of the plausibility checks: rounding of the caller's own
 /// trajectory arithmetic must not read as an impossible motion.
@@ -338,9 +349,10 @@ pub struct ProtectiveChecker {
     /// Per robot, which boxes' terms `least` holds for its current reference (bit `k`: box
     /// `k`).
     least_set: alloc::vec::Vec<u8>,
-    /// The midpoint of this tick's closest points (WCS), where step 6's points are sought from
-    /// ([`balls_swept_meet_near`]).
-    near: Vec3,
+    /// This tick's closest points (WCS) of the closest box pair: step 6 seeks its points from
+    /// their midpoint ([`balls_swept_meet_near`]) and moves them to the stop balls' centres
+    /// ([`ProtectiveChecker::travel_meets`]).
+    points: [Vec3; 2],
     /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
     kept: kept::Kept,
     /// Per robot pair that can meet, what its clearance was at the last tick: where this
@@ -425,7 +437,7 @@ impl ProtectiveChecker {
             no_faces,
             least: alloc::vec![[(0.0, no_faces); MAX_BOXES]; n],
             least_set: alloc::vec![0; n],
-            near: Vec3::zeros(),
+            points: [Vec3::zeros(); 2],
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
             references_stale: true,
@@ -728,7 +740,7 @@ impl ProtectiveChecker {
         // and 7 on the closest pair, which need two reference boxes, not every robot's (step 8).
         let first = !kept && self.certain_stops_first;
         let witnessed = if first { self.witness_holds(tcps_mcs) } else { None };
-        self.near = (points[0] + points[1]) * 0.5;
+        self.points = points;
         let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop)));
         // A STOP not settled by a witness seeks one for the ticks that follow.
         let seek = first && witnessed.is_none();
@@ -1051,16 +1063,54 @@ impl ProtectiveChecker {
     /// them (the same operations, so the same answers), from this tick's stop balls; step 7
     /// only when `also_least`.
     fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool) -> bool {
+        if self.travel_meets(tcps_mcs, p) {
+            return true;
+        }
         let refs = self.reference_pair(tcps_mcs, p);
         let (ra, rb) = (self.step_6_radius(p.a, p.box_a, refs[0].2), self.step_6_radius(p.b, p.box_b, refs[1].2));
         // Swept boxes found sharing a point near the boxes' closest points now have no
         // separating axis: the same answer without the 15 axes (`balls_swept_meet_near`).
-        if balls_swept_meet_near(&refs[0].0, ra, &refs[1].0, rb, &self.near) {
+        if balls_swept_meet_near(&refs[0].0, ra, &refs[1].0, rb, &self.near()) {
             return true;
         }
         let (fa, fb) = (FaceTerms::ball(&refs[0].0, ra), FaceTerms::ball(&refs[1].0, rb));
         !balls_swept_apart_with(&refs[0].0, ra, &fa, &refs[1].0, rb, &fb)
             || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
+    }
+
+    /// The midpoint of this tick's closest points (WCS).
+    fn near(&self) -> Vec3 {
+        (self.points[0] + self.points[1]) * 0.5
+    }
+
+    /// Step 6 on the closest box pair `p` from this tick's boxes, without the reference boxes
+    /// (no inverse kinematics): each closest point now, as a point of its box's body, is where
+    /// [`RobotModel::point_travel`] bounds it once the TCP has moved to its stop ball's centre,
+    /// that is, in the reference box. When those two places, spread included, lie closer than
+    /// the two radii (less `2 MEET_DEPTH + TRAVEL_SLACK`), the reference boxes swept by the
+    /// balls share a point, as in [`balls_swept_meet_near`]. A centre that is not reachable
+    /// gives the boxes now with the radius `S` as the reference
+    /// ([`ProtectiveChecker::reference_at`]): both are tried for each robot, so the answer
+    /// holds whichever reference is built. `false`: not known.
+    fn travel_meets(&self, tcps_mcs: &[Vec3], p: BoxPair) -> bool {
+        let ends = |j: usize, k: usize, point: &Vec3| {
+            let robot = &self.exact.cell().robots[j];
+            let (b, rot) = (&self.exact.boxes(j).as_slice()[k], self.exact.rotation(j));
+            let local = b.axes.tr_mul(&(point - b.center)).zip_map(&b.half, |v, h| v.clamp(-h, h));
+            let now = b.center + b.axes * local;
+            let (s, (centre, radius)) = self.stop_balls[j];
+            let step = centre - tcps_mcs[j];
+            let axis = rot.tr_mul(&b.axes.column(0).into_owned());
+            let travel = robot.model.point_travel(k, &tcps_mcs[j], &step, &axis, &local)?;
+            let at_centre = (now + rot * (step * travel.along), travel.spread, least_radius(&robot.model, k, radius));
+            Some([at_centre, (now, 0.0, least_radius(&robot.model, k, s))])
+        };
+        let (Some(ends_a), Some(ends_b)) = (ends(p.a, p.box_a, &self.points[0]), ends(p.b, p.box_b, &self.points[1])) else {
+            return false;
+        };
+        ends_a.iter().all(|(qa, ea, ra)| {
+            ends_b.iter().all(|(qb, eb, rb)| (qa - qb).norm() + ea + eb <= ra + rb - 2.0 * MEET_DEPTH - TRAVEL_SLACK)
+        })
     }
 
     /// Box pair `p`'s reference boxes (WCS) as [`ProtectiveChecker::reference_at`] builds them
@@ -1092,7 +1142,7 @@ impl ProtectiveChecker {
         let (ra, rb) = (self.step_6_radius(p.a, p.box_a, self.reach[p.a]), self.step_6_radius(p.b, p.box_b, self.reach[p.b]));
         let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
         // Points closer than the radii: no axis separates (as in `reference_pair_stops`).
-        if balls_swept_meet_near(box_a, ra, box_b, rb, &self.near) {
+        if balls_swept_meet_near(box_a, ra, box_b, rb, &self.near()) {
             return true;
         }
         self.set_least(p.a, p.box_a);
@@ -1595,17 +1645,18 @@ mod tests {
         }
     }
 
-    /// Step 6's points answer as its separating axis test on every closest pair of the default
-    /// model's runs of T1 and T2 (points closer than the radii: no axis separates), and they
-    /// settle most of the tests that find no axis: `cargo test --release --lib step_6_points --
-    /// --nocapture` prints how many.
+    /// Step 6's points, at the reference boxes and moved there from the boxes now
+    /// ([`ProtectiveChecker::travel_meets`]), answer as its separating axis test on every
+    /// closest pair of the default model's runs of T1 and T2 (points closer than the radii: no
+    /// axis separates), and they settle most of the tests that find no axis: `cargo test
+    /// --release --lib step_6_points -- --nocapture` prints how many.
     #[test]
     fn step_6_points_answer_as_the_axes() {
         let text = include_str!("../../../c_harness/scenarios.txt");
         for s in crate::cell::trajectory::parse_scenarios(text).unwrap().iter().filter(|s| s.cell != "T3") {
             let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, vec![StopModel::DEFAULT; 2]).unwrap();
             let mut c = ProtectiveChecker::new(cell, 10.0).unwrap().with_speed_limits(false);
-            let (mut tcps, mut meet, mut found) = ([Vec3::zeros(); 2], 0, 0);
+            let (mut tcps, mut meet, mut found, mut moved) = ([Vec3::zeros(); 2], 0, 0, 0);
             for tick in 0..crate::cell::trajectory::RUN_TICKS {
                 s.tcps_at(tick, &mut tcps);
                 c.check(&tcps).unwrap();
@@ -1613,11 +1664,19 @@ mod tests {
                 let [(a, _, reach_a, _), (b, _, reach_b, _)] = c.reference_pair(&tcps, p);
                 let (ra, rb) = (c.step_6_radius(p.a, p.box_a, reach_a), c.step_6_radius(p.b, p.box_b, reach_b));
                 let apart = balls_swept_apart_with(&a, ra, &FaceTerms::ball(&a, ra), &b, rb, &FaceTerms::ball(&b, rb));
-                let points_meet = balls_swept_meet_near(&a, ra, &b, rb, &c.near);
+                let points_meet = balls_swept_meet_near(&a, ra, &b, rb, &c.near());
+                let travel_meets = c.travel_meets(&tcps, p);
                 assert!(!(points_meet && apart), "{} {} tick {tick}", s.cell, s.case);
+                assert!(!(travel_meets && apart), "{} {} tick {tick}: moved points", s.cell, s.case);
                 (meet, found) = (meet + usize::from(!apart), found + usize::from(points_meet));
+                moved += usize::from(travel_meets);
             }
-            println!("{} {}: {found} of the {meet} closest pairs no axis separates are settled by the points", s.cell, s.case);
+            println!(
+                "{} {}: {found} of the {meet} closest pairs no axis separates are settled by the points, \
+                 {moved} by the points moved from the boxes now",
+                s.cell, s.case
+            );
+            assert!(3 * moved > meet, "{} {}: {moved} of {meet} settled by the moved points", s.cell, s.case);
             assert!(10 * found > 9 * meet && meet > 300, "{} {}: {found} of {meet}", s.cell, s.case);
         }
     }
