@@ -88,6 +88,7 @@ impl RobotModel {
     /// its half-extents). `None` when the bound does not hold or is not derived: an upper link,
     /// a segment that nears a singular pose (the link tangent to the elbow's path, or along the
     /// motor axis), a step too long for the bound, or a non-finite input.
+    #[inline]
     pub fn point_travel(
         &self,
         k: usize,
