@@ -1091,7 +1091,8 @@ impl ProtectiveChecker {
     /// balls share a point, as in [`balls_swept_meet_near`]. A centre that is not reachable
     /// gives the boxes now with the radius `S` as the reference
     /// ([`ProtectiveChecker::reference_at`]): both are tried for each robot, so the answer
-    /// holds whichever reference is built. `false`: not known.
+    /// holds whichever reference is built. Any point of each box would do (each is clamped
+    /// into its box); the closest points make the test tight. `false`: not known.
     fn travel_meets(&self, tcps_mcs: &[Vec3], p: BoxPair) -> bool {
         let ends = |j: usize, k: usize, point: &Vec3| {
             let robot = &self.exact.cell().robots[j];
