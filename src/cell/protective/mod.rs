@@ -1106,9 +1106,8 @@ impl ProtectiveChecker {
             let at_centre = (now + rot * (step * travel.along), travel.spread, least_radius(&robot.model, k, radius));
             Some([at_centre, (now, 0.0, least_radius(&robot.model, k, s))])
         };
-        let (Some(ends_a), Some(ends_b)) = (ends(p.a, p.box_a, &self.points[0]), ends(p.b, p.box_b, &self.points[1])) else {
-            return false;
-        };
+        let [a, b] = [(p.a, p.box_a, 0), (p.b, p.box_b, 1)].map(|(j, k, i)| ends(j, k, &self.points[i]));
+        let (Some(ends_a), Some(ends_b)) = (a, b) else { return false };
         ends_a.iter().all(|(qa, ea, ra)| {
             ends_b.iter().all(|(qb, eb, rb)| (qa - qb).norm() + ea + eb <= ra + rb - 2.0 * MEET_DEPTH - TRAVEL_SLACK)
         })
@@ -1680,6 +1679,76 @@ mod tests {
             assert!(3 * moved > meet, "{} {}: {moved} of {meet} settled by the moved points", s.cell, s.case);
             assert!(10 * found > 9 * meet && meet > 300, "{} {}: {found} of {meet}", s.cell, s.case);
         }
+    }
+
+    /// The moved points where they are hardest: TCPs of the collision runs pushed out to within
+    /// 1e-6 mm of the workspace's edge (where the link nears the elbow's tangent and the stop
+    /// ball's centre is often unreachable, so that the reference is the boxes now with radius
+    /// `S`) and moving at random speeds up to `v_max` (half of them near it) in random
+    /// directions. Wherever
+    /// [`ProtectiveChecker::travel_meets`] says "meet", the 15 axes do not prove the reference
+    /// boxes apart, whichever reference was built; both kinds of reference are exercised.
+    #[test]
+    fn moved_points_answer_as_the_axes_at_the_edge() {
+        let text = include_str!("../../../c_harness/scenarios.txt");
+        let mut rng = crate::test_rng::TestRng(97);
+        let (mut settled, mut unreachable_settled, mut tried) = (0, 0, 0);
+        for s in crate::cell::trajectory::parse_scenarios(text).unwrap().iter().filter(|s| s.case == "collision") {
+            let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, vec![StopModel::DEFAULT; 2]).unwrap();
+            let robots = cell.robots.clone();
+            let mut c = ProtectiveChecker::new(cell, 10.0).unwrap().with_speed_limits(false);
+            let mut tcps = [Vec3::zeros(); 2];
+            for tick in (0..crate::cell::trajectory::RUN_TICKS).step_by(7) {
+                s.tcps_at(tick, &mut tcps);
+                let mut now = tcps;
+                for (j, tcp) in now.iter_mut().enumerate() {
+                    let dir = rng.vec(1.0).try_normalize(1e-3).unwrap_or(Vec3::z());
+                    let d = &robots[j].model.delta;
+                    if rng.unit() > 0.0 || d.inverse_kinematics(&(*tcp + dir * 2000.0)).is_ok() {
+                        continue;
+                    }
+                    let (mut lo, mut hi) = (0.0, 2000.0);
+                    for _ in 0..60 {
+                        let mid = 0.5 * (lo + hi);
+                        if d.inverse_kinematics(&(*tcp + dir * mid)).is_ok() {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    *tcp += dir * lo;
+                }
+                // The tick before, one tick of a speed up to v_max away; half of them above 4.2 m/s,
+                // where the reaction's distance is capped by v_max (then `S` is less than the
+                // radius plus the centre's offset, and the other reference matters).
+                let mut speed = || {
+                    let dir = rng.vec(1.0).try_normalize(1e-3).unwrap_or(Vec3::x());
+                    let u = 0.5 * (rng.unit() + 1.0);
+                    dir * if rng.unit() > 0.0 { 4.2 + 0.4 * u } else { 4.6 * u }
+                };
+                let before: Vec<Vec3> = now.iter().map(|q| q - speed()).collect();
+                c.reset();
+                let _ = c.check(&before);
+                let Ok(r) = c.check(&now) else { continue };
+                let Some(p) = r.closest.filter(|_| r.status == ProtectiveStatus::Ok) else { continue };
+                tried += 1;
+                if !c.travel_meets(&now, p) {
+                    continue;
+                }
+                let refs = c.reference_pair(&now, p);
+                let [(a, _, reach_a, _), (b, _, reach_b, _)] = refs;
+                let (ra, rb) = (c.step_6_radius(p.a, p.box_a, reach_a), c.step_6_radius(p.b, p.box_b, reach_b));
+                let apart = balls_swept_apart_with(&a, ra, &FaceTerms::ball(&a, ra), &b, rb, &FaceTerms::ball(&b, rb));
+                assert!(!apart, "{} tick {tick}: {now:?} from {before:?}", s.cell);
+                settled += 1;
+                // A robot whose ball's centre is not its TCP but whose reference is its boxes now:
+                // the centre was unreachable.
+                let fallback = |j: usize, at: &Vec3| c.stop_balls[j].1 .0 != now[j] && *at == now[j];
+                unreachable_settled += usize::from(fallback(p.a, &refs[0].1) || fallback(p.b, &refs[1].1));
+            }
+        }
+        println!("{settled} of {tried} edge ticks settled by the moved points, {unreachable_settled} with an unreachable centre");
+        assert!(settled > 100 && unreachable_settled > 10, "{settled} {unreachable_settled} of {tried}");
     }
 
     #[test]
