@@ -121,15 +121,15 @@ impl RobotModel {
         let inv_k_min = inv_k0 * (1.0 + 2.0 * slope * inv_k0);
         let x1 = d * (1.0 + inv_k_min) * inv_re;
         let turn = (link_axis.dot(step).abs() + d * x1) * inv_k_min * inv_rf;
-        let chord = dl.rf * turn;
-        // max(|D - c g0|, |D + c g0|)^2 = d^2 + c^2 + 2 |D . c g0| (|g0| = 1).
-        let widest = d * d + chord * chord + 2.0 * chord * step.dot(&g0).abs();
-        let x = (float::sqrt(widest) + chord * turn) * inv_re;
+        let elbow_move = dl.rf * turn;
+        // max(|D - m g0|, |D + m g0|)^2 = d^2 + m^2 + 2 m |D . g0| (|g0| = 1, m = rf T).
+        let widest = d * d + elbow_move * elbow_move + 2.0 * elbow_move * step.dot(&g0).abs();
+        let x = (float::sqrt(widest) + elbow_move * turn) * inv_re;
         let tau = link_axis.dot(&t).abs() + x;
         let inv_n = inverse_cosine_bound(tau * tau)?;
         let (y, z) = (x * (1.0 + 2.0 * tau * inv_n), x * (1.0 + tau) * inv_n);
         let a = local.x * inv_re;
-        let spread = (0.5 - a).abs() * chord + local.y.abs() * y + local.z.abs() * z;
+        let spread = (0.5 - a).abs() * elbow_move + local.y.abs() * y + local.z.abs() * z;
         spread.is_finite().then_some(PointTravel { along: 0.5 + a, spread })
     }
 }
