@@ -231,6 +231,8 @@ mod tests {
         std::eprintln!("{bounded} of {checked} points bounded; largest move / bound with steps over 0.1 mm {worst:.3}");
         // The bound must be useful, not only true: most points away from singular poses.
         assert!(bounded * 2 > checked, "{bounded} of {checked}");
+        // And tight: some point moves nearly as far as its bound.
+        assert!(worst > 0.9, "largest move / bound {worst}");
     }
 
     /// At round numbers: the TCP on the axis, a step straight down and one sideways; the
