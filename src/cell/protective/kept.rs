@@ -62,7 +62,7 @@ pub(super) struct KeptBall {
 
 impl KeptBall {
     /// The boxes, sweeps and face terms, as the swept-box proof reads them.
-    fn swept(&self) -> super::SweptBoxes<'_> {
+    fn swept(&self) -> super::stop_sweeps::SweptBoxes<'_> {
         (self.boxes.as_slice(), &self.sweeps, &self.faces)
     }
 }

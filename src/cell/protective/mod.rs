@@ -130,29 +130,32 @@
 //!
 //! Nothing here allocates after [`ProtectiveChecker::new`].
 
-use crate::cell::exact::PairVerdict;
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
-use crate::cspace::guarantee::{box_sweep_forms, box_sweep_forms_into, theta_range, Enclosure};
+use crate::cspace::guarantee::box_sweep_forms;
 use crate::cspace::interval::Interval;
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
 use crate::geometry::sweep::{
-    balls_swept_apart_with, balls_swept_meet_near, swept_boxes_apart_either, FaceTerms, MEET_DEPTH,
+    balls_swept_apart_with, balls_swept_meet_near, FaceTerms, MEET_DEPTH,
 };
 use crate::robot::MAX_BOXES;
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::delta3::{ArmSolution, MotorCosSin};
-use crate::robot::motor_table::{intersect, MotorTable};
+use crate::robot::motor_table::MotorTable;
 use crate::robot::{BoxKind, RobotBoxes, RobotModel, StopModel};
 use alloc::sync::Arc;
 
 mod kept;
 mod lookup;
 mod path;
+mod speed_limit;
+mod stop_sweeps;
 mod witness;
 pub use kept::{KEPT_MARGIN_MM, KEPT_WIDEN};
 pub use lookup::{ClearanceBound, LOOKUP_SLACK_MM};
 pub use path::{path_through_samples, StopPath};
+pub use stop_sweeps::{stop_sweeps_wcs, SweepForms};
+use stop_sweeps::{first_unproved_between, pair_apart_in_some_form, stop_sweeps_wcs_into};
 
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`SPLITS^3` per
 /// arm). The cubes here are tens to hundreds of mm, where finer splits shrink the sweeps by
@@ -812,37 +815,6 @@ impl ProtectiveChecker {
         self.speed_limits_of(tcps_mcs, from_history);
     }
 
-    /// Each robot's speed limit when they are asked for (else NaN), with this tick's stop
-    /// references of every robot already set (the limits search about them).
-    fn speed_limits_of(&mut self, tcps_mcs: &[Vec3], from_history: bool) {
-        if !self.speed_limits {
-            self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
-            return;
-        }
-        // This tick's verdict, when not STOP, proved every pair at each robot's measured speed
-        // (with its measured direction, the ball the search's tests build at that speed too).
-        let proved_now = self.report.verdict != Protective::Stop;
-        let n = tcps_mcs.len();
-        // Without a history (`check_at_speeds`) no search has a last limit to start from, so
-        // none would get far with a few tests: those searches are not capped.
-        let cap = if from_history { self.limit_tests } else { u32::MAX };
-        let (first, mut left) = (self.limit_turn % n.max(1), cap);
-        self.limit_turn = self.limit_turn.wrapping_add(1);
-        for i in 0..n {
-            let j = (first + i) % n;
-            let tcp = &tcps_mcs[j];
-            let start = self.history[j].limit.filter(|_| from_history);
-            let v = self.report.robots[j].speed_mm_s;
-            let floor = if proved_now && v <= self.cell().stops[j].max_speed_mm_s { v } else { 0.0 };
-            // What is left, but one test for each robot after this one (while there are any).
-            let after = (n - 1 - i) as u32;
-            let budget = if left > after { left - after } else { left.min(1) };
-            let (limit, used, step) = self.speed_limit(j, tcp, start, floor, budget);
-            left -= used;
-            (self.report.robots[j].speed_limit_mm_s, self.limit_steps[j]) = (limit, step);
-        }
-    }
-
     /// The verdict and its limiting pair for the sweeps as they are (module doc, step 5).
     /// A robot without sweeps for this tick's reference gets those of the table's tier first,
     /// pair by pair: a line's STOP is often found before most robots need any.
@@ -1171,205 +1143,6 @@ impl ProtectiveChecker {
             self.set_least(j, k);
         }
     }
-
-    /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are: the search
-    /// from `start` (the last tick's limit and the step of the first test above it), never
-    /// below `floor`, a speed this tick's verdict proved for `j` (0 when none), with at most
-    /// `budget` tests of the table's tier. Returns the limit, the tests used, and the step of
-    /// the next tick's first test above the limit.
-    fn speed_limit(
-        &mut self,
-        j: usize,
-        tcp_mcs: &Vec3,
-        start: Option<(Real, Real)>,
-        floor: Real,
-        budget: u32,
-    ) -> (Real, u32, Real) {
-        let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]);
-        let inside = self.kept.inside(j);
-        // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
-        let proved = |me: &mut Self, v: Real, tier: Option<u32>| {
-            let s = me.stop_reference(j, tcp_mcs, v);
-            if me.kept.set_inside(j, &[(me.centres[j], me.reach[j]), (*tcp_mcs, s)]) && me.kept_free(Some(j)) {
-                return true;
-            }
-            if me.certain_stop(Some(j), me.report.closest).is_some() {
-                return false;
-            }
-            let Some(tier) = tier else { return true };
-            // The robots that can meet `j` as they are, with the motor angles of the same tier;
-            // with tier 1, another robot keeps the sweeps it has for this tick's reference,
-            // tier 1 or the verdict's second tier on some arms: each encloses every box of its
-            // stop (module doc, step 4), the second tier within the first, so a test proved
-            // with them is a proof, and tier 2 on every arm proves it too (the precise limit
-            // stays the higher); only a robot without sweeps gets tier 1's.
-            for k in 0..me.exact.verdict().pairs.len() {
-                let p = me.exact.verdict().pairs[k];
-                if p.a == j || p.b == j {
-                    for i in [p.a, p.b] {
-                        if i == j || tier > 0 || me.sweep_tier[i].is_none() {
-                            me.sweeps_at(i, tier, 0b111);
-                        }
-                    }
-                }
-            }
-            let boxes = |i: usize| me.ref_boxes[i].as_slice();
-            first_unproved(&me.exact.verdict().pairs, &boxes, &me.sweeps, &me.faces, Some(j), 0.0).is_none()
-        };
-        let vmax = self.cell().stops[j].max_speed_mm_s;
-        let resolution = vmax / (1u32 << LIMIT_STEPS) as Real;
-        // The speed on the grid of `resolution` nearest the middle of `lo` and `hi` (grid
-        // speeds, at least two steps apart), strictly between them: every search tests grid
-        // speeds only, so that searches of the same proof end at the same bracket (`v_max` is
-        // `2^LIMIT_STEPS` steps exactly; so is every grid speed a whole number of steps).
-        let middle = |lo: Real, hi: Real| lo + (0.5 * (hi - lo) / resolution).floor().max(1.0) * resolution;
-        // From `lo` (proved) and `hi` (not), halves until they are `resolution` apart.
-        let bisect = |me: &mut Self, (mut lo, mut hi): (Real, Real), tier: Option<u32>| {
-            while hi - lo > resolution {
-                let mid = middle(lo, hi);
-                if proved(me, mid, tier) {
-                    lo = mid
-                } else {
-                    hi = mid
-                }
-            }
-            (lo, hi)
-        };
-        // The bracket of one test alone below `top` (not proved there, unless `top = vmax`).
-        let limit_of = |me: &mut Self, tier: Option<u32>, top: Real| {
-            if top == vmax && proved(me, vmax, tier) {
-                (vmax, vmax)
-            } else if !proved(me, 0.0, tier) {
-                (0.0, 0.0)
-            } else {
-                bisect(me, (0.0, top), tier)
-            }
-        };
-        // The same bracket found from `h`, the last tick's limit: steps of doubling length up
-        // (while proved) or down (while not) to a bracket, then the bisection. Limits change
-        // little from tick to tick, so this takes a few tests instead of `LIMIT_STEPS + 2`.
-        let limit_near = |me: &mut Self, h: Real| {
-            let h = ((h / resolution).round() * resolution).clamp(0.0, vmax);
-            let up = proved(me, h, Some(0));
-            let (mut from, mut step) = (h, resolution);
-            loop {
-                let to = if up { (from + step).min(vmax) } else { (from - step).max(0.0) };
-                if to == from {
-                    return (from, from);
-                }
-                if proved(me, to, Some(0)) != up {
-                    return bisect(me, if up { (from, to) } else { (to, from) }, Some(0));
-                }
-                (from, step) = (to, 2.0 * step);
-            }
-        };
-        // `limit_of` or `limit_near` with tier 1 alone, at most `budget` tests: the largest speed
-        // a test proved (0 when none did, or when every speed above `floor` that the search
-        // would still test is at most `floor`: `floor` is the answer then), the tests used, and
-        // where the next tick's first step up starts: where this one's steps or bisection
-        // stopped for want of tests (`resolution` when the search ended).
-        let mut used = 0;
-        let mut capped = |me: &mut Self| -> (Real, Real) {
-            let mut test = |me: &mut Self, v: Real| {
-                let left = used < budget;
-                used += u32::from(left);
-                left.then(|| proved(me, v, Some(0)))
-            };
-            // `lo` proved, `hi` not (`None`: no such speed tested yet).
-            let (mut lo, mut hi) = (None, None);
-            let mut step = resolution;
-            match start {
-                Some((h, carried)) => {
-                    let h = ((h / resolution).round() * resolution).clamp(0.0, vmax);
-                    match test(me, h) {
-                        None => return (0.0, resolution),
-                        Some(true) => (lo, step) = (Some(h), carried.max(resolution)),
-                        Some(false) => hi = Some(h),
-                    }
-                }
-                None => {
-                    match test(me, vmax) {
-                        None => return (0.0, resolution),
-                        Some(true) => return (vmax, resolution),
-                        Some(false) => hi = Some(vmax),
-                    }
-                    match test(me, 0.0) {
-                        Some(true) => lo = Some(0.0),
-                        _ => return (0.0, resolution),
-                    }
-                }
-            }
-            loop {
-                let (to, up) = match (lo, hi) {
-                    (Some(l), None) if l >= vmax => return (vmax, resolution),
-                    (Some(l), None) => ((l + step).min(vmax), true),
-                    (None, Some(h)) if h <= floor || h <= 0.0 => return (0.0, resolution),
-                    (None, Some(h)) => ((h - step).max(0.0), false),
-                    _ => break,
-                };
-                match test(me, to) {
-                    // Out of tests while going up: the next tick goes on with the next step.
-                    None => return (lo.unwrap_or(0.0), if up { step } else { resolution }),
-                    Some(true) => lo = Some(to),
-                    Some(false) => hi = Some(to),
-                }
-                // A bracket found going down from `hi` ends the steps; going up, so does `hi`.
-                if !up && lo.is_some() {
-                    break;
-                }
-                step *= 2.0;
-            }
-            let (Some(mut lo), Some(mut hi)) = (lo, hi) else { return (lo.unwrap_or(0.0), resolution) };
-            while hi - lo > resolution && hi > floor {
-                let mid = middle(lo, hi);
-                match test(me, mid) {
-                    // Out of tests: the next tick tries the middle of the bracket first.
-                    None => return (lo, mid - lo),
-                    Some(true) => lo = mid,
-                    Some(false) => hi = mid,
-                }
-            }
-            (lo, resolution)
-        };
-        let tier = if self.precise_limits { self.precise_splits } else { 0 };
-        // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit (capped), and
-        // the floor of the precise one (not capped).
-        let mut next_step = resolution;
-        let (lo, hi) = match start {
-            _ if tier == 0 => {
-                let (lo, step) = capped(self);
-                next_step = step;
-                (lo, vmax)
-            }
-            Some((h, _)) => limit_near(self, h),
-            None => limit_of(self, Some(0), vmax),
-        };
-        let limit = if tier == 0 || lo == vmax {
-            lo
-        } else {
-            // Above `top` no tier proves anything: the certain-STOP test fails there.
-            let top = limit_of(self, None, vmax).1;
-            if top == 0.0 {
-                0.0
-            } else if hi == 0.0 {
-                // The table proves not even standing still: the second tier alone.
-                limit_of(self, Some(tier), top).0
-            } else if hi >= top || !proved(self, hi, Some(tier)) {
-                lo
-            } else if top == vmax && proved(self, vmax, Some(tier)) {
-                vmax
-            } else {
-                bisect(self, (hi, top), Some(tier)).0
-            }
-        };
-        (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
-        // The certain-STOP terms are those of the last speed tested: built again when needed.
-        self.least_set[j] = 0;
-        self.kept.restore_inside(j, inside);
-        // The step is kept only when the limit is the one the steps were taken from.
-        let next_step = if limit >= floor { next_step } else { resolution };
-        (limit.max(floor), used, next_step)
-    }
 }
 
 /// A ball holding every TCP of the stop when the measured velocity `velocity` is known
@@ -1430,158 +1203,6 @@ fn worse(a: ProtectiveStatus, b: ProtectiveStatus) -> ProtectiveStatus {
     } else {
         a
     }
-}
-
-/// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
-/// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded. The motor
-/// angles come from `table` (built for `model.delta`) where it covers the cube, intersected,
-/// for the arms in the bit mask `arms`, with the interval inverse kinematics in `precise^3`
-/// sub-boxes (none when `precise` is 0); without the table, from the interval inverse
-/// kinematics with [`SPLITS`].
-pub fn stop_sweeps_wcs(
-    model: &RobotModel,
-    rot_wcs: &crate::math::Mat3,
-    tcp_mcs: &Vec3,
-    s: Real,
-    table: Option<&MotorTable>,
-    precise: u32,
-    arms: u8,
-) -> SweepForms {
-    let mut out = [[Sweep::ZERO; MAX_BOXES]; 2];
-    stop_sweeps_wcs_into(&mut out, model, rot_wcs, tcp_mcs, s, table, precise, arms);
-    out
-}
-
-/// [`stop_sweeps_wcs`] written into `out`: the tick's sweeps are recomputed in place, many
-/// times per tick by the speed limits' tests, without whole sets copied on the way.
-#[allow(clippy::too_many_arguments)]
-fn stop_sweeps_wcs_into(
-    out: &mut SweepForms,
-    model: &RobotModel,
-    rot_wcs: &crate::math::Mat3,
-    tcp_mcs: &Vec3,
-    s: Real,
-    table: Option<&MotorTable>,
-    precise: u32,
-    arms: u8,
-) {
-    let d = &model.delta;
-    let direct = |lo: &Vec3, hi: &Vec3, splits: u32| -> [Enclosure; 3] {
-        core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits))
-    };
-    let filled = match table.filter(|t| t.delta() == d) {
-        Some(t) => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| match t.enclose(lo, hi) {
-            Some(th) if precise > 0 => {
-                let refine = |arm: usize| arms >> arm & 1 == 1;
-                core::array::from_fn(|arm| {
-                    if refine(arm) {
-                        intersect(th[arm], theta_range(d, arm, lo, hi, precise))
-                    } else {
-                        th[arm]
-                    }
-                })
-            }
-            Some(th) => th,
-            None => direct(lo, hi, SPLITS),
-        }),
-        None => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| direct(lo, hi, SPLITS)),
-    };
-    write_forms(out, filled, rot_wcs);
-}
-
-/// Both forms of the sweeps in `out` (MCS, when `filled`) rotated to the WCS with `rot_wcs`
-/// in place; infinite balls when not `filled`.
-fn write_forms(out: &mut SweepForms, filled: bool, rot_wcs: &crate::math::Mat3) {
-    if filled {
-        for w in out.iter_mut().flatten() {
-            *w = w.rotated(rot_wcs);
-        }
-    } else {
-        *out = [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2];
-    }
-}
-
-/// Two forms of the same bound on each box's displacements (module doc, step 4): `[0]` with
-/// the TCP's motion as a cube, `[1]` as a ball; either alone is sound.
-pub type SweepForms = [[Sweep; MAX_BOXES]; 2];
-
-/// The first box pair (of the pairs involving `only`, or of all pairs) not proved apart
-/// with `extra` mm added to the first robot's sweep.
-/// `faces[j][form][k]` are the face terms of robot `j`'s box `k` under `sweeps[j][form][k]`.
-fn first_unproved<'a>(
-    pairs: &[PairVerdict],
-    boxes: &impl Fn(usize) -> &'a [Obb],
-    sweeps: &[SweepForms],
-    faces: &[[[FaceTerms; MAX_BOXES]; 2]],
-    only: Option<usize>,
-    extra: Real,
-) -> Option<BoxPair> {
-    for p in pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
-        let found = first_unproved_between(
-            (boxes(p.a), &sweeps[p.a], &faces[p.a]),
-            (boxes(p.b), &sweeps[p.b], &faces[p.b]),
-            extra,
-        );
-        if let Some((box_a, box_b)) = found {
-            return Some(BoxPair { a: p.a, b: p.b, box_a, box_b });
-        }
-    }
-    None
-}
-
-/// Whether box `a` swept by `sa` (one per form, `extra` mm added to its ball) and box `b`
-/// swept by `sb` are proved apart in some combination of forms ([`first_unproved_between`]'s
-/// test for one box pair).
-fn pair_apart_in_some_form(a: &Obb, sa: [&Sweep; 2], b: &Obb, sb: [&Sweep; 2], extra: Real) -> bool {
-    let mut wider = None;
-    let sa = with_extra(sa, extra, &mut wider);
-    let (fa0, fa1) = (FaceTerms::new(a, sa[0]), FaceTerms::new(a, sa[1]));
-    let (fb0, fb1) = (FaceTerms::new(b, sb[0]), FaceTerms::new(b, sb[1]));
-    swept_boxes_apart_either(a, sa, [&fa0, &fa1], b, sb, [&fb0, &fb1])
-}
-
-/// Both forms of a sweep with `extra` mm added to their balls: the forms themselves for 0
-/// (`ball + 0` is `ball`: the tests of the speed limits ask this many times per tick), else
-/// copies kept in `wider`.
-fn with_extra<'a>(forms: [&'a Sweep; 2], extra: Real, wider: &'a mut Option<[Sweep; 2]>) -> [&'a Sweep; 2] {
-    if extra == 0.0 {
-        return forms;
-    }
-    let copies: &'a [Sweep; 2] = wider.insert(forms.map(|w| Sweep { ball: w.ball + extra, ..*w }));
-    [&copies[0], &copies[1]]
-}
-
-/// One robot's boxes, their sweeps, and the face terms of each box under each sweep form.
-pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MAX_BOXES]; 2]);
-
-/// The first box pair `(i, k)` of two robots' swept boxes not proved apart with `extra` mm
-/// added to the first robot's sweeps, any combination of sweep forms allowed.
-fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(usize, usize)> {
-    let ((boxes_a, sweeps_a, faces_a), (boxes_b, sweeps_b, faces_b)) = (a, b);
-    // With `extra`, the first robot's face terms under its widened sweeps (a copy only then:
-    // the tests of the speed limits call this with no `extra`, many times per tick).
-    let mut copy = None;
-    if extra != 0.0 {
-        let terms = copy.insert(*faces_a);
-        for (form, terms) in terms.iter_mut().enumerate() {
-            for (i, box_a) in boxes_a.iter().enumerate() {
-                let sa = &sweeps_a[form][i];
-                terms[i] = FaceTerms::new(box_a, &Sweep { ball: sa.ball + extra, ..*sa });
-            }
-        }
-    }
-    let widened = copy.as_ref().unwrap_or(faces_a);
-    for (i, box_a) in boxes_a.iter().enumerate() {
-        let mut wider = None;
-        let sa = with_extra([&sweeps_a[0][i], &sweeps_a[1][i]], extra, &mut wider);
-        for (k, box_b) in boxes_b.iter().enumerate() {
-            let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
-            if !swept_boxes_apart_either(box_a, sa, fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb) {
-                return Some((i, k));
-            }
-        }
-    }
-    None
 }
 
 /// The signed clearance of the cell as of the exact checker's last check (SPEC §8: the gap

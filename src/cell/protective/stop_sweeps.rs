@@ -1,0 +1,164 @@
+//! The stop's sweeps of a robot's boxes in the WCS (module doc of `protective`, steps 3-4)
+//! and the swept-box proof over the box pairs of two robots (step 5): the first box pair that
+//! no axis proves apart in either sweep form.
+
+use super::{BoxPair, SPLITS};
+use crate::cell::exact::PairVerdict;
+use crate::cspace::guarantee::{box_sweep_forms_into, theta_range, Enclosure};
+use crate::geometry::sweep::{swept_boxes_apart_either, FaceTerms};
+use crate::geometry::{Obb, Sweep};
+use crate::math::{Real, Vec3};
+use crate::robot::motor_table::{intersect, MotorTable};
+use crate::robot::{RobotModel, MAX_BOXES};
+
+/// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
+/// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded. The motor
+/// angles come from `table` (built for `model.delta`) where it covers the cube, intersected,
+/// for the arms in the bit mask `arms`, with the interval inverse kinematics in `precise^3`
+/// sub-boxes (none when `precise` is 0); without the table, from the interval inverse
+/// kinematics with [`SPLITS`].
+pub fn stop_sweeps_wcs(
+    model: &RobotModel,
+    rot_wcs: &crate::math::Mat3,
+    tcp_mcs: &Vec3,
+    s: Real,
+    table: Option<&MotorTable>,
+    precise: u32,
+    arms: u8,
+) -> SweepForms {
+    let mut out = [[Sweep::ZERO; MAX_BOXES]; 2];
+    stop_sweeps_wcs_into(&mut out, model, rot_wcs, tcp_mcs, s, table, precise, arms);
+    out
+}
+
+/// [`stop_sweeps_wcs`] written into `out`: the tick's sweeps are recomputed in place, many
+/// times per tick by the speed limits' tests, without whole sets copied on the way.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn stop_sweeps_wcs_into(
+    out: &mut SweepForms,
+    model: &RobotModel,
+    rot_wcs: &crate::math::Mat3,
+    tcp_mcs: &Vec3,
+    s: Real,
+    table: Option<&MotorTable>,
+    precise: u32,
+    arms: u8,
+) {
+    let d = &model.delta;
+    let direct = |lo: &Vec3, hi: &Vec3, splits: u32| -> [Enclosure; 3] {
+        core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits))
+    };
+    let filled = match table.filter(|t| t.delta() == d) {
+        Some(t) => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| match t.enclose(lo, hi) {
+            Some(th) if precise > 0 => {
+                let refine = |arm: usize| arms >> arm & 1 == 1;
+                core::array::from_fn(|arm| {
+                    if refine(arm) {
+                        intersect(th[arm], theta_range(d, arm, lo, hi, precise))
+                    } else {
+                        th[arm]
+                    }
+                })
+            }
+            Some(th) => th,
+            None => direct(lo, hi, SPLITS),
+        }),
+        None => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| direct(lo, hi, SPLITS)),
+    };
+    write_forms(out, filled, rot_wcs);
+}
+
+/// Both forms of the sweeps in `out` (MCS, when `filled`) rotated to the WCS with `rot_wcs`
+/// in place; infinite balls when not `filled`.
+fn write_forms(out: &mut SweepForms, filled: bool, rot_wcs: &crate::math::Mat3) {
+    if filled {
+        for w in out.iter_mut().flatten() {
+            *w = w.rotated(rot_wcs);
+        }
+    } else {
+        *out = [[Sweep { ball: Real::INFINITY, ..Sweep::ZERO }; MAX_BOXES]; 2];
+    }
+}
+
+/// Two forms of the same bound on each box's displacements (module doc, step 4): `[0]` with
+/// the TCP's motion as a cube, `[1]` as a ball; either alone is sound.
+pub type SweepForms = [[Sweep; MAX_BOXES]; 2];
+
+/// The first box pair (of the pairs involving `only`, or of all pairs) not proved apart
+/// with `extra` mm added to the first robot's sweep.
+/// `faces[j][form][k]` are the face terms of robot `j`'s box `k` under `sweeps[j][form][k]`.
+pub(super) fn first_unproved<'a>(
+    pairs: &[PairVerdict],
+    boxes: &impl Fn(usize) -> &'a [Obb],
+    sweeps: &[SweepForms],
+    faces: &[[[FaceTerms; MAX_BOXES]; 2]],
+    only: Option<usize>,
+    extra: Real,
+) -> Option<BoxPair> {
+    for p in pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
+        let found = first_unproved_between(
+            (boxes(p.a), &sweeps[p.a], &faces[p.a]),
+            (boxes(p.b), &sweeps[p.b], &faces[p.b]),
+            extra,
+        );
+        if let Some((box_a, box_b)) = found {
+            return Some(BoxPair { a: p.a, b: p.b, box_a, box_b });
+        }
+    }
+    None
+}
+
+/// Whether box `a` swept by `sa` (one per form, `extra` mm added to its ball) and box `b`
+/// swept by `sb` are proved apart in some combination of forms ([`first_unproved_between`]'s
+/// test for one box pair).
+pub(super) fn pair_apart_in_some_form(a: &Obb, sa: [&Sweep; 2], b: &Obb, sb: [&Sweep; 2], extra: Real) -> bool {
+    let mut wider = None;
+    let sa = with_extra(sa, extra, &mut wider);
+    let (fa0, fa1) = (FaceTerms::new(a, sa[0]), FaceTerms::new(a, sa[1]));
+    let (fb0, fb1) = (FaceTerms::new(b, sb[0]), FaceTerms::new(b, sb[1]));
+    swept_boxes_apart_either(a, sa, [&fa0, &fa1], b, sb, [&fb0, &fb1])
+}
+
+/// Both forms of a sweep with `extra` mm added to their balls: the forms themselves for 0
+/// (`ball + 0` is `ball`: the tests of the speed limits ask this many times per tick), else
+/// copies kept in `wider`.
+fn with_extra<'a>(forms: [&'a Sweep; 2], extra: Real, wider: &'a mut Option<[Sweep; 2]>) -> [&'a Sweep; 2] {
+    if extra == 0.0 {
+        return forms;
+    }
+    let copies: &'a [Sweep; 2] = wider.insert(forms.map(|w| Sweep { ball: w.ball + extra, ..*w }));
+    [&copies[0], &copies[1]]
+}
+
+/// One robot's boxes, their sweeps, and the face terms of each box under each sweep form.
+pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MAX_BOXES]; 2]);
+
+/// The first box pair `(i, k)` of two robots' swept boxes not proved apart with `extra` mm
+/// added to the first robot's sweeps, any combination of sweep forms allowed.
+pub(super) fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(usize, usize)> {
+    let ((boxes_a, sweeps_a, faces_a), (boxes_b, sweeps_b, faces_b)) = (a, b);
+    // With `extra`, the first robot's face terms under its widened sweeps (a copy only then:
+    // the tests of the speed limits call this with no `extra`, many times per tick).
+    let mut copy = None;
+    if extra != 0.0 {
+        let terms = copy.insert(*faces_a);
+        for (form, terms) in terms.iter_mut().enumerate() {
+            for (i, box_a) in boxes_a.iter().enumerate() {
+                let sa = &sweeps_a[form][i];
+                terms[i] = FaceTerms::new(box_a, &Sweep { ball: sa.ball + extra, ..*sa });
+            }
+        }
+    }
+    let widened = copy.as_ref().unwrap_or(faces_a);
+    for (i, box_a) in boxes_a.iter().enumerate() {
+        let mut wider = None;
+        let sa = with_extra([&sweeps_a[0][i], &sweeps_a[1][i]], extra, &mut wider);
+        for (k, box_b) in boxes_b.iter().enumerate() {
+            let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
+            if !swept_boxes_apart_either(box_a, sa, fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb) {
+                return Some((i, k));
+            }
+        }
+    }
+    None
+}
