@@ -467,3 +467,26 @@ pub(crate) fn label_space_thesis_rows(
 pub fn centres(grid: &SampleGrid) -> Vec<Vec3> {
     (0..grid.cells.len()).map(|s| grid.sample_center(s)).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::sweep::tests::{any_box, any_sweep};
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// A swept box keeps its box's axes and half-extents only in its frame: the box it gives
+        /// back is the one it was made from, to the bit, so the plain separating axis test and
+        /// the cores read the numbers they were given.
+        #[test]
+        fn swept_box_gives_back_its_box(b in any_box(), s in any_sweep()) {
+            let back = SweptBox::new(b, s).obb();
+            let bits = |o: &Obb| {
+                o.center.iter().chain(o.axes.iter()).chain(o.half.iter()).map(|x| x.to_bits()).collect::<Vec<_>>()
+            };
+            prop_assert_eq!(bits(&back), bits(&b));
+        }
+    }
+}

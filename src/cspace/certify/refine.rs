@@ -281,7 +281,10 @@ pub(super) fn cores(boxes: &SampleBoxes) -> Vec<Option<Obb>> {
     let n = boxes.per_entry;
     (0..boxes.boxes.len())
         .into_par_iter()
-        .map(|i| if boxes.slot[i / n] == Slot::Boxes { core(&boxes.boxes[i].obb(), &boxes.boxes[i].sweep) } else { None })
+        .map(|i| {
+            let b = &boxes.boxes[i];
+            (boxes.slot[i / n] == Slot::Boxes).then(|| core(&b.obb(), &b.sweep)).flatten()
+        })
         .collect()
 }
 
