@@ -221,14 +221,14 @@ pub(super) fn meet_at_references(x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb
     meet(&x.boxes[i], &y.boxes[j])
 }
 
-/// Whether two boxes at their entries' reference TCPs (`.obb`) meet: the plain separating axis
+/// Whether two boxes at their entries' reference TCPs ([`SweptBox::obb`]) meet: the plain separating axis
 /// test finds no axis (the premise of [`meet_at_references`]). Boxes whose swept AABBs are apart
 /// (by the slack, 1e-6 mm, along a world axis) are not tried: each swept box holds its box, so
 /// such boxes are apart by more than 1e-6 mm, and boxes on which the plain test finds no axis
 /// are within its touch tolerance (1e-9 mm) on each of their 15 axes, so a few times that
 /// apart at most: the answer is the plain test's, found without it.
 fn meet(a: &SweptBox, b: &SweptBox) -> bool {
-    !aabbs_apart(&a.lo, &a.hi, &b.lo, &b.hi) && separating_axis(&a.obb, &b.obb).is_none()
+    !aabbs_apart(&a.lo, &a.hi, &b.lo, &b.hi) && separating_axis(&a.obb(), &b.obb()).is_none()
 }
 
 /// The octant pairs of `(ia, ib)` (bits as [`sub_cell_index`]) that level 2 and level 3 leave
@@ -281,7 +281,10 @@ pub(super) fn cores(boxes: &SampleBoxes) -> Vec<Option<Obb>> {
     let n = boxes.per_entry;
     (0..boxes.boxes.len())
         .into_par_iter()
-        .map(|i| if boxes.slot[i / n] == Slot::Boxes { core(&boxes.boxes[i].obb, &boxes.boxes[i].sweep) } else { None })
+        .map(|i| {
+            let b = &boxes.boxes[i];
+            (boxes.slot[i / n] == Slot::Boxes).then(|| core(&b.obb(), &b.sweep)).flatten()
+        })
         .collect()
 }
 
