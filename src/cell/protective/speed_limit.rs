@@ -1,4 +1,4 @@
-//! Each robot's speed limit (module doc of `protective`, "The speed limit"): the largest
+//! Each robot's speed limit (the module doc of `protective` defines it): the largest
 //! measured speed at which every pair involving it is still proved, the other robots as they
 //! are, searched by bisection on a grid of `v_max / 2^LIMIT_STEPS` within a budget of tests
 //! per tick.
