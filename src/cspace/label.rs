@@ -111,8 +111,7 @@ pub enum Inflation {
 /// tests read it: the swept AABB, then what every axis of the swept test reads (the centre and
 /// the frame), then the sweep, whose supports only some axes need. The box's axes and
 /// half-extents are kept once, in the frame ([`SweptBox::obb`] gives the box back, the same
-/// numbers): a smaller box is fewer cache lines per test, and the build reads boxes of many
-/// entries in turn.
+/// numbers): a smaller box is fewer cache lines per test.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct SweptBox {
