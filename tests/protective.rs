@@ -275,24 +275,6 @@ fn the_speed_limit_through_the_tick_history_gives_a_proof() {
 }
 
 #[test]
-fn timing_of_one_sweep_set() {
-    use delta_collide::cell::protective::stop_sweeps_wcs;
-    use delta_collide::cspace::guarantee::cube_box_sweeps;
-    let model = delta_collide::robot::RobotModel::THESIS;
-    let p = Vec3::new(100.0, 20.0, -450.0);
-    for splits in [1, 2, 3, 4] {
-        let t = std::time::Instant::now();
-        let mut r = 0.0;
-        for i in 0..2000 {
-            let s = cube_box_sweeps(&model, &p, 50.0 + (i % 7) as Real * 30.0, &p, splits).unwrap();
-            r += s[0].radius();
-        }
-        println!("splits {splits}: {:.1} us per sweep set ({r:.0})", t.elapsed().as_secs_f64() * 1e6 / 2000.0);
-    }
-    let _ = stop_sweeps_wcs;
-}
-
-#[test]
 fn a_tick_never_allocates() {
     let cell = cell("T2", STIFF);
     let mut c = ProtectiveChecker::new(cell.clone(), 5.0).unwrap();

@@ -202,7 +202,7 @@ impl ProtectiveChecker {
                 reference
             }
         };
-        let sweeps = stop_sweeps_wcs(&robot.model, rot, &centre, radius, self.tables[j].as_deref(), 0, 0);
+        let sweeps = stop_sweeps_wcs(&robot.model, rot, &centre, radius, self.tables[j].as_deref());
         let faces = core::array::from_fn(|form| {
             core::array::from_fn(|k| match boxes.as_slice().get(k) {
                 Some(b) => FaceTerms::new(b, &sweeps[form][k]),

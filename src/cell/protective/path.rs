@@ -190,7 +190,7 @@ impl ProtectiveChecker {
                 (self.centres[j], self.reach[j], None)
             }
         };
-        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref(), 0, 0);
+        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref());
         let mut faces = [[self.no_faces; MAX_BOXES]; 2];
         for (form, terms) in faces.iter_mut().enumerate() {
             for (k, b) in boxes.as_slice().iter().enumerate() {

@@ -13,26 +13,25 @@ use crate::robot::{RobotModel, MAX_BOXES};
 
 /// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
 /// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded. The motor
-/// angles come from `table` (built for `model.delta`) where it covers the cube, intersected,
-/// for the arms in the bit mask `arms`, with the interval inverse kinematics in `precise^3`
-/// sub-boxes (none when `precise` is 0); without the table, from the interval inverse
-/// kinematics with [`SPLITS`].
+/// angles come from `table` (built for `model.delta`) where it covers the cube, else from the
+/// interval inverse kinematics with [`SPLITS`]: the first tier, without the second.
 pub fn stop_sweeps_wcs(
     model: &RobotModel,
     rot_wcs: &crate::math::Mat3,
     tcp_mcs: &Vec3,
     s: Real,
     table: Option<&MotorTable>,
-    precise: u32,
-    arms: u8,
 ) -> SweepForms {
     let mut out = [[Sweep::ZERO; MAX_BOXES]; 2];
-    stop_sweeps_wcs_into(&mut out, model, rot_wcs, tcp_mcs, s, table, precise, arms);
+    stop_sweeps_wcs_into(&mut out, model, rot_wcs, tcp_mcs, s, table, 0, 0);
     out
 }
 
-/// [`stop_sweeps_wcs`] written into `out`: the tick's sweeps are recomputed in place, many
-/// times per tick by the speed limits' tests, without whole sets copied on the way.
+/// The sweeps of [`stop_sweeps_wcs`] written into `out` (the tick's are recomputed in place,
+/// many times per tick by the speed limits' tests, without whole sets copied on the way),
+/// with the second tier for the arms in the bit mask `arms`: the table's motor angles
+/// intersected with the interval inverse kinematics in `precise^3` sub-boxes (none when
+/// `precise` is 0).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn stop_sweeps_wcs_into(
     out: &mut SweepForms,
