@@ -49,7 +49,8 @@
 //! arms 1 and 2 swapped), so that a symmetric cell gets symmetric labels (thesis 3.2.8).
 //!
 //! This file runs the labelling; `sweeps.rs` makes the displacement sets of cells and
-//! octants, `refine.rs` holds levels 2 and 3 and the sub-cell labels, and, for the report
+//! octants, `refine.rs` holds levels 2 and 3 and the sub-cell labels, `tiles.rs` the order in
+//! which a streamed build's block of pairs gets its sub-cells, and, for the report
 //! tool only (`eval` feature), `subdivided_labels.rs` spells the sub-cells out as labels at
 //! `2 k`.
 
