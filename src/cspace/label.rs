@@ -24,7 +24,7 @@ use crate::cspace::guarantee::thesis_margin;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::{Label, LabelledSpace};
 use crate::geometry::sat::separating_axis;
-use crate::cspace::swept_sat::{swept_apart, SweptFrame};
+use crate::cspace::swept_sat::{swept_apart, SweptFrame, TableSweep};
 use crate::geometry::sweep::{swept_aabb_half, Sweep};
 use crate::robot::MAX_BOXES;
 use crate::geometry::Obb;
@@ -106,43 +106,57 @@ pub enum Inflation {
     Unknown,
 }
 
-/// One box of a [`SampleBoxes`] entry with everything the box test reads, side by side (one
-/// stretch of memory per box: the tests read boxes of many entries in turn), in the order the
-/// tests read it: the swept AABB, then what every axis of the swept test reads (the centre and
-/// the frame), then the sweep, whose supports only some axes need. The box's axes and
-/// half-extents are kept once, in the frame ([`SweptBox::obb`] gives the box back, the same
-/// numbers): a smaller box is fewer cache lines per test.
+/// The axis-aligned bounds of one swept box. [`SampleBoxes`] keeps them in an array of
+/// their own, apart from the rest of the boxes: the bounds of a box pair are the first thing
+/// its test reads, and a pair they set apart reads no other byte of its two boxes.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C)]
-pub struct SweptBox {
-    /// AABB of the swept box, lower corner.
+pub struct SweptBounds {
+    /// Lower corner.
     pub lo: [Real; 3],
     /// Upper corner.
     pub hi: [Real; 3],
+}
+
+impl SweptBounds {
+    /// The bounds of box `b` swept by `sweep`.
+    pub fn new(b: &Obb, sweep: &Sweep) -> SweptBounds {
+        let h = swept_aabb_half(b, sweep);
+        let (lo, hi) = (b.center - h, b.center + h);
+        SweptBounds { lo: [lo.x, lo.y, lo.z], hi: [hi.x, hi.y, hi.z] }
+    }
+}
+
+/// One box of a [`SampleBoxes`] entry with what the box test reads after the bounds
+/// ([`SweptBounds`]), side by side (one stretch of memory per box: the tests read boxes of
+/// many entries in turn), in the order the tests read it: what every axis of the swept test
+/// reads (the centre and the frame), then the sweep, whose supports only some axes need. The
+/// box's axes and half-extents are kept once, in the frame ([`SweptBox::obb`] gives the box
+/// back, the same numbers), and the sweep without the segment a table's sweep never has
+/// ([`TableSweep`]): 313 bytes, aligned to a 64-byte cache line, so that a box takes five
+/// lines and no more.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+pub struct SweptBox {
     /// Centre of the box at the entry's centre.
     pub center: Vec3,
     /// Its axes, half-extents and the sweep's supports on its axes
     /// ([`crate::cspace::swept_sat`]).
     pub frame: SweptFrame,
     /// Its displacement set in the WCS ([`Sweep::ZERO`] for the exact boxes).
-    pub sweep: Sweep,
-    /// Whether `sweep` is [`Sweep::is_zero`] (an exact box: the separating axis test).
+    pub sweep: TableSweep,
+    /// Whether the sweep is [`Sweep::is_zero`] (an exact box: the separating axis test).
     pub exact: bool,
 }
 
 impl SweptBox {
-    /// Box `b` swept by `sweep`, with its bounds.
+    /// Box `b` swept by `sweep`.
+    ///
+    /// # Panics
+    /// When `sweep` has a segment: the tables' sweeps have none, and the swept test, which
+    /// leaves it out, would not cover it.
     pub fn new(b: Obb, sweep: Sweep) -> SweptBox {
-        let h = swept_aabb_half(&b, &sweep);
-        let (lo, hi) = (b.center - h, b.center + h);
-        SweptBox {
-            lo: [lo.x, lo.y, lo.z],
-            hi: [hi.x, hi.y, hi.z],
-            center: b.center,
-            frame: SweptFrame::new(&b, &sweep),
-            sweep,
-            exact: sweep.is_zero(),
-        }
+        let table = TableSweep::of(&sweep).expect("a table's sweep has no segment");
+        SweptBox { center: b.center, frame: SweptFrame::new(&b, &table), sweep: table, exact: sweep.is_zero() }
     }
 
     /// The box at the entry's centre: the centre, and the frame's axes (as columns) and
@@ -162,6 +176,8 @@ pub struct SampleBoxes {
     pub per_entry: usize,
     /// Box `j` of entry `s` at `s * per_entry + j` (meaningful when `slot[s]` is `Boxes`).
     pub boxes: Vec<SweptBox>,
+    /// The bounds of `boxes[i]` at `bounds[i]`.
+    pub bounds: Vec<SweptBounds>,
     /// Per entry: the AABB of all its boxes, lower corner.
     pub lo: Vec<[Real; 3]>,
     /// Per entry: upper corner.
@@ -199,6 +215,7 @@ impl SampleBoxes {
         let mut out = SampleBoxes {
             per_entry: nb,
             boxes: Vec::with_capacity(n * nb),
+            bounds: Vec::with_capacity(n * nb),
             lo: Vec::with_capacity(n),
             hi: Vec::with_capacity(n),
             slot: Vec::with_capacity(n),
@@ -207,12 +224,13 @@ impl SampleBoxes {
             let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
             for j in 0..nb {
                 let (b, sweep) = boxes.get(j).copied().unwrap_or((empty, Sweep::ZERO));
-                let swept = SweptBox::new(b, sweep);
+                let bounds = SweptBounds::new(&b, &sweep);
                 for a in 0..3 {
-                    lo[a] = min_or_nan(lo[a], swept.lo[a]);
-                    hi[a] = max_or_nan(hi[a], swept.hi[a]);
+                    lo[a] = min_or_nan(lo[a], bounds.lo[a]);
+                    hi[a] = max_or_nan(hi[a], bounds.hi[a]);
                 }
-                out.boxes.push(swept);
+                out.boxes.push(SweptBox::new(b, sweep));
+                out.bounds.push(bounds);
             }
             // A non-finite box or sweep proves nothing: every pair of the entry is a collision.
             if slot == Slot::Boxes && !lo.iter().chain(&hi).all(|v| v.is_finite()) {
@@ -233,6 +251,7 @@ impl SampleBoxes {
         SampleBoxes {
             per_entry: n,
             boxes: entries.iter().flat_map(per_box).map(|i| self.boxes[i]).collect(),
+            bounds: entries.iter().flat_map(per_box).map(|i| self.bounds[i]).collect(),
             lo: entry(&self.lo),
             hi: entry(&self.hi),
             slot: entries.iter().map(|&e| self.slot[e as usize]).collect(),
@@ -251,6 +270,12 @@ pub(crate) fn aabbs_apart(alo: &[Real; 3], ahi: &[Real; 3], blo: &[Real; 3], bhi
     (0..3).any(|k| blo[k] > ahi[k] + AABB_SLACK || alo[k] > bhi[k] + AABB_SLACK)
 }
 
+/// Whether two swept boxes' bounds are apart by more than the slack.
+#[inline]
+pub(crate) fn bounds_apart(a: &SweptBounds, b: &SweptBounds) -> bool {
+    aabbs_apart(&a.lo, &a.hi, &b.lo, &b.hi)
+}
+
 /// Whether the AABBs of A's entry `ia` and B's entry `ib` (all their boxes) are apart.
 #[inline]
 pub(crate) fn entries_apart(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usize) -> bool {
@@ -263,10 +288,10 @@ pub(crate) fn entries_apart(a: &SampleBoxes, ia: usize, b: &SampleBoxes, ib: usi
 /// [`crate::geometry::swept_boxes_apart`] written in A's frame).
 #[inline]
 pub(crate) fn boxes_may_touch(a: &SampleBoxes, i: usize, b: &SampleBoxes, j: usize) -> bool {
-    let (x, y) = (&a.boxes[i], &b.boxes[j]);
-    if aabbs_apart(&x.lo, &x.hi, &y.lo, &y.hi) {
+    if bounds_apart(&a.bounds[i], &b.bounds[j]) {
         return false;
     }
+    let (x, y) = (&a.boxes[i], &b.boxes[j]);
     if x.exact && y.exact {
         separating_axis(&x.obb(), &y.obb()).is_none()
     } else {
@@ -487,5 +512,45 @@ mod tests {
             };
             prop_assert_eq!(bits(&back), bits(&b));
         }
+
+        /// The bounds kept apart from the boxes are each box's own: those of the box and sweep
+        /// it gives back, to the bit, at the same index, in a robot's boxes and in any subset
+        /// of its entries; so the test that reads them first answers as it did with the
+        /// bounds inside the box. An index out of step or a bound of another box fails it.
+        #[test]
+        fn bounds_apart_from_the_boxes_are_each_boxs_own(
+                tcps in prop::collection::vec((-120.0..120.0f64, -120.0..120.0f64, -500.0..-300.0f64), 1..6),
+                sweeps in prop::collection::vec(any_sweep(), MAX_BOXES),
+                exact in any::<bool>(), pick in prop::collection::vec(0..6u32, 0..8)) {
+            let cell = crate::cell::reference::reference_cell("T3").unwrap();
+            let robot = &cell.robots[1];
+            let centres: Vec<Vec3> = tcps.iter().map(|&(x, y, z)| Vec3::new(x, y, z)).collect();
+            let sweeps: [Sweep; MAX_BOXES] = core::array::from_fn(|j| if exact { Sweep::ZERO } else { sweeps[j] });
+            let all = SampleBoxes::new(&robot.model, &robot.placement, &centres, |_| Inflation::Swept(sweeps));
+            let entries: Vec<u32> = pick.iter().map(|&e| e % centres.len() as u32).collect();
+            let some = all.subset(&entries);
+            for boxes in [&all, &some] {
+                prop_assert_eq!(boxes.bounds.len(), boxes.boxes.len());
+                for (bounds, b) in boxes.bounds.iter().zip(&boxes.boxes) {
+                    let own = SweptBounds::new(&b.obb(), &b.sweep.sweep());
+                    let bits = |x: &SweptBounds| x.lo.iter().chain(&x.hi).map(|v| v.to_bits()).collect::<Vec<_>>();
+                    prop_assert_eq!(bits(bounds), bits(&own));
+                }
+            }
+            let n = all.per_entry;
+            for (k, &e) in entries.iter().enumerate() {
+                for j in 0..n {
+                    prop_assert_eq!(some.boxes[k * n + j], all.boxes[e as usize * n + j]);
+                }
+            }
+        }
+    }
+
+    /// A swept box fills five cache lines and starts on one: the swept test reads five lines
+    /// per box, not six or seven.
+    #[test]
+    fn a_swept_box_is_five_aligned_cache_lines() {
+        assert_eq!(size_of::<SweptBox>(), 5 * 64);
+        assert_eq!(align_of::<SweptBox>(), 64);
     }
 }

@@ -52,6 +52,40 @@ use crate::math::{float, Real, Vec3};
 /// Added to every `|R_ij|` entering a radius (module doc, "Numerics").
 pub const R_GUARD: Real = 1e-12;
 
+/// A table's displacement set: a [`Sweep`] without its segment `line`, which the tables'
+/// sweeps ([`crate::cspace::guarantee::cube_box_sweeps`]) never have, so that [`support`]
+/// leaves it out and a swept box need not hold it (24 bytes fewer per box).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TableSweep {
+    /// [`Sweep::cube`].
+    pub cube: [Vec3; 3],
+    /// [`Sweep::round`].
+    pub round: Real,
+    /// [`Sweep::arc`].
+    pub arc: [Vec3; 2],
+    /// [`Sweep::ends`].
+    pub ends: [(Real, Real); 2],
+    /// [`Sweep::ball`].
+    pub ball: Real,
+}
+
+impl TableSweep {
+    /// `s` without its segment; `None` when the segment is not zero (the swept test would
+    /// leave out displacements of the set).
+    pub fn of(s: &Sweep) -> Option<TableSweep> {
+        let Sweep { cube, round, arc, ends, ball, line } = *s;
+        (line == Vec3::zeros()).then_some(TableSweep { cube, round, arc, ends, ball })
+    }
+
+    /// The sweep it holds, with a zero segment: [`Sweep::support`] and everything built on
+    /// it give what they gave on the sweep it was made from, to the bit (a zero segment adds
+    /// `|0 . n| = +0` to a support, whatever the signs of its zeros).
+    pub fn sweep(&self) -> Sweep {
+        let TableSweep { cube, round, arc, ends, ball } = *self;
+        Sweep { cube, round, arc, ends, ball, line: Vec3::zeros() }
+    }
+}
+
 /// One swept box as [`swept_apart`] reads it: axes as rows, half-extents, and the sweep's
 /// support on the box's own axes (computed once per box, used by every pair).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,10 +100,7 @@ pub struct SweptFrame {
 
 impl SweptFrame {
     /// The frame of box `b` swept by `s`.
-    pub fn new(b: &Obb, s: &Sweep) -> SweptFrame {
-        // The tables' sweeps ([`crate::cspace::guarantee::cube_box_sweeps`]) have no segment,
-        // so [`support`] leaves it out.
-        debug_assert!(s.line == Vec3::zeros(), "a table's sweep has no segment");
+    pub fn new(b: &Obb, s: &TableSweep) -> SweptFrame {
         let m = &b.axes;
         let u: [[Real; 3]; 3] = core::array::from_fn(|k| [m[(0, k)], m[(1, k)], m[(2, k)]]);
         SweptFrame { u, h: [b.half.x, b.half.y, b.half.z], face_support: u.map(|n| support(s, &n, 1.0)) }
@@ -83,7 +114,7 @@ fn dot(u: &[Real; 3], v: &[Real; 3]) -> Real {
 
 /// `h_S(n)` of the sweep module doc for a vector `n` of length `norm`.
 #[inline(always)]
-fn support(s: &Sweep, n: &[Real; 3], norm: Real) -> Real {
+fn support(s: &TableSweep, n: &[Real; 3], norm: Real) -> Real {
     let d = |w: &Vec3| (w.x * n[0] + w.y * n[1] + w.z * n[2]).abs();
     let z = d(&s.cube[0]) + d(&s.cube[1]) + d(&s.cube[2]) + s.round * norm;
     let a = d(&s.arc[0]) + d(&s.arc[1]);
@@ -114,9 +145,9 @@ struct Pair<'a> {
     ar: [[Real; 3]; 3],
     t: [Real; 3],
     fa: &'a SweptFrame,
-    sa: &'a Sweep,
+    sa: &'a TableSweep,
     fb: &'a SweptFrame,
-    sb: &'a Sweep,
+    sb: &'a TableSweep,
 }
 
 impl Pair<'_> {
@@ -164,7 +195,7 @@ impl Pair<'_> {
 /// proved". The axes are read in the order of the module doc, "Order of the axes", each
 /// stopping the test when it separates.
 #[inline]
-pub fn swept_apart(ca: &Vec3, fa: &SweptFrame, sa: &Sweep, cb: &Vec3, fb: &SweptFrame, sb: &Sweep) -> bool {
+pub fn swept_apart(ca: &Vec3, fa: &SweptFrame, sa: &TableSweep, cb: &Vec3, fb: &SweptFrame, sb: &TableSweep) -> bool {
     let dv = cb - ca;
     let d = [dv.x, dv.y, dv.z];
     let (ua, ub) = (&fa.u, &fb.u);
@@ -201,7 +232,7 @@ mod tests {
     use super::*;
     use crate::geometry::sat::separating_axis;
     use crate::geometry::sweep::swept_boxes_apart;
-    use crate::geometry::sweep::tests::{any_box, any_sweep, proved_and_stay_apart, rot};
+    use crate::geometry::sweep::tests::{any_box, any_sweep, any_sweep_with_line, proved_and_stay_apart, rot};
     use crate::math::Mat3;
     use proptest::prelude::*;
 
@@ -209,7 +240,14 @@ mod tests {
     /// axis's terms computed when it is reached, stopping at the first that separates. The
     /// statement the reordered form must answer as, to the bit.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // written so that NaN fails the tests
-    fn swept_apart_in_first_order(a: &Obb, fa: &SweptFrame, sa: &Sweep, b: &Obb, fb: &SweptFrame, sb: &Sweep) -> bool {
+    fn swept_apart_in_first_order(
+        a: &Obb,
+        fa: &SweptFrame,
+        sa: &TableSweep,
+        b: &Obb,
+        fb: &SweptFrame,
+        sb: &TableSweep,
+    ) -> bool {
         let dv = b.center - a.center;
         let d = [dv.x, dv.y, dv.z];
         let (ua, ub, ha, hb) = (&fa.u, &fb.u, &fa.h, &fb.h);
@@ -260,14 +298,40 @@ mod tests {
     /// [`swept_apart`], checked against [`swept_apart_in_first_order`] (the same answer) on
     /// every case of the tests below: random, close, parallel and touching boxes.
     fn apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
-        let (fa, fb) = (SweptFrame::new(a, sa), SweptFrame::new(b, sb));
-        let proved = swept_apart(&a.center, &fa, sa, &b.center, &fb, sb);
-        assert_eq!(proved, swept_apart_in_first_order(a, &fa, sa, b, &fb, sb), "{a:?} {sa:?} {b:?} {sb:?}");
+        let (ta, tb) = (TableSweep::of(sa).unwrap(), TableSweep::of(sb).unwrap());
+        let (fa, fb) = (SweptFrame::new(a, &ta), SweptFrame::new(b, &tb));
+        let proved = swept_apart(&a.center, &fa, &ta, &b.center, &fb, &tb);
+        assert_eq!(proved, swept_apart_in_first_order(a, &fa, &ta, b, &fb, &tb), "{a:?} {sa:?} {b:?} {sb:?}");
         proved
     }
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// A table's sweep is the sweep without its segment: made only from a sweep whose
+        /// segment is zero, and what it gives back has every number of the sweep given, to the
+        /// bit, and the same support on any vector (a segment of zeros of either sign adds +0).
+        #[test]
+        fn table_sweep_keeps_every_number_but_the_zero_segment(s in any_sweep_with_line(),
+                n in prop::array::uniform3(-2.0..2.0f64), signs in prop::array::uniform3(any::<bool>())) {
+            let zero = Vec3::from(signs.map(|neg| if neg { -0.0 } else { 0.0 }));
+            let s = if s.line == Vec3::zeros() { Sweep { line: zero, ..s } } else { s };
+            match TableSweep::of(&s) {
+                None => prop_assert!(s.line != Vec3::zeros()),
+                Some(t) => {
+                    let back = t.sweep();
+                    let bits = |w: &Sweep| {
+                        let v = w.cube.iter().chain(&w.arc).flat_map(|v| v.iter().copied());
+                        let e = w.ends.iter().flat_map(|&(e, d)| [e, d]);
+                        v.chain(e).chain([w.round, w.ball]).map(Real::to_bits).collect::<Vec<_>>()
+                    };
+                    prop_assert_eq!(bits(&back), bits(&s));
+                    prop_assert_eq!(back.line, Vec3::zeros());
+                    let n = Vec3::from(n);
+                    prop_assert_eq!(back.support(&n).to_bits(), s.support(&n).to_bits());
+                }
+            }
+        }
 
         /// The reordered test answers as the one first written right at the threshold: B moved
         /// from A's centre along `v` by bisection to where the answer flips, both sides checked

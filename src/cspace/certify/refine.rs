@@ -5,8 +5,8 @@
 use crate::cell::RobotSpec;
 use crate::cspace::guarantee::reference_point;
 use crate::cspace::label::{
-    aabbs_apart, all_box_pairs, boxes_may_touch, collision_mask, entries_apart, Inflation, Rows, SampleBoxes, Slot,
-    SweptBox,
+    aabbs_apart, all_box_pairs, bounds_apart, boxes_may_touch, collision_mask, entries_apart, Inflation, Rows,
+    SampleBoxes, Slot, SweptBounds, SweptBox,
 };
 use crate::cspace::sampler::SampleGrid;
 use crate::cspace::Label;
@@ -98,9 +98,10 @@ impl<'a> SubOctants<'a> {
 }
 
 /// Bytes of one octant's 8 sub-octants with `boxes` boxes each ([`SubOctants::of`]): the
-/// boxes, the per-entry bounds and slots, and the vectors' headers.
+/// boxes and their bounds, the per-entry bounds and slots, and the vectors' headers.
 pub(crate) fn sub_octant_bytes(boxes: usize) -> usize {
-    8 * (boxes * size_of::<SweptBox>() + 2 * size_of::<[Real; 3]>() + size_of::<Slot>()) + 4 * size_of::<Vec<u8>>()
+    let per_box = size_of::<SweptBox>() + size_of::<SweptBounds>();
+    8 * (boxes * per_box + 2 * size_of::<[Real; 3]>() + size_of::<Slot>()) + 5 * size_of::<Vec<u8>>()
 }
 
 /// Whether level 3 proves octant pair (A's entry `sa`, B's entry `sb`) free: for each pair
@@ -218,17 +219,18 @@ impl Known {
 /// It only skips tests whose answers it predicts; a "not free" is never a wrong answer.
 pub(super) fn meet_at_references(x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize) -> bool {
     let (i, j) = (ea * x.per_entry + bit / 8, eb * y.per_entry + bit % 8);
-    meet(&x.boxes[i], &y.boxes[j])
+    !bounds_apart(&x.bounds[i], &y.bounds[j]) && meet(&x.boxes[i], &y.boxes[j])
 }
 
-/// Whether two boxes at their entries' reference TCPs ([`SweptBox::obb`]) meet: the plain separating axis
-/// test finds no axis (the premise of [`meet_at_references`]). Boxes whose swept AABBs are apart
-/// (by the slack, 1e-6 mm, along a world axis) are not tried: each swept box holds its box, so
-/// such boxes are apart by more than 1e-6 mm, and boxes on which the plain test finds no axis
-/// are within its touch tolerance (1e-9 mm) on each of their 15 axes, so a few times that
-/// apart at most: the answer is the plain test's, found without it.
+/// Whether two boxes at their entries' reference TCPs ([`SweptBox::obb`]) meet: the plain
+/// separating axis test finds no axis (the premise of [`meet_at_references`]). Asked only of
+/// boxes whose swept bounds are not apart ([`bounds_apart`]); boxes whose swept bounds are
+/// apart (by the slack, 1e-6 mm, along a world axis) do not meet: each swept box holds its
+/// box, so such boxes are apart by more than 1e-6 mm, and boxes on which the plain test finds
+/// no axis are within its touch tolerance (1e-9 mm) on each of their 15 axes, so a few times
+/// that apart at most: the answer is the plain test's, found without it.
 fn meet(a: &SweptBox, b: &SweptBox) -> bool {
-    !aabbs_apart(&a.lo, &a.hi, &b.lo, &b.hi) && separating_axis(&a.obb(), &b.obb()).is_none()
+    separating_axis(&a.obb(), &b.obb()).is_none()
 }
 
 /// The octant pairs of `(ia, ib)` (bits as [`sub_cell_index`]) that level 2 and level 3 leave
@@ -283,7 +285,7 @@ pub(super) fn cores(boxes: &SampleBoxes) -> Vec<Option<Obb>> {
         .into_par_iter()
         .map(|i| {
             let b = &boxes.boxes[i];
-            (boxes.slot[i / n] == Slot::Boxes).then(|| core(&b.obb(), &b.sweep)).flatten()
+            (boxes.slot[i / n] == Slot::Boxes).then(|| core(&b.obb(), &b.sweep.sweep())).flatten()
         })
         .collect()
 }
