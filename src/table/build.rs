@@ -25,6 +25,7 @@ use crate::table::{
 use crate::table::memory::{plan_memory, MemoryPlan};
 use crate::table::shared6d::SubCellBlocks;
 use core::fmt;
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Why a table could not be built (apart from [`TableError`], which says why a table file
@@ -278,7 +279,8 @@ impl SubCellBlocks for Blocks<'_, '_> {
     fn masks(&mut self, pairs: &[u64], nb: usize) -> Vec<(u64, u64)> {
         let start = Instant::now();
         let source = &*self.source;
-        let masks = source.masks_of(pairs, nb);
+        let nb = nb as u64;
+        let masks = pairs.par_iter().map(|&p| source.masks((p / nb) as usize, (p % nb) as usize)).collect();
         if source.cached_bytes() as u64 > self.cache {
             self.source.clear_cache();
         }

@@ -20,9 +20,8 @@ pub const RESERVE_BYTES: u64 = 256 << 20;
 
 /// Bytes per pair of a block of a streamed subdivided build, when every pair and its mirror
 /// pair are collisions (the worst case): the pair numbers while they are gathered, their
-/// masks and the block's [`crate::cspace::SubCells`], and while the masks are found, the
-/// pairs' tile order and the masks in that order.
-pub const BLOCK_BYTES_PER_PAIR: u64 = 2 * (8 + 16 + 24 + 8 + 16);
+/// masks and the block's [`crate::cspace::SubCells`].
+pub const BLOCK_BYTES_PER_PAIR: u64 = 2 * (8 + 16 + 24);
 
 /// The bound of a build not given one ([`default_max_memory`]): 7 GiB. A `shared-sub` build
 /// spends what its fixed part leaves on blocks and on the sub-octant cache, so the machine's

@@ -49,8 +49,7 @@
 //! arms 1 and 2 swapped), so that a symmetric cell gets symmetric labels (thesis 3.2.8).
 //!
 //! This file runs the labelling; `sweeps.rs` makes the displacement sets of cells and
-//! octants, `refine.rs` holds levels 2 and 3 and the sub-cell labels, `tiles.rs` the order in
-//! which a streamed build's block of pairs gets its sub-cells, and, for the report
+//! octants, `refine.rs` holds levels 2 and 3 and the sub-cell labels, and, for the report
 //! tool only (`eval` feature), `subdivided_labels.rs` spells the sub-cells out as labels at
 //! `2 k`.
 
@@ -59,7 +58,6 @@ mod refine;
 #[cfg(feature = "eval")]
 mod subdivided_labels;
 mod sweeps;
-mod tiles;
 
 #[cfg(feature = "eval")]
 pub use subdivided_labels::SubdividedLabels;
@@ -72,8 +70,6 @@ use crate::cspace::LabelledSpace;
 use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
-use rayon::prelude::*;
-use tiles::{tile_order, TILE_COLUMNS, TILE_ROWS};
 use refine::{octants_prove_free, refine_unknown_cells, sub_cell_masks, sub_cells, Levels, SubOctants};
 use sweeps::{cell_sweeps, inflation, octants, reference_octants, references, unreachable_cells};
 
@@ -228,20 +224,6 @@ impl SubCellSource<'_> {
     /// collision.
     pub(crate) fn masks(&self, ia: usize, ib: usize) -> (u64, u64) {
         sub_cell_masks(&self.a, &self.b, ia, ib, false)
-    }
-
-    /// [`masks`](Self::masks) of each of `pairs` (numbered `ia * nb + ib`), in that order,
-    /// found in parallel tile by tile ([`tiles`]).
-    pub(crate) fn masks_of(&self, pairs: &[u64], nb: usize) -> Vec<(u64, u64)> {
-        let nb = nb as u64;
-        let order = tile_order(pairs, nb, TILE_ROWS, TILE_COLUMNS);
-        let found: Vec<(u64, u64)> =
-            order.par_iter().map(|&i| self.masks((pairs[i] / nb) as usize, (pairs[i] % nb) as usize)).collect();
-        let mut masks = vec![(0, 0); pairs.len()];
-        for (&i, m) in order.iter().zip(found) {
-            masks[i] = m;
-        }
-        masks
     }
 
     /// Bytes held by the sub-octant boxes made so far (both robots).
