@@ -18,9 +18,10 @@ pub const FIXED_BYTES_PER_SAMPLE: u64 = 24_000;
 /// the node pool of the table being built (the size of the output, megabytes) and slack.
 pub const RESERVE_BYTES: u64 = 256 << 20;
 
-/// Bytes per pair of a block of a streamed subdivided build, when every pair and its mirror
-/// pair are collisions (the worst case): the pair numbers while they are gathered, their
-/// masks and the block's [`crate::cspace::SubCells`].
+/// Bytes per pair of a block of a streamed subdivided build, counted twice as a margin: when
+/// every pair is a collision (the worst case), the pair numbers while they are gathered,
+/// their masks and the block's [`crate::cspace::SubCells`] take `8 + 16 + 24` bytes a pair,
+/// and the estimate leaves out the sub-octant boxes a block makes beyond the cache.
 pub const BLOCK_BYTES_PER_PAIR: u64 = 2 * (8 + 16 + 24);
 
 /// The bound of a build not given one ([`default_max_memory`]): 7 GiB. A `shared-sub` build

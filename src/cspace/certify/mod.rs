@@ -24,8 +24,8 @@
 //!    free when, for every pair of sub-octants, each box pair that level 2 left open is
 //!    proved disjoint by (A sub-octant, B sub-octant), (A sub-octant, B octant) or
 //!    (A octant, B sub-octant). The sub-octants cover their octant, so the proof covers the
-//!    whole sub-cell. These sweeps are not made mirror-symmetric: the tables merge each
-//!    sub-cell with its mirror's, collision winning.
+//!    whole sub-cell. These sweeps are not made mirror-symmetric: a symmetric cell's
+//!    sub-cells are found for the half its table stores ("Symmetric cells" below).
 //!
 //! The sub-cells are found faster than by 64 runs of level 2 (`sub_cell_masks`, same
 //! answers): an octant pair is a collision without its tests when a box pair certainly
@@ -47,6 +47,22 @@
 //!
 //! Sweeps are made mirror-symmetric (every size the larger of an entry's and its mirror's,
 //! arms 1 and 2 swapped), so that a symmetric cell gets symmetric labels (thesis 3.2.8).
+//!
+//! # Symmetric cells
+//! A cell with the reflection `y -> -y` ([`crate::cspace::symmetry::reflection_y`]) has a
+//! table that stores A's upper half `iy >= k/2` only, a query in the other half reading its
+//! mirror. Its sub-cells (level 3, by far the largest cost of a build) are found for the
+//! stored half only ([`stored_half`]): a sub-cell proved free is a proof for every
+//! configuration of it, and the reflection maps those configurations onto the mirror
+//! sub-cell's while it maps the two robots onto themselves, so no configuration of the
+//! mirror sub-cell collides either (thesis Lemma 3.2.1). The proof does not use the mirror
+//! pair's own tests; finding them too would only make more sub-cells collisions where the
+//! rounding of the mirror's boxes differs. The reflection is exact up to the placement's
+//! `alpha`, which [`reflection_y`](crate::cspace::symmetry::reflection_y) allows to differ from
+//! 0 or pi by `1e-12` rad: that moves B's boxes by under `1e-8` mm within 5 m of its base,
+//! far inside the `1e-6` mm gap every separating axis of a proof keeps
+//! ([`crate::geometry::sweep`], `SWEEP_GAP`). The whole-cell labels are still found for
+//! every pair (they cost a fifth of a build) and merged with their mirror's by the tables.
 //!
 //! This file runs the labelling; `sweeps.rs` makes the displacement sets of cells and
 //! octants, `refine.rs` holds levels 2 and 3 and the sub-cell labels, and, for the report
@@ -106,7 +122,9 @@ pub struct CertifiedSpace {
 /// Bit `c` of a mask is the sub-cell with child index `c = ax << 5 | ay << 4 | az << 3 |
 /// bx << 2 | by << 1 | bz` (octant bits x, y, z of A then B; the order of
 /// [`crate::table::code`]). A sub-cell outside `care` holds no reachable TCP of A or of B
-/// ("don't care"); one in `collision` could not be proved free.
+/// ("don't care"); one in `collision` could not be proved free. For a cell with the
+/// reflection `y -> -y`, only the pairs of A's stored half have sub-cells (module doc,
+/// "Symmetric cells").
 #[derive(Clone, Debug, PartialEq, Eq, Default)]
 pub struct SubCells {
     /// Pair indices `ia * nb + ib`, increasing.
@@ -122,6 +140,14 @@ impl SubCells {
     pub fn get(&self, pair: u64) -> Option<(u64, u64)> {
         self.pairs.binary_search(&pair).ok().map(|i| (self.care[i], self.collision[i]))
     }
+}
+
+/// For a cell with the reflection `y -> -y`, which of A's samples are in the half a table
+/// stores (`iy >= k/2`): only their sub-cells are found (module doc, "Symmetric cells").
+/// `None` for a cell without it: every sample's are.
+pub(crate) fn stored_half(cell: &Cell, grid_a: &SampleGrid) -> Option<Vec<bool>> {
+    let mirrored = crate::cspace::symmetry::reflection_y(cell);
+    mirrored.then(|| grid_a.cells.iter().map(|c| u32::from(c[1]) >= grid_a.k / 2).collect())
 }
 
 /// The child index of A's octant `i` and B's octant `j` (octant bits x, y, z = 0, 1, 2).
@@ -303,7 +329,8 @@ pub(crate) fn certify_rows_then<R>(
         return Ok(then(certified(labels, None, 0.0, ga, gb), Some(&mut source)));
     }
     let start = std::time::Instant::now();
-    let sub = subdivide.then(|| sub_cells(&la, &lb, &labels, rows));
+    let stored = stored_half(cell, &grid_a);
+    let sub = subdivide.then(|| sub_cells(&la, &lb, &labels, rows, |ia| stored.as_ref().is_none_or(|s| s[ia])));
     let sub_secs = start.elapsed().as_secs_f64();
     Ok(then(certified(labels, sub, sub_secs, ga, gb), None))
 }
@@ -406,7 +433,11 @@ mod tests {
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let nb = b0.len();
             let mut want = SubCells::default();
-            for (p, _) in c.space.labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision) {
+            // A symmetric cell's sub-cells are those of A's stored half (module doc).
+            let stored = stored_half(&cell, &c.space.grid_a);
+            assert_eq!(stored.is_some(), name != "T3");
+            let kept = |p: usize| stored.as_ref().is_none_or(|s| s[p / nb]);
+            for (p, _) in c.space.labels.iter().enumerate().filter(|&(p, &l)| l == Label::Collision && kept(p)) {
                 let (care, collision) = octant_pairs(&a0, &a1, &b0, &b1, p / nb, p % nb, false);
                 want.pairs.push(p as u64);
                 want.care.push(care);
@@ -415,7 +446,7 @@ mod tests {
             assert!(!want.pairs.is_empty());
             let (a, b) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
             assert!(
-                sub_cells(&a, &b, &c.space.labels, Rows::ALL) == want,
+                sub_cells(&a, &b, &c.space.labels, Rows::ALL, |ia| kept(ia * nb)) == want,
                 "{name}: the fast sub-cells differ from the plain ones"
             );
             let got = c.sub.as_ref().unwrap();
@@ -498,7 +529,7 @@ mod tests {
             let nb = b0.len();
             let collisions = labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision);
             let decided = collisions.filter(|&(p, _)| held_by_references(&fa, &fb, p / nb, p % nb) != 0).count();
-            let (fast, plain) = (sub_cells(&fa, &fb, &labels, Rows::ALL), sub_cells(&pa, &pb, &labels, Rows::ALL));
+            let (fast, plain) = (sub_cells(&fa, &fb, &labels, Rows::ALL, |_| true), sub_cells(&pa, &pb, &labels, Rows::ALL, |_| true));
             assert!(fast == plain, "{name}: the references' exit changed sub-cells");
             assert!(decided > 1000, "{name}: {decided} of {} pairs decided by the references", fast.pairs.len());
         }
@@ -658,7 +689,9 @@ mod tests {
 
     /// Level 3 is sound: in every sub-cell that it frees (a collision at level 2, on T1, T2
     /// and T3 at k = 16), 16 random configurations, each TCP uniform in its octant, are free
-    /// for the exact model.
+    /// for the exact model; and so are their mirror images (`y -> -y` of both TCPs in their
+    /// MCS) on the symmetric T1 and T2, whose sub-cells are found for the stored half alone
+    /// (module doc, "Symmetric cells").
     #[test]
     fn sub_cells_freed_by_level_3_hold_no_collision() {
         use crate::cell::{ExactChecker, SatMethod};
@@ -669,12 +702,16 @@ mod tests {
             let cell = reference_cell(name).unwrap();
             let c = label_space_subdivided(&cell, 16, &ws, Progress::Silent).unwrap();
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
-            let plain = sub_cells(&Levels::new(&a0, &a1), &Levels::new(&b0, &b1), &c.space.labels, Rows::ALL);
+            let stored = stored_half(&cell, &c.space.grid_a);
+            let plain = sub_cells(&Levels::new(&a0, &a1), &Levels::new(&b0, &b1), &c.space.labels, Rows::ALL, |ia| {
+                stored.as_ref().is_none_or(|s| s[ia])
+            });
+            assert_eq!(plain.pairs, c.sub.as_ref().unwrap().pairs);
             let got = c.sub.as_ref().unwrap();
             let (ga, gb, nb) = (&c.space.grid_a, &c.space.grid_b, c.space.grid_b.cells.len());
             let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
             let octant = |g: &SampleGrid, s: usize, o: usize| octant_centre(&g.sample_center(s), o, 0.25 * g.r);
-            let (mut freed, mut checked) = (0, 0);
+            let (mut freed, mut checked, mut mirrored) = (0, 0, 0);
             for (e, &pair) in got.pairs.iter().enumerate() {
                 let (ia, ib) = (pair as usize / nb, pair as usize % nb);
                 for (i, j) in (0..8).flat_map(|i| (0..8).map(move |j| (i, j))) {
@@ -697,10 +734,20 @@ mod tests {
                                 "{name}: sub-cell ({i}, {j}) of pair ({ia}, {ib}) collides at {tcps:?}"
                             );
                         }
+                        if stored.is_some() {
+                            let mirror = tcps.map(|p| Vec3::new(p.x, -p.y, p.z));
+                            let v = exact.check(&mirror).unwrap();
+                            mirrored += usize::from(v.unreachable_mask == 0);
+                            assert!(
+                                v.unreachable_mask != 0 || !v.collides(),
+                                "{name}: the mirror of sub-cell ({i}, {j}) of pair ({ia}, {ib}) collides at {mirror:?}"
+                            );
+                        }
                     }
                 }
             }
             assert!(freed > 1000 && checked > 8 * freed, "{name}: {freed} freed sub-cells, {checked} configurations");
+            assert!(stored.is_none() || mirrored > 8 * freed, "{name}: {mirrored} mirror configurations");
         }
     }
 }

@@ -307,13 +307,20 @@ pub(super) fn cores_meet(a: &[Option<Obb>], ia: usize, na: usize, b: &[Option<Ob
     false
 }
 
-/// The sub-cell labels of every pair labelled collision (see [`SubCells`]); `labels` holds
-/// the rows `selection` of A as [`crate::cspace::label::label_pairs`] returns them, the pairs
-/// come out numbered `ia * nb + ib` all the same.
+/// The sub-cell labels of every pair labelled collision whose A sample `stored` keeps (see
+/// [`SubCells`]); `labels` holds the rows `selection` of A as
+/// [`crate::cspace::label::label_pairs`] returns them, the pairs come out numbered
+/// `ia * nb + ib` all the same.
 ///
 /// Rows of A are taken [`SUB_CELL_ROWS`] at a time, column by column, so that B's boxes of a
 /// column are used by every row of the block while they are in the cache.
-pub(super) fn sub_cells(a: &Levels, b: &Levels, labels: &[Label], selection: Rows) -> SubCells {
+pub(super) fn sub_cells(
+    a: &Levels,
+    b: &Levels,
+    labels: &[Label],
+    selection: Rows,
+    stored: impl Fn(usize) -> bool + Sync,
+) -> SubCells {
     let nb = b.whole.len();
     if nb == 0 {
         return SubCells::default();
@@ -325,8 +332,8 @@ pub(super) fn sub_cells(a: &Levels, b: &Levels, labels: &[Label], selection: Row
             let mut out = vec![];
             for ib in 0..nb {
                 for (r, row) in rows.chunks(nb).enumerate() {
-                    if row[ib] == Label::Collision {
-                        let ia = selection.row(block * SUB_CELL_ROWS + r);
+                    let ia = selection.row(block * SUB_CELL_ROWS + r);
+                    if row[ib] == Label::Collision && stored(ia) {
                         let (care, collision) = sub_cell_masks(a, b, ia, ib, false);
                         out.push(((ia * nb + ib) as u64, care, collision));
                     }

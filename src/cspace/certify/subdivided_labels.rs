@@ -5,6 +5,7 @@
 use crate::cell::Cell;
 use crate::cspace::label::two_robot_grids;
 use crate::cspace::sampler::{SampleGrid, Workspace};
+use crate::cspace::symmetry::{mirror_cell, reflection_y};
 use crate::cspace::{Label, LabelledSpace};
 use rayon::prelude::*;
 use super::{sub_cell_index, CertifiedSpace, SubCells};
@@ -17,7 +18,9 @@ use super::{sub_cell_index, CertifiedSpace, SubCells};
 /// there never reach the table. A plain table built from these labels answers as the
 /// subdivided one does on every sub-cell (the baseline for its size); at `k = 64` the dense
 /// labels ([`SubdividedLabels::to_dense`]) would not fit in memory, so the 4-D builder reads them
-/// here ([`crate::table::LinearQuadtree4d::build_subdivided`]).
+/// here ([`crate::table::LinearQuadtree4d::build_subdivided`]). A symmetric cell's sub-cells
+/// are found for the stored half only (module doc of `certify`, "Symmetric cells"): a pair
+/// of the other half takes its mirror pair's, reflected.
 pub struct SubdividedLabels<'a> {
     coarse: &'a LabelledSpace,
     sub: &'a SubCells,
@@ -30,6 +33,8 @@ pub struct SubdividedLabels<'a> {
     parent_b: Vec<Option<(u32, u8)>>,
     /// `sub.pairs[row_start[ia]..row_start[ia + 1]]` are the pairs of A's sample `ia` at `k`.
     row_start: Vec<usize>,
+    /// For a symmetric cell, per sample at `k` of A, then of B: its mirror sample, if any.
+    mirrors: Option<(Vec<Option<usize>>, Vec<Option<usize>>)>,
 }
 
 impl<'a> SubdividedLabels<'a> {
@@ -52,7 +57,11 @@ impl<'a> SubdividedLabels<'a> {
         let nb0 = coarse.grid_b.cells.len() as u64;
         let row_start =
             (0..=coarse.grid_a.cells.len() as u64).map(|ia| sub.pairs.partition_point(|&p| p < ia * nb0)).collect();
-        Ok(SubdividedLabels { coarse, sub, grid_a, grid_b, parent_a, parent_b, row_start })
+        let mirrors = reflection_y(cell).then(|| {
+            let of = |g: &SampleGrid| g.cells.iter().map(|&c| g.index_of(mirror_cell(g, c))).collect();
+            (of(&coarse.grid_a), of(&coarse.grid_b))
+        });
+        Ok(SubdividedLabels { coarse, sub, grid_a, grid_b, parent_a, parent_b, row_start, mirrors })
     }
 
     /// These labels as one array (`8^2` times the bytes of the labels at `k`).
@@ -79,32 +88,43 @@ impl<'a> SubdividedLabels<'a> {
             out.fill(Label::Unreachable);
             return;
         };
-        let (pa, nb0) = (pa as usize, self.coarse.grid_b.cells.len());
-        let labels = &self.coarse.labels[pa * nb0..(pa + 1) * nb0];
-        let (first, last) = (self.row_start[pa], self.row_start[pa + 1]);
-        let row = &self.sub.pairs[first..last];
+        let pa = pa as usize;
         for (l, &ib) in out.iter_mut().zip(ibs) {
             let Some(&Some((pb, j))) = self.parent_b.get(ib as usize) else {
                 *l = Label::Unreachable;
                 continue;
             };
-            *l = match labels[pb as usize] {
-                Label::Collision => match row.binary_search(&((pa * nb0) as u64 + u64::from(pb))) {
-                    Ok(e) => {
-                        let bit = 1u64 << sub_cell_index(usize::from(i), usize::from(j));
-                        if self.sub.care[first + e] & bit == 0 {
-                            Label::Unreachable
-                        } else if self.sub.collision[first + e] & bit != 0 {
-                            Label::Collision
-                        } else {
-                            Label::Free
-                        }
-                    }
-                    Err(_) => Label::Collision,
-                },
-                label => label,
-            };
+            let (pb, i, j) = (pb as usize, usize::from(i), usize::from(j));
+            *l = self
+                .spelled(pa, pb, i, j)
+                .or_else(|| {
+                    let (ma, mb) = self.mirrors.as_ref()?;
+                    // The mirror sub-cell: the y octant bit (bit 1) of both robots flipped.
+                    self.spelled(ma[pa]?, mb[pb]?, i ^ 2, j ^ 2)
+                })
+                .unwrap_or(Label::Collision);
         }
+    }
+
+    /// The label of sub-cell (A's octant `i`, B's octant `j`) of pair `(pa, pb)` at `k`: its
+    /// pair's label, or for a pair labelled collision its sub-cell's; `None` for a collision
+    /// pair without sub-cells.
+    fn spelled(&self, pa: usize, pb: usize, i: usize, j: usize) -> Option<Label> {
+        let nb0 = self.coarse.grid_b.cells.len();
+        let label = self.coarse.labels[pa * nb0 + pb];
+        if label != Label::Collision {
+            return Some(label);
+        }
+        let (first, last) = (self.row_start[pa], self.row_start[pa + 1]);
+        let e = first + self.sub.pairs[first..last].binary_search(&((pa * nb0 + pb) as u64)).ok()?;
+        let bit = 1u64 << sub_cell_index(i, j);
+        Some(if self.sub.care[e] & bit == 0 {
+            Label::Unreachable
+        } else if self.sub.collision[e] & bit != 0 {
+            Label::Collision
+        } else {
+            Label::Free
+        })
     }
 }
 
@@ -116,7 +136,9 @@ mod tests {
     use crate::cspace::Progress;
 
     /// The `2k` labels of a subdivided labelling: every sub-cell of a collision pair as its
-    /// mask says (looked up the plain way), everything else as its parent pair.
+    /// mask says (looked up the plain way), everything else as its parent pair. T2 is
+    /// symmetric, so the pairs of A's lower half have no sub-cells of their own: each takes
+    /// the label of its mirror sample pair at `2k` (both robots' `iy` reflected).
     #[test]
     fn subdivided_labels_spell_out_the_sub_cells() {
         let ws = Workspace::THESIS;
@@ -125,33 +147,47 @@ mod tests {
         let fine = SubdividedLabels::new(&cell, &ws, &c).unwrap().to_dense();
         let sub = c.sub.as_ref().unwrap();
         let (coarse, nb0) = (&c.space, c.space.grid_b.cells.len());
-        let (mut seen, mut freed) = (0, 0);
+        let up = |g: &SampleGrid, x: &[u16; 3]| g.index_of([x[0] / 2, x[1] / 2, x[2] / 2]);
+        let octant = |x: &[u16; 3]| usize::from(x[0] & 1) | usize::from(x[1] & 1) << 1 | usize::from(x[2] & 1) << 2;
+        // The label spelled from the pair's own sub-cells; `None` for a collision pair without.
+        let own = |ca: &[u16; 3], cb: &[u16; 3]| match (up(&coarse.grid_a, ca), up(&coarse.grid_b, cb)) {
+            (Some(ia), Some(ib)) => match sub.get((ia * nb0 + ib) as u64) {
+                Some((care, collision)) => {
+                    let bit = 1u64 << sub_cell_index(octant(ca), octant(cb));
+                    Some(match (care & bit != 0, collision & bit != 0) {
+                        (false, _) => Label::Unreachable,
+                        (true, true) => Label::Collision,
+                        (true, false) => Label::Free,
+                    })
+                }
+                None => Some(coarse.label(ia, ib)).filter(|&l| l != Label::Collision),
+            },
+            _ => Some(Label::Unreachable),
+        };
+        let (mut seen, mut freed, mut mirrored) = (0, 0, 0);
         for (ja, ca) in fine.grid_a.cells.iter().enumerate() {
             for (jb, cb) in fine.grid_b.cells.iter().enumerate() {
-                let up = |g: &SampleGrid, x: &[u16; 3]| g.index_of([x[0] / 2, x[1] / 2, x[2] / 2]);
-                let octant =
-                    |x: &[u16; 3]| usize::from(x[0] & 1) | usize::from(x[1] & 1) << 1 | usize::from(x[2] & 1) << 2;
-                let want = match (up(&coarse.grid_a, ca), up(&coarse.grid_b, cb)) {
-                    (Some(ia), Some(ib)) => match sub.get((ia * nb0 + ib) as u64) {
-                        Some((care, collision)) => {
-                            seen += 1;
-                            let bit = 1u64 << sub_cell_index(octant(ca), octant(cb));
-                            match (care & bit != 0, collision & bit != 0) {
-                                (false, _) => Label::Unreachable,
-                                (true, true) => Label::Collision,
-                                (true, false) => {
-                                    freed += 1;
-                                    Label::Free
-                                }
-                            }
-                        }
-                        None => coarse.label(ia, ib),
-                    },
-                    _ => Label::Unreachable,
-                };
+                let want = own(ca, cb).unwrap_or_else(|| {
+                    mirrored += 1;
+                    let (ma, mb) = (mirror_cell(&fine.grid_a, *ca), mirror_cell(&fine.grid_b, *cb));
+                    own(&ma, &mb).unwrap_or(Label::Collision)
+                });
+                seen += 1;
+                freed += usize::from(want == Label::Free && coarse_collision(coarse, &up, ca, cb));
                 assert_eq!(fine.label(ja, jb), want, "fine pair ({ja}, {jb})");
             }
         }
-        assert!(seen > 0 && freed > 0, "{seen} sub-cells, {freed} freed");
+        assert!(seen > 0 && freed > 0 && mirrored > 0, "{seen} pairs, {freed} sub-cells freed, {mirrored} mirrored");
+    }
+
+    /// Whether the parent pair of fine cells `ca`, `cb` is labelled collision at `k`.
+    fn coarse_collision(
+        coarse: &LabelledSpace,
+        up: &impl Fn(&SampleGrid, &[u16; 3]) -> Option<usize>,
+        ca: &[u16; 3],
+        cb: &[u16; 3],
+    ) -> bool {
+        let nb0 = coarse.grid_b.cells.len();
+        matches!((up(&coarse.grid_a, ca), up(&coarse.grid_b, cb)), (Some(ia), Some(ib)) if coarse.labels[ia * nb0 + ib] == Label::Collision)
     }
 }

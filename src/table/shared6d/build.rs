@@ -154,8 +154,9 @@ impl Builder<'_> {
     }
 
     /// Fetches the sub-cells of the block (depth `d`, block coordinates `a`, `b`) from the
-    /// stream: those of its pairs labelled collision and of their mirror pairs, the ones
-    /// [`subdivided_cell`](Self::subdivided_cell) looks up inside the block.
+    /// stream: those of its pairs labelled collision, the ones
+    /// [`subdivided_cell`](Self::subdivided_cell) looks up inside the block (a block lies in
+    /// the stored half, and a pair's sub-cells are its own, not merged with its mirror's).
     fn fetch_block(&mut self, d: u32, a: [usize; 3], b: [usize; 3]) {
         let side = self.k >> d;
         let in_a = block_samples(&self.dense_a, self.k, side, a);
@@ -164,16 +165,12 @@ impl Builder<'_> {
         let mut pairs = Vec::new();
         for &ia in &in_a {
             for &ib in &in_b {
-                let mirror = self.view.mirror_pair(ia, ib);
-                for (x, y) in core::iter::once((ia, ib)).chain(mirror) {
-                    if self.view.own_label(x, y) == Label::Collision {
-                        pairs.push((x * nb + y) as u64);
-                    }
+                if self.view.own_label(ia, ib) == Label::Collision {
+                    pairs.push((ia * nb + ib) as u64);
                 }
             }
         }
         pairs.sort_unstable();
-        pairs.dedup();
         if let Some(s) = self.stream.as_mut() {
             let masks = s.source.masks(&pairs, nb);
             let (care, collision) = masks.into_iter().unzip();
@@ -198,21 +195,20 @@ impl Builder<'_> {
         (part, Some((ia, ib)))
     }
 
-    /// The part of one cell pair cut into its 64 sub-cells ([`SubCells`]), merged with its
-    /// mirror pair under symmetry as [`SpaceView::label`] merges labels (collision wins).
+    /// The part of one cell pair cut into its 64 sub-cells ([`SubCells`]). Under symmetry the
+    /// sub-cells are the stored pair's own: a labelling finds them for the stored half only,
+    /// its proofs holding for the mirror pair by the cell's symmetry (`crate::cspace::certify`,
+    /// module doc, "Symmetric cells"). A clearance table's words merge with the mirror pair's
+    /// as [`SpaceView::label`] merges labels (the smaller level wins).
     fn subdivided_cell(&mut self, ca: [usize; 3], cb: [usize; 3]) -> Part {
         let (part, Some((ia, ib))) = self.cell(ca, cb) else { return Part::DontCare };
         if part != Part::Collision {
             return part;
         }
         let (mut care, mut value) = self.sub_masks(ia, ib);
-        if let Some((ma, mb)) = self.view.mirror_pair(ia, ib) {
+        if let (Some(Fine::Words(_)), Some((ma, mb))) = (self.sub, self.view.mirror_pair(ia, ib)) {
             let (c, v) = self.sub_masks(ma, mb);
-            let mirror = |m: u64| match self.sub {
-                Some(Fine::Words(_)) => m,
-                _ => mirror_sub_cells(m),
-            };
-            (care, value) = (care | mirror(c), value | mirror(v));
+            (care, value) = (care | c, value | v);
         }
         self.leaf(care, value)
     }
@@ -305,12 +301,6 @@ fn block_samples(dense: &[u32], k: usize, side: usize, c: [usize; 3]) -> Vec<usi
         }
     }
     out
-}
-
-/// A sub-cell mask of a pair mapped to its mirror pair's (`y -> -y` flips the y octant bit of
-/// both robots: child index bits 4 and 1).
-pub(super) fn mirror_sub_cells(mask: u64) -> u64 {
-    (0..64).filter(|&c| mask >> c & 1 == 1).fold(0, |m, c| m | 1 << (c ^ 0b01_0010))
 }
 
 impl SharedQuadtree6d {
