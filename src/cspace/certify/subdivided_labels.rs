@@ -11,6 +11,9 @@ use rayon::prelude::*;
 use super::{sub_cell_index, CertifiedSpace, SubCells};
 
 
+/// Per sample of a grid: the index of its mirror sample (`iy -> k - 1 - iy`), if sampled.
+type Mirrors = Vec<Option<usize>>;
+
 /// The labels a subdivided labelling ([`label_space_subdivided`]) stands for, on the grid of
 /// `2k` cells per axis (the octants of the `k` grid), found pair by pair: a sub-cell takes
 /// its pair's label, or, for a pair with sub-cells, its own ("don't care" outside `care`). A
@@ -34,7 +37,7 @@ pub struct SubdividedLabels<'a> {
     /// `sub.pairs[row_start[ia]..row_start[ia + 1]]` are the pairs of A's sample `ia` at `k`.
     row_start: Vec<usize>,
     /// For a symmetric cell, per sample at `k` of A, then of B: its mirror sample, if any.
-    mirrors: Option<(Vec<Option<usize>>, Vec<Option<usize>>)>,
+    mirrors: Option<(Mirrors, Mirrors)>,
 }
 
 impl<'a> SubdividedLabels<'a> {
