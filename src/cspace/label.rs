@@ -350,51 +350,31 @@ pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, rows: Ro
 where
     F: Fn(usize, usize) -> bool + Sync,
 {
-    let (na, nb) = (a.len(), b.len());
-    let base: Vec<Label> = b
-        .slot
-        .iter()
-        .map(|s| match s {
-            Slot::Boxes | Slot::Vacuous => Label::Free,
-            Slot::Unreachable => Label::Unreachable,
-            Slot::Unknown => Label::Collision,
-        })
-        .collect();
-    // B's entries with boxes, sorted by the lower x of their AABB.
-    let mut order: Vec<u32> = (0..nb as u32).filter(|&i| b.slot[i as usize] == Slot::Boxes).collect();
-    order.sort_by(|&i, &j| b.lo[i as usize][0].total_cmp(&b.lo[j as usize][0]));
-    let keys: Vec<Real> = order.iter().map(|&i| b.lo[i as usize][0]).collect();
-    let widest = order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
-    // The same entries stored in that order: a row's candidates are read in memory order.
-    let sorted = b.subset(&order);
+    label_rows_except(&RowLabeller::new(b), a, second_look, rows, progress, |_| false)
+}
+
+/// As [`label_pairs`] with B's side made once (`labeller`), leaving the rows of A that `skip`
+/// names as `Collision` without testing them (the caller fills them).
+pub(crate) fn label_rows_except<F>(
+    labeller: &RowLabeller,
+    a: &SampleBoxes,
+    second_look: F,
+    rows: Rows,
+    progress: Progress,
+    skip: impl Fn(usize) -> bool + Sync,
+) -> Vec<Label>
+where
+    F: Fn(usize, usize) -> bool + Sync,
+{
+    let nb = labeller.base.len();
     let rows_done = AtomicU64::new(0);
-    let labelled = rows.count(na);
-    let mut labels = vec![Label::Unreachable; labelled * nb];
+    let labelled = rows.count(a.len());
+    let mut labels = vec![Label::Collision; labelled * nb];
     if nb > 0 {
         labels.par_chunks_mut(nb).enumerate().for_each(|(j, row)| {
             let ia = rows.row(j);
-            match a.slot[ia] {
-                Slot::Unreachable => {}
-                Slot::Vacuous => row
-                    .iter_mut()
-                    .zip(&base)
-                    .for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Free }),
-                Slot::Unknown => row
-                    .iter_mut()
-                    .zip(&base)
-                    .for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Collision }),
-                Slot::Boxes => {
-                    row.copy_from_slice(&base);
-                    let (lo, hi) = (a.lo[ia][0], a.hi[ia][0]);
-                    let first = keys.partition_point(|&x| x < lo - widest - AABB_SLACK);
-                    let last = keys.partition_point(|&x| x <= hi + AABB_SLACK).max(first);
-                    for (k, &ib) in order.iter().enumerate().take(last).skip(first) {
-                        let ib = ib as usize;
-                        if entries_collide(a, ia, &sorted, k) && second_look(ia, ib) {
-                            row[ib] = Label::Collision;
-                        }
-                    }
-                }
+            if !skip(ia) {
+                labeller.row(a, ia, &second_look, row);
             }
             if let Progress::Rows(report) = progress {
                 report(rows_done.fetch_add(1, Ordering::Relaxed) + 1, labelled as u64);
@@ -402,6 +382,69 @@ where
         });
     }
     labels
+}
+
+/// What labelling one row of A against every entry of B needs from B alone: each entry's
+/// label when nothing of A meets it, and B's entries with boxes sorted by the lower x of
+/// their AABB (stored in that order, so that a row's candidates are read in memory order).
+pub(crate) struct RowLabeller {
+    base: Vec<Label>,
+    order: Vec<u32>,
+    keys: Vec<Real>,
+    widest: Real,
+    sorted: SampleBoxes,
+}
+
+impl RowLabeller {
+    /// B's side of the labelling.
+    pub(crate) fn new(b: &SampleBoxes) -> RowLabeller {
+        let base: Vec<Label> = b
+            .slot
+            .iter()
+            .map(|s| match s {
+                Slot::Boxes | Slot::Vacuous => Label::Free,
+                Slot::Unreachable => Label::Unreachable,
+                Slot::Unknown => Label::Collision,
+            })
+            .collect();
+        let mut order: Vec<u32> = (0..b.len() as u32).filter(|&i| b.slot[i as usize] == Slot::Boxes).collect();
+        order.sort_by(|&i, &j| b.lo[i as usize][0].total_cmp(&b.lo[j as usize][0]));
+        let keys: Vec<Real> = order.iter().map(|&i| b.lo[i as usize][0]).collect();
+        let widest = order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
+        let sorted = b.subset(&order);
+        RowLabeller { base, order, keys, widest, sorted }
+    }
+
+    /// The labels of A's entry `ia` with every entry of B, into `row` ([`label_pairs`]).
+    pub(crate) fn row<F>(&self, a: &SampleBoxes, ia: usize, second_look: &F, row: &mut [Label])
+    where
+        F: Fn(usize, usize) -> bool,
+    {
+        let base = &self.base;
+        match a.slot[ia] {
+            Slot::Unreachable => row.fill(Label::Unreachable),
+            Slot::Vacuous => row
+                .iter_mut()
+                .zip(base)
+                .for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Free }),
+            Slot::Unknown => row
+                .iter_mut()
+                .zip(base)
+                .for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Collision }),
+            Slot::Boxes => {
+                row.copy_from_slice(base);
+                let (lo, hi) = (a.lo[ia][0], a.hi[ia][0]);
+                let first = self.keys.partition_point(|&x| x < lo - self.widest - AABB_SLACK);
+                let last = self.keys.partition_point(|&x| x <= hi + AABB_SLACK).max(first);
+                for (k, &ib) in self.order.iter().enumerate().take(last).skip(first) {
+                    let ib = ib as usize;
+                    if entries_collide(a, ia, &self.sorted, k) && second_look(ia, ib) {
+                        row[ib] = Label::Collision;
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Robot `i` of a two-robot cell with `margin` added to its model's margin.

@@ -55,14 +55,18 @@
 //! stored half only ([`stored_half`]): a sub-cell proved free is a proof for every
 //! configuration of it, and the reflection maps those configurations onto the mirror
 //! sub-cell's while it maps the two robots onto themselves, so no configuration of the
-//! mirror sub-cell collides either (thesis Lemma 3.2.1). The proof does not use the mirror
+//! mirror sub-cell collides either (thesis Lemma 3.2.1); likewise a sub-cell proved to hold
+//! no reachable TCP ("don't care") mirrors to one without any. The proof does not use the mirror
 //! pair's own tests; finding them too would only make more sub-cells collisions where the
-//! rounding of the mirror's boxes differs. The reflection is exact up to the placement's
+//! rounding of the mirror's boxes differs. For the same reason the whole-cell labels (levels
+//! 1 and 2) of a lower-half sample are its mirror sample's with B's samples reflected
+//! ([`MirrorRows`], when every B sample has its mirror): a shard whose rows' mirrors lie in
+//! other shards labels those mirror rows itself, so that every shard, and a build in one
+//! piece, gives each row the same labels. The reflection is exact up to the placement's
 //! `alpha`, which [`reflection_y`](crate::cspace::symmetry::reflection_y) allows to differ from
-//! 0 or pi by `1e-12` rad: that moves B's boxes by under `1e-8` mm within 5 m of its base,
+//! 0 or pi by `1e-12` rad: that moves B's boxes by at most `1e-8` mm within 5 m of its base,
 //! far inside the `1e-6` mm gap every separating axis of a proof keeps
-//! ([`crate::geometry::sweep`], `SWEEP_GAP`). The whole-cell labels are still found for
-//! every pair (they cost a fifth of a build) and merged with their mirror's by the tables.
+//! ([`crate::geometry::sweep`], `SWEEP_GAP`).
 //!
 //! This file runs the labelling; `sweeps.rs` makes the displacement sets of cells and
 //! octants, `refine.rs` holds levels 2 and 3 and the sub-cell labels, and, for the report
@@ -80,13 +84,18 @@ pub use subdivided_labels::SubdividedLabels;
 
 use crate::cell::{Cell, RobotSpec};
 use crate::cspace::guarantee::SPLITS;
-use crate::cspace::label::{entries_collide, label_pairs, two_robot_grids, Inflation, Progress, Rows, SampleBoxes};
+use crate::cspace::label::{
+    entries_collide, label_pairs, label_rows_except, two_robot_grids, Inflation, Progress, RowLabeller, Rows, SampleBoxes,
+};
+use crate::cspace::symmetry::{mirror_cell, reflection_y};
+use crate::cspace::Label;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::LabelledSpace;
 use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
-use refine::{octants_prove_free, refine_unknown_cells, sub_cell_masks, sub_cells, Levels, SubOctants};
+use rayon::prelude::*;
+use refine::{octants_prove_free, refine_unknown_cells, sub_cell_masks, sub_cells, Levels, SubOctants, UnknownCells};
 use sweeps::{cell_sweeps, inflation, octants, reference_octants, references, unreachable_cells};
 
 
@@ -146,8 +155,56 @@ impl SubCells {
 /// stores (`iy >= k/2`): only their sub-cells are found (module doc, "Symmetric cells").
 /// `None` for a cell without it: every sample's are.
 pub(crate) fn stored_half(cell: &Cell, grid_a: &SampleGrid) -> Option<Vec<bool>> {
-    let mirrored = crate::cspace::symmetry::reflection_y(cell);
-    mirrored.then(|| grid_a.cells.iter().map(|c| u32::from(c[1]) >= grid_a.k / 2).collect())
+    reflection_y(cell).then(|| grid_a.cells.iter().map(|c| u32::from(c[1]) >= grid_a.k / 2).collect())
+}
+
+/// For a cell with the reflection `y -> -y` whose B samples all have their mirror sample:
+/// the mirror of each B sample, and of each A sample outside the half a table stores (when
+/// sampled). Those rows of A take their mirror rows' labels, B's samples reflected (module
+/// doc, "Symmetric cells").
+struct MirrorRows {
+    /// Per A sample: its mirror when it lies outside the stored half, else `None`.
+    a: Vec<Option<usize>>,
+    /// Per B sample: its mirror.
+    b: Vec<usize>,
+}
+
+impl MirrorRows {
+    /// `None` for a cell without the reflection or a B sample without its mirror.
+    fn of(cell: &Cell, grid_a: &SampleGrid, grid_b: &SampleGrid) -> Option<MirrorRows> {
+        if !reflection_y(cell) {
+            return None;
+        }
+        let b = grid_b.cells.iter().map(|&c| grid_b.index_of(mirror_cell(grid_b, c))).collect::<Option<Vec<_>>>()?;
+        let lower = |c: &[u16; 3]| u32::from(c[1]) < grid_a.k / 2;
+        let a = grid_a.cells.iter().map(|c| lower(c).then(|| grid_a.index_of(mirror_cell(grid_a, *c))).flatten()).collect();
+        Some(MirrorRows { a, b })
+    }
+
+    /// Writes each reflected row of `labels` (the rows `rows` of A, `nb` labels each) from its
+    /// mirror row, read from `labels` when `rows` holds it and labelled by `row_of` otherwise
+    /// (the rows of a shard): label `(ia, ib)` is that of `(a[ia], b[ib])`.
+    fn fill(&self, labels: &mut [Label], rows: Rows, row_of: impl Fn(usize) -> Vec<Label> + Sync) {
+        let (count, nb) = (rows.count(self.a.len()), self.b.len());
+        let step = rows.step.max(1);
+        let index = |ia: usize| (ia >= rows.first && (ia - rows.first) % step == 0).then(|| (ia - rows.first) / step);
+        let outside: Vec<(usize, Vec<Label>)> = (0..count)
+            .into_par_iter()
+            .filter_map(|j| self.a[rows.row(j)].filter(|&m| index(m).is_none()).map(|m| (j, row_of(m))))
+            .collect();
+        let mut outside = outside.into_iter().peekable();
+        let mut source = vec![Label::Collision; nb];
+        for j in 0..count {
+            let Some(m) = self.a[rows.row(j)] else { continue };
+            match index(m) {
+                Some(jm) => source.copy_from_slice(&labels[jm * nb..(jm + 1) * nb]),
+                None => source = outside.next_if(|(k, _)| *k == j).expect("labelled above").1,
+            }
+            for (l, &mb) in labels[j * nb..(j + 1) * nb].iter_mut().zip(&self.b) {
+                *l = source[mb];
+            }
+        }
+    }
 }
 
 /// The child index of A's octant `i` and B's octant `j` (octant bits x, y, z = 0, 1, 2).
@@ -320,9 +377,22 @@ pub(crate) fn certify_rows_then<R>(
         (la.subs, lb.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
     }
     let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
-    let mut labels = label_pairs(&a0, &b0, collides, rows, progress);
-    refine_unknown_cells(&la, &lb, &mut labels, rows);
-    drop((xa, xb));
+    // A symmetric cell's lower half takes its mirror rows' labels (module doc, "Symmetric cells").
+    let mirror = MirrorRows::of(cell, &grid_a, &grid_b);
+    let reflected = |ia: usize| mirror.as_ref().is_some_and(|m| m.a[ia].is_some());
+    let labeller = RowLabeller::new(&b0);
+    let mut labels = label_rows_except(&labeller, &a0, collides, rows, progress, reflected);
+    refine_unknown_cells(&la, &lb, &mut labels, rows, reflected);
+    if let Some(m) = &mirror {
+        let unknown = UnknownCells::new(&la, &lb);
+        m.fill(&mut labels, rows, |ia| {
+            let mut row = vec![Label::Collision; b0.len()];
+            labeller.row(&a0, ia, &collides, &mut row);
+            unknown.refine_row(&la, &lb, ia, &mut row);
+            row
+        });
+    }
+    drop((xa, xb, labeller));
     let (ga, gb) = (grid_a.clone(), grid_b.clone());
     if subdivide && defer_sub {
         let mut source = SubCellSource { a: la, b: lb };
@@ -392,6 +462,28 @@ mod tests {
         };
         let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
         (whole(ra, &grid_a), octant_boxes(ra, &grid_a), whole(rb, &grid_b), octant_boxes(rb, &grid_b))
+    }
+
+    /// The labels of A's lower half taken from the mirror rows ([`MirrorRows`]) are those the
+    /// rows' own tests give: on the symmetric T1 and T2 at k = 16, every label of a certified
+    /// labelling equals the one found by levels 1 and 2 on its own row, with no row reflected
+    /// (every reflected row is checked: a third of the rows or more).
+    #[test]
+    fn mirror_rows_give_the_labels_of_their_own_tests() {
+        for name in ["T1", "T2"] {
+            let cell = reference_cell(name).unwrap();
+            let c = label_space_certified(&cell, 16, &Workspace::THESIS, Progress::Silent).unwrap();
+            let (ga, gb) = (&c.space.grid_a, &c.space.grid_b);
+            let mirror = MirrorRows::of(&cell, ga, gb).expect("T1 and T2 are symmetric");
+            let reflected = mirror.a.iter().filter(|m| m.is_some()).count();
+            assert!(3 * reflected >= ga.cells.len(), "{name}: {reflected} rows reflected");
+            let (a0, a1, b0, b1) = level_boxes(&cell, 16);
+            let (la, lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
+            let mut own = label_pairs(&a0, &b0, |ia, ib| !octants_prove_free(&la, &lb, ia, ib), Rows::ALL, Progress::Silent);
+            refine_unknown_cells(&la, &lb, &mut own, Rows::ALL, |_| false);
+            let differ = own.iter().zip(&c.space.labels).filter(|(o, l)| o != l).count();
+            assert_eq!(differ, 0, "{name}: {differ} labels differ");
+        }
     }
 
     /// Reference cell `name` at k = 16 with both robots' sample grids and their whole-cell and

@@ -597,31 +597,59 @@ pub(super) fn octants_prove_free(a: &Levels, b: &Levels, ia: usize, ib: usize) -
 
 /// Level 2 for the pairs that [`label_pairs`] made collisions because a sample has no
 /// whole-cell bound ([`Slot::Unknown`]): each is retried octant by octant (`labels` holds the
-/// rows `rows` of A).
-pub(super) fn refine_unknown_cells(a: &Levels, b: &Levels, labels: &mut [Label], rows: Rows) {
-    let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
-    let unknown_b: Vec<usize> = (0..b0.len()).filter(|&ib| b0.slot[ib] == Slot::Unknown).collect();
-    let (cover_a, cover_b) = (octant_covers(a1), octant_covers(b1));
-    let nb = b0.len();
+/// rows `rows` of A; those that `skip` names are left as they are).
+pub(super) fn refine_unknown_cells(
+    a: &Levels,
+    b: &Levels,
+    labels: &mut [Label],
+    rows: Rows,
+    skip: impl Fn(usize) -> bool + Sync,
+) {
+    let nb = b.whole.len();
     if nb == 0 {
         return;
     }
+    let unknown = UnknownCells::new(a, b);
     labels.par_chunks_mut(nb).enumerate().for_each(|(j, row)| {
         let ia = rows.row(j);
+        if !skip(ia) {
+            unknown.refine_row(a, b, ia, row);
+        }
+    });
+}
+
+/// What [`refine_unknown_cells`] needs once: B's samples without a whole-cell bound and both
+/// robots' octant covers.
+pub(super) struct UnknownCells {
+    unknown_b: Vec<usize>,
+    cover_a: Vec<Option<([Real; 3], [Real; 3])>>,
+    cover_b: Vec<Option<([Real; 3], [Real; 3])>>,
+}
+
+impl UnknownCells {
+    pub(super) fn new(a: &Levels, b: &Levels) -> UnknownCells {
+        let b0 = b.whole;
+        let unknown_b = (0..b0.len()).filter(|&ib| b0.slot[ib] == Slot::Unknown).collect();
+        UnknownCells { unknown_b, cover_a: octant_covers(a.octs), cover_b: octant_covers(b.octs) }
+    }
+
+    /// [`refine_unknown_cells`] on the row of A's sample `ia`.
+    pub(super) fn refine_row(&self, a: &Levels, b: &Levels, ia: usize, row: &mut [Label]) {
+        let (a0, b0) = (a.whole, b.whole);
         let mut retry = |ib: usize| {
             if row[ib] == Label::Collision
                 && b0.slot[ib] != Slot::Unreachable
-                && (cover_apart(&cover_a[ia], &cover_b[ib]) || octants_prove_free(a, b, ia, ib))
+                && (cover_apart(&self.cover_a[ia], &self.cover_b[ib]) || octants_prove_free(a, b, ia, ib))
             {
                 row[ib] = Label::Free;
             }
         };
         match a0.slot[ia] {
-            Slot::Unknown => (0..nb).for_each(&mut retry),
-            Slot::Boxes => unknown_b.iter().for_each(|&ib| retry(ib)),
+            Slot::Unknown => (0..b0.len()).for_each(&mut retry),
+            Slot::Boxes => self.unknown_b.iter().for_each(|&ib| retry(ib)),
             Slot::Unreachable | Slot::Vacuous => {}
         }
-    });
+    }
 }
 
 /// Per sample: the AABB of its 8 octants' boxes (empty when every octant is vacuous), or

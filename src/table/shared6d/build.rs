@@ -155,8 +155,8 @@ impl Builder<'_> {
 
     /// Fetches the sub-cells of the block (depth `d`, block coordinates `a`, `b`) from the
     /// stream: those of its pairs labelled collision, the ones
-    /// [`subdivided_cell`](Self::subdivided_cell) looks up inside the block (a block lies in
-    /// the stored half, and a pair's sub-cells are its own, not merged with its mirror's).
+    /// [`subdivided_cell`](Self::subdivided_cell) looks up inside the block (under symmetry
+    /// too: a pair's sub-cells are its own, not merged with its mirror pair's).
     fn fetch_block(&mut self, d: u32, a: [usize; 3], b: [usize; 3]) {
         let side = self.k >> d;
         let in_a = block_samples(&self.dense_a, self.k, side, a);
@@ -198,8 +198,8 @@ impl Builder<'_> {
     /// The part of one cell pair cut into its 64 sub-cells ([`SubCells`]). Under symmetry the
     /// sub-cells are the stored pair's own: a labelling finds them for the stored half only,
     /// its proofs holding for the mirror pair by the cell's symmetry (`crate::cspace::certify`,
-    /// module doc, "Symmetric cells"). A clearance table's words merge with the mirror pair's
-    /// as [`SpaceView::label`] merges labels (the smaller level wins).
+    /// module doc, "Symmetric cells"). A clearance table's words ([`Fine::Words`]) merge with
+    /// the mirror pair's, unpermuted.
     fn subdivided_cell(&mut self, ca: [usize; 3], cb: [usize; 3]) -> Part {
         let (part, Some((ia, ib))) = self.cell(ca, cb) else { return Part::DontCare };
         if part != Part::Collision {
