@@ -192,13 +192,18 @@ impl MirrorRows {
             .into_par_iter()
             .filter_map(|j| self.a[rows.row(j)].filter(|&m| index(m).is_none()).map(|m| (j, row_of(m))))
             .collect();
-        let mut outside = outside.into_iter().peekable();
+        // In the order of `j`, as the loop below takes them.
+        let mut outside = outside.into_iter();
         let mut source = vec![Label::Collision; nb];
         for j in 0..count {
             let Some(m) = self.a[rows.row(j)] else { continue };
             match index(m) {
                 Some(jm) => source.copy_from_slice(&labels[jm * nb..(jm + 1) * nb]),
-                None => source = outside.next_if(|(k, _)| *k == j).expect("labelled above").1,
+                // A row left out stays all collisions (`label_rows_except`).
+                None => match outside.next() {
+                    Some((_, row)) => source = row,
+                    None => continue,
+                },
             }
             for (l, &mb) in labels[j * nb..(j + 1) * nb].iter_mut().zip(&self.b) {
                 *l = source[mb];
