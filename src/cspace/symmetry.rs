@@ -20,6 +20,7 @@ use crate::cell::Cell;
 use crate::cspace::sampler::{CellIndex, SampleGrid};
 use crate::math::{float, Real};
 use core::f64::consts::PI;
+use alloc::vec::Vec;
 
 /// How far `alpha` may be from 0 or pi (rad) and still count as symmetric.
 pub const ALPHA_TOLERANCE: Real = 1e-12;
@@ -72,6 +73,17 @@ impl Symmetry {
 /// The mirror `(ix, k - 1 - iy, iz)` of a grid cell under `y -> -y`.
 pub fn mirror_cell(grid: &SampleGrid, cell: CellIndex) -> CellIndex {
     [cell[0], (grid.k - 1) as u16 - cell[1], cell[2]]
+}
+
+/// Per sample of `grid`: the index of its mirror sample ([`mirror_cell`]), when sampled.
+pub fn mirror_samples(grid: &SampleGrid) -> Vec<Option<usize>> {
+    grid.cells.iter().map(|&c| grid.index_of(mirror_cell(grid, c))).collect()
+}
+
+/// Whether a grid cell lies in the half that a table of a mirror-symmetric cell stores
+/// (`iy >= k/2`: TCP `y >= 0`, the grid's y origin being `-k r / 2`).
+pub fn in_stored_half(grid: &SampleGrid, cell: CellIndex) -> bool {
+    u32::from(cell[1]) >= grid.k / 2
 }
 
 /// Whether the sampled cells of `grid` are closed under `y -> -y` (every mirror is sampled).

@@ -16,6 +16,8 @@ use super::code::MAX_LEVELS;
 #[cfg(feature = "std")]
 use super::error::{bad_input, TableError};
 #[cfg(feature = "std")]
+use crate::cspace::symmetry::in_stored_half;
+#[cfg(feature = "std")]
 use crate::cspace::{Label, LabelledSpace, SampleGrid};
 
 #[cfg(feature = "std")]
@@ -100,7 +102,8 @@ impl<'a> SpaceView<'a> {
     /// Whether A's sample `ia` is in the stored half (always, without symmetry).
     #[inline]
     pub fn stored(&self, ia: usize) -> bool {
-        !self.symmetric || u32::from(self.space.grid_a.cells[ia][1]) >= self.k / 2
+        let grid_a = &self.space.grid_a;
+        !self.symmetric || in_stored_half(grid_a, grid_a.cells[ia])
     }
 
     /// The label stored for the pair `(ia, ib)` of the stored half: merged with its mirror.

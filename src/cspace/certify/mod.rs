@@ -87,7 +87,7 @@ use crate::cspace::guarantee::SPLITS;
 use crate::cspace::label::{
     entries_collide, label_pairs, label_rows_except, two_robot_grids, Inflation, Progress, RowLabeller, Rows, SampleBoxes,
 };
-use crate::cspace::symmetry::{mirror_cell, reflection_y};
+use crate::cspace::symmetry::{in_stored_half, mirror_samples, reflection_y};
 use crate::cspace::Label;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::LabelledSpace;
@@ -155,7 +155,7 @@ impl SubCells {
 /// stores (`iy >= k/2`): only their sub-cells are found (module doc, "Symmetric cells").
 /// `None` for a cell without it: every sample's are.
 pub(crate) fn stored_half(cell: &Cell, grid_a: &SampleGrid) -> Option<Vec<bool>> {
-    reflection_y(cell).then(|| grid_a.cells.iter().map(|c| u32::from(c[1]) >= grid_a.k / 2).collect())
+    reflection_y(cell).then(|| grid_a.cells.iter().map(|&c| in_stored_half(grid_a, c)).collect())
 }
 
 /// For a cell with the reflection `y -> -y` whose B samples all have their mirror sample:
@@ -175,10 +175,9 @@ impl MirrorRows {
         if !reflection_y(cell) {
             return None;
         }
-        let b = grid_b.cells.iter().map(|&c| grid_b.index_of(mirror_cell(grid_b, c))).collect::<Option<Vec<_>>>()?;
-        let lower = |c: &[u16; 3]| u32::from(c[1]) < grid_a.k / 2;
-        let a = grid_a.cells.iter().map(|c| lower(c).then(|| grid_a.index_of(mirror_cell(grid_a, *c))).flatten()).collect();
-        Some(MirrorRows { a, b })
+        let b = mirror_samples(grid_b).into_iter().collect::<Option<Vec<_>>>()?;
+        let a = grid_a.cells.iter().zip(mirror_samples(grid_a)).map(|(&c, m)| m.filter(|_| !in_stored_half(grid_a, c)));
+        Some(MirrorRows { a: a.collect(), b })
     }
 
     /// Writes each reflected row of `labels` (the rows `rows` of A, `nb` labels each) from its
@@ -387,9 +386,9 @@ pub(crate) fn certify_rows_then<R>(
     let reflected = |ia: usize| mirror.as_ref().is_some_and(|m| m.a[ia].is_some());
     let labeller = RowLabeller::new(&b0);
     let mut labels = label_rows_except(&labeller, &a0, collides, rows, progress, reflected);
-    refine_unknown_cells(&la, &lb, &mut labels, rows, reflected);
+    let unknown = UnknownCells::new(&la, &lb);
+    refine_unknown_cells(&la, &lb, &unknown, &mut labels, rows, reflected);
     if let Some(m) = &mirror {
-        let unknown = UnknownCells::new(&la, &lb);
         m.fill(&mut labels, rows, |ia| {
             let mut row = vec![Label::Collision; b0.len()];
             labeller.row(&a0, ia, &collides, &mut row);
@@ -397,7 +396,7 @@ pub(crate) fn certify_rows_then<R>(
             row
         });
     }
-    drop((xa, xb, labeller));
+    drop((xa, xb, labeller, unknown));
     let (ga, gb) = (grid_a.clone(), grid_b.clone());
     if subdivide && defer_sub {
         let mut source = SubCellSource { a: la, b: lb };
@@ -485,7 +484,7 @@ mod tests {
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let (la, lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
             let mut own = label_pairs(&a0, &b0, |ia, ib| !octants_prove_free(&la, &lb, ia, ib), Rows::ALL, Progress::Silent);
-            refine_unknown_cells(&la, &lb, &mut own, Rows::ALL, |_| false);
+            refine_unknown_cells(&la, &lb, &UnknownCells::new(&la, &lb), &mut own, Rows::ALL, |_| false);
             let differ = own.iter().zip(&c.space.labels).filter(|(o, l)| o != l).count();
             assert_eq!(differ, 0, "{name}: {differ} labels differ");
         }

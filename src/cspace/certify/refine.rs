@@ -601,6 +601,7 @@ pub(super) fn octants_prove_free(a: &Levels, b: &Levels, ia: usize, ib: usize) -
 pub(super) fn refine_unknown_cells(
     a: &Levels,
     b: &Levels,
+    unknown: &UnknownCells,
     labels: &mut [Label],
     rows: Rows,
     skip: impl Fn(usize) -> bool + Sync,
@@ -609,7 +610,6 @@ pub(super) fn refine_unknown_cells(
     if nb == 0 {
         return;
     }
-    let unknown = UnknownCells::new(a, b);
     labels.par_chunks_mut(nb).enumerate().for_each(|(j, row)| {
         let ia = rows.row(j);
         if !skip(ia) {

@@ -5,7 +5,7 @@
 use crate::cell::Cell;
 use crate::cspace::label::two_robot_grids;
 use crate::cspace::sampler::{SampleGrid, Workspace};
-use crate::cspace::symmetry::{mirror_cell, reflection_y};
+use crate::cspace::symmetry::{mirror_samples, reflection_y};
 use crate::cspace::{Label, LabelledSpace};
 use rayon::prelude::*;
 use super::{sub_cell_index, CertifiedSpace, SubCells};
@@ -60,10 +60,7 @@ impl<'a> SubdividedLabels<'a> {
         let nb0 = coarse.grid_b.cells.len() as u64;
         let row_start =
             (0..=coarse.grid_a.cells.len() as u64).map(|ia| sub.pairs.partition_point(|&p| p < ia * nb0)).collect();
-        let mirrors = reflection_y(cell).then(|| {
-            let of = |g: &SampleGrid| g.cells.iter().map(|&c| g.index_of(mirror_cell(g, c))).collect();
-            (of(&coarse.grid_a), of(&coarse.grid_b))
-        });
+        let mirrors = reflection_y(cell).then(|| (mirror_samples(&coarse.grid_a), mirror_samples(&coarse.grid_b)));
         Ok(SubdividedLabels { coarse, sub, grid_a, grid_b, parent_a, parent_b, row_start, mirrors })
     }
 
@@ -136,6 +133,7 @@ mod tests {
     use super::*;
     use crate::cell::reference::reference_cell;
     use crate::cspace::certify::label_space_subdivided;
+    use crate::cspace::symmetry::mirror_cell;
     use crate::cspace::Progress;
 
     /// The `2k` labels of a subdivided labelling: every sub-cell of a collision pair as its
