@@ -45,7 +45,9 @@ pub(crate) fn merge(a: Label, b: Label) -> Label {
     }
 }
 
-/// For each sample of `g`, the index of its mirror sample (`iy -> k-1-iy`), or `NONE`.
+/// For each sample of `g`, the index of its mirror sample (`iy -> k-1-iy`), or `NONE`. By a
+/// dense map rather than [`crate::cspace::symmetry::mirror_samples`]' binary searches: a
+/// table's grids need not list their cells in order ([`check_grids`] does not ask it).
 #[cfg(feature = "std")]
 pub(crate) fn reflections(g: &SampleGrid) -> Vec<u32> {
     let k = g.k as usize;

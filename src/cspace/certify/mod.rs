@@ -85,7 +85,8 @@ pub use subdivided_labels::SubdividedLabels;
 use crate::cell::{Cell, RobotSpec};
 use crate::cspace::guarantee::SPLITS;
 use crate::cspace::label::{
-    entries_collide, label_pairs, label_rows_except, two_robot_grids, Inflation, Progress, RowLabeller, Rows, SampleBoxes,
+    entries_collide, label_pairs, label_rows_except, two_robot_grids, Inflation, Progress, RowLabeller, Rows,
+    SampleBoxes,
 };
 use crate::cspace::symmetry::{in_stored_half, mirror_samples, reflection_y};
 use crate::cspace::Label;
@@ -185,22 +186,20 @@ impl MirrorRows {
     /// (the rows of a shard): label `(ia, ib)` is that of `(a[ia], b[ib])`.
     fn fill(&self, labels: &mut [Label], rows: Rows, row_of: impl Fn(usize) -> Vec<Label> + Sync) {
         let (count, nb) = (rows.count(self.a.len()), self.b.len());
-        let step = rows.step.max(1);
-        let index = |ia: usize| (ia >= rows.first && (ia - rows.first) % step == 0).then(|| (ia - rows.first) / step);
-        let outside: Vec<(usize, Vec<Label>)> = (0..count)
+        let outside: Vec<Vec<Label>> = (0..count)
             .into_par_iter()
-            .filter_map(|j| self.a[rows.row(j)].filter(|&m| index(m).is_none()).map(|m| (j, row_of(m))))
+            .filter_map(|j| self.a[rows.row(j)].filter(|&m| rows.index_of(m).is_none()).map(&row_of))
             .collect();
         // In the order of `j`, as the loop below takes them.
         let mut outside = outside.into_iter();
         let mut source = vec![Label::Collision; nb];
         for j in 0..count {
             let Some(m) = self.a[rows.row(j)] else { continue };
-            match index(m) {
+            match rows.index_of(m) {
                 Some(jm) => source.copy_from_slice(&labels[jm * nb..(jm + 1) * nb]),
                 // A row left out stays all collisions (`label_rows_except`).
                 None => match outside.next() {
-                    Some((_, row)) => source = row,
+                    Some(row) => source = row,
                     None => continue,
                 },
             }
@@ -483,7 +482,8 @@ mod tests {
             assert!(3 * reflected >= ga.cells.len(), "{name}: {reflected} rows reflected");
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let (la, lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
-            let mut own = label_pairs(&a0, &b0, |ia, ib| !octants_prove_free(&la, &lb, ia, ib), Rows::ALL, Progress::Silent);
+            let collides = |ia, ib| !octants_prove_free(&la, &lb, ia, ib);
+            let mut own = label_pairs(&a0, &b0, collides, Rows::ALL, Progress::Silent);
             refine_unknown_cells(&la, &lb, &UnknownCells::new(&la, &lb), &mut own, Rows::ALL, |_| false);
             let differ = own.iter().zip(&c.space.labels).filter(|(o, l)| o != l).count();
             assert_eq!(differ, 0, "{name}: {differ} labels differ");
@@ -625,7 +625,8 @@ mod tests {
             let nb = b0.len();
             let collisions = labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision);
             let decided = collisions.filter(|&(p, _)| held_by_references(&fa, &fb, p / nb, p % nb) != 0).count();
-            let (fast, plain) = (sub_cells(&fa, &fb, &labels, Rows::ALL, |_| true), sub_cells(&pa, &pb, &labels, Rows::ALL, |_| true));
+            let fast = sub_cells(&fa, &fb, &labels, Rows::ALL, |_| true);
+            let plain = sub_cells(&pa, &pb, &labels, Rows::ALL, |_| true);
             assert!(fast == plain, "{name}: the references' exit changed sub-cells");
             assert!(decided > 1000, "{name}: {decided} of {} pairs decided by the references", fast.pairs.len());
         }
