@@ -193,6 +193,10 @@ pub struct SampleBoxes {
     pub slot: Vec<Slot>,
 }
 
+/// One entry of [`SampleBoxes`] made whole: its slot, each box with its bounds, and the
+/// entry's bounds (`lo`, `hi`).
+type EntryBoxes = (Slot, Vec<(SweptBox, SweptBounds)>, [Real; 3], [Real; 3]);
+
 impl SampleBoxes {
     /// The boxes of `model` placed by `placement` with the TCP at each of `centres` (MCS),
     /// enlarged as `inflate(s)` says; an unreachable centre gives [`Slot::Unreachable`].
@@ -201,23 +205,43 @@ impl SampleBoxes {
         F: Fn(usize) -> Inflation + Sync,
     {
         let nb = model.box_count();
-        let per: Vec<(Slot, Vec<(Obb, Sweep)>)> = centres
+        let empty = Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::zeros());
+        // Each entry whole (boxes, their bounds, the entry's bounds and slot) in parallel; only
+        // the copies into the flat arrays below are serial.
+        let per: Vec<EntryBoxes> = centres
             .par_iter()
             .enumerate()
-            .map(|(s, c)| match (inflate(s), model.boxes(c)) {
-                (Inflation::Vacuous, _) => (Slot::Vacuous, vec![]),
-                (Inflation::Unreachable, _) => (Slot::Unreachable, vec![]),
-                (Inflation::Unknown, _) => (Slot::Unknown, vec![]),
-                (_, Err(_)) => (Slot::Unreachable, vec![]),
-                (Inflation::Swept(sweeps), Ok(boxes)) => {
-                    let rot = placement.rotation();
-                    let b =
-                        boxes.as_slice().iter().zip(sweeps).map(|(b, s)| (placement.obb_to_wcs(b), s.rotated(&rot)));
-                    (Slot::Boxes, b.collect())
+            .map(|(s, c)| {
+                let (mut slot, boxes) = match (inflate(s), model.boxes(c)) {
+                    (Inflation::Vacuous, _) => (Slot::Vacuous, vec![]),
+                    (Inflation::Unreachable, _) => (Slot::Unreachable, vec![]),
+                    (Inflation::Unknown, _) => (Slot::Unknown, vec![]),
+                    (_, Err(_)) => (Slot::Unreachable, vec![]),
+                    (Inflation::Swept(sweeps), Ok(boxes)) => {
+                        let rot = placement.rotation();
+                        let b = boxes.as_slice().iter().zip(sweeps);
+                        (Slot::Boxes, b.map(|(b, s)| (placement.obb_to_wcs(b), s.rotated(&rot))).collect())
+                    }
+                };
+                let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
+                let swept = (0..nb)
+                    .map(|j| {
+                        let (b, sweep) = boxes.get(j).copied().unwrap_or((empty, Sweep::ZERO));
+                        let bounds = SweptBounds::new(&b, &sweep);
+                        for a in 0..3 {
+                            lo[a] = min_or_nan(lo[a], bounds.lo[a]);
+                            hi[a] = max_or_nan(hi[a], bounds.hi[a]);
+                        }
+                        (SweptBox::new(b, sweep), bounds)
+                    })
+                    .collect();
+                // A non-finite box or sweep proves nothing: every pair of the entry is a collision.
+                if slot == Slot::Boxes && !lo.iter().chain(&hi).all(|v| v.is_finite()) {
+                    slot = Slot::Unknown;
                 }
+                (slot, swept, lo, hi)
             })
             .collect();
-        let empty = Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::zeros());
         let n = centres.len();
         let mut out = SampleBoxes {
             per_entry: nb,
@@ -227,21 +251,10 @@ impl SampleBoxes {
             hi: Vec::with_capacity(n),
             slot: Vec::with_capacity(n),
         };
-        for (mut slot, boxes) in per {
-            let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
-            for j in 0..nb {
-                let (b, sweep) = boxes.get(j).copied().unwrap_or((empty, Sweep::ZERO));
-                let bounds = SweptBounds::new(&b, &sweep);
-                for a in 0..3 {
-                    lo[a] = min_or_nan(lo[a], bounds.lo[a]);
-                    hi[a] = max_or_nan(hi[a], bounds.hi[a]);
-                }
-                out.boxes.push(SweptBox::new(b, sweep));
+        for (slot, swept, lo, hi) in per {
+            for (b, bounds) in swept {
+                out.boxes.push(b);
                 out.bounds.push(bounds);
-            }
-            // A non-finite box or sweep proves nothing: every pair of the entry is a collision.
-            if slot == Slot::Boxes && !lo.iter().chain(&hi).all(|v| v.is_finite()) {
-                slot = Slot::Unknown;
             }
             out.lo.push(lo);
             out.hi.push(hi);
@@ -376,7 +389,9 @@ where
     let nb = labeller.base.len();
     let rows_done = AtomicU64::new(0);
     let labelled = rows.count(a.len());
-    let mut labels = vec![Label::Collision; labelled * nb];
+    // Written by both threads (`collect` of an indexed iterator fills its parts in place), so
+    // that the pages of a large build are first touched, and zeroed by the kernel, in parallel.
+    let mut labels: Vec<Label> = (0..labelled * nb).into_par_iter().map(|_| Label::Collision).collect();
     if nb > 0 {
         labels.par_chunks_mut(nb).enumerate().for_each(|(j, row)| {
             let ia = rows.row(j);

@@ -18,7 +18,8 @@ pub const FIXED_BYTES_PER_SAMPLE: u64 = 24_000;
 /// the node pool of the table being built (the size of the output, megabytes) and slack.
 pub const RESERVE_BYTES: u64 = 256 << 20;
 
-/// Bytes per pair of a block of a streamed subdivided build, counted twice as a margin: when
+/// Bytes per pair of a block of a streamed subdivided build (which holds two blocks at a time:
+/// the one the tree is in, and the next, found meanwhile), counted twice as a margin: when
 /// every pair is a collision (the worst case), the pair numbers while they are gathered,
 /// their masks and the block's [`crate::cspace::SubCells`] take `8 + 16 + 24` bytes a pair,
 /// and the estimate leaves out the sub-octant boxes a block makes beyond the cache.
@@ -83,7 +84,8 @@ pub fn plan_memory(na: u64, nb: u64, k: u32, variant: Variant, max: u64) -> Resu
     }
     let rest = max - fixed;
     let (block_depth, cache) = match variant {
-        Variant::SharedSubdivided => (block_depth(k, rest / 2), rest / 2),
+        // Half for the sub-octant cache, half for two blocks: the tree's and the next.
+        Variant::SharedSubdivided => (block_depth(k, rest / 4), rest / 2),
         _ => (0, 0),
     };
     Ok(MemoryPlan { fixed, labels, block_depth, cache })

@@ -33,6 +33,9 @@ pub(crate) struct SpaceView<'a> {
     refl_a: Vec<u32>,
     refl_b: Vec<u32>,
     nb: usize,
+    /// Whether every stored pair's label equals its mirror pair's (as the certified labelling
+    /// writes a symmetric cell's labels): then [`SpaceView::label`] need not read the mirror.
+    mirrored_exactly: bool,
 }
 
 /// Collision wins over free, free over unreachable.
@@ -98,7 +101,24 @@ impl<'a> SpaceView<'a> {
             )));
         }
         let (refl_a, refl_b) = if symmetric { (reflections(ga), reflections(gb)) } else { (vec![], vec![]) };
-        Ok(SpaceView { space, k: ga.k, levels: ga.levels, symmetric, refl_a, refl_b, nb })
+        let mut view = SpaceView { space, k: ga.k, levels: ga.levels, symmetric, refl_a, refl_b, nb, mirrored_exactly: false };
+        view.mirrored_exactly = symmetric && view.labels_equal_their_mirrors();
+        Ok(view)
+    }
+
+    /// Whether the label of every pair of the stored half that has a mirror pair equals the
+    /// mirror pair's (rows in parallel, each row's mirror read within one row of labels).
+    fn labels_equal_their_mirrors(&self) -> bool {
+        use rayon::prelude::*;
+        let labels = &self.space.labels;
+        (0..self.space.grid_a.cells.len()).into_par_iter().filter(|&ia| self.stored(ia)).all(|ia| {
+            let ra = self.refl_a[ia];
+            ra == NONE
+                || (0..self.nb).all(|ib| {
+                    let rb = self.refl_b[ib];
+                    rb == NONE || labels[ia * self.nb + ib] == labels[ra as usize * self.nb + rb as usize]
+                })
+        })
     }
 
     /// Whether A's sample `ia` is in the stored half (always, without symmetry).
@@ -112,7 +132,7 @@ impl<'a> SpaceView<'a> {
     #[inline]
     pub fn label(&self, ia: usize, ib: usize) -> Label {
         let own = self.space.labels[ia * self.nb + ib];
-        if !self.symmetric {
+        if !self.symmetric || self.mirrored_exactly {
             return own;
         }
         let (ra, rb) = (self.refl_a[ia], self.refl_b[ib]);
@@ -171,4 +191,35 @@ pub(crate) fn fold(cell: [u16; 6], k: u32, symmetric: bool) -> Option<[u16; 6]> 
         c[4] = top - c[4];
     }
     Some(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::table::synthetic::{space, Pattern};
+
+    /// A symmetric view answers each stored pair with its label merged with its mirror pair's,
+    /// whether it reads the mirror (labels that are not mirror images) or knows it need not
+    /// (labels that are).
+    #[test]
+    fn stored_labels_merge_with_their_mirrors_read_or_not() {
+        for (pattern, exact) in
+            [(Pattern::Noise { p: 0.3, seed: 5 }, true), (Pattern::AsymmetricNoise { p: 0.3, seed: 5 }, false)]
+        {
+            let s = space(3, pattern);
+            let view = SpaceView::new(&s, true).unwrap();
+            assert_eq!(view.mirrored_exactly, exact, "{pattern:?}");
+            let (mut merged, mut changed) = (0, 0);
+            for ia in (0..s.grid_a.cells.len()).filter(|&ia| view.stored(ia)) {
+                for ib in 0..s.grid_b.cells.len() {
+                    let own = s.label(ia, ib);
+                    let want = view.mirror_pair(ia, ib).map_or(own, |(ra, rb)| merge(own, s.label(ra, rb)));
+                    assert_eq!(view.label(ia, ib), want, "{pattern:?} ({ia}, {ib})");
+                    merged += usize::from(view.mirror_pair(ia, ib).is_some());
+                    changed += usize::from(want != own);
+                }
+            }
+            assert!(merged > 0 && (changed > 0) != exact, "{pattern:?}: {merged} merged, {changed} changed");
+        }
+    }
 }

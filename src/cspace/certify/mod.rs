@@ -183,30 +183,33 @@ impl MirrorRows {
 
     /// Writes each reflected row of `labels` (the rows `rows` of A, `nb` labels each) from its
     /// mirror row, read from `labels` when `rows` holds it and labelled by `row_of` otherwise
-    /// (the rows of a shard): label `(ia, ib)` is that of `(a[ia], b[ib])`.
+    /// (the rows of a shard): label `(ia, ib)` is that of `(a[ia], b[ib])`. Rows are written in
+    /// parallel: a mirror row lies in the stored half, so it is never itself written.
     fn fill(&self, labels: &mut [Label], rows: Rows, row_of: impl Fn(usize) -> Vec<Label> + Sync) {
-        let (count, nb) = (rows.count(self.a.len()), self.b.len());
-        let outside: Vec<Vec<Label>> = (0..count)
-            .into_par_iter()
-            .filter_map(|j| self.a[rows.row(j)].filter(|&m| rows.index_of(m).is_none()).map(&row_of))
-            .collect();
-        // In the order of `j`, as the loop below takes them.
-        let mut outside = outside.into_iter();
-        let mut source = vec![Label::Collision; nb];
-        for j in 0..count {
-            let Some(m) = self.a[rows.row(j)] else { continue };
-            match rows.index_of(m) {
-                Some(jm) => source.copy_from_slice(&labels[jm * nb..(jm + 1) * nb]),
-                // A row left out stays all collisions (`label_rows_except`).
-                None => match outside.next() {
-                    Some(row) => source = row,
-                    None => continue,
-                },
-            }
-            for (l, &mb) in labels[j * nb..(j + 1) * nb].iter_mut().zip(&self.b) {
-                *l = source[mb];
+        let nb = self.b.len();
+        if nb == 0 {
+            return;
+        }
+        let (mut targets, mut sources) = (Vec::new(), Vec::new());
+        for (j, row) in labels.chunks_mut(nb).enumerate() {
+            match self.a[rows.row(j)] {
+                Some(m) => {
+                    targets.push((m, row));
+                    sources.push(None);
+                }
+                None => sources.push(Some(&*row)),
             }
         }
+        targets.into_par_iter().for_each(|(m, row)| {
+            let mut write = |source: &[Label]| row.iter_mut().zip(&self.b).for_each(|(l, &mb)| *l = source[mb]);
+            match rows.index_of(m).map(|jm| sources[jm]) {
+                Some(Some(source)) => write(source),
+                // A mirror row is in the stored half, so never reflected itself.
+                Some(None) => {}
+                // The mirror row is not among `rows` (a shard's): labelled here.
+                None => write(&row_of(m)),
+            }
+        });
     }
 }
 

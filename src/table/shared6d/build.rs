@@ -2,7 +2,11 @@
 //! the labels built depth first, every subtree hash-consed so that equal subtrees are stored
 //! once, and, for a subdivided table, one more level from the sub-cell labels: held whole, or
 //! fetched block by block (a block: the subtree of a node at a chosen depth) so that a build
-//! within bounded memory holds one block's sub-cells at a time.
+//! within bounded memory holds two blocks' sub-cells at a time: the one the tree is in, and
+//! the next, which a second thread finds meanwhile. The tree's own work (reading every stored
+//! pair's label, hash-consing) is serial, because the order in which leaves are first stored
+//! decides which leaf a don't-care cell matches; running it beside the sub-cells of the blocks
+//! ahead keeps both cores busy.
 
 use super::SharedQuadtree6d;
 use crate::cspace::{Label, LabelledSpace, SubCells};
@@ -12,6 +16,8 @@ use crate::table::space::SpaceView;
 use crate::cspace::symmetry::Symmetry;
 use alloc::format;
 use std::collections::HashMap;
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+use std::time::{Duration, Instant};
 
 
 /// An inner node while building: non-uniform mask, collision mask, child ids.
@@ -35,44 +41,54 @@ pub(crate) enum Fine<'a> {
     /// levels, `crate::table::clearance`), not 64 places: its mirror pair's word merges in
     /// unpermuted.
     Words(&'a (dyn Fn(usize) -> u64 + Sync)),
-    /// Sub-cells found block by block ([`SubCellBlocks`]), held one block at a time.
+    /// Sub-cells found block by block ([`SubCellBlocks`]), two blocks held at a time.
     Streamed,
 }
 
 /// Where a subdivided build streamed by blocks finds the sub-cells: the masks of a block's
-/// pairs when the build enters the block, so that only one block's sub-cells are alive.
+/// pairs, asked (on a thread of their own) one block ahead of the tree, so that only two
+/// blocks' sub-cells are alive.
 pub(crate) trait SubCellBlocks {
     /// `(care, collision)` of each pair of `pairs` (numbered `ia * nb + ib`, each labelled
     /// collision), in order.
     fn masks(&mut self, pairs: &[u64], nb: usize) -> Vec<(u64, u64)>;
 }
 
-/// The streamed sub-cells: the source, the depth of the blocks and the current block's.
-struct Stream<'a> {
-    source: &'a mut dyn SubCellBlocks,
+/// A block: A's and B's block coordinates at the blocks' depth.
+type BlockAt = ([usize; 3], [usize; 3]);
+
+/// The streamed sub-cells, as the tree sees them: the blocks' depth, the sub-cells of the
+/// block it is in, and where the next block's come from (found ahead, in the order the tree
+/// enters the blocks, [`find_blocks`]).
+struct Stream {
     depth: u32,
     block: SubCells,
+    next: Receiver<(BlockAt, SubCells)>,
+    /// Time spent waiting for a block's sub-cells.
+    waited: Duration,
+    /// Whether a block came that was not the one entered (then the build fails).
+    out_of_order: bool,
 }
 
 /// Hash-consing builder over a [`SpaceView`].
 pub(super) struct Builder<'a> {
-    view: SpaceView<'a>,
+    view: &'a SpaceView<'a>,
     /// The level below the grid cells, if any.
     sub: Option<Fine<'a>>,
     k: usize,
     /// Dense `k^3` maps from cell to sample index (`u32::MAX`: none, or not stored).
-    dense_a: Vec<u32>,
-    dense_b: Vec<u32>,
+    dense_a: &'a [u32],
+    dense_b: &'a [u32],
     /// Per depth: which blocks hold a (stored) sample ([`occupancy`]).
-    occ_a: Vec<Vec<bool>>,
-    occ_b: Vec<Vec<bool>>,
+    occ_a: &'a [Vec<bool>],
+    occ_b: &'a [Vec<bool>],
     /// Per inner depth: node -> id within the depth, and the nodes in id order.
     inner: Vec<HashMap<InnerNode, u32>>,
     inner_nodes: Vec<Vec<InnerNode>>,
     leaf_ids: HashMap<u64, u32>,
     leaves: Vec<u64>,
     /// With [`Fine::Streamed`]: where the blocks' sub-cells come from.
-    stream: Option<Stream<'a>>,
+    stream: Option<Stream>,
 }
 
 pub(super) const NONE: u32 = u32::MAX;
@@ -108,26 +124,97 @@ pub(super) fn occupancy(dense: &[u32], k: usize, levels: u32) -> Vec<Vec<bool>> 
         .collect()
 }
 
+/// Child `i` of the block at per-robot block coordinates `a`, `b`: its coordinates one depth
+/// down (module doc of `shared6d`, "Structure").
+fn kid(i: usize, a: [usize; 3], b: [usize; 3]) -> BlockAt {
+    let bit = |j: usize| (i >> (5 - j)) & 1;
+    ([2 * a[0] + bit(0), 2 * a[1] + bit(1), 2 * a[2] + bit(2)], [2 * b[0] + bit(3), 2 * b[1] + bit(4), 2 * b[2] + bit(5)])
+}
+
+/// Whether the block at depth `d` holds a (stored) sample of each robot: the tree enters it.
+fn occupied(occ_a: &[Vec<bool>], occ_b: &[Vec<bool>], d: u32, (a, b): BlockAt) -> bool {
+    let n = 1usize << d;
+    let at = |c: [usize; 3]| (c[0] * n + c[1]) * n + c[2];
+    occ_a[d as usize][at(a)] && occ_b[d as usize][at(b)]
+}
+
+/// The blocks at `depth` in the order [`Builder::build`] enters them (depth first, child
+/// order): the blocks whose sub-cells it fetches.
+fn blocks_in_order(occ_a: &[Vec<bool>], occ_b: &[Vec<bool>], depth: u32) -> Vec<BlockAt> {
+    fn visit(occ: (&[Vec<bool>], &[Vec<bool>]), d: u32, at: BlockAt, depth: u32, out: &mut Vec<BlockAt>) {
+        if !occupied(occ.0, occ.1, d, at) {
+            return;
+        }
+        if d == depth {
+            out.push(at);
+            return;
+        }
+        for i in 0..64 {
+            visit(occ, d + 1, kid(i, at.0, at.1), depth, out);
+        }
+    }
+    let mut out = Vec::new();
+    visit((occ_a, occ_b), 0, ([0; 3], [0; 3]), depth, &mut out);
+    out
+}
+
+/// The pairs of a block labelled collision (by their own label), numbered `ia * nb + ib`, in
+/// order: the pairs whose sub-cells [`Builder::subdivided_cell`] looks up inside the block
+/// (under symmetry too: a pair's sub-cells are its own, not merged with its mirror pair's).
+fn block_pairs(view: &SpaceView, dense: (&[u32], &[u32]), k: usize, depth: u32, (a, b): BlockAt) -> Vec<u64> {
+    let side = k >> depth;
+    let in_a = block_samples(dense.0, k, side, a);
+    let in_b = block_samples(dense.1, k, side, b);
+    let nb = view.space.grid_b.cells.len();
+    let mut pairs = Vec::new();
+    for &ia in &in_a {
+        for &ib in &in_b {
+            if view.own_label(ia, ib) == Label::Collision {
+                pairs.push((ia * nb + ib) as u64);
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs
+}
+
+/// Finds the sub-cells of the blocks of `order` with `source` and hands each on in that order,
+/// until every block is sent or the tree stops taking them.
+fn find_blocks(
+    view: &SpaceView,
+    dense: (&[u32], &[u32]),
+    k: usize,
+    depth: u32,
+    order: &[BlockAt],
+    source: &mut (dyn SubCellBlocks + Send),
+    to_tree: SyncSender<(BlockAt, SubCells)>,
+) {
+    let nb = view.space.grid_b.cells.len();
+    for &at in order {
+        let pairs = block_pairs(view, dense, k, depth, at);
+        let (care, collision) = source.masks(&pairs, nb).into_iter().unzip();
+        if to_tree.send((at, SubCells { pairs, care, collision })).is_err() {
+            return;
+        }
+    }
+}
+
 impl Builder<'_> {
     /// The part for the 6-D block at depth `d` whose per-robot block coordinates are `a`, `b`
     /// (in units of the block side).
     fn build(&mut self, d: u32, a: [usize; 3], b: [usize; 3]) -> Part {
-        let n = 1usize << d;
-        let at = |c: [usize; 3]| (c[0] * n + c[1]) * n + c[2];
-        if !self.occ_a[d as usize][at(a)] || !self.occ_b[d as usize][at(b)] {
+        if !occupied(self.occ_a, self.occ_b, d, (a, b)) {
             return Part::DontCare;
         }
         let streamed_block = self.stream.as_ref().is_some_and(|s| s.depth == d);
         if streamed_block {
-            self.fetch_block(d, a, b);
+            self.fetch_block((a, b));
         }
         let last = d == self.view.levels - 1;
         let mut kids = [Part::DontCare; 64];
-        for (i, kid) in kids.iter_mut().enumerate() {
-            let bit = |j: usize| (i >> (5 - j)) & 1;
-            let ca = [2 * a[0] + bit(0), 2 * a[1] + bit(1), 2 * a[2] + bit(2)];
-            let cb = [2 * b[0] + bit(3), 2 * b[1] + bit(4), 2 * b[2] + bit(5)];
-            *kid = match (last, self.sub) {
+        for (i, kid_part) in kids.iter_mut().enumerate() {
+            let (ca, cb) = kid(i, a, b);
+            *kid_part = match (last, self.sub) {
                 (false, _) => self.build(d + 1, ca, cb),
                 (true, None) => self.cell(ca, cb).0,
                 (true, Some(_)) => self.subdivided_cell(ca, cb),
@@ -153,29 +240,16 @@ impl Builder<'_> {
         self.node(d as usize, &kids)
     }
 
-    /// Fetches the sub-cells of the block (depth `d`, block coordinates `a`, `b`) from the
-    /// stream: those of its pairs labelled collision, the ones
-    /// [`subdivided_cell`](Self::subdivided_cell) looks up inside the block (under symmetry
-    /// too: a pair's sub-cells are its own, not merged with its mirror pair's).
-    fn fetch_block(&mut self, d: u32, a: [usize; 3], b: [usize; 3]) {
-        let side = self.k >> d;
-        let in_a = block_samples(&self.dense_a, self.k, side, a);
-        let in_b = block_samples(&self.dense_b, self.k, side, b);
-        let nb = self.view.space.grid_b.cells.len();
-        let mut pairs = Vec::new();
-        for &ia in &in_a {
-            for &ib in &in_b {
-                if self.view.own_label(ia, ib) == Label::Collision {
-                    pairs.push((ia * nb + ib) as u64);
-                }
-            }
+    /// Takes the sub-cells of the block entered (`at`) from the stream ([`find_blocks`] sends
+    /// them in the order the tree enters the blocks).
+    fn fetch_block(&mut self, at: BlockAt) {
+        let Some(s) = self.stream.as_mut() else { return };
+        let start = Instant::now();
+        match s.next.recv() {
+            Ok((sent, block)) if sent == at => s.block = block,
+            _ => s.out_of_order = true,
         }
-        pairs.sort_unstable();
-        if let Some(s) = self.stream.as_mut() {
-            let masks = s.source.masks(&pairs, nb);
-            let (care, collision) = masks.into_iter().unzip();
-            s.block = SubCells { pairs, care, collision };
-        }
+        s.waited += start.elapsed();
     }
 
     /// The part of one cell pair without sub-cells, and its sample pair when both are sampled.
@@ -311,7 +385,7 @@ impl SharedQuadtree6d {
     /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
     /// `2 <= levels <= MAX_LEVELS`, or the label count is wrong.
         pub fn build(space: &LabelledSpace, symmetry: Symmetry) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, None, symmetry.is_mirrored(), None)
+        Self::build_with(space, None, symmetry.is_mirrored(), None).map(|(table, _)| table)
     }
 
     /// As [`build`](Self::build) with every pair labelled collision cut into the sub-cells of
@@ -325,7 +399,7 @@ impl SharedQuadtree6d {
         sub: &SubCells,
         symmetry: Symmetry,
     ) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, Some(Fine::SubCells(sub)), symmetry.is_mirrored(), None)
+        Self::build_with(space, Some(Fine::SubCells(sub)), symmetry.is_mirrored(), None).map(|(table, _)| table)
     }
 
     /// As [`build`](Self::build) with one more level whose leaves hold, per pair labelled
@@ -340,32 +414,33 @@ impl SharedQuadtree6d {
         word: &(dyn Fn(usize) -> u64 + Sync),
         symmetry: Symmetry,
     ) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, Some(Fine::Words(word)), symmetry.is_mirrored(), None)
+        Self::build_with(space, Some(Fine::Words(word)), symmetry.is_mirrored(), None).map(|(table, _)| table)
     }
 
     /// As [`build_subdivided`](Self::build_subdivided) with the sub-cells fetched from `source`
     /// block by block: a block is the subtree of a node at depth `block_depth` (clamped to
-    /// the grid cells' parents), one box of A's cells by one of B's, so that only one block's
-    /// sub-cells are held at a time. The same table, for every `block_depth`.
+    /// the grid cells' parents), one box of A's cells by one of B's, so that only two blocks'
+    /// sub-cells are held at a time (the tree's, and the next, found meanwhile on a second
+    /// thread). The same table, for every `block_depth`. Also returns the time the tree waited
+    /// for sub-cells.
     ///
     /// # Errors
     /// As [`build`](Self::build).
     pub(crate) fn build_streamed(
         space: &LabelledSpace,
-        source: &mut dyn SubCellBlocks,
+        source: &mut (dyn SubCellBlocks + Send),
         block_depth: u32,
         symmetry: Symmetry,
-    ) -> Result<SharedQuadtree6d, TableError> {
-        let stream = Stream { source, depth: block_depth, block: SubCells::default() };
-        Self::build_with(space, Some(Fine::Streamed), symmetry.is_mirrored(), Some(stream))
+    ) -> Result<(SharedQuadtree6d, Duration), TableError> {
+        Self::build_with(space, Some(Fine::Streamed), symmetry.is_mirrored(), Some((source, block_depth)))
     }
 
-        fn build_with<'a>(
-        space: &'a LabelledSpace,
-        sub: Option<Fine<'a>>,
+    fn build_with(
+        space: &LabelledSpace,
+        sub: Option<Fine<'_>>,
         symmetric: bool,
-        stream: Option<Stream<'a>>,
-    ) -> Result<SharedQuadtree6d, TableError> {
+        source: Option<(&mut (dyn SubCellBlocks + Send), u32)>,
+    ) -> Result<(SharedQuadtree6d, Duration), TableError> {
         let view = SpaceView::new(space, symmetric)?;
         let levels = view.levels;
         let sub_levels = u32::from(sub.is_some());
@@ -380,31 +455,66 @@ impl SharedQuadtree6d {
         let dense_b = dense_map(&space.grid_b.cells, k, |_| true);
         let (occ_a, occ_b) = (occupancy(&dense_a, k, levels), occupancy(&dense_b, k, levels));
         let inner_depths = (levels + sub_levels) as usize - 1;
-        let stream = stream.map(|s| Stream { depth: s.depth.min(levels - 1), ..s });
-        let mut b = Builder {
-            view,
+        let builder = |stream| Builder {
+            view: &view,
             sub,
             k,
-            dense_a,
-            dense_b,
-            occ_a,
-            occ_b,
+            dense_a: &dense_a,
+            dense_b: &dense_b,
+            occ_a: &occ_a,
+            occ_b: &occ_b,
             inner: vec![HashMap::new(); inner_depths],
             inner_nodes: vec![Vec::new(); inner_depths],
             leaf_ids: HashMap::new(),
             leaves: Vec::new(),
             stream,
         };
-        let root = b.build(0, [0; 3], [0; 3]);
+        let (root, b, waited) = match source {
+            None => {
+                let mut b = builder(None);
+                (b.build(0, [0; 3], [0; 3]), b, Duration::ZERO)
+            }
+            Some((source, depth)) => {
+                let depth = depth.min(levels - 1);
+                let order = blocks_in_order(&occ_a, &occ_b, depth);
+                let (to_tree, next) = sync_channel(0);
+                let (view, dense) = (&view, (&dense_a[..], &dense_b[..]));
+                let (root, b, waited) = std::thread::scope(|scope| {
+                    scope.spawn(move || find_blocks(view, dense, k, depth, &order, source, to_tree));
+                    let stream = Stream { depth, block: SubCells::default(), next, waited: Duration::ZERO, out_of_order: false };
+                    let mut b = builder(Some(stream));
+                    let root = b.build(0, [0; 3], [0; 3]);
+                    // Dropping the receiver stops the finder should it have blocks left.
+                    match b.stream.take() {
+                        Some(s) if !s.out_of_order => Ok((root, b, s.waited)),
+                        _ => Err(bad_input("a block's sub-cells came out of the tree's order")),
+                    }
+                })?;
+                (root, b, waited)
+            }
+        };
+        let table = Self::from_nodes(levels, sub_levels, symmetric, root, b.inner_nodes, b.leaves);
+        Ok((table, waited))
+    }
+
+    /// The table of the hash-consed `inner_nodes` (per depth) and `leaves` under `root`.
+    fn from_nodes(
+        levels: u32,
+        sub_levels: u32,
+        symmetric: bool,
+        root: Part,
+        mut inner_nodes: Vec<Vec<InnerNode>>,
+        leaves: Vec<u64>,
+    ) -> SharedQuadtree6d {
         let (mut masks, mut bases, mut depth_start, mut children) = (vec![], vec![], vec![], vec![]);
         match root {
             // A uniform root is stored as one node with every child uniform.
             Part::Node(_) => {}
-            Part::Collision => b.inner_nodes[0].push((0, u64::MAX, vec![])),
-            Part::Free | Part::DontCare => b.inner_nodes[0].push((0, 0, vec![])),
+            Part::Collision => inner_nodes[0].push((0, u64::MAX, vec![])),
+            Part::Free | Part::DontCare => inner_nodes[0].push((0, 0, vec![])),
         }
         // Depth 0 now holds exactly the root.
-        for nodes in &b.inner_nodes {
+        for nodes in &inner_nodes {
             depth_start.push(masks.len() as u32);
             for (nonuniform, collision, ids) in nodes {
                 masks.push([*nonuniform, *collision]);
@@ -413,7 +523,6 @@ impl SharedQuadtree6d {
             }
         }
         depth_start.push(masks.len() as u32);
-        Ok(Self::assemble(levels, sub_levels, symmetric, (masks, bases, depth_start, children, b.leaves)))
+        Self::assemble(levels, sub_levels, symmetric, (masks, bases, depth_start, children, leaves))
     }
-
 }

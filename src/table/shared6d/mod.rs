@@ -419,6 +419,35 @@ mod tests {
         }
     }
 
+    /// The sub-cells of a pair labelled collision, as a streamed build asks for them.
+    struct Served<'a>(&'a SubCells);
+
+    impl SubCellBlocks for Served<'_> {
+        fn masks(&mut self, pairs: &[u64], _nb: usize) -> Vec<(u64, u64)> {
+            pairs.iter().map(|&p| self.0.get(p).unwrap()).collect()
+        }
+    }
+
+    /// A build whose sub-cells come block by block from a second thread, at every block
+    /// depth, gives the table of the build that holds them all: the blocks come in the order
+    /// the tree enters them, and the order of the leaves first stored (which decides the
+    /// don't-care bits) is kept.
+    #[test]
+    fn streamed_blocks_give_the_table_of_all_sub_cells() {
+        for (pattern, levels, symmetric) in
+            [(Pattern::Blobs, 3, false), (Pattern::Blobs, 4, true), (Pattern::Noise { p: 0.2, seed: 9 }, 3, true)]
+        {
+            let space = space(levels, pattern);
+            let sub = random_sub_cells(&space, u64::from(levels));
+            let symmetry = Symmetry::from_flag(symmetric);
+            let whole = SharedQuadtree6d::build_subdivided(&space, &sub, symmetry).unwrap();
+            for depth in 0..=levels {
+                let (t, _) = SharedQuadtree6d::build_streamed(&space, &mut Served(&sub), depth, symmetry).unwrap();
+                assert!(t == whole, "{pattern:?}, blocks at depth {depth}");
+            }
+        }
+    }
+
     #[test]
     fn out_of_range_cells_are_collisions() {
         let space = space(3, Pattern::Blobs);
