@@ -271,7 +271,9 @@ fn build_streamed(
 /// How many of `labels` are collisions and how many unreachable, counted in parallel (a
 /// billion labels at k = 64).
 fn collisions_and_unreachable(labels: &[Label]) -> (usize, usize) {
-    let count = |(c, u): (usize, usize), l: &Label| (c + usize::from(*l == Label::Collision), u + usize::from(*l == Label::Unreachable));
+    let count = |(c, u): (usize, usize), l: &Label| {
+        (c + usize::from(*l == Label::Collision), u + usize::from(*l == Label::Unreachable))
+    };
     labels.par_iter().fold(|| (0, 0), count).reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
 

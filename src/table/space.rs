@@ -101,7 +101,8 @@ impl<'a> SpaceView<'a> {
             )));
         }
         let (refl_a, refl_b) = if symmetric { (reflections(ga), reflections(gb)) } else { (vec![], vec![]) };
-        let mut view = SpaceView { space, k: ga.k, levels: ga.levels, symmetric, refl_a, refl_b, nb, mirrored_exactly: false };
+        let (k, levels) = (ga.k, ga.levels);
+        let mut view = SpaceView { space, k, levels, symmetric, refl_a, refl_b, nb, mirrored_exactly: false };
         view.mirrored_exactly = symmetric && view.labels_equal_their_mirrors();
         Ok(view)
     }

@@ -128,7 +128,8 @@ pub(super) fn occupancy(dense: &[u32], k: usize, levels: u32) -> Vec<Vec<bool>> 
 /// down (module doc of `shared6d`, "Structure").
 fn kid(i: usize, a: [usize; 3], b: [usize; 3]) -> BlockAt {
     let bit = |j: usize| (i >> (5 - j)) & 1;
-    ([2 * a[0] + bit(0), 2 * a[1] + bit(1), 2 * a[2] + bit(2)], [2 * b[0] + bit(3), 2 * b[1] + bit(4), 2 * b[2] + bit(5)])
+    let a = [2 * a[0] + bit(0), 2 * a[1] + bit(1), 2 * a[2] + bit(2)];
+    (a, [2 * b[0] + bit(3), 2 * b[1] + bit(4), 2 * b[2] + bit(5)])
 }
 
 /// Whether the block at depth `d` holds a (stored) sample of each robot: the tree enters it.
@@ -479,9 +480,10 @@ impl SharedQuadtree6d {
                 let order = blocks_in_order(&occ_a, &occ_b, depth);
                 let (to_tree, next) = sync_channel(0);
                 let (view, dense) = (&view, (&dense_a[..], &dense_b[..]));
-                let (root, b, waited) = std::thread::scope(|scope| {
+                std::thread::scope(|scope| {
                     scope.spawn(move || find_blocks(view, dense, k, depth, &order, source, to_tree));
-                    let stream = Stream { depth, block: SubCells::default(), next, waited: Duration::ZERO, out_of_order: false };
+                    let block = SubCells::default();
+                    let stream = Stream { depth, block, next, waited: Duration::ZERO, out_of_order: false };
                     let mut b = builder(Some(stream));
                     let root = b.build(0, [0; 3], [0; 3]);
                     // Dropping the receiver stops the finder should it have blocks left.
@@ -489,8 +491,7 @@ impl SharedQuadtree6d {
                         Some(s) if !s.out_of_order => Ok((root, b, s.waited)),
                         _ => Err(bad_input("a block's sub-cells came out of the tree's order")),
                     }
-                })?;
-                (root, b, waited)
+                })?
             }
         };
         let table = Self::from_nodes(levels, sub_levels, symmetric, root, b.inner_nodes, b.leaves);
