@@ -111,14 +111,22 @@ impl<'a> SpaceView<'a> {
     /// mirror pair's (rows in parallel, each row's mirror read within one row of labels).
     fn labels_equal_their_mirrors(&self) -> bool {
         use rayon::prelude::*;
+        (0..self.space.grid_a.cells.len())
+            .into_par_iter()
+            .filter(|&ia| self.stored(ia))
+            .all(|ia| self.row_with_mirrors(ia).all(|(own, mirror)| own == mirror))
+    }
+
+    /// Row `ia`'s labels paired with their mirror pairs' labels, for the pairs that have one
+    /// (none when `ia` has no mirror sample).
+    fn row_with_mirrors(&self, ia: usize) -> impl Iterator<Item = (Label, Label)> + '_ {
         let labels = &self.space.labels;
-        (0..self.space.grid_a.cells.len()).into_par_iter().filter(|&ia| self.stored(ia)).all(|ia| {
-            let ra = self.refl_a[ia];
-            ra == NONE
-                || (0..self.nb).all(|ib| {
-                    let rb = self.refl_b[ib];
-                    rb == NONE || labels[ia * self.nb + ib] == labels[ra as usize * self.nb + rb as usize]
-                })
+        let ra = self.refl_a.get(ia).copied().filter(|&ra| ra != NONE);
+        ra.into_iter().flat_map(move |ra| {
+            (0..self.nb).filter_map(move |ib| {
+                let rb = self.refl_b[ib];
+                (rb != NONE).then(|| (labels[ia * self.nb + ib], labels[ra as usize * self.nb + rb as usize]))
+            })
         })
     }
 
@@ -163,18 +171,13 @@ impl<'a> SpaceView<'a> {
         if !self.symmetric {
             return 0;
         }
-        let mut n = 0;
-        for ia in (0..self.space.grid_a.cells.len()).filter(|&ia| self.stored(ia)) {
-            for ib in 0..self.nb {
-                let own = self.space.labels[ia * self.nb + ib];
-                let (ra, rb) = (self.refl_a[ia], self.refl_b[ib]);
-                if ra != NONE && rb != NONE && own != Label::Unreachable {
-                    let other = self.space.labels[ra as usize * self.nb + rb as usize];
-                    n += usize::from(other != Label::Unreachable && other != own);
-                }
-            }
-        }
-        n
+        let disagree = |(own, other): (Label, Label)| {
+            own != Label::Unreachable && other != Label::Unreachable && other != own
+        };
+        (0..self.space.grid_a.cells.len())
+            .filter(|&ia| self.stored(ia))
+            .map(|ia| self.row_with_mirrors(ia).filter(|&p| disagree(p)).count())
+            .sum()
     }
 }
 

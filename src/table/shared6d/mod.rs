@@ -363,15 +363,17 @@ mod tests {
         out
     }
 
+    /// The synthetic spaces the subdivided tables are tested on: pattern, levels, symmetric.
+    const SUBDIVIDED_SPACES: [(Pattern, u32, bool); 3] =
+        [(Pattern::Blobs, 3, false), (Pattern::Blobs, 4, true), (Pattern::Noise { p: 0.2, seed: 9 }, 3, true)];
+
     /// With sub-cells, every sub-cell that is free or collision in its pair is answered
     /// exactly at the fine indices, and, for a symmetric table, so is its mirror sub-cell (both
     /// robots' `y` reflected at `2 k`): a pair's sub-cells are its own, never merged with its
     /// mirror pair's, whose sub-cells a symmetric labelling does not find.
     #[test]
     fn subdivided_table_answers_every_sub_cell() {
-        for (pattern, levels, symmetric) in
-            [(Pattern::Blobs, 3, false), (Pattern::Blobs, 4, true), (Pattern::Noise { p: 0.2, seed: 9 }, 3, true)]
-        {
+        for (pattern, levels, symmetric) in SUBDIVIDED_SPACES {
             let space = space(levels, pattern);
             let sub = random_sub_cells(&space, u64::from(levels));
             let t = SharedQuadtree6d::build_subdivided(&space, &sub, Symmetry::from_flag(symmetric)).unwrap();
@@ -434,9 +436,7 @@ mod tests {
     /// don't-care bits) is kept.
     #[test]
     fn streamed_blocks_give_the_table_of_all_sub_cells() {
-        for (pattern, levels, symmetric) in
-            [(Pattern::Blobs, 3, false), (Pattern::Blobs, 4, true), (Pattern::Noise { p: 0.2, seed: 9 }, 3, true)]
-        {
+        for (pattern, levels, symmetric) in SUBDIVIDED_SPACES {
             let space = space(levels, pattern);
             let sub = random_sub_cells(&space, u64::from(levels));
             let symmetry = Symmetry::from_flag(symmetric);
