@@ -129,6 +129,11 @@
 //! take the proof above, unchanged.
 //!
 //! Nothing here allocates after [`ProtectiveChecker::new`].
+//!
+//! [`box_sweep_forms_into`]: crate::cspace::guarantee::box_sweep_forms_into
+//! [`swept_boxes_apart_either`]: crate::geometry::sweep::swept_boxes_apart_either
+//! [`balls_swept_meet_near`]: crate::geometry::sweep::balls_swept_meet_near
+//! [`RobotModel::point_travel`]: crate::robot::RobotModel::point_travel
 
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
@@ -215,7 +220,7 @@ pub struct BoxPair {
     pub a: usize,
     /// Second robot.
     pub b: usize,
-    /// Box of `a` ([`RobotModel::boxes`] order).
+    /// Box of `a` ([`RobotModel::boxes`](crate::robot::RobotModel::boxes) order).
     pub box_a: usize,
     /// Box of `b`.
     pub box_b: usize,
@@ -337,6 +342,8 @@ pub struct ProtectiveChecker {
     /// This tick's closest points (WCS) of the closest box pair: step 6 seeks its points from
     /// their midpoint ([`balls_swept_meet_near`]) and moves them to the stop balls' centres
     /// ([`ProtectiveChecker::travel_meets`]).
+    ///
+    /// [`balls_swept_meet_near`]: crate::geometry::sweep::balls_swept_meet_near
     points: [Vec3; 2],
     /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
     kept: kept::Kept,
