@@ -27,7 +27,7 @@
 //!
 //! A path that breaks its promise at once (the TCP now is farther than `tol` from `Q`, a
 //! non-finite point or tolerance, a negative tolerance, no point) is
-//! [`ProtectiveStatus::InvalidPath`]: STOP. Nothing here allocates.
+//! [`ProtectiveStatus::InvalidPath`](super::ProtectiveStatus::InvalidPath): STOP. Nothing here allocates.
 
 use super::{first_unproved_between, stop_sweeps_wcs, BoxPair, Protective, ProtectiveChecker, SweepForms};
 use crate::geometry::sweep::FaceTerms;

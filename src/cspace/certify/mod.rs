@@ -72,6 +72,10 @@
 //! octants, `refine.rs` holds levels 2 and 3 and the sub-cell labels, and, for the report
 //! tool only (`eval` feature), `subdivided_labels.rs` spells the sub-cells out as labels at
 //! `2 k`.
+//!
+//! [`box_sweeps`]: crate::cspace::guarantee::box_sweeps
+//! [`cube_box_sweeps`]: crate::cspace::guarantee::cube_box_sweeps
+//! [`cube_unreachable`]: crate::cspace::guarantee::cube_unreachable
 
 pub(crate) mod clearance;
 mod refine;

@@ -25,8 +25,9 @@ use std::sync::OnceLock;
 const SUB_CELL_ROWS: usize = 16;
 
 
-/// One robot's boxes at both levels with their cores ([`core`]: what every configuration of
-/// the (sub)cell covers; `None` for a box without one or an entry without boxes).
+/// One robot's boxes at both levels with their cores ([`core`](fn@core): what every
+/// configuration of the (sub)cell covers; `None` for a box without one or an entry without
+/// boxes).
 pub(super) struct Levels<'a> {
     pub(super) whole: &'a SampleBoxes,
     pub(super) octs: &'a SampleBoxes,
@@ -367,13 +368,13 @@ pub(super) fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize
     (0..8).filter(|&i| a1.slot[8 * ia + i] != Slot::Vacuous).fold(0, |m, i| m | column << sub_cell_index(i, 0))
 }
 
-/// `(care, collision)` over the 64 octant pairs of `(ia, ib)`, as [`octant_pairs`] gives
+/// `(care, collision)` over the 64 octant pairs of `(ia, ib)`, as `octant_pairs` gives
 /// them, faster (every change only skips tests whose answers are implied, or reorders tests
 /// whose answers are combined by "and"/"or"):
 /// - an octant pair is a collision as soon as a box pair certainly intersects for every
 ///   configuration of a (sub)cell pair that holds it ([`cores_meet`]): of the whole cells
 ///   (then every octant pair is), of A's octant and B's cell (its row), of A's cell and B's
-///   octant (its column). Such an octant pair is never proved free by [`octant_pairs`]: its
+///   octant (its column). Such an octant pair is never proved free by `octant_pairs`: its
 ///   octants are [`Slot::Boxes`] only with reachable reference TCPs, a configuration of the
 ///   pair that collides, and its tests are sound; other octants it calls collisions anyway.
 /// - an octant pair is a collision without its tests when a box pair meets at the whole
@@ -595,9 +596,10 @@ pub(super) fn octants_prove_free(a: &Levels, b: &Levels, ia: usize, ib: usize) -
     sub_cell_masks(a, b, ia, ib, true).1 == 0
 }
 
-/// Level 2 for the pairs that [`label_pairs`] made collisions because a sample has no
-/// whole-cell bound ([`Slot::Unknown`]): each is retried octant by octant (`labels` holds the
-/// rows `rows` of A; those that `skip` names are left as they are).
+/// Level 2 for the pairs that [`label_pairs`](crate::cspace::label::label_pairs) made
+/// collisions because a sample has no whole-cell bound ([`Slot::Unknown`]): each is retried
+/// octant by octant (`labels` holds the rows `rows` of A; those that `skip` names are left as
+/// they are).
 pub(super) fn refine_unknown_cells(
     a: &Levels,
     b: &Levels,

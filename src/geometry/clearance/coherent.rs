@@ -23,6 +23,8 @@
 //! So every answer is [`boxes_clearance`]'s, to that rounding slack, whatever the memory
 //! holds: a stale direction only costs a skipped pair being computed, a stale feature only a
 //! computation from scratch. No allocation.
+//!
+//! [`obb_clearance`]: crate::geometry::clearance::obb_clearance
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
@@ -35,7 +37,7 @@ use crate::math::{float, Real, Vec3};
 
 /// Below this distance (mm) a warm start is not taken: the pair is computed from scratch, so
 /// that touching and nearly touching boxes are decided by the separating axis test's own
-/// tolerances, as in [`obb_clearance`].
+/// tolerances, as in [`obb_clearance`](crate::geometry::clearance::obb_clearance).
 pub const WARM_MIN_GAP: Real = 0.01;
 
 /// The shortest distance between the witness points (mm) from which a pair keeps their
