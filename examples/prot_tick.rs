@@ -42,7 +42,8 @@ fn main() {
         let (mut tp, mut te) = (Vec::new(), Vec::new());
         // The protective times again, by the tick's verdict (FREE, WARN, STOP).
         let mut by_verdict: [Vec<f64>; 3] = Default::default();
-        let (mut stops, mut warns) = (0, 0);
+        // Ticks settled by a FREE proof kept from an earlier tick (`ProtectiveReport::kept_proof`).
+        let (mut stops, mut warns, mut kept) = (0, 0, 0);
         // The reported speed limits of the first pass (mm/s): their sum and count, for the mean.
         let (mut limit_sum, mut limit_count) = (0.0, 0u32);
         // The first pass's verdicts and limiting pairs, tick by tick, hashed (FNV-1a): equal
@@ -79,6 +80,7 @@ fn main() {
                     first_warn = first_warn.or((v == Protective::Warn).then_some(tick));
                     first_stop = first_stop.or((v == Protective::Stop).then_some(tick));
                     stops += (v == Protective::Stop) as u32;
+                    kept += u32::from(r.kept_proof);
                     warns += (v == Protective::Warn) as u32;
                 }
             }
@@ -141,7 +143,7 @@ fn main() {
             n => format!(", mean speed limit {:.1} mm/s", limit_sum / n as f64),
         };
         println!(
-            "{} {}: STOP {stops} WARN {warns}; protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, \
+            "{} {}: STOP {stops} WARN {warns} kept-proof FREE {kept}; protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, \
              exact median {em:.3} us{mean_limit}; least of repeats: protective {pl:.3} exact {el:.3} us ({ratio:.2}x); first WARN {first_warn:?} STOP {first_stop:?}, \
              answers {answers:016x}, verdicts {verdicts:016x}",
             s.cell,
