@@ -143,8 +143,11 @@ fn main() {
             n => format!(", mean speed limit {:.1} mm/s", limit_sum / n as f64),
         };
         println!(
-            "{} {}: STOP {stops} WARN {warns} kept-proof FREE {kept}; protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, \
-             exact median {em:.3} us{mean_limit}; least of repeats: protective {pl:.3} exact {el:.3} us ({ratio:.2}x); first WARN {first_warn:?} STOP {first_stop:?}, \
+            "{} {}: STOP {stops} WARN {warns} kept-proof FREE {kept}; \
+             protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, \
+             exact median {em:.3} us{mean_limit}; \
+             least of repeats: protective {pl:.3} exact {el:.3} us ({ratio:.2}x); \
+             first WARN {first_warn:?} STOP {first_stop:?}, \
              answers {answers:016x}, verdicts {verdicts:016x}",
             s.cell,
             s.case,
