@@ -374,22 +374,72 @@ fn wedge_radii(r0: Interval, rho: Real, nearest: Real) -> Interval {
 /// Lattice points per half-axis searched by [`reference_point`] (`(2 n + 1)^3` in all).
 pub const REFERENCE_STEPS: i32 = 3;
 
+/// Points of [`reference_point`]'s lattice.
+const LATTICE_POINTS: usize = (2 * REFERENCE_STEPS + 1).pow(3) as usize;
+
+/// [`reference_point`]'s lattice offsets `(i, j, l)` in the order it tries them, for cells with
+/// `y >= 0` (`[1]`) and `y < 0` (`[0]`): by `i^2 + j^2 + l^2`, then `|i|`, `|j|`, `|l|`, `i`,
+/// `l`, then `j` downward for `y >= 0` and upward for `y < 0`, so that mirror cells try mirror
+/// points. That key names each offset once, so the order is a strict one. Made when compiling.
+const LATTICE: [[[i32; 3]; LATTICE_POINTS]; 2] = [lattice_order(-1), lattice_order(1)];
+
+/// The offsets of [`LATTICE`] for `side` (`1`: `y >= 0`, `-1`: `y < 0`), written out in order:
+/// each shell `i^2 + j^2 + l^2 = s` in turn, its absolute values in increasing order, then the
+/// signs (`-|i|` before `|i|`, likewise `l`; `j` as `side` says).
+const fn lattice_order(side: i32) -> [[i32; 3]; LATTICE_POINTS] {
+    let n = REFERENCE_STEPS;
+    let mut out = [[0; 3]; LATTICE_POINTS];
+    let mut len = 0;
+    let mut shell = 0;
+    while shell <= 3 * n * n {
+        let mut ai = 0;
+        while ai <= n {
+            let mut aj = 0;
+            while aj <= n {
+                let mut al = 0;
+                while al <= n {
+                    if ai * ai + aj * aj + al * al == shell {
+                        // Each sign in increasing order of its key term; a zero once.
+                        let (is, js, ls) = ([-ai, ai], [side * aj, -side * aj], [-al, al]);
+                        let mut x = 0;
+                        while x < 2 - (ai == 0) as usize {
+                            let mut z = 0;
+                            while z < 2 - (al == 0) as usize {
+                                let mut y = 0;
+                                while y < 2 - (aj == 0) as usize {
+                                    out[len] = [is[x], js[y], ls[z]];
+                                    len += 1;
+                                    y += 1;
+                                }
+                                z += 1;
+                            }
+                            x += 1;
+                        }
+                    }
+                    al += 1;
+                }
+                aj += 1;
+            }
+            ai += 1;
+        }
+        shell += 1;
+    }
+    assert!(len == LATTICE_POINTS);
+    out
+}
+
 /// The point of the closed cube of centre `c` and half-side `h` that displacements are
 /// measured from: the centre when it is reachable, otherwise the reachable point nearest the
 /// centre on the lattice `c + h (i, j, l) / n` (`|i|, |j|, |l| <= n = REFERENCE_STEPS`), ties
-/// broken the same way in mirror cells (`y -> -y`). `None` when no lattice point is reachable.
+/// broken the same way in mirror cells (`y -> -y`; [`LATTICE`]). `None` when no lattice point
+/// is reachable.
 pub fn reference_point(delta: &Delta3, c: &Vec3, h: Real) -> Option<Vec3> {
     if delta.is_reachable(c) {
         return Some(*c);
     }
-    let n = REFERENCE_STEPS;
-    let side = if c.y < 0.0 { -1 } else { 1 };
-    let mut offsets: Vec<[i32; 3]> =
-        (-n..=n).flat_map(|i| (-n..=n).flat_map(move |j| (-n..=n).map(move |l| [i, j, l]))).collect();
-    offsets.sort_by_key(|o| {
-        (o[0] * o[0] + o[1] * o[1] + o[2] * o[2], o[0].abs(), o[1].abs(), o[2].abs(), o[0], o[2], -side * o[1])
-    });
-    let step = h / n as Real;
+    // `y < 0` takes side -1, anything else (NaN too) side 1.
+    let offsets = &LATTICE[if c.y < 0.0 { 0 } else { 1 }];
+    let step = h / REFERENCE_STEPS as Real;
     offsets
         .iter()
         .map(|o| c + Vec3::new(o[0] as Real, o[1] as Real, o[2] as Real) * step)
@@ -886,6 +936,21 @@ mod tests {
             false => Vec3::from_fn(|_, _| rng.random::<Real>()) * 2.0 - Vec3::repeat(1.0),
         };
         (0..n).map(|q| c + off(q, rng) * h).collect()
+    }
+
+    /// [`LATTICE`], written out in order when compiling, is the lattice sorted by the key its
+    /// doc states (here by a sort), for both sides.
+    #[test]
+    fn lattice_is_in_key_order() {
+        let n = REFERENCE_STEPS;
+        for (index, side) in [(0, -1), (1, 1)] {
+            let mut sorted: Vec<[i32; 3]> =
+                (-n..=n).flat_map(|i| (-n..=n).flat_map(move |j| (-n..=n).map(move |l| [i, j, l]))).collect();
+            sorted.sort_by_key(|o| {
+                (o[0] * o[0] + o[1] * o[1] + o[2] * o[2], o[0].abs(), o[1].abs(), o[2].abs(), o[0], o[2], -side * o[1])
+            });
+            assert_eq!(LATTICE[index].to_vec(), sorted, "side {side}");
+        }
     }
 
     /// A cube proved unreachable holds no TCP that the inverse kinematics accepts (dense
