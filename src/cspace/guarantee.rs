@@ -384,43 +384,31 @@ const LATTICE_POINTS: usize = (2 * REFERENCE_STEPS + 1).pow(3) as usize;
 const LATTICE: [[[i32; 3]; LATTICE_POINTS]; 2] = [lattice_order(-1), lattice_order(1)];
 
 /// The offsets of [`LATTICE`] for `side` (`1`: `y >= 0`, `-1`: `y < 0`), written out in order:
-/// each shell `i^2 + j^2 + l^2 = s` in turn, its absolute values in increasing order, then the
-/// signs (`-|i|` before `|i|`, likewise `l`; `j` as `side` says).
+/// each shell `i^2 + j^2 + l^2 = s` in turn, its absolute values `(|i|, |j|, |l|)` in increasing
+/// order, then the signs (`-|i|` before `|i|`, likewise `l`; `j` as `side` says; a zero once).
 const fn lattice_order(side: i32) -> [[i32; 3]; LATTICE_POINTS] {
     let n = REFERENCE_STEPS;
+    let w = n + 1;
     let mut out = [[0; 3]; LATTICE_POINTS];
     let mut len = 0;
     let mut shell = 0;
     while shell <= 3 * n * n {
-        let mut ai = 0;
-        while ai <= n {
-            let mut aj = 0;
-            while aj <= n {
-                let mut al = 0;
-                while al <= n {
-                    if ai * ai + aj * aj + al * al == shell {
-                        // Each sign in increasing order of its key term; a zero once.
-                        let (is, js, ls) = ([-ai, ai], [side * aj, -side * aj], [-al, al]);
-                        let mut x = 0;
-                        while x < 2 - (ai == 0) as usize {
-                            let mut z = 0;
-                            while z < 2 - (al == 0) as usize {
-                                let mut y = 0;
-                                while y < 2 - (aj == 0) as usize {
-                                    out[len] = [is[x], js[y], ls[z]];
-                                    len += 1;
-                                    y += 1;
-                                }
-                                z += 1;
-                            }
-                            x += 1;
-                        }
-                    }
-                    al += 1;
-                }
-                aj += 1;
+        // `q` runs over the absolute values (slowest: `|i|`, then `|j|`, `|l|`) and, for each, the
+        // sign choices (slowest: `i`, then `l`, `j`).
+        let mut q = 0;
+        while q < 8 * w * w * w {
+            let (abs, signs) = (q / 8, q % 8);
+            let (ai, aj, al) = (abs / (w * w), abs / w % w, abs % w);
+            let (si, sl, sj) = (signs / 4, signs / 2 % 2, signs % 2);
+            let zero_once = (ai > 0 || si == 0) && (aj > 0 || sj == 0) && (al > 0 || sl == 0);
+            if zero_once && ai * ai + aj * aj + al * al == shell {
+                let i = if si == 0 { -ai } else { ai };
+                let j = if sj == 0 { side * aj } else { -side * aj };
+                let l = if sl == 0 { -al } else { al };
+                out[len] = [i, j, l];
+                len += 1;
             }
-            ai += 1;
+            q += 1;
         }
         shell += 1;
     }
