@@ -1,0 +1,351 @@
+//! An adversary against the protective verdict (SPEC §8). Random stopping motions
+//! (`tests/protective.rs`) rarely hit the worst one; here, for every FREE or WARN tick, a
+//! search over the stops the model allows looks for the one that brings the two robots
+//! closest, and none may bring two boxes into contact.
+//!
+//! A stop of one robot is given by ten numbers, each mapped into the model's limits:
+//! - the true velocity now: the finite difference `v_fd` plus up to `a_max T` in any
+//!   direction, at most `v_max` (the model's bound on how far they differ);
+//! - a constant push during the reaction (`T_r` = reaction time plus one tick, the verdict's
+//!   own latency), up to `a_max` in any direction, the speed held under `v_max` (the
+//!   velocity projected back onto that ball, which never changes it faster than the push);
+//! - where the stop is looked at: a moment of the reaction, or a point of the braking path,
+//!   which may run in any direction from where the reaction ends and is at most
+//!   `v_r^2 / (2 decel)` long (`v_r` the speed then).
+//!
+//! The search minimises the exact signed clearance of the two robots over both robots'
+//! numbers (twenty in all) with a (1+1) evolution strategy from several starts, one of them
+//! each robot pushing and braking toward the other. Every point the model allows for each
+//! robot is checked against every point of the other's, whatever the moments: what a FREE
+//! proof covers (every TCP of each stop ball against every TCP of the other's), and more than
+//! a stop at one common moment needs. Unreachable TCPs are not physical: left out.
+//!
+//! That the search has teeth is asserted too: among the STOP ticks, whose robots the proof
+//! could not keep apart, it finds stops that bring boxes into contact.
+
+use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveStatus};
+use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
+use delta_collide::cell::{Cell, ExactChecker};
+use delta_collide::geometry::boxes_clearance;
+use delta_collide::math::{Real, Vec3};
+use delta_collide::robot::{RobotBoxes, StopModel};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+
+mod protective_common;
+use protective_common::{cell, tcp_near_reach_boundary, tcp_toward_other, unit, STIFF};
+
+/// Numbers per robot: velocity offset (3), push (3), braking direction (3), moment (1).
+const PER_ROBOT: usize = 10;
+
+/// Steps of the reaction's simulation (trapezoidal: exact for a constant push below the cap).
+const REACTION_STEPS: usize = 64;
+
+/// One robot's state at a tick and its stopping model.
+struct Robot {
+    tcp: Vec3,
+    v_fd: Vec3,
+    stop: StopModel,
+    tick_s: Real,
+}
+
+/// `v` shortened to length `max` when longer.
+fn capped(v: Vec3, max: Real) -> Vec3 {
+    let n = v.norm();
+    if n > max {
+        v * (max / n)
+    } else {
+        v
+    }
+}
+
+impl Robot {
+    /// The TCP (MCS) of the stop that `x` describes (module doc).
+    fn point(&self, x: &[Real]) -> Vec3 {
+        let s = &self.stop;
+        let v0 = capped(
+            self.v_fd + capped(Vec3::new(x[0], x[1], x[2]), 1.0) * (s.max_accel_mm_s2 * self.tick_s),
+            s.max_speed_mm_s,
+        );
+        let push = capped(Vec3::new(x[3], x[4], x[5]), 1.0) * s.max_accel_mm_s2;
+        let reaction_s = (s.reaction_ms + self.tick_s * 1e3) * 1e-3;
+        // Moment in [0, 2]: below 1 a share of the reaction, above it a share of the braking path.
+        let moment = x[9].clamp(0.0, 2.0);
+        let steps = if moment < 1.0 { (moment * REACTION_STEPS as Real).ceil() as usize } else { REACTION_STEPS };
+        let dt = reaction_s / REACTION_STEPS as Real;
+        let (mut p, mut v) = (self.tcp, v0);
+        for _ in 0..steps {
+            let next = capped(v + push * dt, s.max_speed_mm_s);
+            p += (v + next) * (0.5 * dt);
+            v = next;
+        }
+        if moment <= 1.0 {
+            return p;
+        }
+        let w = Vec3::new(x[6], x[7], x[8]).try_normalize(1e-12).unwrap_or(Vec3::z());
+        let braking = v.norm_squared() / (2.0 * s.decel_mm_s2);
+        p + w * ((moment - 1.0) * braking)
+    }
+}
+
+/// The robots' signed clearance (mm) for the stops `x` (robot 0's numbers, then robot 1's),
+/// `+inf` where a TCP is unreachable.
+struct Objective<'a> {
+    exact: ExactChecker,
+    robots: &'a [Robot; 2],
+    boxes: [RobotBoxes; 2],
+}
+
+impl Objective<'_> {
+    fn tcps(&self, x: &[Real]) -> [Vec3; 2] {
+        [self.robots[0].point(&x[..PER_ROBOT]), self.robots[1].point(&x[PER_ROBOT..])]
+    }
+
+    fn clearance(&mut self, x: &[Real]) -> Real {
+        let tcps = self.tcps(x);
+        for (j, b) in self.boxes.iter_mut().enumerate() {
+            if self.exact.boxes_in_wcs(j, &tcps[j], b).is_err() {
+                return Real::INFINITY;
+            }
+        }
+        boxes_clearance(self.boxes[0].as_slice(), self.boxes[1].as_slice()).distance
+    }
+}
+
+/// A (1+1) evolution strategy with the one-fifth success rule: the least clearance found from
+/// `start`, and where.
+fn descend(f: &mut Objective, start: Vec<Real>, evaluations: usize, rng: &mut StdRng) -> (Real, Vec<Real>) {
+    let (mut best, mut x) = (f.clearance(&start), start);
+    let mut sigma = 0.3;
+    for _ in 0..evaluations {
+        let y: Vec<Real> = x.iter().map(|xi| xi + sigma * gauss(rng)).collect();
+        let fy = f.clearance(&y);
+        if fy <= best {
+            (best, x) = (fy, y);
+            sigma *= 1.5;
+        } else {
+            sigma *= 0.9;
+        }
+        sigma = sigma.clamp(1e-4, 1.0);
+    }
+    (best, x)
+}
+
+fn gauss(rng: &mut StdRng) -> Real {
+    let (u, v): (Real, Real) = (rng.random_range(1e-12..1.0), rng.random_range(0.0..1.0));
+    (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+}
+
+/// The least clearance the adversary finds for the robots' stops from this tick, and the
+/// TCPs there.
+fn worst_stop(cell: &Cell, robots: &[Robot; 2], evaluations: usize, rng: &mut StdRng) -> (Real, [Vec3; 2]) {
+    let mut f =
+        Objective { exact: ExactChecker::new(cell.clone()), robots, boxes: [RobotBoxes::empty(), RobotBoxes::empty()] };
+    let toward = |j: usize| {
+        let other = cell.robots[1 - j].placement.t - cell.robots[j].placement.t;
+        let (s, c) = cell.robots[j].placement.alpha.sin_cos();
+        Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize()
+    };
+    let mut starts: Vec<Vec<Real>> = Vec::new();
+    // Each robot at full push and braking toward the other, looked at when it stands still.
+    starts.push(
+        (0..2)
+            .flat_map(|j| {
+                let d = toward(j);
+                [d.x, d.y, d.z, d.x, d.y, d.z, d.x, d.y, d.z, 2.0]
+            })
+            .collect(),
+    );
+    for _ in 0..3 {
+        starts.push(
+            (0..2 * PER_ROBOT)
+                .map(|i| if i % PER_ROBOT == 9 { rng.random_range(0.0..2.0) } else { rng.random_range(-1.0..1.0) })
+                .collect(),
+        );
+    }
+    let mut worst = (Real::INFINITY, Vec::new());
+    for s in starts {
+        let found = descend(&mut f, s, evaluations, rng);
+        if found.0 < worst.0 {
+            worst = found;
+        }
+    }
+    let tcps = if worst.1.is_empty() { [robots[0].tcp, robots[1].tcp] } else { f.tcps(&worst.1) };
+    (worst.0, tcps)
+}
+
+/// The least clearance over as many stops drawn at random (each number uniform in its range)
+/// as [`worst_stop`] evaluates: what the search adds over random stops.
+fn random_stops(cell: &Cell, robots: &[Robot; 2], evaluations: usize, rng: &mut StdRng) -> Real {
+    let mut f =
+        Objective { exact: ExactChecker::new(cell.clone()), robots, boxes: [RobotBoxes::empty(), RobotBoxes::empty()] };
+    (0..4 * (evaluations + 1))
+        .map(|_| {
+            let x: Vec<Real> = (0..2 * PER_ROBOT)
+                .map(|i| if i % PER_ROBOT == 9 { rng.random_range(0.0..2.0) } else { rng.random_range(-1.0..1.0) })
+                .collect();
+            f.clearance(&x)
+        })
+        .fold(Real::INFINITY, Real::min)
+}
+
+/// A tick of `cell` from `tcps` and the finite differences `v_fd`: the verdict (after a first
+/// tick at `tcps - v_fd T`, so that the checker knows the speeds) and the robots.
+fn tick_of(
+    checker: &mut ProtectiveChecker,
+    cell: &Cell,
+    tcps: [Vec3; 2],
+    v_fd: [Vec3; 2],
+) -> Option<(Protective, [Robot; 2])> {
+    let tick_s = cell.tick_ms * 1e-3;
+    checker.reset();
+    checker.check(&[tcps[0] - v_fd[0] * tick_s, tcps[1] - v_fd[1] * tick_s]).unwrap();
+    let r = checker.check(&tcps).unwrap();
+    (r.status == ProtectiveStatus::Ok).then(|| {
+        (r.verdict, std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd[j], stop: cell.stops[j], tick_s }))
+    })
+}
+
+/// What the adversary found over some ticks.
+#[derive(Default)]
+struct Tally {
+    /// FREE or WARN ticks searched, and the least clearance reached over them (mm).
+    proved: usize,
+    least: Real,
+    /// The least clearance of as many random stops over the same ticks (mm), when asked.
+    random: Real,
+    /// STOP ticks searched, and those where it found contact.
+    stops: usize,
+    touched: usize,
+}
+
+impl Tally {
+    fn new() -> Self {
+        Tally { least: Real::INFINITY, random: Real::INFINITY, ..Default::default() }
+    }
+
+    /// Searches the stops of one tick; panics when a FREE or WARN tick's stop touches.
+    fn search(&mut self, cell: &Cell, verdict: Protective, robots: &[Robot; 2], evaluations: usize, rng: &mut StdRng) {
+        let (least, tcps) = worst_stop(cell, robots, evaluations, rng);
+        if verdict == Protective::Stop {
+            self.stops += 1;
+            self.touched += usize::from(least <= 0.0);
+            return;
+        }
+        let contact = ExactChecker::new(cell.clone()).check(&tcps).unwrap().collides();
+        assert!(
+            least > 0.0 && !contact,
+            "{verdict:?} tick, yet a stop the model allows reaches clearance {least} mm at TCPs {tcps:?} \
+             (from {:?} {:?}, v_fd {:?} {:?})",
+            robots[0].tcp, robots[1].tcp, robots[0].v_fd, robots[1].v_fd
+        );
+        self.proved += 1;
+        self.least = self.least.min(least);
+    }
+
+    /// As [`Tally::search`], with random stops beside it on FREE and WARN ticks.
+    fn search_and_draw(
+        &mut self,
+        cell: &Cell,
+        verdict: Protective,
+        robots: &[Robot; 2],
+        evaluations: usize,
+        rng: &mut StdRng,
+    ) {
+        self.search(cell, verdict, robots, evaluations, rng);
+        if verdict != Protective::Stop {
+            self.random = self.random.min(random_stops(cell, robots, evaluations, rng));
+        }
+    }
+}
+
+/// Evaluations per start of the search on random ticks: 400, or `ADVERSARY_EVALUATIONS`.
+fn evaluations() -> usize {
+    std::env::var("ADVERSARY_EVALUATIONS").map_or(400, |v| v.parse().expect("ADVERSARY_EVALUATIONS: a count"))
+}
+
+/// Random ticks with the robots reaching toward each other (and near their reach boundary,
+/// where elbows swing fastest), speeds mostly low, directions random.
+#[test]
+fn no_stop_the_model_allows_touches_after_a_free_verdict() {
+    let mut all = Tally::new();
+    for (i, name) in ["T1", "T2", "T3"].iter().enumerate() {
+        for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
+            let cell = cell(name, stop);
+            let mut checker = ProtectiveChecker::new(cell.clone(), 5.0).unwrap().with_speed_limits(false);
+            let mut rng = StdRng::seed_from_u64(900 + 10 * i as u64 + k as u64);
+            // The search draws from its own stream: the ticks do not depend on its budget.
+            let mut search = StdRng::seed_from_u64(1900 + 10 * i as u64 + k as u64);
+            let mut tally = Tally::new();
+            for state in 0..120 {
+                let sample = if state % 2 == 0 { tcp_toward_other } else { tcp_near_reach_boundary };
+                let tcps = [sample(&cell, 0, &mut rng), sample(&cell, 1, &mut rng)];
+                let v_fd = std::array::from_fn(|_| unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3));
+                let Some((verdict, robots)) = tick_of(&mut checker, &cell, tcps, v_fd) else { continue };
+                // Every FREE and WARN tick; one STOP tick in four (to show the search's teeth).
+                if verdict != Protective::Stop || state % 4 == 0 {
+                    tally.search_and_draw(&cell, verdict, &robots, evaluations(), &mut search);
+                }
+            }
+            println!(
+                "{name} model {k}: {} FREE/WARN ticks, least clearance reached {:.3} mm (random stops {:.3} mm); \
+                 {} of {} STOP ticks brought into contact",
+                tally.proved, tally.least, tally.random, tally.touched, tally.stops
+            );
+            all.proved += tally.proved;
+            all.least = all.least.min(tally.least);
+            all.random = all.random.min(tally.random);
+            all.stops += tally.stops;
+            all.touched += tally.touched;
+        }
+    }
+    println!(
+        "in all: {} FREE/WARN ticks searched, least clearance {:.3} mm (random stops {:.3} mm)",
+        all.proved, all.least, all.random
+    );
+    assert!(all.proved >= 60, "too few FREE ticks to search: {}", all.proved);
+    assert!(all.least < all.random, "the search gets no closer than random stops: {} {}", all.least, all.random);
+    assert!(
+        all.touched * 4 >= all.stops,
+        "the search finds contact in too few STOP ticks: {} of {}",
+        all.touched,
+        all.stops
+    );
+}
+
+/// The ticks of the C harness's runs (practical and collision, T1-T3, both models), where
+/// most FREE ticks reuse a proof kept from an earlier tick: every 25th FREE or WARN tick.
+#[test]
+fn no_stop_the_model_allows_touches_along_the_scenarios() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let mut rng = StdRng::seed_from_u64(31);
+    let mut all = Tally::new();
+    for s in parse_scenarios(&text).unwrap() {
+        for stop in [STIFF, StopModel::DEFAULT] {
+            let cell = cell(&s.cell, stop);
+            let tick_s = cell.tick_ms * 1e-3;
+            let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let (mut tcps, mut prev) = ([Vec3::zeros(); 2], [Vec3::zeros(); 2]);
+            let mut proved = 0;
+            for t in 0..RUN_TICKS {
+                s.tcps_at(t, &mut tcps);
+                let verdict = checker.check(&tcps).unwrap().verdict;
+                if t > 0 && verdict != Protective::Stop {
+                    proved += 1;
+                    if proved % 25 == 0 {
+                        let robots: [Robot; 2] = std::array::from_fn(|j| Robot {
+                            tcp: tcps[j],
+                            v_fd: (tcps[j] - prev[j]) / tick_s,
+                            stop,
+                            tick_s,
+                        });
+                        all.search(&cell, verdict, &robots, 300, &mut rng);
+                    }
+                }
+                prev = tcps;
+            }
+        }
+    }
+    println!("{} FREE/WARN ticks of the runs searched, least clearance reached {:.3} mm", all.proved, all.least);
+    assert!(all.proved >= 200, "too few FREE ticks to search: {}", all.proved);
+}
