@@ -53,7 +53,8 @@ fn reach(b: &Obb, s: &Sweep, n: &Vec3, directed: bool) -> Real {
 /// the smaller reach of either sweep form per box and axis.
 fn proved(a: &Obb, fa: [&Sweep; 2], b: &Obb, fb: [&Sweep; 2], closest: bool, directed: bool) -> bool {
     let c = obb_clearance(a, b);
-    if !(c.distance > 0.0) {
+    // Boxes that touch or overlap now (or a NaN) are not proved apart.
+    if c.distance.is_nan() || c.distance <= 0.0 {
         return false;
     }
     let cols = |o: &Obb| [0, 1, 2].map(|i| o.axes.column(i).into_owned());
