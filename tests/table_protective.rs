@@ -1,8 +1,9 @@
 //! The protective verdict in table mode (SPEC §8; clearance tables, SPEC §6) against brute
 //! force: every tick answered FREE by the clearance table's lookup alone
 //! (`ProtectiveReport::table_lookup`) is followed by random stops within the stopping model,
-//! checked with the exact model every 0.1 ms (the oracle of `tests/protective.rs`), and none
-//! may bring two boxes into contact: random states in the open, next to the reach boundary
+//! checked with the exact model every 0.1 ms (the oracle of `tests/protective.rs`), and by the
+//! stop that comes closest, searched (the adversary of `tests/protective_adversary.rs`), and
+//! none may bring two boxes into contact: random states in the open, next to the reach boundary
 //! and with TCPs on the table's grid-cell faces (where the level changes), and the reference
 //! runs. The reported clearance of a lookup tick never exceeds the exact one; a boolean table
 //! changes no verdict; a tick allocates nothing. The clearance tables are certified, at
@@ -26,6 +27,7 @@ use rand::{RngExt, SeedableRng};
 use std::sync::OnceLock;
 
 mod protective_common;
+use protective_common::adversary::{worst_stop, Robot};
 use protective_common::{allocations, assert_stops_never_touch, cell, tcp_toward_other, unit, STIFF};
 
 /// Resolution of the tables built here (SPEC §4: r = 33.125 mm).
@@ -154,6 +156,10 @@ fn brute_force(
             w * (stop.max_speed_mm_s / w.norm()).min(1.0)
         });
         steps += assert_stops_never_touch(cell, &tcps, &vel, 8, &mut rng);
+        // The stop that comes closest, searched (`tests/protective_adversary.rs`).
+        let robots = std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd[j], stop, tick_s: tick });
+        let (least, at) = worst_stop(cell, &robots, 100, &mut rng);
+        assert!(least > 0.0, "a stop after a lookup FREE reaches clearance {least} mm at {at:?} from {tcps:?}");
     }
     (lookups, steps)
 }
@@ -222,7 +228,8 @@ impl SideBySide {
 /// bound proved; the proof took the others) reports a clearance at most the exact one (which
 /// the exact-mode checker reports on the same tick); at every fifth one, and at every fifth
 /// tick FREE by a proof kept since (a lookup keeps its balls as a proof does), random stops
-/// from the true velocities (the finite difference moved within `a_max T`) never touch, each
+/// from the true velocities (the finite difference moved within `a_max T`) and the stop that
+/// comes closest (searched) never touch, each
 /// pair that can meet checked as its pair cell (the two robots where they stand relative to
 /// each other: a two-robot cell's own pair, a line's as its bundle reduces it, whose soundness
 /// `tests/bundles.rs` checks against the whole line).
@@ -258,7 +265,12 @@ fn side_by_side(cell: &Cell, bound: ClearanceBound, s: &Scenario, stop: StopMode
                     })
                     .collect();
                 for (a, b) in cell.pairs_that_can_meet() {
-                    assert_stops_never_touch(&pair_cell(cell, a, b), &[tcps[a], tcps[b]], &[vel[a], vel[b]], 4, rng);
+                    let pair = pair_cell(cell, a, b);
+                    assert_stops_never_touch(&pair, &[tcps[a], tcps[b]], &[vel[a], vel[b]], 4, rng);
+                    let robot = |j: usize| Robot { tcp: tcps[j], v_fd: (tcps[j] - prev[j]) / tick, stop, tick_s: tick };
+                    let (least, at) = worst_stop(&pair, &[robot(a), robot(b)], 100, rng);
+                    let (name, case) = (&cell.name, &s.case);
+                    assert!(least > 0.0, "{name} {case} tick {t}: a stop reaches clearance {least} mm at {at:?}");
                 }
                 out.tested += 1;
             }

@@ -1,8 +1,11 @@
 //! What the protective tests share: the stiff stopping model, the reference cells with one
 //! model for every robot, random directions and TCPs near the other robot, and the brute-force
-//! oracle (random stops within the model, checked with the exact model every 0.1 ms), and an
-//! allocator that counts.
+//! oracle (random stops within the model, checked with the exact model every 0.1 ms), the
+//! adversary (`adversary.rs`: the stop that comes closest, searched), and an allocator that
+//! counts.
 #![allow(dead_code)] // each test file uses a subset
+
+pub mod adversary;
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker};
