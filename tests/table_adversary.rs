@@ -8,9 +8,11 @@
 //! - the cell pairs labelled free whose centres are closest, among many drawn at random.
 //!
 //! A region is a 6-D box: each robot's TCP anywhere in its cube (a cell of side `r`, or an
-//! octant of side `r / 2`, pulled in by 1e-9 mm), unreachable TCPs left out. The search is a
-//! (1+1) evolution strategy from the centre and three random starts. That it has teeth is
-//! asserted too: in sub-cells left collision it finds colliding configurations.
+//! octant of side `r / 2`, pulled in by 1e-9 mm), unreachable TCPs left out. The search is the
+//! protective adversary's (1+1) evolution strategy (`tests/protective_common/adversary.rs`)
+//! from the centre and three random starts, over six numbers whose sines place the TCPs in
+//! their cubes (so that no step leaves the region). That it has teeth is asserted too: in
+//! sub-cells left collision it finds colliding configurations.
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker};
@@ -21,6 +23,9 @@ use delta_collide::robot::RobotBoxes;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
+
+mod protective_common;
+use protective_common::adversary::descend;
 
 const K: u32 = 16;
 
@@ -53,8 +58,7 @@ struct Objective {
 
 impl Objective {
     fn tcps(r: &Region, x: &[Real; 6]) -> [Vec3; 2] {
-        let at =
-            |(c, h): (Vec3, Real), o: usize| c + Vec3::new(x[o], x[o + 1], x[o + 2]).map(|t| t.clamp(-1.0, 1.0) * h);
+        let at = |(c, h): (Vec3, Real), o: usize| c + Vec3::new(x[o], x[o + 1], x[o + 2]).map(|t| t.sin() * h);
         [at(r.a, 0), at(r.b, 3)]
     }
 
@@ -69,30 +73,14 @@ impl Objective {
     }
 }
 
-fn gauss(rng: &mut StdRng) -> Real {
-    let (u, v): (Real, Real) = (rng.random_range(1e-12..1.0), rng.random_range(0.0..1.0));
-    (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
-}
-
 /// The least clearance found in `region` and the TCPs there.
 fn worst_in(f: &mut Objective, region: &Region, rng: &mut StdRng) -> (Real, [Vec3; 2]) {
     let mut worst = (Real::INFINITY, [0.0; 6]);
     for start in 0..4 {
-        let mut x: [Real; 6] = std::array::from_fn(|_| if start == 0 { 0.0 } else { rng.random_range(-1.0..1.0) });
-        let (mut best, mut sigma) = (f.clearance(region, &x), 0.3);
-        for _ in 0..evaluations() {
-            let y: [Real; 6] = std::array::from_fn(|i| (x[i] + sigma * gauss(rng)).clamp(-1.0, 1.0));
-            let fy = f.clearance(region, &y);
-            if fy <= best {
-                (best, x) = (fy, y);
-                sigma *= 1.5;
-            } else {
-                sigma *= 0.9;
-            }
-            sigma = sigma.clamp(1e-4, 1.0);
-        }
+        let x: Vec<Real> = (0..6).map(|_| if start == 0 { 0.0 } else { rng.random_range(-1.0..1.0) }).collect();
+        let (best, x) = descend(|x| f.clearance(region, &std::array::from_fn(|i| x[i])), x, evaluations(), rng);
         if best < worst.0 {
-            worst = (best, x);
+            worst = (best, std::array::from_fn(|i| x[i]));
         }
     }
     (worst.0, Objective::tcps(region, &worst.1))

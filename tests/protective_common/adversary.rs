@@ -87,14 +87,19 @@ impl Objective<'_> {
     }
 }
 
-/// A (1+1) evolution strategy with the one-fifth success rule: the least clearance found from
-/// `start`, and where.
-pub fn descend(f: &mut Objective, start: Vec<Real>, evaluations: usize, rng: &mut StdRng) -> (Real, Vec<Real>) {
-    let (mut best, mut x) = (f.clearance(&start), start);
+/// A (1+1) evolution strategy with the one-fifth success rule: the least value of `f` found
+/// from `start` in `evaluations` steps, and where.
+pub fn descend(
+    mut f: impl FnMut(&[Real]) -> Real,
+    start: Vec<Real>,
+    evaluations: usize,
+    rng: &mut StdRng,
+) -> (Real, Vec<Real>) {
+    let (mut best, mut x) = (f(&start), start);
     let mut sigma = 0.3;
     for _ in 0..evaluations {
         let y: Vec<Real> = x.iter().map(|xi| xi + sigma * gauss(rng)).collect();
-        let fy = f.clearance(&y);
+        let fy = f(&y);
         if fy <= best {
             (best, x) = (fy, y);
             sigma *= 1.5;
@@ -106,7 +111,8 @@ pub fn descend(f: &mut Objective, start: Vec<Real>, evaluations: usize, rng: &mu
     (best, x)
 }
 
-pub fn gauss(rng: &mut StdRng) -> Real {
+/// A standard normal draw (Box-Muller).
+fn gauss(rng: &mut StdRng) -> Real {
     let (u, v): (Real, Real) = (rng.random_range(1e-12..1.0), rng.random_range(0.0..1.0));
     (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
 }
@@ -140,7 +146,7 @@ pub fn worst_stop(cell: &Cell, robots: &[Robot; 2], evaluations: usize, rng: &mu
     }
     let mut worst = (Real::INFINITY, Vec::new());
     for s in starts {
-        let found = descend(&mut f, s, evaluations, rng);
+        let found = descend(|x| f.clearance(x), s, evaluations, rng);
         if found.0 < worst.0 {
             worst = found;
         }
