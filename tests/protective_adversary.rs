@@ -32,7 +32,7 @@ use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
 mod protective_common;
-use protective_common::adversary::{worst_stop, Objective, Robot, PER_ROBOT};
+use protective_common::adversary::{random_stop, worst_stop, Objective, Robot};
 use protective_common::{cell, tcp_near_reach_boundary, tcp_toward_other, unit, STIFF};
 
 /// The least clearance over as many stops drawn at random (each number uniform in its range)
@@ -40,14 +40,7 @@ use protective_common::{cell, tcp_near_reach_boundary, tcp_toward_other, unit, S
 fn random_stops(cell: &Cell, robots: &[Robot; 2], evaluations: usize, rng: &mut StdRng) -> Real {
     let mut f =
         Objective { exact: ExactChecker::new(cell.clone()), robots, boxes: [RobotBoxes::empty(), RobotBoxes::empty()] };
-    (0..4 * (evaluations + 1))
-        .map(|_| {
-            let x: Vec<Real> = (0..2 * PER_ROBOT)
-                .map(|i| if i % PER_ROBOT == 9 { rng.random_range(0.0..2.0) } else { rng.random_range(-1.0..1.0) })
-                .collect();
-            f.clearance(&x)
-        })
-        .fold(Real::INFINITY, Real::min)
+    (0..4 * (evaluations + 1)).map(|_| f.clearance(&random_stop(rng))).fold(Real::INFINITY, Real::min)
 }
 
 /// A tick of `cell` from `tcps` and the finite differences `v_fd`: the verdict (after a first
@@ -103,7 +96,10 @@ impl Tally {
             least > 0.0 && !contact,
             "{verdict:?} tick, yet a stop the model allows reaches clearance {least} mm at TCPs {tcps:?} \
              (from {:?} {:?}, v_fd {:?} {:?})",
-            robots[0].tcp, robots[1].tcp, robots[0].v_fd, robots[1].v_fd
+            robots[0].tcp,
+            robots[1].tcp,
+            robots[0].v_fd,
+            robots[1].v_fd
         );
         self.proved += 1;
         self.least = self.least.min(least);

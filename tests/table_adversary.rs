@@ -17,7 +17,6 @@
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{label_space_subdivided, CertifiedSpace, Label, Progress, Workspace};
-use delta_collide::geometry::boxes_clearance;
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::RobotBoxes;
 use rand::rngs::StdRng;
@@ -25,7 +24,7 @@ use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 
 mod protective_common;
-use protective_common::adversary::descend;
+use protective_common::adversary::{clearance_at, descend};
 
 const K: u32 = 16;
 
@@ -63,13 +62,7 @@ impl Objective {
     }
 
     fn clearance(&mut self, r: &Region, x: &[Real; 6]) -> Real {
-        let tcps = Self::tcps(r, x);
-        for (j, b) in self.boxes.iter_mut().enumerate() {
-            if self.exact.boxes_in_wcs(j, &tcps[j], b).is_err() {
-                return Real::INFINITY;
-            }
-        }
-        boxes_clearance(self.boxes[0].as_slice(), self.boxes[1].as_slice()).distance
+        clearance_at(&self.exact, &mut self.boxes, &Self::tcps(r, x))
     }
 }
 

@@ -78,12 +78,7 @@ impl Objective<'_> {
 
     pub fn clearance(&mut self, x: &[Real]) -> Real {
         let tcps = self.tcps(x);
-        for (j, b) in self.boxes.iter_mut().enumerate() {
-            if self.exact.boxes_in_wcs(j, &tcps[j], b).is_err() {
-                return Real::INFINITY;
-            }
-        }
-        boxes_clearance(self.boxes[0].as_slice(), self.boxes[1].as_slice()).distance
+        clearance_at(&self.exact, &mut self.boxes, &tcps)
     }
 }
 
@@ -117,33 +112,39 @@ fn gauss(rng: &mut StdRng) -> Real {
     (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
 }
 
+/// Both robots' numbers drawn at random, each uniform in its range.
+pub fn random_stop(rng: &mut StdRng) -> Vec<Real> {
+    (0..2 * PER_ROBOT)
+        .map(|i| if i % PER_ROBOT == 9 { rng.random_range(0.0..2.0) } else { rng.random_range(-1.0..1.0) })
+        .collect()
+}
+
+/// The robots' exact signed clearance at `tcps` (MCS), `+inf` where a TCP is unreachable.
+pub fn clearance_at(exact: &ExactChecker, boxes: &mut [RobotBoxes; 2], tcps: &[Vec3; 2]) -> Real {
+    for (j, b) in boxes.iter_mut().enumerate() {
+        if exact.boxes_in_wcs(j, &tcps[j], b).is_err() {
+            return Real::INFINITY;
+        }
+    }
+    boxes_clearance(boxes[0].as_slice(), boxes[1].as_slice()).distance
+}
+
 /// The least clearance the adversary finds for the robots' stops from this tick, and the
 /// TCPs there.
 pub fn worst_stop(cell: &Cell, robots: &[Robot; 2], evaluations: usize, rng: &mut StdRng) -> (Real, [Vec3; 2]) {
     let mut f =
         Objective { exact: ExactChecker::new(cell.clone()), robots, boxes: [RobotBoxes::empty(), RobotBoxes::empty()] };
-    let toward = |j: usize| {
-        let other = cell.robots[1 - j].placement.t - cell.robots[j].placement.t;
-        let (s, c) = cell.robots[j].placement.alpha.sin_cos();
-        Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize()
-    };
     let mut starts: Vec<Vec<Real>> = Vec::new();
     // Each robot at full push and braking toward the other, looked at when it stands still.
     starts.push(
         (0..2)
             .flat_map(|j| {
-                let d = toward(j);
+                let d = super::toward_other(cell, j);
                 [d.x, d.y, d.z, d.x, d.y, d.z, d.x, d.y, d.z, 2.0]
             })
             .collect(),
     );
-    for _ in 0..3 {
-        starts.push(
-            (0..2 * PER_ROBOT)
-                .map(|i| if i % PER_ROBOT == 9 { rng.random_range(0.0..2.0) } else { rng.random_range(-1.0..1.0) })
-                .collect(),
-        );
-    }
+    starts.extend((0..3).map(|_| random_stop(rng)));
     let mut worst = (Real::INFINITY, Vec::new());
     for s in starts {
         let found = descend(|x| f.clearance(x), s, evaluations, rng);

@@ -48,7 +48,6 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-
 /// A stiffer robot than the default (short reaction, hard braking): FREE then happens with
 /// the robots close, where a wrong bound would show.
 pub const STIFF: StopModel =
@@ -68,6 +67,14 @@ pub fn unit(rng: &mut StdRng) -> Vec3 {
             return v / n;
         }
     }
+}
+
+/// The direction from robot `j`'s base to the other robot's, in `j`'s MCS (horizontal, unit):
+/// where the other robot's TCP roughly lies.
+pub fn toward_other(cell: &Cell, j: usize) -> Vec3 {
+    let other = cell.robots[1 - j].placement.t - cell.robots[j].placement.t;
+    let (s, c) = cell.robots[j].placement.alpha.sin_cos();
+    Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize()
 }
 
 /// A reachable TCP of robot `j` (MCS) out toward the other robot, at a random depth.
@@ -169,12 +176,7 @@ pub fn assert_stops_never_touch(
     let mut steps = 0;
     for m in 0..motions {
         let kind = m % 4;
-        let toward = |j: usize| {
-            // The other robot's TCP in robot j's MCS, roughly: its base direction.
-            let other = cell.robots[1 - j].placement.t - cell.robots[j].placement.t;
-            let (s, c) = cell.robots[j].placement.alpha.sin_cos();
-            Vec3::new(c * other.x + s * other.y, -s * other.x + c * other.y, 0.0).normalize()
-        };
+        let toward = |j: usize| toward_other(cell, j);
         let mut robots: Vec<Motion> = (0..2)
             .map(|j| Motion {
                 p: tcps[j],
