@@ -14,6 +14,30 @@
 //!
 //! `h_S(n) = c |n| + |l . n| + max_k ( e_k (sum_a |w_a . n| + r |n|) + d_k sum_b |v_b . n| )`.
 //!
+//! # Graded along the box
+//! The sets `E_1` and `E_2` belong to the box's two faces across its axis 0 (`u_0`, the link's
+//! axis for a link box): `E_1` to the face at `-half_0 u_0`, `E_2` to the one at `+half_0 u_0`.
+//! A sweep built for a box ([`crate::cspace::guarantee`]) also bounds each point's displacement
+//! by where the point lies: the point at fraction `f` of the way from the first face to the
+//! second moves within `ball(c) + [-l, l] + (1 - f) E_1 + f E_2` (for a lower link the point at
+//! `l` along the link moves within `|l| Z + |1 - l| A`, convex in `l`, so below its chord
+//! between the faces; the other boxes have `E_1 = E_2`). That set is inside `S` (the hull holds
+//! every convex combination), so this *graded* reading claims less motion than `S`. Along a
+//! vector `m` pointing from the box toward the other box, the swept box then reaches, beyond
+//! the box's own projection, at most
+//!
+//! `g(m) = c |m| + |l . m| + max(h_1 - half_0 (s + |s|), h_2 + half_0 (s - |s|))`,
+//!
+//! with `h_k = e_k (sum_a |w_a . m| + r |m|) + d_k sum_b |v_b . m|` and `s = u_0 . m`: the reach
+//! `max_f ((2 f - 1) half_0 s + (1 - f) h_1 + f h_2)` is linear in `f`, so attained at a face,
+//! and the box's own projection on `m` is `half_0 |s|` plus the terms of axes 1 and 2.
+//! `g(m) <= h_S(m)` (both brackets are at most `max(h_1, h_2)`), with equality where `s = 0`
+//! or `E_1 = E_2`: the gain is on axes along the box (for two lower links, their own face 0 and
+//! the edges across it), where the end nearer the other box moves with its own set only.
+//! [`swept_boxes_apart_either`] and [`balls_swept_apart_with`] read sweeps so (the protective
+//! verdict); [`swept_boxes_apart`] reads every point in all of `S` (the tables' test, whose
+//! faster form [`crate::cspace::swept_sat`] is kept equal to it).
+//!
 //! # The test
 //! If every point of a box at some configuration lies within `S` of the point with the same
 //! box coordinates at the reference configuration (box `B0`), the box lies in `B0 + S`. On an
@@ -112,10 +136,34 @@ impl Sweep {
     /// same value).
     #[inline(always)]
     fn support_with_norm(&self, n: &Vec3, norm: Real) -> Real {
+        let [h1, h2] = self.end_terms(n, norm);
+        self.ball * norm + self.line.dot(n).abs() + h1.max(h2)
+    }
+
+    /// `h_1` and `h_2` of the module doc ("Graded along the box"): the supports of `E_1` and
+    /// `E_2` on `n`, of norm `norm`.
+    #[inline(always)]
+    fn end_terms(&self, n: &Vec3, norm: Real) -> [Real; 2] {
         let z = self.cube[0].dot(n).abs() + self.cube[1].dot(n).abs() + self.cube[2].dot(n).abs() + self.round * norm;
         let a = self.arc[0].dot(n).abs() + self.arc[1].dot(n).abs();
         let [(e1, d1), (e2, d2)] = self.ends;
-        self.ball * norm + self.line.dot(n).abs() + (e1 * z + d1 * a).max(e2 * z + d2 * a)
+        [e1 * z + d1 * a, e2 * z + d2 * a]
+    }
+
+    /// `g(m)` of the module doc ("Graded along the box"): how far a box swept by this set
+    /// reaches along `m` (of norm `norm`) beyond the box's own projection, where
+    /// `half_s = half_0 (u_0 . m)` for the box's axis 0 and half-extent along it.
+    #[inline(always)]
+    pub fn graded_support(&self, m: &Vec3, norm: Real, half_s: Real) -> Real {
+        self.ball * norm + self.line.dot(m).abs() + graded_ends(self.end_terms(m, norm), half_s)
+    }
+
+    /// The support on `n` of the set that the point of a box on face `end` (0: at
+    /// `-half_0 u_0`, 1: at `+half_0 u_0`) moves within under the graded reading (module doc):
+    /// `c |n| + |l . n| + h_end`.
+    pub fn face_support(&self, end: usize, n: &Vec3) -> Real {
+        let norm = float::sqrt(n.norm_squared());
+        self.ball * norm + self.line.dot(n).abs() + self.end_terms(n, norm)[end]
     }
 
     /// The largest displacement in the set: `h_S` over unit vectors is at most this.
@@ -132,6 +180,14 @@ impl Sweep {
     }
 }
 
+/// The bracket of `g(m)` (module doc, "Graded along the box"): the larger of what the two
+/// faces' sets add, `h[0]` and `h[1]`, less what each face lies behind the box's front along
+/// `m` (`half_s = half_0 (u_0 . m)`). Never above `max(h[0], h[1])`.
+#[inline(always)]
+fn graded_ends(h: [Real; 2], half_s: Real) -> Real {
+    (h[0] - (half_s + half_s.abs())).max(h[1] + (half_s - half_s.abs()))
+}
+
 /// Half-extents of the world-axis-aligned box around `b + s`, rounded up by a relative 1e-12.
 pub fn swept_aabb_half(b: &Obb, s: &Sweep) -> Vec3 {
     let h = b.aabb_half();
@@ -143,10 +199,11 @@ pub fn swept_aabb_half(b: &Obb, s: &Sweep) -> Vec3 {
     Vec3::new(e(0), e(1), e(2))
 }
 
-/// The terms of [`swept_boxes_apart`] on a box's own face axes that depend on that box and its
-/// sweep alone: per axis `u_k`, the box's projected radius and the sweep's support. Computed
-/// once per swept box ([`swept_boxes_apart_with`]), with the very operations the test would
-/// use, so that the answers are the same to the bit.
+/// The terms of the swept tests on a box's own face axes that depend on that box and its sweep
+/// alone: per axis `u_k`, the box's projected radius and the sweep's support, and the graded
+/// supports along `-u_0` and `+u_0` (module doc, "Graded along the box"). Computed once per
+/// swept box ([`swept_boxes_apart_with`], [`swept_boxes_apart_either`]), with the very
+/// operations the tests would use, so that the answers are the same to the bit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaceTerms {
     /// The box's axes (columns of `axes`).
@@ -155,6 +212,9 @@ pub struct FaceTerms {
     radius: [Real; 3],
     /// `h_S(u_k)`, per `k`.
     support: [Real; 3],
+    /// `g(-u_0)` and `g(u_0)`; on axes 1 and 2 the graded tests take `h_S(u_k)`, which is at
+    /// least `g(+-u_k)` (sound; `u_0 . u_k` is a rounding error there, so it is all they lose).
+    graded_x: [Real; 2],
     /// `float::sqrt(|u_k|^2)`, per `k`.
     norm: [Real; 3],
     /// Whether `|u_k|^2 < 1e-10` (never for a box's unit axes; kept to answer as the test).
@@ -166,54 +226,123 @@ impl FaceTerms {
     pub fn new(b: &Obb, s: &Sweep) -> FaceTerms {
         let u = axes(b);
         let norm = u.map(|n| float::sqrt(n.norm_squared()));
+        let along = b.half.x * u[0].dot(&u[0]);
         FaceTerms {
             short: u.map(|n| n.norm_squared() < 1e-10),
             u,
             radius: core::array::from_fn(|k| radius(&u, &b.half, &u[k])),
             support: core::array::from_fn(|k| s.support_with_norm(&u[k], norm[k])),
+            graded_x: [-along, along].map(|half_s| s.graded_support(&u[0], norm[0], half_s)),
             norm,
         }
     }
-}
 
-impl FaceTerms {
-    /// [`FaceTerms::new`] for the sweep that is the ball of radius `r >= 0` alone: the same
-    /// values to the bit (that sweep's support on `n` is `r |n|` plus exact zeros), without
-    /// evaluating the other terms of a sweep.
-    pub fn ball(b: &Obb, r: Real) -> FaceTerms {
+    /// [`FaceTerms::new`] for [`Sweep::graded_ball`]`(r)`: the same values to the bit, without
+    /// evaluating the terms of a sweep that are zero.
+    pub fn ball(b: &Obb, r: [Real; 2]) -> FaceTerms {
         let u = axes(b);
         let norm = u.map(|n| float::sqrt(n.norm_squared()));
+        let along = b.half.x * u[0].dot(&u[0]);
         FaceTerms {
             short: u.map(|n| n.norm_squared() < 1e-10),
             u,
             radius: core::array::from_fn(|k| radius(&u, &b.half, &u[k])),
-            support: norm.map(|len| r * len),
+            support: norm.map(|len| (r[0] * len).max(r[1] * len)),
+            graded_x: [-along, along].map(|half_s| graded_ends([r[0] * norm[0], r[1] * norm[0]], half_s)),
             norm,
+        }
+    }
+
+    /// The graded support on the box's own face axis `k`, toward the other box when
+    /// `sign > 0` points `u_k` that way.
+    #[inline(always)]
+    fn graded(&self, k: usize, sign: Real) -> Real {
+        match k {
+            0 => self.graded_x[usize::from(sign > 0.0)],
+            _ => self.support[k],
         }
     }
 }
 
-/// [`swept_boxes_apart_with`] where `a` is swept by the ball of radius `ra` alone and `b` by
-/// that of radius `rb` (`fa = FaceTerms::ball(a, ra)`, `fb = FaceTerms::ball(b, rb)`): the
-/// same answer to the bit, the supports on the cross axes taken as `r |n|` directly.
-#[inline]
-pub fn balls_swept_apart_with(a: &Obb, ra: Real, fa: &FaceTerms, b: &Obb, rb: Real, fb: &FaceTerms) -> bool {
-    let (ha, hb) = (|k: usize| fa.support[k], |k: usize| fb.support[k]);
-    apart_on_an_axis((a, fa, ha, |_: &Vec3, len| ra * len), (b, fb, hb, |_: &Vec3, len| rb * len))
+impl Sweep {
+    /// The ball of radius `r[0]` at the face of a box at `-half_0 u_0`, growing linearly to
+    /// `r[1]` at the face at `+half_0 u_0` under the graded reading (module doc), and of
+    /// radius `max(r[0], r[1])` under the other: `E_k = r_k Z` with `Z` the unit ball.
+    pub fn graded_ball(r: [Real; 2]) -> Sweep {
+        Sweep { round: 1.0, ends: [(r[0], 0.0), (r[1], 0.0)], ..Sweep::ZERO }
+    }
 }
 
-/// Whether `a` swept by the ball of radius `ra` and `b` swept by that of radius `rb` certainly
-/// share a point, so that [`balls_swept_apart_with`] (and the test of any sweeps holding those
-/// balls) finds no separating axis: a point `y_a` of `a` and a point `y_b` of `b` lie within
-/// `ra + rb - 2 MEET_DEPTH` of each other. Then the point of segment `y_a y_b` at `ra / (ra + rb)`
-/// of the way lies in both swept sets, more than `MEET_DEPTH` inside one of them, so on every
-/// axis `n` their projections overlap by more than `MEET_DEPTH |n|`: far above the rounding of
-/// the separating test, which asks for a gap above `SWEEP_GAP |n|` besides. The points are
-/// found from `near` by projecting onto `a`, `b`, `a` again (alternating projections, each no
-/// farther from the other box than the last); a false answer means "not known".
-pub fn balls_swept_meet_near(a: &Obb, ra: Real, b: &Obb, rb: Real, near: &Vec3) -> bool {
+/// [`swept_boxes_apart_either`] with one form per box, each box swept by its
+/// [`Sweep::graded_ball`] (`fa = FaceTerms::ball(a, ra)`, `fb = FaceTerms::ball(b, rb)`): the
+/// same answer to the bit, the supports on the cross axes taken from the radii directly.
+#[inline]
+pub fn balls_swept_apart_with(a: &Obb, ra: [Real; 2], fa: &FaceTerms, b: &Obb, rb: [Real; 2], fb: &FaceTerms) -> bool {
+    apart_on_an_axis(
+        (a, fa, |k: usize, sign| fa.graded(k, sign), graded_ball_support(ra, fa.u[0], a.half.x)),
+        (b, fb, |k: usize, sign| fb.graded(k, sign), graded_ball_support(rb, fb.u[0], b.half.x)),
+    )
+}
+
+/// The graded support of [`Sweep::graded_ball`]`(r)` for a box with axis 0 `x` and half-extent
+/// `half` along it: `(m, |m|, sign)` to `g(sign m)`.
+#[inline(always)]
+fn graded_ball_support(r: [Real; 2], x: Vec3, half: Real) -> impl Fn(&Vec3, Real, Real) -> Real {
+    move |n: &Vec3, len: Real, sign: Real| graded_ends([r[0] * len, r[1] * len], half * (sign * x.dot(n)))
+}
+
+/// [`swept_boxes_apart_either`] with one sweep per box (`fa = FaceTerms::new(a, sa)`,
+/// `fb = FaceTerms::new(b, sb)`): the same answer as giving each sweep as both forms.
+pub fn swept_boxes_apart_graded(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: &Sweep, fb: &FaceTerms) -> bool {
+    apart_on_an_axis(
+        (a, fa, |k: usize, sign| fa.graded(k, sign), graded_support_of(sa, fa.u[0], a.half.x)),
+        (b, fb, |k: usize, sign| fb.graded(k, sign), graded_support_of(sb, fb.u[0], b.half.x)),
+    )
+}
+
+/// The graded support of `s` for a box with axis 0 `x` and half-extent `half` along it:
+/// `(m, |m|, sign)` to `g(sign m)`.
+#[inline(always)]
+fn graded_support_of(s: &Sweep, x: Vec3, half: Real) -> impl Fn(&Vec3, Real, Real) -> Real + '_ {
+    move |n: &Vec3, len: Real, sign: Real| s.graded_support(n, len, half * (sign * x.dot(n)))
+}
+
+/// The smaller graded support of two sweeps of a box with axis 0 `x` and half-extent `half`
+/// along it: `(m, |m|, sign)` to `min_f g_f(sign m)`.
+#[inline(always)]
+fn least_graded_support<'a>(s: [&'a Sweep; 2], x: Vec3, half: Real) -> impl Fn(&Vec3, Real, Real) -> Real + 'a {
+    move |n: &Vec3, len: Real, sign: Real| {
+        let half_s = half * (sign * x.dot(n));
+        s[0].graded_support(n, len, half_s).min(s[1].graded_support(n, len, half_s))
+    }
+}
+
+/// The radius at point `y` of box `b` of [`Sweep::graded_ball`]`(r)`, from `y`'s place along
+/// the box's axis 0 (clamped to the box).
+fn graded_radius(b: &Obb, r: [Real; 2], y: &Vec3) -> Real {
+    if r[0] == r[1] {
+        return r[0];
+    }
+    let x = b.axes.column(0).dot(&(y - b.center));
+    let f = (0.5 + 0.5 * x / b.half.x).clamp(0.0, 1.0);
+    r[0] + (r[1] - r[0]) * f
+}
+
+/// Whether `a` swept by [`Sweep::graded_ball`]`(ra)` and `b` by that of `rb` certainly share a
+/// point, so that [`balls_swept_apart_with`] (and the graded test of any sweeps holding those
+/// sets) finds no separating axis: a point `y_a` of `a` and a point `y_b` of `b` lie within
+/// `r_a + r_b - 2 MEET_DEPTH` of each other, `r_a` the radius of `a`'s set at `y_a` and `r_b`
+/// that of `b`'s at `y_b`. Then the point of segment `y_a y_b` at `r_a / (r_a + r_b)` of the
+/// way lies in both swept sets (each holds the ball of its radius around the point),
+/// more than `MEET_DEPTH` inside one of them, so on every axis `n` their projections overlap
+/// by more than `MEET_DEPTH |n|`: far above the rounding of the separating test, which asks
+/// for a gap above `SWEEP_GAP |n|` besides. The points are found from `near` by projecting
+/// onto `a`, `b`, `a` again (alternating projections, each no farther from the other box than
+/// the last); a false answer means "not known".
+pub fn balls_swept_meet_near(a: &Obb, ra: [Real; 2], b: &Obb, rb: [Real; 2], near: &Vec3) -> bool {
     let yb = b.closest_point(&a.closest_point(near));
-    (a.closest_point(&yb) - yb).norm() <= ra + rb - 2.0 * MEET_DEPTH
+    let ya = a.closest_point(&yb);
+    (ya - yb).norm() <= graded_radius(a, ra, &ya) + graded_radius(b, rb, &yb) - 2.0 * MEET_DEPTH
 }
 
 fn axes(b: &Obb) -> [Vec3; 3] {
@@ -226,8 +355,9 @@ fn radius(u: &[Vec3; 3], half: &Vec3, n: &Vec3) -> Real {
     half.x * u[0].dot(n).abs() + half.y * u[1].dot(n).abs() + half.z * u[2].dot(n).abs()
 }
 
-/// Whether `a + sa` and `b + sb` are proved disjoint by one of the 15 axes of `a` and `b`
-/// (see the module doc; `false` means "not proved").
+/// Whether `a + sa` and `b + sb` are proved disjoint by one of the 15 axes of `a` and `b`,
+/// every point of a box moving anywhere in its set (see the module doc; `false` means "not
+/// proved").
 pub fn swept_boxes_apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
     swept_boxes_apart_with(a, sa, &FaceTerms::new(a, sa), b, sb, &FaceTerms::new(b, sb))
 }
@@ -237,21 +367,22 @@ pub fn swept_boxes_apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
 /// a box meets many others.
 #[inline]
 pub fn swept_boxes_apart_with(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: &Sweep, fb: &FaceTerms) -> bool {
-    let (ha, hb) = (|k: usize| fa.support[k], |k: usize| fb.support[k]);
+    let (ha, hb) = (|k: usize, _| fa.support[k], |k: usize, _| fb.support[k]);
     apart_on_an_axis(
-        (a, fa, ha, |n: &Vec3, len| sa.support_with_norm(n, len)),
-        (b, fb, hb, |n: &Vec3, len| sb.support_with_norm(n, len)),
+        (a, fa, ha, |n: &Vec3, len, _| sa.support_with_norm(n, len)),
+        (b, fb, hb, |n: &Vec3, len, _| sb.support_with_norm(n, len)),
     )
 }
 
-/// Whether `a` and `b` are proved apart by [`swept_boxes_apart_with`] with some pair of their
-/// sweeps, when each box has two sound bounds on its displacements (`sa[0]` or `sa[1]`, with
-/// face terms `fa[f] = FaceTerms::new(a, sa[f])`; likewise `b`): one pass over the 15 axes
-/// instead of four. The same answer, to the bit, as trying the four pairs: on an axis, a pair
-/// separates when `dn - (ra + rb) > gap` (the same for all pairs) and
-/// `dn - ((ra + rb + ha) + hb) > gap`; a rounded sum never decreases when an addend grows, so
-/// the smaller support of each box gives the smallest sum, and some pair separates exactly
-/// when that one does. A NaN support fails its pairs, and `min` takes the other form's.
+/// Whether `a` and `b` are proved apart on one of their 15 axes under the graded reading of
+/// their sweeps (module doc, "Graded along the box"; `sa[f]` a sweep of `a` with face terms
+/// `fa[f] = FaceTerms::new(a, sa[f])`, likewise `b`), when each box has two sound bounds on
+/// its displacements: one pass over the 15 axes instead of four. The same answer, to the
+/// bit, as trying the four pairs of forms one by one: on an axis, a pair separates when
+/// `dn - (ra + rb) > gap` (the same for all pairs) and `dn - ((ra + rb + ga) + gb) > gap`; a
+/// rounded sum never decreases when an addend grows, so the smaller graded support of each
+/// box gives the smallest sum, and some pair separates exactly when that one does. A NaN
+/// support fails its pairs, and `min` takes the other form's.
 pub fn swept_boxes_apart_either(
     a: &Obb,
     sa: [&Sweep; 2],
@@ -260,30 +391,47 @@ pub fn swept_boxes_apart_either(
     sb: [&Sweep; 2],
     fb: [&FaceTerms; 2],
 ) -> bool {
-    let least_a = |n: &Vec3, len| sa[0].support_with_norm(n, len).min(sa[1].support_with_norm(n, len));
-    let least_b = |n: &Vec3, len| sb[0].support_with_norm(n, len).min(sb[1].support_with_norm(n, len));
-    let (ha, hb) =
-        (|k: usize| fa[0].support[k].min(fa[1].support[k]), |k: usize| fb[0].support[k].min(fb[1].support[k]));
+    let (ga, gb) = (
+        |k: usize, sign| fa[0].graded(k, sign).min(fa[1].graded(k, sign)),
+        |k: usize, sign| fb[0].graded(k, sign).min(fb[1].graded(k, sign)),
+    );
     // The axes, radii and norms depend on the boxes alone: the same in both forms.
-    apart_on_an_axis((a, fa[0], ha, least_a), (b, fb[0], hb, least_b))
+    apart_on_an_axis(
+        (a, fa[0], ga, least_graded_support(sa, fa[0].u[0], a.half.x)),
+        (b, fb[0], gb, least_graded_support(sb, fb[0].u[0], b.half.x)),
+    )
 }
 
-/// The 15 axes of [`swept_boxes_apart_with`] for each box's terms `(box, face terms, its
-/// support on its own face axis k, its support on any vector of the given norm)`.
+/// The 15 axes of the swept tests for each box's terms `(box, face terms, its support on its
+/// own face axis k, its support on any vector of the given norm)`; each support is also given
+/// the sign (`1` or `-1`) that turns the axis toward the other box (along `d = c_b - c_a` for
+/// `a`, against it for `b`), which the graded supports read and the others ignore.
 ///
 /// Axis `n` of norm `len` separates when `|n . d|` exceeds the four radii by the gap: `ra`,
 /// `rb` the boxes', `ha`, `hb` the sweeps' supports, `(ra + rb + ha) + hb`. The supports are
-/// never negative (a sweep's sizes are not), so a rounded sum with them is never below the
-/// rounded `ra + rb`: when the boxes alone do not clear the gap (or do not even come apart,
-/// then the norm is not needed either), the swept ones do not, and what is left is not
-/// computed. The same answer, to the bit, as computing everything.
+/// never negative (a sweep's sizes are not, and a graded bracket is at least `h_1` or `h_2`),
+/// so a rounded sum with them is never below the rounded `ra + rb`: when the boxes alone do
+/// not clear the gap (or do not even come apart, then the norm is not needed either), the
+/// swept ones do not, and what is left is not computed. The same answer, to the bit, as
+/// computing everything.
 #[inline(always)]
 fn apart_on_an_axis(
-    (a, fa, face_a_support, a_support): (&Obb, &FaceTerms, impl Fn(usize) -> Real, impl Fn(&Vec3, Real) -> Real),
-    (b, fb, face_b_support, b_support): (&Obb, &FaceTerms, impl Fn(usize) -> Real, impl Fn(&Vec3, Real) -> Real),
+    (a, fa, face_a_support, a_support): (
+        &Obb,
+        &FaceTerms,
+        impl Fn(usize, Real) -> Real,
+        impl Fn(&Vec3, Real, Real) -> Real,
+    ),
+    (b, fb, face_b_support, b_support): (
+        &Obb,
+        &FaceTerms,
+        impl Fn(usize, Real) -> Real,
+        impl Fn(&Vec3, Real, Real) -> Real,
+    ),
 ) -> bool {
     let d = b.center - a.center;
     let (ua, ub) = (&fa.u, &fb.u);
+    /// `ha(sign)`, `hb(sign)`: the sweeps' supports, `sign` turning `n` from `a` toward `b`.
     #[inline(always)]
     fn separates(
         d: &Vec3,
@@ -291,26 +439,30 @@ fn apart_on_an_axis(
         len: impl Fn() -> Real,
         ra: Real,
         rb: Real,
-        ha: impl Fn() -> Real,
-        hb: impl Fn() -> Real,
+        ha: impl Fn(Real) -> Real,
+        hb: impl Fn(Real) -> Real,
     ) -> bool {
-        let (dn, boxes) = (d.dot(n).abs(), ra + rb);
+        let dn_signed = d.dot(n);
+        let (dn, boxes) = (dn_signed.abs(), ra + rb);
         // The boxes alone overlap along `n` (or a value is NaN): not apart.
         if (dn - boxes).is_nan() || dn - boxes <= 0.0 {
             return false;
         }
         let gap = SWEEP_GAP * len();
-        dn - boxes > gap && dn - (boxes + ha() + hb()) > gap
+        let sign = if dn_signed >= 0.0 { 1.0 } else { -1.0 };
+        dn - boxes > gap && dn - (boxes + ha(sign) + hb(-sign)) > gap
     }
     let face_a = |k: usize| {
         let (n, len) = (&ua[k], fa.norm[k]);
         let rb = radius(ub, &b.half, n);
-        !fa.short[k] && separates(&d, n, || len, fa.radius[k], rb, || face_a_support(k), || b_support(n, len))
+        let (ha, hb) = (|sign| face_a_support(k, sign), |sign| b_support(n, len, sign));
+        !fa.short[k] && separates(&d, n, || len, fa.radius[k], rb, ha, hb)
     };
     let face_b = |k: usize| {
         let (n, len) = (&ub[k], fb.norm[k]);
         let ra = radius(ua, &a.half, n);
-        !fb.short[k] && separates(&d, n, || len, ra, fb.radius[k], || a_support(n, len), || face_b_support(k))
+        let (ha, hb) = (|sign| a_support(n, len, sign), |sign| face_b_support(k, sign));
+        !fb.short[k] && separates(&d, n, || len, ra, fb.radius[k], ha, hb)
     };
     let edge = |i: usize, j: usize| {
         let n = ua[i].cross(&ub[j]);
@@ -320,7 +472,7 @@ fn apart_on_an_axis(
         }
         let len = || float::sqrt(len2);
         let (ra, rb) = (radius(ua, &a.half, &n), radius(ub, &b.half, &n));
-        separates(&d, &n, len, ra, rb, || a_support(&n, len()), || b_support(&n, len()))
+        separates(&d, &n, len, ra, rb, |sign| a_support(&n, len(), sign), |sign| b_support(&n, len(), sign))
     };
     (0..3).any(face_a) || (0..3).any(face_b) || (0..3).any(|i| (0..3).any(|j| edge(i, j)))
 }
@@ -424,6 +576,47 @@ pub(crate) mod tests {
         z * e + a * d + ball + s.line * (2.0 * t[0].abs() - 1.0)
     }
 
+    prop_compose! {
+        /// Radii of a [`Sweep::graded_ball`]: equal, graded, or zero at one end.
+        fn any_radii()(r in prop::array::uniform2(0.0..60.0f64), kind in 0..4usize) -> [Real; 2] {
+            match kind { 0 => [r[0]; 2], 1 => [0.0, r[1]], 2 => [r[0], 0.0], _ => r }
+        }
+    }
+
+    /// A point of the set that the points of a box's face `end` move within under the graded
+    /// reading (module doc): `E_end` plus a point of the ball and one of the segment, from
+    /// parameters in `[-1, 1]` pushed to the set's boundary for a third of their range.
+    fn point_of_end(s: &Sweep, end: usize, t: &[Real; 8]) -> Vec3 {
+        let t = t.map(|x| (1.5 * x).clamp(-1.0, 1.0));
+        let (e, d) = s.ends[end];
+        let u = Vec3::new(t[1], t[2], t[3]);
+        let z = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3] + u.try_normalize(1e-9).unwrap_or(u) * s.round;
+        let a = s.arc[0] * t[4] + s.arc[1] * t[5];
+        let any = Vec3::new(t[5], t[6], t[7]);
+        z * e + a * d + any.try_normalize(1e-9).unwrap_or(any) * s.ball + s.line * t[0]
+    }
+
+    /// The corners of `b` after its face at `-half_0 u_0` moved by `d[0]` and the one at
+    /// `+half_0 u_0` by `d[1]` (every point in between by the mix of the two, as the graded
+    /// reading allows).
+    fn deformed_corners(b: &Obb, d: [Vec3; 2]) -> [Vec3; 8] {
+        let x = b.axes.column(0).into_owned();
+        b.vertices().map(|v| v + d[usize::from(x.dot(&(v - b.center)) > 0.0)])
+    }
+
+    /// Whether one of the 15 axes of `a` and `b` separates the point sets `pa` and `pb`.
+    fn corners_apart(a: &Obb, b: &Obb, pa: &[Vec3; 8], pb: &[Vec3; 8]) -> bool {
+        let (ua, ub) = (axes(a), axes(b));
+        let apart = |n: &Vec3| {
+            let range = |p: &[Vec3; 8]| {
+                p.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), q| (lo.min(q.dot(n)), hi.max(q.dot(n))))
+            };
+            let ((alo, ahi), (blo, bhi)) = (range(pa), range(pb));
+            ahi < blo || bhi < alo
+        };
+        ua.iter().chain(&ub).any(apart) || ua.iter().any(|x| ub.iter().any(|y| apart(&x.cross(y))))
+    }
+
     /// Displacement parameters for [`point_of`], one per robot box, as the property tests draw them.
     pub(crate) type Moves = Vec<([Real; 8], [Real; 8])>;
 
@@ -512,11 +705,15 @@ pub(crate) mod tests {
                     Obb::new(c, axes, Vec3::new(20.0, 20.0, 20.0))
                 };
                 let near = origin + Vec3::new(20.0 * gap_scale, 0.0, 0.0);
-                assert!(!balls_swept_meet_near(&a, 4.0, &at(10.0), 6.0, &near), "{origin} {gap_scale}");
-                let b = at(10.0 - 1e-5);
-                assert!(balls_swept_meet_near(&a, 4.0, &b, 6.0, &near), "{origin} {gap_scale}");
-                let (fa, fb) = (FaceTerms::ball(&a, 4.0), FaceTerms::ball(&b, 6.0));
-                assert!(!balls_swept_apart_with(&a, 4.0, &fa, &b, 6.0, &fb));
+                // The radii where the boxes face each other (A's face or edge at `+half_0 u_0`,
+                // B's at `-half_0 u_0`): 4 mm and 6 mm, graded or not.
+                for (ra, rb) in [([4.0; 2], [6.0; 2]), ([8.0, 4.0], [6.0, 6.0]), ([0.0, 4.0], [6.0, 0.0])] {
+                    assert!(!balls_swept_meet_near(&a, ra, &at(10.0), rb, &near), "{origin} {gap_scale}");
+                    let b = at(10.0 - 1e-5);
+                    assert!(balls_swept_meet_near(&a, ra, &b, rb, &near), "{origin} {gap_scale}");
+                    let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
+                    assert!(!balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb));
+                }
             }
         }
     }
@@ -538,19 +735,20 @@ pub(crate) mod tests {
             agree_through_the_flip(same)?;
         }
 
-        /// The test of boxes swept by balls alone answers as the general test with those balls
-        /// as sweeps, also right at the threshold (B moved along `v` by bisection to where the
-        /// answer flips), with parallel boxes and with a zero radius.
+        /// The test of boxes swept by graded balls answers as the general graded test with those
+        /// balls as sweeps, also right at the threshold (B moved along `v` by bisection to where
+        /// the answer flips), with parallel boxes and with zero radii.
         #[test]
-        fn ball_swept_test_answers_as_the_general_one(a in any_box(), b in any_box(), ra in 0.0..60.0f64,
-                rb in prop_oneof![Just(0.0), 0.0..60.0f64], v in prop::array::uniform3(-1.0..1.0f64), parallel in any::<bool>()) {
+        fn ball_swept_test_answers_as_the_general_one(a in any_box(), b in any_box(), ra in any_radii(),
+                rb in any_radii(), v in prop::array::uniform3(-1.0..1.0f64), parallel in any::<bool>()) {
             let v = unit(Vec3::from(v));
             let b = if parallel { Obb { axes: a.axes, ..b } } else { b };
-            let (sa, sb) = (Sweep { ball: ra, ..Sweep::ZERO }, Sweep { ball: rb, ..Sweep::ZERO });
+            let (sa, sb) = (Sweep::graded_ball(ra), Sweep::graded_ball(rb));
             prop_assert_eq!(FaceTerms::ball(&a, ra), FaceTerms::new(&a, &sa));
             let same = |t: Real| {
                 let b = Obb { center: a.center + v * t, ..b };
-                let general = swept_boxes_apart(&a, &sa, &b, &sb);
+                let (ga, gb) = (FaceTerms::new(&a, &sa), FaceTerms::new(&b, &sb));
+                let general = swept_boxes_apart_graded(&a, &sa, &ga, &b, &sb, &gb);
                 let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
                 (balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb) == general, general)
             };
@@ -561,8 +759,8 @@ pub(crate) mod tests {
         /// also right where either answer flips (B moved along `v` by bisection), with parallel
         /// boxes and a zero radius; started at a point both boxes hold, it finds them meeting.
         #[test]
-        fn balls_found_meeting_are_not_apart(a in any_box(), b in any_box(), ra in 0.0..60.0f64,
-                rb in prop_oneof![Just(0.0), 0.0..60.0f64], v in prop::array::uniform3(-1.0..1.0f64),
+        fn balls_found_meeting_are_not_apart(a in any_box(), b in any_box(), ra in any_radii(),
+                rb in any_radii(), v in prop::array::uniform3(-1.0..1.0f64),
                 parallel in any::<bool>(), near in prop::array::uniform3(-300.0..300.0f64)) {
             let v = unit(Vec3::from(v));
             let b = if parallel { Obb { axes: a.axes, ..b } } else { b };
@@ -575,12 +773,15 @@ pub(crate) mod tests {
             // Through the flip of each answer: the swept test's, then the certificate's.
             agree_through_the_flip(|t| { let (found, apart) = answers(t); (!(found && apart), apart) })?;
             agree_through_the_flip(|t| { let (found, apart) = answers(t); (!(found && apart), !found) })?;
-            // Started at a point the boxes share, it finds them meeting.
+            // Started at a point the boxes share (their centres, halfway along each box), it
+            // finds them meeting.
             let inside = Obb { center: a.center, ..b };
-            prop_assert_eq!(balls_swept_meet_near(&a, ra, &inside, rb, &a.center), ra + rb >= 2.0 * MEET_DEPTH);
+            let middle = |r: [Real; 2]| r[0] + (r[1] - r[0]) * 0.5;
+            let expected = middle(ra) + middle(rb) >= 2.0 * MEET_DEPTH;
+            prop_assert_eq!(balls_swept_meet_near(&a, ra, &inside, rb, &a.center), expected);
         }
 
-        /// The one-pass test over two forms per box answers as the four pairs of forms tried
+        /// The one-pass graded test over two forms per box answers as the four pairs of forms tried
         /// one by one, also right at the threshold of each pair (B moved along `v` by bisection
         /// to where that pair's answer flips, both sides), with parallel boxes (`b` turned like
         /// `a`) and with sweeps that are NaN or infinite in one form.
@@ -597,7 +798,7 @@ pub(crate) mod tests {
                 let (fa, fb) = ([sa, sa1].map(|w| FaceTerms::new(&a, &w)), [sb, sb1].map(|w| FaceTerms::new(&b, &w)));
                 let pairs: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
                 let (wa, wb) = ([&sa, &sa1], [&sb, &sb1]);
-                let each = pairs.map(|(i, k)| swept_boxes_apart_with(&a, wa[i], &fa[i], &b, wb[k], &fb[k]));
+                let each = pairs.map(|(i, k)| swept_boxes_apart_graded(&a, wa[i], &fa[i], &b, wb[k], &fb[k]));
                 let once = swept_boxes_apart_either(&a, wa, [&fa[0], &fa[1]], &b, wb, [&fb[0], &fb[1]]);
                 (once == each.iter().any(|&x| x), each)
             };
@@ -623,6 +824,61 @@ pub(crate) mod tests {
                 sa in any_sweep_with_line(), sb in any_sweep_with_line(),
                 ts in prop::collection::vec((prop::array::uniform8(-1.0..1.0f64), prop::array::uniform8(-1.0..1.0f64)), 32)) {
             proved_and_stay_apart(swept_boxes_apart, (&a, &sa), (&b, &sb), &ts)?;
+        }
+
+        /// Boxes whose faces across axis 0 move by any displacements of their own end sets (and
+        /// every point in between by the mix, a deformation the graded reading allows) stay
+        /// apart on one of the 15 axes when the graded test proves them apart (brute force on
+        /// the moved corners); the proof is symmetric, and it proves at least what the test
+        /// that moves every point in all of `S` proves.
+        #[test]
+        fn graded_apart_boxes_stay_apart_under_every_graded_displacement(a in any_box(), b in any_box(),
+                sa in any_sweep_with_line(), sb in any_sweep_with_line(), toward in prop::array::uniform3(-1.0..1.0f64),
+                ts in prop::collection::vec(prop::array::uniform4(prop::array::uniform8(-1.0..1.0f64)), 32)) {
+            // B near A, so that both answers occur.
+            let b = Obb { center: a.center + Vec3::from(toward) * 400.0, ..b };
+            let (fa, fb) = (FaceTerms::new(&a, &sa), FaceTerms::new(&b, &sb));
+            let proved = swept_boxes_apart_graded(&a, &sa, &fa, &b, &sb, &fb);
+            prop_assert_eq!(proved, swept_boxes_apart_graded(&b, &sb, &fb, &a, &sa, &fa));
+            prop_assert!(proved || !swept_boxes_apart(&a, &sa, &b, &sb));
+            if proved {
+                for t in &ts {
+                    let pa = deformed_corners(&a, [point_of_end(&sa, 0, &t[0]), point_of_end(&sa, 1, &t[1])]);
+                    let pb = deformed_corners(&b, [point_of_end(&sb, 0, &t[2]), point_of_end(&sb, 1, &t[3])]);
+                    prop_assert!(corners_apart(&a, &b, &pa, &pb));
+                }
+            }
+        }
+
+        /// The graded support is the reach of the swept box beyond the box along `m`, attained:
+        /// the largest `m . (corner + displacement)` over the corners and the vertices of the
+        /// corner's face's end set (brute force), less the box's own reach.
+        #[test]
+        fn graded_support_is_the_reach_of_the_corners(b in any_box(), s in any_sweep_with_line(),
+                m in prop::array::uniform3(-1.0..1.0f64)) {
+            let m = Vec3::from(m);
+            let x = b.axes.column(0).into_owned();
+            let sign = |i: usize, j: usize| if i >> j & 1 == 1 { 1.0 } else { -1.0 };
+            let signs = |k: usize| (0..1 << k).map(move |i| (0..k).map(|j| sign(i, j)).collect::<Vec<Real>>());
+            let mut reach = Real::NEG_INFINITY;
+            for v in b.vertices() {
+                let end = usize::from(x.dot(&(v - b.center)) > 0.0);
+                let (e, d) = s.ends[end];
+                for z in signs(3) {
+                    for a in signs(2) {
+                        for l in [-1.0, 1.0] {
+                            let cube = s.cube[0] * z[0] + s.cube[1] * z[1] + s.cube[2] * z[2];
+                            let disp = (cube + m.normalize() * s.round) * e + (s.arc[0] * a[0] + s.arc[1] * a[1]) * d
+                                + m.normalize() * s.ball + s.line * l;
+                            reach = reach.max(m.dot(&(v - b.center + disp)));
+                        }
+                    }
+                }
+            }
+            let own = radius(&axes(&b), &b.half, &m);
+            let g = s.graded_support(&m, m.norm(), b.half.x * x.dot(&m));
+            prop_assert!((own + g - reach).abs() <= 1e-9 * (1.0 + reach.abs()), "{} + {} vs {}", own, g, reach);
+            prop_assert!(g <= s.support(&m) + 1e-12);
         }
 
         /// With no displacement the test is the separating-axis test (up to its tolerances), and

@@ -5,7 +5,6 @@ pub mod model;
 #[cfg(feature = "std")]
 pub mod motor_table;
 pub mod stopping;
-pub mod travel;
 
 pub use delta3::{ArmSolution, Delta3, MotorCosSin, Unreachable};
 pub use model::{BoxKind, ModelOptions, RobotBoxes, RobotModel, ToolBox, MAX_BOXES};

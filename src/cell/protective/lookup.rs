@@ -84,8 +84,9 @@ impl ProtectiveChecker {
     /// Whether `bound` proves robots `a` and `b` apart with `warn_mm` to spare (module doc).
     fn pair_proved(&mut self, bound: ClearanceBound, a: usize, b: usize) -> bool {
         let Some(at_centres) = bound(a, b, &[self.centres[a], self.centres[b]]) else { return false };
-        // Every sweep of a lower-link, platform or tool box holds the ball of the stop's radius
-        // (module doc of `protective`, step 6), so `d_j >= R_j`: where the bound cannot exceed
+        // A lower link's sweep at its platform joint's end, and a platform's or tool's sweep,
+        // hold the ball of the stop's radius (module doc of `protective`, step 6), so
+        // `d_j >= R_j`: where the bound cannot exceed
         // that, the sweeps are not computed (the proof may still need them).
         let least = self.reach[a] + self.reach[b] + self.warn_mm;
         if at_centres.partial_cmp(&least) != Some(core::cmp::Ordering::Greater) {
