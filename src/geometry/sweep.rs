@@ -274,11 +274,21 @@ impl Sweep {
 }
 
 /// [`swept_boxes_apart_either`] with one form per box, each box swept by its
-/// [`Sweep::graded_ball`] (`fa = FaceTerms::ball(a, ra)`, `fb = FaceTerms::ball(b, rb)`): the
-/// same answer to the bit, the supports on the cross axes taken from the radii directly.
+/// [`Sweep::graded_ball`] (`fa = FaceTerms::ball(a, ra)`, `fb = FaceTerms::ball(b, rb)`), and
+/// the axis `also` besides the 15: the same answer to the bit, the supports on the cross axes
+/// taken from the radii directly.
 #[inline]
-pub fn balls_swept_apart_with(a: &Obb, ra: [Real; 2], fa: &FaceTerms, b: &Obb, rb: [Real; 2], fb: &FaceTerms) -> bool {
+pub fn balls_swept_apart_with(
+    a: &Obb,
+    ra: [Real; 2],
+    fa: &FaceTerms,
+    b: &Obb,
+    rb: [Real; 2],
+    fb: &FaceTerms,
+    also: &Vec3,
+) -> bool {
     apart_on_an_axis(
+        also,
         (a, fa, |k: usize, sign| fa.graded(k, sign), graded_ball_support(ra, fa.u[0], a.half.x)),
         (b, fb, |k: usize, sign| fb.graded(k, sign), graded_ball_support(rb, fb.u[0], b.half.x)),
     )
@@ -293,8 +303,17 @@ fn graded_ball_support(r: [Real; 2], x: Vec3, half: Real) -> impl Fn(&Vec3, Real
 
 /// [`swept_boxes_apart_either`] with one sweep per box (`fa = FaceTerms::new(a, sa)`,
 /// `fb = FaceTerms::new(b, sb)`): the same answer as giving each sweep as both forms.
-pub fn swept_boxes_apart_graded(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: &Sweep, fb: &FaceTerms) -> bool {
+pub fn swept_boxes_apart_graded(
+    a: &Obb,
+    sa: &Sweep,
+    fa: &FaceTerms,
+    b: &Obb,
+    sb: &Sweep,
+    fb: &FaceTerms,
+    also: &Vec3,
+) -> bool {
     apart_on_an_axis(
+        also,
         (a, fa, |k: usize, sign| fa.graded(k, sign), graded_support_of(sa, fa.u[0], a.half.x)),
         (b, fb, |k: usize, sign| fb.graded(k, sign), graded_support_of(sb, fb.u[0], b.half.x)),
     )
@@ -369,15 +388,17 @@ pub fn swept_boxes_apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
 pub fn swept_boxes_apart_with(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: &Sweep, fb: &FaceTerms) -> bool {
     let (ha, hb) = (|k: usize, _| fa.support[k], |k: usize, _| fb.support[k]);
     apart_on_an_axis(
+        &Vec3::zeros(),
         (a, fa, ha, |n: &Vec3, len, _| sa.support_with_norm(n, len)),
         (b, fb, hb, |n: &Vec3, len, _| sb.support_with_norm(n, len)),
     )
 }
 
-/// Whether `a` and `b` are proved apart on one of their 15 axes under the graded reading of
-/// their sweeps (module doc, "Graded along the box"; `sa[f]` a sweep of `a` with face terms
+/// Whether `a` and `b` are proved apart on one of their 15 axes or on `also` (any vector;
+/// none when shorter than `1e-5`) under the graded reading of their sweeps (module doc,
+/// "Graded along the box"; `sa[f]` a sweep of `a` with face terms
 /// `fa[f] = FaceTerms::new(a, sa[f])`, likewise `b`), when each box has two sound bounds on
-/// its displacements: one pass over the 15 axes instead of four. The same answer, to the
+/// its displacements: one pass over the axes instead of four. The same answer, to the
 /// bit, as trying the four pairs of forms one by one: on an axis, a pair separates when
 /// `dn - (ra + rb) > gap` (the same for all pairs) and `dn - ((ra + rb + ga) + gb) > gap`; a
 /// rounded sum never decreases when an addend grows, so the smaller graded support of each
@@ -390,6 +411,7 @@ pub fn swept_boxes_apart_either(
     b: &Obb,
     sb: [&Sweep; 2],
     fb: [&FaceTerms; 2],
+    also: &Vec3,
 ) -> bool {
     let (ga, gb) = (
         |k: usize, sign| fa[0].graded(k, sign).min(fa[1].graded(k, sign)),
@@ -397,13 +419,15 @@ pub fn swept_boxes_apart_either(
     );
     // The axes, radii and norms depend on the boxes alone: the same in both forms.
     apart_on_an_axis(
+        also,
         (a, fa[0], ga, least_graded_support(sa, fa[0].u[0], a.half.x)),
         (b, fb[0], gb, least_graded_support(sb, fb[0].u[0], b.half.x)),
     )
 }
 
-/// The 15 axes of the swept tests for each box's terms `(box, face terms, its support on its
-/// own face axis k, its support on any vector of the given norm)`; each support is also given
+/// The 15 axes of the swept tests, and `also` first (skipped, as a cross-product axis is, when
+/// shorter than `1e-5`), for each box's terms `(box, face terms, its support on its own face
+/// axis k, its support on any vector of the given norm)`; each support is also given
 /// the sign (`1` or `-1`) that turns the axis toward the other box (along `d = c_b - c_a` for
 /// `a`, against it for `b`), which the graded supports read and the others ignore.
 ///
@@ -416,6 +440,7 @@ pub fn swept_boxes_apart_either(
 /// computing everything.
 #[inline(always)]
 fn apart_on_an_axis(
+    also: &Vec3,
     (a, fa, face_a_support, a_support): (
         &Obb,
         &FaceTerms,
@@ -464,17 +489,17 @@ fn apart_on_an_axis(
         let (ha, hb) = (|sign| a_support(n, len, sign), |sign| face_b_support(k, sign));
         !fb.short[k] && separates(&d, n, || len, ra, fb.radius[k], ha, hb)
     };
-    let edge = |i: usize, j: usize| {
-        let n = ua[i].cross(&ub[j]);
+    let any = |n: &Vec3| {
         let len2 = n.norm_squared();
         if len2 < 1e-10 {
             return false;
         }
         let len = || float::sqrt(len2);
-        let (ra, rb) = (radius(ua, &a.half, &n), radius(ub, &b.half, &n));
-        separates(&d, &n, len, ra, rb, |sign| a_support(&n, len(), sign), |sign| b_support(&n, len(), sign))
+        let (ra, rb) = (radius(ua, &a.half, n), radius(ub, &b.half, n));
+        separates(&d, n, len, ra, rb, |sign| a_support(n, len(), sign), |sign| b_support(n, len(), sign))
     };
-    (0..3).any(face_a) || (0..3).any(face_b) || (0..3).any(|i| (0..3).any(|j| edge(i, j)))
+    let edge = |i: usize, j: usize| any(&ua[i].cross(&ub[j]));
+    any(also) || (0..3).any(face_a) || (0..3).any(face_b) || (0..3).any(|i| (0..3).any(|j| edge(i, j)))
 }
 
 /// The core of `b` under the displacement set `s` (module doc): the box shrunk along each of
@@ -604,8 +629,9 @@ pub(crate) mod tests {
         b.vertices().map(|v| v + d[usize::from(x.dot(&(v - b.center)) > 0.0)])
     }
 
-    /// Whether one of the 15 axes of `a` and `b` separates the point sets `pa` and `pb`.
-    fn corners_apart(a: &Obb, b: &Obb, pa: &[Vec3; 8], pb: &[Vec3; 8]) -> bool {
+    /// Whether one of the 15 axes of `a` and `b`, or `also`, separates the point sets `pa` and
+    /// `pb`.
+    fn corners_apart(a: &Obb, b: &Obb, pa: &[Vec3; 8], pb: &[Vec3; 8], also: &Vec3) -> bool {
         let (ua, ub) = (axes(a), axes(b));
         let apart = |n: &Vec3| {
             let range = |p: &[Vec3; 8]| {
@@ -614,7 +640,14 @@ pub(crate) mod tests {
             let ((alo, ahi), (blo, bhi)) = (range(pa), range(pb));
             ahi < blo || bhi < alo
         };
-        ua.iter().chain(&ub).any(apart) || ua.iter().any(|x| ub.iter().any(|y| apart(&x.cross(y))))
+        apart(also) || ua.iter().chain(&ub).any(apart) || ua.iter().any(|x| ub.iter().any(|y| apart(&x.cross(y))))
+    }
+
+    prop_compose! {
+        /// An extra axis for the graded tests: none, or any vector.
+        fn any_axis()(v in prop::array::uniform3(-2.0..2.0f64), on in any::<bool>()) -> Vec3 {
+            if on { Vec3::from(v) } else { Vec3::zeros() }
+        }
     }
 
     /// Displacement parameters for [`point_of`], one per robot box, as the property tests draw them.
@@ -712,7 +745,9 @@ pub(crate) mod tests {
                     let b = at(10.0 - 1e-5);
                     assert!(balls_swept_meet_near(&a, ra, &b, rb, &near), "{origin} {gap_scale}");
                     let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
-                    assert!(!balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb));
+                    for also in [Vec3::zeros(), Vec3::x(), Vec3::new(1.0, 1.0, 0.0)] {
+                        assert!(!balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, &also));
+                    }
                 }
             }
         }
@@ -740,7 +775,8 @@ pub(crate) mod tests {
         /// the answer flips), with parallel boxes and with zero radii.
         #[test]
         fn ball_swept_test_answers_as_the_general_one(a in any_box(), b in any_box(), ra in any_radii(),
-                rb in any_radii(), v in prop::array::uniform3(-1.0..1.0f64), parallel in any::<bool>()) {
+                rb in any_radii(), v in prop::array::uniform3(-1.0..1.0f64), parallel in any::<bool>(),
+                also in any_axis()) {
             let v = unit(Vec3::from(v));
             let b = if parallel { Obb { axes: a.axes, ..b } } else { b };
             let (sa, sb) = (Sweep::graded_ball(ra), Sweep::graded_ball(rb));
@@ -748,9 +784,9 @@ pub(crate) mod tests {
             let same = |t: Real| {
                 let b = Obb { center: a.center + v * t, ..b };
                 let (ga, gb) = (FaceTerms::new(&a, &sa), FaceTerms::new(&b, &sb));
-                let general = swept_boxes_apart_graded(&a, &sa, &ga, &b, &sb, &gb);
+                let general = swept_boxes_apart_graded(&a, &sa, &ga, &b, &sb, &gb, &also);
                 let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
-                (balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb) == general, general)
+                (balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, &also) == general, general)
             };
             agree_through_the_flip(same)?;
         }
@@ -761,13 +797,13 @@ pub(crate) mod tests {
         #[test]
         fn balls_found_meeting_are_not_apart(a in any_box(), b in any_box(), ra in any_radii(),
                 rb in any_radii(), v in prop::array::uniform3(-1.0..1.0f64),
-                parallel in any::<bool>(), near in prop::array::uniform3(-300.0..300.0f64)) {
+                parallel in any::<bool>(), near in prop::array::uniform3(-300.0..300.0f64), also in any_axis()) {
             let v = unit(Vec3::from(v));
             let b = if parallel { Obb { axes: a.axes, ..b } } else { b };
             let (fa, near) = (FaceTerms::ball(&a, ra), Vec3::from(near));
             let answers = |t: Real| {
                 let b = Obb { center: a.center + v * t, ..b };
-                let apart = balls_swept_apart_with(&a, ra, &fa, &b, rb, &FaceTerms::ball(&b, rb));
+                let apart = balls_swept_apart_with(&a, ra, &fa, &b, rb, &FaceTerms::ball(&b, rb), &also);
                 (balls_swept_meet_near(&a, ra, &b, rb, &near), apart)
             };
             // Through the flip of each answer: the swept test's, then the certificate's.
@@ -788,7 +824,7 @@ pub(crate) mod tests {
         #[test]
         fn either_form_test_answers_as_the_four_pairs(a in any_box(), b in any_box(), sa in any_sweep_with_line(),
                 sa1 in any_sweep_with_line(), sb in any_sweep_with_line(), sb1 in any_sweep_with_line(), v in prop::array::uniform3(-1.0..1.0f64),
-                parallel in any::<bool>(), odd in 0..4usize) {
+                parallel in any::<bool>(), odd in 0..4usize, also in any_axis()) {
             let v = unit(Vec3::from(v));
             let b = if parallel { Obb { axes: a.axes, ..b } } else { b };
             let sa1 = match odd { 1 => Sweep { ball: Real::NAN, ..sa1 }, 2 => Sweep { ball: Real::INFINITY, ..sa1 }, _ => sa1 };
@@ -798,8 +834,8 @@ pub(crate) mod tests {
                 let (fa, fb) = ([sa, sa1].map(|w| FaceTerms::new(&a, &w)), [sb, sb1].map(|w| FaceTerms::new(&b, &w)));
                 let pairs: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
                 let (wa, wb) = ([&sa, &sa1], [&sb, &sb1]);
-                let each = pairs.map(|(i, k)| swept_boxes_apart_graded(&a, wa[i], &fa[i], &b, wb[k], &fb[k]));
-                let once = swept_boxes_apart_either(&a, wa, [&fa[0], &fa[1]], &b, wb, [&fb[0], &fb[1]]);
+                let each = pairs.map(|(i, k)| swept_boxes_apart_graded(&a, wa[i], &fa[i], &b, wb[k], &fb[k], &also));
+                let once = swept_boxes_apart_either(&a, wa, [&fa[0], &fa[1]], &b, wb, [&fb[0], &fb[1]], &also);
                 (once == each.iter().any(|&x| x), each)
             };
             prop_assert!(same(0.0).0 && same(2000.0).0);
@@ -834,18 +870,19 @@ pub(crate) mod tests {
         #[test]
         fn graded_apart_boxes_stay_apart_under_every_graded_displacement(a in any_box(), b in any_box(),
                 sa in any_sweep_with_line(), sb in any_sweep_with_line(), toward in prop::array::uniform3(-1.0..1.0f64),
+                also in any_axis(),
                 ts in prop::collection::vec(prop::array::uniform4(prop::array::uniform8(-1.0..1.0f64)), 32)) {
             // B near A, so that both answers occur.
             let b = Obb { center: a.center + Vec3::from(toward) * 400.0, ..b };
             let (fa, fb) = (FaceTerms::new(&a, &sa), FaceTerms::new(&b, &sb));
-            let proved = swept_boxes_apart_graded(&a, &sa, &fa, &b, &sb, &fb);
-            prop_assert_eq!(proved, swept_boxes_apart_graded(&b, &sb, &fb, &a, &sa, &fa));
+            let proved = swept_boxes_apart_graded(&a, &sa, &fa, &b, &sb, &fb, &also);
+            prop_assert_eq!(proved, swept_boxes_apart_graded(&b, &sb, &fb, &a, &sa, &fa, &also));
             prop_assert!(proved || !swept_boxes_apart(&a, &sa, &b, &sb));
             if proved {
                 for t in &ts {
                     let pa = deformed_corners(&a, [point_of_end(&sa, 0, &t[0]), point_of_end(&sa, 1, &t[1])]);
                     let pb = deformed_corners(&b, [point_of_end(&sb, 0, &t[2]), point_of_end(&sb, 1, &t[3])]);
-                    prop_assert!(corners_apart(&a, &b, &pa, &pb));
+                    prop_assert!(corners_apart(&a, &b, &pa, &pb, &also));
                 }
             }
         }

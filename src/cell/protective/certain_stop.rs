@@ -99,7 +99,15 @@ impl ProtectiveChecker {
         else {
             return false;
         };
-        !pair_apart_in_some_form(&box_a, [&la[0], &la[1]], &box_b, [&lb[0], &lb[1]], extra)
+        let axis = self.pair_axis(p);
+        !pair_apart_in_some_form(&box_a, [&la[0], &la[1]], &box_b, [&lb[0], &lb[1]], extra, &axis)
+    }
+
+    /// The axis the proofs of this tick try for box pair `p`'s robot pair besides the 15 of
+    /// each box pair (`pair_axes`); none for a pair that cannot meet.
+    fn pair_axis(&self, p: BoxPair) -> Vec3 {
+        let pairs = &self.exact.verdict().pairs;
+        pairs.iter().position(|q| (q.a, q.b) == (p.a, p.b)).map_or(Vec3::zeros(), |k| self.pair_axes[k])
     }
 
     /// A box pair (of the pairs involving `only`, or of all) that no sweeps of any tier can
@@ -118,10 +126,10 @@ impl ProtectiveChecker {
             }
             self.set_least_all(p.a);
             self.set_least_all(p.b);
-            let (swept_a, swept_b) = (&self.least[p.a], &self.least[p.b]);
+            let (swept_a, swept_b, axis) = (&self.least[p.a], &self.least[p.b], &self.pair_axes[k]);
             for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(swept_a).enumerate() {
                 for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(swept_b).enumerate() {
-                    if !balls_swept_apart_with(box_a, *sa, fa, box_b, *sb, fb) {
+                    if !balls_swept_apart_with(box_a, *sa, fa, box_b, *sb, fb, axis) {
                         return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
                     }
                 }
@@ -143,7 +151,7 @@ impl ProtectiveChecker {
             return true;
         }
         let (fa, fb) = (FaceTerms::ball(&refs[0].0, ra), FaceTerms::ball(&refs[1].0, rb));
-        !balls_swept_apart_with(&refs[0].0, ra, &fa, &refs[1].0, rb, &fb)
+        !balls_swept_apart_with(&refs[0].0, ra, &fa, &refs[1].0, rb, &fb, &self.pair_axis(p))
             || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
     }
 
@@ -189,7 +197,7 @@ impl ProtectiveChecker {
         self.set_least(p.b, p.box_b);
         let ((sa, fa), (sb, fb)) = (&self.least[p.a][p.box_a], &self.least[p.b][p.box_b]);
         let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
-        !balls_swept_apart_with(box_a, *sa, fa, box_b, *sb, fb)
+        !balls_swept_apart_with(box_a, *sa, fa, box_b, *sb, fb, &self.pair_axis(p))
     }
 
     /// Box `k` of robot `j`'s terms of [`ProtectiveChecker::certain_stop`] for its current
@@ -244,7 +252,8 @@ mod tests {
                 let Some(p) = c.report.closest else { continue };
                 let [(a, _, reach_a, _), (b, _, reach_b, _)] = c.reference_pair(&tcps, p);
                 let (ra, rb) = (c.step_6_radii(p.a, p.box_a, reach_a), c.step_6_radii(p.b, p.box_b, reach_b));
-                let apart = balls_swept_apart_with(&a, ra, &FaceTerms::ball(&a, ra), &b, rb, &FaceTerms::ball(&b, rb));
+                let (fa, fb, axis) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb), c.pair_axis(p));
+                let apart = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, &axis);
                 let points_meet = balls_swept_meet_near(&a, ra, &b, rb, &c.near());
                 assert!(!(points_meet && apart), "{} {} tick {tick}", s.cell, s.case);
                 (meet, found) = (meet + usize::from(!apart), found + usize::from(points_meet));

@@ -156,7 +156,7 @@ impl ProtectiveChecker {
             if self.kept.pairs[k].is_some_and(|(ga, gb, _)| (ga, gb) == (ka.generation, kb.generation)) {
                 continue;
             }
-            let free = first_unproved_between(ka.swept(), kb.swept(), extra).is_none();
+            let free = first_unproved_between(ka.swept(), kb.swept(), extra, &self.pair_axes[k]).is_none();
             self.kept.pairs[k] = Some((ka.generation, kb.generation, free));
         }
         let free = self.kept_free(None);

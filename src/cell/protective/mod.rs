@@ -355,6 +355,9 @@ pub struct ProtectiveChecker {
     /// Per robot pair that can meet, what its clearance was at the last tick: where this
     /// tick's computation starts (same answer, a fraction of the time).
     clearances: alloc::vec::Vec<CoherentClearance>,
+    /// Per pair that can meet, the direction between its closest points this tick: an axis
+    /// the proofs of the tick try besides the 15 of each box pair (module doc, step 5).
+    pair_axes: alloc::vec::Vec<Vec3>,
     /// Per robot pair that can meet, whether the clearance table's bound proved it apart
     /// over this tick's stop balls (`protective/lookup.rs`).
     table_proved: alloc::vec::Vec<bool>,
@@ -436,6 +439,7 @@ impl ProtectiveChecker {
             least_set: alloc::vec![0; n],
             points: [Vec3::zeros(); 2],
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
+            pair_axes: alloc::vec![Vec3::zeros(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
             references_stale: true,
             certain_stops_first: true,
@@ -729,8 +733,12 @@ impl ProtectiveChecker {
             let r = &mut self.report.robots[j];
             (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
         }
-        let memory = &mut self.clearances;
-        let (clearance, closest, points) = clearance_over_pairs(&self.exact, |k, a, b| memory[k].boxes_clearance(a, b));
+        let (memory, axes) = (&mut self.clearances, &mut self.pair_axes);
+        let (clearance, closest, points) = clearance_over_pairs(&self.exact, |k, a, b| {
+            let c = memory[k].boxes_clearance(a, b);
+            axes[k] = c.point_b - c.point_a;
+            c
+        });
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         let kept = self.kept_free(None);
         // A witness kept from an earlier STOP tick (no inverse kinematics at all), then steps 6
@@ -826,7 +834,8 @@ impl ProtectiveChecker {
                     }
                 }
                 let swept = |j: usize| (self.ref_boxes[j].as_slice(), &self.sweeps[j], &self.faces[j]);
-                if let Some((box_a, box_b)) = first_unproved_between(swept(p.a), swept(p.b), extra) {
+                let axis = &self.pair_axes[k];
+                if let Some((box_a, box_b)) = first_unproved_between(swept(p.a), swept(p.b), extra, axis) {
                     return (verdict, Some(BoxPair { a: p.a, b: p.b, box_a, box_b }));
                 }
             }

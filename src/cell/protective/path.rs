@@ -223,6 +223,7 @@ impl ProtectiveChecker {
             (pa.boxes.as_slice(), &pa.sweeps, &pa.faces),
             (pb.boxes.as_slice(), &pb.sweeps, &pb.faces),
             extra,
+            &Vec3::zeros(),
         )
         .map(|(box_a, box_b)| BoxPair { a, b, box_a, box_b })?;
         let span = |p: &Piece| p.arc.map_or(-1.0, |(s0, s1)| s1 - s0);

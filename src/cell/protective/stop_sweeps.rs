@@ -84,21 +84,22 @@ fn write_forms(out: &mut SweepForms, filled: bool, rot_wcs: &crate::math::Mat3) 
 pub type SweepForms = [[Sweep; MAX_BOXES]; 2];
 
 /// The first box pair (of the pairs involving `only`, or of all pairs) not proved apart
-/// with `extra` mm added to the first robot's sweep.
+/// with `extra` mm added to the first robot's sweep, each pair `k` also on `axes[k]`.
 /// `faces[j][form][k]` are the face terms of robot `j`'s box `k` under `sweeps[j][form][k]`.
 pub(super) fn first_unproved<'a>(
     pairs: &[PairVerdict],
     boxes: &impl Fn(usize) -> &'a [Obb],
-    sweeps: &[SweepForms],
-    faces: &[[[FaceTerms; MAX_BOXES]; 2]],
+    (sweeps, faces): (&[SweepForms], &[[[FaceTerms; MAX_BOXES]; 2]]),
+    axes: &[Vec3],
     only: Option<usize>,
     extra: Real,
 ) -> Option<BoxPair> {
-    for p in pairs.iter().filter(|p| only.is_none_or(|j| p.a == j || p.b == j)) {
+    for (p, axis) in pairs.iter().zip(axes).filter(|(p, _)| only.is_none_or(|j| p.a == j || p.b == j)) {
         let found = first_unproved_between(
             (boxes(p.a), &sweeps[p.a], &faces[p.a]),
             (boxes(p.b), &sweeps[p.b], &faces[p.b]),
             extra,
+            axis,
         );
         if let Some((box_a, box_b)) = found {
             return Some(BoxPair { a: p.a, b: p.b, box_a, box_b });
@@ -108,14 +109,21 @@ pub(super) fn first_unproved<'a>(
 }
 
 /// Whether box `a` swept by `sa` (one per form, `extra` mm added to its ball) and box `b`
-/// swept by `sb` are proved apart in some combination of forms ([`first_unproved_between`]'s
-/// test for one box pair).
-pub(super) fn pair_apart_in_some_form(a: &Obb, sa: [&Sweep; 2], b: &Obb, sb: [&Sweep; 2], extra: Real) -> bool {
+/// swept by `sb` are proved apart in some combination of forms, also on `axis`
+/// ([`first_unproved_between`]'s test for one box pair).
+pub(super) fn pair_apart_in_some_form(
+    a: &Obb,
+    sa: [&Sweep; 2],
+    b: &Obb,
+    sb: [&Sweep; 2],
+    extra: Real,
+    axis: &Vec3,
+) -> bool {
     let mut wider = None;
     let sa = with_extra(sa, extra, &mut wider);
     let (fa0, fa1) = (FaceTerms::new(a, sa[0]), FaceTerms::new(a, sa[1]));
     let (fb0, fb1) = (FaceTerms::new(b, sb[0]), FaceTerms::new(b, sb[1]));
-    swept_boxes_apart_either(a, sa, [&fa0, &fa1], b, sb, [&fb0, &fb1])
+    swept_boxes_apart_either(a, sa, [&fa0, &fa1], b, sb, [&fb0, &fb1], axis)
 }
 
 /// Both forms of a sweep with `extra` mm added to their balls: the forms themselves for 0
@@ -133,8 +141,14 @@ fn with_extra<'a>(forms: [&'a Sweep; 2], extra: Real, wider: &'a mut Option<[Swe
 pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MAX_BOXES]; 2]);
 
 /// The first box pair `(i, k)` of two robots' swept boxes not proved apart with `extra` mm
-/// added to the first robot's sweeps, any combination of sweep forms allowed.
-pub(super) fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) -> Option<(usize, usize)> {
+/// added to the first robot's sweeps, any combination of sweep forms allowed, on the 15 axes
+/// of each box pair or on `axis`.
+pub(super) fn first_unproved_between(
+    a: SweptBoxes,
+    b: SweptBoxes,
+    extra: Real,
+    axis: &Vec3,
+) -> Option<(usize, usize)> {
     let ((boxes_a, sweeps_a, faces_a), (boxes_b, sweeps_b, faces_b)) = (a, b);
     // With `extra`, the first robot's face terms under its widened sweeps (a copy only then:
     // the tests of the speed limits call this with no `extra`, many times per tick).
@@ -154,7 +168,7 @@ pub(super) fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real) 
         let sa = with_extra([&sweeps_a[0][i], &sweeps_a[1][i]], extra, &mut wider);
         for (k, box_b) in boxes_b.iter().enumerate() {
             let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
-            if !swept_boxes_apart_either(box_a, sa, fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb) {
+            if !swept_boxes_apart_either(box_a, sa, fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb, axis) {
                 return Some((i, k));
             }
         }
