@@ -726,7 +726,7 @@ impl CubeSwing {
 /// sweeps ([`Sweep::ends`], the face at `-half_0 u_0` first): `|l|` at the ends
 /// `l = -mu, 1 + mu` of a lower link (step 4), 1 for the boxes that translate with the TCP,
 /// 0 for an upper link.
-pub(crate) fn tcp_weights(model: &RobotModel, k: usize) -> [Real; 2] {
+pub fn tcp_weights(model: &RobotModel, k: usize) -> [Real; 2] {
     match model.box_kind(k) {
         BoxKind::LowerLink(_) => {
             let mu = model.options.margin / model.delta.re;

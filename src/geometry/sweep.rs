@@ -34,9 +34,12 @@
 //! `g(m) <= h_S(m)` (both brackets are at most `max(h_1, h_2)`), with equality where `s = 0`
 //! or `E_1 = E_2`: the gain is on axes along the box (for two lower links, their own face 0 and
 //! the edges across it), where the end nearer the other box moves with its own set only.
-//! [`swept_boxes_apart_either`] and [`balls_swept_apart_with`] read sweeps so (the protective
-//! verdict); [`swept_boxes_apart`] reads every point in all of `S` (the tables' test, whose
-//! faster form [`crate::cspace::swept_sat`] is kept equal to it).
+//! [`swept_boxes_apart_either`], [`swept_boxes_apart_graded`] and [`balls_swept_apart_with`]
+//! read sweeps so (the protective verdict); [`swept_boxes_apart`] reads every point in all of
+//! `S` (the tables' test, whose faster form [`crate::cspace::swept_sat`] is kept equal to it).
+//! The graded tests also take one more axis, any vector: the 15 axes decide whether two boxes
+//! meet, but not whether two swept sets do, so a good guess (the protective verdict gives the
+//! direction between the boxes' closest points now) proves pairs that none of the 15 does.
 //!
 //! # The test
 //! If every point of a box at some configuration lies within `S` of the point with the same

@@ -119,14 +119,14 @@ impl ProtectiveChecker {
         if let Some(h) = hint.filter(|h| only.is_none_or(|j| h.a == j || h.b == j) && self.ball_swept_meet(*h)) {
             return Some(h);
         }
-        for k in 0..self.exact.verdict().pairs.len() {
-            let p = self.exact.verdict().pairs[k];
+        for q in 0..self.exact.verdict().pairs.len() {
+            let p = self.exact.verdict().pairs[q];
             if !only.is_none_or(|j| p.a == j || p.b == j) {
                 continue;
             }
             self.set_least_all(p.a);
             self.set_least_all(p.b);
-            let (swept_a, swept_b, axis) = (&self.least[p.a], &self.least[p.b], &self.pair_axes[k]);
+            let (swept_a, swept_b, axis) = (&self.least[p.a], &self.least[p.b], &self.pair_axes[q]);
             for (i, (box_a, (sa, fa))) in self.ref_boxes[p.a].as_slice().iter().zip(swept_a).enumerate() {
                 for (k, (box_b, (sb, fb))) in self.ref_boxes[p.b].as_slice().iter().zip(swept_b).enumerate() {
                     if !balls_swept_apart_with(box_a, *sa, fa, box_b, *sb, fb, axis) {

@@ -53,10 +53,12 @@
 //!    a lower link at `l` along it moves within `|l| Z + |1 - l| A` (`cspace::guarantee`, step
 //!    4), so the end nearer the platform joint carries the TCP's set and hardly any of the
 //!    elbow's arc, the end at the elbow the reverse; likewise for `b`.
-//!    [`swept_boxes_apart_either`] proves the two swept sets disjoint on one of the 15 axes
-//!    (with a positive gap). All box pairs of all pairs that can meet proved: FREE. Proved
-//!    again with `warn_mm` added to one sweep's ball: else WARN. Any unproved pair,
-//!    unreachable TCP, unbounded sweep or status other than OK: STOP.
+//!    [`swept_boxes_apart_either`] proves the two swept sets disjoint on one of the 15 axes,
+//!    or on the direction between the robot pair's closest points this tick (any axis is
+//!    sound; this one looks where the robots are nearest), with a positive gap. All box pairs
+//!    of all pairs that can meet proved: FREE. Proved again with `warn_mm` added to one
+//!    sweep's ball: else WARN. Any unproved pair, unreachable TCP, unbounded sweep or status
+//!    other than OK: STOP.
 //! 6. **Certain STOP, before any sweep.** In every sweep of a box, a point at fraction `f` of
 //!    the way from the box's face at `-half_0 u_0` to the one at `+half_0 u_0` moves within a
 //!    set that holds the ball of radius `((1 - f) e_1 + f e_2) S'` (`S'` the radius of step 3's
@@ -81,8 +83,7 @@
 //!    parallel to `w`, so these are where the angle is largest and smallest to first order),
 //!    those that are reachable. Step 4's sweep of a box depends on the enclosure only through its arm's
 //!    `dth = max(th.hi - th(p0), th(p0) - th.lo)`, and grows with it on every axis, at both
-//!    ends (the
-//!    elbow's chord `2 rf sin(dth / 2)`, the arc's `sin dth` and `1 - cos dth`, all
+//!    ends (the elbow's chord `2 rf sin(dth / 2)`, the arc's `sin dth` and `1 - cos dth`, all
 //!    increasing on `[0, pi]`; the TCP terms do not depend on it). So the sweeps built from
 //!    the hull of those angles alone ([`ProtectiveChecker::least_sweeps`]: each angle taken
 //!    `ANGLE_SLACK` toward `th(p0)`, far above the rounding of the inverse kinematics, and
