@@ -231,7 +231,7 @@ fn least_radii(model: &RobotModel, k: usize, reach: Real) -> [Real; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
-        use crate::cell::reference::reference_cell;
+    use crate::cell::reference::reference_cell;
     use crate::robot::StopModel;
 
     /// Step 6's points answer as its separating axis test on every closest pair of the

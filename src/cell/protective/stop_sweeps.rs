@@ -143,12 +143,7 @@ pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MA
 /// The first box pair `(i, k)` of two robots' swept boxes not proved apart with `extra` mm
 /// added to the first robot's sweeps, any combination of sweep forms allowed, on the 15 axes
 /// of each box pair or on `axis`.
-pub(super) fn first_unproved_between(
-    a: SweptBoxes,
-    b: SweptBoxes,
-    extra: Real,
-    axis: &Vec3,
-) -> Option<(usize, usize)> {
+pub(super) fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real, axis: &Vec3) -> Option<(usize, usize)> {
     let ((boxes_a, sweeps_a, faces_a), (boxes_b, sweeps_b, faces_b)) = (a, b);
     // With `extra`, the first robot's face terms under its widened sweeps (a copy only then:
     // the tests of the speed limits call this with no `extra`, many times per tick).
