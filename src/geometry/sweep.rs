@@ -34,9 +34,9 @@
 //! `g(m) <= h_S(m)` (both brackets are at most `max(h_1, h_2)`), with equality where `s = 0`
 //! or `E_1 = E_2`: the gain is on axes along the box (for two lower links, their own face 0 and
 //! the edges across it), where the end nearer the other box moves with its own set only.
-//! [`swept_boxes_apart_either`], [`swept_boxes_apart_graded`] and [`balls_swept_apart_with`]
-//! read sweeps so (the protective verdict); [`swept_boxes_apart`] reads every point in all of
-//! `S` (the tables' test, whose faster form [`crate::cspace::swept_sat`] is kept equal to it).
+//! [`swept_boxes_apart_either`] and [`balls_swept_apart_with`] read sweeps so (the protective
+//! verdict); [`swept_boxes_apart`] reads every point in all of `S` (the tables' test, whose
+//! faster form [`crate::cspace::swept_sat`] is kept equal to it).
 //! The graded tests also take one more axis, any vector: the 15 axes decide whether two boxes
 //! meet, but not whether two swept sets do, so a good guess (the protective verdict gives the
 //! direction between the boxes' closest points now) proves pairs that none of the 15 does.
@@ -302,31 +302,6 @@ pub fn balls_swept_apart_with(
 #[inline(always)]
 fn graded_ball_support(r: [Real; 2], x: Vec3, half: Real) -> impl Fn(&Vec3, Real, Real) -> Real {
     move |n: &Vec3, len: Real, sign: Real| graded_ends([r[0] * len, r[1] * len], half * (sign * x.dot(n)))
-}
-
-/// [`swept_boxes_apart_either`] with one sweep per box (`fa = FaceTerms::new(a, sa)`,
-/// `fb = FaceTerms::new(b, sb)`): the same answer as giving each sweep as both forms.
-pub fn swept_boxes_apart_graded(
-    a: &Obb,
-    sa: &Sweep,
-    fa: &FaceTerms,
-    b: &Obb,
-    sb: &Sweep,
-    fb: &FaceTerms,
-    also: &Vec3,
-) -> bool {
-    apart_on_an_axis(
-        also,
-        (a, fa, |k: usize, sign| fa.graded(k, sign), graded_support_of(sa, fa.u[0], a.half.x)),
-        (b, fb, |k: usize, sign| fb.graded(k, sign), graded_support_of(sb, fb.u[0], b.half.x)),
-    )
-}
-
-/// The graded support of `s` for a box with axis 0 `x` and half-extent `half` along it:
-/// `(m, |m|, sign)` to `g(sign m)`.
-#[inline(always)]
-fn graded_support_of(s: &Sweep, x: Vec3, half: Real) -> impl Fn(&Vec3, Real, Real) -> Real + '_ {
-    move |n: &Vec3, len: Real, sign: Real| s.graded_support(n, len, half * (sign * x.dot(n)))
 }
 
 /// The smaller graded support of two sweeps of a box with axis 0 `x` and half-extent `half`
@@ -653,6 +628,12 @@ pub(crate) mod tests {
         }
     }
 
+    /// [`swept_boxes_apart_either`] with one sweep per box, given as both forms.
+    fn graded_apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep, also: &Vec3) -> bool {
+        let (fa, fb) = (FaceTerms::new(a, sa), FaceTerms::new(b, sb));
+        swept_boxes_apart_either(a, [sa, sa], [&fa, &fa], b, [sb, sb], [&fb, &fb], also)
+    }
+
     /// Displacement parameters for [`point_of`], one per robot box, as the property tests draw them.
     pub(crate) type Moves = Vec<([Real; 8], [Real; 8])>;
 
@@ -786,8 +767,7 @@ pub(crate) mod tests {
             prop_assert_eq!(FaceTerms::ball(&a, ra), FaceTerms::new(&a, &sa));
             let same = |t: Real| {
                 let b = Obb { center: a.center + v * t, ..b };
-                let (ga, gb) = (FaceTerms::new(&a, &sa), FaceTerms::new(&b, &sb));
-                let general = swept_boxes_apart_graded(&a, &sa, &ga, &b, &sb, &gb, &also);
+                let general = graded_apart(&a, &sa, &b, &sb, &also);
                 let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
                 (balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, &also) == general, general)
             };
@@ -837,7 +817,7 @@ pub(crate) mod tests {
                 let (fa, fb) = ([sa, sa1].map(|w| FaceTerms::new(&a, &w)), [sb, sb1].map(|w| FaceTerms::new(&b, &w)));
                 let pairs: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
                 let (wa, wb) = ([&sa, &sa1], [&sb, &sb1]);
-                let each = pairs.map(|(i, k)| swept_boxes_apart_graded(&a, wa[i], &fa[i], &b, wb[k], &fb[k], &also));
+                let each = pairs.map(|(i, k)| graded_apart(&a, wa[i], &b, wb[k], &also));
                 let once = swept_boxes_apart_either(&a, wa, [&fa[0], &fa[1]], &b, wb, [&fb[0], &fb[1]], &also);
                 (once == each.iter().any(|&x| x), each)
             };
@@ -877,9 +857,8 @@ pub(crate) mod tests {
                 ts in prop::collection::vec(prop::array::uniform4(prop::array::uniform8(-1.0..1.0f64)), 32)) {
             // B near A, so that both answers occur.
             let b = Obb { center: a.center + Vec3::from(toward) * 400.0, ..b };
-            let (fa, fb) = (FaceTerms::new(&a, &sa), FaceTerms::new(&b, &sb));
-            let proved = swept_boxes_apart_graded(&a, &sa, &fa, &b, &sb, &fb, &also);
-            prop_assert_eq!(proved, swept_boxes_apart_graded(&b, &sb, &fb, &a, &sa, &fa, &also));
+            let proved = graded_apart(&a, &sa, &b, &sb, &also);
+            prop_assert_eq!(proved, graded_apart(&b, &sb, &a, &sa, &also));
             prop_assert!(proved || !swept_boxes_apart(&a, &sa, &b, &sb));
             if proved {
                 for t in &ts {
