@@ -1014,6 +1014,22 @@ pub(crate) mod tests {
         assert!(proved * 4 > intersecting, "{proved} proved of {intersecting} intersecting");
     }
 
+    /// Two cubes corner to corner, swept by balls: no face axis separates the rounded boxes
+    /// (and their edge axes are degenerate), the direction between the corners does, and only
+    /// while the corners are farther apart than the two radii.
+    #[test]
+    fn the_extra_axis_proves_what_the_fifteen_cannot() {
+        let a = Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::repeat(1.0));
+        let b = Obb::new(Vec3::repeat(2.5), Mat3::identity(), Vec3::repeat(1.0));
+        let (fa, fb) = (FaceTerms::ball(&a, [0.3; 2]), FaceTerms::ball(&b, [0.3; 2]));
+        let diagonal = Vec3::repeat(1.0);
+        assert!(!balls_swept_apart_with(&a, [0.3; 2], &fa, &b, [0.3; 2], &fb, &Vec3::zeros()));
+        assert!(balls_swept_apart_with(&a, [0.3; 2], &fa, &b, [0.3; 2], &fb, &diagonal));
+        // The corners are 0.866 apart: radii of 0.44 each leave no room on any axis.
+        let (ga, gb) = (FaceTerms::ball(&a, [0.44; 2]), FaceTerms::ball(&b, [0.44; 2]));
+        assert!(!balls_swept_apart_with(&a, [0.44; 2], &ga, &b, [0.44; 2], &gb, &diagonal));
+    }
+
     #[test]
     fn zero_sweep_is_zero_and_a_ball_is_not() {
         assert!(Sweep::ZERO.is_zero());
