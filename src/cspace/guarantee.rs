@@ -714,9 +714,13 @@ impl CubeSwing {
                 let (tau0, nu0, along, inward) = self.arcs[arm as usize];
                 let (l, w) = (d.rf + m, du + m);
                 let arc = [tau0 * (l * along + w * inward), nu0 * (l * inward + w * along)];
-                Sweep { cube, round, arc, ends: [(0.0, 1.0); 2], ..Sweep::ZERO }
+                let [e1, e2] = tcp_weights(model, j);
+                Sweep { cube, round, arc, ends: [(e1, 1.0), (e2, 1.0)], ..Sweep::ZERO }
             }
-            BoxKind::Platform | BoxKind::Tool => Sweep { cube, round, ends: [(1.0, 0.0); 2], ..Sweep::ZERO },
+            BoxKind::Platform | BoxKind::Tool => {
+                let [e1, e2] = tcp_weights(model, j);
+                Sweep { cube, round, ends: [(e1, 0.0), (e2, 0.0)], ..Sweep::ZERO }
+            }
         };
         Sweep { ball: sweep.ball + BOUND_SLACK, ..sweep }
     }

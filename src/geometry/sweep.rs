@@ -164,7 +164,8 @@ impl Sweep {
     /// The support on `n` of the set that the point of a box on face `end` (0: at
     /// `-half_0 u_0`, 1: at `+half_0 u_0`) moves within under the graded reading (module doc):
     /// `c |n| + |l . n| + h_end`.
-    pub fn face_support(&self, end: usize, n: &Vec3) -> Real {
+    #[cfg(test)]
+    pub(crate) fn face_support(&self, end: usize, n: &Vec3) -> Real {
         let norm = float::sqrt(n.norm_squared());
         self.ball * norm + self.line.dot(n).abs() + self.end_terms(n, norm)[end]
     }
@@ -227,22 +228,28 @@ pub struct FaceTerms {
 impl FaceTerms {
     /// The face terms of box `b` swept by `s`.
     pub fn new(b: &Obb, s: &Sweep) -> FaceTerms {
-        let u = axes(b);
-        let norm = u.map(|n| float::sqrt(n.norm_squared()));
-        let along = b.half.x * u[0].dot(&u[0]);
-        FaceTerms {
-            short: u.map(|n| n.norm_squared() < 1e-10),
-            u,
-            radius: core::array::from_fn(|k| radius(&u, &b.half, &u[k])),
-            support: core::array::from_fn(|k| s.support_with_norm(&u[k], norm[k])),
-            graded_x: [-along, along].map(|half_s| s.graded_support(&u[0], norm[0], half_s)),
-            norm,
-        }
+        let graded = |n: &Vec3, len, half_s| s.graded_support(n, len, half_s);
+        FaceTerms::from_supports(b, |n, len| s.support_with_norm(n, len), graded)
     }
 
     /// [`FaceTerms::new`] for [`Sweep::graded_ball`]`(r)`: the same values to the bit, without
     /// evaluating the terms of a sweep that are zero.
     pub fn ball(b: &Obb, r: [Real; 2]) -> FaceTerms {
+        FaceTerms::from_supports(
+            b,
+            |_, len| (r[0] * len).max(r[1] * len),
+            |_, len, half_s| graded_ends([r[0] * len, r[1] * len], half_s),
+        )
+    }
+
+    /// The face terms of box `b` from a sweep's support `(n, |n|)` and graded support
+    /// `(n, |n|, half_s)`.
+    #[inline(always)]
+    fn from_supports(
+        b: &Obb,
+        support: impl Fn(&Vec3, Real) -> Real,
+        graded: impl Fn(&Vec3, Real, Real) -> Real,
+    ) -> FaceTerms {
         let u = axes(b);
         let norm = u.map(|n| float::sqrt(n.norm_squared()));
         let along = b.half.x * u[0].dot(&u[0]);
@@ -250,8 +257,8 @@ impl FaceTerms {
             short: u.map(|n| n.norm_squared() < 1e-10),
             u,
             radius: core::array::from_fn(|k| radius(&u, &b.half, &u[k])),
-            support: norm.map(|len| (r[0] * len).max(r[1] * len)),
-            graded_x: [-along, along].map(|half_s| graded_ends([r[0] * norm[0], r[1] * norm[0]], half_s)),
+            support: core::array::from_fn(|k| support(&u[k], norm[k])),
+            graded_x: [-along, along].map(|half_s| graded(&u[0], norm[0], half_s)),
             norm,
         }
     }
@@ -566,17 +573,19 @@ pub(crate) mod tests {
     /// one of the segment.
     pub(crate) fn point_of(s: &Sweep, t: &[Real; 8]) -> Vec3 {
         let k = if t[0] < 0.0 { 0 } else { 1 };
-        let (e, d) = s.ends[k];
-        // A point of the box `Z` and one of its rounding ball (from the same parameters).
-        let u = Vec3::new(t[1], t[2], t[3]);
-        let z = s.cube[0] * t[1]
-            + s.cube[1] * t[2]
-            + s.cube[2] * t[3]
-            + if u.norm() > 1.0 { u.normalize() } else { u } * s.round;
+        let into_ball = |v: Vec3| if v.norm() > 1.0 { v.normalize() } else { v };
+        end_set_point(s, k, t, into_ball) + s.line * (2.0 * t[0].abs() - 1.0)
+    }
+
+    /// A point of `E_end` plus one of the ball `c`, from `t[1..8]`: a point of the box `Z` and
+    /// one of its rounding ball (from the same parameters), one of the rectangle `A`; `into_ball`
+    /// maps `[-1, 1]^3` into the unit ball.
+    fn end_set_point(s: &Sweep, end: usize, t: &[Real; 8], into_ball: impl Fn(Vec3) -> Vec3) -> Vec3 {
+        let (e, d) = s.ends[end];
+        let cube = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3];
+        let z = cube + into_ball(Vec3::new(t[1], t[2], t[3])) * s.round;
         let a = s.arc[0] * t[4] + s.arc[1] * t[5];
-        let any = Vec3::new(t[5], t[6], t[7]);
-        let ball = if any.norm() > 1.0 { any.normalize() } else { any } * s.ball;
-        z * e + a * d + ball + s.line * (2.0 * t[0].abs() - 1.0)
+        z * e + a * d + into_ball(Vec3::new(t[5], t[6], t[7])) * s.ball
     }
 
     prop_compose! {
@@ -591,12 +600,7 @@ pub(crate) mod tests {
     /// parameters in `[-1, 1]` pushed to the set's boundary for a third of their range.
     fn point_of_end(s: &Sweep, end: usize, t: &[Real; 8]) -> Vec3 {
         let t = t.map(|x| (1.5 * x).clamp(-1.0, 1.0));
-        let (e, d) = s.ends[end];
-        let u = Vec3::new(t[1], t[2], t[3]);
-        let z = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3] + u.try_normalize(1e-9).unwrap_or(u) * s.round;
-        let a = s.arc[0] * t[4] + s.arc[1] * t[5];
-        let any = Vec3::new(t[5], t[6], t[7]);
-        z * e + a * d + any.try_normalize(1e-9).unwrap_or(any) * s.ball + s.line * t[0]
+        end_set_point(s, end, &t, |v: Vec3| v.try_normalize(1e-9).unwrap_or(v)) + s.line * t[0]
     }
 
     /// The corners of `b` after its face at `-half_0 u_0` moved by `d[0]` and the one at
