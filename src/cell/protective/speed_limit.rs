@@ -52,7 +52,8 @@ impl ProtectiveChecker {
         floor: Real,
         budget: u32,
     ) -> (Real, u32, Real) {
-        let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]);
+        let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.graded[j]);
+        let saved_tier = self.sweep_tier[j];
         let inside = self.kept.inside(j);
         // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
         let proved = |me: &mut Self, v: Real, tier: Option<u32>| {
@@ -81,7 +82,7 @@ impl ProtectiveChecker {
                 }
             }
             let boxes = |i: usize| me.ref_boxes[i].as_slice();
-            first_unproved(&me.exact.verdict().pairs, &boxes, (&me.sweeps, &me.faces), &me.pair_axes, Some(j), 0.0)
+            first_unproved(&me.exact.verdict().pairs, &boxes, (&me.sweeps, &me.faces, &me.graded), &me.pair_axes, Some(j), 0.0)
                 .is_none()
         };
         let vmax = self.cell().stops[j].max_speed_mm_s;
@@ -230,7 +231,8 @@ impl ProtectiveChecker {
                 bisect(self, (hi, top), Some(tier)).0
             }
         };
-        (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.sweep_tier[j]) = saved;
+        (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.graded[j]) = saved;
+        self.sweep_tier[j] = saved_tier;
         // The certain-STOP terms are those of the last speed tested: built again when needed.
         self.least_set[j] = 0;
         self.kept.restore_inside(j, inside);

@@ -5,7 +5,8 @@
 use super::{BoxPair, SPLITS};
 use crate::cell::exact::PairVerdict;
 use crate::cspace::guarantee::{box_sweep_forms_into, theta_range, Enclosure};
-use crate::geometry::sweep::{swept_boxes_apart_either, FaceTerms};
+use crate::geometry::graded_closest::{graded_closest, GradedClosest};
+use crate::geometry::sweep::{swept_boxes_apart_either, swept_boxes_apart_either_along, FaceTerms};
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::motor_table::{intersect, MotorTable};
@@ -89,15 +90,15 @@ pub type SweepForms = [[Sweep; MAX_BOXES]; 2];
 pub(super) fn first_unproved<'a>(
     pairs: &[PairVerdict],
     boxes: &impl Fn(usize) -> &'a [Obb],
-    (sweeps, faces): (&[SweepForms], &[[[FaceTerms; MAX_BOXES]; 2]]),
+    (sweeps, faces, radii): EveryRobotSwept,
     axes: &[Vec3],
     only: Option<usize>,
     extra: Real,
 ) -> Option<BoxPair> {
     for (p, axis) in pairs.iter().zip(axes).filter(|(p, _)| only.is_none_or(|j| p.a == j || p.b == j)) {
         let found = first_unproved_between(
-            (boxes(p.a), &sweeps[p.a], &faces[p.a]),
-            (boxes(p.b), &sweeps[p.b], &faces[p.b]),
+            (boxes(p.a), &sweeps[p.a], &faces[p.a], &radii[p.a]),
+            (boxes(p.b), &sweeps[p.b], &faces[p.b], &radii[p.b]),
             extra,
             axis,
         );
@@ -109,13 +110,12 @@ pub(super) fn first_unproved<'a>(
 }
 
 /// Whether box `a` swept by `sa` (one per form, `extra` mm added to its ball) and box `b`
-/// swept by `sb` are proved apart in some combination of forms, also on `axis`
-/// ([`first_unproved_between`]'s test for one box pair).
+/// swept by `sb` are proved apart in some combination of forms, on their 15 axes, on `axis`
+/// or on their graded axis ([`graded_points`]) from the graded radii `ra` and `rb` ([`first_unproved_between`]'s
+/// test for one box pair).
 pub(super) fn pair_apart_in_some_form(
-    a: &Obb,
-    sa: [&Sweep; 2],
-    b: &Obb,
-    sb: [&Sweep; 2],
+    (a, sa, ra): (&Obb, [&Sweep; 2], [Real; 2]),
+    (b, sb, rb): (&Obb, [&Sweep; 2], [Real; 2]),
     extra: Real,
     axis: &Vec3,
 ) -> bool {
@@ -123,7 +123,19 @@ pub(super) fn pair_apart_in_some_form(
     let sa = with_extra(sa, extra, &mut wider);
     let (fa0, fa1) = (FaceTerms::new(a, sa[0]), FaceTerms::new(a, sa[1]));
     let (fb0, fb1) = (FaceTerms::new(b, sb[0]), FaceTerms::new(b, sb[1]));
-    swept_boxes_apart_either(a, sa, [&fa0, &fa1], b, sb, [&fb0, &fb1], axis)
+    let (fa, fb) = ([&fa0, &fa1], [&fb0, &fb1]);
+    swept_boxes_apart_either(a, sa, fa, b, sb, fb, axis)
+        || swept_boxes_apart_either_along(a, sa, fa, b, sb, fb, &graded_points((a, ra), (b, rb), extra).axis())
+}
+
+/// The closest points of box `a` swept by the graded ball of radii `ra` (plus `extra`) and box
+/// `b` by that of `rb`, sought from `b`'s centre ([`graded_closest`]); the direction between
+/// them is the axis the swept-box proofs try for the box pair besides the 15 and the robot
+/// pair's (module doc of `protective`, step 5). Every sweep of a box holds its graded ball
+/// (step 6), so the direction looks where the sweeps come nearest; a function of the boxes and
+/// radii alone, so that the certain STOPs (steps 6 and 7) test the very axis the proof would.
+pub(super) fn graded_points((a, ra): (&Obb, [Real; 2]), (b, rb): (&Obb, [Real; 2]), extra: Real) -> GradedClosest {
+    graded_closest(a, ra.map(|r| r + extra), b, rb, &b.center)
 }
 
 /// Both forms of a sweep with `extra` mm added to their balls: the forms themselves for 0
@@ -137,16 +149,23 @@ fn with_extra<'a>(forms: [&'a Sweep; 2], extra: Real, wider: &'a mut Option<[Swe
     [&copies[0], &copies[1]]
 }
 
-/// One robot's boxes, their sweeps, and the face terms of each box under each sweep form.
-pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MAX_BOXES]; 2]);
+/// One robot's boxes, their sweeps, the face terms of each box under each sweep form, and the
+/// boxes' graded radii.
+pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MAX_BOXES]; 2], &'a GradedRadii);
+
+/// Every robot's sweeps, face terms and graded radii, as [`first_unproved`] reads them.
+pub(super) type EveryRobotSwept<'a> = (&'a [SweepForms], &'a [[[FaceTerms; MAX_BOXES]; 2]], &'a [GradedRadii]);
+
+/// Per box of a robot, the radii of the graded ball that every sweep of the box holds (module
+/// doc of `protective`, step 6): what graded axis ([`graded_points`]) reads.
+pub(super) type GradedRadii = [[Real; 2]; MAX_BOXES];
 
 /// The first box pair `(i, k)` of two robots' swept boxes not proved apart with `extra` mm
 /// added to the first robot's sweeps, any combination of sweep forms allowed, on the 15 axes
-/// of each box pair or on `axis`.
+/// of each box pair, on `axis` or on the pair's graded axis ([`graded_points`]) (computed only for the pairs
+/// that the others leave unproved).
 pub(super) fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real, axis: &Vec3) -> Option<(usize, usize)> {
-    let ((boxes_a, sweeps_a, faces_a), (boxes_b, sweeps_b, faces_b)) = (a, b);
-    // With `extra`, the first robot's face terms under its widened sweeps (a copy only then:
-    // the tests of the speed limits call this with no `extra`, many times per tick).
+    let ((boxes_a, sweeps_a, faces_a, radii_a), (boxes_b, sweeps_b, faces_b, radii_b)) = (a, b);
     let mut copy = None;
     if extra != 0.0 {
         let terms = copy.insert(*faces_a);
@@ -163,7 +182,12 @@ pub(super) fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real, 
         let sa = with_extra([&sweeps_a[0][i], &sweeps_a[1][i]], extra, &mut wider);
         for (k, box_b) in boxes_b.iter().enumerate() {
             let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
-            if !swept_boxes_apart_either(box_a, sa, fa, box_b, [&sweeps_b[0][k], &sweeps_b[1][k]], fb, axis) {
+            let sb = [&sweeps_b[0][k], &sweeps_b[1][k]];
+            let apart = || {
+                let graded = graded_points((box_a, radii_a[i]), (box_b, radii_b[k]), extra).axis();
+                swept_boxes_apart_either_along(box_a, sa, fa, box_b, sb, fb, &graded)
+            };
+            if !(swept_boxes_apart_either(box_a, sa, fa, box_b, sb, fb, axis) || apart()) {
                 return Some((i, k));
             }
         }
