@@ -110,35 +110,6 @@ impl ProtectiveChecker {
         pairs.iter().position(|q| (q.a, q.b) == (p.a, p.b)).map_or(Vec3::zeros(), |k| self.pair_axes[k])
     }
 
-    /// A box pair (of the pairs involving `only`, or of all) that no sweeps of any tier can
-    /// prove apart: every sweep of a box holds the graded ball of the TCP's stopping radius
-    /// times the TCP's weight at each end (module doc, step 6), so when the reference boxes
-    /// swept by those balls alone are not proved apart, neither are they with the full sweeps.
-    pub(super) fn certain_stop(&mut self, only: Option<usize>, hint: Option<BoxPair>) -> Option<BoxPair> {
-        // The closest box pair now is the likeliest to fail: tested first.
-        if let Some(h) = hint.filter(|h| only.is_none_or(|j| h.a == j || h.b == j) && self.ball_swept_meet(*h)) {
-            return Some(h);
-        }
-        for q in 0..self.exact.verdict().pairs.len() {
-            let p = self.exact.verdict().pairs[q];
-            if !only.is_none_or(|j| p.a == j || p.b == j) {
-                continue;
-            }
-            self.set_least_all(p.a);
-            self.set_least_all(p.b);
-            let axis = &self.pair_axes[q];
-            let swept = |j: usize| self.ref_boxes[j].as_slice().iter().zip(self.least[j].iter().zip(&self.graded[j]));
-            for (i, (box_a, (fa, ra))) in swept(p.a).enumerate() {
-                for (k, (box_b, (fb, rb))) in swept(p.b).enumerate() {
-                    if !balls_apart((box_a, *ra, fa), (box_b, *rb, fb), axis) {
-                        return Some(BoxPair { a: p.a, b: p.b, box_a: i, box_b: k });
-                    }
-                }
-            }
-        }
-        None
-    }
-
     /// The certain STOPs of steps 6 and 7 on box pair `p` before the references are set
     /// (step 8): its two reference boxes built as [`ProtectiveChecker::reference_at`] builds
     /// them (the same operations, so the same answers), from this tick's stop balls; step 7
@@ -175,33 +146,12 @@ impl ProtectiveChecker {
     }
 
     /// Whether box pair `p`'s reference boxes swept by their stop balls alone are not proved
-    /// apart: step 6 for one pair.
-    fn ball_swept_meet(&mut self, p: BoxPair) -> bool {
-        self.set_least(p.a, p.box_a);
-        self.set_least(p.b, p.box_b);
+    /// apart: step 6 for one pair, as the speed limits' search asks it before each test's sweeps.
+    pub(super) fn ball_swept_meet(&self, p: BoxPair) -> bool {
         let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
         let (ra, rb) = (self.graded[p.a][p.box_a], self.graded[p.b][p.box_b]);
-        let (fa, fb) = (&self.least[p.a][p.box_a], &self.least[p.b][p.box_b]);
-        !balls_apart((box_a, ra, fa), (box_b, rb, fb), &self.pair_axis(p))
-    }
-
-    /// Box `k` of robot `j`'s terms of [`ProtectiveChecker::certain_stop`] for its current
-    /// reference, when not yet built: each box's sweep and face terms once per reference, not
-    /// once per box pair (the same test as `swept_boxes_apart`, which builds both face terms for
-    /// every pair), and only for the boxes tested.
-    fn set_least(&mut self, j: usize, k: usize) {
-        if self.least_set[j] >> k & 1 == 1 {
-            return;
-        }
-        self.least[j][k] = FaceTerms::ball(&self.ref_boxes[j].as_slice()[k], self.graded[j][k]);
-        self.least_set[j] |= 1 << k;
-    }
-
-    /// [`ProtectiveChecker::set_least`] for every box of robot `j`.
-    fn set_least_all(&mut self, j: usize) {
-        for k in 0..self.ref_boxes[j].len {
-            self.set_least(j, k);
-        }
+        let (fa, fb) = (FaceTerms::ball(box_a, ra), FaceTerms::ball(box_b, rb));
+        !balls_apart((box_a, ra, &fa), (box_b, rb, &fb), &self.pair_axis(p))
     }
 }
 

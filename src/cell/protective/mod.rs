@@ -342,13 +342,6 @@ pub struct ProtectiveChecker {
     /// Per robot, the radii of each box's graded ball of step 6 (module doc) for its current
     /// reference: what every sweep of the box holds, and what the box pairs' graded axes read.
     graded: alloc::vec::Vec<GradedRadii>,
-    /// Per robot, the face terms of each box swept by its graded ball, for
-    /// [`ProtectiveChecker::certain_stop`]: built once per reference, not once per test
-    /// (another robot's stay the same through all the speed-limit tests of a tick).
-    least: alloc::vec::Vec<[FaceTerms; MAX_BOXES]>,
-    /// Per robot, which boxes' terms `least` holds for its current reference (bit `k`: box
-    /// `k`).
-    least_set: alloc::vec::Vec<u8>,
     /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
     kept: kept::Kept,
     /// Per robot pair that can meet, what its clearance was at the last tick: where this
@@ -435,8 +428,6 @@ impl ProtectiveChecker {
             sweep_tier: alloc::vec![None; n],
             no_faces,
             graded: alloc::vec![[[0.0; 2]; MAX_BOXES]; n],
-            least: alloc::vec![[no_faces; MAX_BOXES]; n],
-            least_set: alloc::vec![0; n],
             clearances: alloc::vec![CoherentClearance::new(); n_pairs],
             pair_axes: alloc::vec![Vec3::zeros(); n_pairs],
             table_proved: alloc::vec![false; n_pairs],
@@ -766,7 +757,7 @@ impl ProtectiveChecker {
         // table's bounds (this tick's sweeps of the table's tier, which the proof reuses).
         if kept {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
-        } else if let Some(pair) = early.or_else(|| self.certain_stop(None, None)) {
+        } else if let Some(pair) = early {
             (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
         } else if was_free && self.keep_and_prove() {
             (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
@@ -890,7 +881,7 @@ impl ProtectiveChecker {
                 (*tcp_mcs, s)
             }
         };
-        (self.centres[j], self.reach[j], self.sweep_tier[j], self.least_set[j]) = (centre, radius, None, 0);
+        (self.centres[j], self.reach[j], self.sweep_tier[j]) = (centre, radius, None);
         self.graded[j] = certain_stop::graded_radii(&self.exact.cell().robots[j].model, radius);
         s
     }

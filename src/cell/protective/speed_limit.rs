@@ -61,7 +61,7 @@ impl ProtectiveChecker {
             if me.kept.set_inside(j, &[(me.centres[j], me.reach[j]), (*tcp_mcs, s)]) && me.kept_free(Some(j)) {
                 return true;
             }
-            if me.certain_stop(Some(j), me.report.closest).is_some() {
+            if me.report.closest.is_some_and(|h| (h.a == j || h.b == j) && me.ball_swept_meet(h)) {
                 return false;
             }
             let Some(tier) = tier else { return true };
@@ -233,8 +233,6 @@ impl ProtectiveChecker {
         };
         (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.graded[j]) = saved;
         self.sweep_tier[j] = saved_tier;
-        // The certain-STOP terms are those of the last speed tested: built again when needed.
-        self.least_set[j] = 0;
         self.kept.restore_inside(j, inside);
         // The step is kept only when the limit is the one the steps were taken from.
         let next_step = if limit >= floor { next_step } else { resolution };
