@@ -1,5 +1,6 @@
-//! The closest points of two boxes swept by graded balls ([`Sweep::graded_ball`]): the points
-//! `x` of box `a` and `y` of box `b` that minimise `F(x, y) = |x - y| - r_a(x) - r_b(y)`, where
+//! The closest points of two boxes swept by graded balls
+//! ([`Sweep::graded_ball`](crate::geometry::Sweep::graded_ball)): the points `x` of box `a`
+//! and `y` of box `b` that minimise `F(x, y) = |x - y| - r_a(x) - r_b(y)`, where
 //! `r(x)` is the graded radius at `x` (`r_0` at the box's face at `-half_0 u_0`, growing
 //! linearly along `u_0` to `r_1` at the face at `+half_0 u_0`). The protective verdict uses
 //! them twice (module doc of `cell::protective`, steps 5 and 6):
@@ -118,7 +119,8 @@ impl GradedBox {
 
     /// The local point of the box nearest `y` (a plain projection).
     fn clamp(&self, y: &Vec3) -> Vec3 {
-        Vec3::new(y.x.clamp(-self.half.x, self.half.x), y.y.clamp(-self.half.y, self.half.y), y.z.clamp(-self.half.z, self.half.z))
+        let h = &self.half;
+        Vec3::new(y.x.clamp(-h.x, h.x), y.y.clamp(-h.y, h.y), y.z.clamp(-h.z, h.z))
     }
 }
 
@@ -210,7 +212,8 @@ mod tests {
             let b = if parallel { Obb { axes: a.axes, ..b } } else { b };
             let c = graded_closest(&a, ra, &b, rb, &Vec3::from(from));
             prop_assert!(inside(&a, &c.points[0]) && inside(&b, &c.points[1]));
-            let f = (c.points[1] - c.points[0]).norm() - graded_radius(&a, ra, &c.points[0]) - graded_radius(&b, rb, &c.points[1]);
+            let [x, y] = c.points;
+            let f = (y - x).norm() - graded_radius(&a, ra, &x) - graded_radius(&b, rb, &y);
             prop_assert!((f - c.margin).abs() <= 1e-9 * (1.0 + c.margin.abs()), "{} {}", f, c.margin);
             let oracle = grid_minimum(&a, ra, &b, rb);
             if oracle > 0.0 {

@@ -37,9 +37,11 @@
 //! [`swept_boxes_apart_either`] and [`balls_swept_apart_with`] read sweeps so (the protective
 //! verdict); [`swept_boxes_apart`] reads every point in all of `S` (the tables' test, whose
 //! faster form [`crate::cspace::swept_sat`] is kept equal to it).
-//! The graded tests also take one more axis, any vector: the 15 axes decide whether two boxes
-//! meet, but not whether two swept sets do, so a good guess (the protective verdict gives the
-//! direction between the boxes' closest points now) proves pairs that none of the 15 does.
+//! The graded tests also take one more axis, any vector, or test that axis alone (the
+//! `_along` forms): the 15 axes decide whether two boxes meet, but not whether two swept sets
+//! do, so a good guess proves pairs that none of the 15 does (the protective verdict tries the
+//! direction between the boxes' closest points now, then that between the closest points of
+//! the boxes swept by graded balls: [`crate::geometry::graded_closest`]).
 //!
 //! # The test
 //! If every point of a box at some configuration lies within `S` of the point with the same
@@ -440,8 +442,9 @@ enum Axes<'a> {
 }
 
 /// The 15 axes of the swept tests, and `also` first, or `also` alone ([`Axes`]; an axis is
-/// skipped, as a cross-product axis is, when shorter than `1e-5`), for each box's terms `(box, face terms, its support on its own face
-/// axis k, its support on any vector of the given norm)`; each support is also given
+/// skipped, as a cross-product axis is, when shorter than `1e-5`), for each box's terms
+/// `(box, face terms, its support on its own face axis k, its support on any vector of the
+/// given norm)`; each support is also given
 /// the sign (`1` or `-1`) that turns the axis toward the other box (along `d = c_b - c_a` for
 /// `a`, against it for `b`), which the graded supports read and the others ignore.
 ///

@@ -100,7 +100,8 @@ impl ProtectiveChecker {
             return false;
         };
         let (ra, rb) = (self.step_6_radii(p.a, p.box_a, sa), self.step_6_radii(p.b, p.box_b, sb));
-        !pair_apart_in_some_form((&box_a, [&la[0], &la[1]], ra), (&box_b, [&lb[0], &lb[1]], rb), extra, &self.pair_axis(p))
+        let (a, b) = ((&box_a, [&la[0], &la[1]], ra), (&box_b, [&lb[0], &lb[1]], rb));
+        !pair_apart_in_some_form(a, b, extra, &self.pair_axis(p))
     }
 
     /// The axis the proofs of this tick try for box pair `p`'s robot pair besides the 15 of
@@ -171,7 +172,11 @@ pub(super) fn graded_radii(model: &RobotModel, reach: Real) -> GradedRadii {
 /// of `rb` are proved apart on the axes the proof tries (module doc, step 5): the 15, `axis`
 /// (the robot pair's) and the pair's graded axis ([`graded_points`]). `false` also when the
 /// two swept sets are found to share a point there, which no axis separates.
-fn balls_apart((a, ra, fa): (&Obb, [Real; 2], &FaceTerms), (b, rb, fb): (&Obb, [Real; 2], &FaceTerms), axis: &Vec3) -> bool {
+fn balls_apart(
+    (a, ra, fa): (&Obb, [Real; 2], &FaceTerms),
+    (b, rb, fb): (&Obb, [Real; 2], &FaceTerms),
+    axis: &Vec3,
+) -> bool {
     if balls_swept_apart_with(a, ra, fa, b, rb, fb, axis) {
         return true;
     }

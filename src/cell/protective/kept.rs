@@ -180,7 +180,8 @@ impl ProtectiveChecker {
     pub(super) fn keep_references(&mut self) {
         for j in 0..self.kept.balls.len() {
             if self.sweep_tier[j] == Some((0, 0)) {
-                let ball = (self.centres[j], self.reach[j], self.ref_boxes[j], self.sweeps[j], self.faces[j], self.graded[j]);
+                let (centre, reach, boxes) = (self.centres[j], self.reach[j], self.ref_boxes[j]);
+                let ball = (centre, reach, boxes, self.sweeps[j], self.faces[j], self.graded[j]);
                 self.keep(j, ball);
             }
         }

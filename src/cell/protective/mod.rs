@@ -53,12 +53,18 @@
 //!    a lower link at `l` along it moves within `|l| Z + |1 - l| A` (`cspace::guarantee`, step
 //!    4), so the end nearer the platform joint carries the TCP's set and hardly any of the
 //!    elbow's arc, the end at the elbow the reverse; likewise for `b`.
-//!    [`swept_boxes_apart_either`] proves the two swept sets disjoint on one of the 15 axes,
-//!    or on the direction between the robot pair's closest points this tick (any axis is
-//!    sound; this one looks where the robots are nearest), with a positive gap. All box pairs
-//!    of all pairs that can meet proved: FREE. Proved again with `warn_mm` added to one
-//!    sweep's ball: else WARN. Any unproved pair, unreachable TCP, unbounded sweep or status
-//!    other than OK: STOP.
+//!    [`swept_boxes_apart_either`] proves the two swept sets disjoint, with a positive gap, on
+//!    one of the 15 axes of the box pair, on the direction between the robot pair's closest
+//!    points this tick, or on the box pair's *graded axis*: the direction between the closest
+//!    points of the two boxes swept by the graded balls of step 6, which every sweep holds
+//!    ([`graded_closest`], found from the boxes and radii alone, and only for pairs the
+//!    others leave unproved). Any axis is sound; the 15 decide whether two boxes meet, not
+//!    whether two swept sets do, and the graded axis looks where the sweeps come nearest (on
+//!    the reference runs it proves most of the pairs that the 16 others leave unproved:
+//!    `cargo test --release --lib step_6_points -- --nocapture`). All box pairs of all pairs
+//!    that can meet proved: FREE. Proved again with `warn_mm` added to one sweep's ball (and
+//!    to the graded ball its axis is sought with): else WARN. Any unproved pair, unreachable
+//!    TCP, unbounded sweep or status other than OK: STOP.
 //! 6. **Certain STOP, before any sweep.** In every sweep of a box, a point at fraction `f` of
 //!    the way from the box's face at `-half_0 u_0` to the one at `+half_0 u_0` moves within a
 //!    set that holds the ball of radius `((1 - f) e_1 + f e_2) S'` (`S'` the radius of step 3's
@@ -67,14 +73,15 @@
 //!    links): form 0's `Z` is the cube of half-side `S >= S'`, form 1's the ball of radius `S`,
 //!    and the arc, ball and segment terms hold 0. So on every axis, toward either box, each
 //!    form's graded support is at least that of the [`Sweep::graded_ball`] of radii
-//!    `e_k S'`. When [`balls_swept_apart_with`] does not separate the boxes swept by those
-//!    graded balls (radii shrunk by a relative 1e-9, far above rounding), no tier can: STOP at
-//!    once, without inverse kinematics beyond the reference boxes'. Two points, one of each
-//!    box, closer than their two radii (sought from the closest points now:
-//!    [`balls_swept_meet_near`]) show the swept boxes share a point, so that no axis separates
-//!    them: the same answer without reading the 15 axes. An elbow's end holds only `mu S'` of
-//!    the TCP's ball, so this step settles the pairs that meet near platform joints, platforms
-//!    and tools; near the elbows step 7 does. Steps 6 and 7 live in
+//!    `e_k S'`. When the boxes swept by those graded balls (radii shrunk by a relative 1e-9,
+//!    far above rounding) are not separated on the axes of step 5 ([`balls_swept_apart_with`]
+//!    on the 16, [`balls_swept_apart_along`] on the graded axis, which the graded balls define
+//!    alone, so that this step and the proof try the very same axis), no tier can: STOP at
+//!    once, without inverse kinematics beyond the reference boxes'. The graded axis's two
+//!    points, one of each box, lying closer than their two radii show the swept boxes share a
+//!    point ([`GradedClosest::meet`]), so that no axis at all separates them. An elbow's end
+//!    holds only `mu S'` of the TCP's ball, so this step settles the pairs that meet near
+//!    platform joints, platforms and tools; near the elbows step 7 does. Steps 6 and 7 live in
 //!    `protective/certain_stop.rs`.
 //! 7. **Certain STOP, before tier 2.** Every tier's enclosure of an arm's angle over the ball
 //!    holds the angle `th(p)` of every reachable TCP `p` of the ball, whichever points are
@@ -90,7 +97,8 @@
 //!    each ball shrunk by `LEAST_SLACK`, far above the rounding of the supports, which stay
 //!    `>= 0`: every ball holds `BOUND_SLACK`) have, on every axis and in both forms, a support
 //!    at most that of the sweeps of any tier. When they do not prove the limiting box pair of
-//!    tier 1 apart (with `warn_mm` for a WARN), no refinement of tier 2 proves it: the pairs
+//!    tier 1 apart on the axes of step 5 (with `warn_mm` for a WARN; the graded axis depends
+//!    on the reference boxes and radii, not on the tier), no refinement of tier 2 proves it: the pairs
 //!    before it stay proved (a narrower angle range, a smaller sweep), it stays the first
 //!    unproved one, and the verdict and limiting pair are final without tier 2's direct
 //!    enclosures. This test only ends a search for a proof; it never proves anything.
@@ -99,7 +107,10 @@
 //!    order in which pairs are tried, only the limiting pair reported (then that pair: one
 //!    the proof cannot separate). So both tests are tried first on the closest box pair now,
 //!    the likeliest to fail (step 7 only after a STOP tick, when another STOP is likely),
-//!    before step 6 on every pair and before any sweep of a tier.
+//!    before any reference is set and any sweep of a tier, and step 6 again on that pair
+//!    before each speed tested for a limit. (Step 6 over every box pair, tried after the
+//!    references before the graded axes existed, settled no tick of the reference runs once
+//!    they did: `prot_tick` printed the same answers without it.)
 //! 9. **Certain STOP, kept.** Two reachable TCPs, one in each robot's stop ball, whose boxes
 //!    overlap, make every tick whose balls still hold them STOP (`protective/witness.rs`:
 //!    every sweep holds the boxes of every TCP of its ball). After a STOP the checker seeks
@@ -139,8 +150,10 @@
 //! [`box_sweep_forms_into`]: crate::cspace::guarantee::box_sweep_forms_into
 //! [`tcp_weights`]: crate::cspace::guarantee::tcp_weights
 //! [`balls_swept_apart_with`]: crate::geometry::sweep::balls_swept_apart_with
+//! [`balls_swept_apart_along`]: crate::geometry::sweep::balls_swept_apart_along
 //! [`swept_boxes_apart_either`]: crate::geometry::sweep::swept_boxes_apart_either
-//! [`balls_swept_meet_near`]: crate::geometry::sweep::balls_swept_meet_near
+//! [`graded_closest`]: crate::geometry::graded_closest
+//! [`GradedClosest::meet`]: crate::geometry::graded_closest::GradedClosest::meet
 
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};

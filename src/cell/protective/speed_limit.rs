@@ -82,8 +82,8 @@ impl ProtectiveChecker {
                 }
             }
             let boxes = |i: usize| me.ref_boxes[i].as_slice();
-            first_unproved(&me.exact.verdict().pairs, &boxes, (&me.sweeps, &me.faces, &me.graded), &me.pair_axes, Some(j), 0.0)
-                .is_none()
+            let swept = (&me.sweeps[..], &me.faces[..], &me.graded[..]);
+            first_unproved(&me.exact.verdict().pairs, &boxes, swept, &me.pair_axes, Some(j), 0.0).is_none()
         };
         let vmax = self.cell().stops[j].max_speed_mm_s;
         let resolution = vmax / (1u32 << LIMIT_STEPS) as Real;
