@@ -167,7 +167,7 @@ pub fn graded_closest(a: &Obb, ra: [Real; 2], b: &Obb, rb: [Real; 2], from: &Vec
 mod tests {
     use super::*;
     use crate::geometry::sweep::tests::{any_box, any_radii, rot, unit};
-    use crate::geometry::sweep::{balls_swept_apart_along, balls_swept_apart_with, FaceTerms};
+    use crate::geometry::sweep::{balls_swept_apart_with, Axes, FaceTerms};
     use crate::math::Mat3;
     use proptest::prelude::*;
 
@@ -236,9 +236,10 @@ mod tests {
                 let b = Obb { center: a.center + v * t, ..b };
                 let fb = FaceTerms::ball(&b, rb);
                 let c = graded_closest(&a, ra, &b, rb, &a.center);
-                let along = balls_swept_apart_along(&a, ra, &fa, &b, rb, &fb, &c.axis());
+                let along = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::Only(&c.axis()));
                 if c.meet() {
-                    prop_assert!(!along && !balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, &Vec3::from(other)));
+                    let other = Axes::FifteenAnd(&Vec3::from(other));
+                    prop_assert!(!along && !balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, other));
                 }
                 if c.margin > 1.0 {
                     prop_assert!(along, "margin {}", c.margin);
@@ -290,7 +291,7 @@ mod tests {
                     assert!(graded_closest(&a, ra, &b, rb, &near).meet(), "{origin} {gap_scale}");
                     let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
                     for also in [Vec3::zeros(), Vec3::x(), Vec3::new(1.0, 1.0, 0.0)] {
-                        assert!(!balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, &also));
+                        assert!(!balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::FifteenAnd(&also)));
                     }
                 }
             }
@@ -307,9 +308,9 @@ mod tests {
         let b = Obb::new(Vec3::new(0.0, 60.0, 0.0), Mat3::identity(), Vec3::new(200.0, 10.0, 10.0));
         let (ra, rb) = ([0.0, 30.0], [30.0, 0.0]);
         let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
-        assert!(!balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, &Vec3::y()));
+        assert!(!balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::FifteenAnd(&Vec3::y())));
         let c = graded_closest(&a, ra, &b, rb, &Vec3::new(0.0, 30.0, 0.0));
         assert!(!c.meet() && c.margin > 0.0, "{c:?}");
-        assert!(balls_swept_apart_along(&a, ra, &fa, &b, rb, &fb, &c.axis()), "{c:?}");
+        assert!(balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::Only(&c.axis())), "{c:?}");
     }
 }

@@ -37,8 +37,8 @@
 //! [`swept_boxes_apart_either`] and [`balls_swept_apart_with`] read sweeps so (the protective
 //! verdict); [`swept_boxes_apart`] reads every point in all of `S` (the tables' test, whose
 //! faster form [`crate::cspace::swept_sat`] is kept equal to it).
-//! The graded tests also take one more axis, any vector, or test that axis alone (the
-//! `_along` forms): the 15 axes decide whether two boxes meet, but not whether two swept sets
+//! The graded tests also take one more axis, any vector, or test that axis alone ([`Axes`]):
+//! the 15 axes decide whether two boxes meet, but not whether two swept sets
 //! do, so a good guess proves pairs that none of the 15 does (the protective verdict tries the
 //! direction between the boxes' closest points now, then that between the closest points of
 //! the boxes swept by graded balls: [`crate::geometry::graded_closest`]).
@@ -286,9 +286,9 @@ impl Sweep {
 }
 
 /// [`swept_boxes_apart_either`] with one form per box, each box swept by its
-/// [`Sweep::graded_ball`] (`fa = FaceTerms::ball(a, ra)`, `fb = FaceTerms::ball(b, rb)`), and
-/// the axis `also` besides the 15: the same answer to the bit, the supports on the cross axes
-/// taken from the radii directly.
+/// [`Sweep::graded_ball`] (`fa = FaceTerms::ball(a, ra)`, `fb = FaceTerms::ball(b, rb)`), on
+/// `axes`: the same answer to the bit, the supports on the cross axes taken from the radii
+/// directly.
 #[inline]
 pub fn balls_swept_apart_with(
     a: &Obb,
@@ -297,32 +297,7 @@ pub fn balls_swept_apart_with(
     b: &Obb,
     rb: [Real; 2],
     fb: &FaceTerms,
-    also: &Vec3,
-) -> bool {
-    balls_swept_apart_on(Axes::FifteenAnd(also), a, (ra, fa), b, (rb, fb))
-}
-
-/// [`balls_swept_apart_with`] on axis `n` alone (none when shorter than `1e-5`).
-#[inline]
-pub fn balls_swept_apart_along(
-    a: &Obb,
-    ra: [Real; 2],
-    fa: &FaceTerms,
-    b: &Obb,
-    rb: [Real; 2],
-    fb: &FaceTerms,
-    n: &Vec3,
-) -> bool {
-    balls_swept_apart_on(Axes::Only(n), a, (ra, fa), b, (rb, fb))
-}
-
-#[inline(always)]
-fn balls_swept_apart_on(
     axes: Axes,
-    a: &Obb,
-    (ra, fa): ([Real; 2], &FaceTerms),
-    b: &Obb,
-    (rb, fb): ([Real; 2], &FaceTerms),
 ) -> bool {
     apart_on_an_axis(
         axes,
@@ -378,8 +353,9 @@ pub fn swept_boxes_apart_with(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: 
     )
 }
 
-/// Whether `a` and `b` are proved apart on one of their 15 axes or on `also` (any vector;
-/// none when shorter than `1e-5`) under the graded reading of their sweeps (module doc,
+/// Whether `a` and `b` are proved apart on one of `axes` (the 15 of the two boxes and one more
+/// vector, or that vector alone; a vector shorter than `1e-5` is none) under the graded reading
+/// of their sweeps (module doc,
 /// "Graded along the box"; `sa[f]` a sweep of `a` with face terms
 /// `fa[f] = FaceTerms::new(a, sa[f])`, likewise `b`), when each box has two sound bounds on
 /// its displacements: one pass over the axes instead of four. The same answer, to the
@@ -395,31 +371,7 @@ pub fn swept_boxes_apart_either(
     b: &Obb,
     sb: [&Sweep; 2],
     fb: [&FaceTerms; 2],
-    also: &Vec3,
-) -> bool {
-    swept_boxes_apart_either_on(Axes::FifteenAnd(also), a, (sa, fa), b, (sb, fb))
-}
-
-/// [`swept_boxes_apart_either`] on axis `n` alone (none when shorter than `1e-5`).
-pub fn swept_boxes_apart_either_along(
-    a: &Obb,
-    sa: [&Sweep; 2],
-    fa: [&FaceTerms; 2],
-    b: &Obb,
-    sb: [&Sweep; 2],
-    fb: [&FaceTerms; 2],
-    n: &Vec3,
-) -> bool {
-    swept_boxes_apart_either_on(Axes::Only(n), a, (sa, fa), b, (sb, fb))
-}
-
-#[inline(always)]
-fn swept_boxes_apart_either_on(
     axes: Axes,
-    a: &Obb,
-    (sa, fa): ([&Sweep; 2], [&FaceTerms; 2]),
-    b: &Obb,
-    (sb, fb): ([&Sweep; 2], [&FaceTerms; 2]),
 ) -> bool {
     let (ga, gb) = (
         |k: usize, sign| fa[0].graded(k, sign).min(fa[1].graded(k, sign)),
@@ -433,11 +385,13 @@ fn swept_boxes_apart_either_on(
     )
 }
 
-/// Which axes a swept test tries: the 15 of the two boxes and one more vector (tried first),
-/// or that vector alone.
-#[derive(Clone, Copy)]
-enum Axes<'a> {
+/// Which axes a graded swept test tries.
+#[derive(Clone, Copy, Debug)]
+pub enum Axes<'a> {
+    /// The 15 of the two boxes, and this vector first: a guess that proves pairs none of the
+    /// 15 does (module doc, "Graded along the box").
     FifteenAnd(&'a Vec3),
+    /// This vector alone.
     Only(&'a Vec3),
 }
 
@@ -672,7 +626,7 @@ pub(crate) mod tests {
     /// [`swept_boxes_apart_either`] with one sweep per box, given as both forms.
     fn graded_apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep, also: &Vec3) -> bool {
         let (fa, fb) = (FaceTerms::new(a, sa), FaceTerms::new(b, sb));
-        swept_boxes_apart_either(a, [sa, sa], [&fa, &fa], b, [sb, sb], [&fb, &fb], also)
+        swept_boxes_apart_either(a, [sa, sa], [&fa, &fa], b, [sb, sb], [&fb, &fb], Axes::FifteenAnd(also))
     }
 
     /// Displacement parameters for [`point_of`], one per robot box, as the property tests draw them.
@@ -779,7 +733,7 @@ pub(crate) mod tests {
                 let b = Obb { center: a.center + v * t, ..b };
                 let general = graded_apart(&a, &sa, &b, &sb, &also);
                 let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
-                (balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, &also) == general, general)
+                (balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::FifteenAnd(&also)) == general, general)
             };
             agree_through_the_flip(same)?;
         }
@@ -802,7 +756,8 @@ pub(crate) mod tests {
                 let pairs: [(usize, usize); 4] = [(0, 0), (1, 1), (0, 1), (1, 0)];
                 let (wa, wb) = ([&sa, &sa1], [&sb, &sb1]);
                 let each = pairs.map(|(i, k)| graded_apart(&a, wa[i], &b, wb[k], &also));
-                let once = swept_boxes_apart_either(&a, wa, [&fa[0], &fa[1]], &b, wb, [&fb[0], &fb[1]], &also);
+                let (fa, fb) = ([&fa[0], &fa[1]], [&fb[0], &fb[1]]);
+                let once = swept_boxes_apart_either(&a, wa, fa, &b, wb, fb, Axes::FifteenAnd(&also));
                 (once == each.iter().any(|&x| x), each)
             };
             prop_assert!(same(0.0).0 && same(2000.0).0);
@@ -1007,11 +962,11 @@ pub(crate) mod tests {
         let b = Obb::new(Vec3::repeat(2.5), Mat3::identity(), Vec3::repeat(1.0));
         let (fa, fb) = (FaceTerms::ball(&a, [0.3; 2]), FaceTerms::ball(&b, [0.3; 2]));
         let diagonal = Vec3::repeat(1.0);
-        assert!(!balls_swept_apart_with(&a, [0.3; 2], &fa, &b, [0.3; 2], &fb, &Vec3::zeros()));
-        assert!(balls_swept_apart_with(&a, [0.3; 2], &fa, &b, [0.3; 2], &fb, &diagonal));
+        assert!(!balls_swept_apart_with(&a, [0.3; 2], &fa, &b, [0.3; 2], &fb, Axes::FifteenAnd(&Vec3::zeros())));
+        assert!(balls_swept_apart_with(&a, [0.3; 2], &fa, &b, [0.3; 2], &fb, Axes::FifteenAnd(&diagonal)));
         // The corners are 0.866 apart: radii of 0.44 each leave no room on any axis.
         let (ga, gb) = (FaceTerms::ball(&a, [0.44; 2]), FaceTerms::ball(&b, [0.44; 2]));
-        assert!(!balls_swept_apart_with(&a, [0.44; 2], &ga, &b, [0.44; 2], &gb, &diagonal));
+        assert!(!balls_swept_apart_with(&a, [0.44; 2], &ga, &b, [0.44; 2], &gb, Axes::FifteenAnd(&diagonal)));
     }
 
     #[test]

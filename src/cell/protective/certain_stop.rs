@@ -9,7 +9,7 @@ use super::stop_sweeps::{graded_points, pair_apart_in_some_form, GradedRadii};
 use super::{BoxPair, ProtectiveChecker};
 use crate::cspace::guarantee::{box_sweep_forms, tcp_weights};
 use crate::cspace::interval::Interval;
-use crate::geometry::sweep::{balls_swept_apart_along, balls_swept_apart_with, FaceTerms};
+use crate::geometry::sweep::{balls_swept_apart_with, Axes, FaceTerms};
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::delta3::{ArmSolution, MotorCosSin};
@@ -177,12 +177,12 @@ fn balls_apart(
     (b, rb, fb): (&Obb, [Real; 2], &FaceTerms),
     axis: &Vec3,
 ) -> bool {
-    if balls_swept_apart_with(a, ra, fa, b, rb, fb, axis) {
+    if balls_swept_apart_with(a, ra, fa, b, rb, fb, Axes::FifteenAnd(axis)) {
         return true;
     }
     // When the graded balls meet, no axis separates the sweeps that hold them.
     let closest = graded_points((a, ra), (b, rb), 0.0);
-    !closest.meet() && balls_swept_apart_along(a, ra, fa, b, rb, fb, &closest.axis())
+    !closest.meet() && balls_swept_apart_with(a, ra, fa, b, rb, fb, Axes::Only(&closest.axis()))
 }
 
 #[cfg(test)]
@@ -212,8 +212,8 @@ mod tests {
                 let (ra, rb) = (c.step_6_radii(p.a, p.box_a, reach_a), c.step_6_radii(p.b, p.box_b, reach_b));
                 let (fa, fb, axis) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb), c.pair_axis(p));
                 let points = graded_points((&a, ra), (&b, rb), 0.0);
-                let apart = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, &axis);
-                let graded = balls_swept_apart_along(&a, ra, &fa, &b, rb, &fb, &points.axis());
+                let apart = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::FifteenAnd(&axis));
+                let graded = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::Only(&points.axis()));
                 assert!(!(points.meet() && (apart || graded)), "{} {} tick {tick}", s.cell, s.case);
                 assert_eq!(balls_apart((&a, ra, &fa), (&b, rb, &fb), &axis), apart || graded);
                 unproved += usize::from(!apart);

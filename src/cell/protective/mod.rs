@@ -75,8 +75,8 @@
 //!    form's graded support is at least that of the [`Sweep::graded_ball`] of radii
 //!    `e_k S'`. When the boxes swept by those graded balls (radii shrunk by a relative 1e-9,
 //!    far above rounding) are not separated on the axes of step 5 ([`balls_swept_apart_with`]
-//!    on the 16, [`balls_swept_apart_along`] on the graded axis, which the graded balls define
-//!    alone, so that this step and the proof try the very same axis), no tier can: STOP at
+//!    on the 16, then on the graded axis, which the graded balls define alone, so that this
+//!    step and the proof try the very same axis), no tier can: STOP at
 //!    once, without inverse kinematics beyond the reference boxes'. The graded axis's two
 //!    points, one of each box, lying closer than their two radii show the swept boxes share a
 //!    point ([`GradedClosest::meet`]), so that no axis at all separates them. An elbow's end
@@ -150,7 +150,6 @@
 //! [`box_sweep_forms_into`]: crate::cspace::guarantee::box_sweep_forms_into
 //! [`tcp_weights`]: crate::cspace::guarantee::tcp_weights
 //! [`balls_swept_apart_with`]: crate::geometry::sweep::balls_swept_apart_with
-//! [`balls_swept_apart_along`]: crate::geometry::sweep::balls_swept_apart_along
 //! [`swept_boxes_apart_either`]: crate::geometry::sweep::swept_boxes_apart_either
 //! [`graded_closest`]: crate::geometry::graded_closest
 //! [`GradedClosest::meet`]: crate::geometry::graded_closest::GradedClosest::meet

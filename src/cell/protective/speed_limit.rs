@@ -52,8 +52,9 @@ impl ProtectiveChecker {
         floor: Real,
         budget: u32,
     ) -> (Real, u32, Real) {
-        let saved = (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.graded[j]);
-        let saved_tier = self.sweep_tier[j];
+        // Robot `j`'s reference, which each test replaces: restored after the search.
+        let saved_sweeps = (self.sweeps[j], self.ref_boxes[j], self.faces[j]);
+        let saved_ball = (self.centres[j], self.reach[j], self.graded[j], self.sweep_tier[j]);
         let inside = self.kept.inside(j);
         // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
         let proved = |me: &mut Self, v: Real, tier: Option<u32>| {
@@ -231,8 +232,8 @@ impl ProtectiveChecker {
                 bisect(self, (hi, top), Some(tier)).0
             }
         };
-        (self.sweeps[j], self.ref_boxes[j], self.faces[j], self.centres[j], self.reach[j], self.graded[j]) = saved;
-        self.sweep_tier[j] = saved_tier;
+        (self.sweeps[j], self.ref_boxes[j], self.faces[j]) = saved_sweeps;
+        (self.centres[j], self.reach[j], self.graded[j], self.sweep_tier[j]) = saved_ball;
         self.kept.restore_inside(j, inside);
         // The step is kept only when the limit is the one the steps were taken from.
         let next_step = if limit >= floor { next_step } else { resolution };

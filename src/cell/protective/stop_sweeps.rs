@@ -6,7 +6,7 @@ use super::{BoxPair, SPLITS};
 use crate::cell::exact::PairVerdict;
 use crate::cspace::guarantee::{box_sweep_forms_into, theta_range, Enclosure};
 use crate::geometry::graded_closest::{graded_closest, GradedClosest};
-use crate::geometry::sweep::{swept_boxes_apart_either, swept_boxes_apart_either_along, FaceTerms};
+use crate::geometry::sweep::{swept_boxes_apart_either, Axes, FaceTerms};
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::motor_table::{intersect, MotorTable};
@@ -111,8 +111,8 @@ pub(super) fn first_unproved<'a>(
 
 /// Whether box `a` swept by `sa` (one per form, `extra` mm added to its ball) and box `b`
 /// swept by `sb` are proved apart in some combination of forms, on their 15 axes, on `axis`
-/// or on their graded axis ([`graded_points`]) from the graded radii `ra` and `rb` ([`first_unproved_between`]'s
-/// test for one box pair).
+/// or on their graded axis ([`graded_points`]) from the graded radii `ra` and `rb`
+/// ([`first_unproved_between`]'s test for one box pair).
 pub(super) fn pair_apart_in_some_form(
     (a, sa, ra): (&Obb, [&Sweep; 2], [Real; 2]),
     (b, sb, rb): (&Obb, [&Sweep; 2], [Real; 2]),
@@ -124,8 +124,17 @@ pub(super) fn pair_apart_in_some_form(
     let (fa0, fa1) = (FaceTerms::new(a, sa[0]), FaceTerms::new(a, sa[1]));
     let (fb0, fb1) = (FaceTerms::new(b, sb[0]), FaceTerms::new(b, sb[1]));
     let (fa, fb) = ([&fa0, &fa1], [&fb0, &fb1]);
-    swept_boxes_apart_either(a, sa, fa, b, sb, fb, axis)
-        || swept_boxes_apart_either_along(a, sa, fa, b, sb, fb, &graded_points((a, ra), (b, rb), extra).axis())
+    swept_boxes_apart_either(a, sa, fa, b, sb, fb, Axes::FifteenAnd(axis))
+        || apart_on_graded_axis(graded_points((a, ra), (b, rb), extra), |n| {
+            swept_boxes_apart_either(a, sa, fa, b, sb, fb, Axes::Only(n))
+        })
+}
+
+/// Whether `along` proves a box pair apart on the axis of its graded points `closest`; not
+/// tried where the points show the graded balls meeting: every sweep holds its box's graded
+/// ball, so then no axis separates the sweeps (the same answer, without the test).
+fn apart_on_graded_axis(closest: GradedClosest, along: impl Fn(&Vec3) -> bool) -> bool {
+    !closest.meet() && along(&closest.axis())
 }
 
 /// The closest points of box `a` swept by the graded ball of radii `ra` (plus `extra`) and box
@@ -184,10 +193,10 @@ pub(super) fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real, 
             let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
             let sb = [&sweeps_b[0][k], &sweeps_b[1][k]];
             let apart = || {
-                let graded = graded_points((box_a, radii_a[i]), (box_b, radii_b[k]), extra).axis();
-                swept_boxes_apart_either_along(box_a, sa, fa, box_b, sb, fb, &graded)
+                let closest = graded_points((box_a, radii_a[i]), (box_b, radii_b[k]), extra);
+                apart_on_graded_axis(closest, |n| swept_boxes_apart_either(box_a, sa, fa, box_b, sb, fb, Axes::Only(n)))
             };
-            if !(swept_boxes_apart_either(box_a, sa, fa, box_b, sb, fb, axis) || apart()) {
+            if !(swept_boxes_apart_either(box_a, sa, fa, box_b, sb, fb, Axes::FifteenAnd(axis)) || apart()) {
                 return Some((i, k));
             }
         }
