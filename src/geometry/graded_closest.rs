@@ -27,21 +27,25 @@
 //! `g = (r_1 - r_0) / (2 half_0)` the radius's slope), the cross-section's coordinates take
 //! `y`'s, clamped (they enter only `|x - y|`), leaving `rho` across; then
 //! `sqrt((t - y_0)^2 + rho^2) - g t` is convex in `t`, least at `t = y_0 + g rho / sqrt(1 - g^2)`
-//! for `|g| < 1` (clamped to the box), and at the end `sign(g) half_0` for `|g| >= 1`. Each step
-//! never increases `F`; the iteration stops when neither point moves by more than
-//! [`STILL_MM`], or after [`MAX_STEPS`] steps.
+//! for `|g| < 1` (clamped to the box), and at the end `sign(g) half_0` for `|g| >= 1`. Where
+//! the boxes run side by side the steps zig-zag, so after each step the points go on along it,
+//! twice as far each time, while that lowers `F` (each box's own projection keeps them in
+//! it). No step increases `F`; the iteration stops when a step moves the two points by no
+//! more than [`STILL_MM`] together, or after [`MAX_STEPS`] steps.
 
 use crate::geometry::obb::Obb;
 use crate::geometry::sweep::MEET_DEPTH;
 use crate::math::{float, Real, Vec3};
 
-/// Movement (mm) of both points in one step below which the minimisation stops.
+/// Movement (mm) of the two points together in one step at or below which the minimisation
+/// stops.
 pub const STILL_MM: Real = 1e-2;
 
 /// The most steps (each moving `x`, then `y`) the minimisation takes.
 pub const MAX_STEPS: u32 = 24;
 
-/// The most strides along a step after it (module doc, "The minimisation").
+/// The most strides along a step after it, each twice as long as the last (module doc, "The
+/// minimisation").
 pub const MAX_STRIDES: u32 = 8;
 
 /// Points of two boxes swept by graded balls near their closest (module doc).
