@@ -34,7 +34,8 @@ fn tight(cell: &str) -> u64 {
 }
 
 fn streamed_matches_one_shot(cell: &str) {
-    let dir = std::env::temp_dir().join(format!("dc-bounded-{cell}-{}", std::process::id()));
+    let tmp = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let dir = tmp.join(format!("dc-bounded-{cell}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("t.dct");
     let max = tight(cell).to_string();

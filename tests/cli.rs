@@ -39,7 +39,7 @@ fn stdout(out: &Output) -> String {
 
 /// A new empty directory of this test process.
 fn fresh_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("dc-cli-{name}-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-cli-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -112,7 +112,7 @@ fn demo_reports_no_collision_when_practical_the_same_first_tick_for_both_methods
 
 #[test]
 fn check_writes_one_line_per_row_matching_the_exact_checker() {
-    let dir = std::env::temp_dir().join(format!("dc-cli-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (input, output) = (dir.join("in.csv"), dir.join("out.csv"));
     let mut rows = vec!["x,y,z,x2,y2,z2".to_string()];
@@ -159,7 +159,7 @@ fn bad_arguments_and_rows_fail_with_a_message() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("nope.toml"));
     let out = cli(&["demo", "--cel", "T1"]);
     assert_eq!(out.status.code(), Some(2));
-    let dir = std::env::temp_dir().join(format!("dc-cli-bad-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-cli-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("bad.csv");
     std::fs::write(&input, "1,2,3,4,5,6\n1,2,three,4,5,6\n").unwrap();
@@ -170,7 +170,7 @@ fn bad_arguments_and_rows_fail_with_a_message() {
 
 #[test]
 fn build_inspect_eval_and_check_with_a_table() {
-    let dir = std::env::temp_dir().join(format!("dc-cli-table-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-cli-table-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let table = dir.join("t3.dct");
     let table = table.to_str().unwrap();

@@ -216,7 +216,7 @@ fn init_rejects_bad_configs_and_clears_the_handle() {
 
 #[test]
 fn cell_files_init_the_same_checker_as_configs() {
-    let dir = std::env::temp_dir().join(format!("dc-ffi-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-ffi-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, "[[robot]]\nmodel = { margn = 1 }\n").unwrap();

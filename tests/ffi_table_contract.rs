@@ -227,7 +227,7 @@ fn table_confirmation_is_chosen_per_handle_checked_and_read_from_the_cell_file()
         dc_destroy(exact);
     }
     // The cell file's table_confirm, read by dc_init_from_files.
-    let dir = std::env::temp_dir().join(format!("dc-ffi-confirm-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-ffi-confirm-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let table_path = dir.join("t1_k16.dct");
     std::fs::write(&table_path, table_bytes("T1")).unwrap();
@@ -261,7 +261,7 @@ fn table_confirmation_is_chosen_per_handle_checked_and_read_from_the_cell_file()
 
 #[test]
 fn table_files_init_the_same_checker_as_buffers() {
-    let dir = std::env::temp_dir().join(format!("dc-ffi-table-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-ffi-table-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let table_path = dir.join("t1_k16.dct");
     std::fs::write(&table_path, table_bytes("T1")).unwrap();

@@ -24,7 +24,7 @@ fn ok(out: &Output) -> String {
 fn temp_dir() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = std::env::temp_dir().join(format!("dc-pictures-{}", std::process::id()));
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-pictures-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         dir
     })

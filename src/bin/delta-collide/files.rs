@@ -113,6 +113,7 @@ mod tests {
         write_file(&target, |w| w.write_all(b"new").map_err(|e| e.to_string())).unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
         assert_eq!(names(&d), ["out.csv"]);
+        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[cfg(unix)]
@@ -126,5 +127,6 @@ mod tests {
         assert!(link.symlink_metadata().unwrap().file_type().is_symlink());
         assert_eq!(std::fs::read_to_string(&real).unwrap(), "new");
         assert_eq!(names(&d), ["link.dct", "real.dct"]);
+        std::fs::remove_dir_all(&d).unwrap();
     }
 }
