@@ -118,8 +118,7 @@ impl ProtectiveChecker {
     pub(super) fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool) -> bool {
         let refs = self.reference_pair(tcps_mcs, p);
         let (ra, rb) = (self.step_6_radii(p.a, p.box_a, refs[0].2), self.step_6_radii(p.b, p.box_b, refs[1].2));
-        let (fa, fb) = (FaceTerms::ball(&refs[0].0, ra), FaceTerms::ball(&refs[1].0, rb));
-        !balls_apart((&refs[0].0, ra, &fa), (&refs[1].0, rb, &fb), &self.pair_axis(p))
+        !balls_apart((&refs[0].0, ra), (&refs[1].0, rb), &self.pair_axis(p))
             || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
     }
 
@@ -151,8 +150,7 @@ impl ProtectiveChecker {
     pub(super) fn ball_swept_meet(&self, p: BoxPair) -> bool {
         let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
         let (ra, rb) = (self.graded[p.a][p.box_a], self.graded[p.b][p.box_b]);
-        let (fa, fb) = (FaceTerms::ball(box_a, ra), FaceTerms::ball(box_b, rb));
-        !balls_apart((box_a, ra, &fa), (box_b, rb, &fb), &self.pair_axis(p))
+        !balls_apart((box_a, ra), (box_b, rb), &self.pair_axis(p))
     }
 }
 
@@ -168,21 +166,18 @@ pub(super) fn graded_radii(model: &RobotModel, reach: Real) -> GradedRadii {
     core::array::from_fn(|k| if k < model.box_count() { least_radii(model, k, reach) } else { [0.0; 2] })
 }
 
-/// Whether box `a` swept by the graded ball of radii `ra` (face terms `fa`) and box `b` by that
-/// of `rb` are proved apart on the axes the proof tries (module doc, step 5): the 15, `axis`
-/// (the robot pair's) and the pair's graded axis ([`graded_points`]). `false` also when the
-/// two swept sets are found to share a point there, which no axis separates.
-fn balls_apart(
-    (a, ra, fa): (&Obb, [Real; 2], &FaceTerms),
-    (b, rb, fb): (&Obb, [Real; 2], &FaceTerms),
-    axis: &Vec3,
-) -> bool {
-    if balls_swept_apart_with(a, ra, fa, b, rb, fb, Axes::FifteenAnd(axis)) {
+/// Whether box `a` swept by the graded ball of radii `ra` and box `b` by that of `rb` are
+/// proved apart on the axes the proof tries (module doc, step 5): the 15, `axis` (the robot
+/// pair's) and the pair's graded axis ([`graded_points`]). `false` also when the two swept sets
+/// are found to share a point there, which no axis separates.
+fn balls_apart((a, ra): (&Obb, [Real; 2]), (b, rb): (&Obb, [Real; 2]), axis: &Vec3) -> bool {
+    let (fa, fb) = (FaceTerms::ball(a, ra), FaceTerms::ball(b, rb));
+    if balls_swept_apart_with(a, ra, &fa, b, rb, &fb, Axes::FifteenAnd(axis)) {
         return true;
     }
     // When the graded balls meet, no axis separates the sweeps that hold them.
     let closest = graded_points((a, ra), (b, rb), 0.0);
-    !closest.meet() && balls_swept_apart_with(a, ra, fa, b, rb, fb, Axes::Only(&closest.axis()))
+    !closest.meet() && balls_swept_apart_with(a, ra, &fa, b, rb, &fb, Axes::Only(&closest.axis()))
 }
 
 #[cfg(test)]
@@ -215,7 +210,7 @@ mod tests {
                 let apart = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::FifteenAnd(&axis));
                 let graded = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::Only(&points.axis()));
                 assert!(!(points.meet() && (apart || graded)), "{} {} tick {tick}", s.cell, s.case);
-                assert_eq!(balls_apart((&a, ra, &fa), (&b, rb, &fb), &axis), apart || graded);
+                assert_eq!(balls_apart((&a, ra), (&b, rb), &axis), apart || graded);
                 unproved += usize::from(!apart);
                 found += usize::from(points.meet());
                 along += usize::from(!apart && graded);

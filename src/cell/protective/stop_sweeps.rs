@@ -123,18 +123,26 @@ pub(super) fn pair_apart_in_some_form(
     let sa = with_extra(sa, extra, &mut wider);
     let (fa0, fa1) = (FaceTerms::new(a, sa[0]), FaceTerms::new(a, sa[1]));
     let (fb0, fb1) = (FaceTerms::new(b, sb[0]), FaceTerms::new(b, sb[1]));
-    let (fa, fb) = ([&fa0, &fa1], [&fb0, &fb1]);
-    swept_boxes_apart_either(a, sa, fa, b, sb, fb, Axes::FifteenAnd(axis))
-        || apart_on_graded_axis(graded_points((a, ra), (b, rb), extra), |n| {
-            swept_boxes_apart_either(a, sa, fa, b, sb, fb, Axes::Only(n))
-        })
+    swept_pair_apart((a, sa, [&fa0, &fa1], ra), (b, sb, [&fb0, &fb1], rb), extra, axis)
 }
 
-/// Whether `along` proves a box pair apart on the axis of its graded points `closest`; not
-/// tried where the points show the graded balls meeting: every sweep holds its box's graded
-/// ball, so then no axis separates the sweeps (the same answer, without the test).
-fn apart_on_graded_axis(closest: GradedClosest, along: impl Fn(&Vec3) -> bool) -> bool {
-    !closest.meet() && along(&closest.axis())
+/// Whether box `a` swept by `sa` (face terms `fa`, graded radii `ra`, `extra` already in its
+/// sweeps) and box `b` are proved apart in some combination of forms: on the 15 axes and
+/// `axis`, then on their graded axis ([`graded_points`], only for a pair the others leave
+/// unproved). Not tried where the graded points show the graded balls meeting: every sweep
+/// holds its box's graded ball, so then no axis separates the sweeps (the same answer,
+/// without the test).
+fn swept_pair_apart(
+    (a, sa, fa, ra): (&Obb, [&Sweep; 2], [&FaceTerms; 2], [Real; 2]),
+    (b, sb, fb, rb): (&Obb, [&Sweep; 2], [&FaceTerms; 2], [Real; 2]),
+    extra: Real,
+    axis: &Vec3,
+) -> bool {
+    if swept_boxes_apart_either(a, sa, fa, b, sb, fb, Axes::FifteenAnd(axis)) {
+        return true;
+    }
+    let closest = graded_points((a, ra), (b, rb), extra);
+    !closest.meet() && swept_boxes_apart_either(a, sa, fa, b, sb, fb, Axes::Only(&closest.axis()))
 }
 
 /// The closest points of box `a` swept by the graded ball of radii `ra` (plus `extra`) and box
@@ -192,11 +200,7 @@ pub(super) fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real, 
         for (k, box_b) in boxes_b.iter().enumerate() {
             let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
             let sb = [&sweeps_b[0][k], &sweeps_b[1][k]];
-            let apart = || {
-                let closest = graded_points((box_a, radii_a[i]), (box_b, radii_b[k]), extra);
-                apart_on_graded_axis(closest, |n| swept_boxes_apart_either(box_a, sa, fa, box_b, sb, fb, Axes::Only(n)))
-            };
-            if !(swept_boxes_apart_either(box_a, sa, fa, box_b, sb, fb, Axes::FifteenAnd(axis)) || apart()) {
+            if !swept_pair_apart((box_a, sa, fa, radii_a[i]), (box_b, sb, fb, radii_b[k]), extra, axis) {
                 return Some((i, k));
             }
         }
