@@ -126,9 +126,10 @@ fn main() {
             let mut m: Vec<f64> = (0..RUN_TICKS as usize)
                 .map(|i| t.iter().skip(i).step_by(RUN_TICKS as usize).copied().fold(f64::INFINITY, f64::min))
                 .collect();
-            q(&mut m).0
+            let median = q(&mut m).0;
+            (median, m[m.len() - 1])
         };
-        let (pl, el) = (least(&tp), least(&te));
+        let ((pl, worst), (el, _)) = (least(&tp), least(&te));
         let ((pm, p99, pmean), (em, _, _)) = (q(&mut tp), q(&mut te));
         for (name, t) in ["FREE", "WARN", "STOP"].iter().zip(&mut by_verdict).filter(|(_, t)| !t.is_empty()) {
             let (m, p, _) = q(t);
@@ -146,7 +147,7 @@ fn main() {
             "{} {}: STOP {stops} WARN {warns} kept-proof FREE {kept}; \
              protective median {pm:.3} p99 {p99:.1} mean {pmean:.2}, \
              exact median {em:.3} us{mean_limit}; \
-             least of repeats: protective {pl:.3} exact {el:.3} us ({ratio:.2}x); \
+             least of repeats: protective {pl:.3} exact {el:.3} us ({ratio:.2}x), worst tick {worst:.1} us; \
              first WARN {first_warn:?} STOP {first_stop:?}, \
              answers {answers:016x}, verdicts {verdicts:016x}",
             s.cell,
