@@ -12,7 +12,10 @@ use crate::table::{BuildReport, Header, Table, TableKind};
 /// the table a one-shot build writes: its header, the table and the build's report
 /// (`label_secs` is the sum of the shards' labelling times). The files are read one at a
 /// time, each dropped once its labels are copied: the merge holds the whole label set (one
-/// byte per pair of samples), the sub-cells and one file.
+/// byte per pair of samples), the sub-cells and one file. A subdivided table's files are read
+/// twice: first for the labels and for how many sub-cell entries each row of A has, then to
+/// put each entry at its place in the pair order, so that the sub-cells are held once (a
+/// shard's rows are interleaved with the others', so its entries are not in one run).
 ///
 /// # Errors
 /// [`ShardError::InFile`] for a file that cannot be read or is not a valid shard (naming it),
@@ -25,7 +28,6 @@ pub fn merge_shards(
 ) -> Result<(Header, Table, BuildReport), ShardError> {
     let in_file = |file: &str, error: ShardError| ShardError::InFile { file: file.to_string(), error: Box::new(error) };
     let mut first: Option<First> = None;
-    let mut sub = Vec::new();
     let mut secs = (0.0, 0.0);
     for name in files {
         let bytes = read(name).map_err(|what| in_file(name, ShardError::Unreadable { what }))?;
@@ -51,10 +53,9 @@ pub fn merge_shards(
                 f.counts[ia * nb..(ia + 1) * nb].copy_from_slice(&s.counts[j * nb..(j + 1) * nb]);
             }
         }
-        sub.extend(s.sub.chunks_exact(24).map(|e| {
-            let word = |w: usize| u64::from_le_bytes(core::array::from_fn(|i| e[8 * w + i]));
-            (word(0), word(1), word(2))
-        }));
+        for e in s.sub.chunks_exact(24) {
+            f.row_entries[(entry(e, 0) / nb.max(1) as u64) as usize] += 1;
+        }
         secs = (secs.0 + s.info.label_secs, secs.1 + s.info.sub_secs);
     }
     let f = first.ok_or(ShardError::NoShards)?;
@@ -62,14 +63,7 @@ pub fn merge_shards(
     if !missing.is_empty() {
         return Err(ShardError::Missing { missing, count: f.holder.len() as u32 });
     }
-    sub.sort_unstable_by_key(|&(pair, _, _)| pair);
-    let mut cells = SubCells::default();
-    if f.info.kind == TableKind::SharedSub {
-        cells.pairs = sub.iter().map(|e| e.0).collect();
-        cells.care = sub.iter().map(|e| e.1).collect();
-        cells.collision = sub.iter().map(|e| e.2).collect();
-    }
-    drop(sub);
+    let cells = if f.info.kind == TableKind::SharedSub { sub_cells_in_order(&f, read)? } else { SubCells::default() };
     let info = f.info;
     let space = LabelledSpace { grid_a: f.grid_a, grid_b: f.grid_b, labels: f.labels, margin: info.header.margin };
     let sub = (info.kind == TableKind::SharedSub).then_some(cells);
@@ -92,6 +86,58 @@ pub fn merge_shards(
     Ok((info.header, table, report))
 }
 
+/// Word `w` (little-endian `u64`) of sub-cell entry `e`: its pair, care and collision masks.
+fn entry(e: &[u8], w: usize) -> u64 {
+    u64::from_le_bytes(core::array::from_fn(|i| e[8 * w + i]))
+}
+
+/// The sub-cells of every shard of `f` (all read once before), in the order of their pairs:
+/// each file read again, each entry written at its row's place (the rows before it hold
+/// `row_entries` entries; the entries of one row are one shard's, in order). A file that
+/// is not what the first reading found (another shard, or other entries) is refused.
+fn sub_cells_in_order(
+    f: &First,
+    read: &mut dyn FnMut(&str) -> Result<Vec<u8>, String>,
+) -> Result<SubCells, ShardError> {
+    // Row `ia`'s entries go to `next[ia]..ends[ia]`, after those of the rows before it.
+    let mut ends = f.row_entries.clone();
+    for ia in 1..ends.len() {
+        ends[ia] += ends[ia - 1];
+    }
+    let mut next: Vec<usize> = ends.iter().zip(&f.row_entries).map(|(end, k)| end - k).collect();
+    let n = ends.last().copied().unwrap_or(0);
+    let mut cells = SubCells { pairs: vec![0; n], care: vec![0; n], collision: vec![0; n] };
+    let nb = f.info.samples.1.max(1) as u64;
+    for (index, name) in f.holder.iter().enumerate() {
+        let Some(name) = name else { continue };
+        let changed = |what: &str| ShardError::InFile {
+            file: name.clone(),
+            error: Box::new(ShardError::Unreadable { what: format!("changed during the merge: {what}") }),
+        };
+        let bytes = read(name).map_err(|e| changed(&e))?;
+        let s = parse(&bytes).map_err(|e| changed(&e.to_string()))?;
+        if let Some(what) = differs(f, &s) {
+            return Err(changed(&what));
+        }
+        if s.info.shard.index() as usize != index {
+            return Err(changed("another shard"));
+        }
+        for e in s.sub.chunks_exact(24) {
+            let row = (entry(e, 0) / nb) as usize;
+            let at = next[row];
+            if at == ends[row] {
+                return Err(changed("more sub-cell entries"));
+            }
+            (cells.pairs[at], cells.care[at], cells.collision[at]) = (entry(e, 0), entry(e, 1), entry(e, 2));
+            next[row] += 1;
+        }
+    }
+    if next != ends {
+        return Err(ShardError::Unreadable { what: "a shard changed during the merge: fewer sub-cell entries".into() });
+    }
+    Ok(cells)
+}
+
 /// The first shard read: what the others must match, and the merge's state.
 struct First {
     name: String,
@@ -105,6 +151,8 @@ struct First {
     labels: Vec<Label>,
     /// Every pair's clearance level count (clearance shards; else empty).
     counts: Vec<u8>,
+    /// Per row of A: how many sub-cell entries the shards hold.
+    row_entries: Vec<usize>,
 }
 
 impl First {
@@ -119,6 +167,7 @@ impl First {
             holder: vec![None; s.info.shard.count() as usize],
             labels: vec![Label::Unreachable; na * nb],
             counts: if s.info.ladder.is_some() { vec![0; na * nb] } else { vec![] },
+            row_entries: vec![0; na],
         }
     }
 }

@@ -239,6 +239,30 @@ mod tests {
         assert!(matches!(thesis, Err(BuildError::ClearanceNeedsCertified)));
     }
 
+    /// The merge reads a subdivided table's files twice (the labels, then the sub-cells in
+    /// the pairs' order): a file that is another shard at the second reading is refused,
+    /// naming it; read unchanged, the same files merge.
+    #[test]
+    fn a_shard_changed_during_the_merge_is_refused() {
+        let cell = reference_cell("T3").unwrap();
+        let kind = (TableKind::SharedSub, 0);
+        let shard = |i| {
+            let index = ShardIndex::new(i, 2).unwrap();
+            build_shard(&cell, 16, &Workspace::THESIS, kind, Labelling::Certified, index, Progress::Silent).unwrap().0
+        };
+        let files = [shard(0), shard(1)];
+        let names = ["s0".to_string(), "s1".to_string()];
+        let mut reads = 0;
+        let mut swapped = |name: &str| {
+            reads += 1;
+            Ok(files[usize::from((name == "s1") != (reads > 2))].clone())
+        };
+        let e = merge_shards(&names, &mut swapped).err().unwrap().to_string();
+        assert!(e.contains("s0") && e.contains("another shard"), "{e}");
+        let mut unchanged = |name: &str| Ok(files[usize::from(name == "s1")].clone());
+        assert!(merge_shards(&names, &mut unchanged).is_ok());
+    }
+
     #[test]
     fn fields_are_checked_beyond_the_checksum() {
         let bytes = small_shard();
