@@ -40,8 +40,8 @@ fn naive_labels(cell: &Cell, ga: &SampleGrid, gb: &SampleGrid) -> Vec<Label> {
     labels
 }
 
-fn collisions(labels: &[Label]) -> usize {
-    labels.iter().filter(|&&l| l == Label::Collision).count()
+fn collisions(labels: impl IntoIterator<Item = Label>) -> usize {
+    labels.into_iter().filter(|&l| l == Label::Collision).count()
 }
 
 fn bench_labelling(c: &mut Criterion) {
@@ -50,30 +50,30 @@ fn bench_labelling(c: &mut Criterion) {
     let ours = label_space(&cell, K, &ws, 0.0, Progress::Silent).unwrap();
     let naive = naive_labels(&cell, &ours.grid_a, &ours.grid_b);
     assert_eq!(ours.labels.len(), naive.len());
-    let differ = ours.labels.iter().zip(&naive).filter(|(a, b)| a != b).count();
+    let differ = ours.labels.iter().zip(naive.iter().copied()).filter(|(a, b)| a != b).count();
     assert_eq!(differ, 0, "product-structure labels differ from the per-pair exact check");
-    let expected = collisions(&naive);
+    let expected = collisions(naive.iter().copied());
     assert!(expected > 0);
-    let certified_expected = collisions(&label_space_certified(&cell, K, &ws, Progress::Silent).unwrap().space.labels);
+    let certified_expected = collisions(label_space_certified(&cell, K, &ws, Progress::Silent).unwrap().space.labels.iter());
 
     let mut group = c.benchmark_group(format!("label_T1_k{K}_{}_pairs", naive.len()));
     group.sample_size(10);
     group.bench_function("ours_product_pruned", |b| {
         b.iter(|| {
             let s = label_space(black_box(&cell), K, &ws, 0.0, Progress::Silent).unwrap();
-            assert_eq!(collisions(&s.labels), expected);
+            assert_eq!(collisions(s.labels.iter()), expected);
         })
     });
     group.bench_function("naive_exact_checker_per_pair", |b| {
         b.iter(|| {
             let l = naive_labels(black_box(&cell), &ours.grid_a, &ours.grid_b);
-            assert_eq!(collisions(&l), expected);
+            assert_eq!(collisions(l), expected);
         })
     });
     group.bench_function("ours_certified_refined", |b| {
         b.iter(|| {
             let s = label_space_certified(black_box(&cell), K, &ws, Progress::Silent).unwrap();
-            assert_eq!(collisions(&s.space.labels), certified_expected);
+            assert_eq!(collisions(s.space.labels.iter()), certified_expected);
         })
     });
     group.finish();
@@ -83,13 +83,13 @@ fn bench_labelling(c: &mut Criterion) {
 fn bench_labelling_k32(c: &mut Criterion) {
     let cell = reference_cell("T1").unwrap();
     let ws = Workspace::THESIS;
-    let expected = collisions(&label_space(&cell, 32, &ws, 0.0, Progress::Silent).unwrap().labels);
+    let expected = collisions(label_space(&cell, 32, &ws, 0.0, Progress::Silent).unwrap().labels.iter());
     let mut group = c.benchmark_group("label_T1_k32_all_pairs");
     group.sample_size(10);
     group.bench_function("ours_product_pruned", |b| {
         b.iter(|| {
             let s = label_space(black_box(&cell), 32, &ws, 0.0, Progress::Silent).unwrap();
-            assert_eq!(collisions(&s.labels), expected);
+            assert_eq!(collisions(s.labels.iter()), expected);
         })
     });
     group.finish();

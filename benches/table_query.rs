@@ -69,7 +69,7 @@ impl<'a> LabelArray<'a> {
 fn build(s: &LabelledSpace) -> Vec<Table> {
     let sym = symmetry_mismatches(s).unwrap() == 0;
     let b = s.grid_a.cells.iter().map(|c| c[1]).collect::<std::collections::BTreeSet<_>>().len();
-    let collisions = s.labels.iter().filter(|&&l| l == Label::Collision).count();
+    let collisions = s.labels.count(Label::Collision);
     eprintln!(
         "k = 32 synthetic blobs: {} samples per robot, {} pairs, {collisions} collisions, symmetric {sym}",
         s.grid_a.cells.len(),

@@ -28,7 +28,7 @@ fn tables(s: &LabelledSpace) -> Vec<Table> {
 
 /// Clearance level counts of every pair: 0 unless free, else 1 to 7 from the pair's number.
 fn level_counts(s: &LabelledSpace) -> Vec<u8> {
-    let free = |l: &delta_collide::cspace::Label| *l == delta_collide::cspace::Label::Free;
+    let free = |l: delta_collide::cspace::Label| l == delta_collide::cspace::Label::Free;
     s.labels.iter().enumerate().map(|(i, l)| if free(l) { 1 + (i * 7 / 3 % 7) as u8 } else { 0 }).collect()
 }
 
@@ -36,7 +36,7 @@ fn level_counts(s: &LabelledSpace) -> Vec<u8> {
 fn sub_cells(s: &LabelledSpace) -> delta_collide::cspace::SubCells {
     let mut sub = delta_collide::cspace::SubCells::default();
     for (pair, l) in s.labels.iter().enumerate() {
-        if *l == delta_collide::cspace::Label::Collision {
+        if l == delta_collide::cspace::Label::Collision {
             sub.pairs.push(pair as u64);
             sub.care.push(!0xff00u64.rotate_left(pair as u32 % 64));
             sub.collision.push(0x5555_5555_5555_5555u64.rotate_left(pair as u32 % 2));

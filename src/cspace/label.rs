@@ -22,7 +22,7 @@
 use crate::cell::{Cell, Placement};
 use crate::cspace::guarantee::thesis_margin;
 use crate::cspace::sampler::{SampleGrid, Workspace};
-use crate::cspace::{Label, LabelledSpace};
+use crate::cspace::{Label, LabelledSpace, PairLabels};
 use crate::geometry::sat::separating_axis;
 use crate::cspace::swept_sat::{swept_apart, SweptFrame, TableSweep};
 use crate::geometry::sweep::{swept_aabb_half, Sweep};
@@ -366,15 +366,16 @@ pub fn all_box_pairs(na: usize, nb: usize) -> u64 {
 /// centre is unreachable, `Collision` when either is `Unknown` or some pair of boxes
 /// intersects and `second_look(ia, ib)` (called only then) confirms it, else `Free`.
 /// Rows are labelled in parallel, each reported to `progress`.
-pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, rows: Rows, progress: Progress) -> Vec<Label>
+pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, rows: Rows, progress: Progress) -> PairLabels
 where
     F: Fn(usize, usize) -> bool + Sync,
 {
-    label_rows_except(&RowLabeller::new(b), a, second_look, rows, progress, |_| false)
+    label_rows_except(&RowLabeller::new(b), a, second_look, rows, progress, |_| false, |_, _| {})
 }
 
 /// As [`label_pairs`] with B's side made once (`labeller`), leaving the rows of A that `skip`
-/// names as `Collision` without testing them (the caller fills them).
+/// names as `Collision` without testing them (the caller fills them), and every other row
+/// finished by `then(ia, row)` before it is stored.
 pub(crate) fn label_rows_except<F>(
     labeller: &RowLabeller,
     a: &SampleBoxes,
@@ -382,28 +383,24 @@ pub(crate) fn label_rows_except<F>(
     rows: Rows,
     progress: Progress,
     skip: impl Fn(usize) -> bool + Sync,
-) -> Vec<Label>
+    then: impl Fn(usize, &mut [Label]) + Sync,
+) -> PairLabels
 where
     F: Fn(usize, usize) -> bool + Sync,
 {
     let nb = labeller.base.len();
     let rows_done = AtomicU64::new(0);
     let labelled = rows.count(a.len());
-    // Written by both threads (`collect` of an indexed iterator fills its parts in place), so
-    // that the pages of a large build are first touched, and zeroed by the kernel, in parallel.
-    let mut labels: Vec<Label> = (0..labelled * nb).into_par_iter().map(|_| Label::Collision).collect();
-    if nb > 0 {
-        labels.par_chunks_mut(nb).enumerate().for_each(|(j, row)| {
-            let ia = rows.row(j);
-            if !skip(ia) {
-                labeller.row(a, ia, &second_look, row);
-            }
-            if let Progress::Rows(report) = progress {
-                report(rows_done.fetch_add(1, Ordering::Relaxed) + 1, labelled as u64);
-            }
-        });
-    }
-    labels
+    PairLabels::from_rows(labelled, nb, |j, row| {
+        let ia = rows.row(j);
+        if !skip(ia) {
+            labeller.row(a, ia, &second_look, row);
+            then(ia, row);
+        }
+        if let Progress::Rows(report) = progress {
+            report(rows_done.fetch_add(1, Ordering::Relaxed) + 1, labelled as u64);
+        }
+    })
 }
 
 /// What labelling one row of A against every entry of B needs from B alone: each entry's

@@ -16,12 +16,12 @@ pub mod guarantee;
 pub(crate) mod interval;
 #[cfg(feature = "std")]
 pub(crate) mod label;
+pub mod pair_labels;
 pub mod sampler;
 #[cfg(feature = "std")]
 pub(crate) mod swept_sat;
 pub mod symmetry;
 
-use alloc::vec::Vec;
 #[cfg(feature = "std")]
 pub use certify::{
     label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, CertifyConfig, Refinement,
@@ -31,6 +31,7 @@ pub use certify::{
 pub use certify::SubdividedLabels;
 #[cfg(feature = "std")]
 pub use label::{label_space, label_space_thesis, Progress, Rows};
+pub use pair_labels::PairLabels;
 pub use sampler::{CellIndex, SampleGrid, Workspace};
 pub use symmetry::Symmetry;
 
@@ -55,8 +56,9 @@ pub struct LabelledSpace {
     pub grid_a: SampleGrid,
     /// Robot B's grid.
     pub grid_b: SampleGrid,
-    /// `labels[ia * grid_b.cells.len() + ib]` for sample `ia` of A and `ib` of B.
-    pub labels: Vec<Label>,
+    /// `labels[ia * grid_b.cells.len() + ib]` for sample `ia` of A and `ib` of B, a row per
+    /// sample of A.
+    pub labels: PairLabels,
     /// The margin (mm) added to every box half-extent when labelling.
     pub margin: f64,
 }

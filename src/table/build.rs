@@ -17,7 +17,7 @@ use crate::cspace::certify::{certify_rows, certify_rows_then, SubCellSource};
 use crate::cspace::certify::clearance::clearance_counts;
 use crate::cspace::label::label_space_thesis_rows;
 use crate::cspace::symmetry::Symmetry;
-use crate::cspace::{CertifyConfig, Label, LabelledSpace, Progress, Refinement, Rows, SubCells, Workspace};
+use crate::cspace::{CertifyConfig, Label, LabelledSpace, PairLabels, Progress, Refinement, Rows, SubCells, Workspace};
 use crate::table::{
     Certification, ClearanceTable, Header, Ladder, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
     TableError,
@@ -75,7 +75,7 @@ impl fmt::Display for BuildError {
             BuildError::Memory { needed, labels, max } => write!(
                 f,
                 "the build needs about {} of memory whatever the block size (the robots' boxes and sweeps, \
-                 and {} of labels, one byte per sample pair), more than the {} allowed; allow more \
+                 and {} of labels, 2 bits per sample pair), more than the {} allowed; allow more \
                  memory, use a smaller k (each halving needs 64 times less for the labels) or shards",
                 gigabytes(*needed),
                 gigabytes(*labels),
@@ -270,11 +270,8 @@ fn build_streamed(
 
 /// How many of `labels` are collisions and how many unreachable, counted in parallel (a
 /// billion labels at k = 64).
-fn collisions_and_unreachable(labels: &[Label]) -> (usize, usize) {
-    let count = |(c, u): (usize, usize), l: &Label| {
-        (c + usize::from(*l == Label::Collision), u + usize::from(*l == Label::Unreachable))
-    };
-    labels.par_iter().fold(|| (0, 0), count).reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+fn collisions_and_unreachable(labels: &PairLabels) -> (usize, usize) {
+    (labels.count(Label::Collision), labels.count(Label::Unreachable))
 }
 
 /// The sub-cells of a streamed build's blocks, found in parallel; the sub-octant boxes made
@@ -408,7 +405,7 @@ pub(crate) fn assemble(
         build_secs: 0.0,
     };
     if labelling == Labelling::ThesisMargin {
-        space.labels.iter_mut().filter(|l| **l == Label::Unreachable).for_each(|l| *l = Label::Collision);
+        space.labels.replace(Label::Unreachable, Label::Collision);
     }
     let start = Instant::now();
     let tables = variants

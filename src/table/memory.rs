@@ -1,5 +1,5 @@
 //! How much memory a table build needs and how a build bounded by `max` bytes spends it:
-//! the fixed part (both robots' boxes and sweeps, one byte of label per sample pair, the tree
+//! the fixed part (both robots' boxes and sweeps, 2 bits of label per sample pair, the tree
 //! builder's maps) must fit, and a subdivided build streams its sub-cells by blocks of the
 //! quadtree sized from what is left ([`MemoryPlan`]).
 //!
@@ -8,7 +8,7 @@
 //! 2 x 47,548 samples, `docs/record/2026-11-24-shards.md`) and rounded up.
 
 use super::build::{BuildError, Variant};
-use crate::cspace::Label;
+use crate::cspace::PairLabels;
 
 /// Bytes per sample of either robot that a labelling holds whatever the rows: boxes and
 /// sweeps of the whole cells and of their octants, with their cores (measured 22.6 KB).
@@ -28,10 +28,10 @@ pub const BLOCK_BYTES_PER_PAIR: u64 = 2 * (8 + 16 + 24);
 /// The bound of a build not given one ([`default_max_memory`]): 7 GiB. A `shared-sub` build
 /// spends what its fixed part leaves on blocks and on the sub-octant cache, so the machine's
 /// whole memory as the bound lets the cache grow past 8 GB at k = 64 (T3: 8.06 GB peak
-/// resident on a 24 GB machine). The reference cells' fixed part at k = 64 is estimated at
-/// 4.81 GB; 7 GiB (7.5 GB) leaves 2.7 GB for the blocks and the cache, and about half a
-/// gigabyte below 8 GB for what the estimate leaves out (a block's sub-octant boxes made
-/// beyond the cache before it is dropped, the allocator's slack).
+/// resident on a 24 GB machine, when a label took a byte). The reference cells' fixed part at
+/// k = 64 is estimated at 3.12 GB; 7 GiB (7.5 GB) leaves 4.4 GB for the blocks and the cache,
+/// and about half a gigabyte below 8 GB for what the estimate leaves out (a block's
+/// sub-octant boxes made beyond the cache before it is dropped, the allocator's slack).
 pub const DEFAULT_MAX_MEMORY: u64 = 7 << 30;
 
 /// The bound of a build not given one, whose fixed part needs `fixed` bytes
@@ -54,7 +54,7 @@ pub fn default_max_memory(fixed: u64, total: Option<u64>) -> u64 {
 pub struct MemoryPlan {
     /// Bytes held whatever the blocks (boxes, labels, builder, reserve).
     pub fixed: u64,
-    /// Of `fixed`: the labels (one byte per sample pair).
+    /// Of `fixed`: the labels (2 bits per sample pair).
     pub labels: u64,
     /// Subdivided builds: the depth of the quadtree whose subtrees are the blocks (0: the
     /// whole table is one block).
@@ -70,7 +70,7 @@ pub struct MemoryPlan {
 /// # Errors
 /// [`BuildError::Memory`] when the fixed part alone needs more than `max`.
 pub fn plan_memory(na: u64, nb: u64, k: u32, variant: Variant, max: u64) -> Result<MemoryPlan, BuildError> {
-    let labels = na.saturating_mul(nb).saturating_mul(core::mem::size_of::<Label>() as u64);
+    let labels = PairLabels::bytes_for(na.saturating_mul(nb));
     // A clearance build holds one more byte per pair: its proved level count.
     let counts = if matches!(variant, Variant::Clearance(_)) { na.saturating_mul(nb) } else { 0 };
     let fixed = FIXED_BYTES_PER_SAMPLE

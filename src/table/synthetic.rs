@@ -6,7 +6,7 @@
 //! the cylinder + frustum plus r/sqrt 2), with deep far cells marked unreachable (like the real
 //! robot's ~12 %). It is symmetric in y by construction.
 
-use crate::cspace::{CellIndex, Label, LabelledSpace, SampleGrid, Workspace};
+use crate::cspace::{CellIndex, Label, LabelledSpace, PairLabels, SampleGrid, Workspace};
 use crate::math::Vec3;
 
 /// Which labels a synthetic space gets.
@@ -125,5 +125,6 @@ pub fn space(levels: u32, pattern: Pattern) -> LabelledSpace {
             });
         }
     }
+    let labels = PairLabels::from_labels(g.cells.len(), &labels);
     LabelledSpace { grid_a: g.clone(), grid_b: g, labels, margin: 0.0 }
 }

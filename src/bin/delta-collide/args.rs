@@ -93,7 +93,7 @@ pub enum Command {
     /// Reads every shard file of one `build --shard I/N` run, in any order, and writes the
     /// table: byte for byte the one a one-shot build writes. A missing, repeated, truncated or
     /// corrupt shard, or one of another cell, k, variant, labelling or N, is an error naming
-    /// the file. Needs the memory of a one-shot build (one byte per pair of samples).
+    /// the file. Needs the memory of a one-shot build (2 bits per pair of samples).
     Merge(MergeArgs),
     /// Print what a table file holds
     Inspect(InspectArgs),
@@ -259,7 +259,7 @@ pub struct BuildArgs {
     pub shards: Option<u32>,
     /// The memory the build may use, in bytes or with K, M, G or T (powers of 1024), e.g. 8G: a
     /// shared-sub build finds its sub-cells by blocks of the quadtree sized to fit (the same
-    /// table); a build whose fixed part (boxes, one byte of label per sample pair) does not fit
+    /// table); a build whose fixed part (boxes, 2 bits of label per sample pair) does not fit
     /// is refused before it starts (one-shot builds; docs/CLUSTER.md) [default: 7G, or the
     /// machine's memory when it has less or when the fixed part alone needs more]
     #[arg(long, value_name = "BYTES", conflicts_with = "shard", value_parser = clipped(parse_bytes))]

@@ -32,7 +32,7 @@ use args::{BuildArgs, CheckArgs, Cli, Command, InspectArgs};
 use clap::CommandFactory;
 use delta_collide::cell::exact::PairState;
 use delta_collide::cell::{Cell, ExactChecker};
-use delta_collide::cspace::{Label, Progress, SampleGrid, Workspace};
+use delta_collide::cspace::{PairLabels, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
     build_table_bounded, default_max_memory, from_bytes, is_bundle, memory_plan, to_bytes, BoundedBuild, BundleChecker,
@@ -406,7 +406,7 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Refuses, before anything big is allocated, a `k` whose label array (one byte per pair of
+/// Refuses, before anything big is allocated, a `k` whose label array (2 bits per pair of
 /// sampled grid cells, about `(0.2 k^3)^2`, divided among `shards` shards) needs more memory
 /// than the machine has.
 ///
@@ -422,16 +422,15 @@ pub(crate) fn check_memory(cell: &Cell, k: u32, ws: &Workspace, shards: u32) -> 
     let samples = |delta| SampleGrid::new(ws, k0, delta).map(|g| g.cells.len() as u64 * scale);
     let (na, nb) = (samples(&a.model.delta)?, samples(&b.model.delta)?);
     let rows = na.div_ceil(u64::from(shards.max(1)));
-    let needed = rows.saturating_mul(nb).saturating_mul(std::mem::size_of::<Label>() as u64);
+    let needed = PairLabels::bytes_for(rows.saturating_mul(nb));
     if needed > total {
         let per = if shards > 1 { format!(" per shard of {shards}") } else { String::new() };
         return Err(format!(
             "k = {k}: labelling cell {} needs about {} of memory{per} for its labels alone ({rows} x {nb} \
-             sample pairs, {} byte each), more than this machine's {}; use a smaller k (each \
+             sample pairs, 2 bits each), more than this machine's {}; use a smaller k (each \
              halving needs 64 times less) or more shards",
             cell.name,
             gigabytes(needed),
-            std::mem::size_of::<Label>(),
             gigabytes(total)
         ));
     }

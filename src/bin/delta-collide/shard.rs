@@ -5,7 +5,7 @@
 use crate::args::{BuildArgs, MergeArgs, ShardArg};
 use crate::files;
 use crate::Failure;
-use delta_collide::cspace::{Progress, Workspace};
+use delta_collide::cspace::{PairLabels, Progress, Workspace};
 use delta_collide::table::shard::{build_shard_of, merge_shards, read_shard_info, ShardIndex};
 use delta_collide::table::{to_bytes, Labelling, TableKind, Variant};
 use std::io::Write;
@@ -141,15 +141,15 @@ pub fn build(args: &BuildArgs, shard: &ShardArg, progress: Progress) -> Result<(
 pub fn merge(args: &MergeArgs) -> Result<(), Failure> {
     let names: Vec<String> = args.shards.iter().map(|p| p.display().to_string()).collect();
     let mut read = |name: &str| std::fs::read(name).map_err(|e| e.to_string());
-    // The merge holds one byte per pair: refuse, before allocating, what the memory cannot hold.
+    // The merge holds 2 bits per pair: refuse, before allocating, what the memory cannot hold.
     if let (Some(first), Some(total)) = (names.first(), crate::total_memory()) {
         if let Ok((na, nb)) =
             read(first).and_then(|b| read_shard_info(&b).map_err(|e| e.to_string())).map(|i| i.samples)
         {
-            let needed = (na as u64).saturating_mul(nb as u64);
+            let needed = PairLabels::bytes_for((na as u64).saturating_mul(nb as u64));
             if needed > total {
                 return Err(Failure::Failed(format!(
-                    "merging needs about {} of memory for the labels alone ({na} x {nb} pairs, one byte \
+                    "merging needs about {} of memory for the labels alone ({na} x {nb} pairs, 2 bits \
                      each), more than this machine's {}; merge on a larger machine",
                     crate::gigabytes(needed),
                     crate::gigabytes(total)

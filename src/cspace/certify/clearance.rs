@@ -19,7 +19,7 @@ use super::sweeps::{cell_sweeps, inflation, references, unreachable_cells};
 use crate::cell::Cell;
 use crate::cspace::label::{entries_collide, two_robot_grids, Inflation, Rows, SampleBoxes, Slot};
 use crate::cspace::sampler::Workspace;
-use crate::cspace::Label;
+use crate::cspace::{Label, PairLabels};
 use crate::geometry::Sweep;
 use crate::math::Real;
 use rayon::prelude::*;
@@ -35,7 +35,7 @@ pub(crate) fn clearance_counts(
     cell: &Cell,
     k: u32,
     ws: &Workspace,
-    labels: &[Label],
+    labels: &PairLabels,
     ladder_mm: &[Real],
     rows: Rows,
 ) -> Result<Vec<u8>, String> {
@@ -71,10 +71,10 @@ pub(crate) fn clearance_counts(
     if nb == 0 {
         return Ok(counts);
     }
-    counts.par_chunks_mut(nb).zip(labels.par_chunks(nb)).enumerate().for_each(|(j, (row, row_labels))| {
+    counts.par_chunks_mut(nb).enumerate().for_each(|(j, row)| {
         let ia = rows.row(j);
-        for (ib, (c, &l)) in row.iter_mut().zip(row_labels).enumerate() {
-            if l == Label::Free {
+        for (ib, c) in row.iter_mut().enumerate() {
+            if labels[j * nb + ib] == Label::Free {
                 *c = proved_levels(ladder_mm, |i| {
                     let a = &a_at[i];
                     a.slot[ia] == Slot::Boxes && b.slot[ib] == Slot::Boxes && !entries_collide(a, ia, &b, ib)

@@ -93,14 +93,12 @@ use crate::cspace::label::{
     SampleBoxes,
 };
 use crate::cspace::symmetry::{in_stored_half, mirror_samples, reflection_y};
-use crate::cspace::Label;
 use crate::cspace::sampler::{SampleGrid, Workspace};
-use crate::cspace::LabelledSpace;
+use crate::cspace::{Label, LabelledSpace, PairLabels};
 use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
-use rayon::prelude::*;
-use refine::{octants_prove_free, refine_unknown_cells, sub_cell_masks, sub_cells, Levels, SubOctants, UnknownCells};
+use refine::{octants_prove_free, sub_cell_masks, sub_cells, Levels, SubOctants, UnknownCells};
 use sweeps::{cell_sweeps, inflation, octants, reference_octants, references, unreachable_cells};
 
 
@@ -189,30 +187,23 @@ impl MirrorRows {
     /// mirror row, read from `labels` when `rows` holds it and labelled by `row_of` otherwise
     /// (the rows of a shard): label `(ia, ib)` is that of `(a[ia], b[ib])`. Rows are written in
     /// parallel: a mirror row lies in the stored half, so it is never itself written.
-    fn fill(&self, labels: &mut [Label], rows: Rows, row_of: impl Fn(usize) -> Vec<Label> + Sync) {
-        let nb = self.b.len();
-        if nb == 0 {
+    fn fill(&self, labels: &mut PairLabels, rows: Rows, row_of: impl Fn(usize) -> Vec<Label> + Sync) {
+        if self.b.is_empty() {
             return;
         }
-        let (mut targets, mut sources) = (Vec::new(), Vec::new());
-        for (j, row) in labels.chunks_mut(nb).enumerate() {
-            match self.a[rows.row(j)] {
-                Some(m) => {
-                    targets.push((m, row));
-                    sources.push(None);
-                }
-                None => sources.push(Some(&*row)),
-            }
-        }
-        targets.into_par_iter().for_each(|(m, row)| {
-            let mut write = |source: &[Label]| row.iter_mut().zip(&self.b).for_each(|(l, &mb)| *l = source[mb]);
-            match rows.index_of(m).map(|jm| sources[jm]) {
-                Some(Some(source)) => write(source),
+        // The mirror rows are read from a copy (a quarter byte per pair) while the reflected
+        // rows are written.
+        let sources = labels.clone();
+        labels.rows_mut(|j, row| {
+            let Some(m) = self.a[rows.row(j)] else { return };
+            let source = match rows.index_of(m) {
                 // A mirror row is in the stored half, so never reflected itself.
-                Some(None) => {}
+                Some(_) if self.a[m].is_some() => return,
+                Some(jm) => sources.row(jm),
                 // The mirror row is not among `rows` (a shard's): labelled here.
-                None => write(&row_of(m)),
-            }
+                None => row_of(m),
+            };
+            row.iter_mut().zip(&self.b).for_each(|(l, &mb)| *l = source[mb]);
         });
     }
 }
@@ -391,9 +382,9 @@ pub(crate) fn certify_rows_then<R>(
     let mirror = MirrorRows::of(cell, &grid_a, &grid_b);
     let reflected = |ia: usize| mirror.as_ref().is_some_and(|m| m.a[ia].is_some());
     let labeller = RowLabeller::new(&b0);
-    let mut labels = label_rows_except(&labeller, &a0, collides, rows, progress, reflected);
     let unknown = UnknownCells::new(&la, &lb);
-    refine_unknown_cells(&la, &lb, &unknown, &mut labels, rows, reflected);
+    let refine_row = |ia, row: &mut [Label]| unknown.refine_row(&la, &lb, ia, row);
+    let mut labels = label_rows_except(&labeller, &a0, collides, rows, progress, reflected, refine_row);
     if let Some(m) = &mirror {
         m.fill(&mut labels, rows, |ia| {
             let mut row = vec![Label::Collision; b0.len()];
@@ -451,13 +442,13 @@ mod tests {
             let coarse = label_space_certified_with(&cell, 16, &ws, &whole_cells).unwrap();
             let fine = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap();
             let (mut freed, mut added) = (0, 0);
-            for ((e, c), f) in exact.labels.iter().zip(&coarse.space.labels).zip(&fine.space.labels) {
-                assert!(*f != Label::Unreachable || *e == Label::Unreachable);
-                assert_eq!(*c == Label::Unreachable, *f == Label::Unreachable);
-                assert!(*e != Label::Collision || *f == Label::Collision);
-                assert!(*c != Label::Free || *f == Label::Free);
-                freed += (*c == Label::Collision && *f == Label::Free) as usize;
-                added += (*e == Label::Free && *f == Label::Collision) as usize;
+            for ((e, c), f) in exact.labels.iter().zip(coarse.space.labels.iter()).zip(fine.space.labels.iter()) {
+                assert!(f != Label::Unreachable || e == Label::Unreachable);
+                assert_eq!(c == Label::Unreachable, f == Label::Unreachable);
+                assert!(e != Label::Collision || f == Label::Collision);
+                assert!(c != Label::Free || f == Label::Free);
+                freed += (c == Label::Collision && f == Label::Free) as usize;
+                added += (e == Label::Free && f == Label::Collision) as usize;
             }
             assert!(freed > 0 && added > 0, "{name}: {freed} freed, {added} added");
         }
@@ -491,8 +482,9 @@ mod tests {
             let (la, lb) = (Levels::new(&a0, &a1), Levels::new(&b0, &b1));
             let collides = |ia, ib| !octants_prove_free(&la, &lb, ia, ib);
             let mut own = label_pairs(&a0, &b0, collides, Rows::ALL, Progress::Silent);
-            refine_unknown_cells(&la, &lb, &UnknownCells::new(&la, &lb), &mut own, Rows::ALL, |_| false);
-            let differ = own.iter().zip(&c.space.labels).filter(|(o, l)| o != l).count();
+            let unknown = UnknownCells::new(&la, &lb);
+            own.rows_mut(|ia, row| unknown.refine_row(&la, &lb, ia, row));
+            let differ = own.iter().zip(c.space.labels.iter()).filter(|(o, l)| o != l).count();
             assert_eq!(differ, 0, "{name}: {differ} labels differ");
         }
     }
@@ -540,7 +532,7 @@ mod tests {
             let stored = stored_half(&cell, &c.space.grid_a);
             assert_eq!(stored.is_some(), name != "T3");
             let kept = |p: usize| stored.as_ref().is_none_or(|s| s[p / nb]);
-            for (p, _) in c.space.labels.iter().enumerate().filter(|&(p, &l)| l == Label::Collision && kept(p)) {
+            for (p, _) in c.space.labels.iter().enumerate().filter(|&(p, l)| l == Label::Collision && kept(p)) {
                 let (care, collision) = octant_pairs(&a0, &a1, &b0, &b1, p / nb, p % nb, false);
                 want.pairs.push(p as u64);
                 want.care.push(care);
@@ -630,7 +622,7 @@ mod tests {
             };
             let ((fa, fb), (pa, pb)) = (levels(true), levels(false));
             let nb = b0.len();
-            let collisions = labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision);
+            let collisions = labels.iter().enumerate().filter(|&(_, l)| l == Label::Collision);
             let decided = collisions.filter(|&(p, _)| held_by_references(&fa, &fb, p / nb, p % nb) != 0).count();
             let fast = sub_cells(&fa, &fb, &labels, Rows::ALL, |_| true);
             let plain = sub_cells(&pa, &pb, &labels, Rows::ALL, |_| true);
@@ -679,7 +671,7 @@ mod tests {
             let all = all_box_pairs(a0.per_entry, b0.per_entry);
             let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
             let (mut pairs, mut freed) = (0, 0);
-            for (p, _) in labels.iter().enumerate().filter(|(_, &l)| l == Label::Collision).step_by(3) {
+            for (p, _) in labels.iter().enumerate().filter(|&(_, l)| l == Label::Collision).step_by(3) {
                 let (ia, ib) = (p / nb, p % nb);
                 let (care, level_2) = octant_pairs(&a0, &a1, &b0, &b1, ia, ib, false);
                 let (whole_a, whole_b) = (boxes(&a0, ia), boxes(&b0, ib));

@@ -9,7 +9,7 @@ use crate::cspace::label::{
     SampleBoxes, Slot, SweptBounds, SweptBox,
 };
 use crate::cspace::sampler::SampleGrid;
-use crate::cspace::Label;
+use crate::cspace::{Label, PairLabels};
 use crate::geometry::sat::separating_axis;
 use crate::geometry::sweep::{boxes_overlap_deeply, core};
 use crate::geometry::Obb;
@@ -318,7 +318,7 @@ pub(super) fn cores_meet(a: &[Option<Obb>], ia: usize, na: usize, b: &[Option<Ob
 pub(super) fn sub_cells(
     a: &Levels,
     b: &Levels,
-    labels: &[Label],
+    labels: &PairLabels,
     selection: Rows,
     stored: impl Fn(usize) -> bool + Sync,
 ) -> SubCells {
@@ -326,15 +326,16 @@ pub(super) fn sub_cells(
     if nb == 0 {
         return SubCells::default();
     }
-    let rows: Vec<Vec<(u64, u64, u64)>> = labels
-        .par_chunks(nb * SUB_CELL_ROWS)
-        .enumerate()
-        .map(|(block, rows)| {
+    let labelled = labels.len() / nb;
+    let rows: Vec<Vec<(u64, u64, u64)>> = (0..labelled.div_ceil(SUB_CELL_ROWS))
+        .into_par_iter()
+        .map(|block| {
             let mut out = vec![];
+            let first = block * SUB_CELL_ROWS;
             for ib in 0..nb {
-                for (r, row) in rows.chunks(nb).enumerate() {
-                    let ia = selection.row(block * SUB_CELL_ROWS + r);
-                    if row[ib] == Label::Collision && stored(ia) {
+                for j in first..labelled.min(first + SUB_CELL_ROWS) {
+                    let ia = selection.row(j);
+                    if labels[j * nb + ib] == Label::Collision && stored(ia) {
                         let (care, collision) = sub_cell_masks(a, b, ia, ib, false);
                         out.push(((ia * nb + ib) as u64, care, collision));
                     }
@@ -596,31 +597,9 @@ pub(super) fn octants_prove_free(a: &Levels, b: &Levels, ia: usize, ib: usize) -
     sub_cell_masks(a, b, ia, ib, true).1 == 0
 }
 
-/// Level 2 for the pairs that [`label_pairs`](crate::cspace::label::label_pairs) made
-/// collisions because a sample has no whole-cell bound ([`Slot::Unknown`]): each is retried
-/// octant by octant (`labels` holds the rows `rows` of A; those that `skip` names are left as
-/// they are).
-pub(super) fn refine_unknown_cells(
-    a: &Levels,
-    b: &Levels,
-    unknown: &UnknownCells,
-    labels: &mut [Label],
-    rows: Rows,
-    skip: impl Fn(usize) -> bool + Sync,
-) {
-    let nb = b.whole.len();
-    if nb == 0 {
-        return;
-    }
-    labels.par_chunks_mut(nb).enumerate().for_each(|(j, row)| {
-        let ia = rows.row(j);
-        if !skip(ia) {
-            unknown.refine_row(a, b, ia, row);
-        }
-    });
-}
-
-/// What [`refine_unknown_cells`] needs once: B's samples without a whole-cell bound and both
+/// What level 2 needs once for the pairs that [`label_pairs`](crate::cspace::label::label_pairs)
+/// made collisions because a sample has no whole-cell bound ([`Slot::Unknown`]), each retried
+/// octant by octant ([`UnknownCells::refine_row`]): B's samples without a whole-cell bound and both
 /// robots' octant covers.
 pub(super) struct UnknownCells {
     unknown_b: Vec<usize>,
@@ -635,7 +614,7 @@ impl UnknownCells {
         UnknownCells { unknown_b, cover_a: octant_covers(a.octs), cover_b: octant_covers(b.octs) }
     }
 
-    /// [`refine_unknown_cells`] on the row of A's sample `ia`.
+    /// Level 2 for those pairs of the row of A's sample `ia`.
     pub(super) fn refine_row(&self, a: &Levels, b: &Levels, ia: usize, row: &mut [Label]) {
         let (a0, b0) = (a.whole, b.whole);
         let mut retry = |ib: usize| {

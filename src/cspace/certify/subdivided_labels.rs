@@ -6,8 +6,7 @@ use crate::cell::Cell;
 use crate::cspace::label::two_robot_grids;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::symmetry::{mirror_samples, reflection_y};
-use crate::cspace::{Label, LabelledSpace};
-use rayon::prelude::*;
+use crate::cspace::{Label, LabelledSpace, PairLabels};
 use super::{sub_cell_index, CertifiedSpace, SubCells};
 
 
@@ -68,10 +67,7 @@ impl<'a> SubdividedLabels<'a> {
     pub fn to_dense(&self) -> LabelledSpace {
         let nb = self.grid_b.cells.len();
         let ibs: Vec<u32> = (0..nb as u32).collect();
-        let mut labels = vec![Label::Unreachable; self.grid_a.cells.len() * nb];
-        if nb > 0 {
-            labels.par_chunks_mut(nb).enumerate().for_each(|(ia, row)| self.row(Some(ia), &ibs, row));
-        }
+        let labels = PairLabels::from_rows(self.grid_a.cells.len(), nb, |ia, row| self.row(Some(ia), &ibs, row));
         let (grid_a, grid_b) = (self.grid_a.clone(), self.grid_b.clone());
         LabelledSpace { grid_a, grid_b, labels, margin: self.coarse.margin }
     }

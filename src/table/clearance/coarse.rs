@@ -2,7 +2,7 @@
 //! `2^shift` grid cells per axis and robot, each coarse pair holding the smallest level
 //! count of the free pairs in it.
 
-use crate::cspace::{CellIndex, Label, LabelledSpace, SampleGrid};
+use crate::cspace::{CellIndex, Label, LabelledSpace, PairLabels, SampleGrid};
 
 /// `grid` with every cell index shifted right by `shift`: the coarse cells that hold a
 /// sample, sorted, and for each sample its coarse cell's index.
@@ -33,13 +33,13 @@ pub(super) fn coarsen(space: &LabelledSpace, counts: &[u8], shift: u32, n_top: u
     let (gb, ib_of) = coarse_grid(&space.grid_b, shift);
     let (nb, cnb) = (space.grid_b.cells.len(), gb.cells.len());
     let mut min = vec![u8::MAX; ga.cells.len() * cnb];
-    for (pair, (&l, &c)) in space.labels.iter().zip(counts).enumerate() {
+    for (pair, (l, &c)) in space.labels.iter().zip(counts).enumerate() {
         if l == Label::Free {
             let m = &mut min[ia_of[pair / nb] as usize * cnb + ib_of[pair % nb] as usize];
             *m = (*m).min(c);
         }
     }
-    let labels = min
+    let labels: Vec<Label> = min
         .iter()
         .map(|&m| match m {
             u8::MAX => Label::Unreachable,
@@ -47,6 +47,7 @@ pub(super) fn coarsen(space: &LabelledSpace, counts: &[u8], shift: u32, n_top: u
             _ => Label::Collision,
         })
         .collect();
+    let labels = PairLabels::from_labels(cnb, &labels);
     let counts = min.iter().map(|&m| if m == u8::MAX { 0 } else { m }).collect();
     (LabelledSpace { grid_a: ga, grid_b: gb, labels, margin: space.margin }, counts)
 }

@@ -557,7 +557,7 @@ mod tests {
     /// Seeded counts: 0 on pairs not free, on free ones 1 to `n` from a hash of the pair.
     fn counts_for(space: &crate::cspace::LabelledSpace, n: usize) -> Vec<u8> {
         let hash = |i: usize| ((i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 58) as usize;
-        let count = |(i, l): (usize, &Label)| if *l == Label::Free { (1 + hash(i) % n) as u8 } else { 0 };
+        let count = |(i, l): (usize, Label)| if l == Label::Free { (1 + hash(i) % n) as u8 } else { 0 };
         space.labels.iter().enumerate().map(count).collect()
     }
 

@@ -57,13 +57,11 @@ pub fn subdivided_slices(
     let coarse = labels.coarse();
     let (ca0, cb0, k0) = (&coarse.grid_a.cells, &coarse.grid_b.cells, coarse.grid_a.k as u16);
     let nb0 = cb0.len().max(1);
-    let mut coarse_ranges: Vec<[u16; 4]> = coarse
-        .labels
-        .par_chunks(nb0)
-        .enumerate()
-        .flat_map_iter(|(pa, row)| {
+    let mut coarse_ranges: Vec<[u16; 4]> = (0..coarse.labels.len() / nb0)
+        .into_par_iter()
+        .flat_map_iter(|pa| {
             let (a, mut out) = (ca0[pa], Vec::new());
-            for (pb, _) in row.iter().enumerate().filter(|(_, &l)| l == Label::Collision) {
+            for pb in (0..nb0).filter(|&pb| coarse.labels[pa * nb0 + pb] == Label::Collision) {
                 let b = cb0[pb];
                 out.push([a[0], a[second], b[0], b[second]]);
                 if symmetric && second == 1 {

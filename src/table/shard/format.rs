@@ -147,9 +147,7 @@ pub(super) fn to_bytes(info: &ShardInfo, labels: &RowLabels) -> Vec<u8> {
     h.cell_parameters.iter().for_each(|v| put(&mut out, &v.to_le_bytes()));
     put_grid(&mut out, ga);
     put_grid(&mut out, gb);
-    for quad in labels.space.labels.chunks(4) {
-        out.push(quad.iter().enumerate().fold(0u8, |b, (j, &l)| b | (l as u8) << (2 * j)));
-    }
+    put(&mut out, labels.space.labels.bytes());
     if let Some(s) = sub {
         for ((p, c), x) in s.pairs.iter().zip(&s.care).zip(&s.collision) {
             [p, c, x].iter().for_each(|v| put(&mut out, &v.to_le_bytes()));

@@ -4,15 +4,15 @@
 
 use super::error::ShardError;
 use super::format::{parse, unpack_row, Parsed, ShardInfo};
-use crate::cspace::{Label, LabelledSpace, SampleGrid, SubCells};
+use crate::cspace::{Label, LabelledSpace, PairLabels, SampleGrid, SubCells};
 use crate::table::build::{assemble, RowLabels, Variant};
 use crate::table::{BuildReport, Header, Table, TableKind};
 
 /// Merges the shard files `files` (names, in any order; `read` gives a file's bytes) into
 /// the table a one-shot build writes: its header, the table and the build's report
 /// (`label_secs` is the sum of the shards' labelling times). The files are read one at a
-/// time, each dropped once its labels are copied: the merge holds the whole label set (one
-/// byte per pair of samples), the sub-cells and one file. A subdivided table's files are read
+/// time, each dropped once its labels are copied: the merge holds the whole label set (2
+/// bits per pair of samples), the sub-cells and one file. A subdivided table's files are read
 /// twice: first for the labels and for how many sub-cell entries each row of A has, then to
 /// put each entry at its place in the pair order, so that the sub-cells are held once (a
 /// shard's rows are interleaved with the others', so its entries are not in one run).
@@ -46,9 +46,11 @@ pub fn merge_shards(
             return Err(ShardError::Duplicate { index: i as u32, first: other, second: name.clone() });
         }
         let (rows, nb) = (s.info.shard.rows(), s.info.samples.1);
+        let mut row = vec![Label::Free; nb];
         for j in 0..s.info.rows {
             let ia = rows.row(j);
-            unpack_row(s.labels, j, &mut f.labels[ia * nb..(ia + 1) * nb]);
+            unpack_row(s.labels, j, &mut row);
+            f.labels.set_row(ia, &row);
             if !s.counts.is_empty() {
                 f.counts[ia * nb..(ia + 1) * nb].copy_from_slice(&s.counts[j * nb..(j + 1) * nb]);
             }
@@ -148,7 +150,7 @@ struct First {
     /// Per shard number, the file holding it.
     holder: Vec<Option<String>>,
     /// Every pair's label.
-    labels: Vec<Label>,
+    labels: PairLabels,
     /// Every pair's clearance level count (clearance shards; else empty).
     counts: Vec<u8>,
     /// Per row of A: how many sub-cell entries the shards hold.
@@ -165,7 +167,7 @@ impl First {
             grid_a: s.grid_a.clone(),
             grid_b: s.grid_b.clone(),
             holder: vec![None; s.info.shard.count() as usize],
-            labels: vec![Label::Unreachable; na * nb],
+            labels: PairLabels::filled(na, nb, Label::Unreachable),
             counts: if s.info.ladder.is_some() { vec![0; na * nb] } else { vec![] },
             row_entries: vec![0; na],
         }

@@ -8,7 +8,7 @@
 //! not parts of a tree, so the merge builds whichever variant the shards were labelled for.
 //! A pair's level count depends on the pair alone (its two cells' sweeps and its label), so
 //! the counts of the rows of all shards are the one-shot build's. The merge therefore needs
-//! the whole label set in memory (one byte per pair of samples; a clearance table one more
+//! the whole label set in memory (2 bits per pair of samples; a clearance table a byte more
 //! for the counts), as a one-shot build does; the shards need `1/n` of it each.
 //!
 //! A shard file (`format.rs`) records the cell, `k`, the variant, the labelling, `i` and `n`

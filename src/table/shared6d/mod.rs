@@ -348,7 +348,7 @@ mod tests {
         let mut out = SubCells::default();
         let mut rng = crate::test_rng::TestRng(seed.max(1));
         let mut next = || rng.next_u64();
-        for (pair, &l) in space.labels.iter().enumerate() {
+        for (pair, l) in space.labels.iter().enumerate() {
             if l == Label::Collision {
                 let care = next() | next();
                 out.pairs.push(pair as u64);
