@@ -18,7 +18,7 @@ use rayon::prelude::*;
 static LABELS: [Label; 4] = [Label::Free, Label::Collision, Label::Unreachable, Label::Collision];
 
 /// Labels of `rows` x `nb` sample pairs, 2 bits each (module doc).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PairLabels {
     nb: usize,
     len: usize,
@@ -60,11 +60,6 @@ impl PairLabels {
         self.len == 0
     }
 
-    /// Labels per row.
-    pub fn per_row(&self) -> usize {
-        self.nb
-    }
-
     /// The packed bytes (module doc).
     pub fn bytes(&self) -> &[u8] {
         &self.bytes
@@ -88,23 +83,24 @@ impl PairLabels {
         (0..self.len).map(|p| self.get(p))
     }
 
-    /// Row `j` into `out` (`nb` labels).
-    pub fn row_into(&self, j: usize, out: &mut [Label]) {
-        let start = j * self.nb;
-        out.iter_mut().enumerate().for_each(|(ib, l)| *l = self.get(start + ib));
-    }
-
     /// Row `j`.
     pub fn row(&self, j: usize) -> Vec<Label> {
-        let mut out = vec![Label::Free; self.nb];
-        self.row_into(j, &mut out);
-        out
+        (j * self.nb..(j + 1) * self.nb).map(|p| self.get(p)).collect()
     }
 
-    /// Writes `row` as row `j`.
+    /// Writes `row` as row `j`: label by label up to the first whole byte of the row, then a
+    /// byte per four labels, then the rest.
     pub fn set_row(&mut self, j: usize, row: &[Label]) {
         let start = j * self.nb;
-        row.iter().enumerate().for_each(|(ib, &l)| self.set(start + ib, l));
+        let head = ((4 - start % 4) % 4).min(row.len());
+        row[..head].iter().enumerate().for_each(|(i, &l)| self.set(start + i, l));
+        let quads = row[head..].chunks_exact(4);
+        let (tail, first) = (quads.remainder(), (start + head) / 4);
+        for (byte, q) in self.bytes[first..].iter_mut().zip(quads) {
+            *byte = q[0] as u8 | (q[1] as u8) << 2 | (q[2] as u8) << 4 | (q[3] as u8) << 6;
+        }
+        let at = start + row.len() - tail.len();
+        tail.iter().enumerate().for_each(|(i, &l)| self.set(at + i, l));
     }
 }
 
@@ -205,12 +201,15 @@ mod tests {
                 assert!(packed.iter().eq(plain.iter().map(|&l| turned(l))));
                 packed.replace(Label::Unreachable, Label::Collision);
                 assert!(packed.iter().all(|l| l == Label::Collision));
-                if rows > 0 {
-                    let mut one = PairLabels::filled(rows, nb, Label::Unreachable);
-                    one.set_row(rows - 1, &plain[(rows - 1) * nb..]);
-                    assert_eq!(one.row(rows - 1), &plain[(rows - 1) * nb..]);
-                    assert!(one.iter().take((rows - 1) * nb).all(|l| l == Label::Unreachable));
+                // Row by row over other labels, each row starting at every offset in its byte
+                // as `nb` and `j` vary: the rows after it untouched.
+                let mut by_rows = PairLabels::filled(rows, nb, Label::Unreachable);
+                for j in 0..rows {
+                    by_rows.set_row(j, &plain[j * nb..(j + 1) * nb]);
+                    assert!(by_rows.iter().skip((j + 1) * nb).all(|l| l == Label::Unreachable));
                 }
+                assert_eq!(by_rows, PairLabels::from_labels(nb, &plain));
+                assert!((0..rows).all(|j| by_rows.row(j) == plain[j * nb..(j + 1) * nb]));
             }
         }
     }

@@ -186,13 +186,11 @@ impl MirrorRows {
     /// Writes each reflected row of `labels` (the rows `rows` of A, `nb` labels each) from its
     /// mirror row, read from `labels` when `rows` holds it and labelled by `row_of` otherwise
     /// (the rows of a shard): label `(ia, ib)` is that of `(a[ia], b[ib])`. Rows are written in
-    /// parallel: a mirror row lies in the stored half, so it is never itself written.
+    /// parallel, the mirror rows read from a copy of the labels (a quarter byte per pair).
     fn fill(&self, labels: &mut PairLabels, rows: Rows, row_of: impl Fn(usize) -> Vec<Label> + Sync) {
         if self.b.is_empty() {
             return;
         }
-        // The mirror rows are read from a copy (a quarter byte per pair) while the reflected
-        // rows are written.
         let sources = labels.clone();
         labels.rows_mut(|j, row| {
             let Some(m) = self.a[rows.row(j)] else { return };
