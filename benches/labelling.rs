@@ -54,7 +54,8 @@ fn bench_labelling(c: &mut Criterion) {
     assert_eq!(differ, 0, "product-structure labels differ from the per-pair exact check");
     let expected = collisions(naive.iter().copied());
     assert!(expected > 0);
-    let certified_expected = collisions(label_space_certified(&cell, K, &ws, Progress::Silent).unwrap().space.labels.iter());
+    let certified = label_space_certified(&cell, K, &ws, Progress::Silent).unwrap();
+    let certified_expected = collisions(certified.space.labels.iter());
 
     let mut group = c.benchmark_group(format!("label_T1_k{K}_{}_pairs", naive.len()));
     group.sample_size(10);

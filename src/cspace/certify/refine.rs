@@ -599,8 +599,8 @@ pub(super) fn octants_prove_free(a: &Levels, b: &Levels, ia: usize, ib: usize) -
 
 /// What level 2 needs once for the pairs that [`label_pairs`](crate::cspace::label::label_pairs)
 /// made collisions because a sample has no whole-cell bound ([`Slot::Unknown`]), each retried
-/// octant by octant ([`UnknownCells::refine_row`]): B's samples without a whole-cell bound and both
-/// robots' octant covers.
+/// octant by octant ([`UnknownCells::refine_row`]): B's samples without a whole-cell bound
+/// and both robots' octant covers.
 pub(super) struct UnknownCells {
     unknown_b: Vec<usize>,
     cover_a: Vec<Option<([Real; 3], [Real; 3])>>,
