@@ -17,6 +17,17 @@ use rayon::prelude::*;
 /// The labels a code stands for (3 is never stored).
 static LABELS: [Label; 4] = [Label::Free, Label::Collision, Label::Unreachable, Label::Collision];
 
+/// The label of pair `p` of packed labels `bytes` (module doc).
+#[inline]
+pub(crate) fn label_in(bytes: &[u8], p: usize) -> Label {
+    LABELS[usize::from(bytes[p / 4] >> (2 * (p % 4)) & 3)]
+}
+
+/// The byte of up to four labels, the first in the low bits.
+fn packed(labels: &[Label]) -> u8 {
+    labels.iter().enumerate().fold(0, |byte, (i, &l)| byte | (l as u8) << (2 * i))
+}
+
 /// Labels of `rows` x `nb` sample pairs, 2 bits each (module doc).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PairLabels {
@@ -68,7 +79,7 @@ impl PairLabels {
     /// The label of pair `p`.
     #[inline]
     pub fn get(&self, p: usize) -> Label {
-        LABELS[usize::from(self.bytes[p / 4] >> (2 * (p % 4)) & 3)]
+        label_in(&self.bytes, p)
     }
 
     /// Sets the label of pair `p`.
@@ -97,7 +108,7 @@ impl PairLabels {
         let quads = row[head..].chunks_exact(4);
         let (tail, first) = (quads.remainder(), (start + head) / 4);
         for (byte, q) in self.bytes[first..].iter_mut().zip(quads) {
-            *byte = q[0] as u8 | (q[1] as u8) << 2 | (q[2] as u8) << 4 | (q[3] as u8) << 6;
+            *byte = packed(q);
         }
         let at = start + row.len() - tail.len();
         tail.iter().enumerate().for_each(|(i, &l)| self.set(at + i, l));
@@ -133,12 +144,11 @@ impl PairLabels {
             let rows = (len / nb - first).min(4);
             let mut labels = vec![Label::Collision; nb * rows];
             if unpack {
-                let code = |q: usize| bytes[q / 4] >> (2 * (q % 4)) & 3;
-                labels.iter_mut().enumerate().for_each(|(q, l)| *l = LABELS[usize::from(code(q))]);
+                labels.iter_mut().enumerate().for_each(|(q, l)| *l = label_in(bytes, q));
             }
             labels.chunks_mut(nb).enumerate().for_each(|(r, row)| f(first + r, row));
-            bytes.fill(0);
-            labels.iter().enumerate().for_each(|(q, &l)| bytes[q / 4] |= (l as u8) << (2 * (q % 4)));
+            // The group's bytes hold exactly its labels, four to a byte (the last maybe fewer).
+            bytes.iter_mut().zip(labels.chunks(4)).for_each(|(byte, q)| *byte = packed(q));
         });
     }
 
@@ -165,7 +175,7 @@ impl Index<usize> for PairLabels {
     /// The label of pair `p`, as [`PairLabels::get`].
     #[inline]
     fn index(&self, p: usize) -> &Label {
-        &LABELS[usize::from(self.bytes[p / 4] >> (2 * (p % 4)) & 3)]
+        &LABELS[label_in(&self.bytes, p) as usize]
     }
 }
 

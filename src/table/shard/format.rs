@@ -41,7 +41,7 @@ use super::error::{corrupt, ShardError};
 use crate::table::reader::Reader;
 use super::ShardIndex;
 use crate::cell::{fingerprint_of, fnv1a64};
-use crate::cspace::{CellIndex, Label, SampleGrid, Symmetry, Workspace};
+use crate::cspace::{CellIndex, SampleGrid, Symmetry, Workspace};
 use crate::math::Vec3;
 use crate::table::build::{Labelling, RowLabels};
 use crate::table::clearance::MAX_RUNGS;
@@ -353,17 +353,4 @@ fn check_sub_cells(sub: &[u8], shard: ShardIndex, na: usize, nb: usize) -> Resul
         last = Some(pair);
     }
     Ok(())
-}
-
-/// Unpacks row `j` of the shard's packed labels (`nb` per row) into `out`.
-pub(super) fn unpack_row(packed: &[u8], j: usize, out: &mut [Label]) {
-    let nb = out.len();
-    for (ib, l) in out.iter_mut().enumerate() {
-        let at = j * nb + ib;
-        *l = match packed[at / 4] >> (2 * (at % 4)) & 3 {
-            0 => Label::Free,
-            1 => Label::Collision,
-            _ => Label::Unreachable,
-        };
-    }
 }

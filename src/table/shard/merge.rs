@@ -3,7 +3,8 @@
 //! the table from them (the same builder, so the same bytes).
 
 use super::error::ShardError;
-use super::format::{parse, unpack_row, Parsed, ShardInfo};
+use super::format::{parse, Parsed, ShardInfo};
+use crate::cspace::pair_labels::label_in;
 use crate::cspace::{Label, LabelledSpace, PairLabels, SampleGrid, SubCells};
 use crate::table::build::{assemble, RowLabels, Variant};
 use crate::table::{BuildReport, Header, Table, TableKind};
@@ -49,7 +50,7 @@ pub fn merge_shards(
         let mut row = vec![Label::Free; nb];
         for j in 0..s.info.rows {
             let ia = rows.row(j);
-            unpack_row(s.labels, j, &mut row);
+            row.iter_mut().enumerate().for_each(|(ib, l)| *l = label_in(s.labels, j * nb + ib));
             f.labels.set_row(ia, &row);
             if !s.counts.is_empty() {
                 f.counts[ia * nb..(ia + 1) * nb].copy_from_slice(&s.counts[j * nb..(j + 1) * nb]);
