@@ -14,6 +14,12 @@
 #include <stdint.h>
 
 /*
+ Most ticks between two timed protective calls whose interval still bounds the speeds; a
+ longer gap answers `DC_STATUS_TIME_JUMP`.
+ */
+#define DC_MAX_INTERVAL_TICKS 4
+
+/*
  Most robots of a cell; the size of the per-robot arrays of `DcProtectiveReport`.
  */
 #define DC_MAX_ROBOTS 32
@@ -346,6 +352,47 @@ typedef struct DcStopPath {
 } DcStopPath;
 
 /*
+ What `DcProtectiveRequest::time` counts (`clock`).
+ */
+typedef uint32_t DcClock;
+
+/*
+ The inputs of one timed protective query (`dc_protective_query_timed`); start from
+ `dc_protective_request_default()`, which sets `struct_size`.
+ */
+typedef struct DcProtectiveRequest {
+  /*
+   `sizeof(DcProtectiveRequest)` as the caller compiled it: lets later versions add fields.
+   */
+  size_t struct_size;
+  /*
+   What `time` counts: `DC_CLOCK_CYCLE` (the default) or `DC_CLOCK_NANOS`.
+   */
+  DcClock clock;
+  /*
+   The cycle counter, or the timestamp (ns), at which `tcps_mcs` hold.
+   */
+  uint64_t time;
+  /*
+   Robot j's TCP at `time`, in its own MCS: `n_tcps` entries, one per robot.
+   */
+  const struct DcVec3 *tcps_mcs;
+  /*
+   How many TCPs.
+   */
+  size_t n_tcps;
+  /*
+   Per robot, the path its stop will follow (as for `dc_protective_query_with_paths`), or
+   NULL with `n_paths` 0: no paths.
+   */
+  const struct DcStopPath *paths;
+  /*
+   How many paths: 0, or one per robot.
+   */
+  size_t n_paths;
+} DcProtectiveRequest;
+
+/*
  One robot pair's result of the last query.
  */
 typedef struct DcPairResult {
@@ -494,6 +541,38 @@ typedef uint32_t DcConfirmation;
 #define DC_STATUS_TABLE_WRONG_PAIR 19
 
 /*
+ Timed protective query: the same cycle (or timestamp) as the last call, with other TCPs.
+ (The same cycle with the same TCPs gets the last call's verdict and report unchanged.)
+ */
+#define DC_STATUS_TIME_REPEATED 20
+
+/*
+ Timed protective query: a cycle or timestamp before the last call's.
+ */
+#define DC_STATUS_TIME_BACKWARDS 21
+
+/*
+ Timed protective query: more than `DC_MAX_INTERVAL_TICKS` ticks after the last call.
+ */
+#define DC_STATUS_TIME_JUMP 22
+
+/*
+ Timed protective query (`DC_CLOCK_NANOS`): less than half a tick after the last call.
+ */
+#define DC_STATUS_TIME_EARLY 23
+
+/*
+ Timed protective query: a cycle counter after a timestamp, or the reverse.
+ */
+#define DC_STATUS_CLOCK_CHANGED 24
+
+/*
+ The handle is in use by another call (another task or thread) right now; nothing was
+ done. A handle is for one task: give each task its own.
+ */
+#define DC_STATUS_BUSY 25
+
+/*
  Could not decide (any error): stop the robots.
  */
 #define DC_VERDICT_STOP 0
@@ -513,6 +592,17 @@ typedef uint32_t DcConfirmation;
  than `warn_mm` to spare. Only ever written together with `DC_STATUS_OK`.
  */
 #define DC_VERDICT_WARN 3
+
+/*
+ The controller's cycle counter: one more per tick (`dc_set_stop_model`'s `tick_ms`); the
+ TCPs are that cycle's set-points, or positions measured at the cycle's nominal time.
+ */
+#define DC_CLOCK_CYCLE 0
+
+/*
+ A monotonic timestamp in nanoseconds of the moment the TCPs were measured.
+ */
+#define DC_CLOCK_NANOS 1
 
 /*
  No handle (`dc_mode(NULL)`).
@@ -682,11 +772,12 @@ struct DcStopConfig dc_stop_config_default(void);
 DcStatus dc_set_stop_model(struct DcCollider *handle, double tick_ms, double warn_mm, const struct DcStopConfig *stops, size_t n_stops);
 
 /*
- Forgets the previous TCPs of the protective verdict (e.g. after the robots were moved by
- hand): the next `dc_protective_query` assumes every robot at full speed. NULL is a no-op.
+ Forgets the previous TCPs of the protective verdict and the last call's cycle (e.g. after
+ the robots were moved by hand): the next protective query assumes every robot at full
+ speed. NULL is a no-op; a panic inside poisons the handle.
 
  # Safety
- `handle` must be NULL or a live handle not used by another thread.
+ `handle` must be NULL or a live handle.
  */
 void dc_protective_reset(struct DcCollider *handle);
 
@@ -737,6 +828,46 @@ DcStatus dc_protective_query(struct DcCollider *handle, const struct DcVec3 *tcp
  `DcStopPath`, each with `points` NULL or pointing to `n_points` readable `DcVec3`.
  */
 DcStatus dc_protective_query_with_paths(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, const struct DcStopPath *paths, size_t n_paths, DcVerdict *out_verdict, struct DcProtectiveReport *out_report);
+
+/*
+ A `DcProtectiveRequest` with `struct_size` set, `DC_CLOCK_CYCLE`, time 0, no TCPs and no
+ paths: set `time`, `tcps_mcs` and `n_tcps` (and the paths, if known) before each call.
+ */
+struct DcProtectiveRequest dc_protective_request_default(void);
+
+/*
+ The protective query with the time its TCPs hold, the call for the tick loop:
+ `dc_protective_query` (or, with paths, `dc_protective_query_with_paths`) whose speeds are
+ bounded over the real interval since the last call, from `request->time`:
+ - `DC_CLOCK_CYCLE`: the controller's cycle counter, one more per `tick_ms`, the TCPs that
+   cycle's; `DC_CLOCK_NANOS`: a monotonic timestamp (ns) of the TCPs' measurement.
+ - The same cycle (or timestamp) as the last call with the same TCPs (a function block
+   called twice, a retried call) writes the last call's verdict, report and status again,
+   unchanged. Every other timing fault is STOP with its own status, and the next call
+   assumes full speed: the same cycle with other TCPs `DC_STATUS_TIME_REPEATED`, an
+   earlier one `DC_STATUS_TIME_BACKWARDS`, more than `DC_MAX_INTERVAL_TICKS` ticks later
+   `DC_STATUS_TIME_JUMP`, a timestamp less than half a tick later `DC_STATUS_TIME_EARLY`,
+   a change of `clock` `DC_STATUS_CLOCK_CHANGED`. A skipped cycle (up to
+   `DC_MAX_INTERVAL_TICKS`) is bounded over its real interval.
+ - The first timed call, and the first after an untimed call, an error or
+   `dc_protective_reset`, assumes full speed.
+ A FREE or WARN covers a STOP issued at the next cycle: a controller that misses one must
+ stop the robots itself.
+
+ Statuses: those of `dc_protective_query_with_paths`, the timing statuses above,
+ `DC_STATUS_NULL_POINTER` (request NULL, or paths NULL with `n_paths` > 0),
+ `DC_STATUS_INVALID_ARGUMENT` (a `struct_size` that is not this header's
+ `sizeof(DcProtectiveRequest)`, an unknown `clock`), `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths` neither 0 nor the robot
+ count), `DC_STATUS_BUSY` (the handle is in another call). `*out_verdict` and
+ `*out_report` are written on every call. Never allocates, locks or does I/O.
+
+ # Safety
+ `handle` must be NULL or a live handle from `dc_init*`; `request` must be NULL or point
+ to a readable `DcProtectiveRequest` whose `tcps_mcs` is NULL or points to `n_tcps`
+ readable `DcVec3` and whose `paths` is as for `dc_protective_query_with_paths`; the out
+ pointers must be NULL or writable.
+ */
+DcStatus dc_protective_query_timed(struct DcCollider *handle, const struct DcProtectiveRequest *request, DcVerdict *out_verdict, struct DcProtectiveReport *out_report);
 
 /*
  Copies the per-pair results of the last query into `out[0..]` and their number into

@@ -7,7 +7,8 @@
 
 use crate::cell::exact::PairState;
 use crate::cell::protective::{
-    BoxPair, Protective, ProtectiveChecker, ProtectiveReport, ProtectiveStatus, StopPath, DEFAULT_WARN_MM,
+    BoxPair, Protective, ProtectiveChecker, ProtectiveReport, ProtectiveRequest, ProtectiveStatus, StopPath,
+    TickTime, TimingFault, DEFAULT_WARN_MM,
 };
 use crate::cell::{Cell, ExactChecker, MAX_ROBOTS};
 use crate::ffi::convert::{cell_error_status, table_error_status};
@@ -298,66 +299,46 @@ impl Collider {
         self.protective.reset();
     }
 
-    /// The protective query: fills `report` (which starts as [`DcProtectiveReport::STOP`])
-    /// and returns the status; the verdict is FREE or WARN only with `DC_STATUS_OK`.
-    pub(crate) fn protective_query(&mut self, tcps: &[DcVec3], report: &mut DcProtectiveReport) -> DcStatus {
-        if tcps.len() != self.tcps.len() {
-            return DC_STATUS_WRONG_ROBOT_COUNT;
-        }
-        for (dst, src) in self.tcps.iter_mut().zip(tcps) {
-            *dst = src.to_vec3();
-        }
-        let r = match &self.checker {
-            Checker::Table(t) if t.table().as_clearance().is_some() => {
-                self.protective.check_with_table(&self.tcps, &|_, _, tcps| t.clearance_bound(tcps))
-            }
-            Checker::Bundle(b) if b.has_clearance() => {
-                self.protective.check_with_table(&self.tcps, &|i, j, tcps| b.clearance_bound(i, j, tcps))
-            }
-            _ => self.protective.check(&self.tcps),
-        };
-        let Ok(r) = r else { return DC_STATUS_WRONG_ROBOT_COUNT };
-        self.protective_lookups += u64::from(r.table_lookup);
-        write_protective(r, report)
-    }
-
-    /// The protective query with the robots' stop paths (`paths[j].n_points` 0: none; the
-    /// caller checked that every path's points are readable and at most
-    /// `DC_MAX_PATH_POINTS`): fills `report` as [`Collider::protective_query`] does.
-    pub(crate) fn protective_query_with_paths(
+    /// The protective query at `time` with the robots' stop paths (`None`: no paths;
+    /// `paths[j].0` empty: none for robot j; the caller checked that every path's points are
+    /// readable and at most `DC_MAX_PATH_POINTS`): fills `report` (which starts as
+    /// [`DcProtectiveReport::STOP`]) and returns the status; the verdict is FREE or WARN only
+    /// with `DC_STATUS_OK`.
+    pub(crate) fn protective_query(
         &mut self,
+        time: TickTime,
         tcps: &[DcVec3],
-        paths: &[(&[DcVec3], f64)],
+        paths: Option<&[(&[DcVec3], f64)]>,
         report: &mut DcProtectiveReport,
     ) -> DcStatus {
-        if tcps.len() != self.tcps.len() || paths.len() != self.tcps.len() {
+        if tcps.len() != self.tcps.len() || paths.is_some_and(|p| p.len() != self.tcps.len()) {
             return DC_STATUS_WRONG_ROBOT_COUNT;
         }
         for (dst, src) in self.tcps.iter_mut().zip(tcps) {
             *dst = src.to_vec3();
         }
+        let paths = paths.unwrap_or(&[]);
         for (dst, (src, _)) in self.path_points.iter_mut().zip(paths) {
             for (d, s) in dst.iter_mut().zip(src.iter()) {
                 *d = s.to_vec3();
             }
         }
         let mut stop_paths: [Option<StopPath>; MAX_ROBOTS] = [None; MAX_ROBOTS];
+        let n_paths = paths.len();
         for (j, (points, tolerance_mm)) in paths.iter().enumerate() {
             if !points.is_empty() {
                 stop_paths[j] = Some(StopPath { points: &self.path_points[j][..points.len()], tolerance_mm: *tolerance_mm });
             }
         }
-        let stop_paths = &stop_paths[..paths.len()];
+        let request = ProtectiveRequest::new(&self.tcps).at(time).with_paths(&stop_paths[..n_paths]);
         let r = match &self.checker {
             Checker::Table(t) if t.table().as_clearance().is_some() => {
-                self.protective.check_with_paths_and_table(&self.tcps, stop_paths, &|_, _, tcps| t.clearance_bound(tcps))
+                self.protective.check(request.with_table(&|_, _, tcps| t.clearance_bound(tcps)))
             }
-            Checker::Bundle(b) if b.has_clearance() => self.protective.check_with_paths_and_table(
-                &self.tcps,
-                stop_paths,
-                &|i, j, tcps| b.clearance_bound(i, j, tcps),
-            ),
-            _ => self.protective.check_with_paths(&self.tcps, stop_paths),
+            Checker::Bundle(b) if b.has_clearance() => {
+                self.protective.check(request.with_table(&|i, j, tcps| b.clearance_bound(i, j, tcps)))
+            }
+            _ => self.protective.check(request),
         };
         let Ok(r) = r else { return DC_STATUS_WRONG_ROBOT_COUNT };
         self.protective_lookups += u64::from(r.table_lookup);
@@ -415,6 +396,7 @@ fn write_protective(r: &ProtectiveReport, report: &mut DcProtectiveReport) -> Dc
         ProtectiveStatus::Unreachable(j) => (DC_STATUS_UNREACHABLE, Some(j)),
         ProtectiveStatus::ImplausibleMotion(j) => (DC_STATUS_IMPLAUSIBLE_MOTION, Some(j)),
         ProtectiveStatus::InvalidPath(j) => (DC_STATUS_INVALID_ARGUMENT, Some(j)),
+        ProtectiveStatus::Timing(fault) => (timing_status(fault), None),
     };
     report.unreachable_mask = robot.map_or(0, |j| 1 << j);
     report.verdict = match r.verdict {
@@ -424,6 +406,20 @@ fn write_protective(r: &ProtectiveReport, report: &mut DcProtectiveReport) -> Dc
     };
     status
 }
+
+/// The C status of a timing fault.
+fn timing_status(fault: TimingFault) -> DcStatus {
+    match fault {
+        TimingFault::Repeated => DC_STATUS_TIME_REPEATED,
+        TimingFault::Backwards => DC_STATUS_TIME_BACKWARDS,
+        TimingFault::Jump => DC_STATUS_TIME_JUMP,
+        TimingFault::Early => DC_STATUS_TIME_EARLY,
+        TimingFault::ClockChanged => DC_STATUS_CLOCK_CHANGED,
+    }
+}
+
+// The header states the bound as a number (cbindgen writes no paths): keep the two equal.
+const _: () = assert!(DC_MAX_INTERVAL_TICKS == crate::cell::protective::MAX_INTERVAL_TICKS);
 
 fn query_exact(checker: &mut ExactChecker, tcps: &[Vec3], report: &mut DcQueryReport) -> DcStatus {
     let Ok(v) = checker.check(tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };

@@ -17,7 +17,9 @@
 //!   answers as exact mode; `dc_table_confirmations` counts those ticks. With a clearance
 //!   table the protective verdict is FREE by one lookup where the table's bound proves it
 //!   (`dc_table_protective_lookups`), else the exact protective check.
-//! - A handle is used by one thread at a time; distinct handles are independent.
+//! - A handle is used by one task at a time; distinct handles are independent. A call that
+//!   finds its handle in use by another call returns `DC_STATUS_BUSY` and does nothing
+//!   ([`live`]: the handle's state is reached only under its busy flag).
 #![allow(unsafe_code)]
 
 mod collider;
@@ -27,17 +29,55 @@ pub mod types;
 pub use convert::table_error_status;
 pub use types::*;
 
+use crate::cell::protective::TickTime;
 use collider::{Collider, InitError};
-use std::cell::RefCell;
+use std::cell::{RefCell, UnsafeCell};
 use std::ffi::{c_char, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// An initialised collision checker for one cell, in exact or table mode (opaque to C).
 pub struct DcCollider {
-    inner: Collider,
-    /// Set when a panic was caught inside a query: the handle's state is not trusted.
-    poisoned: bool,
+    /// Reached only through [`live`], while `busy` is held.
+    inner: UnsafeCell<Collider>,
+    /// Set when a panic was caught inside a call: the handle's state is not trusted.
+    poisoned: AtomicBool,
+    /// Set while a call uses `inner`: a second call meanwhile (another task) is refused.
+    busy: AtomicBool,
+}
+
+/// Runs `f` on the collider of a live handle: `DC_STATUS_NULL_POINTER` for NULL,
+/// `DC_STATUS_BUSY` while another call uses the handle (nothing is done),
+/// `DC_STATUS_PANIC` for a poisoned handle or a panic in `f` (which poisons it).
+///
+/// # Safety
+/// `handle` must be NULL or a live handle from `dc_init*`.
+unsafe fn live<R>(handle: *const DcCollider, f: impl FnOnce(&mut Collider) -> R) -> Result<R, DcStatus> {
+    // SAFETY: the caller guarantees NULL or live; only shared references to the handle are
+    // made, and its collider is reached through the cell below while `busy` is ours.
+    let Some(h) = (unsafe { handle.as_ref() }) else { return Err(DC_STATUS_NULL_POINTER) };
+    if h.busy.swap(true, Ordering::Acquire) {
+        return Err(DC_STATUS_BUSY);
+    }
+    let result = if h.poisoned.load(Ordering::Relaxed) {
+        Err(DC_STATUS_PANIC)
+    } else {
+        // SAFETY: `busy` was clear and is now set by this call: no other reference to the
+        // collider exists until it is cleared below.
+        let inner = unsafe { &mut *h.inner.get() };
+        catch_unwind(AssertUnwindSafe(|| f(inner))).map_err(|_| {
+            h.poisoned.store(true, Ordering::Relaxed);
+            DC_STATUS_PANIC
+        })
+    };
+    h.busy.store(false, Ordering::Release);
+    result
+}
+
+/// The status of a call whose body returns its own status.
+fn flatten(result: Result<DcStatus, DcStatus>) -> DcStatus {
+    result.unwrap_or_else(|status| status)
 }
 
 thread_local! {
@@ -75,7 +115,12 @@ unsafe fn init_handle(
         let (status, message) = match result {
             Ok(inner) => {
                 // SAFETY: `result` is Ok only when `out_handle` was checked non-null above.
-                unsafe { *out_handle = Box::into_raw(Box::new(DcCollider { inner, poisoned: false })) };
+                let handle = DcCollider {
+                    inner: UnsafeCell::new(inner),
+                    poisoned: AtomicBool::new(false),
+                    busy: AtomicBool::new(false),
+                };
+                unsafe { *out_handle = Box::into_raw(Box::new(handle)) };
                 (DC_STATUS_OK, String::new())
             }
             Err(e) => (e.status, e.message),
@@ -300,21 +345,13 @@ pub unsafe extern "C" fn dc_query(
 ) -> DcStatus {
     let mut report = DcQueryReport::STOP;
     let status = boundary(|| {
-        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
-        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
         if out_verdict.is_null() || tcps_mcs.is_null() {
             return DC_STATUS_NULL_POINTER;
         }
-        if h.poisoned {
-            return DC_STATUS_PANIC;
-        }
         // SAFETY: non-null, and the caller guarantees `n_tcps` readable elements.
         let tcps = unsafe { std::slice::from_raw_parts(tcps_mcs, n_tcps) };
-        let status = catch_unwind(AssertUnwindSafe(|| h.inner.query(tcps, &mut report)));
-        status.unwrap_or_else(|_| {
-            h.poisoned = true;
-            DC_STATUS_PANIC
-        })
+        // SAFETY: the caller guarantees `handle` is NULL or live.
+        flatten(unsafe { live(handle, |c| c.query(tcps, &mut report)) })
     });
     if status != DC_STATUS_OK {
         report.verdict = DC_VERDICT_STOP;
@@ -362,39 +399,37 @@ pub unsafe extern "C" fn dc_set_stop_model(
     n_stops: usize,
 ) -> DcStatus {
     boundary(|| {
-        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
-        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
         if stops.is_null() {
             return DC_STATUS_NULL_POINTER;
         }
-        if h.poisoned {
-            return DC_STATUS_PANIC;
-        }
-        if n_stops != h.inner.robot_count() {
-            return DC_STATUS_WRONG_ROBOT_COUNT;
-        }
         // SAFETY: non-null, and the caller guarantees `n_stops` readable elements.
         let stops = unsafe { std::slice::from_raw_parts(stops, n_stops) };
-        let (status, message) = match h.inner.set_stopping(tick_ms, warn_mm, stops) {
-            Ok(()) => (DC_STATUS_OK, String::new()),
-            Err(e) => (e.status, e.message),
+        let set = |c: &mut Collider| {
+            if n_stops != c.robot_count() {
+                return DC_STATUS_WRONG_ROBOT_COUNT;
+            }
+            let (status, message) = match c.set_stopping(tick_ms, warn_mm, stops) {
+                Ok(()) => (DC_STATUS_OK, String::new()),
+                Err(e) => (e.status, e.message),
+            };
+            let _ = LAST_INIT_ERROR.try_with(|m| *m.borrow_mut() = message);
+            status
         };
-        let _ = LAST_INIT_ERROR.try_with(|m| *m.borrow_mut() = message);
-        status
+        // SAFETY: the caller guarantees `handle` is NULL or live.
+        flatten(unsafe { live(handle, set) })
     })
 }
 
-/// Forgets the previous TCPs of the protective verdict (e.g. after the robots were moved by
-/// hand): the next `dc_protective_query` assumes every robot at full speed. NULL is a no-op.
+/// Forgets the previous TCPs of the protective verdict and the last call's cycle (e.g. after
+/// the robots were moved by hand): the next protective query assumes every robot at full
+/// speed. NULL is a no-op; a panic inside poisons the handle.
 ///
 /// # Safety
-/// `handle` must be NULL or a live handle not used by another thread.
+/// `handle` must be NULL or a live handle.
 #[no_mangle]
 pub unsafe extern "C" fn dc_protective_reset(handle: *mut DcCollider) {
-    // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
-    if let Some(h) = unsafe { handle.as_mut() } {
-        let _ = catch_unwind(AssertUnwindSafe(|| h.inner.reset_protective()));
-    }
+    // SAFETY: the caller guarantees `handle` is NULL or live.
+    let _ = unsafe { live(handle, Collider::reset_protective) };
 }
 
 /// The per-tick protective query (SPEC section 8): can every robot still stop, from now on,
@@ -431,8 +466,8 @@ pub unsafe extern "C" fn dc_protective_query(
 ) -> DcStatus {
     // SAFETY: the caller's guarantees on `handle`, `tcps_mcs` and the outputs are passed on.
     unsafe {
-        protective_entry(handle, tcps_mcs, n_tcps, out_verdict, out_report, |h, tcps, report| {
-            h.protective_query(tcps, report)
+        protective_entry(handle, tcps_mcs, n_tcps, out_verdict, out_report, |c, tcps, report| {
+            c.protective_query(TickTime::Nominal, tcps, None, report)
         })
     }
 }
@@ -463,36 +498,136 @@ pub unsafe extern "C" fn dc_protective_query_with_paths(
     out_verdict: *mut DcVerdict,
     out_report: *mut DcProtectiveReport,
 ) -> DcStatus {
-    if paths.is_null() {
-        // SAFETY: as below; the query is not run.
-        return unsafe {
-            protective_entry(handle, tcps_mcs, n_tcps, out_verdict, out_report, |_, _, _| DC_STATUS_NULL_POINTER)
-        };
-    }
     // SAFETY: the caller's guarantees on `handle`, `tcps_mcs` and the outputs are passed on.
     unsafe {
-        protective_entry(handle, tcps_mcs, n_tcps, out_verdict, out_report, |h, tcps, report| {
-            // SAFETY: non-null, and the caller guarantees `n_paths` readable elements.
-            let paths = std::slice::from_raw_parts(paths, n_paths);
-            let mut views: [(&[DcVec3], f64); crate::cell::MAX_ROBOTS] = [(&[], 0.0); crate::cell::MAX_ROBOTS];
-            if n_paths != h.robot_count() || tcps.len() != h.robot_count() {
-                return DC_STATUS_WRONG_ROBOT_COUNT;
-            }
-            for (j, (view, path)) in views.iter_mut().zip(paths).enumerate() {
-                if path.n_points == 0 {
-                    continue;
-                }
-                if path.points.is_null() || path.n_points > DC_MAX_PATH_POINTS {
-                    report.unreachable_mask = 1 << j;
-                    h.reset_protective();
-                    return if path.points.is_null() { DC_STATUS_NULL_POINTER } else { DC_STATUS_INVALID_ARGUMENT };
-                }
-                // SAFETY: non-null, and the caller guarantees `n_points` readable elements.
-                *view = (std::slice::from_raw_parts(path.points, path.n_points), path.tolerance_mm);
-            }
-            h.protective_query_with_paths(tcps, &views[..n_paths], report)
+        protective_entry(handle, tcps_mcs, n_tcps, out_verdict, out_report, |c, tcps, report| {
+            // SAFETY: non-null, and the caller guarantees `n_paths` readable paths.
+            with_path_views(c, paths, n_paths, report, |c, views, report| {
+                c.protective_query(TickTime::Nominal, tcps, Some(views), report)
+            })
         })
     }
+}
+
+/// A `DcProtectiveRequest` with `struct_size` set, `DC_CLOCK_CYCLE`, time 0, no TCPs and no
+/// paths: set `time`, `tcps_mcs` and `n_tcps` (and the paths, if known) before each call.
+#[no_mangle]
+pub extern "C" fn dc_protective_request_default() -> DcProtectiveRequest {
+    DcProtectiveRequest {
+        struct_size: std::mem::size_of::<DcProtectiveRequest>(),
+        clock: DC_CLOCK_CYCLE,
+        time: 0,
+        tcps_mcs: std::ptr::null(),
+        n_tcps: 0,
+        paths: std::ptr::null(),
+        n_paths: 0,
+    }
+}
+
+/// The protective query with the time its TCPs hold, the call for the tick loop:
+/// `dc_protective_query` (or, with paths, `dc_protective_query_with_paths`) whose speeds are
+/// bounded over the real interval since the last call, from `request->time`:
+/// - `DC_CLOCK_CYCLE`: the controller's cycle counter, one more per `tick_ms`, the TCPs that
+///   cycle's; `DC_CLOCK_NANOS`: a monotonic timestamp (ns) of the TCPs' measurement.
+/// - The same cycle (or timestamp) as the last call with the same TCPs (a function block
+///   called twice, a retried call) writes the last call's verdict, report and status again,
+///   unchanged. Every other timing fault is STOP with its own status, and the next call
+///   assumes full speed: the same cycle with other TCPs `DC_STATUS_TIME_REPEATED`, an
+///   earlier one `DC_STATUS_TIME_BACKWARDS`, more than `DC_MAX_INTERVAL_TICKS` ticks later
+///   `DC_STATUS_TIME_JUMP`, a timestamp less than half a tick later `DC_STATUS_TIME_EARLY`,
+///   a change of `clock` `DC_STATUS_CLOCK_CHANGED`. A skipped cycle (up to
+///   `DC_MAX_INTERVAL_TICKS`) is bounded over its real interval.
+/// - The first timed call, and the first after an untimed call, an error or
+///   `dc_protective_reset`, assumes full speed.
+/// A FREE or WARN covers a STOP issued at the next cycle: a controller that misses one must
+/// stop the robots itself.
+///
+/// Statuses: those of `dc_protective_query_with_paths`, the timing statuses above,
+/// `DC_STATUS_NULL_POINTER` (request NULL, or paths NULL with `n_paths` > 0),
+/// `DC_STATUS_INVALID_ARGUMENT` (a `struct_size` that is not this header's
+/// `sizeof(DcProtectiveRequest)`, an unknown `clock`), `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths` neither 0 nor the robot
+/// count), `DC_STATUS_BUSY` (the handle is in another call). `*out_verdict` and
+/// `*out_report` are written on every call. Never allocates, locks or does I/O.
+///
+/// # Safety
+/// `handle` must be NULL or a live handle from `dc_init*`; `request` must be NULL or point
+/// to a readable `DcProtectiveRequest` whose `tcps_mcs` is NULL or points to `n_tcps`
+/// readable `DcVec3` and whose `paths` is as for `dc_protective_query_with_paths`; the out
+/// pointers must be NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn dc_protective_query_timed(
+    handle: *mut DcCollider,
+    request: *const DcProtectiveRequest,
+    out_verdict: *mut DcVerdict,
+    out_report: *mut DcProtectiveReport,
+) -> DcStatus {
+    // SAFETY: the caller guarantees `request` is NULL or readable.
+    let request = match unsafe { request.as_ref() } {
+        Some(r) => *r,
+        None => DcProtectiveRequest { tcps_mcs: std::ptr::null(), ..dc_protective_request_default() },
+    };
+    let time = match (request.struct_size == std::mem::size_of::<DcProtectiveRequest>(), request.clock) {
+        (true, DC_CLOCK_CYCLE) => Ok(TickTime::Cycle(request.time)),
+        (true, DC_CLOCK_NANOS) => Ok(TickTime::Nanos(request.time)),
+        _ => Err(DC_STATUS_INVALID_ARGUMENT),
+    };
+    let (tcps, n_tcps, paths, n_paths) = (request.tcps_mcs, request.n_tcps, request.paths, request.n_paths);
+    // SAFETY: the caller's guarantees on `handle`, the request's TCPs and the outputs are
+    // passed on; a NULL request reads as NULL TCPs.
+    unsafe {
+        protective_entry(handle, tcps, n_tcps, out_verdict, out_report, |c, tcps, report| {
+            let time = match time {
+                Ok(time) => time,
+                Err(status) => return status,
+            };
+            if n_paths == 0 {
+                return c.protective_query(time, tcps, None, report);
+            }
+            // SAFETY: the caller guarantees `n_paths` readable paths when `paths` is not NULL.
+            with_path_views(c, paths, n_paths, report, |c, views, report| {
+                c.protective_query(time, tcps, Some(views), report)
+            })
+        })
+    }
+}
+
+/// Runs `query` with the robots' stop paths `paths[0..n_paths]` read as slices (after the
+/// checks of `dc_protective_query_with_paths`: a path with NULL points and `n_points` > 0,
+/// or more than `DC_MAX_PATH_POINTS` points, names its robot in the report and forgets the
+/// previous TCPs).
+///
+/// # Safety
+/// `paths` must be NULL or point to `n_paths` readable `DcStopPath`, each with `points` NULL
+/// or pointing to `n_points` readable `DcVec3`, alive for the call.
+unsafe fn with_path_views(
+    c: &mut Collider,
+    paths: *const DcStopPath,
+    n_paths: usize,
+    report: &mut DcProtectiveReport,
+    query: impl FnOnce(&mut Collider, &[(&[DcVec3], f64)], &mut DcProtectiveReport) -> DcStatus,
+) -> DcStatus {
+    if paths.is_null() {
+        return DC_STATUS_NULL_POINTER;
+    }
+    if n_paths != c.robot_count() {
+        return DC_STATUS_WRONG_ROBOT_COUNT;
+    }
+    // SAFETY: non-null, and the caller guarantees `n_paths` readable elements.
+    let paths = unsafe { std::slice::from_raw_parts(paths, n_paths) };
+    let mut views: [(&[DcVec3], f64); crate::cell::MAX_ROBOTS] = [(&[], 0.0); crate::cell::MAX_ROBOTS];
+    for (j, (view, path)) in views.iter_mut().zip(paths).enumerate() {
+        if path.n_points == 0 {
+            continue;
+        }
+        if path.points.is_null() || path.n_points > DC_MAX_PATH_POINTS {
+            report.unreachable_mask = 1 << j;
+            c.reset_protective();
+            return if path.points.is_null() { DC_STATUS_NULL_POINTER } else { DC_STATUS_INVALID_ARGUMENT };
+        }
+        // SAFETY: non-null, and the caller guarantees `n_points` readable elements.
+        *view = (unsafe { std::slice::from_raw_parts(path.points, path.n_points) }, path.tolerance_mm);
+    }
+    query(c, &views[..n_paths], report)
 }
 
 /// The common part of the protective entry points: checks the handle and the pointers, runs
@@ -512,21 +647,13 @@ unsafe fn protective_entry(
 ) -> DcStatus {
     let mut report = DcProtectiveReport::STOP;
     let status = boundary(|| {
-        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
-        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
         if out_verdict.is_null() || tcps_mcs.is_null() {
             return DC_STATUS_NULL_POINTER;
         }
-        if h.poisoned {
-            return DC_STATUS_PANIC;
-        }
         // SAFETY: non-null, and the caller guarantees `n_tcps` readable elements.
         let tcps = unsafe { std::slice::from_raw_parts(tcps_mcs, n_tcps) };
-        let status = catch_unwind(AssertUnwindSafe(|| query(&mut h.inner, tcps, &mut report)));
-        status.unwrap_or_else(|_| {
-            h.poisoned = true;
-            DC_STATUS_PANIC
-        })
+        // SAFETY: the caller guarantees `handle` is NULL or live.
+        flatten(unsafe { live(handle, |c| query(c, tcps, &mut report)) })
     });
     if status != DC_STATUS_OK {
         report.verdict = DC_VERDICT_STOP;
@@ -562,21 +689,23 @@ pub unsafe extern "C" fn dc_pair_results(
     out_len: *mut usize,
 ) -> DcStatus {
     boundary(|| {
-        // SAFETY: the caller guarantees `handle` is NULL or live.
-        let Some(h) = (unsafe { handle.as_ref() }) else { return DC_STATUS_NULL_POINTER };
         if out.is_null() || out_len.is_null() {
             return DC_STATUS_NULL_POINTER;
         }
-        let n = h.inner.pair_count();
-        // SAFETY: non-null; the caller guarantees it is writable.
-        unsafe { *out_len = n };
-        if capacity < n {
-            return DC_STATUS_INVALID_ARGUMENT;
-        }
-        // SAFETY: non-null, and the caller guarantees `capacity >= n` writable elements.
-        let out = unsafe { std::slice::from_raw_parts_mut(out, n) };
-        h.inner.pair_results(out);
-        DC_STATUS_OK
+        let copy = |c: &mut Collider| {
+            let n = c.pair_count();
+            // SAFETY: non-null; the caller guarantees it is writable.
+            unsafe { *out_len = n };
+            if capacity < n {
+                return DC_STATUS_INVALID_ARGUMENT;
+            }
+            // SAFETY: non-null, and the caller guarantees `capacity >= n` writable elements.
+            let out = unsafe { std::slice::from_raw_parts_mut(out, n) };
+            c.pair_results(out);
+            DC_STATUS_OK
+        };
+        // SAFETY: the caller guarantees `handle` is NULL or live.
+        flatten(unsafe { live(handle, copy) })
     })
 }
 
@@ -587,7 +716,7 @@ pub unsafe extern "C" fn dc_pair_results(
 #[no_mangle]
 pub unsafe extern "C" fn dc_mode(handle: *const DcCollider) -> DcMode {
     // SAFETY: the caller guarantees `handle` is NULL or live.
-    unsafe { handle.as_ref() }.map_or(DC_MODE_NONE, |h| h.inner.mode())
+    unsafe { live(handle, |c| c.mode()) }.unwrap_or(DC_MODE_NONE)
 }
 
 /// Table mode: how many queries so far were answered by the exact model because a TCP lay
@@ -599,7 +728,7 @@ pub unsafe extern "C" fn dc_mode(handle: *const DcCollider) -> DcMode {
 #[no_mangle]
 pub unsafe extern "C" fn dc_table_fallbacks(handle: *const DcCollider) -> u64 {
     // SAFETY: the caller guarantees `handle` is NULL or live.
-    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.table_fallbacks())
+    unsafe { live(handle, |c| c.table_fallbacks()) }.unwrap_or(0)
 }
 
 /// Table mode with a clearance table (`delta-collide build --variant clearance`): the
@@ -625,21 +754,13 @@ pub unsafe extern "C" fn dc_table_clearance_bound(
 ) -> DcStatus {
     let mut bound = f64::NEG_INFINITY;
     let status = boundary(|| {
-        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
-        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
         if out_mm.is_null() || tcps_mcs.is_null() {
             return DC_STATUS_NULL_POINTER;
         }
-        if h.poisoned {
-            return DC_STATUS_PANIC;
-        }
         // SAFETY: non-null, and the caller guarantees `n_tcps` readable elements.
         let tcps = unsafe { std::slice::from_raw_parts(tcps_mcs, n_tcps) };
-        let answer = catch_unwind(AssertUnwindSafe(|| h.inner.clearance_bound(tcps)));
-        let (status, mm) = answer.unwrap_or_else(|_| {
-            h.poisoned = true;
-            (DC_STATUS_PANIC, f64::NEG_INFINITY)
-        });
+        // SAFETY: the caller guarantees `handle` is NULL or live.
+        let (status, mm) = unsafe { live(handle, |c| c.clearance_bound(tcps)) }.unwrap_or_else(|s| (s, f64::NEG_INFINITY));
         bound = mm;
         status
     });
@@ -683,19 +804,16 @@ pub unsafe extern "C" fn dc_set_table_confirmation(handle: *mut DcCollider, conf
 /// # Safety
 /// `handle` must be NULL or a live handle not used by another thread.
 unsafe fn set_on_handle(handle: *mut DcCollider, set: impl FnOnce(&mut Collider) -> Result<(), String>) -> DcStatus {
-    boundary(|| {
-        // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
-        let Some(h) = (unsafe { handle.as_mut() }) else { return DC_STATUS_NULL_POINTER };
-        if h.poisoned {
-            return DC_STATUS_PANIC;
-        }
-        let (status, message) = match set(&mut h.inner) {
+    let apply = |c: &mut Collider| {
+        let (status, message) = match set(c) {
             Ok(()) => (DC_STATUS_OK, String::new()),
             Err(message) => (DC_STATUS_INVALID_ARGUMENT, message),
         };
         let _ = LAST_INIT_ERROR.try_with(|m| *m.borrow_mut() = message);
         status
-    })
+    };
+    // SAFETY: the caller guarantees `handle` is NULL or live.
+    boundary(|| flatten(unsafe { live(handle, apply) }))
 }
 
 /// Whether `dc_protective_query` (and `..._with_paths`) finds each robot's speed limit (`on`
@@ -757,7 +875,7 @@ pub unsafe extern "C" fn dc_set_limit_tests(handle: *mut DcCollider, tests: u32)
 #[no_mangle]
 pub unsafe extern "C" fn dc_table_confirmations(handle: *const DcCollider) -> u64 {
     // SAFETY: the caller guarantees `handle` is NULL or live.
-    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.table_confirmations())
+    unsafe { live(handle, |c| c.table_confirmations()) }.unwrap_or(0)
 }
 
 /// Table mode with a clearance table (`build --variant clearance`): how many protective
@@ -771,7 +889,7 @@ pub unsafe extern "C" fn dc_table_confirmations(handle: *const DcCollider) -> u6
 #[no_mangle]
 pub unsafe extern "C" fn dc_table_protective_lookups(handle: *const DcCollider) -> u64 {
     // SAFETY: the caller guarantees `handle` is NULL or live.
-    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.table_protective_lookups())
+    unsafe { live(handle, |c| c.table_protective_lookups()) }.unwrap_or(0)
 }
 
 /// Number of robots of the handle's cell; 0 for NULL.
@@ -781,7 +899,7 @@ pub unsafe extern "C" fn dc_table_protective_lookups(handle: *const DcCollider) 
 #[no_mangle]
 pub unsafe extern "C" fn dc_robot_count(handle: *const DcCollider) -> usize {
     // SAFETY: the caller guarantees `handle` is NULL or live.
-    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.robot_count())
+    unsafe { live(handle, |c| c.robot_count()) }.unwrap_or(0)
 }
 
 /// Number of robot pairs `dc_pair_results` reports: exact mode, the pairs that can meet
@@ -793,7 +911,7 @@ pub unsafe extern "C" fn dc_robot_count(handle: *const DcCollider) -> usize {
 #[no_mangle]
 pub unsafe extern "C" fn dc_pair_count(handle: *const DcCollider) -> usize {
     // SAFETY: the caller guarantees `handle` is NULL or live.
-    unsafe { handle.as_ref() }.map_or(0, |h| h.inner.pair_count())
+    unsafe { live(handle, |c| c.pair_count()) }.unwrap_or(0)
 }
 
 /// Frees a handle (POU shut-down). NULL is a no-op. The handle must not be used afterwards.
@@ -846,6 +964,12 @@ pub extern "C" fn dc_status_str(status: DcStatus) -> *const c_char {
         DC_STATUS_TABLE_WRONG_PAIR => {
             c"the table bundle's table for a pair was built for another spacing: rebuild it with `delta-collide build --cell ...`"
         }
+        DC_STATUS_TIME_REPEATED => c"the same cycle as the last protective call, with other TCPs",
+        DC_STATUS_TIME_BACKWARDS => c"a cycle or timestamp before the last protective call's",
+        DC_STATUS_TIME_JUMP => c"more than DC_MAX_INTERVAL_TICKS ticks since the last protective call",
+        DC_STATUS_TIME_EARLY => c"a timestamp less than half a tick after the last protective call's",
+        DC_STATUS_CLOCK_CHANGED => c"a cycle counter after a timestamp, or a timestamp after a cycle counter",
+        DC_STATUS_BUSY => c"the handle is in use by another call: give each task its own handle",
         _ => c"unknown status",
     };
     s.as_ptr()

@@ -58,6 +58,20 @@ pub const DC_STATUS_TABLE_MISSING_PAIR: DcStatus = 18;
 /// model of that pair (another spacing of the line; `dc_last_init_error` names the value that
 /// differs); rebuild the bundle with `delta-collide build --cell ...` for this cell.
 pub const DC_STATUS_TABLE_WRONG_PAIR: DcStatus = 19;
+/// Timed protective query: the same cycle (or timestamp) as the last call, with other TCPs.
+/// (The same cycle with the same TCPs gets the last call's verdict and report unchanged.)
+pub const DC_STATUS_TIME_REPEATED: DcStatus = 20;
+/// Timed protective query: a cycle or timestamp before the last call's.
+pub const DC_STATUS_TIME_BACKWARDS: DcStatus = 21;
+/// Timed protective query: more than `DC_MAX_INTERVAL_TICKS` ticks after the last call.
+pub const DC_STATUS_TIME_JUMP: DcStatus = 22;
+/// Timed protective query (`DC_CLOCK_NANOS`): less than half a tick after the last call.
+pub const DC_STATUS_TIME_EARLY: DcStatus = 23;
+/// Timed protective query: a cycle counter after a timestamp, or the reverse.
+pub const DC_STATUS_CLOCK_CHANGED: DcStatus = 24;
+/// The handle is in use by another call (another task or thread) right now; nothing was
+/// done. A handle is for one task: give each task its own.
+pub const DC_STATUS_BUSY: DcStatus = 25;
 
 /// What the controller should do; 0 is STOP so that zeroed memory fails closed.
 pub type DcVerdict = u32;
@@ -70,6 +84,18 @@ pub const DC_VERDICT_COLLISION: DcVerdict = 2;
 /// Protective query: a stop started now is proved to keep every box apart, but with less
 /// than `warn_mm` to spare. Only ever written together with `DC_STATUS_OK`.
 pub const DC_VERDICT_WARN: DcVerdict = 3;
+
+/// What `DcProtectiveRequest::time` counts (`clock`).
+pub type DcClock = u32;
+/// The controller's cycle counter: one more per tick (`dc_set_stop_model`'s `tick_ms`); the
+/// TCPs are that cycle's set-points, or positions measured at the cycle's nominal time.
+pub const DC_CLOCK_CYCLE: DcClock = 0;
+/// A monotonic timestamp in nanoseconds of the moment the TCPs were measured.
+pub const DC_CLOCK_NANOS: DcClock = 1;
+
+/// Most ticks between two timed protective calls whose interval still bounds the speeds; a
+/// longer gap answers `DC_STATUS_TIME_JUMP`.
+pub const DC_MAX_INTERVAL_TICKS: u64 = 4;
 
 /// Most robots of a cell; the size of the per-robot arrays of `DcProtectiveReport`.
 pub const DC_MAX_ROBOTS: usize = 32;
@@ -287,6 +313,28 @@ pub struct DcStopPath {
     pub n_points: usize,
     /// How far the TCP may be from the polyline at any moment of the stop (mm, >= 0).
     pub tolerance_mm: f64,
+}
+
+/// The inputs of one timed protective query (`dc_protective_query_timed`); start from
+/// `dc_protective_request_default()`, which sets `struct_size`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct DcProtectiveRequest {
+    /// `sizeof(DcProtectiveRequest)` as the caller compiled it: lets later versions add fields.
+    pub struct_size: usize,
+    /// What `time` counts: `DC_CLOCK_CYCLE` (the default) or `DC_CLOCK_NANOS`.
+    pub clock: DcClock,
+    /// The cycle counter, or the timestamp (ns), at which `tcps_mcs` hold.
+    pub time: u64,
+    /// Robot j's TCP at `time`, in its own MCS: `n_tcps` entries, one per robot.
+    pub tcps_mcs: *const DcVec3,
+    /// How many TCPs.
+    pub n_tcps: usize,
+    /// Per robot, the path its stop will follow (as for `dc_protective_query_with_paths`), or
+    /// NULL with `n_paths` 0: no paths.
+    pub paths: *const DcStopPath,
+    /// How many paths: 0, or one per robot.
+    pub n_paths: usize,
 }
 
 /// Summary of one protective query, written on every call when the pointer is not NULL.

@@ -154,6 +154,7 @@ fn replay_rows(
             ProtectiveStatus::ImplausibleMotion(j) => format!("implausible {}", names[j]),
             ProtectiveStatus::Unreachable(j) => format!("unreachable {}", names[j]),
             ProtectiveStatus::InvalidPath(j) => format!("invalid path {}", names[j]),
+            ProtectiveStatus::Timing(fault) => format!("timing {fault:?}").to_lowercase(),
         };
         let mut row = format!("{},{verdict},{:.3},{status}", ticks[tick], r.clearance_mm);
         r.robots.iter().for_each(|x| row += &format!(",{:.3}", x.protective_mm));

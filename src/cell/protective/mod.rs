@@ -2,13 +2,16 @@
 //! any box of one touching any box of the other? FREE only when that is proved.
 //!
 //! # The bound
-//! 1. **Speed now.** The controller gives TCPs, not speeds. With `v_fd = |p - p_prev| / T`
-//!    (`T = tick_ms`) the average velocity over the last tick, the true speed now differs from
-//!    `|v_fd|` by at most `a_max T` (`|v(t) - v(s)| <= a_max |t - s|` for `s` in the tick), so
-//!    `v <= v_b := min(|v_fd| + a_max T, v_max)`. Without a previous TCP (first tick, after
-//!    any error) `v_b = v_max`. A step longer than `v_max T`, or a change of `v_fd` between
-//!    two ticks larger than `a_max T` (two consecutive averages differ by at most that), is
-//!    impossible under the model: [`ProtectiveStatus::ImplausibleMotion`], STOP.
+//! 1. **Speed now.** The controller gives TCPs, not speeds. With `v_fd = (p - p_prev) / dt`
+//!    the average velocity since the previous call, `dt` the real interval between the two
+//!    calls' times ([`TickTime`]; `protective/clock.rs`: `T = tick_ms` for an untimed call,
+//!    a timing fault is STOP), the true speed now differs from `|v_fd|` by at most `a_max dt`
+//!    (`|v(t) - v(s)| <= a_max |t - s|` for `s` in the interval), so
+//!    `v <= v_b := min(|v_fd| + a_max dt, v_max)`. Without a previous TCP (first tick, after
+//!    any error) `v_b = v_max`. A step longer than `v_max dt`, or a change of `v_fd` between
+//!    two intervals `dt_1`, `dt_2` larger than `a_max (dt_1 + dt_2) / 2` (two consecutive
+//!    averages differ by at most that), is impossible under the model:
+//!    [`ProtectiveStatus::ImplausibleMotion`], STOP.
 //! 2. **Latency of the verdict itself.** A FREE at tick `k` must cover a STOP issued at tick
 //!    `k + 1`: the robot then moves one more tick before its reaction starts. The reaction
 //!    time used is therefore `T_r = reaction_ms + tick_ms`.
@@ -18,7 +21,7 @@
 //!    `S` ([`StopModel::stopping_distance`]). The path is unknown, so every TCP of the whole
 //!    stop lies in the ball of radius `S` around the TCP now, hence in the cube of half-side
 //!    `S` around it (and in the robot's reachable space). With a measured velocity `v_fd`
-//!    the direction is known during the reaction: the TCP is within `a_max T t + a_max t^2/2`
+//!    the direction is known during the reaction: the TCP is within `a_max dt t + a_max t^2/2`
 //!    of `p + v_fd t`, so the whole stop lies in the capsule around `p .. p + v_fd T_r` of
 //!    radius `S - |v_fd| T_r`, and in the ball around its middle of radius
 //!    `S - |v_fd| T_r / 2` ([`capsule_ball`]); that ball is used, with the boxes built at its
@@ -165,15 +168,19 @@ use crate::robot::{BoxKind, RobotBoxes, StopModel};
 use alloc::sync::Arc;
 
 mod certain_stop;
+mod clock;
 mod kept;
 mod lookup;
 mod path;
+mod request;
 mod speed_limit;
 mod stop_sweeps;
 mod witness;
 pub use kept::{KEPT_MARGIN_MM, KEPT_WIDEN};
 pub use lookup::{ClearanceBound, LOOKUP_SLACK_MM};
+pub use clock::{TickTime, TimingFault, MAX_INTERVAL_TICKS, MIN_INTERVAL_TICKS};
 pub use path::{path_through_samples, StopPath};
+pub use request::ProtectiveRequest;
 pub use stop_sweeps::{stop_sweeps_wcs, SweepForms};
 use stop_sweeps::{first_unproved_between, stop_sweeps_wcs_into, GradedRadii};
 
@@ -230,6 +237,8 @@ pub enum ProtectiveStatus {
     /// Robot `.0`'s stop path is unusable: no point, a non-finite point or tolerance, a
     /// negative tolerance, or the TCP now farther than the tolerance from it ([`StopPath`]).
     InvalidPath(usize),
+    /// The call's time gives no interval to bound the speeds with (`protective/clock.rs`).
+    Timing(TimingFault),
 }
 
 /// Box `box_a` of robot `a` and box `box_b` of robot `b`.
@@ -302,8 +311,8 @@ pub struct ProtectiveReport {
 #[derive(Clone, Copy, Debug)]
 struct History {
     tcp: Option<Vec3>,
-    /// The last finite-difference velocity (mm/s).
-    velocity: Option<Vec3>,
+    /// The last finite-difference velocity (mm/s) and the interval it was measured over (s).
+    velocity: Option<(Vec3, Real)>,
     /// The last speed limit (mm/s): where this tick's search starts; and the step of its
     /// first test above that limit (mm/s; module doc).
     limit: Option<(Real, Real)>,
@@ -375,6 +384,14 @@ pub struct ProtectiveChecker {
     /// Two TCPs in earlier stop balls whose boxes overlap, which make every tick whose stop
     /// balls still hold them STOP (`protective/witness.rs`).
     witness: witness::KeptWitness,
+    /// The interval the speeds of this tick are bounded over (s; `protective/clock.rs`).
+    interval_s: Real,
+    /// The time of the last call (`None`: none since the checker was made or reset).
+    time: Option<TickTime>,
+    /// The TCPs of the last call and its report: a call of the same cycle with the same TCPs
+    /// gets that report again (`protective/clock.rs`).
+    last_tcps: alloc::vec::Vec<Vec3>,
+    cycle_report: ProtectiveReport,
     report: ProtectiveReport,
 }
 
@@ -416,9 +433,21 @@ impl ProtectiveChecker {
         }
         let unit = Obb::new(Vec3::zeros(), crate::math::Mat3::identity(), Vec3::repeat(1.0));
         let no_faces = FaceTerms::new(&unit, &Sweep::ZERO);
+        let tick_s = cell.tick_ms * 1e-3;
         let exact = ExactChecker::new(cell);
         let n_pairs = exact.verdict().pairs.len();
         let kept = kept::Kept::new(n, n_pairs);
+        let report = ProtectiveReport {
+            verdict: Protective::Stop,
+            status: ProtectiveStatus::Ok,
+            clearance_mm: Real::NAN,
+            closest: None,
+            limiting: None,
+            robots: alloc::vec![RobotProtection::UNKNOWN; n],
+            kept_proof: false,
+            table_lookup: false,
+            table_pairs: 0,
+        };
         Ok(ProtectiveChecker {
             exact,
             warn_mm,
@@ -447,17 +476,11 @@ impl ProtectiveChecker {
             certain_stops_first: true,
             witness: witness::KeptWitness::default(),
             kept,
-            report: ProtectiveReport {
-                verdict: Protective::Stop,
-                status: ProtectiveStatus::Ok,
-                clearance_mm: Real::NAN,
-                closest: None,
-                limiting: None,
-                robots: alloc::vec![RobotProtection::UNKNOWN; n],
-                kept_proof: false,
-                table_lookup: false,
-                table_pairs: 0,
-            },
+            interval_s: tick_s,
+            time: None,
+            last_tcps: alloc::vec![Vec3::zeros(); n],
+            cycle_report: report.clone(),
+            report,
         })
     }
 
@@ -542,19 +565,80 @@ impl ProtectiveChecker {
         &self.report
     }
 
-    /// Forgets every previous TCP: the next tick assumes full speed (module doc, step 1).
+    /// Forgets every previous TCP and the last call's time: the next tick assumes full speed
+    /// (module doc, step 1).
     pub fn reset(&mut self) {
+        self.forget_motion();
+        self.time = None;
+    }
+
+    /// Forgets every previous TCP, and the witness found from them.
+    fn forget_motion(&mut self) {
         self.history.fill(NO_HISTORY);
         self.witness = witness::KeptWitness::default();
     }
 
-    /// One tick: `tcps_mcs[j]` is robot `j`'s TCP now, in its own MCS; the speeds come from
-    /// the TCPs of the previous call (module doc).
+    /// One tick: robot `j`'s TCP now is `request.tcps_mcs[j]` (its MCS); its speed comes from
+    /// its TCP at the previous call and the interval between the two calls' times
+    /// (`protective/clock.rs`); with paths, the verdict is also proved along them
+    /// ([`ProtectiveChecker::check_with_paths`]); with a table, a tick its bound proves FREE is
+    /// answered from it ([`ProtectiveChecker::check_with_table`]). A slice of TCPs is an untimed
+    /// request ([`TickTime::Nominal`]: one tick after the last call, whenever it comes).
+    ///
+    /// A call of the same cycle (or timestamp) as the last one with the same TCPs gets the
+    /// last report unchanged; every other timing fault is STOP with
+    /// [`ProtectiveStatus::Timing`], and the next call assumes full speed.
     ///
     /// # Errors
-    /// [`QueryError::WrongRobotCount`] (the history is then left as it was).
-    pub fn check(&mut self, tcps_mcs: &[Vec3]) -> Result<&ProtectiveReport, QueryError> {
-        self.check_bounded(tcps_mcs, None)
+    /// [`QueryError::WrongRobotCount`] when the TCPs, or the paths when given, are not one per
+    /// robot (the history and the last call's time are then left as they were).
+    pub fn check<'r>(&mut self, request: impl Into<ProtectiveRequest<'r>>) -> Result<&ProtectiveReport, QueryError> {
+        let request = request.into();
+        let n = self.cell().robots.len();
+        for len in [request.tcps_mcs.len(), if request.paths.is_empty() { n } else { request.paths.len() }] {
+            if len != n {
+                return Err(QueryError::WrongRobotCount { expected: n, found: len });
+            }
+        }
+        let tick_s = self.cell().tick_ms * 1e-3;
+        let tcps = request.tcps_mcs;
+        match clock::interval(self.time, request.time, tick_s) {
+            clock::Interval::Same if same_bits(&self.last_tcps, tcps) => {
+                self.report.clone_from(&self.cycle_report);
+                return Ok(&self.report);
+            }
+            clock::Interval::Same => self.timing_fault(tcps, TimingFault::Repeated),
+            clock::Interval::Fault(fault) => self.timing_fault(tcps, fault),
+            clock::Interval::Unknown => {
+                self.forget_motion();
+                self.interval_s = tick_s;
+                self.tick(&request);
+            }
+            clock::Interval::Seconds(dt) => {
+                self.interval_s = dt;
+                self.tick(&request);
+            }
+        }
+        self.time = Some(request.time);
+        self.last_tcps.copy_from_slice(tcps);
+        self.cycle_report.clone_from(&self.report);
+        Ok(&self.report)
+    }
+
+    /// A call whose time gives no interval: STOP, every previous TCP forgotten.
+    fn timing_fault(&mut self, tcps_mcs: &[Vec3], fault: TimingFault) {
+        self.forget_motion();
+        self.report.robots.fill(RobotProtection::UNKNOWN);
+        self.evaluate(tcps_mcs, ProtectiveStatus::Timing(fault), true, None);
+    }
+
+    /// The tick of a request whose interval is `self.interval_s` (counts checked).
+    fn tick(&mut self, request: &ProtectiveRequest) {
+        if request.paths.is_empty() {
+            self.check_bounded(request.tcps_mcs, request.table);
+        } else {
+            self.paths_bounded(request.tcps_mcs, request.paths, request.table);
+        }
     }
 
     /// One tick like [`ProtectiveChecker::check`] in table mode: `bound` gives a certified
@@ -566,15 +650,13 @@ impl ProtectiveChecker {
     /// # Errors
     /// As [`ProtectiveChecker::check`].
     pub fn check_with_table(&mut self, tcps_mcs: &[Vec3], bound: ClearanceBound) -> Result<&ProtectiveReport, QueryError> {
-        self.check_bounded(tcps_mcs, Some(bound))
+        self.check(ProtectiveRequest::new(tcps_mcs).with_table(bound))
     }
 
-    fn check_bounded(&mut self, tcps_mcs: &[Vec3], bound: Option<ClearanceBound>) -> Result<&ProtectiveReport, QueryError> {
-        let n = self.cell().robots.len();
-        if tcps_mcs.len() != n {
-            return Err(QueryError::WrongRobotCount { expected: n, found: tcps_mcs.len() });
-        }
-        let tick_s = self.cell().tick_ms * 1e-3;
+    /// The verdict without paths, the speeds bounded over `self.interval_s` (module doc, step
+    /// 1; counts checked by the caller).
+    fn check_bounded(&mut self, tcps_mcs: &[Vec3], bound: Option<ClearanceBound>) {
+        let dt = self.interval_s;
         let mut status = ProtectiveStatus::Ok;
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let stop = self.exact.cell().stops[j];
@@ -586,17 +668,19 @@ impl ProtectiveChecker {
                 continue;
             }
             let Some(prev) = self.history[j].tcp else { continue };
-            let velocity = (tcp - prev) / tick_s;
+            let velocity = (tcp - prev) / dt;
             let plausible = |x: Real, limit: Real| x <= limit * (1.0 + PLAUSIBLE_SLACK) + PLAUSIBLE_SLACK;
+            // Two averages over consecutive intervals differ by at most `a_max` times the
+            // distance between the intervals' middles.
             let accel_ok = self.history[j]
                 .velocity
-                .is_none_or(|v| plausible((velocity - v).norm(), stop.max_accel_mm_s2 * tick_s));
+                .is_none_or(|(v, before)| plausible((velocity - v).norm(), stop.max_accel_mm_s2 * (before + dt) / 2.0));
             if !plausible(velocity.norm(), stop.max_speed_mm_s) || !accel_ok {
                 status = worse(status, ProtectiveStatus::ImplausibleMotion(j));
             }
             slot.speed_mm_s = velocity.norm();
             self.velocity[j] = velocity;
-            self.history[j].velocity = Some(velocity);
+            self.history[j].velocity = Some((velocity, dt));
         }
         self.evaluate(tcps_mcs, status, true, bound);
         // Only a tick without error (unreachable included) becomes the next one's history.
@@ -607,9 +691,8 @@ impl ProtectiveChecker {
                 h.limit = Some(r.speed_limit_mm_s).filter(|v| v.is_finite()).map(|v| (v, *step));
             }
         } else {
-            self.reset();
+            self.forget_motion();
         }
-        Ok(&self.report)
     }
 
     /// One tick like [`ProtectiveChecker::check`], where the controller also gives, per robot,
@@ -626,7 +709,7 @@ impl ProtectiveChecker {
         tcps_mcs: &[Vec3],
         paths: &[Option<StopPath>],
     ) -> Result<&ProtectiveReport, QueryError> {
-        self.paths_bounded(tcps_mcs, paths, None)
+        self.check(ProtectiveRequest::new(tcps_mcs).with_paths(paths))
     }
 
     /// [`ProtectiveChecker::check_with_paths`] in table mode: the tick without paths is
@@ -640,30 +723,23 @@ impl ProtectiveChecker {
         paths: &[Option<StopPath>],
         bound: ClearanceBound,
     ) -> Result<&ProtectiveReport, QueryError> {
-        self.paths_bounded(tcps_mcs, paths, Some(bound))
+        self.check(ProtectiveRequest::new(tcps_mcs).with_paths(paths).with_table(bound))
     }
 
-    fn paths_bounded(
-        &mut self,
-        tcps_mcs: &[Vec3],
-        paths: &[Option<StopPath>],
-        bound: Option<ClearanceBound>,
-    ) -> Result<&ProtectiveReport, QueryError> {
-        let n = self.cell().robots.len();
-        if paths.len() != n {
-            return Err(QueryError::WrongRobotCount { expected: n, found: paths.len() });
-        }
-        self.check_bounded(tcps_mcs, bound)?;
+    /// The verdict with paths (counts checked by the caller): the better of the one without
+    /// paths and the one along them.
+    fn paths_bounded(&mut self, tcps_mcs: &[Vec3], paths: &[Option<StopPath>], bound: Option<ClearanceBound>) {
+        self.check_bounded(tcps_mcs, bound);
         if self.report.status != ProtectiveStatus::Ok {
-            return Ok(&self.report);
+            return;
         }
         let invalid = paths.iter().zip(tcps_mcs).position(|(p, tcp)| p.as_ref().is_some_and(|p| !path::path_is_valid(p, tcp)));
         if let Some(j) = invalid {
             let report = &mut self.report;
             (report.verdict, report.status, report.limiting) = (Protective::Stop, ProtectiveStatus::InvalidPath(j), None);
             report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = 0.0);
-            self.reset();
-            return Ok(&self.report);
+            self.forget_motion();
+            return;
         }
         if self.report.verdict != Protective::Free && paths.iter().any(Option::is_some) {
             // The proof along the paths reads this tick's references (a robot without a path
@@ -676,7 +752,6 @@ impl ProtectiveChecker {
                 (self.report.verdict, self.report.limiting) = (verdict, limiting);
             }
         }
-        Ok(&self.report)
     }
 
     /// The verdict for TCPs `tcps_mcs` moving at measured speeds `speeds_mm_s` (`INFINITY`:
@@ -696,6 +771,8 @@ impl ProtectiveChecker {
                 return Err(QueryError::WrongRobotCount { expected: n, found: len });
             }
         }
+        // A given speed is the speed now: bounded as a measured one over one tick.
+        self.interval_s = self.cell().tick_ms * 1e-3;
         let mut status = ProtectiveStatus::Ok;
         for (j, (tcp, &v)) in tcps_mcs.iter().zip(speeds_mm_s).enumerate() {
             self.report.robots[j] = RobotProtection { speed_mm_s: v, ..RobotProtection::UNKNOWN };
@@ -847,7 +924,7 @@ impl ProtectiveChecker {
     /// `v_b` of robot `j` for measured speed `v` (module doc, step 1).
     fn speed_bound(&self, j: usize, v: Real) -> Real {
         let stop = &self.cell().stops[j];
-        let bound = v + stop.max_accel_mm_s2 * self.cell().tick_ms * 1e-3;
+        let bound = v + stop.max_accel_mm_s2 * self.interval_s;
         if bound.is_finite() {
             bound.min(stop.max_speed_mm_s)
         } else {
@@ -863,7 +940,7 @@ impl ProtectiveChecker {
         let stop = cell.stops[j];
         let reaction_s = (stop.reaction_ms + cell.tick_ms) * 1e-3;
         let s = stop.stopping_distance(self.speed_bound(j, v), reaction_s);
-        (s, capsule_ball(&stop, cell.tick_ms * 1e-3, reaction_s, tcp_mcs, &self.velocity[j], v, s))
+        (s, capsule_ball(&stop, self.interval_s, reaction_s, tcp_mcs, &self.velocity[j], v, s))
     }
 
     /// Every robot's reference for this tick's stop ball ([`ProtectiveChecker::reference_at`]),
@@ -934,14 +1011,14 @@ impl ProtectiveChecker {
 
 /// A ball holding every TCP of the stop when the measured velocity `velocity` is known
 /// (module doc, step 3, direction-aware): while reacting the TCP is within
-/// `a_max T t + a_max t^2 / 2` of `p + v_fd t` (`v_fd` scaled to speed `v`), then travels at
+/// `a_max dt t + a_max t^2 / 2` of `p + v_fd t` (`v_fd` scaled to speed `v`), then travels at
 /// most `L_b` more; all of it lies in the capsule around the segment from `p` to
-/// `p + v_fd T_r` of radius `R = a_max T T_r + a_max T_r^2 / 2 + L_b`, and so in the ball
+/// `p + v_fd T_r` of radius `R = a_max dt T_r + a_max T_r^2 / 2 + L_b`, and so in the ball
 /// around the segment's middle of radius `R + v T_r / 2`. Returns that ball when it is
 /// smaller than the ball of radius `s` around `p`, else `(p, s)`.
 fn capsule_ball(
     stop: &StopModel,
-    tick_s: Real,
+    interval_s: Real,
     reaction_s: Real,
     p: &Vec3,
     velocity: &Vec3,
@@ -953,7 +1030,7 @@ fn capsule_ball(
         return (*p, s);
     }
     let (a, vmax, t) = (stop.max_accel_mm_s2, stop.max_speed_mm_s, reaction_s);
-    let delta = a * tick_s;
+    let delta = a * interval_s;
     let v_r = (v + delta + a * t).min(vmax);
     let r = delta * t + 0.5 * a * t * t + v_r * v_r / (2.0 * stop.decel_mm_s2);
     let radius = r + 0.5 * v * t;
@@ -973,12 +1050,18 @@ fn worse(a: ProtectiveStatus, b: ProtectiveStatus) -> ProtectiveStatus {
         ProtectiveStatus::InvalidPath(_) => 2,
         ProtectiveStatus::ImplausibleMotion(_) => 3,
         ProtectiveStatus::NonFinite(_) => 4,
+        ProtectiveStatus::Timing(_) => 5,
     };
     if rank(&b) > rank(&a) {
         b
     } else {
         a
     }
+}
+
+/// Whether `a` and `b` hold the same numbers, bit for bit (NaN equal to itself).
+fn same_bits(a: &[Vec3], b: &[Vec3]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.iter().zip(y.iter()).all(|(p, q)| p.to_bits() == q.to_bits()))
 }
 
 /// The signed clearance of the cell as of the exact checker's last check (SPEC §8: the gap
