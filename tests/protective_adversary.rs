@@ -56,7 +56,7 @@ fn tick_of(
     checker.check(&[tcps[0] - v_fd[0] * tick_s, tcps[1] - v_fd[1] * tick_s]).unwrap();
     let r = checker.check(&tcps).unwrap();
     (r.status == ProtectiveStatus::Ok).then(|| {
-        (r.verdict, std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd[j], stop: cell.stops[j], tick_s }))
+        (r.verdict, std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd[j], stop: cell.stops[j], tick_s, interval_s: tick_s }))
     })
 }
 
@@ -208,7 +208,7 @@ fn no_stop_the_model_allows_touches_along_the_scenarios() {
                 if t > 0 && *count % 25 == 0 {
                     let v_fd = |j: usize| (tcps[j] - prev[j]) / tick_s;
                     let robots: [Robot; 2] =
-                        std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd(j), stop, tick_s });
+                        std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd(j), stop, tick_s, interval_s: tick_s });
                     tally.search(&cell, verdict, &robots, 300, &mut rng);
                 }
                 prev = tcps;

@@ -157,7 +157,7 @@ fn brute_force(
         });
         steps += assert_stops_never_touch(cell, &tcps, &vel, 8, &mut rng);
         // The stop that comes closest, searched (`tests/protective_adversary.rs`).
-        let robots = std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd[j], stop, tick_s: tick });
+        let robots = std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd[j], stop, tick_s: tick, interval_s: tick });
         let (least, at) = worst_stop(cell, &robots, 100, &mut rng);
         assert!(least > 0.0, "a stop after a lookup FREE reaches clearance {least} mm at {at:?} from {tcps:?}");
     }
@@ -267,7 +267,7 @@ fn side_by_side(cell: &Cell, bound: ClearanceBound, s: &Scenario, stop: StopMode
                 for (a, b) in cell.pairs_that_can_meet() {
                     let pair = pair_cell(cell, a, b);
                     assert_stops_never_touch(&pair, &[tcps[a], tcps[b]], &[vel[a], vel[b]], 4, rng);
-                    let robot = |j: usize| Robot { tcp: tcps[j], v_fd: (tcps[j] - prev[j]) / tick, stop, tick_s: tick };
+                    let robot = |j: usize| Robot { tcp: tcps[j], v_fd: (tcps[j] - prev[j]) / tick, stop, tick_s: tick, interval_s: tick };
                     let (least, at) = worst_stop(&pair, &[robot(a), robot(b)], 100, rng);
                     let (name, case) = (&cell.name, &s.case);
                     assert!(least > 0.0, "{name} {case} tick {t}: a stop reaches clearance {least} mm at {at:?}");

@@ -16,12 +16,15 @@ pub const PER_ROBOT: usize = 10;
 /// Steps of the reaction's simulation (trapezoidal: exact for a constant push below the cap).
 const REACTION_STEPS: usize = 64;
 
-/// One robot's state at a tick and its stopping model.
+/// One robot's state at a tick and its stopping model: the true velocity now is within
+/// `a_max interval_s` of `v_fd` (the average over the last `interval_s`), and a STOP comes at
+/// most one tick (`tick_s`) later.
 pub struct Robot {
     pub tcp: Vec3,
     pub v_fd: Vec3,
     pub stop: StopModel,
     pub tick_s: Real,
+    pub interval_s: Real,
 }
 
 /// `v` shortened to length `max` when longer.
@@ -39,7 +42,7 @@ impl Robot {
     pub fn point(&self, x: &[Real]) -> Vec3 {
         let s = &self.stop;
         let v0 = capped(
-            self.v_fd + capped(Vec3::new(x[0], x[1], x[2]), 1.0) * (s.max_accel_mm_s2 * self.tick_s),
+            self.v_fd + capped(Vec3::new(x[0], x[1], x[2]), 1.0) * (s.max_accel_mm_s2 * self.interval_s),
             s.max_speed_mm_s,
         );
         let push = capped(Vec3::new(x[3], x[4], x[5]), 1.0) * s.max_accel_mm_s2;
