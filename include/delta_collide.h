@@ -782,11 +782,13 @@ DcStatus dc_set_stop_model(struct DcCollider *handle, double tick_ms, double war
 void dc_protective_reset(struct DcCollider *handle);
 
 /*
- The per-tick protective query (SPEC section 8): can every robot still stop, from now on,
- without any box touching a box of another robot? Robot j's TCP is `tcps_mcs[j]` (its
- MCS); its speed is estimated from the TCP of the previous call, so call it once per tick
- with the tick of `dc_set_stop_model` (works in exact and table mode: it reads the exact
- boxes). In table mode with a clearance table, a tick whose certified clearance bound
+ The protective query (SPEC section 8) without a time: can every robot still stop, from
+ now on, without any box touching a box of another robot? Robot j's TCP is `tcps_mcs[j]`
+ (its MCS); its speed is estimated from the TCP of the previous call, assumed exactly one
+ tick of `dc_set_stop_model` earlier. Correct only when called exactly once per cycle, at
+ the cycle's nominal time: called twice in one cycle it reads a moving robot as standing.
+ `dc_protective_query_timed` takes the cycle and fails closed on every timing fault: use
+ it in the tick loop. Works in exact and table mode (it reads the exact boxes). In table mode with a clearance table, a tick whose certified clearance bound
  exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup,
  without the box-pair proof (`dc_table_protective_lookups`); every other tick takes the
  exact protective check, as in exact mode. The report is filled alike in both modes.
@@ -810,9 +812,10 @@ void dc_protective_reset(struct DcCollider *handle);
 DcStatus dc_protective_query(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, DcVerdict *out_verdict, struct DcProtectiveReport *out_report);
 
 /*
- `dc_protective_query` for a controller that knows the path each robot's stop will follow
- (a path-maintaining stop: its next set-points), which brings STOPs down toward the ticks
- where a stop really cannot avoid contact. `paths[j]` is robot `j`'s `DcStopPath`
+ `dc_protective_query` (untimed: exactly once per cycle, at its nominal time; the timed
+ call takes the paths in its request) for a controller that knows the path each robot's
+ stop will follow (a path-maintaining stop: its next set-points), which brings STOPs down
+ toward the ticks where a stop really cannot avoid contact. `paths[j]` is robot `j`'s `DcStopPath`
  (`n_points` 0: not known; that robot is then bounded as by `dc_protective_query`). The
  verdict is the better of the proof without paths and the proof along them; the speed
  limits are those without paths. Statuses: those of `dc_protective_query`, and

@@ -1125,6 +1125,96 @@ mod tests {
         }
     }
 
+    /// Robot A at 1 m/s along x, B still: calls at cycles 0, 1 and 3 (cycle 2 skipped)
+    /// measure A at 1 m/s over the two ticks of the gap, with the bound `a_max dt` of that
+    /// interval; the same TCPs called without time read 2 m/s after 1 m/s, a change the
+    /// model forbids within one tick.
+    #[test]
+    fn a_skipped_cycle_is_measured_over_its_real_interval() {
+        let (b, v) = (Vec3::new(150.0, 0.0, -450.0), Vec3::new(1000.0, 0.0, 0.0));
+        let a = |cycle: u64| Vec3::new(-250.0, 0.0, -450.0) + v * (cycle as Real * 1e-3);
+        let mut timed = checker("T1");
+        let mut untimed = checker("T1");
+        for cycle in [0, 1, 3] {
+            let tcps = [a(cycle), b];
+            let r = timed.check(ProtectiveRequest::new(&tcps).at(TickTime::Cycle(cycle))).unwrap();
+            assert_eq!(r.status, ProtectiveStatus::Ok, "cycle {cycle}");
+            untimed.check(&tcps).unwrap();
+        }
+        let r = timed.report();
+        let a_max = timed.cell().stops[0].max_accel_mm_s2;
+        assert!((r.robots[0].speed_mm_s - 1000.0).abs() < 1e-6, "{r:?}");
+        assert!((r.robots[0].speed_bound_mm_s - (1000.0 + a_max * 2e-3)).abs() < 1e-6, "{r:?}");
+        assert_eq!(untimed.report().status, ProtectiveStatus::ImplausibleMotion(0));
+    }
+
+    /// Every state kept between calls that a speed or a kept STOP depends on is forgotten by
+    /// an error, a timing fault and `reset`: the next call has no previous TCP (full speed)
+    /// and no witness; `reset` also forgets the cycle, so a call of the same cycle with the
+    /// same TCPs is computed again instead of answered from the last report.
+    #[test]
+    fn errors_timing_faults_and_reset_forget_the_motion_and_the_witness() {
+        let text = include_str!("../../../c_harness/scenarios.txt");
+        let s = crate::cell::trajectory::parse_scenarios(text).unwrap();
+        let s = s.iter().find(|s| s.cell == "T2" && s.case == "collision").unwrap();
+        let mut c = checker("T2");
+        let mut tcps = [Vec3::zeros(); 2];
+        fn at(cycle: u64, tcps: &[Vec3; 2]) -> ProtectiveRequest<'_> {
+            ProtectiveRequest::new(tcps).at(TickTime::Cycle(cycle))
+        }
+        let mut cycle = 0;
+        // Drive the collision run until a witness is kept (a STOP tick that found one).
+        while !c.witness.is_kept() {
+            cycle += 1;
+            s.tcps_at(cycle as u32, &mut tcps);
+            c.check(at(cycle, &tcps)).unwrap();
+            assert!(cycle < 6000, "no witness on T2's collision run");
+        }
+        let speeds_unknown = |c: &ProtectiveChecker| c.report().robots.iter().all(|r| r.speed_mm_s.is_infinite());
+        // Each fault relative to the last call's cycle: the same one with other TCPs, one
+        // before it, and past the largest interval.
+        let faults: [(fn(u64) -> u64, TimingFault); 3] = [
+            (|c| c, TimingFault::Repeated),
+            (|c| c - 1, TimingFault::Backwards),
+            (|c| c + MAX_INTERVAL_TICKS + 1, TimingFault::Jump),
+        ];
+        for (time, fault) in faults {
+            let time = time(cycle);
+            let mut sent = tcps;
+            if fault == TimingFault::Repeated {
+                sent[0].z -= 0.5;
+            }
+            let r = c.check(at(time, &sent)).unwrap();
+            assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Timing(fault)));
+            assert!(!c.witness.is_kept() && c.history.iter().all(|h| h.tcp.is_none()), "{fault:?}");
+            // Back in step: the next call's speeds are unknown, its own witness search aside.
+            cycle = time + 1;
+            s.tcps_at(cycle as u32, &mut tcps);
+            c.check(at(cycle, &tcps)).unwrap();
+            assert!(speeds_unknown(&c), "after {fault:?}");
+            // A kept witness needs a STOP tick with history: run on until the next is kept.
+            while !c.witness.is_kept() {
+                cycle += 1;
+                s.tcps_at(cycle as u32, &mut tcps);
+                c.check(at(cycle, &tcps)).unwrap();
+            }
+        }
+        let mut bad = tcps;
+        bad[1].x = Real::NAN;
+        assert_eq!(c.check(at(cycle + 1, &bad)).unwrap().status, ProtectiveStatus::NonFinite(1));
+        assert!(!c.witness.is_kept());
+        s.tcps_at(cycle as u32 + 2, &mut tcps);
+        c.check(at(cycle + 2, &tcps)).unwrap();
+        assert!(speeds_unknown(&c));
+        s.tcps_at(cycle as u32 + 3, &mut tcps);
+        c.check(at(cycle + 3, &tcps)).unwrap();
+        assert!(!speeds_unknown(&c));
+        c.reset();
+        assert!(!c.witness.is_kept() && c.time.is_none());
+        c.check(at(cycle + 3, &tcps)).unwrap();
+        assert!(speeds_unknown(&c), "after reset the same cycle is computed again");
+    }
+
     #[test]
     fn far_apart_and_still_is_free_and_close_at_speed_is_stop() {
         let mut c = checker("T1");

@@ -54,6 +54,14 @@ pub(super) struct KeptWitness {
     backoff: u32,
 }
 
+#[cfg(test)]
+impl KeptWitness {
+    /// Whether a witness is kept.
+    pub(super) fn is_kept(&self) -> bool {
+        self.witness.is_some()
+    }
+}
+
 impl ProtectiveChecker {
     /// The box pair of the kept witness when its TCPs lie in this tick's stop balls of both
     /// robots (`tcps_mcs`: this tick's TCPs, whose balls `stop_balls` holds).
