@@ -758,6 +758,27 @@ fn replay_writes_one_verdict_per_tick() {
     }
 }
 
+/// `replay` reads the tick column as the controller's cycle: a repeated tick with the same
+/// TCPs repeats its row, with other TCPs it is STOP; a tick that goes back or jumps by more
+/// than four is STOP; the ticks after each fault assume full speed (STOP here, then FREE).
+#[test]
+fn replay_takes_the_tick_column_as_the_cycle() {
+    let (a, b) = ("-150,0,-450,150,0,-450", "-150,0,-449.5,150,0,-450");
+    let rows = format!("tick,x,y,z,x2,y2,z2\n7,{a}\n8,{a}\n8,{a}\n8,{b}\n9,{a}\n10,{a}\n4,{a}\n5,{a}\n6,{a}\n20,{a}\n");
+    let out = cli_stdin(&["replay", "--cell", "T1"], &rows);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let lines: Vec<&str> = text.lines().skip(1).collect();
+    let rest = |i: usize| lines[i].split_once(',').unwrap().1;
+    let field = |i: usize, k: usize| lines[i].split(',').nth(k).unwrap();
+    assert!(lines[1].starts_with("8,free,") && rest(2) == rest(1), "{text}");
+    assert_eq!((field(3, 1), field(3, 3)), ("stop", "timing repeated"), "{text}");
+    assert!(lines[4].starts_with("9,stop,") && lines[5].starts_with("10,free,"), "{text}");
+    assert_eq!((field(6, 1), field(6, 3)), ("stop", "timing backwards"), "{text}");
+    assert!(lines[7].starts_with("5,stop,") && lines[8].starts_with("6,free,"), "{text}");
+    assert_eq!((field(9, 1), field(9, 3)), ("stop", "timing jump"), "{text}");
+}
+
 /// `replay` on the four-robot line: columns `x,y,z` to `x4,y4,z4`, a protective distance and
 /// a speed limit per robot, the verdict of every pair that can meet.
 #[test]

@@ -76,8 +76,11 @@ pub enum Command {
     /// 3 numbers per robot and ticks counted from 0), with the cell's tick_ms and stopping
     /// models, and writes per tick
     /// `tick,verdict,clearance_mm,status,protective_mm_<robot>...,speed_limit_mm_s_<robot>...`
-    /// (verdict free, warn or stop; SPEC section 8). --plot draws the clearance, the protective
-    /// distances and the verdict along the run.
+    /// (verdict free, warn or stop; SPEC section 8). The tick column is the controller's cycle
+    /// counter: a skipped tick bounds the speeds over its real interval, a repeated tick with
+    /// the same TCPs repeats its row, and a tick that goes back, repeats with other TCPs or
+    /// comes more than 4 ticks later is stop (status `timing ...`). --plot draws the clearance,
+    /// the protective distances and the verdict along the run.
     Replay(ReplayArgs),
     /// Sample, label and build a table file
     ///

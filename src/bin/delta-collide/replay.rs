@@ -6,7 +6,9 @@ use crate::args::ReplayArgs;
 use crate::clearance::{pair_clearances, signed_clearance};
 use crate::replay_plot::{draw_replay, ReplayTrace};
 use crate::{load_table_or_bundle, open_input, write_output, Failure, Loaded};
-use delta_collide::cell::protective::{path_through_samples, Protective, ProtectiveChecker, ProtectiveStatus, StopPath};
+use delta_collide::cell::protective::{
+    path_through_samples, Protective, ProtectiveChecker, ProtectiveRequest, ProtectiveStatus, StopPath, TickTime,
+};
 use delta_collide::math::Vec3;
 use delta_collide::table::Confirmation;
 use std::io::{BufRead, Write};
@@ -105,7 +107,10 @@ fn replay_rows(
     let (protective, limits) = (columns("protective_mm"), columns("speed_limit_mm_s"));
     writeln!(out, "tick,verdict,clearance_mm,status{protective}{limits}{pair_columns}").map_err(write_err)?;
     let (mut rows, mut ticks): (Vec<Vec<Vec3>>, Vec<String>) = (Vec::new(), Vec::new());
+    // Each row's cycle: its tick when it is a whole number, else its row number.
+    let mut cycles: Vec<u64> = Vec::new();
     crate::rows::for_each_row(input, n, |_, tick, tcps| {
+        cycles.push(tick.and_then(|t| t.trim().parse().ok()).unwrap_or(rows.len() as u64));
         ticks.push(tick.map_or_else(|| rows.len().to_string(), str::to_string));
         rows.push(tcps.to_vec());
         Ok(())
@@ -115,26 +120,24 @@ fn replay_rows(
         if paths.is_some() { (0..n).map(|j| rows.iter().map(|r| r[j]).collect()).collect() } else { Vec::new() };
     let mut points = vec![[Vec3::zeros(); PATH_POINTS]; n];
     for (tick, tcps) in rows.iter().enumerate() {
-        match paths {
-            None if table.is_some() => checker.check_with_table(tcps, &bound),
-            None => checker.check(tcps),
-            Some(p) => {
-                // Robot j's samples ahead: its TCP in this row and the rows that follow.
-                let lens: Vec<Option<usize>> = (0..n)
-                    .map(|j| path_through_samples(&runs[j][tick..], p.length_mm, p.tolerance_mm, &mut points[j]))
-                    .collect();
-                let stop_paths: Vec<Option<StopPath>> = lens
-                    .iter()
-                    .zip(&points)
-                    .map(|(len, pts)| len.map(|len| StopPath { points: &pts[..len], tolerance_mm: p.tolerance_mm }))
-                    .collect();
-                match table {
-                    Some(_) => checker.check_with_paths_and_table(tcps, &stop_paths, &bound),
-                    None => checker.check_with_paths(tcps, &stop_paths),
-                }
-            }
+        // Robot j's samples ahead: its TCP in this row and the rows that follow.
+        let lens: Vec<Option<usize>> = match paths {
+            Some(p) => (0..n)
+                .map(|j| path_through_samples(&runs[j][tick..], p.length_mm, p.tolerance_mm, &mut points[j]))
+                .collect(),
+            None => Vec::new(),
+        };
+        let tolerance_mm = paths.map_or(0.0, |p| p.tolerance_mm);
+        let stop_paths: Vec<Option<StopPath>> = lens
+            .iter()
+            .zip(&points)
+            .map(|(len, pts)| len.map(|len| StopPath { points: &pts[..len], tolerance_mm }))
+            .collect();
+        let mut request = ProtectiveRequest::new(tcps).at(TickTime::Cycle(cycles[tick])).with_paths(&stop_paths);
+        if table.is_some() {
+            request = request.with_table(&bound);
         }
-        .map_err(|e| format!("row {tick}: {e}"))?;
+        checker.check(request).map_err(|e| format!("row {tick}: {e}"))?;
         let r = checker.report();
         lookups.ticks += usize::from(r.table_lookup);
         lookups.pairs += r.table_pairs as usize;
