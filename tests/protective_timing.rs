@@ -526,3 +526,32 @@ fn the_untimed_call_twice_per_cycle_answers_free_where_a_stop_touches() {
     }
     assert!(touched_total > 0, "the oracle found no FREE/WARN of the untimed repeat that touches");
 }
+
+/// At the nominal timing the timed call is the untimed one: once per cycle, with each cycle's
+/// call made twice, it answers every tick of every run, the line of four included, as the
+/// untimed call made once per cycle (the same reports); a fault on the line is STOP there too.
+#[test]
+fn timed_calls_at_the_nominal_timing_answer_as_the_untimed_calls() {
+    let mut runs: Vec<Run> = reference_runs();
+    let line = include_str!("../c_harness/line_scenarios.txt");
+    let line_cell = parse_cell(include_str!("../cells/line4.toml")).unwrap();
+    for s in parse_scenarios(line).unwrap() {
+        let cell = line_cell.clone().with_stopping(TICK_MS, vec![MODEL; 4]).unwrap();
+        runs.push(Run { name: format!("{} {}", s.cell, s.case), cell, robots: s.robots });
+    }
+    for run in &runs {
+        let mut timed = ProtectiveChecker::new(run.cell.clone(), 10.0).unwrap();
+        let mut untimed = timed.clone();
+        let n = run.robots.len();
+        for c in 0..RUN_TICKS {
+            let p: Vec<Vec3> = (0..n).map(|j| position(&run.robots[j], Real::from(c))).collect();
+            let want = format!("{:?}", untimed.check(&p).unwrap());
+            let request = ProtectiveRequest::new(&p).at(TickTime::Cycle(u64::from(c)));
+            assert_eq!(format!("{:?}", timed.check(request).unwrap()), want, "{} tick {c}", run.name);
+            assert_eq!(format!("{:?}", timed.check(request).unwrap()), want, "{} tick {c}, again", run.name);
+        }
+        let p: Vec<Vec3> = (0..n).map(|j| position(&run.robots[j], Real::from(RUN_TICKS))).collect();
+        let r = timed.check(ProtectiveRequest::new(&p).at(TickTime::Cycle(3))).unwrap();
+        assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Timing(TimingFault::Backwards)));
+    }
+}
