@@ -23,10 +23,11 @@
 
 use crate::cell::placement::Placement;
 use crate::cell::{Cell, CellError, RobotSpec, SatMethod};
+use super::Confirmation;
 use crate::math::{Real, Vec3};
 use crate::robot::{Delta3, ModelOptions, RobotModel, StopModel, ToolBox, DEFAULT_TICK_MS};
-use crate::table::Confirmation;
 use serde::Deserialize;
+
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -6,6 +6,7 @@
 
 #[cfg(feature = "std")]
 pub mod config;
+mod confirmation;
 pub mod exact;
 pub mod placement;
 #[cfg(feature = "std")]
@@ -16,6 +17,7 @@ pub mod trajectory;
 
 #[cfg(feature = "std")]
 pub use config::{parse_cell, parse_cell_file, CellFileContents};
+pub use confirmation::Confirmation;
 pub use exact::{CellVerdict, ExactChecker, PairVerdict, QueryError};
 pub use placement::Placement;
 

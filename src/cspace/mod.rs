@@ -13,8 +13,6 @@ pub(crate) mod certify;
 #[cfg(feature = "std")]
 pub mod guarantee;
 #[cfg(feature = "std")]
-pub(crate) mod interval;
-#[cfg(feature = "std")]
 pub(crate) mod label;
 pub mod pair_labels;
 pub mod sampler;

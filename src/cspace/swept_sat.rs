@@ -53,7 +53,7 @@ use crate::math::{float, Real, Vec3};
 pub const R_GUARD: Real = 1e-12;
 
 /// A table's displacement set: a [`Sweep`] without its segment `line`, which the tables'
-/// sweeps ([`crate::cspace::guarantee::cube_box_sweeps`]) never have, so that [`support`]
+/// sweeps ([`crate::robot::motion_bound::cube_box_sweeps`]) never have, so that [`support`]
 /// leaves it out and a swept box need not hold it (24 bytes fewer per box).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TableSweep {

@@ -418,8 +418,9 @@ fn timing_status(fault: TimingFault) -> DcStatus {
     }
 }
 
-// The header states the bound as a number (cbindgen writes no paths): keep the two equal.
+// The header states these bounds as numbers (cbindgen writes no paths): keep them equal.
 const _: () = assert!(DC_MAX_INTERVAL_TICKS == crate::cell::protective::MAX_INTERVAL_TICKS);
+const _: () = assert!(DC_MAX_PATH_POINTS == crate::cell::protective::MAX_PATH_POINTS);
 
 fn query_exact(checker: &mut ExactChecker, tcps: &[Vec3], report: &mut DcQueryReport) -> DcStatus {
     let Ok(v) = checker.check(tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };

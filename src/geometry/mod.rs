@@ -17,3 +17,8 @@ pub use obb::Obb;
 pub use sat::{obbs_intersect, separating_axis, separating_axis_hinted, Axis};
 pub use sweep::{swept_boxes_apart, Sweep};
 pub use witness::{first_intersecting_pair, WitnessCache};
+
+/// Most boxes in one set of the all-pairs tests and the witness cache ([`witness`]): one
+/// robot's boxes (3 lower links, 3 upper links, platform, tool), in fixed arrays so that no
+/// test allocates.
+pub const MAX_BOXES: usize = 8;

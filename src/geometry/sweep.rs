@@ -5,7 +5,7 @@
 //! # The displacement set
 //! A [`Sweep`] is the convex, centrally symmetric set
 //! `S = ball(c) + [-l, l] + hull(E_1 u E_2)`, `E_k = e_k Z + d_k A`, where `[-l, l]` is a
-//! segment (a lower link's turn along its own axis, `cspace::guarantee` steps 10-11), `Z` is the box
+//! segment (a lower link's turn along its own axis, `robot::motion_bound` steps 10-11), `Z` is the box
 //! `[-w_0, w_0] + [-w_1, w_1] + [-w_2, w_2]` plus the ball of radius `r` (the TCP's cell: `w_a`
 //! is its half-edge along axis `a`, `r = 0`; or the TCP's ball: `w = 0`, `r` its radius) and
 //! `A` the rectangle `[-v_0, v_0] + [-v_1, v_1]` (around the arc an elbow moves on:
@@ -17,7 +17,7 @@
 //! # Graded along the box
 //! The sets `E_1` and `E_2` belong to the box's two faces across its axis 0 (`u_0`, the link's
 //! axis for a link box): `E_1` to the face at `-half_0 u_0`, `E_2` to the one at `+half_0 u_0`.
-//! A sweep built for a box ([`crate::cspace::guarantee`]) also bounds each point's displacement
+//! A sweep built for a box (`robot::motion_bound`) also bounds each point's displacement
 //! by where the point lies: the point at fraction `f` of the way from the first face to the
 //! second moves within `ball(c) + [-l, l] + (1 - f) E_1 + f E_2` (for a lower link the point at
 //! `l` along the link moves within `|l| Z + |1 - l| A`, convex in `l`, so below its chord

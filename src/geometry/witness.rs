@@ -12,8 +12,8 @@
 
 use crate::geometry::obb::Obb;
 use crate::geometry::sat::{aabb_half_rounded_up, aabbs_disjoint, separating_axis, separating_axis_hinted, Axis};
+use crate::geometry::MAX_BOXES;
 use crate::math::Real;
-use crate::robot::MAX_BOXES;
 
 /// The rounded-up AABB half-extents of up to [`MAX_BOXES`] boxes, filled in place.
 ///

@@ -3,6 +3,8 @@
 pub mod delta3;
 pub mod model;
 #[cfg(feature = "std")]
+pub mod motion_bound;
+#[cfg(feature = "std")]
 pub mod motor_table;
 pub mod stopping;
 

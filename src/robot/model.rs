@@ -113,8 +113,9 @@ pub enum BoxKind {
 
 /// Most boxes one robot model may have (3 lower links, 3 upper links, platform, tool): the
 /// size of every per-robot box array (the witness cache, the sweeps of the certified
-/// labelling), so that a tick never allocates.
-pub const MAX_BOXES: usize = 8;
+/// labelling), so that a tick never allocates. Defined with the box sets of `geometry`,
+/// which hold one robot's boxes.
+pub use crate::geometry::MAX_BOXES;
 
 /// Up to [`MAX_BOXES`] boxes of one robot, in a fixed array (no allocation per tick).
 #[derive(Clone, Copy, Debug)]

@@ -1,11 +1,11 @@
 //! A precomputed table of certified motor-angle enclosures over a robot's TCP space, for the
 //! protective verdict's per-tick sweeps (SPEC §8 "Link points outrun the TCP"; the interval
-//! inverse kinematics of `cspace::guarantee`, thesis 3.2.7).
+//! inverse kinematics of `robot::motion_bound`, thesis 3.2.7).
 //!
 //! # What it answers
 //! [`MotorTable::enclose`] returns, per arm, an interval holding the elbow-out motor angle of
 //! every reachable TCP of an axis-aligned box `[lo, hi]` (MCS): the meaning of
-//! [`theta_range`], at the cost of 8 table reads per arm instead of `SPLITS^3` interval
+//! [`theta_range`], at the cost of 8 table reads per arm instead of `splits^3` interval
 //! inverse kinematics.
 //!
 //! # Why it is a proof
@@ -34,13 +34,13 @@
 //!    changes) gets `None`: the caller then encloses with the interval inverse kinematics.
 //!
 //! The table is coarser than a direct enclosure for boxes of a few cells (the cover rounds out
-//! to whole cells), and tighter for large ones (16 mm cells against `SPLITS^3` sub-boxes of
+//! to whole cells), and tighter for large ones (16 mm cells against `splits^3` sub-boxes of
 //! the whole box); [`MotorTable::enclose`] intersects it with one direct interval enclosure
 //! of the box when the box spans at most [`DIRECT_CELLS`] cells on an axis (both are sound,
 //! so is their intersection).
 
-use crate::cspace::guarantee::{theta_range, Enclosure};
-use crate::cspace::interval::Interval;
+use super::motion_bound::{theta_range, Enclosure};
+use crate::math::interval::Interval;
 use crate::math::{Real, Vec3};
 use crate::robot::Delta3;
 use alloc::vec::Vec;
@@ -270,22 +270,10 @@ impl MotorTable {
         }
         if span <= DIRECT_CELLS {
             for (arm, slot) in out.iter_mut().enumerate() {
-                *slot = intersect(*slot, theta_range(&self.delta, arm, lo, hi, 1));
+                *slot = slot.intersect(theta_range(&self.delta, arm, lo, hi, 1));
             }
         }
         Some(out)
-    }
-}
-
-/// The intersection of two enclosures of the same angles over the same box (both sound, so
-/// is it): `Empty` when either is or they are disjoint, the other when one is unbounded.
-pub fn intersect(a: Enclosure, b: Enclosure) -> Enclosure {
-    match (a, b) {
-        (Enclosure::Range(x), Enclosure::Range(y)) if x.lo.max(y.lo) <= x.hi.min(y.hi) => {
-            Enclosure::Range(Interval::new(x.lo.max(y.lo), x.hi.min(y.hi)))
-        }
-        (Enclosure::Range(_), Enclosure::Range(_)) | (Enclosure::Empty, _) | (_, Enclosure::Empty) => Enclosure::Empty,
-        (Enclosure::Unbounded, other) | (other, Enclosure::Unbounded) => other,
     }
 }
 

@@ -7,7 +7,7 @@
 //! The quadtrees treat `Unreachable` as "don't care" and may store it as free, which is safe
 //! only where no reachable TCP can be queried. The certified labelling marks a sample
 //! `Unreachable` only when its whole cell is proved unreachable
-//! ([`crate::cspace::guarantee::cube_unreachable`]), and stores a cell whose centre is
+//! ([`crate::robot::motion_bound::cube_unreachable`]), and stores a cell whose centre is
 //! unreachable but which holds reachable TCPs as collision. The thesis-style labelling marks
 //! cells by their *centre* (2.7 % of random reachable configurations of T1 fall into such a
 //! cell), so for it the builder turns every `Unreachable` into `Collision` first.

@@ -13,8 +13,9 @@
 
 use crate::cell::exact::PairState;
 use crate::cell::{Cell, ExactChecker, QueryError};
+pub use crate::cell::Confirmation;
 #[cfg(feature = "std")]
-use crate::cspace::guarantee::cube_reachable;
+use crate::robot::motion_bound::cube_reachable;
 use crate::cspace::symmetry::reflection_y;
 use crate::cspace::SampleGrid;
 use crate::cspace::Workspace;
@@ -35,37 +36,6 @@ pub enum TableAnswer {
     Collision,
     /// Bit j set: robot j's TCP is unreachable or not finite.
     Unreachable(u32),
-}
-
-/// What table mode does when its lookup says COLLISION (the lookup's FREE is a proof and is
-/// answered as it is).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Confirmation {
-    /// Confirm by the exact check and answer its verdict: the same verdicts as exact mode, at
-    /// the exact check's cost on those ticks only. The default of C handles, cell files and
-    /// `check --table`.
-    #[default]
-    Exact,
-    /// Answer the table's label: COLLISION may come where the robots are a little apart.
-    None,
-}
-
-impl Confirmation {
-    /// Every setting, by its name in cell files and on the command line.
-    pub const ALL: [(&'static str, Confirmation); 2] = [("exact", Confirmation::Exact), ("none", Confirmation::None)];
-
-    /// The setting named `name` (`"exact"` or `"none"`).
-    pub fn from_name(name: &str) -> Option<Confirmation> {
-        Confirmation::ALL.iter().find(|(n, _)| *n == name).map(|&(_, c)| c)
-    }
-
-    /// Its name in cell files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Confirmation::Exact => "exact",
-            Confirmation::None => "none",
-        }
-    }
 }
 
 /// Refuses a table whose header disagrees with what the cell determines: the workspace its
@@ -118,7 +88,7 @@ impl CellSet {
     }
 
     /// The sampled cells of which every TCP is proved reachable by `delta`
-    /// (`cspace::guarantee::cube_reachable`), so that a TCP found in one needs no inverse
+    /// (`robot::motion_bound::cube_reachable`), so that a TCP found in one needs no inverse
     /// kinematics.
     #[cfg(feature = "std")]
     fn reachable(grid: &SampleGrid, delta: &Delta3) -> Self {
@@ -291,7 +261,7 @@ impl TableChecker {
 
     /// Robot `j`'s TCP (its own MCS) located: `None` when it is unreachable or not finite
     /// ([`Delta3::is_reachable`]), else [`TableChecker::cell_of`]. A TCP in a grid cell proved
-    /// wholly reachable (`cspace::guarantee::cube_reachable`, whose margins make
+    /// wholly reachable (`robot::motion_bound::cube_reachable`, whose margins make
     /// `is_reachable` accept every TCP of the cell) skips the inverse kinematics.
     pub(crate) fn locate(&self, j: usize, tcp: &Vec3) -> Option<Option<[u16; 3]>> {
         let cell = self.cell_of(j, tcp);

@@ -22,7 +22,7 @@ use crate::picture::{draw_png, legend, plot_err, text, Swatch, COLLISION, FREE, 
 use crate::{load_table, Failure};
 use clap::error::ErrorKind;
 use delta_collide::cell::Cell;
-use delta_collide::cspace::guarantee::cube_unreachable;
+use delta_collide::robot::motion_bound::cube_unreachable;
 use delta_collide::cspace::{SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::robot::Delta3;

@@ -74,8 +74,8 @@ struct PathsAhead {
     tolerance_mm: f64,
 }
 
-/// Most points of a stop path (the C ABI's `DC_MAX_PATH_POINTS`).
-const PATH_POINTS: usize = delta_collide::ffi::DC_MAX_PATH_POINTS;
+/// Most points of a stop path, as a controller passes them.
+const PATH_POINTS: usize = delta_collide::cell::protective::MAX_PATH_POINTS;
 
 /// Replays every row of `input` (one tick each) and writes one line per tick on `out`, with
 /// stop paths from the rows ahead, table mode and per-pair clearances as `columns` says;

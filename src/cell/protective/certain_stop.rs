@@ -7,8 +7,8 @@
 
 use super::stop_sweeps::{graded_points, pair_apart_in_some_form, GradedRadii};
 use super::{BoxPair, ProtectiveChecker};
-use crate::cspace::guarantee::{box_sweep_forms, tcp_weights};
-use crate::cspace::interval::Interval;
+use crate::math::interval::Interval;
+use crate::robot::motion_bound::{box_sweep_forms, tcp_weights};
 use crate::geometry::sweep::{balls_swept_apart_with, Axes, FaceTerms};
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};

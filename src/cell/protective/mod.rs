@@ -47,13 +47,13 @@
 //!    a narrower angle range gives a smaller sweep on every axis, so tier 2 proves whatever
 //!    the direct enclosure alone proved before the table existed). Each tier's angles are
 //!    then intersected with
-//!    [`ball_theta_range`](crate::cspace::guarantee::ball_theta_range), an enclosure over
+//!    [`ball_theta_range`](crate::robot::motion_bound::ball_theta_range), an enclosure over
 //!    the ball itself in the arm's polar coordinates (the TCP never leaves the ball; the cube
 //!    only writes it as a box), and a lower link's turn is split between a ball and a
-//!    segment along its own axis (`cspace::guarantee`, steps 10 and 11).
+//!    segment along its own axis (`robot::motion_bound`, steps 10 and 11).
 //! 5. **Apart.** Box `i` of robot `a` over the stop lies in `box_i(now)` with each point moved
 //!    within `sweep_i` as the graded reading of [`crate::geometry::sweep`] allows: a point of
-//!    a lower link at `l` along it moves within `|l| Z + |1 - l| A` (`cspace::guarantee`, step
+//!    a lower link at `l` along it moves within `|l| Z + |1 - l| A` (`robot::motion_bound`, step
 //!    4), so the end nearer the platform joint carries the TCP's set and hardly any of the
 //!    elbow's arc, the end at the elbow the reverse; likewise for `b`.
 //!    [`swept_boxes_apart_either`] proves the two swept sets disjoint, with a positive gap, on
@@ -150,8 +150,8 @@
 //!
 //! Nothing here allocates after [`ProtectiveChecker::new`].
 //!
-//! [`box_sweep_forms_into`]: crate::cspace::guarantee::box_sweep_forms_into
-//! [`tcp_weights`]: crate::cspace::guarantee::tcp_weights
+//! [`box_sweep_forms_into`]: crate::robot::motion_bound::box_sweep_forms_into
+//! [`tcp_weights`]: crate::robot::motion_bound::tcp_weights
 //! [`balls_swept_apart_with`]: crate::geometry::sweep::balls_swept_apart_with
 //! [`swept_boxes_apart_either`]: crate::geometry::sweep::swept_boxes_apart_either
 //! [`graded_closest`]: crate::geometry::graded_closest
@@ -179,16 +179,16 @@ mod witness;
 pub use kept::{KEPT_MARGIN_MM, KEPT_WIDEN};
 pub use lookup::{ClearanceBound, LOOKUP_SLACK_MM};
 pub use clock::{TickTime, TimingFault, MAX_INTERVAL_TICKS, MIN_INTERVAL_TICKS};
-pub use path::{path_through_samples, StopPath};
+pub use path::{path_through_samples, StopPath, MAX_PATH_POINTS};
 pub use request::ProtectiveRequest;
 pub use stop_sweeps::{stop_sweeps_wcs, SweepForms};
 use stop_sweeps::{first_unproved_between, stop_sweeps_wcs_into, GradedRadii};
 
-/// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`SPLITS^3` per
+/// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`STOP_SPLITS^3` per
 /// arm). The cubes here are tens to hundreds of mm, where finer splits shrink the sweeps by
 /// about 1 % for 7 times the time (2: about 11 us per robot, 4: 74 us); a tick evaluates up
 /// to `2 + LIMIT_STEPS + 1` sweep sets per robot.
-pub const SPLITS: u32 = 2;
+pub const STOP_SPLITS: u32 = 2;
 
 /// The WARN threshold of the C ABI until `dc_set_stop_model` sets one (mm): the 10 mm by which
 /// the practical scenarios clear the robots (SPEC §5).

@@ -36,6 +36,11 @@ use crate::geometry::sweep::FaceTerms;
 use crate::math::{Real, Vec3};
 use crate::robot::{RobotBoxes, MAX_BOXES};
 
+/// Most points of one stop path that a controller passes (the C ABI's
+/// `DC_MAX_PATH_POINTS`): a stop of a few hundred mm in points a few ticks apart, in a
+/// buffer of fixed size. The proof itself takes any number.
+pub const MAX_PATH_POINTS: usize = 32;
+
 /// Halvings of one robot's piece at most, per robot pair (up to `2^MAX_DEPTH` pieces).
 pub const MAX_DEPTH: u32 = 3;
 

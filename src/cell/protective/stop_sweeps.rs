@@ -2,20 +2,20 @@
 //! and the swept-box proof over the box pairs of two robots (step 5): the first box pair that
 //! no axis proves apart in either sweep form.
 
-use super::{BoxPair, SPLITS};
+use super::{BoxPair, STOP_SPLITS};
 use crate::cell::exact::PairVerdict;
-use crate::cspace::guarantee::{box_sweep_forms_into, theta_range, Enclosure};
+use crate::robot::motion_bound::{box_sweep_forms_into, theta_range, Enclosure};
 use crate::geometry::graded_closest::{graded_closest, GradedClosest};
 use crate::geometry::sweep::{swept_boxes_apart_either, Axes, FaceTerms};
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
-use crate::robot::motor_table::{intersect, MotorTable};
+use crate::robot::motor_table::MotorTable;
 use crate::robot::{RobotModel, MAX_BOXES};
 
 /// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
 /// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded. The motor
 /// angles come from `table` (built for `model.delta`) where it covers the cube, else from the
-/// interval inverse kinematics with [`SPLITS`]: the first tier, without the second.
+/// interval inverse kinematics with [`STOP_SPLITS`]: the first tier, without the second.
 pub fn stop_sweeps_wcs(
     model: &RobotModel,
     rot_wcs: &crate::math::Mat3,
@@ -54,16 +54,16 @@ pub(super) fn stop_sweeps_wcs_into(
                 let refine = |arm: usize| arms >> arm & 1 == 1;
                 core::array::from_fn(|arm| {
                     if refine(arm) {
-                        intersect(th[arm], theta_range(d, arm, lo, hi, precise))
+                        th[arm].intersect(theta_range(d, arm, lo, hi, precise))
                     } else {
                         th[arm]
                     }
                 })
             }
             Some(th) => th,
-            None => direct(lo, hi, SPLITS),
+            None => direct(lo, hi, STOP_SPLITS),
         }),
-        None => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| direct(lo, hi, SPLITS)),
+        None => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| direct(lo, hi, STOP_SPLITS)),
     };
     write_forms(out, filled, rot_wcs);
 }

@@ -74,8 +74,8 @@
 //! `2 k`.
 //!
 //! [`box_sweeps`]: crate::cspace::guarantee::box_sweeps
-//! [`cube_box_sweeps`]: crate::cspace::guarantee::cube_box_sweeps
-//! [`cube_unreachable`]: crate::cspace::guarantee::cube_unreachable
+//! [`cube_box_sweeps`]: crate::robot::motion_bound::cube_box_sweeps
+//! [`cube_unreachable`]: crate::robot::motion_bound::cube_unreachable
 
 pub(crate) mod clearance;
 mod refine;
@@ -87,7 +87,7 @@ mod sweeps;
 pub use subdivided_labels::SubdividedLabels;
 
 use crate::cell::{Cell, RobotSpec};
-use crate::cspace::guarantee::SPLITS;
+use crate::cspace::guarantee::CELL_SPLITS;
 use crate::cspace::label::{
     entries_collide, label_pairs, label_rows_except, two_robot_grids, Inflation, Progress, RowLabeller, Rows,
     SampleBoxes,
@@ -103,8 +103,8 @@ use sweeps::{cell_sweeps, inflation, octants, reference_octants, references, unr
 
 
 /// Sub-boxes per axis when enclosing the motor angles over an octant (an octant is half as
-/// wide as a cell, so this gives the same sub-box size as [`SPLITS`] on a cell).
-pub const OCTANT_SPLITS: u32 = SPLITS / 2;
+/// wide as a cell, so this gives the same sub-box size as [`CELL_SPLITS`] on a cell).
+pub const OCTANT_SPLITS: u32 = CELL_SPLITS / 2;
 
 /// A labelling whose free labels are proofs for whole 6-D cells, with the bounds it used.
 #[derive(Clone, Debug, PartialEq)]

@@ -3,7 +3,7 @@
 //! sub-cell labels ([`SubCells`]) of the pairs that stay collisions.
 
 use crate::cell::RobotSpec;
-use crate::cspace::guarantee::reference_point;
+use crate::robot::motion_bound::reference_point;
 use crate::cspace::label::{
     aabbs_apart, all_box_pairs, bounds_apart, boxes_may_touch, collision_mask, entries_apart, Inflation, Rows,
     SampleBoxes, Slot, SweptBounds, SweptBox,

@@ -3,7 +3,8 @@
 //! symmetric cell gets symmetric labels (thesis 3.2.8), and which cells are proved
 //! unreachable.
 
-use crate::cspace::guarantee::{box_sweeps, cube_box_sweeps, cube_unreachable, reference_point};
+use crate::cspace::guarantee::box_sweeps;
+use crate::robot::motion_bound::{cube_box_sweeps, cube_unreachable, reference_point};
 use crate::cspace::label::Inflation;
 use crate::cspace::sampler::SampleGrid;
 use crate::cspace::symmetry::mirror_cell;

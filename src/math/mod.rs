@@ -4,6 +4,9 @@
 //! Every tolerance here errs toward "collision": a tie or a rounding error may turn a free
 //! configuration into a reported collision, never the other way round.
 
+#[cfg(feature = "std")]
+pub(crate) mod interval;
+
 /// The one scalar type of the crate.
 pub type Real = f64;
 /// A point or direction in 3-D, in millimetres.

@@ -1,5 +1,5 @@
-//! A tiny closed-interval arithmetic, enough to enclose the inverse kinematics over a grid
-//! cell (SPEC §6; used by [`crate::cspace::guarantee`]).
+//! A tiny closed-interval arithmetic, enough to enclose the inverse kinematics over a box of
+//! TCPs (SPEC §6 and §8; used by [`crate::robot::motion_bound`]).
 //!
 //! # Numerics
 //! Every operation is computed in round-to-nearest and its result widened outward by a few
