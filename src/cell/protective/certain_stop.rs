@@ -99,7 +99,7 @@ impl ProtectiveChecker {
         else {
             return false;
         };
-        let (ra, rb) = (self.step_6_radii(p.a, p.box_a, sa), self.step_6_radii(p.b, p.box_b, sb));
+        let (ra, rb) = (self.graded_ball_radii(p.a, p.box_a, sa), self.graded_ball_radii(p.b, p.box_b, sb));
         let (a, b) = ((&box_a, [&la[0], &la[1]], ra), (&box_b, [&lb[0], &lb[1]], rb));
         !pair_apart_in_some_form(a, b, extra, &self.pair_axis(p))
     }
@@ -117,7 +117,7 @@ impl ProtectiveChecker {
     /// only when `also_least`.
     pub(super) fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool) -> bool {
         let refs = self.reference_pair(tcps_mcs, p);
-        let (ra, rb) = (self.step_6_radii(p.a, p.box_a, refs[0].2), self.step_6_radii(p.b, p.box_b, refs[1].2));
+        let (ra, rb) = (self.graded_ball_radii(p.a, p.box_a, refs[0].2), self.graded_ball_radii(p.b, p.box_b, refs[1].2));
         !balls_apart((&refs[0].0, ra), (&refs[1].0, rb), &self.pair_axis(p))
             || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
     }
@@ -141,7 +141,7 @@ impl ProtectiveChecker {
     }
 
     /// [`least_radii`] of robot `j`'s box `k` for reference radius `reach`.
-    fn step_6_radii(&self, j: usize, k: usize, reach: Real) -> [Real; 2] {
+    fn graded_ball_radii(&self, j: usize, k: usize, reach: Real) -> [Real; 2] {
         least_radii(&self.exact.cell().robots[j].model, k, reach)
     }
 
@@ -189,10 +189,10 @@ mod tests {
     /// Step 6's points answer as its separating axis tests on every closest pair of the
     /// default model's runs (graded balls found meeting: no axis separates, neither the 16 nor
     /// the pair's graded axis), and the graded axis separates most of the pairs that the 16
-    /// leave unproved: `cargo test --release --lib step_6_points -- --nocapture` prints how
+    /// leave unproved: `cargo test --release --lib graded_points -- --nocapture` prints how
     /// many of each.
     #[test]
-    fn step_6_points_answer_as_the_axes() {
+    fn graded_points_answer_as_the_axes() {
         let text = include_str!("../../../c_harness/scenarios.txt");
         let (mut settled, mut separated) = (0, 0);
         for s in crate::cell::trajectory::parse_scenarios(text).unwrap().iter() {
@@ -204,7 +204,7 @@ mod tests {
                 c.check(&tcps).unwrap();
                 let Some(p) = c.report.closest else { continue };
                 let [(a, _, reach_a, _), (b, _, reach_b, _)] = c.reference_pair(&tcps, p);
-                let (ra, rb) = (c.step_6_radii(p.a, p.box_a, reach_a), c.step_6_radii(p.b, p.box_b, reach_b));
+                let (ra, rb) = (c.graded_ball_radii(p.a, p.box_a, reach_a), c.graded_ball_radii(p.b, p.box_b, reach_b));
                 let (fa, fb, axis) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb), c.pair_axis(p));
                 let points = graded_points((&a, ra), (&b, rb), 0.0);
                 let apart = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::FifteenAnd(&axis));

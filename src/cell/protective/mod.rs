@@ -64,7 +64,7 @@
 //!    others leave unproved). Any axis is sound; the 15 decide whether two boxes meet, not
 //!    whether two swept sets do, and the graded axis looks where the sweeps come nearest (on
 //!    the reference runs it proves most of the pairs that the 16 others leave unproved:
-//!    `cargo test --release --lib step_6_points -- --nocapture`). All box pairs of all pairs
+//!    `cargo test --release --lib graded_points -- --nocapture`). All box pairs of all pairs
 //!    that can meet proved: FREE. Proved again with `warn_mm` added to one sweep's ball (and
 //!    to the graded ball its axis is sought with): else WARN. Any unproved pair, unreachable
 //!    TCP, unbounded sweep or status other than OK: STOP.
