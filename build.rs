@@ -7,6 +7,7 @@
 use std::path::PathBuf;
 
 fn main() {
+    // cbindgen reads src/ffi/mod.rs and the modules it declares.
     println!("cargo:rerun-if-changed=src/ffi");
     println!("cargo:rerun-if-changed=cbindgen.toml");
     println!("cargo:rerun-if-env-changed=CI");

@@ -198,69 +198,6 @@ typedef struct DcCellConfig {
 typedef uint32_t DcVerdict;
 
 /*
- Summary of one query, written on every call when the pointer is not NULL.
- */
-typedef struct DcQueryReport {
-  /*
-   Same value as `*out_verdict`.
-   */
-  DcVerdict verdict;
-  /*
-   Number of robot pairs that collide.
-   */
-  uint32_t colliding_pairs;
-  /*
-   Bit j set: robot j's TCP is unreachable or not finite.
-   */
-  uint32_t unreachable_mask;
-  /*
-   First colliding pair's first robot, or `DC_BOX_NONE`.
-   */
-  uint32_t first_robot_a;
-  /*
-   First colliding pair's second robot, or `DC_BOX_NONE`.
-   */
-  uint32_t first_robot_b;
-  /*
-   Box of `first_robot_a`: 0..2 lower links, then upper links, platform, tool. In table
-   mode `DC_BOX_NONE` when the lookup alone answered (no exact check ran).
-   */
-  uint32_t first_box_a;
-  /*
-   Box of `first_robot_b`.
-   */
-  uint32_t first_box_b;
-} DcQueryReport;
-
-/*
- One robot's stopping model (SPEC section 8) for `dc_set_stop_model`; start from
- `dc_stop_config_default()`, which also sets `struct_size`.
- */
-typedef struct DcStopConfig {
-  /*
-   `sizeof(DcStopConfig)` as the caller compiled it: lets later versions add fields.
-   */
-  size_t struct_size;
-  /*
-   Time from a STOP until braking starts (ms); the TCP may do anything within the
-   limits meanwhile. Default 4.
-   */
-  double reaction_ms;
-  /*
-   Least deceleration along the path while braking (mm/s^2). Default 40000.
-   */
-  double decel_mm_s2;
-  /*
-   Largest TCP acceleration at any time (mm/s^2); at least `decel_mm_s2`. Default 130000.
-   */
-  double max_accel_mm_s2;
-  /*
-   Largest TCP speed at any time (mm/s). Default 4600.
-   */
-  double max_speed_mm_s;
-} DcStopConfig;
-
-/*
  Summary of one protective query, written on every call when the pointer is not NULL.
  */
 typedef struct DcProtectiveReport {
@@ -393,6 +330,41 @@ typedef struct DcProtectiveRequest {
 } DcProtectiveRequest;
 
 /*
+ Summary of one query, written on every call when the pointer is not NULL.
+ */
+typedef struct DcQueryReport {
+  /*
+   Same value as `*out_verdict`.
+   */
+  DcVerdict verdict;
+  /*
+   Number of robot pairs that collide.
+   */
+  uint32_t colliding_pairs;
+  /*
+   Bit j set: robot j's TCP is unreachable or not finite.
+   */
+  uint32_t unreachable_mask;
+  /*
+   First colliding pair's first robot, or `DC_BOX_NONE`.
+   */
+  uint32_t first_robot_a;
+  /*
+   First colliding pair's second robot, or `DC_BOX_NONE`.
+   */
+  uint32_t first_robot_b;
+  /*
+   Box of `first_robot_a`: 0..2 lower links, then upper links, platform, tool. In table
+   mode `DC_BOX_NONE` when the lookup alone answered (no exact check ran).
+   */
+  uint32_t first_box_a;
+  /*
+   Box of `first_robot_b`.
+   */
+  uint32_t first_box_b;
+} DcQueryReport;
+
+/*
  One robot pair's result of the last query.
  */
 typedef struct DcPairResult {
@@ -422,6 +394,34 @@ typedef struct DcPairResult {
  How a handle answers (`dc_mode`).
  */
 typedef uint32_t DcMode;
+
+/*
+ One robot's stopping model (SPEC section 8) for `dc_set_stop_model`; start from
+ `dc_stop_config_default()`, which also sets `struct_size`.
+ */
+typedef struct DcStopConfig {
+  /*
+   `sizeof(DcStopConfig)` as the caller compiled it: lets later versions add fields.
+   */
+  size_t struct_size;
+  /*
+   Time from a STOP until braking starts (ms); the TCP may do anything within the
+   limits meanwhile. Default 4.
+   */
+  double reaction_ms;
+  /*
+   Least deceleration along the path while braking (mm/s^2). Default 40000.
+   */
+  double decel_mm_s2;
+  /*
+   Largest TCP acceleration at any time (mm/s^2); at least `decel_mm_s2`. Default 130000.
+   */
+  double max_accel_mm_s2;
+  /*
+   Largest TCP speed at any time (mm/s). Default 4600.
+   */
+  double max_speed_mm_s;
+} DcStopConfig;
 
 /*
  Table mode: what a query does when the table's lookup says COLLISION
@@ -726,50 +726,34 @@ DcStatus dc_init_from_files(const char *cell_path, const char *table_path, struc
 size_t dc_last_init_error(char *buf, size_t capacity);
 
 /*
- The per-tick query: do the robots collide with robot j's TCP at `tcps_mcs[j]` (its MCS)?
- Works the same in exact and table mode.
-
- Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
- `DC_VERDICT_FREE` or `DC_VERDICT_COLLISION` with `DC_STATUS_OK`, else `DC_VERDICT_STOP`.
- Statuses: `DC_STATUS_NULL_POINTER` (handle, tcps_mcs or out_verdict NULL),
- `DC_STATUS_WRONG_ROBOT_COUNT`, `DC_STATUS_NON_FINITE` (a NaN/inf coordinate; the
- report's `unreachable_mask` names the robot), `DC_STATUS_UNREACHABLE` (a TCP outside
- the robot's reach or motor limits; mask as before), `DC_STATUS_PANIC` (destroy the
- handle). In table mode a COLLISION report names robots 0 and 1 and no boxes
- (`DC_BOX_NONE`). Never allocates, locks or does I/O.
+ Frees a handle (POU shut-down). NULL is a no-op. The handle must not be used afterwards.
 
  # Safety
- `handle` must be NULL or a live handle from `dc_init*` not used by another thread;
- `tcps_mcs` must be NULL or point to `n_tcps` readable `DcVec3`; the out pointers must be
- NULL or writable.
+ `handle` must be NULL or a live handle from `dc_init*`, destroyed only once.
  */
-DcStatus dc_query(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, DcVerdict *out_verdict, struct DcQueryReport *out_report);
+void dc_destroy(struct DcCollider *handle);
 
 /*
- The default stopping model (SPEC section 8: reaction 4 ms, decel 40000 mm/s^2, max accel
- 130000 mm/s^2, max speed 4600 mm/s) with `struct_size` set: start from it and change
- the fields that differ.
- */
-struct DcStopConfig dc_stop_config_default(void);
-
-/*
- Sets the protective verdict's controller tick (ms), WARN threshold (mm) and one stopping
- model per robot (`n_stops` = the cell's robots), and forgets the previous TCPs. Until it
- is called a handle uses the cell file's `tick_ms` and `stop` keys, or for `dc_init` the
- defaults (tick 1 ms, `dc_stop_config_default()`), and `warn_mm` = 10. Setup only: it
- allocates; call it before the tick loop. On failure the handle keeps its previous models
- and `dc_last_init_error` names the field at fault.
-
- Statuses: `DC_STATUS_NULL_POINTER` (handle or stops NULL), `DC_STATUS_WRONG_ROBOT_COUNT`,
- `DC_STATUS_INVALID_ARGUMENT` (a `struct_size` that is not this header's
- `sizeof(DcStopConfig)`), `DC_STATUS_INVALID_CONFIG` (a value NaN, infinite or not > 0,
- `decel_mm_s2` above `max_accel_mm_s2`, `warn_mm` negative), `DC_STATUS_PANIC`.
+ Elbow-out inverse kinematics (SPEC section 2) of `tcp_mcs`, for a controller or a test harness
+ to cross-check its own kinematics. Writes `out_theta[0..3]` (rad) on success.
+ Statuses: `DC_STATUS_NULL_POINTER`, `DC_STATUS_NON_FINITE`, `DC_STATUS_INVALID_CONFIG`
+ (bad geometry), `DC_STATUS_UNREACHABLE`.
 
  # Safety
- `handle` must be NULL or a live handle not used by another thread; `stops` must be NULL
- or point to `n_stops` readable `DcStopConfig`.
+ `geometry` must be NULL or valid; `out_theta` must be NULL or hold 3 writable doubles.
  */
-DcStatus dc_set_stop_model(struct DcCollider *handle, double tick_ms, double warn_mm, const struct DcStopConfig *stops, size_t n_stops);
+DcStatus dc_delta3_inverse_kinematics(const struct DcDelta3 *geometry, struct DcVec3 tcp_mcs, double *out_theta);
+
+/*
+ Forward kinematics (SPEC section 2): the TCP for motor angles `theta[0..3]` (rad), written to
+ `*out_tcp`. Statuses: `DC_STATUS_NULL_POINTER`, `DC_STATUS_NON_FINITE`,
+ `DC_STATUS_INVALID_CONFIG`, `DC_STATUS_UNREACHABLE` (the three spheres do not meet).
+
+ # Safety
+ `geometry` must be NULL or valid; `theta` NULL or 3 readable doubles; `out_tcp` NULL or
+ writable.
+ */
+DcStatus dc_delta3_forward_kinematics(const struct DcDelta3 *geometry, const double *theta, struct DcVec3 *out_tcp);
 
 /*
  Forgets the previous TCPs of the protective verdict and the last call's cycle (e.g. after
@@ -873,6 +857,26 @@ struct DcProtectiveRequest dc_protective_request_default(void);
 DcStatus dc_protective_query_timed(struct DcCollider *handle, const struct DcProtectiveRequest *request, DcVerdict *out_verdict, struct DcProtectiveReport *out_report);
 
 /*
+ The per-tick query: do the robots collide with robot j's TCP at `tcps_mcs[j]` (its MCS)?
+ Works the same in exact and table mode.
+
+ Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
+ `DC_VERDICT_FREE` or `DC_VERDICT_COLLISION` with `DC_STATUS_OK`, else `DC_VERDICT_STOP`.
+ Statuses: `DC_STATUS_NULL_POINTER` (handle, tcps_mcs or out_verdict NULL),
+ `DC_STATUS_WRONG_ROBOT_COUNT`, `DC_STATUS_NON_FINITE` (a NaN/inf coordinate; the
+ report's `unreachable_mask` names the robot), `DC_STATUS_UNREACHABLE` (a TCP outside
+ the robot's reach or motor limits; mask as before), `DC_STATUS_PANIC` (destroy the
+ handle). In table mode a COLLISION report names robots 0 and 1 and no boxes
+ (`DC_BOX_NONE`). Never allocates, locks or does I/O.
+
+ # Safety
+ `handle` must be NULL or a live handle from `dc_init*` not used by another thread;
+ `tcps_mcs` must be NULL or point to `n_tcps` readable `DcVec3`; the out pointers must be
+ NULL or writable.
+ */
+DcStatus dc_query(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, DcVerdict *out_verdict, struct DcQueryReport *out_report);
+
+/*
  Copies the per-pair results of the last query into `out[0..]` and their number into
  `*out_len`. Exact mode: the pairs whose reach can overlap (`dc_pair_count`), with the
  colliding boxes. Table mode: one pair (robots 0 and 1), `collides` as the last verdict,
@@ -925,6 +929,72 @@ uint64_t dc_table_fallbacks(const struct DcCollider *handle);
 DcStatus dc_table_clearance_bound(struct DcCollider *handle, const struct DcVec3 *tcps_mcs, size_t n_tcps, double *out_mm);
 
 /*
+ Table mode: how many queries so far the table's lookup said COLLISION and the exact check
+ confirmed or refuted it (`DC_CONFIRMATION_EXACT`); ticks answered by the exact fallback
+ are counted by `dc_table_fallbacks` instead. 0 in exact mode and for NULL.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+uint64_t dc_table_confirmations(const struct DcCollider *handle);
+
+/*
+ Table mode with a clearance table (`build --variant clearance`): how many protective
+ queries so far (`dc_protective_query`, `dc_protective_query_with_paths`) were answered
+ FREE by the table's certified clearance bound alone, which exceeded both robots' motion
+ bounds over their stops plus `warn_mm` (docs/PROTECTIVE.md); every other protective query
+ took the exact protective proof. 0 in exact mode, with a boolean table and for NULL.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+uint64_t dc_table_protective_lookups(const struct DcCollider *handle);
+
+/*
+ Number of robots of the handle's cell; 0 for NULL.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+size_t dc_robot_count(const struct DcCollider *handle);
+
+/*
+ Number of robot pairs `dc_pair_results` reports: exact mode, the pairs that can meet
+ (kept after pruning at init); table mode, 1 (a bundle: the pairs that can meet, one lookup
+ each); 0 for NULL.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+size_t dc_pair_count(const struct DcCollider *handle);
+
+/*
+ The default stopping model (SPEC section 8: reaction 4 ms, decel 40000 mm/s^2, max accel
+ 130000 mm/s^2, max speed 4600 mm/s) with `struct_size` set: start from it and change
+ the fields that differ.
+ */
+struct DcStopConfig dc_stop_config_default(void);
+
+/*
+ Sets the protective verdict's controller tick (ms), WARN threshold (mm) and one stopping
+ model per robot (`n_stops` = the cell's robots), and forgets the previous TCPs. Until it
+ is called a handle uses the cell file's `tick_ms` and `stop` keys, or for `dc_init` the
+ defaults (tick 1 ms, `dc_stop_config_default()`), and `warn_mm` = 10. Setup only: it
+ allocates; call it before the tick loop. On failure the handle keeps its previous models
+ and `dc_last_init_error` names the field at fault.
+
+ Statuses: `DC_STATUS_NULL_POINTER` (handle or stops NULL), `DC_STATUS_WRONG_ROBOT_COUNT`,
+ `DC_STATUS_INVALID_ARGUMENT` (a `struct_size` that is not this header's
+ `sizeof(DcStopConfig)`), `DC_STATUS_INVALID_CONFIG` (a value NaN, infinite or not > 0,
+ `decel_mm_s2` above `max_accel_mm_s2`, `warn_mm` negative), `DC_STATUS_PANIC`.
+
+ # Safety
+ `handle` must be NULL or a live handle not used by another thread; `stops` must be NULL
+ or point to `n_stops` readable `DcStopConfig`.
+ */
+DcStatus dc_set_stop_model(struct DcCollider *handle, double tick_ms, double warn_mm, const struct DcStopConfig *stops, size_t n_stops);
+
+/*
  Table mode: chooses what a query does when the table's lookup says COLLISION, from the
  next query on: `DC_CONFIRMATION_EXACT` (the default) runs the exact check and answers its
  verdict, so the handle answers as exact mode; `DC_CONFIRMATION_NONE` answers the table's
@@ -974,54 +1044,6 @@ DcStatus dc_set_speed_limits(struct DcCollider *handle, uint32_t on);
 DcStatus dc_set_limit_tests(struct DcCollider *handle, uint32_t tests);
 
 /*
- Table mode: how many queries so far the table's lookup said COLLISION and the exact check
- confirmed or refuted it (`DC_CONFIRMATION_EXACT`); ticks answered by the exact fallback
- are counted by `dc_table_fallbacks` instead. 0 in exact mode and for NULL.
-
- # Safety
- `handle` must be NULL or live.
- */
-uint64_t dc_table_confirmations(const struct DcCollider *handle);
-
-/*
- Table mode with a clearance table (`build --variant clearance`): how many protective
- queries so far (`dc_protective_query`, `dc_protective_query_with_paths`) were answered
- FREE by the table's certified clearance bound alone, which exceeded both robots' motion
- bounds over their stops plus `warn_mm` (docs/PROTECTIVE.md); every other protective query
- took the exact protective proof. 0 in exact mode, with a boolean table and for NULL.
-
- # Safety
- `handle` must be NULL or live.
- */
-uint64_t dc_table_protective_lookups(const struct DcCollider *handle);
-
-/*
- Number of robots of the handle's cell; 0 for NULL.
-
- # Safety
- `handle` must be NULL or live.
- */
-size_t dc_robot_count(const struct DcCollider *handle);
-
-/*
- Number of robot pairs `dc_pair_results` reports: exact mode, the pairs that can meet
- (kept after pruning at init); table mode, 1 (a bundle: the pairs that can meet, one lookup
- each); 0 for NULL.
-
- # Safety
- `handle` must be NULL or live.
- */
-size_t dc_pair_count(const struct DcCollider *handle);
-
-/*
- Frees a handle (POU shut-down). NULL is a no-op. The handle must not be used afterwards.
-
- # Safety
- `handle` must be NULL or a live handle from `dc_init*`, destroyed only once.
- */
-void dc_destroy(struct DcCollider *handle);
-
-/*
  A static, NUL-terminated English description of `status`; never NULL.
  */
 const char *dc_status_str(DcStatus status);
@@ -1030,28 +1052,6 @@ const char *dc_status_str(DcStatus status);
  The library version, a static NUL-terminated string such as "0.1.0".
  */
 const char *dc_version(void);
-
-/*
- Elbow-out inverse kinematics (SPEC section 2) of `tcp_mcs`, for a controller or a test harness
- to cross-check its own kinematics. Writes `out_theta[0..3]` (rad) on success.
- Statuses: `DC_STATUS_NULL_POINTER`, `DC_STATUS_NON_FINITE`, `DC_STATUS_INVALID_CONFIG`
- (bad geometry), `DC_STATUS_UNREACHABLE`.
-
- # Safety
- `geometry` must be NULL or valid; `out_theta` must be NULL or hold 3 writable doubles.
- */
-DcStatus dc_delta3_inverse_kinematics(const struct DcDelta3 *geometry, struct DcVec3 tcp_mcs, double *out_theta);
-
-/*
- Forward kinematics (SPEC section 2): the TCP for motor angles `theta[0..3]` (rad), written to
- `*out_tcp`. Statuses: `DC_STATUS_NULL_POINTER`, `DC_STATUS_NON_FINITE`,
- `DC_STATUS_INVALID_CONFIG`, `DC_STATUS_UNREACHABLE` (the three spheres do not meet).
-
- # Safety
- `geometry` must be NULL or valid; `theta` NULL or 3 readable doubles; `out_tcp` NULL or
- writable.
- */
-DcStatus dc_delta3_forward_kinematics(const struct DcDelta3 *geometry, const double *theta, struct DcVec3 *out_tcp);
 
 #ifdef __cplusplus
 }  /* extern "C" */

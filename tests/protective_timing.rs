@@ -30,7 +30,7 @@ use rand::{RngExt, SeedableRng};
 
 mod protective_common;
 use protective_common::adversary::{clearance_at, worst_stop, Robot};
-use protective_common::toward_other;
+use protective_common::{allocations, toward_other};
 
 /// The stopping model of the dense runs that found the hazard: 3 ms reaction, 40 m/s^2
 /// braking, 150 m/s^2 and 5 m/s at most.
@@ -529,7 +529,8 @@ fn the_untimed_call_twice_per_cycle_answers_free_where_a_stop_touches() {
 
 /// At the nominal timing the timed call is the untimed one: once per cycle, with each cycle's
 /// call made twice, it answers every tick of every run, the line of four included, as the
-/// untimed call made once per cycle (the same reports); a fault on the line is STOP there too.
+/// untimed call made once per cycle (the same reports), and allocates nothing; a fault on
+/// the line is STOP there too.
 #[test]
 fn timed_calls_at_the_nominal_timing_answer_as_the_untimed_calls() {
     let mut runs: Vec<Run> = reference_runs();
@@ -547,8 +548,14 @@ fn timed_calls_at_the_nominal_timing_answer_as_the_untimed_calls() {
             let p: Vec<Vec3> = (0..n).map(|j| position(&run.robots[j], Real::from(c))).collect();
             let want = format!("{:?}", untimed.check(&p).unwrap());
             let request = ProtectiveRequest::new(&p).at(TickTime::Cycle(u64::from(c)));
-            assert_eq!(format!("{:?}", timed.check(request).unwrap()), want, "{} tick {c}", run.name);
-            assert_eq!(format!("{:?}", timed.check(request).unwrap()), want, "{} tick {c}, again", run.name);
+            let before = allocations();
+            timed.check(request).unwrap();
+            let first = allocations() - before;
+            assert_eq!(format!("{:?}", timed.report()), want, "{} tick {c}", run.name);
+            let before = allocations();
+            timed.check(request).unwrap();
+            assert_eq!((first, allocations() - before), (0, 0), "{}: tick {c} allocated", run.name);
+            assert_eq!(format!("{:?}", timed.report()), want, "{} tick {c}, again", run.name);
         }
         let p: Vec<Vec3> = (0..n).map(|j| position(&run.robots[j], Real::from(RUN_TICKS))).collect();
         let r = timed.check(ProtectiveRequest::new(&p).at(TickTime::Cycle(3))).unwrap();

@@ -278,7 +278,7 @@ impl RobotProtection {
 }
 
 /// The result of one protective check.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct ProtectiveReport {
     /// FREE, WARN or STOP.
     pub verdict: Protective,
@@ -306,6 +306,33 @@ pub struct ProtectiveReport {
     /// How many pairs that can meet the table's bound proved apart this tick, which the
     /// swept-box proof then skipped (all of them when `table_lookup`).
     pub table_pairs: u32,
+}
+
+impl Clone for ProtectiveReport {
+    fn clone(&self) -> Self {
+        let mut out = ProtectiveReport { robots: alloc::vec::Vec::new(), ..self.head() };
+        out.robots.clone_from(&self.robots);
+        out
+    }
+
+    /// Field by field, the robots' entries into the capacity already there: a tick that keeps
+    /// its report for a repeated cycle allocates nothing.
+    fn clone_from(&mut self, source: &Self) {
+        let robots = core::mem::take(&mut self.robots);
+        *self = ProtectiveReport { robots, ..source.head() };
+        self.robots.clone_from(&source.robots);
+    }
+}
+
+impl ProtectiveReport {
+    /// A copy of this report without the robots' entries (no allocation).
+    fn head(&self) -> ProtectiveReport {
+        let (verdict, status, clearance_mm, closest, limiting) =
+            (self.verdict, self.status, self.clearance_mm, self.closest, self.limiting);
+        let (kept_proof, table_lookup, table_pairs) = (self.kept_proof, self.table_lookup, self.table_pairs);
+        let robots = alloc::vec::Vec::new();
+        ProtectiveReport { verdict, status, clearance_mm, closest, limiting, robots, kept_proof, table_lookup, table_pairs }
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
