@@ -325,11 +325,12 @@ impl<'a> Driver<'a> {
             return;
         }
         let last = self.last.as_ref().map(|l| l.0);
-        let measurable = match (last, time) {
-            (_, TickTime::Nominal) => true,
-            (Some(TickTime::Cycle(_)), TickTime::Cycle(_)) | (Some(TickTime::Nanos(_)), TickTime::Nanos(_)) => true,
-            _ => false,
-        };
+        let measurable = matches!(
+            (last, time),
+            (_, TickTime::Nominal)
+                | (Some(TickTime::Cycle(_)), TickTime::Cycle(_))
+                | (Some(TickTime::Nanos(_)), TickTime::Nanos(_))
+        );
         for j in 0..2 {
             let got = r.robots[j].speed_mm_s;
             match previous.filter(|_| measurable) {

@@ -39,8 +39,8 @@ unsafe fn init_handle(
         };
         let (status, message) = match result {
             Ok(inner) => {
-                // SAFETY: `result` is Ok only when `out_handle` was checked non-null above.
                 let handle = DcCollider::new(inner);
+                // SAFETY: `result` is Ok only when `out_handle` was checked non-null above.
                 unsafe { *out_handle = Box::into_raw(Box::new(handle)) };
                 (DC_STATUS_OK, String::new())
             }

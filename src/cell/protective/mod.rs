@@ -1200,7 +1200,8 @@ mod tests {
         let speeds_unknown = |c: &ProtectiveChecker| c.report().robots.iter().all(|r| r.speed_mm_s.is_infinite());
         // Each fault relative to the last call's cycle: the same one with other TCPs, one
         // before it, and past the largest interval.
-        let faults: [(fn(u64) -> u64, TimingFault); 3] = [
+        type Fault = (fn(u64) -> u64, TimingFault);
+        let faults: [Fault; 3] = [
             (|c| c, TimingFault::Repeated),
             (|c| c - 1, TimingFault::Backwards),
             (|c| c + MAX_INTERVAL_TICKS + 1, TimingFault::Jump),
