@@ -838,6 +838,7 @@ struct DcProtectiveRequest dc_protective_request_default(void);
    `DC_MAX_INTERVAL_TICKS`) is bounded over its real interval.
  - The first timed call, and the first after an untimed call, an error or
    `dc_protective_reset`, assumes full speed.
+
  A FREE or WARN covers a STOP issued at the next cycle: a controller that misses one must
  stop the robots itself.
 
