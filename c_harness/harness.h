@@ -156,4 +156,11 @@ void line_scenarios(const HarnessOptions *options);
  * Skipped with --quick and --protective-quick. */
 void speed_override_scenarios(const HarnessOptions *options);
 
+/* The timed protective query under the controller's clock (timing.c): called twice per cycle
+ * on the collision scenarios (the second answer unchanged; the untimed call's second answer
+ * compared with its first), and driven by schedules that repeat, skip, jump back and change
+ * clocks, with a stop simulated after every FREE and WARN. --quick and --protective-quick run
+ * T1 collision only, on 200 ticks. */
+void timing_scenarios(const HarnessOptions *options);
+
 #endif /* HARNESS_H */

@@ -13,8 +13,10 @@
  * (table_mode.c), and once with the protective verdict and a simulated stop (protective.c);
  * the practical ones once more with the speed limits applied as a speed override
  * (speed_override.c). The four-robot line (line.c) runs its two cases in exact mode and with
- * the protective verdict. Then the bad-input scenarios (bad_input.c) check every documented
- * error status and the fail-closed outputs, in both modes.
+ * the protective verdict. The timed protective query (timing.c) is called twice per cycle and
+ * driven by schedules that repeat, skip and go back in time. Then the bad-input scenarios
+ * (bad_input.c) check every documented error status and the fail-closed outputs, in both
+ * modes.
  *
  * Usage (from the repository root):
  *   c_harness [--quick] [--tmp DIR] [--table T1=PATH] [--table T2=PATH] [--table T3=PATH]
@@ -364,6 +366,7 @@ int main(int argc, char **argv)
     line_scenarios(&options);
     protective_scenarios(&options);
     speed_override_scenarios(&options);
+    timing_scenarios(&options);
     bad_input(&options);
     for (c = 0; c < 3; ++c) {
         for (k = 0; k < 2; ++k) {

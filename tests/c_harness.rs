@@ -6,7 +6,8 @@
 //! with UndefinedBehaviorSanitizer (and LeakSanitizer where it can run) and, with `--quick`,
 //! under valgrind memcheck. Also compiles the header into two C++ translation units (wasmtime's
 //! double-include check) and records whether it is valid C89. The four-robot line runs in
-//! exact mode and with the protective verdict (`c_harness/line.c`).
+//! exact mode and with the protective verdict (`c_harness/line.c`); the timed protective query
+//! runs twice per cycle and under adversarial schedules (`c_harness/timing.c`).
 //!
 //! The static library is the one cargo builds in the same run: the test executable is
 //! `target/<profile>/deps/c_harness-HASH` and the library lies next to it in `deps/`.
@@ -306,6 +307,36 @@ fn assert_line(stdout: &str) {
     }
 }
 
+/// The timed protective query's lines (`c_harness/timing.c`). Twice per cycle on each cell's
+/// collision run: every second timed call answered as the first, and the first calls as an
+/// untimed handle called once per tick; the untimed call twice per tick answered better the
+/// second time on some tick where a stop from the true motion touches (the hazard). One line
+/// per cell, case and schedule: every status as the timing rules say, no stop after FREE or
+/// WARN touches, and over all schedules every timing fault was provoked.
+fn assert_timing(stdout: &str) {
+    let twice: Vec<&str> = stdout.lines().filter(|l| l.contains(" collision twice per cycle: ")).collect();
+    assert_eq!(twice.len(), 3, "one twice-per-cycle line per cell: {twice:?}");
+    let mut touching = 0.0;
+    for l in &twice {
+        assert_eq!(number(l, "twice per cycle: "), number(l, "second timed call unchanged on "), "{l}");
+        assert_eq!(number(l, "untimed once per tick differs on "), 0.0, "{l}");
+        touching += number(l, "of which a stop from the true motion touches on ");
+    }
+    assert!(touching > 0.0, "the untimed call twice per tick never answered a touching FREE: {twice:?}");
+    let runs: Vec<&str> = stdout.lines().filter(|l| l.starts_with("timing T") && l.contains(" calls (")).collect();
+    assert_eq!(runs.len(), 3 * 2 * 8, "eight schedules per cell and case: {runs:?}");
+    for l in &runs {
+        assert_eq!(number(l, "statuses not as the rules "), 0.0, "{l}");
+        assert_eq!(number(l, "other statuses "), 0.0, "{l}");
+        assert_eq!(number(l, "contacts "), 0.0, "{l}");
+        assert!(number(l, "least clearance of the stops ") > 0.0, "{l}");
+    }
+    for fault in ["REPEATED ", "BACKWARDS ", "JUMP ", "EARLY ", "CLOCK_CHANGED "] {
+        let n: f64 = runs.iter().map(|l| number(l, fault)).sum();
+        assert!(n > 0.0, "no schedule provoked {fault}");
+    }
+}
+
 /// The harness's `summary` lines: (cell, case, table stop tick, first exact collision tick).
 fn summaries(stdout: &str) -> Vec<(String, String, Option<u64>, Option<u64>)> {
     let tick = |s: &str| s.trim_end_matches(',').parse().ok();
@@ -348,6 +379,7 @@ fn harness_passes_with_tables(kind: usize) {
     }
     assert!(stdout.contains("bad input: done (exact and table mode)"), "table-mode bad inputs did not run");
     assert_speed_override(&stdout);
+    assert_timing(&stdout);
     assert_line(&stdout);
     let runs = summaries(&stdout);
     assert_eq!(runs.len(), 6, "one table-mode summary per cell and case: {runs:?}");

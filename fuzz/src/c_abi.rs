@@ -18,12 +18,20 @@
 //!   `TableChecker::new`), leave `*out_handle` NULL on failure, and `dc_last_init_error`
 //!   holds a message exactly when they failed; pair results agree with the report.
 //! - Kinematics: outputs are finite; for the thesis robot FK(IK(p)) = p.
+//! - The timed protective query (`dc_protective_query_timed`): never BUSY from one thread; a
+//!   wrong `struct_size` or an unknown clock is `DC_STATUS_INVALID_ARGUMENT`; against the last
+//!   timed call on the same handle (when no other call used the handle since), the timing
+//!   rules' status: a change of clock `DC_STATUS_CLOCK_CHANGED`, an earlier time
+//!   `DC_STATUS_TIME_BACKWARDS`, the same time with other TCPs `DC_STATUS_TIME_REPEATED`, a
+//!   cycle more than `DC_MAX_INTERVAL_TICKS` later `DC_STATUS_TIME_JUMP`; the same clock, time
+//!   and TCPs (bit for bit) again answer that call's status, verdict and report unchanged.
 
 mod init;
 
 use super::input::{Encoder, Input};
 use delta_collide::ffi::*;
 use delta_collide::table::TableKind;
+use std::cell::RefCell;
 use std::ffi::CStr;
 
 /// Calls per input at most.
@@ -31,7 +39,7 @@ pub const MAX_OPS: usize = 64;
 /// Live handles at most; a further init destroys the oldest.
 pub const MAX_HANDLES: usize = 4;
 /// Number of opcodes.
-const OPS: u8 = 12;
+const OPS: u8 = 13;
 
 /// The opcodes.
 #[derive(Clone, Copy, Debug)]
@@ -79,12 +87,50 @@ pub enum Op {
     /// table takes about 0.3 s to build (so the default model's stops, too long for any
     /// clearance level, never let a lookup answer).
     Protective = 11,
+    /// `dc_protective_query_timed`: handle; a flag to send the TCPs of the handle's last timed
+    /// call again (when it has one), else count and points as for `Query`; paths as for
+    /// `Protective`; `struct_size` (byte % 8: 0-3 right, then 0, 8 short, 8 long, `usize::MAX`);
+    /// clock (byte: below 200 its parity, `DC_CLOCK_CYCLE` or `DC_CLOCK_NANOS`; then the byte
+    /// itself, 255 `u32::MAX`); time (byte % 4, the last three only after a timed call on the
+    /// handle: a `u64`; that call's time; that time plus a byte % 8 cycles, or plus a `u16` *
+    /// 128 ns on `DC_CLOCK_NANOS`; that time minus 1 + byte % 8); NULL flags (byte: request,
+    /// tcps, out_verdict, out_report).
+    ProtectiveTimed = 12,
 }
 
-/// A live handle and the robots it was made from.
+/// A live handle, the robots it was made from and its timed protective calls.
 struct Live {
     handle: *mut DcCollider,
     robots: Vec<DcRobotConfig>,
+    timed: RefCell<Timed>,
+}
+
+impl Live {
+    fn new(handle: *mut DcCollider, robots: Vec<DcRobotConfig>) -> Live {
+        Live { handle, robots, timed: RefCell::default() }
+    }
+}
+
+/// The timed protective calls on one handle.
+#[derive(Default)]
+struct Timed {
+    /// The clock and time of the last timed call that reached the checker: the next ones are
+    /// aimed near it.
+    time: Option<(DcClock, u64)>,
+    /// That call, while it is the handle's last call: the timing rules compare with it.
+    last: Option<LastTimed>,
+}
+
+/// A timed call that reached the checker, and its answer.
+#[derive(Clone)]
+struct LastTimed {
+    clock: DcClock,
+    time: u64,
+    tcps: Vec<DcVec3>,
+    status: DcStatus,
+    verdict: DcVerdict,
+    /// `None` when the call's `out_report` was NULL.
+    report: Option<DcProtectiveReport>,
 }
 
 /// The target: never panics on any input.
@@ -107,7 +153,8 @@ pub fn c_abi(data: &[u8]) {
             8 => init::init_from_file(&mut input, &mut live),
             9 => init::init_with_table(&mut input, &mut live),
             10 => init::init_from_files(&mut input, &mut live),
-            _ => protective(&mut input, &live),
+            11 => protective(&mut input, &live),
+            _ => protective_timed(&mut input, &live),
         }
     }
     for l in live {
@@ -121,7 +168,17 @@ fn sentinel() -> *mut DcCollider {
     std::ptr::NonNull::dangling().as_ptr()
 }
 
+/// A handle argument; the handle's last call is then no longer a timed one.
 fn pick<'a>(input: &mut Input, live: &'a [Live]) -> Option<&'a Live> {
+    let l = pick_keeping(input, live);
+    if let Some(l) = l {
+        l.timed.borrow_mut().last = None;
+    }
+    l
+}
+
+/// A handle argument, keeping what its last timed call was.
+fn pick_keeping<'a>(input: &mut Input, live: &'a [Live]) -> Option<&'a Live> {
     live.get(usize::from(input.byte()) % (live.len() + 1))
 }
 
@@ -308,6 +365,163 @@ fn protective(input: &mut Input, live: &[Live]) {
     assert!(tcp_finite || status == DC_STATUS_NON_FINITE, "non-finite TCPs {tcps:?}: status {status}");
 }
 
+/// `Op::ProtectiveTimed` (encoding in [`Op`], properties in the module doc).
+fn protective_timed(input: &mut Input, live: &[Live]) {
+    let l = pick_keeping(input, live);
+    let n = l.map_or(0, |l| l.robots.len());
+    let (aim, last) = l.map_or((None, None), |l| {
+        let t = l.timed.borrow();
+        (t.time, t.last.clone())
+    });
+    let point = |input: &mut Input| {
+        let [x, y, z] = input.point();
+        DcVec3 { x, y, z }
+    };
+    let tcps: Vec<DcVec3> = match (input.flag(), &last) {
+        (true, Some(last)) => last.tcps.clone(),
+        _ => {
+            let count = match input.byte() {
+                b @ 192.. => usize::from(b % 40),
+                _ => n,
+            };
+            (0..count).map(|_| point(input)).collect()
+        }
+    };
+    let count = tcps.len();
+    let with_paths = input.flag();
+    let points: Vec<Vec<DcVec3>> = if with_paths {
+        (0..count).map(|_| (0..input.byte() % 40).map(|_| point(input)).collect()).collect()
+    } else {
+        Vec::new()
+    };
+    let paths: Vec<DcStopPath> = points
+        .iter()
+        .map(|p| DcStopPath { points: p.as_ptr(), n_points: p.len(), tolerance_mm: input.f64() })
+        .collect();
+    let null_paths = with_paths && input.flag();
+    let size = std::mem::size_of::<DcProtectiveRequest>();
+    let struct_size = match input.byte() % 8 {
+        0..=3 => size,
+        4 => 0,
+        5 => size - 8,
+        6 => size + 8,
+        _ => usize::MAX,
+    };
+    let clock = match input.byte() {
+        b @ 0..=199 => DcClock::from(b % 2),
+        255 => DcClock::MAX,
+        b => DcClock::from(b),
+    };
+    let time = match (input.byte() % 4, aim) {
+        (1, Some((_, t))) => t,
+        (2, Some((DC_CLOCK_NANOS, t))) => t.wrapping_add(u64::from(u16::from_le_bytes(input.bytes())) * 128),
+        (2, Some((_, t))) => t.wrapping_add(u64::from(input.byte() % 8)),
+        (3, Some((_, t))) => t.wrapping_sub(1 + u64::from(input.byte() % 8)),
+        _ => input.u64(),
+    };
+    let nulls = input.byte();
+    let request = DcProtectiveRequest {
+        struct_size,
+        clock,
+        time,
+        tcps_mcs: if nulls & 2 != 0 { std::ptr::null() } else { tcps.as_ptr() },
+        n_tcps: count,
+        paths: if null_paths { std::ptr::null() } else { paths.as_ptr() },
+        n_paths: if with_paths { count } else { 0 },
+    };
+    let request_ptr: *const DcProtectiveRequest = if nulls & 1 != 0 { std::ptr::null() } else { &request };
+    let mut verdict = DC_VERDICT_COLLISION;
+    // SAFETY: all-zero is a valid `DcProtectiveReport` (numbers and integers only).
+    let mut report: DcProtectiveReport = unsafe { std::mem::zeroed() };
+    report.verdict = 7;
+    let (out_verdict, out_report) = (null_if(nulls & 4 != 0, &mut verdict), null_if(nulls & 8 != 0, &mut report));
+    // SAFETY: the handle is NULL or live; the request is NULL or readable, its TCPs hold
+    // `count` points and its paths one path per TCP whose points they hold (or NULL);
+    // outputs are NULL or writable.
+    let status = unsafe { dc_protective_query_timed(handle_of(l), request_ptr, out_verdict, out_report) };
+    assert_ne!(status, DC_STATUS_PANIC, "the timed protective query panicked");
+    assert_ne!(status, DC_STATUS_BUSY, "a handle busy with no other thread");
+    if nulls & 4 == 0 {
+        assert!([DC_VERDICT_FREE, DC_VERDICT_WARN, DC_VERDICT_STOP].contains(&verdict), "verdict {verdict}");
+        assert!(status == DC_STATUS_OK || verdict == DC_VERDICT_STOP, "status {status} with verdict {verdict}");
+    }
+    if nulls & 8 == 0 {
+        assert!(nulls & 4 != 0 || report.verdict == verdict, "report {}, verdict {verdict}", report.verdict);
+        assert!(status == DC_STATUS_OK || report.verdict == DC_VERDICT_STOP, "status {status}, report {report:?}");
+    }
+    // Which checks refuse the call before the checker sees it: from here on the call is the
+    // handle's last, so the rules compare with it only if it reaches the checker.
+    let Some(l) = l else { return assert_eq!(status, DC_STATUS_NULL_POINTER) };
+    let mut timed = l.timed.borrow_mut();
+    timed.last = None;
+    if nulls & 7 != 0 {
+        return assert_eq!(status, DC_STATUS_NULL_POINTER, "a NULL request, TCPs or verdict");
+    }
+    if struct_size != size || clock > DC_CLOCK_NANOS {
+        return assert_eq!(status, DC_STATUS_INVALID_ARGUMENT, "struct_size {struct_size} (not {size}), clock {clock}");
+    }
+    // No paths (`n_paths` 0) are not read at all, NULL or not.
+    if null_paths && count > 0 {
+        return assert_eq!(status, DC_STATUS_NULL_POINTER, "NULL paths");
+    }
+    if count != n {
+        return assert_eq!(status, DC_STATUS_WRONG_ROBOT_COUNT);
+    }
+    if paths.iter().any(|p| p.n_points > DC_MAX_PATH_POINTS) {
+        return assert_eq!(status, DC_STATUS_INVALID_ARGUMENT, "a path of more than {DC_MAX_PATH_POINTS} points");
+    }
+    let timing = [
+        DC_STATUS_TIME_REPEATED,
+        DC_STATUS_TIME_BACKWARDS,
+        DC_STATUS_TIME_JUMP,
+        DC_STATUS_TIME_EARLY,
+        DC_STATUS_CLOCK_CHANGED,
+    ];
+    let allowed = [
+        DC_STATUS_OK,
+        DC_STATUS_NON_FINITE,
+        DC_STATUS_UNREACHABLE,
+        DC_STATUS_IMPLAUSIBLE_MOTION,
+        DC_STATUS_INVALID_ARGUMENT,
+    ];
+    assert!(allowed.contains(&status) || timing.contains(&status), "status {status}");
+    let tcp_finite = tcps.iter().all(|p| p.x.is_finite() && p.y.is_finite() && p.z.is_finite());
+    assert!(tcp_finite || status == DC_STATUS_NON_FINITE || timing.contains(&status), "TCPs {tcps:?}: status {status}");
+    let answer = if nulls & 8 == 0 { Some(report) } else { None };
+    if let Some(last) = last {
+        let same_tcps = tcps.iter().zip(&last.tcps).all(|(a, b)| bits(a) == bits(b));
+        let expected = if clock != last.clock {
+            Some(DC_STATUS_CLOCK_CHANGED)
+        } else if time < last.time {
+            Some(DC_STATUS_TIME_BACKWARDS)
+        } else if time == last.time && !same_tcps {
+            Some(DC_STATUS_TIME_REPEATED)
+        } else if time == last.time {
+            Some(last.status)
+        } else if clock == DC_CLOCK_CYCLE && time - last.time > DC_MAX_INTERVAL_TICKS {
+            Some(DC_STATUS_TIME_JUMP)
+        } else {
+            None
+        };
+        if let Some(expected) = expected {
+            assert_eq!(status, expected, "clock {clock} time {time} after clock {} time {}", last.clock, last.time);
+        }
+        if time == last.time && clock == last.clock && same_tcps {
+            assert_eq!(verdict, last.verdict, "a repeated call's verdict");
+            if let (Some(now), Some(then)) = (answer, last.report) {
+                assert_eq!(format!("{now:?}"), format!("{then:?}"), "a repeated call's report");
+            }
+        }
+    }
+    timed.time = Some((clock, time));
+    timed.last = Some(LastTimed { clock, time, tcps, status, verdict, report: answer });
+}
+
+/// The bits of a point: equal exactly when the library's repeat test finds them equal.
+fn bits(p: &DcVec3) -> [u64; 3] {
+    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
+}
+
 /// Whether `dc_delta3_inverse_kinematics` accepts `tcp` for `geometry`.
 fn reachable(geometry: &DcDelta3, tcp: DcVec3) -> bool {
     let mut theta = [0.0; 3];
@@ -485,7 +699,7 @@ fn status_str(input: &mut Input) {
     // SAFETY: `dc_status_str` returns a static NUL-terminated string.
     let text = unsafe { CStr::from_ptr(dc_status_str(status)) };
     assert!(!text.to_bytes().is_empty() && text.to_str().is_ok(), "status {status}: {text:?}");
-    if status <= DC_STATUS_TABLE_WRONG_PAIR {
+    if status <= DC_STATUS_BUSY {
         assert_ne!(text.to_bytes(), b"unknown status", "status {status} has no description");
     }
     // SAFETY: `dc_version` returns a static NUL-terminated string.
@@ -547,6 +761,53 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.byte(2).point([-150.0, 0.0, -450.0]).point([-100.0, 0.0, -450.0]).byte(0);
     e.f64(1.0).f64(0.0).byte(0).byte(0);
     out.push(("protective", e.bytes));
+    // The timed protective query on handle 0: TCPs (None: the last call's again), no paths,
+    // then struct_size, clock and time bytes, and the NULL flags.
+    let timed = |e: &mut Encoder, tcps: Option<[[f64; 3]; 2]>, size: u8, clock: u8, time: &[u8], nulls: u8| {
+        e.byte(Op::ProtectiveTimed as u8).byte(0);
+        match tcps {
+            None => e.byte(1),
+            Some([a, b]) => e.byte(0).byte(0).point(a).point(b),
+        };
+        e.byte(0).byte(size).byte(clock);
+        e.bytes.extend_from_slice(time);
+        e.byte(nulls);
+    };
+    // The time bytes: a u64; the last call's time; cycles or 128 ns steps on; cycles back - 1.
+    let time = |tag: u8, rest: &[u8]| [&[tag][..], rest].concat();
+    let raw = |t: u64| time(0, &t.to_le_bytes());
+    let last = || time(1, &[]);
+    let ahead = |k: u8| time(2, &[k]);
+    let ahead_ns = |steps: u16| time(2, &steps.to_le_bytes());
+    let back = |k: u8| time(3, &[k]);
+    let (a, b) = ([-150.0, 0.0, -450.0], [150.0, 0.0, -450.0]);
+    let (a2, b2) = ([-149.5, 0.0, -450.0], [149.5, 0.0, -450.0]);
+    let mut e = Encoder::default();
+    init(&mut e, 2, 1, 0);
+    timed(&mut e, Some([a, b]), 0, 0, &raw(1000), 0);
+    // The same cycle and TCPs (the last answer again), the next cycle, the same one with
+    // other TCPs (REPEATED), 7 cycles on (JUMP), 2 back (BACKWARDS), timestamps (CLOCK_CHANGED),
+    // 1.000064 ms on, 12.8 us on (EARLY) and that again with no report.
+    timed(&mut e, None, 0, 0, &last(), 0);
+    timed(&mut e, Some([a2, b2]), 0, 0, &ahead(1), 0);
+    timed(&mut e, Some([a, b]), 0, 0, &last(), 0);
+    timed(&mut e, None, 0, 0, &ahead(7), 0);
+    timed(&mut e, None, 0, 0, &back(1), 0);
+    timed(&mut e, None, 0, 1, &raw(5_000_000_000), 0);
+    timed(&mut e, None, 0, 1, &ahead_ns(7813), 0);
+    timed(&mut e, None, 0, 1, &ahead_ns(100), 0);
+    timed(&mut e, None, 0, 1, &last(), 8);
+    // Refused: struct_size 8 short, clock 200, a NULL request.
+    timed(&mut e, None, 5, 0, &raw(1010), 0);
+    timed(&mut e, Some([a, b]), 0, 200, &raw(1010), 0);
+    timed(&mut e, Some([a, b]), 0, 0, &raw(7), 1);
+    // With paths: robot 0 along x for 50 mm (tolerance 1), robot 1 none; 1.000064 ms on.
+    e.byte(Op::ProtectiveTimed as u8).byte(0).byte(0).byte(0).point(a).point(b).byte(1);
+    e.byte(2).point(a).point([-100.0, 0.0, -450.0]).byte(0);
+    e.f64(1.0).f64(0.0).byte(0).byte(0).byte(1);
+    e.bytes.extend_from_slice(&ahead_ns(7813));
+    e.byte(0);
+    out.push(("protective_timed", e.bytes));
     let mut e = Encoder::default();
     e.byte(Op::Init as u8).byte(2).byte(0).byte(0).byte(1).byte(0).byte(0).f64(-100.0).byte(0).byte(8);
     init(&mut e, 0, 0, 0);
@@ -563,7 +824,7 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.byte(Op::Forward as u8).byte(0).f64(f64::INFINITY).f64(0.0).f64(0.0).byte(4);
     out.push(("kinematics", e.bytes));
     let mut e = Encoder::default();
-    for s in 0..20 {
+    for s in 0..26 {
         e.byte(Op::StatusStr as u8).byte(1).byte(s);
     }
     e.byte(Op::StatusStr as u8).byte(0).u32(u32::MAX);

@@ -123,6 +123,12 @@ impl Encoder {
         self
     }
 
+    /// Appends a little-endian `u64`.
+    pub fn u64(&mut self, v: u64) -> &mut Self {
+        self.bytes.extend_from_slice(&v.to_le_bytes());
+        self
+    }
+
     /// Appends `v` as raw bits (read back exactly by [`Input::f64`]).
     pub fn f64(&mut self, v: f64) -> &mut Self {
         self.byte(1);

@@ -54,6 +54,7 @@ pub fn harness_sources() -> Vec<PathBuf> {
         "protective.c",
         "speed_override.c",
         "table_mode.c",
+        "timing.c",
     ];
     assert_eq!(names, expected, "c_harness/ sources changed: update this list and the README");
     sources

@@ -180,7 +180,7 @@ impl Config {
 
     fn into_live(mut self, handle: *mut DcCollider) -> Live {
         self.robots.truncate(self.n);
-        Live { handle, robots: self.robots }
+        Live::new(handle, self.robots)
     }
 }
 
@@ -345,7 +345,7 @@ pub(super) fn init_from_file(input: &mut Input, live: &mut Vec<Live>) {
     let expected = if null_out { DC_STATUS_NULL_POINTER } else { path_status(kind).unwrap_or(DC_STATUS_OK) };
     assert_eq!(status, expected, "dc_init_from_cell_file, path kind {kind}");
     if let Some(h) = finish(status, (!null_out).then_some(out), input) {
-        keep(live, Live { handle: h, robots: t1_robots() });
+        keep(live, Live::new(h, t1_robots()));
     }
 }
 
@@ -371,6 +371,6 @@ pub(super) fn init_from_files(input: &mut Input, live: &mut Vec<Live>) {
     };
     assert_eq!(status, expected, "dc_init_from_files, path kinds {cell_kind}, {table_kind}");
     if let Some(h) = finish(status, (!null_out).then_some(out), input) {
-        keep(live, Live { handle: h, robots: t1_robots() });
+        keep(live, Live::new(h, t1_robots()));
     }
 }
