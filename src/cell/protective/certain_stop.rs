@@ -81,7 +81,7 @@ impl ProtectiveChecker {
     /// first robot's sweeps) by the sweeps of any tier (module doc, step 7); `false` when that
     /// is not known.
     pub(super) fn beyond_every_tier(&self, p: BoxPair, extra: Real) -> bool {
-        let reference = |j: usize, k: usize| (self.ref_boxes[j].as_slice()[k], self.centres[j], self.reach[j], None);
+        let reference = |j: usize, k: usize| (self.robots[j].reference.boxes.as_slice()[k], self.robots[j].reference.centre, self.robots[j].reference.radius, None);
         self.beyond_every_tier_at(p, [reference(p.a, p.box_a), reference(p.b, p.box_b)], extra)
     }
 
@@ -108,7 +108,7 @@ impl ProtectiveChecker {
     /// each box pair (`pair_axes`); none for a pair that cannot meet.
     fn pair_axis(&self, p: BoxPair) -> Vec3 {
         let pairs = &self.exact.verdict().pairs;
-        pairs.iter().position(|q| (q.a, q.b) == (p.a, p.b)).map_or(Vec3::zeros(), |k| self.pair_axes[k])
+        pairs.iter().position(|q| (q.a, q.b) == (p.a, p.b)).map_or(Vec3::zeros(), |k| self.pairs[k].axis)
     }
 
     /// The certain STOPs of steps 6 and 7 on box pair `p` before the references are set
@@ -128,7 +128,7 @@ impl ProtectiveChecker {
     fn reference_pair(&self, tcps_mcs: &[Vec3], p: BoxPair) -> [(Obb, Vec3, Real, Option<MotorCosSin>); 2] {
         let reference = |j: usize, k: usize| {
             let robot = &self.exact.cell().robots[j];
-            let (tcp, (s, (centre, radius))) = (&tcps_mcs[j], self.stop_balls[j]);
+            let (tcp, (s, (centre, radius))) = (&tcps_mcs[j], self.robots[j].stop_ball);
             match robot.model.delta.inverse_kinematics_cos_sin(&centre) {
                 Ok(sol) if centre != *tcp => {
                     let b = robot.model.box_from_cos_sin(&centre, &sol, k);
@@ -148,8 +148,8 @@ impl ProtectiveChecker {
     /// Whether box pair `p`'s reference boxes swept by their stop balls alone are not proved
     /// apart: step 6 for one pair, as the speed limits' search asks it before each test's sweeps.
     pub(super) fn ball_swept_meet(&self, p: BoxPair) -> bool {
-        let (box_a, box_b) = (&self.ref_boxes[p.a].as_slice()[p.box_a], &self.ref_boxes[p.b].as_slice()[p.box_b]);
-        let (ra, rb) = (self.graded[p.a][p.box_a], self.graded[p.b][p.box_b]);
+        let (box_a, box_b) = (&self.robots[p.a].reference.boxes.as_slice()[p.box_a], &self.robots[p.b].reference.boxes.as_slice()[p.box_b]);
+        let (ra, rb) = (self.robots[p.a].reference.graded[p.box_a], self.robots[p.b].reference.graded[p.box_b]);
         !balls_apart((box_a, ra), (box_b, rb), &self.pair_axis(p))
     }
 }

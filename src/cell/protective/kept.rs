@@ -29,11 +29,10 @@
 //! Keeping turns no verdict of the full proof into a worse one: it only adds a way to FREE.
 
 use super::certain_stop::graded_radii;
-use super::stop_sweeps::GradedRadii;
-use super::{first_unproved_between, stop_sweeps_wcs, ProtectiveChecker, SweepForms};
-use crate::geometry::sweep::FaceTerms;
+use super::stop_sweeps::SweptBall;
+use super::{first_unproved_between, stop_sweeps_wcs, ProtectiveChecker};
 use crate::math::{Real, Vec3};
-use crate::robot::{RobotBoxes, MAX_BOXES};
+use crate::robot::MAX_BOXES;
 
 /// A kept ball's radius is the stop ball's times `1 + KEPT_WIDEN`, plus [`KEPT_MARGIN_MM`].
 pub const KEPT_WIDEN: Real = 0.1;
@@ -48,27 +47,12 @@ pub const KEPT_MARGIN_MM: Real = 3.0;
 /// 40 % of the FREE ticks over 1 us, one tick 29 %: `prot_tick default verdict`).
 pub const KEPT_BACKOFF: u32 = 1;
 
-/// A robot's kept ball: where its sweeps were measured from, and the sweeps.
+/// A robot's kept ball: the ball, its boxes and their sweeps, and which ball it is.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct KeptBall {
-    /// Centre (MCS) and radius of the ball.
-    centre: Vec3,
-    radius: Real,
-    /// The robot's boxes (WCS) at the centre, their sweeps over the ball, face terms and
-    /// graded radii.
-    boxes: RobotBoxes,
-    sweeps: SweepForms,
-    faces: [[FaceTerms; MAX_BOXES]; 2],
-    radii: GradedRadii,
+    ball: SweptBall,
     /// Tells this ball from the robot's earlier ones.
     generation: u64,
-}
-
-impl KeptBall {
-    /// The boxes, sweeps and face terms, as the swept-box proof reads them.
-    fn swept(&self) -> super::stop_sweeps::SweptBoxes<'_> {
-        (self.boxes.as_slice(), &self.sweeps, &self.faces, &self.radii)
-    }
 }
 
 /// What is kept: per robot its ball and whether this tick's stop lies in it, per pair that
@@ -100,7 +84,7 @@ impl Kept {
     pub(super) fn set_inside(&mut self, j: usize, balls: &[(Vec3, Real)]) -> bool {
         let inside = self.balls[j]
             .as_ref()
-            .is_some_and(|k| balls.iter().any(|(c, r)| r.is_finite() && (c - k.centre).norm() + r <= k.radius));
+            .is_some_and(|k| balls.iter().any(|(c, r)| r.is_finite() && (c - k.ball.centre).norm() + r <= k.ball.radius));
         self.inside[j] = inside;
         inside
     }
@@ -126,10 +110,6 @@ impl Kept {
         }
     }
 }
-
-/// What [`ProtectiveChecker::keep`] keeps of a ball: centre, radius, boxes, sweeps, face terms
-/// and graded radii.
-type KeptParts = (Vec3, Real, RobotBoxes, SweepForms, [[FaceTerms; MAX_BOXES]; 2], GradedRadii);
 
 impl ProtectiveChecker {
     /// Whether the kept proofs cover every pair that can meet (of the pairs involving `only`,
@@ -157,14 +137,14 @@ impl ProtectiveChecker {
                 self.keep_wider(j);
             }
         }
-        let extra = self.warn_mm;
+        let extra = self.model.warn_mm;
         let pairs = &self.exact.verdict().pairs;
         for (k, p) in pairs.iter().enumerate() {
             let (Some(ka), Some(kb)) = (&self.kept.balls[p.a], &self.kept.balls[p.b]) else { continue };
             if self.kept.pairs[k].is_some_and(|(ga, gb, _)| (ga, gb) == (ka.generation, kb.generation)) {
                 continue;
             }
-            let free = first_unproved_between(ka.swept(), kb.swept(), extra, &self.pair_axes[k]).is_none();
+            let free = first_unproved_between(&ka.ball, &kb.ball, extra, &self.pairs[k].axis).is_none();
             self.kept.pairs[k] = Some((ka.generation, kb.generation, free));
         }
         let free = self.kept_free(None);
@@ -179,10 +159,8 @@ impl ProtectiveChecker {
     /// of a pair that can meet) and marks every pair proved for them.
     pub(super) fn keep_references(&mut self) {
         for j in 0..self.kept.balls.len() {
-            if self.sweep_tier[j] == Some((0, 0)) {
-                let (centre, reach, boxes) = (self.centres[j], self.reach[j], self.ref_boxes[j]);
-                let ball = (centre, reach, boxes, self.sweeps[j], self.faces[j], self.graded[j]);
-                self.keep(j, ball);
+            if self.robots[j].tier == Some((0, 0)) {
+                self.keep(j, self.robots[j].reference);
             }
         }
         let balls = &self.kept.balls;
@@ -199,35 +177,28 @@ impl ProtectiveChecker {
     /// the robot stands or the centre ahead is unreachable.
     fn keep_wider(&mut self, j: usize) {
         let robot = &self.exact.cell().robots[j];
-        let (reference, reach) = (self.centres[j], self.reach[j]);
-        let radius = reach * (1.0 + KEPT_WIDEN) + KEPT_MARGIN_MM;
+        let reference = &self.robots[j].reference;
+        let radius = reference.radius * (1.0 + KEPT_WIDEN) + KEPT_MARGIN_MM;
         let rot = self.exact.rotation(j);
-        let mut boxes = self.ref_boxes[j];
-        let ahead = self.velocity[j].try_normalize(0.0).map(|u| reference + u * (0.5 * (radius - reach)));
-        let centre = match ahead {
-            Some(c) if self.exact.boxes_in_wcs(j, &c, &mut boxes).is_ok() => c,
-            _ => {
-                boxes = self.ref_boxes[j];
-                reference
-            }
-        };
-        let sweeps = stop_sweeps_wcs(&robot.model, rot, &centre, radius, self.tables[j].as_deref());
-        let faces = core::array::from_fn(|form| {
-            core::array::from_fn(|k| match boxes.as_slice().get(k) {
-                Some(b) => FaceTerms::new(b, &sweeps[form][k]),
-                None => self.no_faces,
-            })
-        });
-        let radii = graded_radii(&robot.model, radius);
-        self.keep(j, (centre, radius, boxes, sweeps, faces, radii));
+        let mut ball = SweptBall { radius, ..*reference };
+        let ahead = self.robots[j].velocity.try_normalize(0.0);
+        let ahead = ahead.map(|u| reference.centre + u * (0.5 * (radius - reference.radius)));
+        match ahead {
+            Some(c) if self.exact.boxes_in_wcs(j, &c, &mut ball.boxes).is_ok() => ball.centre = c,
+            _ => ball.boxes = reference.boxes,
+        }
+        ball.sweeps = stop_sweeps_wcs(&robot.model, rot, &ball.centre, radius, self.model.tables[j].as_deref());
+        ball.faces = [[self.model.no_faces; MAX_BOXES]; 2];
+        ball.set_faces();
+        ball.graded = graded_radii(&robot.model, radius);
+        self.keep(j, ball);
     }
 
-    /// Keeps, for robot `j`, the ball `(centre, radius)` with its boxes at the centre (WCS),
-    /// their sweeps, face terms and graded radii, under a new generation.
-    fn keep(&mut self, j: usize, (centre, radius, boxes, sweeps, faces, radii): KeptParts) {
+    /// Keeps `ball` for robot `j` under a new generation.
+    fn keep(&mut self, j: usize, ball: SweptBall) {
         let generation = self.kept.next_generation;
         self.kept.next_generation += 1;
-        self.kept.balls[j] = Some(KeptBall { centre, radius, boxes, sweeps, faces, radii, generation });
+        self.kept.balls[j] = Some(KeptBall { ball, generation });
         self.kept.inside[j] = true;
     }
 }
@@ -262,21 +233,21 @@ mod tests {
                     }
                     last[j] = Some(k.generation);
                     let mut at = tcps;
-                    at[j] = k.centre;
+                    at[j] = k.ball.centre;
                     exact.place_boxes(&at).unwrap();
-                    for (x, y) in k.boxes.as_slice().iter().zip(exact.boxes(j).as_slice()) {
+                    for (x, y) in k.ball.boxes.as_slice().iter().zip(exact.boxes(j).as_slice()) {
                         let close = (x.center - y.center).norm() < 1e-9 && (x.axes - y.axes).norm() < 1e-12;
                         assert!(close && x.half == y.half, "{} tick {tick} robot {j}: {x:?} {y:?}", s.cell);
                     }
-                    let (_, (centre, radius)) = c.stop_balls[j];
-                    let inside = (centre - k.centre).norm() + radius <= k.radius * (1.0 + 1e-12);
-                    let (sc, ss) = (tcps[j], c.stop_balls[j].0);
+                    let (_, (centre, radius)) = c.robots[j].stop_ball;
+                    let inside = (centre - k.ball.centre).norm() + radius <= k.ball.radius * (1.0 + 1e-12);
+                    let (sc, ss) = (tcps[j], c.robots[j].stop_ball.0);
                     assert!(
-                        inside || (sc - k.centre).norm() + ss <= k.radius * (1.0 + 1e-12),
+                        inside || (sc - k.ball.centre).norm() + ss <= k.ball.radius * (1.0 + 1e-12),
                         "{} tick {tick}",
                         s.cell
                     );
-                    moved += usize::from(k.centre != c.centres[j]);
+                    moved += usize::from(k.ball.centre != c.robots[j].reference.centre);
                 }
             }
             assert!(moved > 50, "{}: {moved} balls kept ahead", s.cell);

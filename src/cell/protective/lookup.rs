@@ -56,7 +56,7 @@ impl ProtectiveChecker {
     /// is found.
     fn motion_bound(&mut self, j: usize) -> Real {
         self.sweeps_at(j, 0, 0);
-        let [cube, ball] = &self.sweeps[j];
+        let [cube, ball] = &self.robots[j].reference.sweeps;
         // Either form holds every displacement: the smaller radius bounds it.
         let d = cube.iter().zip(ball).map(|(c, b)| c.radius().min(b.radius())).fold(0.0, Real::max);
         if d.is_nan() {
@@ -74,25 +74,25 @@ impl ProtectiveChecker {
         let mut proved = 0;
         for k in 0..self.exact.verdict().pairs.len() {
             let (a, b) = (self.exact.verdict().pairs[k].a, self.exact.verdict().pairs[k].b);
-            self.table_proved[k] = self.pair_proved(bound, a, b);
-            proved += u32::from(self.table_proved[k]);
+            self.pairs[k].table_proved = self.pair_proved(bound, a, b);
+            proved += u32::from(self.pairs[k].table_proved);
         }
         self.report.table_pairs = proved;
-        proved as usize == self.table_proved.len()
+        proved as usize == self.pairs.len()
     }
 
     /// Whether `bound` proves robots `a` and `b` apart with `warn_mm` to spare (module doc).
     fn pair_proved(&mut self, bound: ClearanceBound, a: usize, b: usize) -> bool {
-        let Some(at_centres) = bound(a, b, &[self.centres[a], self.centres[b]]) else { return false };
+        let Some(at_centres) = bound(a, b, &[self.robots[a].reference.centre, self.robots[b].reference.centre]) else { return false };
         // A lower link's sweep at its platform joint's end, and a platform's or tool's sweep,
         // hold the ball of the stop's radius (module doc of `protective`, step 6), so
         // `d_j >= R_j`: where the bound cannot exceed
         // that, the sweeps are not computed (the proof may still need them).
-        let least = self.reach[a] + self.reach[b] + self.warn_mm;
+        let least = self.robots[a].reference.radius + self.robots[b].reference.radius + self.model.warn_mm;
         if at_centres.partial_cmp(&least) != Some(core::cmp::Ordering::Greater) {
             return false;
         }
         let motion = self.motion_bound(a) + self.motion_bound(b);
-        motion.is_finite() && at_centres > motion + self.warn_mm + LOOKUP_SLACK_MM
+        motion.is_finite() && at_centres > motion + self.model.warn_mm + LOOKUP_SLACK_MM
     }
 }

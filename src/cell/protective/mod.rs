@@ -160,11 +160,10 @@
 use crate::cell::{Cell, CellError, ExactChecker, QueryError};
 use crate::geometry::clearance::{boxes_clearance, CoherentClearance, PairClearance};
 use crate::geometry::sweep::FaceTerms;
-use crate::robot::MAX_BOXES;
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::motor_table::MotorTable;
-use crate::robot::{BoxKind, RobotBoxes, StopModel};
+use crate::robot::{BoxKind, StopModel};
 use alloc::sync::Arc;
 
 mod certain_stop;
@@ -182,7 +181,7 @@ pub use clock::{TickTime, TimingFault, MAX_INTERVAL_TICKS, MIN_INTERVAL_TICKS};
 pub use path::{path_through_samples, StopPath, MAX_PATH_POINTS};
 pub use request::ProtectiveRequest;
 pub use stop_sweeps::{stop_sweeps_wcs, SweepForms};
-use stop_sweeps::{first_unproved_between, stop_sweeps_wcs_into, GradedRadii};
+use stop_sweeps::{first_unproved_between, stop_sweeps_wcs_into, SweptBall};
 
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`STOP_SPLITS^3` per
 /// arm). The cubes here are tens to hundreds of mm, where finer splits shrink the sweeps by
@@ -347,23 +346,50 @@ struct History {
 
 const NO_HISTORY: History = History { tcp: None, velocity: None, limit: None };
 
-/// The protective check of one cell; keeps each robot's previous TCP between ticks.
+/// What the checker keeps of one robot: what the previous calls left (its history, where
+/// its limit search goes on) and this tick's stop (the measured velocity, the stop ball, the
+/// reference swept over it).
+#[derive(Clone, Copy, Debug)]
+struct RobotState {
+    history: History,
+    /// The measured velocity of this tick (MCS, mm/s; zero when unknown).
+    velocity: Vec3,
+    /// `S` and the ball of [`ProtectiveChecker::stop_ball`] at this tick's measured speed:
+    /// computed once per tick, read again when the tick needs its references.
+    stop_ball: (Real, (Vec3, Real)),
+    /// The step of the next tick's first test above the speed limit.
+    limit_step: Real,
+    /// The boxes at the centre of the ball that holds the TCP over the stop, and their sweeps
+    /// over it (module doc, steps 3-6).
+    reference: SweptBall,
+    /// The tier the reference's sweeps were computed with (`None`: not for this reference).
+    tier: Option<(u32, u8)>,
+    /// Whether the reference is an earlier tick's: the last tick ended before setting it (a
+    /// kept proof or a certain STOP without speed limits).
+    stale: bool,
+}
+
+/// What the checker keeps of one pair of robots that can meet.
 #[derive(Clone, Debug)]
-pub struct ProtectiveChecker {
-    exact: ExactChecker,
-    warn_mm: Real,
-    history: alloc::vec::Vec<History>,
-    /// Per robot, the WCS displacement sets of its boxes over the stop.
-    sweeps: alloc::vec::Vec<SweepForms>,
-    /// Per robot, per form and box, the face terms of its reference box under that sweep.
-    faces: alloc::vec::Vec<[[FaceTerms; MAX_BOXES]; 2]>,
+struct PairState {
+    /// Its clearance at the last tick: where this tick's computation starts (same answer, a
+    /// fraction of the time).
+    clearance: CoherentClearance,
+    /// The direction between its closest points this tick: an axis the proofs of the tick
+    /// try besides the 15 of each box pair (module doc, step 5).
+    axis: Vec3,
+    /// Whether the clearance table's bound proved it apart over this tick's stop balls
+    /// (`protective/lookup.rs`).
+    table_proved: bool,
+}
+
+/// What does not change from tick to tick: the robots' motor-angle tables and the settings.
+#[derive(Clone, Debug)]
+struct Model {
     /// Per robot, the motor-angle table of its kinematics (shared by equal robots; `None`:
     /// the interval inverse kinematics alone).
     tables: alloc::vec::Vec<Option<Arc<MotorTable>>>,
-    /// Per robot, the measured velocity of this tick (MCS, mm/s; zero when unknown).
-    velocity: alloc::vec::Vec<Vec3>,
-    /// Per robot, its boxes (WCS) at the reference TCP its sweeps are measured from.
-    ref_boxes: alloc::vec::Vec<RobotBoxes>,
+    warn_mm: Real,
     /// Whether each tick also finds the speed limits (most of its time).
     speed_limits: bool,
     /// Sub-boxes per axis of the second tier's direct enclosure (0: no second tier).
@@ -373,52 +399,44 @@ pub struct ProtectiveChecker {
     /// Speeds tested per tick at most, all robots together, by the searches of the table
     /// tier's limits.
     limit_tests: u32,
-    /// Per robot, the step of the next tick's first test above its limit.
-    limit_steps: alloc::vec::Vec<Real>,
-    /// Which robot's search comes first this tick (and may use the most tests).
-    limit_turn: usize,
-    /// Per robot, `S` and the ball of [`ProtectiveChecker::stop_ball`] at this tick's measured
-    /// speed: computed once per tick, read again when the tick needs its references.
-    stop_balls: alloc::vec::Vec<(Real, (Vec3, Real))>,
-    /// Per robot, the centre (MCS) and radius of the ball holding its TCP over the stop.
-    centres: alloc::vec::Vec<Vec3>,
-    reach: alloc::vec::Vec<Real>,
-    /// Per robot, the tier its sweeps were computed with (`None`: not for this reference).
-    sweep_tier: alloc::vec::Vec<Option<(u32, u8)>>,
-    /// Face terms of no box (fills the unused entries of a box list).
-    no_faces: FaceTerms,
-    /// Per robot, the radii of each box's graded ball of step 6 (module doc) for its current
-    /// reference: what every sweep of the box holds, and what the box pairs' graded axes read.
-    graded: alloc::vec::Vec<GradedRadii>,
-    /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
-    kept: kept::Kept,
-    /// Per robot pair that can meet, what its clearance was at the last tick: where this
-    /// tick's computation starts (same answer, a fraction of the time).
-    clearances: alloc::vec::Vec<CoherentClearance>,
-    /// Per pair that can meet, the direction between its closest points this tick: an axis
-    /// the proofs of the tick try besides the 15 of each box pair (module doc, step 5).
-    pair_axes: alloc::vec::Vec<Vec3>,
-    /// Per robot pair that can meet, whether the clearance table's bound proved it apart
-    /// over this tick's stop balls (`protective/lookup.rs`).
-    table_proved: alloc::vec::Vec<bool>,
     /// Whether the certain STOPs are tried on the closest pair before any reference is set
     /// (module doc, step 8; off only in the test that checks it changes no verdict).
     certain_stops_first: bool,
-    /// Whether the last tick ended before setting the references of its stop balls (a kept
-    /// proof or a certain STOP without speed limits): `centres`, `reach`, `ref_boxes` and
-    /// the sweeps are then an earlier tick's.
-    references_stale: bool,
-    /// Two TCPs in earlier stop balls whose boxes overlap, which make every tick whose stop
-    /// balls still hold them STOP (`protective/witness.rs`).
-    witness: witness::KeptWitness,
-    /// The interval the speeds of this tick are bounded over (s; `protective/clock.rs`).
+    /// Face terms of no box (fills the unused entries of a box list).
+    no_faces: FaceTerms,
+}
+
+/// What the sequence of calls left (`protective/clock.rs`): the last call's time, TCPs and
+/// report, this tick's interval, and whose limit search goes first.
+#[derive(Clone, Debug)]
+struct Calls {
+    /// The interval the speeds of this tick are bounded over (s).
     interval_s: Real,
     /// The time of the last call (`None`: none since the checker was made or reset).
     time: Option<TickTime>,
     /// The TCPs of the last call and its report: a call of the same cycle with the same TCPs
-    /// gets that report again (`protective/clock.rs`).
+    /// gets that report again.
     last_tcps: alloc::vec::Vec<Vec3>,
     cycle_report: ProtectiveReport,
+    /// Which robot's speed-limit search comes first this tick (and may use the most tests).
+    limit_turn: usize,
+}
+
+/// The protective check of one cell: the exact checker of the cell, what does not change,
+/// and what each robot, each pair that can meet and the sequence of calls leave from tick to
+/// tick (each in its own type).
+#[derive(Clone, Debug)]
+pub struct ProtectiveChecker {
+    exact: ExactChecker,
+    model: Model,
+    robots: alloc::vec::Vec<RobotState>,
+    pairs: alloc::vec::Vec<PairState>,
+    /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
+    kept: kept::Kept,
+    /// Two TCPs in earlier stop balls whose boxes overlap, which make every tick whose stop
+    /// balls still hold them STOP (`protective/witness.rs`).
+    witness: witness::KeptWitness,
+    calls: Calls,
     report: ProtectiveReport,
 }
 
@@ -475,38 +493,41 @@ impl ProtectiveChecker {
             table_lookup: false,
             table_pairs: 0,
         };
-        Ok(ProtectiveChecker {
-            exact,
-            warn_mm,
-            history: alloc::vec![NO_HISTORY; n],
-            sweeps: alloc::vec![[[Sweep::ZERO; MAX_BOXES]; 2]; n],
-            faces: alloc::vec![[[no_faces; MAX_BOXES]; 2]; n],
+        let robot = RobotState {
+            history: NO_HISTORY,
+            velocity: Vec3::zeros(),
+            stop_ball: (0.0, (Vec3::zeros(), 0.0)),
+            limit_step: 0.0,
+            reference: SweptBall::empty(no_faces),
+            tier: None,
+            stale: true,
+        };
+        let pair = PairState { clearance: CoherentClearance::new(), axis: Vec3::zeros(), table_proved: false };
+        let model = Model {
             tables,
-            velocity: alloc::vec![Vec3::zeros(); n],
-            ref_boxes: alloc::vec![RobotBoxes::empty(); n],
+            warn_mm,
             speed_limits: true,
             precise_splits: PRECISE_SPLITS,
             precise_limits: false,
             limit_tests: n as u32 + DEFAULT_EXTRA_LIMIT_TESTS,
-            limit_steps: alloc::vec![0.0; n],
-            limit_turn: 0,
-            stop_balls: alloc::vec![(0.0, (Vec3::zeros(), 0.0)); n],
-            centres: alloc::vec![Vec3::zeros(); n],
-            reach: alloc::vec![0.0; n],
-            sweep_tier: alloc::vec![None; n],
-            no_faces,
-            graded: alloc::vec![[[0.0; 2]; MAX_BOXES]; n],
-            clearances: alloc::vec![CoherentClearance::new(); n_pairs],
-            pair_axes: alloc::vec![Vec3::zeros(); n_pairs],
-            table_proved: alloc::vec![false; n_pairs],
-            references_stale: true,
             certain_stops_first: true,
-            witness: witness::KeptWitness::default(),
-            kept,
+            no_faces,
+        };
+        let calls = Calls {
             interval_s: tick_s,
             time: None,
             last_tcps: alloc::vec![Vec3::zeros(); n],
             cycle_report: report.clone(),
+            limit_turn: 0,
+        };
+        Ok(ProtectiveChecker {
+            exact,
+            model,
+            robots: alloc::vec![robot; n],
+            pairs: alloc::vec![pair; n_pairs],
+            kept,
+            witness: witness::KeptWitness::default(),
+            calls,
             report,
         })
     }
@@ -520,23 +541,23 @@ impl ProtectiveChecker {
     /// alone takes under a third of the time (`benches/protective.rs`), and the limits then
     /// read NaN.
     pub fn with_speed_limits(self, on: bool) -> Self {
-        ProtectiveChecker { speed_limits: on, ..self }
+        ProtectiveChecker { model: Model { speed_limits: on, ..self.model }, ..self }
     }
 
     /// Turns the speed limits of the ticks to come on or off ([`ProtectiveChecker::with_speed_limits`]).
     pub fn set_speed_limits(&mut self, on: bool) {
-        self.speed_limits = on;
+        self.model.speed_limits = on;
     }
 
     /// Whether each tick finds the speed limits.
     pub fn speed_limits(&self) -> bool {
-        self.speed_limits
+        self.model.speed_limits
     }
 
     /// This checker with a second tier of `splits^3` direct sub-boxes ([`PRECISE_SPLITS`] by
     /// default; 0: the table alone, faster, more STOPs).
     pub fn with_precise_splits(self, splits: u32) -> Self {
-        ProtectiveChecker { precise_splits: splits, ..self }
+        ProtectiveChecker { model: Model { precise_splits: splits, ..self.model }, ..self }
     }
 
     /// This checker finding the speed limits with both tiers (`true`: the largest speed at
@@ -544,7 +565,7 @@ impl ProtectiveChecker {
     /// per robot) or with the table's tier alone (`false`, the default: a few us per robot,
     /// never above the precise limit, so FREE holds at it too).
     pub fn with_precise_limits(self, on: bool) -> Self {
-        ProtectiveChecker { precise_limits: on, ..self }
+        ProtectiveChecker { model: Model { precise_limits: on, ..self.model }, ..self }
     }
 
     /// This checker testing at most `tests` speeds per tick, all robots together, in the
@@ -561,23 +582,23 @@ impl ProtectiveChecker {
     /// ([`ProtectiveChecker::with_precise_limits`]), and the searches of
     /// [`ProtectiveChecker::check_at_speeds`], which has no last limit to start from.
     pub fn with_limit_tests(self, tests: u32) -> Self {
-        ProtectiveChecker { limit_tests: tests, ..self }
+        ProtectiveChecker { model: Model { limit_tests: tests, ..self.model }, ..self }
     }
 
     /// Sets the cap on speeds tested per tick from the next tick on
     /// ([`ProtectiveChecker::with_limit_tests`]).
     pub fn set_limit_tests(&mut self, tests: u32) {
-        self.limit_tests = tests;
+        self.model.limit_tests = tests;
     }
 
     /// The cap on speeds tested per tick ([`ProtectiveChecker::with_limit_tests`]).
     pub fn limit_tests(&self) -> u32 {
-        self.limit_tests
+        self.model.limit_tests
     }
 
     /// The WARN threshold (mm).
     pub fn warn_mm(&self) -> Real {
-        self.warn_mm
+        self.model.warn_mm
     }
 
     /// The exact checker underneath: its boxes and unreachable robots are those of the last
@@ -596,12 +617,12 @@ impl ProtectiveChecker {
     /// (module doc, step 1).
     pub fn reset(&mut self) {
         self.forget_motion();
-        self.time = None;
+        self.calls.time = None;
     }
 
     /// Forgets every previous TCP, and the witness found from them.
     fn forget_motion(&mut self) {
-        self.history.fill(NO_HISTORY);
+        self.robots.iter_mut().for_each(|r| r.history = NO_HISTORY);
         self.witness = witness::KeptWitness::default();
     }
 
@@ -629,26 +650,26 @@ impl ProtectiveChecker {
         }
         let tick_s = self.cell().tick_ms * 1e-3;
         let tcps = request.tcps_mcs;
-        match clock::interval(self.time, request.time, tick_s) {
-            clock::Interval::Same if same_bits(&self.last_tcps, tcps) => {
-                self.report.clone_from(&self.cycle_report);
+        match clock::interval(self.calls.time, request.time, tick_s) {
+            clock::Interval::Same if same_bits(&self.calls.last_tcps, tcps) => {
+                self.report.clone_from(&self.calls.cycle_report);
                 return Ok(&self.report);
             }
             clock::Interval::Same => self.timing_fault(tcps, TimingFault::Repeated),
             clock::Interval::Fault(fault) => self.timing_fault(tcps, fault),
             clock::Interval::Unknown => {
                 self.forget_motion();
-                self.interval_s = tick_s;
+                self.calls.interval_s = tick_s;
                 self.tick(&request);
             }
             clock::Interval::Seconds(dt) => {
-                self.interval_s = dt;
+                self.calls.interval_s = dt;
                 self.tick(&request);
             }
         }
-        self.time = Some(request.time);
-        self.last_tcps.copy_from_slice(tcps);
-        self.cycle_report.clone_from(&self.report);
+        self.calls.time = Some(request.time);
+        self.calls.last_tcps.copy_from_slice(tcps);
+        self.calls.cycle_report.clone_from(&self.report);
         Ok(&self.report)
     }
 
@@ -659,7 +680,7 @@ impl ProtectiveChecker {
         self.evaluate(tcps_mcs, ProtectiveStatus::Timing(fault), true, None);
     }
 
-    /// The tick of a request whose interval is `self.interval_s` (counts checked).
+    /// The tick of a request whose interval is `self.calls.interval_s` (counts checked).
     fn tick(&mut self, request: &ProtectiveRequest) {
         if request.paths.is_empty() {
             self.check_bounded(request.tcps_mcs, request.table);
@@ -680,42 +701,42 @@ impl ProtectiveChecker {
         self.check(ProtectiveRequest::new(tcps_mcs).with_table(bound))
     }
 
-    /// The verdict without paths, the speeds bounded over `self.interval_s` (module doc, step
+    /// The verdict without paths, the speeds bounded over `self.calls.interval_s` (module doc, step
     /// 1; counts checked by the caller).
     fn check_bounded(&mut self, tcps_mcs: &[Vec3], bound: Option<ClearanceBound>) {
-        let dt = self.interval_s;
+        let dt = self.calls.interval_s;
         let mut status = ProtectiveStatus::Ok;
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let stop = self.exact.cell().stops[j];
             let slot = &mut self.report.robots[j];
             *slot = RobotProtection::UNKNOWN;
-            self.velocity[j] = Vec3::zeros();
+            self.robots[j].velocity = Vec3::zeros();
             if !tcp.iter().all(|v| v.is_finite()) {
                 status = worse(status, ProtectiveStatus::NonFinite(j));
                 continue;
             }
-            let Some(prev) = self.history[j].tcp else { continue };
+            let Some(prev) = self.robots[j].history.tcp else { continue };
             let velocity = (tcp - prev) / dt;
             let plausible = |x: Real, limit: Real| x <= limit * (1.0 + PLAUSIBLE_SLACK) + PLAUSIBLE_SLACK;
             // Two averages over consecutive intervals differ by at most `a_max` times the
             // distance between the intervals' middles.
-            let accel_ok = self.history[j]
+            let accel_ok = self.robots[j].history
                 .velocity
                 .is_none_or(|(v, before)| plausible((velocity - v).norm(), stop.max_accel_mm_s2 * (before + dt) / 2.0));
             if !plausible(velocity.norm(), stop.max_speed_mm_s) || !accel_ok {
                 status = worse(status, ProtectiveStatus::ImplausibleMotion(j));
             }
             slot.speed_mm_s = velocity.norm();
-            self.velocity[j] = velocity;
-            self.history[j].velocity = Some((velocity, dt));
+            self.robots[j].velocity = velocity;
+            self.robots[j].history.velocity = Some((velocity, dt));
         }
         self.evaluate(tcps_mcs, status, true, bound);
         // Only a tick without error (unreachable included) becomes the next one's history.
         if self.report.status == ProtectiveStatus::Ok {
-            let robots = self.history.iter_mut().zip(tcps_mcs).zip(&self.report.robots).zip(&self.limit_steps);
-            for (((h, tcp), r), step) in robots {
-                h.tcp = Some(*tcp);
-                h.limit = Some(r.speed_limit_mm_s).filter(|v| v.is_finite()).map(|v| (v, *step));
+            for ((robot, tcp), r) in self.robots.iter_mut().zip(tcps_mcs).zip(&self.report.robots) {
+                robot.history.tcp = Some(*tcp);
+                let limit = Some(r.speed_limit_mm_s).filter(|v| v.is_finite());
+                robot.history.limit = limit.map(|v| (v, robot.limit_step));
             }
         } else {
             self.forget_motion();
@@ -771,7 +792,7 @@ impl ProtectiveChecker {
         if self.report.verdict != Protective::Free && paths.iter().any(Option::is_some) {
             // The proof along the paths reads this tick's references (a robot without a path
             // keeps its stop ball's), which a tick settled early has not set.
-            if self.references_stale {
+            if self.robots.iter().any(|r| r.stale) {
                 self.set_references(tcps_mcs);
             }
             let (verdict, limiting) = self.prove_with_paths(tcps_mcs, paths);
@@ -799,11 +820,11 @@ impl ProtectiveChecker {
             }
         }
         // A given speed is the speed now: bounded as a measured one over one tick.
-        self.interval_s = self.cell().tick_ms * 1e-3;
+        self.calls.interval_s = self.cell().tick_ms * 1e-3;
         let mut status = ProtectiveStatus::Ok;
         for (j, (tcp, &v)) in tcps_mcs.iter().zip(speeds_mm_s).enumerate() {
             self.report.robots[j] = RobotProtection { speed_mm_s: v, ..RobotProtection::UNKNOWN };
-            self.velocity[j] = Vec3::zeros();
+            self.robots[j].velocity = Vec3::zeros();
             if !tcp.iter().all(|x| x.is_finite()) || v.is_nan() || v < 0.0 {
                 status = worse(status, ProtectiveStatus::NonFinite(j));
             }
@@ -821,7 +842,7 @@ impl ProtectiveChecker {
         (report.verdict, report.status, report.clearance_mm) = (Protective::Stop, status, Real::NAN);
         (report.closest, report.limiting, report.kept_proof, report.table_lookup) = (None, None, false, false);
         report.table_pairs = 0;
-        self.table_proved.fill(false);
+        self.pairs.iter_mut().for_each(|p| p.table_proved = false);
         if status != ProtectiveStatus::Ok {
             return;
         }
@@ -833,28 +854,28 @@ impl ProtectiveChecker {
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let v = self.report.robots[j].speed_mm_s;
             let (s, ball) = self.stop_ball(j, tcp, v);
-            self.stop_balls[j] = (s, ball);
+            self.robots[j].stop_ball = (s, ball);
             self.kept.set_inside(j, &[ball, (*tcp, s)]);
             let bound = self.speed_bound(j, v);
             let r = &mut self.report.robots[j];
             (r.speed_bound_mm_s, r.protective_mm) = (bound, s);
         }
-        let (memory, axes) = (&mut self.clearances, &mut self.pair_axes);
+        let pairs = &mut self.pairs;
         let (clearance, closest, points) = clearance_over_pairs(&self.exact, |k, a, b| {
-            let c = memory[k].boxes_clearance(a, b);
-            axes[k] = c.point_b - c.point_a;
+            let c = pairs[k].clearance.boxes_clearance(a, b);
+            pairs[k].axis = c.point_b - c.point_a;
             c
         });
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
         let kept = self.kept_free(None);
         // A witness kept from an earlier STOP tick (no inverse kinematics at all), then steps 6
         // and 7 on the closest pair, which need two reference boxes, not every robot's (step 8).
-        let first = !kept && self.certain_stops_first;
+        let first = !kept && self.model.certain_stops_first;
         let witnessed = if first { self.witness_holds(tcps_mcs) } else { None };
         let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop)));
         // A STOP not settled by a witness seeks one for the ticks that follow.
         let seek = first && witnessed.is_none();
-        if (kept || early.is_some()) && !self.speed_limits {
+        if (kept || early.is_some()) && !self.model.speed_limits {
             if kept {
                 (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
             } else {
@@ -864,7 +885,7 @@ impl ProtectiveChecker {
                 }
             }
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
-            self.references_stale = true;
+            self.robots.iter_mut().for_each(|r| r.stale = true);
             return;
         }
         self.set_references(tcps_mcs);
@@ -892,19 +913,19 @@ impl ProtectiveChecker {
             // pair proved with fewer arms refined stays proved with more).
             // A limiting pair that the sweeps of the angles sampled in the cube cannot prove
             // apart, no tier can (module doc, step 7): the verdict stands.
-            let splits = self.precise_splits;
+            let splits = self.model.precise_splits;
             // Tried on tier 1's limiting pair only: a pair that tier 2 proved is followed by
             // another mostly when tier 2 proves that one too.
             let mut first = true;
             while let (Some(p), true) = (self.report.limiting, splits > 0) {
-                let extra = if self.report.verdict == Protective::Warn { self.warn_mm } else { 0.0 };
+                let extra = if self.report.verdict == Protective::Warn { self.model.warn_mm } else { 0.0 };
                 if core::mem::take(&mut first) && self.beyond_every_tier(p, extra) {
                     break;
                 }
                 let (arms_a, arms_b) = (self.arm_bit(p.a, p.box_a), self.arm_bit(p.b, p.box_b));
-                let refined = |me: &Self, j: usize| match me.tables[j] {
+                let refined = |me: &Self, j: usize| match me.model.tables[j] {
                     None => 0b111,
-                    Some(_) => me.sweep_tier[j].filter(|t| t.0 == splits).map_or(0, |t| t.1),
+                    Some(_) => me.robots[j].tier.filter(|t| t.0 == splits).map_or(0, |t| t.1),
                 };
                 let (ra, rb) = (refined(self, p.a), refined(self, p.b));
                 if ra & arms_a == arms_a && rb & arms_b == arms_b {
@@ -926,21 +947,20 @@ impl ProtectiveChecker {
     /// A robot without sweeps for this tick's reference gets those of the table's tier first,
     /// pair by pair: a line's STOP is often found before most robots need any.
     fn prove(&mut self) -> (Protective, Option<BoxPair>) {
-        let passes = [(0.0, Protective::Stop), (self.warn_mm, Protective::Warn)];
+        let passes = [(0.0, Protective::Stop), (self.model.warn_mm, Protective::Warn)];
         for (extra, verdict) in passes.into_iter().filter(|&(extra, v)| v == Protective::Stop || extra > 0.0) {
             for k in 0..self.exact.verdict().pairs.len() {
                 let p = self.exact.verdict().pairs[k];
-                if self.table_proved[k] {
+                if self.pairs[k].table_proved {
                     continue;
                 }
                 for j in [p.a, p.b] {
-                    if self.sweep_tier[j].is_none() {
+                    if self.robots[j].tier.is_none() {
                         self.sweeps_at(j, 0, 0);
                     }
                 }
-                let swept = |j: usize| (self.ref_boxes[j].as_slice(), &self.sweeps[j], &self.faces[j], &self.graded[j]);
-                let axis = &self.pair_axes[k];
-                if let Some((box_a, box_b)) = first_unproved_between(swept(p.a), swept(p.b), extra, axis) {
+                let (ra, rb) = (&self.robots[p.a].reference, &self.robots[p.b].reference);
+                if let Some((box_a, box_b)) = first_unproved_between(ra, rb, extra, &self.pairs[k].axis) {
                     return (verdict, Some(BoxPair { a: p.a, b: p.b, box_a, box_b }));
                 }
             }
@@ -951,7 +971,7 @@ impl ProtectiveChecker {
     /// `v_b` of robot `j` for measured speed `v` (module doc, step 1).
     fn speed_bound(&self, j: usize, v: Real) -> Real {
         let stop = &self.cell().stops[j];
-        let bound = v + stop.max_accel_mm_s2 * self.interval_s;
+        let bound = v + stop.max_accel_mm_s2 * self.calls.interval_s;
         if bound.is_finite() {
             bound.min(stop.max_speed_mm_s)
         } else {
@@ -967,16 +987,16 @@ impl ProtectiveChecker {
         let stop = cell.stops[j];
         let reaction_s = (stop.reaction_ms + cell.tick_ms) * 1e-3;
         let s = stop.stopping_distance(self.speed_bound(j, v), reaction_s);
-        (s, capsule_ball(&stop, self.interval_s, reaction_s, tcp_mcs, &self.velocity[j], v, s))
+        (s, capsule_ball(&stop, self.calls.interval_s, reaction_s, tcp_mcs, &self.robots[j].velocity, v, s))
     }
 
     /// Every robot's reference for this tick's stop ball ([`ProtectiveChecker::reference_at`]),
     /// from the stop balls [`ProtectiveChecker::evaluate`] computed for `tcps_mcs`.
     fn set_references(&mut self, tcps_mcs: &[Vec3]) {
         for (j, tcp) in tcps_mcs.iter().enumerate() {
-            self.reference_at(j, tcp, self.stop_balls[j]);
+            self.reference_at(j, tcp, self.robots[j].stop_ball);
         }
-        self.references_stale = false;
+        self.robots.iter_mut().for_each(|r| r.stale = false);
     }
 
     /// Sets robot `j`'s reference boxes, the centre and radius of the ball that holds its TCP
@@ -990,15 +1010,16 @@ impl ProtectiveChecker {
     /// [`ProtectiveChecker::stop_reference`] from `S` and the ball already computed by
     /// [`ProtectiveChecker::stop_ball`] for this robot, TCP and speed.
     fn reference_at(&mut self, j: usize, tcp_mcs: &Vec3, (s, (centre, radius)): (Real, (Vec3, Real))) -> Real {
-        let (centre, radius) = match self.exact.boxes_in_wcs(j, &centre, &mut self.ref_boxes[j]) {
+        let robot = &mut self.robots[j];
+        let (centre, radius) = match self.exact.boxes_in_wcs(j, &centre, &mut robot.reference.boxes) {
             Ok(()) if centre != *tcp_mcs => (centre, radius),
             _ => {
-                self.ref_boxes[j] = *self.exact.boxes(j);
+                robot.reference.boxes = *self.exact.boxes(j);
                 (*tcp_mcs, s)
             }
         };
-        (self.centres[j], self.reach[j], self.sweep_tier[j]) = (centre, radius, None);
-        self.graded[j] = certain_stop::graded_radii(&self.exact.cell().robots[j].model, radius);
+        (robot.reference.centre, robot.reference.radius, robot.tier) = (centre, radius, None);
+        robot.reference.graded = certain_stop::graded_radii(&self.exact.cell().robots[j].model, radius);
         s
     }
 
@@ -1016,22 +1037,17 @@ impl ProtectiveChecker {
     /// arms in the bit mask `arms`).
     fn sweeps_at(&mut self, j: usize, tier: u32, arms: u8) {
         // Without a table, tier 1 is already the direct enclosure: a second tier repeats it.
-        let (tier, arms) = if tier == 0 || self.tables[j].is_none() { (0, 0) } else { (tier, arms) };
-        if self.sweep_tier[j] == Some((tier, arms)) {
+        let (tier, arms) = if tier == 0 || self.model.tables[j].is_none() { (0, 0) } else { (tier, arms) };
+        if self.robots[j].tier == Some((tier, arms)) {
             return;
         }
-        let robot = &self.exact.cell().robots[j];
+        let model = &self.exact.cell().robots[j].model;
         let rot = self.exact.rotation(j);
-        let (centre, radius) = (self.centres[j], self.reach[j]);
-        let table = self.tables[j].as_deref();
-        stop_sweeps_wcs_into(&mut self.sweeps[j], &robot.model, rot, &centre, radius, table, tier, arms);
-        let boxes = &self.ref_boxes[j];
-        for (form, faces) in self.faces[j].iter_mut().enumerate() {
-            for (k, b) in boxes.as_slice().iter().enumerate() {
-                faces[k] = FaceTerms::new(b, &self.sweeps[j][form][k]);
-            }
-        }
-        self.sweep_tier[j] = Some((tier, arms));
+        let table = self.model.tables[j].as_deref();
+        let r = &mut self.robots[j].reference;
+        stop_sweeps_wcs_into(&mut r.sweeps, model, rot, &r.centre, r.radius, table, tier, arms);
+        r.set_faces();
+        self.robots[j].tier = Some((tier, arms));
     }
 
 }
@@ -1138,12 +1154,13 @@ mod tests {
         for s in crate::cell::trajectory::parse_scenarios(text).unwrap().iter() {
             let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, vec![StopModel::DEFAULT; 2]).unwrap();
             let mut first = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
-            let mut plain = ProtectiveChecker { certain_stops_first: false, ..first.clone() };
+            let mut plain = first.clone();
+            plain.model.certain_stops_first = false;
             let (mut tcps, mut early, mut stops) = ([Vec3::zeros(); 2], 0, 0);
             for tick in 0..crate::cell::trajectory::RUN_TICKS {
                 s.tcps_at(tick, &mut tcps);
                 let v = first.check(&tcps).unwrap().verdict;
-                early += usize::from(v == Protective::Stop && first.references_stale);
+                early += usize::from(v == Protective::Stop && first.robots.iter().any(|r| r.stale));
                 stops += usize::from(v == Protective::Stop);
                 assert_eq!(plain.check(&tcps).unwrap().verdict, v, "{} {} tick {tick}", s.cell, s.case);
             }
@@ -1214,7 +1231,7 @@ mod tests {
             }
             let r = c.check(at(time, &sent)).unwrap();
             assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Timing(fault)));
-            assert!(!c.witness.is_kept() && c.history.iter().all(|h| h.tcp.is_none()), "{fault:?}");
+            assert!(!c.witness.is_kept() && c.robots.iter().all(|r| r.history.tcp.is_none()), "{fault:?}");
             // Back in step: the next call's speeds are unknown, its own witness search aside.
             cycle = time + 1;
             s.tcps_at(cycle as u32, &mut tcps);
@@ -1238,7 +1255,7 @@ mod tests {
         c.check(at(cycle + 3, &tcps)).unwrap();
         assert!(!speeds_unknown(&c));
         c.reset();
-        assert!(!c.witness.is_kept() && c.time.is_none());
+        assert!(!c.witness.is_kept() && c.calls.time.is_none());
         c.check(at(cycle + 3, &tcps)).unwrap();
         assert!(speeds_unknown(&c), "after reset the same cycle is computed again");
     }

@@ -30,9 +30,8 @@
 //! [`ProtectiveStatus::InvalidPath`](super::ProtectiveStatus::InvalidPath): STOP. Nothing here allocates.
 
 use super::certain_stop::graded_radii;
-use super::stop_sweeps::GradedRadii;
-use super::{first_unproved_between, stop_sweeps_wcs, BoxPair, Protective, ProtectiveChecker, SweepForms};
-use crate::geometry::sweep::FaceTerms;
+use super::stop_sweeps::SweptBall;
+use super::{first_unproved_between, stop_sweeps_wcs, BoxPair, Protective, ProtectiveChecker};
 use crate::math::{Real, Vec3};
 use crate::robot::{RobotBoxes, MAX_BOXES};
 
@@ -174,10 +173,7 @@ pub fn path_through_samples(samples: &[Vec3], length_mm: Real, tolerance_mm: Rea
 struct Piece {
     /// The arc range of the path (`None`: the ball of the verdict without paths).
     arc: Option<(Real, Real)>,
-    boxes: RobotBoxes,
-    sweeps: SweepForms,
-    faces: [[FaceTerms; MAX_BOXES]; 2],
-    radii: GradedRadii,
+    ball: SweptBall,
 }
 
 impl ProtectiveChecker {
@@ -185,27 +181,26 @@ impl ProtectiveChecker {
     fn piece(&self, j: usize, path: Option<&StopPath>, arc: Option<(Real, Real)>) -> Piece {
         let robot = &self.cell().robots[j];
         let rot = *self.exact.rotation(j);
+        let reference = &self.robots[j].reference;
         let mut boxes = RobotBoxes::empty();
         let ball = match (path, arc) {
             (Some(p), Some(range)) => Some(piece_ball(p.points, range, p.tolerance_mm)),
             _ => None,
         };
-        let ball = ball.filter(|&(c, r)| r < self.reach[j] && self.exact.boxes_in_wcs(j, &c, &mut boxes).is_ok());
+        let ball = ball.filter(|&(c, r)| r < reference.radius && self.exact.boxes_in_wcs(j, &c, &mut boxes).is_ok());
         let (centre, radius, arc) = match ball {
             Some((c, r)) => (c, r, arc),
             None => {
-                boxes = self.ref_boxes[j];
-                (self.centres[j], self.reach[j], None)
+                boxes = reference.boxes;
+                (reference.centre, reference.radius, None)
             }
         };
-        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.tables[j].as_deref());
-        let mut faces = [[self.no_faces; MAX_BOXES]; 2];
-        for (form, terms) in faces.iter_mut().enumerate() {
-            for (k, b) in boxes.as_slice().iter().enumerate() {
-                terms[k] = FaceTerms::new(b, &sweeps[form][k]);
-            }
-        }
-        Piece { arc, boxes, sweeps, faces, radii: graded_radii(&robot.model, radius) }
+        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.model.tables[j].as_deref());
+        let faces = [[self.model.no_faces; MAX_BOXES]; 2];
+        let graded = graded_radii(&robot.model, radius);
+        let mut ball = SweptBall { centre, radius, boxes, sweeps, faces, graded };
+        ball.set_faces();
+        Piece { arc, ball }
     }
 
     /// The halves of `piece` of robot `j`, when it has a path range to split.
@@ -228,8 +223,8 @@ impl ProtectiveChecker {
         extra: Real,
     ) -> Option<BoxPair> {
         let unproved = first_unproved_between(
-            (pa.boxes.as_slice(), &pa.sweeps, &pa.faces, &pa.radii),
-            (pb.boxes.as_slice(), &pb.sweeps, &pb.faces, &pb.radii),
+            &pa.ball,
+            &pb.ball,
             extra,
             &Vec3::zeros(),
         )
@@ -270,7 +265,7 @@ impl ProtectiveChecker {
             });
             self.piece(j, path, arc)
         };
-        for (extra, verdict) in [(0.0, Protective::Stop), (self.warn_mm, Protective::Warn)] {
+        for (extra, verdict) in [(0.0, Protective::Stop), (self.model.warn_mm, Protective::Warn)] {
             if extra == 0.0 && verdict == Protective::Warn {
                 break;
             }

@@ -11,7 +11,7 @@ impl ProtectiveChecker {
     /// Each robot's speed limit when they are asked for (else NaN), with this tick's stop
     /// references of every robot already set (the limits search about them).
     pub(super) fn speed_limits_of(&mut self, tcps_mcs: &[Vec3], from_history: bool) {
-        if !self.speed_limits {
+        if !self.model.speed_limits {
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
             return;
         }
@@ -21,13 +21,13 @@ impl ProtectiveChecker {
         let n = tcps_mcs.len();
         // Without a history (`check_at_speeds`) no search has a last limit to start from, so
         // none would get far with a few tests: those searches are not capped.
-        let cap = if from_history { self.limit_tests } else { u32::MAX };
-        let (first, mut left) = (self.limit_turn % n.max(1), cap);
-        self.limit_turn = self.limit_turn.wrapping_add(1);
+        let cap = if from_history { self.model.limit_tests } else { u32::MAX };
+        let (first, mut left) = (self.calls.limit_turn % n.max(1), cap);
+        self.calls.limit_turn = self.calls.limit_turn.wrapping_add(1);
         for i in 0..n {
             let j = (first + i) % n;
             let tcp = &tcps_mcs[j];
-            let start = self.history[j].limit.filter(|_| from_history);
+            let start = self.robots[j].history.limit.filter(|_| from_history);
             let v = self.report.robots[j].speed_mm_s;
             let floor = if proved_now && v <= self.cell().stops[j].max_speed_mm_s { v } else { 0.0 };
             // What is left, but one test for each robot after this one (while there are any).
@@ -35,7 +35,7 @@ impl ProtectiveChecker {
             let budget = if left > after { left - after } else { left.min(1) };
             let (limit, used, step) = self.speed_limit(j, tcp, start, floor, budget);
             left -= used;
-            (self.report.robots[j].speed_limit_mm_s, self.limit_steps[j]) = (limit, step);
+            (self.report.robots[j].speed_limit_mm_s, self.robots[j].limit_step) = (limit, step);
         }
     }
 
@@ -52,14 +52,13 @@ impl ProtectiveChecker {
         floor: Real,
         budget: u32,
     ) -> (Real, u32, Real) {
-        // Robot `j`'s reference, which each test replaces: restored after the search.
-        let saved_sweeps = (self.sweeps[j], self.ref_boxes[j], self.faces[j]);
-        let saved_ball = (self.centres[j], self.reach[j], self.graded[j], self.sweep_tier[j]);
+        // Robot `j`'s state, whose reference each test replaces: restored after the search.
+        let saved = self.robots[j];
         let inside = self.kept.inside(j);
         // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
         let proved = |me: &mut Self, v: Real, tier: Option<u32>| {
             let s = me.stop_reference(j, tcp_mcs, v);
-            if me.kept.set_inside(j, &[(me.centres[j], me.reach[j]), (*tcp_mcs, s)]) && me.kept_free(Some(j)) {
+            if me.kept.set_inside(j, &[(me.robots[j].reference.centre, me.robots[j].reference.radius), (*tcp_mcs, s)]) && me.kept_free(Some(j)) {
                 return true;
             }
             if me.report.closest.is_some_and(|h| (h.a == j || h.b == j) && me.ball_swept_meet(h)) {
@@ -76,15 +75,15 @@ impl ProtectiveChecker {
                 let p = me.exact.verdict().pairs[k];
                 if p.a == j || p.b == j {
                     for i in [p.a, p.b] {
-                        if i == j || tier > 0 || me.sweep_tier[i].is_none() {
+                        if i == j || tier > 0 || me.robots[i].tier.is_none() {
                             me.sweeps_at(i, tier, 0b111);
                         }
                     }
                 }
             }
-            let boxes = |i: usize| me.ref_boxes[i].as_slice();
-            let swept = (&me.sweeps[..], &me.faces[..], &me.graded[..]);
-            first_unproved(&me.exact.verdict().pairs, &boxes, swept, &me.pair_axes, Some(j), 0.0).is_none()
+            let (robots, pairs) = (&me.robots, &me.pairs);
+            let (ball, axis) = (|i: usize| &robots[i].reference, |k: usize| &pairs[k].axis);
+            first_unproved(&me.exact.verdict().pairs, ball, axis, Some(j), 0.0).is_none()
         };
         let vmax = self.cell().stops[j].max_speed_mm_s;
         let resolution = vmax / (1u32 << LIMIT_STEPS) as Real;
@@ -201,7 +200,7 @@ impl ProtectiveChecker {
             }
             (lo, resolution)
         };
-        let tier = if self.precise_limits { self.precise_splits } else { 0 };
+        let tier = if self.model.precise_limits { self.model.precise_splits } else { 0 };
         // Tier 1 alone on the grid `v_max k / 2^LIMIT_STEPS`: the default limit (capped), and
         // the floor of the precise one (not capped).
         let mut next_step = resolution;
@@ -232,8 +231,7 @@ impl ProtectiveChecker {
                 bisect(self, (hi, top), Some(tier)).0
             }
         };
-        (self.sweeps[j], self.ref_boxes[j], self.faces[j]) = saved_sweeps;
-        (self.centres[j], self.reach[j], self.graded[j], self.sweep_tier[j]) = saved_ball;
+        self.robots[j] = saved;
         self.kept.restore_inside(j, inside);
         // The step is kept only when the limit is the one the steps were taken from.
         let next_step = if limit >= floor { next_step } else { resolution };

@@ -10,7 +10,44 @@ use crate::geometry::sweep::{swept_boxes_apart_either, Axes, FaceTerms};
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
 use crate::robot::motor_table::MotorTable;
-use crate::robot::{RobotModel, MAX_BOXES};
+use crate::robot::{RobotBoxes, RobotModel, MAX_BOXES};
+
+/// A robot's boxes swept over every TCP of a ball (module doc of `protective`, steps 3-6):
+/// the ball, the boxes at its centre, their sweeps in both forms, the face terms of each box
+/// under each form and the boxes' graded radii. A stop's reference, a kept ball and a piece of
+/// a stop path are each one.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SweptBall {
+    /// The ball's centre (MCS) and radius (mm).
+    pub(super) centre: Vec3,
+    pub(super) radius: Real,
+    /// The robot's boxes (WCS) at the centre.
+    pub(super) boxes: RobotBoxes,
+    /// Per form and box, the displacements of the box's points over the ball (WCS).
+    pub(super) sweeps: SweepForms,
+    /// Per form and box, the face terms of the box under that sweep.
+    pub(super) faces: [[FaceTerms; MAX_BOXES]; 2],
+    /// Per box, the radii of the graded ball that every sweep of the box holds (step 6).
+    pub(super) graded: GradedRadii,
+}
+
+impl SweptBall {
+    /// No ball: no boxes, zero sweeps, `faces` for every face term (those of a box without
+    /// sweep).
+    pub(super) fn empty(faces: FaceTerms) -> SweptBall {
+        let (sweeps, faces) = ([[Sweep::ZERO; MAX_BOXES]; 2], [[faces; MAX_BOXES]; 2]);
+        SweptBall { centre: Vec3::zeros(), radius: 0.0, boxes: RobotBoxes::empty(), sweeps, faces, graded: [[0.0; 2]; MAX_BOXES] }
+    }
+
+    /// Sets the face terms of every box from its sweeps.
+    pub(super) fn set_faces(&mut self) {
+        for (form, faces) in self.faces.iter_mut().enumerate() {
+            for (k, b) in self.boxes.as_slice().iter().enumerate() {
+                faces[k] = FaceTerms::new(b, &self.sweeps[form][k]);
+            }
+        }
+    }
+}
 
 /// The WCS displacement sets of the boxes of a robot at `tcp_mcs` when its TCP may go
 /// anywhere within `s` of it (module doc, steps 3-4); infinite balls when unbounded. The motor
@@ -85,24 +122,17 @@ fn write_forms(out: &mut SweepForms, filled: bool, rot_wcs: &crate::math::Mat3) 
 pub type SweepForms = [[Sweep; MAX_BOXES]; 2];
 
 /// The first box pair (of the pairs involving `only`, or of all pairs) not proved apart
-/// with `extra` mm added to the first robot's sweep, each pair `k` also on `axes[k]`.
-/// `faces[j][form][k]` are the face terms of robot `j`'s box `k` under `sweeps[j][form][k]`.
+/// with `extra` mm added to the first robot's sweep, robot `j` swept as `ball(j)`, each pair
+/// `k` also tried on `axis(k)`.
 pub(super) fn first_unproved<'a>(
     pairs: &[PairVerdict],
-    boxes: &impl Fn(usize) -> &'a [Obb],
-    (sweeps, faces, radii): EveryRobotSwept,
-    axes: &[Vec3],
+    ball: impl Fn(usize) -> &'a SweptBall,
+    axis: impl Fn(usize) -> &'a Vec3,
     only: Option<usize>,
     extra: Real,
 ) -> Option<BoxPair> {
-    for (p, axis) in pairs.iter().zip(axes).filter(|(p, _)| only.is_none_or(|j| p.a == j || p.b == j)) {
-        let found = first_unproved_between(
-            (boxes(p.a), &sweeps[p.a], &faces[p.a], &radii[p.a]),
-            (boxes(p.b), &sweeps[p.b], &faces[p.b], &radii[p.b]),
-            extra,
-            axis,
-        );
-        if let Some((box_a, box_b)) = found {
+    for (k, p) in pairs.iter().enumerate().filter(|(_, p)| only.is_none_or(|j| p.a == j || p.b == j)) {
+        if let Some((box_a, box_b)) = first_unproved_between(ball(p.a), ball(p.b), extra, axis(k)) {
             return Some(BoxPair { a: p.a, b: p.b, box_a, box_b });
         }
     }
@@ -166,13 +196,6 @@ fn with_extra<'a>(forms: [&'a Sweep; 2], extra: Real, wider: &'a mut Option<[Swe
     [&copies[0], &copies[1]]
 }
 
-/// One robot's boxes, their sweeps, the face terms of each box under each sweep form, and the
-/// boxes' graded radii.
-pub(super) type SweptBoxes<'a> = (&'a [Obb], &'a SweepForms, &'a [[FaceTerms; MAX_BOXES]; 2], &'a GradedRadii);
-
-/// Every robot's sweeps, face terms and graded radii, as [`first_unproved`] reads them.
-pub(super) type EveryRobotSwept<'a> = (&'a [SweepForms], &'a [[[FaceTerms; MAX_BOXES]; 2]], &'a [GradedRadii]);
-
 /// Per box of a robot, the radii of the graded ball that every sweep of the box holds (module
 /// doc of `protective`, step 6): what graded axis ([`graded_points`]) reads.
 pub(super) type GradedRadii = [[Real; 2]; MAX_BOXES];
@@ -181,8 +204,9 @@ pub(super) type GradedRadii = [[Real; 2]; MAX_BOXES];
 /// added to the first robot's sweeps, any combination of sweep forms allowed, on the 15 axes
 /// of each box pair, on `axis` or on the pair's graded axis ([`graded_points`]) (computed only for the pairs
 /// that the others leave unproved).
-pub(super) fn first_unproved_between(a: SweptBoxes, b: SweptBoxes, extra: Real, axis: &Vec3) -> Option<(usize, usize)> {
-    let ((boxes_a, sweeps_a, faces_a, radii_a), (boxes_b, sweeps_b, faces_b, radii_b)) = (a, b);
+pub(super) fn first_unproved_between(a: &SweptBall, b: &SweptBall, extra: Real, axis: &Vec3) -> Option<(usize, usize)> {
+    let (boxes_a, sweeps_a, faces_a, radii_a) = (a.boxes.as_slice(), &a.sweeps, &a.faces, &a.graded);
+    let (boxes_b, sweeps_b, faces_b, radii_b) = (b.boxes.as_slice(), &b.sweeps, &b.faces, &b.graded);
     let mut copy = None;
     if extra != 0.0 {
         let terms = copy.insert(*faces_a);

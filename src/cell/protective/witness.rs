@@ -68,7 +68,7 @@ impl ProtectiveChecker {
     pub(super) fn witness_holds(&self, tcps_mcs: &[Vec3]) -> Option<BoxPair> {
         let w = self.witness.witness?;
         let inside = |j: usize, q: &Vec3| {
-            let (s, (centre, radius)) = self.stop_balls[j];
+            let (s, (centre, radius)) = self.robots[j].stop_ball;
             (q - centre).norm() <= radius - INSIDE_SLACK_MM && (q - tcps_mcs[j]).norm() <= s - INSIDE_SLACK_MM
         };
         (inside(w.pair.a, &w.tcps[0]) && inside(w.pair.b, &w.tcps[1])).then_some(w.pair)
@@ -96,7 +96,7 @@ impl ProtectiveChecker {
         let Some(u) = toward.try_normalize(0.0) else { return };
         let (rot_a, rot_b) = (self.exact.rotation(closest.a), self.exact.rotation(closest.b));
         let (ua, ub) = (rot_a.transpose() * u, -(rot_b.transpose() * u));
-        let ((_, (ca, sa)), (_, (cb, sb))) = (self.stop_balls[closest.a], self.stop_balls[closest.b]);
+        let ((_, (ca, sa)), (_, (cb, sb))) = (self.robots[closest.a].stop_ball, self.robots[closest.b].stop_ball);
         for f in REACH_FRACTIONS {
             let (qa, qb) = (ca + ua * (f * sa), cb + ub * (f * sb));
             let (Ok(ika), Ok(ikb)) =
