@@ -836,20 +836,52 @@ impl ProtectiveChecker {
     /// Fills the report from the TCPs and the measured speeds already in `report.robots`;
     /// with `from_history`, each speed limit's search starts at the last tick's limit; with
     /// `table`, a tick the table's bound proves FREE is answered from it.
+    ///
+    /// A flat chain of steps, the cheaper first, each settling the verdict or passing on: a
+    /// kept proof and a certain STOP need no reference (and end the tick when no speed limit
+    /// is asked for); a proof kept for wider balls needs sweeps only where those widen; the
+    /// table's bounds read this tick's sweeps of the table's tier, which the proof in tiers
+    /// then reuses.
     fn evaluate(&mut self, tcps_mcs: &[Vec3], status: ProtectiveStatus, from_history: bool, table: Option<ClearanceBound>) {
-        let (was_free, was_stop) = (self.report.verdict == Protective::Free, self.report.verdict == Protective::Stop);
+        let last = self.report.verdict;
+        self.clear_report(status);
+        if status != ProtectiveStatus::Ok {
+            return;
+        }
+        let Some(points) = self.measure(tcps_mcs) else { return };
+        let early = self.kept_proof().or_else(|| self.certain_stop(tcps_mcs, last));
+        if early.is_some() && !self.model.speed_limits {
+            self.settle(early.unwrap_or(Settled::KeptProof), points);
+            self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
+            self.robots.iter_mut().for_each(|r| r.stale = true);
+            return;
+        }
+        self.set_references(tcps_mcs);
+        let settled = early
+            .or_else(|| self.wider_kept_proof(last))
+            .or_else(|| table.and_then(|bound| self.table_lookup(bound)))
+            .unwrap_or_else(|| self.prove_in_tiers());
+        self.settle(settled, points);
+        self.speed_limits_of(tcps_mcs, from_history);
+    }
+
+    /// The report of a tick not yet decided: STOP with `status`, nothing measured.
+    fn clear_report(&mut self, status: ProtectiveStatus) {
         let report = &mut self.report;
         (report.verdict, report.status, report.clearance_mm) = (Protective::Stop, status, Real::NAN);
         (report.closest, report.limiting, report.kept_proof, report.table_lookup) = (None, None, false, false);
         report.table_pairs = 0;
         self.pairs.iter_mut().for_each(|p| p.table_proved = false);
-        if status != ProtectiveStatus::Ok {
-            return;
-        }
-        let Ok(exact) = self.exact.place_boxes(tcps_mcs) else { return };
+    }
+
+    /// The boxes now, each robot's stop ball and motion bound (module doc, steps 1-3) and the
+    /// clearance with its closest pair; the closest pair's points (WCS). `None` when a TCP is
+    /// unreachable (the status says which) or the boxes cannot be placed.
+    fn measure(&mut self, tcps_mcs: &[Vec3]) -> Option<[Vec3; 2]> {
+        let exact = self.exact.place_boxes(tcps_mcs).ok()?;
         if let Some((j, _)) = exact.first_unreachable {
             self.report.status = ProtectiveStatus::Unreachable(j);
-            return;
+            return None;
         }
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             let v = self.report.robots[j].speed_mm_s;
@@ -867,80 +899,97 @@ impl ProtectiveChecker {
             c
         });
         (self.report.clearance_mm, self.report.closest) = (clearance, closest);
-        let kept = self.kept_free(None);
-        // A witness kept from an earlier STOP tick (no inverse kinematics at all), then steps 6
-        // and 7 on the closest pair, which need two reference boxes, not every robot's (step 8).
-        let first = !kept && self.model.certain_stops_first;
-        let witnessed = if first { self.witness_holds(tcps_mcs) } else { None };
-        let early = witnessed.or_else(|| closest.filter(|&p| first && self.reference_pair_stops(tcps_mcs, p, was_stop)));
-        // A STOP not settled by a witness seeks one for the ticks that follow.
-        let seek = first && witnessed.is_none();
-        if (kept || early.is_some()) && !self.model.speed_limits {
-            if kept {
-                (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
-            } else {
-                (self.report.verdict, self.report.limiting) = (Protective::Stop, early);
-                if let (true, Some(p)) = (seek, closest) {
-                    self.seek_witness(p, points);
-                }
-            }
-            self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
-            self.robots.iter_mut().for_each(|r| r.stale = true);
-            return;
+        Some(points)
+    }
+
+    /// FREE by the proofs kept from earlier ticks (`protective/kept.rs`), with no sweeps.
+    fn kept_proof(&self) -> Option<Settled> {
+        self.kept_free(None).then_some(Settled::KeptProof)
+    }
+
+    /// STOP without a proof: by a witness kept from an earlier STOP tick (no inverse
+    /// kinematics at all), else by steps 6 and 7 on the closest pair, which need two reference
+    /// boxes, not every robot's (module doc, step 8).
+    fn certain_stop(&mut self, tcps_mcs: &[Vec3], last: Protective) -> Option<Settled> {
+        if !self.model.certain_stops_first {
+            return None;
         }
-        self.set_references(tcps_mcs);
-        // The cheaper answers first: a kept proof (no sweeps), a certain STOP (none either), a
-        // proof kept for wider balls (sweeps only where the kept balls widen), then the
-        // table's bounds (this tick's sweeps of the table's tier, which the proof reuses).
-        if kept {
-            (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
-        } else if let Some(pair) = early {
-            (self.report.verdict, self.report.limiting) = (Protective::Stop, Some(pair));
-        } else if was_free && self.keep_and_prove() {
-            (self.report.verdict, self.report.kept_proof) = (Protective::Free, true);
-        } else if table.is_some_and(|bound| self.lookup_pairs(bound)) {
-            (self.report.verdict, self.report.table_lookup) = (Protective::Free, true);
-            // The lookup proved FREE for every TCP of every stop ball: kept like a proof.
+        if let Some(pair) = self.witness_holds(tcps_mcs) {
+            return Some(Settled::Witnessed(pair));
+        }
+        let was_stop = last == Protective::Stop;
+        let closest = self.report.closest?;
+        self.reference_pair_stops(tcps_mcs, closest, was_stop).then_some(Settled::CertainStop(closest))
+    }
+
+    /// FREE by balls wider than the stop balls, kept after a FREE tick (`protective/kept.rs`).
+    fn wider_kept_proof(&mut self, last: Protective) -> Option<Settled> {
+        (last == Protective::Free && self.keep_and_prove()).then_some(Settled::KeptProof)
+    }
+
+    /// FREE by the clearance table's bounds alone (`protective/lookup.rs`); the pairs it
+    /// proves are left out of the proof that follows when it does not prove them all.
+    fn table_lookup(&mut self, bound: ClearanceBound) -> Option<Settled> {
+        self.lookup_pairs(bound).then_some(Settled::TableLookup)
+    }
+
+    /// The proof (module doc, step 5) with the table's tier, then tier 2 arm by arm: a box's
+    /// sweep depends on its own arm's angles only, so the arms of the limiting pair are
+    /// refined until it is proved or both are refined (then the full tier 2 fails on it too:
+    /// the same verdict and limiting pair, as a pair proved with fewer arms refined stays
+    /// proved with more). A limiting pair that the sweeps of the angles sampled in the cube
+    /// cannot prove apart, no tier can (step 7): the verdict stands. Tried on tier 1's
+    /// limiting pair only: a pair that tier 2 proved is followed by another mostly when tier 2
+    /// proves that one too.
+    fn prove_in_tiers(&mut self) -> Settled {
+        let (mut verdict, mut limiting) = self.prove();
+        if verdict == Protective::Free {
             self.keep_references();
-        } else {
-            (self.report.verdict, self.report.limiting) = self.prove();
-            if self.report.verdict == Protective::Free {
+        }
+        let splits = self.model.precise_splits;
+        let mut first = true;
+        while let (Some(p), true) = (limiting, splits > 0) {
+            let extra = if verdict == Protective::Warn { self.model.warn_mm } else { 0.0 };
+            if core::mem::take(&mut first) && self.beyond_every_tier(p, extra) {
+                break;
+            }
+            let (arms_a, arms_b) = (self.arm_bit(p.a, p.box_a), self.arm_bit(p.b, p.box_b));
+            let refined = |me: &Self, j: usize| match me.model.tables[j] {
+                None => 0b111,
+                Some(_) => me.robots[j].tier.filter(|t| t.0 == splits).map_or(0, |t| t.1),
+            };
+            let (ra, rb) = (refined(self, p.a), refined(self, p.b));
+            if ra & arms_a == arms_a && rb & arms_b == arms_b {
+                break;
+            }
+            self.sweeps_at(p.a, splits, ra | arms_a);
+            let rb = refined(self, p.b);
+            self.sweeps_at(p.b, splits, rb | arms_b);
+            (verdict, limiting) = self.prove();
+        }
+        Settled::Proved(verdict, limiting)
+    }
+
+    /// Writes the settled verdict into the report; a STOP not settled by a kept witness seeks
+    /// one for the ticks that follow (from the closest pair and its points `points`).
+    fn settle(&mut self, settled: Settled, points: [Vec3; 2]) {
+        let report = &mut self.report;
+        match settled {
+            Settled::KeptProof => (report.verdict, report.kept_proof) = (Protective::Free, true),
+            Settled::TableLookup => {
+                (report.verdict, report.table_lookup) = (Protective::Free, true);
+                // The lookup proved FREE for every TCP of every stop ball: kept like a proof.
                 self.keep_references();
             }
-            // Tier 2, arm by arm: a box's sweep depends on its own arm's angles only, so the
-            // arms of the limiting pair are refined until it is proved or both are refined
-            // (then the full tier 2 fails on it too: the same verdict and limiting pair, as a
-            // pair proved with fewer arms refined stays proved with more).
-            // A limiting pair that the sweeps of the angles sampled in the cube cannot prove
-            // apart, no tier can (module doc, step 7): the verdict stands.
-            let splits = self.model.precise_splits;
-            // Tried on tier 1's limiting pair only: a pair that tier 2 proved is followed by
-            // another mostly when tier 2 proves that one too.
-            let mut first = true;
-            while let (Some(p), true) = (self.report.limiting, splits > 0) {
-                let extra = if self.report.verdict == Protective::Warn { self.model.warn_mm } else { 0.0 };
-                if core::mem::take(&mut first) && self.beyond_every_tier(p, extra) {
-                    break;
-                }
-                let (arms_a, arms_b) = (self.arm_bit(p.a, p.box_a), self.arm_bit(p.b, p.box_b));
-                let refined = |me: &Self, j: usize| match me.model.tables[j] {
-                    None => 0b111,
-                    Some(_) => me.robots[j].tier.filter(|t| t.0 == splits).map_or(0, |t| t.1),
-                };
-                let (ra, rb) = (refined(self, p.a), refined(self, p.b));
-                if ra & arms_a == arms_a && rb & arms_b == arms_b {
-                    break;
-                }
-                self.sweeps_at(p.a, splits, ra | arms_a);
-                let rb = refined(self, p.b);
-                self.sweeps_at(p.b, splits, rb | arms_b);
-                (self.report.verdict, self.report.limiting) = self.prove();
+            Settled::Witnessed(pair) | Settled::CertainStop(pair) => {
+                (report.verdict, report.limiting) = (Protective::Stop, Some(pair))
             }
+            Settled::Proved(verdict, limiting) => (report.verdict, report.limiting) = (verdict, limiting),
         }
-        if let (true, Protective::Stop, Some(p)) = (seek, self.report.verdict, closest) {
+        let seek = self.model.certain_stops_first && !matches!(settled, Settled::Witnessed(_));
+        if let (true, Protective::Stop, Some(p)) = (seek, self.report.verdict, self.report.closest) {
             self.seek_witness(p, points);
         }
-        self.speed_limits_of(tcps_mcs, from_history);
     }
 
     /// The verdict and its limiting pair for the sweeps as they are (module doc, step 5).
@@ -1050,6 +1099,21 @@ impl ProtectiveChecker {
         self.robots[j].tier = Some((tier, arms));
     }
 
+}
+
+/// How a step of the tick settled its verdict ([`ProtectiveChecker::evaluate`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Settled {
+    /// FREE by a proof kept from earlier ticks, or kept for wider balls.
+    KeptProof,
+    /// STOP: a witness kept from an earlier tick still holds (module doc, step 9).
+    Witnessed(BoxPair),
+    /// STOP: steps 6 or 7 show that no tier proves the closest pair apart.
+    CertainStop(BoxPair),
+    /// FREE by the clearance table's bounds.
+    TableLookup,
+    /// The proof's verdict and limiting pair.
+    Proved(Protective, Option<BoxPair>),
 }
 
 /// A ball holding every TCP of the stop when the measured velocity `velocity` is known
