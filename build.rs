@@ -12,17 +12,21 @@ fn main() {
     println!("cargo:rerun-if-changed=cbindgen.toml");
     println!("cargo:rerun-if-env-changed=CI");
     println!("cargo:rerun-if-env-changed=DELTA_COLLIDE_CHECK_HEADER");
-    let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
-    let config = cbindgen::Config::from_file(root.join("cbindgen.toml")).expect("cbindgen.toml is valid");
+    let root =
+        PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    let config =
+        cbindgen::Config::from_file(root.join("cbindgen.toml")).expect("cbindgen.toml is valid");
     let bindings = cbindgen::Builder::new()
         .with_config(config)
         .with_src(root.join("src/ffi/types.rs"))
         .with_src(root.join("src/ffi/mod.rs"))
         .generate()
         .expect("cbindgen can parse src/ffi");
-    let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("delta_collide.h");
+    let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
+        .join("delta_collide.h");
     bindings.write_to_file(&out);
-    let check_only = std::env::var_os("CI").is_some() || std::env::var_os("DELTA_COLLIDE_CHECK_HEADER").is_some();
+    let check_only = std::env::var_os("CI").is_some()
+        || std::env::var_os("DELTA_COLLIDE_CHECK_HEADER").is_some();
     let committed = root.join("include/delta_collide.h");
     // cbindgen closes its C++ guards with `// comments`, which strict C89 rejects: use /* */.
     let fresh = std::fs::read_to_string(&out)

@@ -19,8 +19,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use delta_collide::geometry::{
-    boxes_clearance, boxes_clearance_lower_bound, obb_clearance, separating_axis, CoherentClearance, Obb,
-    PairClearance,
+    boxes_clearance, boxes_clearance_lower_bound, obb_clearance, separating_axis,
+    CoherentClearance, Obb, PairClearance,
 };
 use delta_collide::math::{Mat3, Real, Vec3};
 use delta_collide::robot::model::RobotModel;
@@ -44,8 +44,10 @@ struct Config {
 
 fn parry_parts(o: &Obb) -> (Pose, Cuboid) {
     let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(o.axes));
-    let pose =
-        Pose::from_parts(Vector::new(o.center.x, o.center.y, o.center.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w));
+    let pose = Pose::from_parts(
+        Vector::new(o.center.x, o.center.y, o.center.z),
+        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
+    );
     (pose, Cuboid::new(Vector::new(o.half.x, o.half.y, o.half.z)))
 }
 
@@ -56,7 +58,12 @@ fn config(tcp_a: &Vec3, tcp_b: &Vec3) -> Option<Config> {
     let shift = Vec3::new(450.0, 0.0, 0.0);
     let a: [Obb; 3] = std::array::from_fn(|k| ra.boxes[k]);
     let b: [Obb; 3] = std::array::from_fn(|k| rb.boxes[k].transformed(&Mat3::identity(), &shift));
-    Some(Config { parry_a: a.each_ref().map(parry_parts), parry_b: b.each_ref().map(parry_parts), a, b })
+    Some(Config {
+        parry_a: a.each_ref().map(parry_parts),
+        parry_b: b.each_ref().map(parry_parts),
+        a,
+        b,
+    })
 }
 
 /// A TCP in the cylinder part of the thesis workspace (SPEC §4).
@@ -73,7 +80,8 @@ fn random_tcp(rng: &mut StdRng) -> Vec3 {
 fn rings() -> [(&'static str, Vec<Config>); 4] {
     let mut rng = StdRng::seed_from_u64(0xc1ea);
     let (mut far, mut near, mut touching, mut colliding) = (vec![], vec![], vec![], vec![]);
-    let clearance = |ta: &Vec3, tb: &Vec3| config(ta, tb).map(|c| boxes_clearance(&c.a, &c.b).distance);
+    let clearance =
+        |ta: &Vec3, tb: &Vec3| config(ta, tb).map(|c| boxes_clearance(&c.a, &c.b).distance);
     while far.len() < RING || near.len() < RING || touching.len() < RING || colliding.len() < RING {
         let (ta, tb) = (random_tcp(&mut rng), random_tcp(&mut rng));
         let Some(d) = clearance(&ta, &tb) else { continue };
@@ -142,9 +150,14 @@ fn clearance(c: &mut Criterion) {
         let ours: Vec<PairClearance> = ring.iter().map(|c| boxes_clearance(&c.a, &c.b)).collect();
         let nine: Vec<Real> = ring.iter().map(all_nine).collect();
         let parry: Vec<Real> = ring.iter().map(parry_nine).collect();
-        let worst = ours.iter().zip(&parry).map(|(o, p)| (o.distance.max(0.0) - p).abs()).fold(0.0, Real::max);
-        let (lo, hi) =
-            ours.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(l, h), o| (l.min(o.distance), h.max(o.distance)));
+        let worst = ours
+            .iter()
+            .zip(&parry)
+            .map(|(o, p)| (o.distance.max(0.0) - p).abs())
+            .fold(0.0, Real::max);
+        let (lo, hi) = ours.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(l, h), o| {
+            (l.min(o.distance), h.max(o.distance))
+        });
         println!("{band}: clearance {lo:.6} .. {hi:.6} mm; largest |ours (0 if < 0) - parry| {worst:e} mm");
 
         let mut g = c.benchmark_group(format!("clearance/{band}"));
@@ -170,7 +183,8 @@ fn clearance(c: &mut Criterion) {
         });
         g.finish();
 
-        let bound: Vec<Real> = ring.iter().map(|c| boxes_clearance_lower_bound(&c.a, &c.b)).collect();
+        let bound: Vec<Real> =
+            ring.iter().map(|c| boxes_clearance_lower_bound(&c.a, &c.b)).collect();
         let hit: Vec<bool> = ring.iter().map(sat_loop).collect();
         assert!(bound.iter().zip(&ours).all(|(b, o)| b <= &o.distance));
         let mut g = c.benchmark_group(format!("bound/{band}"));
@@ -195,15 +209,25 @@ fn clearance(c: &mut Criterion) {
 /// (3 m/s), sampled every 1 ms; unreachable ticks left out.
 fn run() -> Vec<Config> {
     let tcp = |t: Real, phase: Real, x: Real| {
-        Vec3::new(x + 150.0 * (20.0 * t + phase).cos(), 150.0 * (20.0 * t + phase).sin(), -420.0 - 40.0 * (7.0 * t).sin())
+        Vec3::new(
+            x + 150.0 * (20.0 * t + phase).cos(),
+            150.0 * (20.0 * t + phase).sin(),
+            -420.0 - 40.0 * (7.0 * t).sin(),
+        )
     };
-    (0..3000).filter_map(|i| config(&tcp(i as Real * 1e-3, 0.0, 40.0), &tcp(i as Real * 1e-3, 2.0, -40.0))).collect()
+    (0..3000)
+        .filter_map(|i| {
+            config(&tcp(i as Real * 1e-3, 0.0, 40.0), &tcp(i as Real * 1e-3, 2.0, -40.0))
+        })
+        .collect()
 }
 
 fn tick_by_tick(c: &mut Criterion) {
     let run = run();
     let cold: Vec<PairClearance> = run.iter().map(|c| boxes_clearance(&c.a, &c.b)).collect();
-    let (lo, hi) = cold.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(l, h), o| (l.min(o.distance), h.max(o.distance)));
+    let (lo, hi) = cold.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(l, h), o| {
+        (l.min(o.distance), h.max(o.distance))
+    });
     println!("tick_by_tick: {} ticks, clearance {lo:.3} .. {hi:.3} mm", run.len());
     let mut g = c.benchmark_group("clearance/tick_by_tick");
     let (mut k, mut memory) = (0, CoherentClearance::new());
@@ -211,7 +235,11 @@ fn tick_by_tick(c: &mut Criterion) {
         bench.iter(|| {
             k = (k + 1) % run.len();
             let d = memory.boxes_clearance(black_box(&run[k].a), black_box(&run[k].b)).distance;
-            assert!((d - cold[k].distance).abs() <= 1e-9, "tick {k}: {d} against {}", cold[k].distance);
+            assert!(
+                (d - cold[k].distance).abs() <= 1e-9,
+                "tick {k}: {d} against {}",
+                cold[k].distance
+            );
         })
     });
     g.bench_function("ours_boxes_clearance", |bench| {

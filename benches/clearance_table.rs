@@ -69,7 +69,10 @@ fn lookups<'a>(
 
 fn row(what: &str, ns: &[u64]) -> String {
     let (median, p999, max) = percentiles(ns);
-    format!("{what:<34} median {median:>5} ns  p99.9 {p999:>6} ns  max {max:>8} ns  ({} queries)", ns.len())
+    format!(
+        "{what:<34} median {median:>5} ns  p99.9 {p999:>6} ns  max {max:>8} ns  ({} queries)",
+        ns.len()
+    )
 }
 
 /// Times and compares both tables of one cell on `cells`; `cold` of them flushed.
@@ -77,7 +80,11 @@ fn report(name: &str, shared: &Table, clearance_table: &Table, cells: &[[u16; 6]
     let clearance = clearance_table.as_clearance().expect("a clearance table");
     let (boolean, bound) = lookups(shared, clearance);
     for &c in cells {
-        assert_eq!(boolean(c), bound(c).is_none(), "{name} {c:?}: the level and the boolean table disagree");
+        assert_eq!(
+            boolean(c),
+            bound(c).is_none(),
+            "{name} {c:?}: the level and the boolean table disagree"
+        );
     }
     let clock = Clock::tsc().unwrap_or(Clock::Instant);
     println!(
@@ -123,9 +130,22 @@ fn main() {
         // Smoke run (cargo test): T1 at k = 16 built in memory.
         let cell = reference_cell("T1").unwrap();
         let variants = [Variant::Shared, Variant::Clearance(Ladder::default_ladder())];
-        let (_, tables, _) =
-            build_tables(&cell, 16, &Workspace::THESIS, &variants, Labelling::Certified, Progress::Silent).unwrap();
-        report("T1 k = 16 (smoke run)", &tables[0], &tables[1], &random_cells(&cell, 16, 20_000), 2_000);
+        let (_, tables, _) = build_tables(
+            &cell,
+            16,
+            &Workspace::THESIS,
+            &variants,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap();
+        report(
+            "T1 k = 16 (smoke run)",
+            &tables[0],
+            &tables[1],
+            &random_cells(&cell, 16, 20_000),
+            2_000,
+        );
         return;
     }
     let dir = arg(&args, "--dir").expect("--dir DIR: the tables built by the CLI (module doc)");
@@ -136,7 +156,8 @@ fn main() {
     for name in cells.split(',') {
         let cell = reference_cell(name).unwrap();
         let load = |kind: &str| {
-            let path = std::path::Path::new(&dir).join(format!("{}_k{k}_{kind}.dct", name.to_lowercase()));
+            let path =
+                std::path::Path::new(&dir).join(format!("{}_k{k}_{kind}.dct", name.to_lowercase()));
             let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
             let (header, table) = format::from_bytes(&bytes).unwrap();
             header.check_cell_parameters(&cell).unwrap();

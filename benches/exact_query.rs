@@ -17,12 +17,17 @@ const SCENARIOS: &str = include_str!("../c_harness/scenarios.txt");
 
 /// 128 two-robot configurations along `case` on T1, with their verdicts.
 fn ring(case: &str) -> Vec<([Vec3; 2], bool)> {
-    let scenario = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == case).unwrap();
+    let scenario = parse_scenarios(SCENARIOS)
+        .unwrap()
+        .into_iter()
+        .find(|s| s.cell == "T1" && s.case == case)
+        .unwrap();
     let mut checker = ExactChecker::new(reference_cell("T1").unwrap());
     (0..128)
         .map(|i| {
             // The collision run's last part collides: weight the ring toward it there.
-            let tick = if case == "collision" { 3000 + (i * 23) % 3000 } else { (i * 47) % RUN_TICKS };
+            let tick =
+                if case == "collision" { 3000 + (i * 23) % 3000 } else { (i * 47) % RUN_TICKS };
             let mut tcps = [Vec3::zeros(); 2];
             scenario.tcps_at(tick, &mut tcps);
             let hit = checker.check(&tcps).unwrap().collides();
@@ -51,7 +56,8 @@ fn exact_query(c: &mut Criterion) {
         // The same query through the C ABI (handle, pointer checks, panic boundary).
         let mut robots = [dc_robot_config_thesis(); 2];
         robots[1].translation = DcVec3 { x: 450.0, y: 0.0, z: 0.0 };
-        let config = DcCellConfig { robots: robots.as_ptr(), n_robots: 2, method: DC_METHOD_SAT_CACHE };
+        let config =
+            DcCellConfig { robots: robots.as_ptr(), n_robots: 2, method: DC_METHOD_SAT_CACHE };
         let mut h = std::ptr::null_mut();
         // SAFETY: valid config and out pointer.
         assert_eq!(unsafe { dc_init(&config, &mut h) }, DC_STATUS_OK);
@@ -69,7 +75,9 @@ fn exact_query(c: &mut Criterion) {
                 i += 1;
                 let mut verdict = DC_VERDICT_STOP;
                 // SAFETY: live handle, two readable TCPs, writable verdict.
-                let s = unsafe { dc_query(h, black_box(tcps.as_ptr()), 2, &mut verdict, std::ptr::null_mut()) };
+                let s = unsafe {
+                    dc_query(h, black_box(tcps.as_ptr()), 2, &mut verdict, std::ptr::null_mut())
+                };
                 assert_eq!((s, verdict), (DC_STATUS_OK, *want));
             })
         });

@@ -66,7 +66,8 @@ fn spec_formula_ik(d: &Delta3, tcp: &Vec3) -> Option<[Real; 3]> {
 fn bench_ik(c: &mut Criterion) {
     let d = Delta3::THESIS;
     let tcps = ring(0x1c_0001);
-    let expected: Vec<[Real; 3]> = tcps.iter().map(|p| d.inverse_kinematics(p).unwrap().theta).collect();
+    let expected: Vec<[Real; 3]> =
+        tcps.iter().map(|p| d.inverse_kinematics(p).unwrap().theta).collect();
     for (p, t) in tcps.iter().zip(&expected) {
         let peer = spec_formula_ik(&d, p).unwrap();
         assert!((0..3).all(|i| (peer[i] - t[i]).abs() < 1e-9), "peer and ours disagree at {p:?}");
@@ -106,7 +107,12 @@ fn bench_model(c: &mut Criterion) {
     let (ring_a, ring_b) = (ring(0x1c_0002), ring(0x1c_0003));
     // Reference centres of box 0 (A) and box 2 (B), from the direct form.
     let expected: Vec<(Vec3, Vec3)> = (0..LEN)
-        .map(|i| (model.boxes(&ring_a[i]).unwrap().boxes[0].center, model.boxes(&ring_b[i]).unwrap().boxes[2].center))
+        .map(|i| {
+            (
+                model.boxes(&ring_a[i]).unwrap().boxes[0].center,
+                model.boxes(&ring_b[i]).unwrap().boxes[2].center,
+            )
+        })
         .collect();
     let mut g = c.benchmark_group("model_two_robots");
     let mut i = 0usize;
@@ -125,7 +131,9 @@ fn bench_model(c: &mut Criterion) {
             i = (i + 1) % LEN;
             model.boxes_into(black_box(&ring_a[i]), &mut buf_a).unwrap();
             model.boxes_into(black_box(&ring_b[i]), &mut buf_b).unwrap();
-            assert!(buf_a.boxes[0].center == expected[i].0 && buf_b.boxes[2].center == expected[i].1);
+            assert!(
+                buf_a.boxes[0].center == expected[i].0 && buf_b.boxes[2].center == expected[i].1
+            );
             black_box((&buf_a, &buf_b));
         })
     });

@@ -11,7 +11,9 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker};
-use delta_collide::cspace::{label_space, label_space_certified, Label, Progress, SampleGrid, Workspace};
+use delta_collide::cspace::{
+    label_space, label_space_certified, Label, Progress, SampleGrid, Workspace,
+};
 use rayon::prelude::*;
 use std::hint::black_box;
 
@@ -84,7 +86,8 @@ fn bench_labelling(c: &mut Criterion) {
 fn bench_labelling_k32(c: &mut Criterion) {
     let cell = reference_cell("T1").unwrap();
     let ws = Workspace::THESIS;
-    let expected = collisions(label_space(&cell, 32, &ws, 0.0, Progress::Silent).unwrap().labels.iter());
+    let expected =
+        collisions(label_space(&cell, 32, &ws, 0.0, Progress::Silent).unwrap().labels.iter());
     let mut group = c.benchmark_group("label_T1_k32_all_pairs");
     group.sample_size(10);
     group.bench_function("ours_product_pruned", |b| {

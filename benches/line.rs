@@ -16,8 +16,8 @@ use delta_collide::cell::protective::{Protective, ProtectiveChecker};
 use delta_collide::cell::ExactChecker;
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::Vec3;
-use delta_collide::table::bundle::build_bundle;
 use delta_collide::robot::StopModel;
+use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::{BundleChecker, Confirmation, Labelling, Ladder, TableAnswer, Variant};
 use std::hint::black_box;
 
@@ -27,8 +27,12 @@ use line_run::{line, ticks};
 
 /// The stiff stopping model of the protective tests (2 ms reaction, 120 m/s^2 braking): stops
 /// short enough for a clearance table's levels to prove far pairs.
-const STIFF: StopModel =
-    StopModel { reaction_ms: 2.0, decel_mm_s2: 120_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 };
+const STIFF: StopModel = StopModel {
+    reaction_ms: 2.0,
+    decel_mm_s2: 120_000.0,
+    max_accel_mm_s2: 130_000.0,
+    max_speed_mm_s: 4_600.0,
+};
 
 /// The bundle of clearance tables (k = 16, default levels) of a line 450 mm apart.
 fn clearance_bundle() -> Vec<u8> {
@@ -41,14 +45,30 @@ fn clearance_bundle() -> Vec<u8> {
 /// The bundle of a line 450 mm apart (three tables: 450, 900 and 1350 mm), its k, and bytes.
 fn bundle() -> (u32, Vec<u8>) {
     let k = if std::env::args().any(|a| a == "--bench") { 32 } else { 16 };
-    let built = build_bundle(&line(4), k, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
-        .expect("the line's bundle builds");
-    println!("bundle of line4, k = {k}: {} tables, {} bytes", built.tables.len(), built.bytes.len());
+    let built = build_bundle(
+        &line(4),
+        k,
+        &Workspace::THESIS,
+        Variant::Shared,
+        Labelling::Certified,
+        Progress::Silent,
+    )
+    .expect("the line's bundle builds");
+    println!(
+        "bundle of line4, k = {k}: {} tables, {} bytes",
+        built.tables.len(),
+        built.bytes.len()
+    );
     (k, built.bytes)
 }
 
 /// Times `tick(k)` on ticks `k = 0, 1, ..., len - 1, 0, ...` in order, as a controller sends them.
-fn replay(group: &mut BenchmarkGroup<WallTime>, id: BenchmarkId, len: usize, mut tick: impl FnMut(usize)) {
+fn replay(
+    group: &mut BenchmarkGroup<WallTime>,
+    id: BenchmarkId,
+    len: usize,
+    mut tick: impl FnMut(usize),
+) {
     let mut i = 0;
     group.bench_function(id, |b| {
         b.iter(|| {
@@ -77,9 +97,13 @@ fn lines(c: &mut Criterion) {
         replay(&mut group, id, run.len(), |k| {
             assert_eq!(table.check(black_box(&run[k])).unwrap() == TableAnswer::Collision, hits[k]);
         });
-        for (name, limits) in [("protective verdict", false), ("protective with speed limits", true)] {
-            let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
-            let verdicts: Vec<Protective> = run.iter().map(|t| checker.check(t).unwrap().verdict).collect();
+        for (name, limits) in
+            [("protective verdict", false), ("protective with speed limits", true)]
+        {
+            let mut checker =
+                ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
+            let verdicts: Vec<Protective> =
+                run.iter().map(|t| checker.check(t).unwrap().verdict).collect();
             replay(&mut group, BenchmarkId::new(name, &label), run.len(), |k| {
                 if k == 0 {
                     checker.reset();
@@ -98,10 +122,16 @@ fn lines(c: &mut Criterion) {
         let run = ticks(n);
         let table = BundleChecker::new(cell.clone(), &clearance, Confirmation::Exact).unwrap();
         let bound = |a: usize, b: usize, t: &[Vec3]| table.clearance_bound(a, b, t);
-        let mut exact = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
-        let mut lookup = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
-        let verdicts: Vec<Protective> = run.iter().map(|t| exact.check(t).unwrap().verdict).collect();
-        let pairs: u64 = run.iter().map(|t| u64::from(lookup.check_with_table(t, &bound).unwrap().table_pairs)).sum();
+        let mut exact =
+            ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+        let mut lookup =
+            ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+        let verdicts: Vec<Protective> =
+            run.iter().map(|t| exact.check(t).unwrap().verdict).collect();
+        let pairs: u64 = run
+            .iter()
+            .map(|t| u64::from(lookup.check_with_table(t, &bound).unwrap().table_pairs))
+            .sum();
         println!("{label}, stiff: {pairs} pairs proved by a lookup over {} ticks", run.len());
         for (name, table_mode) in [("protective", false), ("protective, table mode", true)] {
             let checker = if table_mode { &mut lookup } else { &mut exact };

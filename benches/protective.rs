@@ -21,8 +21,8 @@ use delta_collide::cell::protective::{Protective, ProtectiveChecker, StopPath};
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker};
-use delta_collide::robot::StopModel;
 use delta_collide::math::{Real, Vec3};
+use delta_collide::robot::StopModel;
 use std::hint::black_box;
 
 const SCENARIOS: &str = include_str!("../c_harness/scenarios.txt");
@@ -31,7 +31,11 @@ type Case = ([Vec3; 2], [Real; 2], Protective, bool);
 
 /// 128 configurations along T1 practical with speeds, protective verdicts and collisions.
 fn ring(protective: &mut ProtectiveChecker, exact: &mut ExactChecker) -> Vec<Case> {
-    let s = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let s = parse_scenarios(SCENARIOS)
+        .unwrap()
+        .into_iter()
+        .find(|s| s.cell == "T1" && s.case == "practical")
+        .unwrap();
     (0..128)
         .map(|i| {
             let tick = 1 + (i * 47) % (RUN_TICKS - 1);
@@ -56,17 +60,24 @@ fn protective_query(c: &mut Criterion) {
         b.iter(|| {
             let (tcps, speeds, verdict, _) = &inputs[i % inputs.len()];
             i += 1;
-            assert_eq!(protective.check_at_speeds(black_box(tcps), speeds).unwrap().verdict, *verdict);
+            assert_eq!(
+                protective.check_at_speeds(black_box(tcps), speeds).unwrap().verdict,
+                *verdict
+            );
         })
     });
-    let mut verdict_only =
-        ProtectiveChecker::new(reference_cell("T1").unwrap(), 10.0).unwrap().with_speed_limits(false);
+    let mut verdict_only = ProtectiveChecker::new(reference_cell("T1").unwrap(), 10.0)
+        .unwrap()
+        .with_speed_limits(false);
     let mut i = 0;
     group.bench_function(BenchmarkId::new("protective", "verdict only"), |b| {
         b.iter(|| {
             let (tcps, speeds, verdict, _) = &inputs[i % inputs.len()];
             i += 1;
-            assert_eq!(verdict_only.check_at_speeds(black_box(tcps), speeds).unwrap().verdict, *verdict);
+            assert_eq!(
+                verdict_only.check_at_speeds(black_box(tcps), speeds).unwrap().verdict,
+                *verdict
+            );
         })
     });
     let mut i = 0;
@@ -85,7 +96,11 @@ type PathAhead = ([Vec3; 32], usize);
 
 /// The run's TCPs, tick by tick, with each robot's programmed path ahead.
 fn run_ticks() -> Vec<([Vec3; 2], [PathAhead; 2])> {
-    let s = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let s = parse_scenarios(SCENARIOS)
+        .unwrap()
+        .into_iter()
+        .find(|s| s.cell == "T1" && s.case == "practical")
+        .unwrap();
     (0..RUN_TICKS)
         .map(|tick| {
             let mut now = [Vec3::zeros(); 2];
@@ -106,8 +121,17 @@ fn stop_paths(paths: &[PathAhead; 2]) -> [Option<StopPath<'_>>; 2] {
 
 fn protective_replay(c: &mut Criterion) {
     replay(c, "protective_T1_practical_replay", reference_cell("T1").unwrap());
-    let stiff = StopModel { reaction_ms: 2.0, decel_mm_s2: 120_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 };
-    replay(c, "protective_T1_practical_replay_stiff", reference_cell("T1").unwrap().with_stopping(1.0, vec![stiff; 2]).unwrap());
+    let stiff = StopModel {
+        reaction_ms: 2.0,
+        decel_mm_s2: 120_000.0,
+        max_accel_mm_s2: 130_000.0,
+        max_speed_mm_s: 4_600.0,
+    };
+    replay(
+        c,
+        "protective_T1_practical_replay_stiff",
+        reference_cell("T1").unwrap().with_stopping(1.0, vec![stiff; 2]).unwrap(),
+    );
 }
 
 fn replay(c: &mut Criterion, name: &str, cell: Cell) {
@@ -116,8 +140,10 @@ fn replay(c: &mut Criterion, name: &str, cell: Cell) {
     let hits: Vec<bool> = ticks.iter().map(|t| exact.check(&t.0).unwrap().collides()).collect();
     let mut group = c.benchmark_group(name);
     for (name, limits) in [("with speed limits", true), ("verdict only", false)] {
-        let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
-        let verdicts: Vec<Protective> = ticks.iter().map(|t| checker.check(&t.0).unwrap().verdict).collect();
+        let mut checker =
+            ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(limits);
+        let verdicts: Vec<Protective> =
+            ticks.iter().map(|t| checker.check(&t.0).unwrap().verdict).collect();
         let mut i = 0;
         group.bench_function(BenchmarkId::new("protective", name), |b| {
             b.iter(|| {
@@ -131,8 +157,10 @@ fn replay(c: &mut Criterion, name: &str, cell: Cell) {
         });
     }
     let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
-    let verdicts: Vec<Protective> =
-        ticks.iter().map(|(t, p)| checker.check_with_paths(t, &stop_paths(p)).unwrap().verdict).collect();
+    let verdicts: Vec<Protective> = ticks
+        .iter()
+        .map(|(t, p)| checker.check_with_paths(t, &stop_paths(p)).unwrap().verdict)
+        .collect();
     let mut i = 0;
     group.bench_function(BenchmarkId::new("protective", "verdict with paths"), |b| {
         b.iter(|| {
@@ -142,7 +170,10 @@ fn replay(c: &mut Criterion, name: &str, cell: Cell) {
             }
             i += 1;
             let (tcps, paths) = &ticks[k];
-            assert_eq!(checker.check_with_paths(black_box(tcps), &stop_paths(paths)).unwrap().verdict, verdicts[k]);
+            assert_eq!(
+                checker.check_with_paths(black_box(tcps), &stop_paths(paths)).unwrap().verdict,
+                verdicts[k]
+            );
         })
     });
     let mut i = 0;

@@ -14,7 +14,9 @@
 //! Run: `cargo bench --bench sat -- --warm-up-time 1 --measurement-time 3`.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use delta_collide::geometry::{first_intersecting_pair, obbs_intersect, separating_axis, Obb, WitnessCache};
+use delta_collide::geometry::{
+    first_intersecting_pair, obbs_intersect, separating_axis, Obb, WitnessCache,
+};
 use delta_collide::math::{Mat3, Real, Vec3};
 use delta_collide::robot::model::RobotModel;
 use parry3d_f64::math::{Pose, Rotation, Vector};
@@ -62,9 +64,13 @@ fn pair_ring() -> Vec<Pair> {
     (0..RING)
         .map(|_| {
             let (qa, qb) = (random_quat(&mut rng), random_quat(&mut rng));
-            let ca = Vec3::new(rng.random_range(-500.0..500.0), rng.random_range(-500.0..500.0), -430.0);
-            let offset =
-                Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            let ca =
+                Vec3::new(rng.random_range(-500.0..500.0), rng.random_range(-500.0..500.0), -430.0);
+            let offset = Vec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
             let cb = ca + offset * 220.0;
             let (pose_a, pose_b) = (pose(qa, ca), pose(qb, cb));
             Pair {
@@ -84,7 +90,11 @@ fn box_pair(c: &mut Criterion) {
     let ours: Vec<bool> = ring.iter().map(|p| obbs_intersect(&p.a, &p.b)).collect();
     let parry: Vec<bool> = ring
         .iter()
-        .map(|p| query::intersection_test(&p.pose_a, &p.cuboid, &p.pose_b, &p.cuboid).unwrap().intersecting)
+        .map(|p| {
+            query::intersection_test(&p.pose_a, &p.cuboid, &p.pose_b, &p.cuboid)
+                .unwrap()
+                .intersecting
+        })
         .collect();
     let agree = ours.iter().zip(&parry).filter(|(a, b)| a == b).count();
     println!(
@@ -105,8 +115,13 @@ fn box_pair(c: &mut Criterion) {
         bench.iter(|| {
             k = (k + 1) % RING;
             let p = &ring[k];
-            let hit =
-                query::intersection_test(black_box(&p.pose_a), &p.cuboid, black_box(&p.pose_b), &p.cuboid).unwrap();
+            let hit = query::intersection_test(
+                black_box(&p.pose_a),
+                &p.cuboid,
+                black_box(&p.pose_b),
+                &p.cuboid,
+            )
+            .unwrap();
             assert_eq!(hit.intersecting, parry[k]);
         })
     });
@@ -114,7 +129,11 @@ fn box_pair(c: &mut Criterion) {
         bench.iter(|| {
             k = (k + 1) % RING;
             let p = &ring[k];
-            let hit = query::details::intersection_test_cuboid_cuboid(black_box(&p.pose_ab), &p.cuboid, &p.cuboid);
+            let hit = query::details::intersection_test_cuboid_cuboid(
+                black_box(&p.pose_ab),
+                &p.cuboid,
+                &p.cuboid,
+            );
             assert_eq!(hit, parry[k]);
         })
     });
@@ -132,7 +151,12 @@ fn random_tcp(rng: &mut StdRng) -> Vec3 {
 }
 
 /// The three lower-link boxes of robot A (at the origin) and of robot B (at `(d, 0, 0)`).
-fn lower_links(model: &RobotModel, tcp_a: &Vec3, tcp_b: &Vec3, d: Real) -> Option<([Obb; 3], [Obb; 3])> {
+fn lower_links(
+    model: &RobotModel,
+    tcp_a: &Vec3,
+    tcp_b: &Vec3,
+    d: Real,
+) -> Option<([Obb; 3], [Obb; 3])> {
     let a = model.boxes(tcp_a).ok()?;
     let b = model.boxes(tcp_b).ok()?;
     let shift = Vec3::new(d, 0.0, 0.0);
@@ -165,7 +189,10 @@ fn nine_pairs(c: &mut Criterion) {
         }
     }
     let expected: Vec<bool> = ring.iter().map(|(a, b)| plain_loop(a, b).is_some()).collect();
-    println!("nine_pairs ring: {} of {RING} configurations collide", expected.iter().filter(|&&v| v).count());
+    println!(
+        "nine_pairs ring: {} of {RING} configurations collide",
+        expected.iter().filter(|&&v| v).count()
+    );
 
     let mut g = c.benchmark_group("nine_pairs");
     let mut k = 0;
@@ -188,7 +215,10 @@ fn nine_pairs(c: &mut Criterion) {
         bench.iter(|| {
             k = (k + 1) % RING;
             let (a, b) = &ring[k];
-            assert_eq!(cache.first_intersecting_pair(black_box(a), black_box(b)).is_some(), expected[k]);
+            assert_eq!(
+                cache.first_intersecting_pair(black_box(a), black_box(b)).is_some(),
+                expected[k]
+            );
         })
     });
     g.finish();
@@ -210,7 +240,10 @@ fn trajectory(reach: Real) -> Vec<([Obb; 3], [Obb; 3])> {
 
 fn trajectories(c: &mut Criterion) {
     let (practical, collision) = (trajectory(300.0), trajectory(400.0));
-    assert!(practical.iter().all(|(a, b)| plain_loop(a, b).is_none()), "the practical case never collides");
+    assert!(
+        practical.iter().all(|(a, b)| plain_loop(a, b).is_none()),
+        "the practical case never collides"
+    );
     let colliding = collision.iter().filter(|(a, b)| plain_loop(a, b).is_some()).count();
     println!("trajectory: practical 0 of 6000 ticks collide, collision case {colliding} of 6000");
     assert!(colliding > 300, "the collision case collides in its last part");
@@ -231,7 +264,10 @@ fn trajectories(c: &mut Criterion) {
                 WitnessCache::new,
                 |cache| {
                     for ((a, b), &e) in run.iter().zip(&expected) {
-                        assert_eq!(cache.first_intersecting_pair(black_box(a), black_box(b)).is_some(), e);
+                        assert_eq!(
+                            cache.first_intersecting_pair(black_box(a), black_box(b)).is_some(),
+                            e
+                        );
                     }
                 },
                 BatchSize::SmallInput,

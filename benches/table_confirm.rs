@@ -21,13 +21,18 @@ const TABLE: &[u8] = include_bytes!("../tests/data/golden/t1_k16_6d.dct");
 
 /// 128 configurations along `case` on T1: (TCPs, exact answer, the table's label).
 fn ring(case: &str) -> Vec<([Vec3; 2], TableAnswer, TableAnswer)> {
-    let scenario = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == case).unwrap();
+    let scenario = parse_scenarios(SCENARIOS)
+        .unwrap()
+        .into_iter()
+        .find(|s| s.cell == "T1" && s.case == case)
+        .unwrap();
     let cell = reference_cell("T1").unwrap();
     let mut exact = ExactChecker::new(cell.clone());
     let mut labels = TableChecker::with_confirmation(cell, TABLE, Confirmation::None).unwrap();
     (0..128)
         .map(|i| {
-            let tick = if case == "collision" { 3000 + (i * 23) % 3000 } else { (i * 47) % RUN_TICKS };
+            let tick =
+                if case == "collision" { 3000 + (i * 23) % 3000 } else { (i * 47) % RUN_TICKS };
             let mut tcps = [Vec3::zeros(); 2];
             scenario.tcps_at(tick, &mut tcps);
             let hit = exact.check(&tcps).unwrap().collides();
@@ -42,8 +47,12 @@ fn table_confirm(c: &mut Criterion) {
     for case in ["practical", "collision"] {
         let inputs = ring(case);
         let alarms = inputs.iter().filter(|(_, truth, label)| label != truth).count();
-        let lookups = inputs.iter().filter(|(_, _, label)| *label == TableAnswer::Collision).count();
-        eprintln!("T1 {case}: {lookups} of {} ring ticks confirmed, {alarms} of them false alarms", inputs.len());
+        let lookups =
+            inputs.iter().filter(|(_, _, label)| *label == TableAnswer::Collision).count();
+        eprintln!(
+            "T1 {case}: {lookups} of {} ring ticks confirmed, {alarms} of them false alarms",
+            inputs.len()
+        );
         let mut exact = ExactChecker::new(reference_cell("T1").unwrap());
         let mut i = 0;
         group.bench_function(BenchmarkId::new("exact", case), |b| {
@@ -54,7 +63,9 @@ fn table_confirm(c: &mut Criterion) {
                 assert_eq!(hit, *truth == TableAnswer::Collision);
             })
         });
-        for (name, confirmation) in [("table+confirm", Confirmation::Exact), ("table labels", Confirmation::None)] {
+        for (name, confirmation) in
+            [("table+confirm", Confirmation::Exact), ("table labels", Confirmation::None)]
+        {
             let cell = reference_cell("T1").unwrap();
             let mut table = TableChecker::with_confirmation(cell, TABLE, confirmation).unwrap();
             let mut i = 0;

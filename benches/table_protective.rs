@@ -28,7 +28,11 @@ const SCENARIOS: &str = include_str!("../c_harness/scenarios.txt");
 const K: u32 = 16;
 
 fn run_ticks() -> Vec<[Vec3; 2]> {
-    let s = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let s = parse_scenarios(SCENARIOS)
+        .unwrap()
+        .into_iter()
+        .find(|s| s.cell == "T1" && s.case == "practical")
+        .unwrap();
     (0..RUN_TICKS)
         .map(|tick| {
             let mut now = [Vec3::zeros(); 2];
@@ -51,9 +55,15 @@ fn table_protective(c: &mut Criterion) {
     .unwrap();
     let bytes = to_bytes(&table, &header);
     let ticks = run_ticks();
-    let stiff =
-        StopModel { reaction_ms: 2.0, decel_mm_s2: 120_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 };
-    for (name, cell) in [("default", t1.clone()), ("stiff", t1.clone().with_stopping(1.0, vec![stiff; 2]).unwrap())] {
+    let stiff = StopModel {
+        reaction_ms: 2.0,
+        decel_mm_s2: 120_000.0,
+        max_accel_mm_s2: 130_000.0,
+        max_speed_mm_s: 4_600.0,
+    };
+    for (name, cell) in
+        [("default", t1.clone()), ("stiff", t1.clone().with_stopping(1.0, vec![stiff; 2]).unwrap())]
+    {
         group(c, name, &cell, &bytes, &ticks);
     }
 }
@@ -62,7 +72,8 @@ fn group(c: &mut Criterion, model: &str, cell: &Cell, bytes: &[u8], ticks: &[[Ve
     let lookup = TableChecker::new(cell.clone(), bytes).unwrap();
     let bound = |_: usize, _: usize, t: &[Vec3]| lookup.clearance_bound(t);
     let mut group = c.benchmark_group(format!("table_protective_T1_practical_{model}"));
-    let mut table_mode = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+    let mut table_mode =
+        ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
     let reports: Vec<(Protective, bool)> = ticks
         .iter()
         .map(|t| {
@@ -70,9 +81,12 @@ fn group(c: &mut Criterion, model: &str, cell: &Cell, bytes: &[u8], ticks: &[[Ve
             (r.verdict, r.table_lookup)
         })
         .collect();
-    let mut exact_mode = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
-    let verdicts: Vec<Protective> = ticks.iter().map(|t| exact_mode.check(t).unwrap().verdict).collect();
-    let count = |v: Protective, of: &mut dyn Iterator<Item = Protective>| of.filter(|x| *x == v).count();
+    let mut exact_mode =
+        ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+    let verdicts: Vec<Protective> =
+        ticks.iter().map(|t| exact_mode.check(t).unwrap().verdict).collect();
+    let count =
+        |v: Protective, of: &mut dyn Iterator<Item = Protective>| of.filter(|x| *x == v).count();
     let lookups = reports.iter().filter(|r| r.1).count();
     println!(
         "{model}: table mode STOP {} WARN {}, {lookups} of {} ticks by the lookup alone; exact mode STOP {} WARN {}",
@@ -92,7 +106,10 @@ fn group(c: &mut Criterion, model: &str, cell: &Cell, bytes: &[u8], ticks: &[[Ve
             i += 1;
             // The verdict as in the first pass; whether the lookup or a proof kept from the
             // previous pass gives it may differ (kept proofs outlive `reset`).
-            assert_eq!(table_mode.check_with_table(black_box(&ticks[k]), &bound).unwrap().verdict, reports[k].0);
+            assert_eq!(
+                table_mode.check_with_table(black_box(&ticks[k]), &bound).unwrap().verdict,
+                reports[k].0
+            );
         })
     });
     let mut i = 0;
@@ -116,7 +133,8 @@ fn group(c: &mut Criterion, model: &str, cell: &Cell, bytes: &[u8], ticks: &[[Ve
             assert_eq!(exact.check(black_box(&ticks[k])).unwrap().collides(), hits[k]);
         })
     });
-    let mut table = TableChecker::with_confirmation(cell.clone(), bytes, Confirmation::Exact).unwrap();
+    let mut table =
+        TableChecker::with_confirmation(cell.clone(), bytes, Confirmation::Exact).unwrap();
     let mut i = 0;
     group.bench_function(BenchmarkId::new("dc_query", "table"), |b| {
         b.iter(|| {

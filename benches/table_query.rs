@@ -49,13 +49,17 @@ impl<'a> LabelArray<'a> {
         let k = space.grid_a.k as usize;
         let dense = |cells: &[[u16; 3]]| {
             let mut m = vec![u32::MAX; k * k * k];
-            cells
-                .iter()
-                .enumerate()
-                .for_each(|(i, c)| m[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] = i as u32);
+            cells.iter().enumerate().for_each(|(i, c)| {
+                m[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] = i as u32
+            });
             m
         };
-        LabelArray { k, index_a: dense(&space.grid_a.cells), index_b: dense(&space.grid_b.cells), space }
+        LabelArray {
+            k,
+            index_a: dense(&space.grid_a.cells),
+            index_b: dense(&space.grid_b.cells),
+            space,
+        }
     }
 
     fn query(&self, c: [u16; 6]) -> bool {
@@ -103,14 +107,22 @@ fn build(s: &LabelledSpace) -> Vec<Table> {
     };
     for symmetric in [false, sym] {
         let tag = if symmetric { " sym" } else { "" };
-        timed(&format!("6D{tag}"), &|| Table::D6(LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).unwrap()));
-        timed(&format!("5D{tag}"), &|| Table::D5(LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).unwrap()));
+        timed(&format!("6D{tag}"), &|| {
+            Table::D6(LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).unwrap())
+        });
+        timed(&format!("5D{tag}"), &|| {
+            Table::D5(LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).unwrap())
+        });
         for (axes, t) in [(SliceAxes::YY, 0), (SliceAxes::YY, 150), (SliceAxes::ZZ, 0)] {
             timed(&format!("4D/{axes:?} t={t}{tag}"), &|| {
-                Table::D4(LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), axes, t).unwrap())
+                Table::D4(
+                    LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), axes, t).unwrap(),
+                )
             });
         }
-        timed(&format!("6D-shared{tag}"), &|| Table::Shared(SharedQuadtree6d::build(s, Symmetry::from_flag(symmetric)).unwrap()));
+        timed(&format!("6D-shared{tag}"), &|| {
+            Table::Shared(SharedQuadtree6d::build(s, Symmetry::from_flag(symmetric)).unwrap())
+        });
         if !sym {
             break;
         }
@@ -155,7 +167,9 @@ fn bench_query(c: &mut Criterion) {
     let peer0 = LabelArray::new(&s);
     tail("label_array (peer)", &cases, &|c| peer0.query(c));
     for t in &tables {
-        tail(&format!("{}{}", t.name(), if t.symmetric() { " sym" } else { "" }), &cases, &|c| t.query(c));
+        tail(&format!("{}{}", t.name(), if t.symmetric() { " sym" } else { "" }), &cases, &|c| {
+            t.query(c)
+        });
     }
     let peer = LabelArray::new(&s);
     let mut g = c.benchmark_group("table_query_k32");

@@ -40,8 +40,8 @@ use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::cspace::symmetry::reflection_y;
 use delta_collide::cspace::{
-    label_space_certified, label_space_subdivided, label_space_thesis, CertifiedSpace, LabelledSpace, Progress,
-    SampleGrid, SubdividedLabels, Symmetry, Workspace,
+    label_space_certified, label_space_subdivided, label_space_thesis, CertifiedSpace,
+    LabelledSpace, Progress, SampleGrid, SubdividedLabels, Symmetry, Workspace,
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::*;
@@ -56,7 +56,9 @@ use rng::BenchRng;
 use shared_peer::SeparateArrays;
 use std::collections::HashSet;
 use std::time::Instant;
-use timing::{fastest_of_passes, fastest_of_passes_in_turns, flush, hottest_of_passes, percentiles, Clock};
+use timing::{
+    fastest_of_passes, fastest_of_passes_in_turns, flush, hottest_of_passes, percentiles, Clock,
+};
 
 /// The tables of the report, by the key `--variants` takes, in report order (see
 /// [`entries`]; the plain kinds by their [`TableKind`] names, the two `-bound` keys are
@@ -116,8 +118,10 @@ fn options() -> Options {
         println!("{USAGE}");
         std::process::exit(0);
     }
-    let value = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
-    let num = |name: &str, default: usize| value(name).map_or(default, |v| v.parse().expect("a number"));
+    let value =
+        |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
+    let num =
+        |name: &str, default: usize| value(name).map_or(default, |v| v.parse().expect("a number"));
     let all = || VARIANTS.iter().map(|v| v.to_string()).collect();
     if !args.iter().any(|a| a == "--bench") {
         return Options {
@@ -133,7 +137,8 @@ fn options() -> Options {
             smoke: true,
         };
     }
-    let list = |name: &str| value(name).map(|v| v.split(',').map(str::to_string).collect::<Vec<_>>());
+    let list =
+        |name: &str| value(name).map(|v| v.split(',').map(str::to_string).collect::<Vec<_>>());
     let variants = list("--variants").unwrap_or_else(all);
     if let Some(v) = variants.iter().find(|v| !VARIANTS.contains(&v.as_str())) {
         panic!("--variants: unknown table {v:?}; use {}", VARIANTS.join(","));
@@ -199,7 +204,11 @@ fn configurations(cell: &Cell, space: &LabelledSpace, n: usize, ws: &Workspace) 
     while out.len() < n {
         for t in &mut tcps {
             let (x, y, d) = (rng.uniform(), rng.uniform(), rng.uniform());
-            *t = Vec3::new(rmax * (2.0 * x - 1.0), rmax * (2.0 * y - 1.0), -(ws.zu + (dmax - ws.zu) * d));
+            *t = Vec3::new(
+                rmax * (2.0 * x - 1.0),
+                rmax * (2.0 * y - 1.0),
+                -(ws.zu + (dmax - ws.zu) * d),
+            );
         }
         if !tcps.iter().all(|t| ws.contains(t)) {
             continue;
@@ -208,7 +217,10 @@ fn configurations(cell: &Cell, space: &LabelledSpace, n: usize, ws: &Workspace) 
         if v.unreachable_mask != 0 {
             continue;
         }
-        let cell = match (grid_cell(&space.grid_a, &sa, &tcps[0]), grid_cell(&space.grid_b, &sb, &tcps[1])) {
+        let cell = match (
+            grid_cell(&space.grid_a, &sa, &tcps[0]),
+            grid_cell(&space.grid_b, &sb, &tcps[1]),
+        ) {
             (Some(a), Some(b)) => Some([a[0], a[1], a[2], b[0], b[1], b[2]]),
             _ => None,
         };
@@ -217,7 +229,12 @@ fn configurations(cell: &Cell, space: &LabelledSpace, n: usize, ws: &Workspace) 
     out
 }
 
-fn query_ns(clock: Clock, table: &Table, cell: [u16; 6], regions: Option<&[(usize, usize)]>) -> u64 {
+fn query_ns(
+    clock: Clock,
+    table: &Table,
+    cell: [u16; 6],
+    regions: Option<&[(usize, usize)]>,
+) -> u64 {
     if let Some(r) = regions {
         flush(r);
     }
@@ -240,9 +257,18 @@ struct Times {
 
 /// As [`time_queries`] for a shared table and its separate-arrays peer, taking turns: the
 /// table's times, then the peer's.
-fn time_with_peer(clock: Clock, table: &Table, peer: &SeparateArrays, cells: &[[u16; 6]], cold: usize) -> [Times; 2] {
-    let (hot, hot_peer) =
-        hottest_of_passes(cells, |c| query_ns(clock, table, c, None), Some(&mut |c| clock.time(c, |c| peer.query(c))));
+fn time_with_peer(
+    clock: Clock,
+    table: &Table,
+    peer: &SeparateArrays,
+    cells: &[[u16; 6]],
+    cold: usize,
+) -> [Times; 2] {
+    let (hot, hot_peer) = hottest_of_passes(
+        cells,
+        |c| query_ns(clock, table, c, None),
+        Some(&mut |c| clock.time(c, |c| peer.query(c))),
+    );
     let (streamed, streamed_peer) = fastest_of_passes_in_turns(
         cells,
         WARM_UP,
@@ -264,7 +290,10 @@ fn time_with_peer(clock: Clock, table: &Table, peer: &SeparateArrays, cells: &[[
     } else {
         (vec![], vec![])
     };
-    [Times { hot, streamed, flushed }, Times { hot: hot_peer, streamed: streamed_peer, flushed: flushed_peer }]
+    [
+        Times { hot, streamed, flushed },
+        Times { hot: hot_peer, streamed: streamed_peer, flushed: flushed_peer },
+    ]
 }
 
 /// The report's three timing cells: hot, streamed, flushed (of `cold` queries).
@@ -300,7 +329,8 @@ fn own_lines_flushed(clock: Clock, table: &Table, cells: &[[u16; 6]]) -> Vec<u64
         return vec![];
     }
     fastest_of_passes(cells, |c| {
-        let lines: Vec<(usize, usize)> = shared.query_reads(c).1.iter().map(|&(a, n, _)| (a, n)).collect();
+        let lines: Vec<(usize, usize)> =
+            shared.query_reads(c).1.iter().map(|&(a, n, _)| (a, n)).collect();
         query_ns(clock, table, c, Some(&lines))
     })
 }
@@ -308,7 +338,8 @@ fn own_lines_flushed(clock: Clock, table: &Table, cells: &[[u16; 6]]) -> Vec<u64
 /// The reads of one shared-table query: dependent steps, reads, cache lines, 4 KiB pages.
 fn read_counts(reads: &[(usize, usize, u32)]) -> (u32, usize, usize, usize) {
     let steps = reads.iter().map(|r| r.2 + 1).max().unwrap_or(0);
-    let mut lines: Vec<usize> = reads.iter().flat_map(|&(a, n, _)| [a / 64, (a + n - 1) / 64]).collect();
+    let mut lines: Vec<usize> =
+        reads.iter().flat_map(|&(a, n, _)| [a / 64, (a + n - 1) / 64]).collect();
     let mut pages: Vec<usize> = reads.iter().map(|&(a, _, _)| a / 4096).collect();
     for v in [&mut lines, &mut pages] {
         v.sort_unstable();
@@ -343,7 +374,9 @@ fn slowest_report(
     let refs: Vec<usize> = p
         .depth_start
         .windows(2)
-        .map(|w| p.masks[w[0] as usize..w[1] as usize].iter().map(|m| m[0].count_ones() as usize).sum())
+        .map(|w| {
+            p.masks[w[0] as usize..w[1] as usize].iter().map(|m| m[0].count_ones() as usize).sum()
+        })
         .collect();
     let mut out = vec![
         format!(
@@ -387,9 +420,16 @@ fn contents(table: &Table) -> String {
             let per_depth = q.nodes_per_depth();
             let depths: Vec<String> = per_depth.iter().map(|n| n.to_string()).collect();
             let bits: Vec<String> = q.slot_bits().iter().map(|b| b.to_string()).collect();
-            format!("{} nodes ({}; slot bits {})", per_depth.iter().sum::<usize>(), depths.join("/"), bits.join("/"))
+            format!(
+                "{} nodes ({}; slot bits {})",
+                per_depth.iter().sum::<usize>(),
+                depths.join("/"),
+                bits.join("/")
+            )
         }
-        Table::Clearance(q) => format!("{} levels, level tree at k / {}", q.ladder().len(), 1u32 << q.shift()),
+        Table::Clearance(q) => {
+            format!("{} levels, level tree at k / {}", q.ladder().len(), 1u32 << q.shift())
+        }
     }
 }
 
@@ -420,9 +460,15 @@ const OF_SUB_CELL_LABELS: [&str; 6] =
     ["4d-yy-sub", "4d-zz-sub", "4d-yy-sub-bound", "4d-zz-sub-bound", "6d-sub", "5d-sub"];
 
 /// The subdivided certified labelling of `cell`, when a table `wants` asks for needs it.
-fn subdivided(cell: &Cell, k: u32, ws: &Workspace, wants: &dyn Fn(&str) -> bool) -> Option<(CertifiedSpace, f64)> {
-    (wants("shared-sub") || OF_SUB_CELL_LABELS.iter().any(|key| wants(key)))
-        .then(|| timed(|| label_space_subdivided(cell, k, ws, Progress::Silent).expect("labelling")))
+fn subdivided(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    wants: &dyn Fn(&str) -> bool,
+) -> Option<(CertifiedSpace, f64)> {
+    (wants("shared-sub") || OF_SUB_CELL_LABELS.iter().any(|key| wants(key))).then(|| {
+        timed(|| label_space_subdivided(cell, k, ws, Progress::Silent).expect("labelling"))
+    })
 }
 
 impl<'s> Labellings<'s> {
@@ -438,7 +484,9 @@ impl<'s> Labellings<'s> {
         // The 6-D table of the plain labels is also the reference the shared tables are
         // checked against.
         let plain = needs(&["6d", "5d", "4d-yy", "4d-zz", "4d-yy-lossy", "shared"]);
-        let certified = plain.then(|| timed(|| label_space_certified(cell, k, ws, Progress::Silent).expect("labelling").space));
+        let certified = plain.then(|| {
+            timed(|| label_space_certified(cell, k, ws, Progress::Silent).expect("labelling").space)
+        });
         let fine = subdivided.filter(|_| needs(&OF_SUB_CELL_LABELS)).map(|(s, secs)| {
             let (f, more) = timed(|| SubdividedLabels::new(cell, ws, s).expect("2k grids"));
             (f, secs + more)
@@ -447,7 +495,9 @@ impl<'s> Labellings<'s> {
             let (d, more) = timed(|| f.to_dense());
             (d, secs + more)
         });
-        let thesis = wants("thesis").then(|| timed(|| label_space_thesis(cell, k, ws, Progress::Silent).expect("labelling")));
+        let thesis = wants("thesis").then(|| {
+            timed(|| label_space_thesis(cell, k, ws, Progress::Silent).expect("labelling"))
+        });
         Labellings { certified, subdivided, fine, dense, thesis }
     }
 
@@ -480,9 +530,22 @@ struct Entry<'a> {
 }
 
 impl<'a> Entry<'a> {
-    fn new(key: &'static str, label: impl Into<String>, labels: &'a (LabelledSpace, f64), build: Build<'a>) -> Self {
+    fn new(
+        key: &'static str,
+        label: impl Into<String>,
+        labels: &'a (LabelledSpace, f64),
+        build: Build<'a>,
+    ) -> Self {
         let label = label.into();
-        Entry { key, label, space: &labels.0, label_secs: labels.1, certified: true, of_sub_cell_labels: false, build }
+        Entry {
+            key,
+            label,
+            space: &labels.0,
+            label_secs: labels.1,
+            certified: true,
+            of_sub_cell_labels: false,
+            build,
+        }
     }
 }
 
@@ -490,36 +553,100 @@ impl<'a> Entry<'a> {
 fn entries<'a>(l: &'a Labellings<'a>, symmetric: bool, t_lossy: u32) -> Vec<Entry<'a>> {
     let mut out = vec![];
     if let Some(c) = &l.certified {
-        let d4 = |axes, t| -> Build<'a> { Box::new(move |s| LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), axes, t).map(Table::D4)) };
-        out.push(Entry::new(TableKind::D6.name(), "6D", c, Box::new(move |s| LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::D6))));
-        out.push(Entry::new(TableKind::D5.name(), "5D", c, Box::new(move |s| LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).map(Table::D5))));
+        let d4 = |axes, t| -> Build<'a> {
+            Box::new(move |s| {
+                LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), axes, t).map(Table::D4)
+            })
+        };
+        out.push(Entry::new(
+            TableKind::D6.name(),
+            "6D",
+            c,
+            Box::new(move |s| {
+                LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::D6)
+            }),
+        ));
+        out.push(Entry::new(
+            TableKind::D5.name(),
+            "5D",
+            c,
+            Box::new(move |s| {
+                LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).map(Table::D5)
+            }),
+        ));
         out.push(Entry::new(TableKind::D4yy.name(), "4D/yy t=0", c, d4(SliceAxes::YY, 0)));
         out.push(Entry::new(TableKind::D4zz.name(), "4D/zz t=0", c, d4(SliceAxes::ZZ, 0)));
-        out.push(Entry::new("4d-yy-lossy", format!("4D/yy t={t_lossy}"), c, d4(SliceAxes::YY, t_lossy)));
-        let shared: Build = Box::new(move |s| SharedQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::Shared));
+        out.push(Entry::new(
+            "4d-yy-lossy",
+            format!("4D/yy t={t_lossy}"),
+            c,
+            d4(SliceAxes::YY, t_lossy),
+        ));
+        let shared: Build = Box::new(move |s| {
+            SharedQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::Shared)
+        });
         out.push(Entry::new(TableKind::Shared.name(), "6D-shared", c, shared));
     }
     if let Some((sub, secs)) = l.subdivided {
         let sub_cells = sub.sub.as_ref().expect("sub-cells");
-        let build: Build = Box::new(move |s| SharedQuadtree6d::build_subdivided(s, sub_cells, Symmetry::from_flag(symmetric)).map(Table::Shared));
-        out.push(Entry { key: TableKind::SharedSub.name(), label: "6D-shared/sub".into(), space: &sub.space, label_secs: *secs, certified: true, of_sub_cell_labels: false, build });
+        let build: Build = Box::new(move |s| {
+            SharedQuadtree6d::build_subdivided(s, sub_cells, Symmetry::from_flag(symmetric))
+                .map(Table::Shared)
+        });
+        out.push(Entry {
+            key: TableKind::SharedSub.name(),
+            label: "6D-shared/sub".into(),
+            space: &sub.space,
+            label_secs: *secs,
+            certified: true,
+            of_sub_cell_labels: false,
+            build,
+        });
     }
     if let (Some((sub, _)), Some((fine, secs))) = (l.subdivided, &l.fine) {
-        for (key, axes, name) in [("4d-yy-sub", SliceAxes::YY, "yy"), ("4d-zz-sub", SliceAxes::ZZ, "zz")] {
-            let build: Build = Box::new(move |_| LinearQuadtree4d::build_subdivided(fine, Symmetry::from_flag(symmetric), axes, 0).map(Table::D4));
+        for (key, axes, name) in
+            [("4d-yy-sub", SliceAxes::YY, "yy"), ("4d-zz-sub", SliceAxes::ZZ, "zz")]
+        {
+            let build: Build = Box::new(move |_| {
+                LinearQuadtree4d::build_subdivided(fine, Symmetry::from_flag(symmetric), axes, 0)
+                    .map(Table::D4)
+            });
             let label = format!("4D/{name} t=0 of the sub-cell labels (2k)");
-            out.push(Entry { key, label, space: &sub.space, label_secs: *secs, certified: true, of_sub_cell_labels: true, build });
+            out.push(Entry {
+                key,
+                label,
+                space: &sub.space,
+                label_secs: *secs,
+                certified: true,
+                of_sub_cell_labels: true,
+                build,
+            });
         }
     }
     if let Some(dense) = &l.dense {
-        let d6: Build = Box::new(move |s| LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::D6));
-        let d5: Build = Box::new(move |s| LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).map(Table::D5));
-        out.push(Entry { of_sub_cell_labels: true, ..Entry::new("6d-sub", "6D of the sub-cell labels (2k)", dense, d6) });
-        out.push(Entry { of_sub_cell_labels: true, ..Entry::new("5d-sub", "5D of the sub-cell labels (2k)", dense, d5) });
+        let d6: Build = Box::new(move |s| {
+            LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::D6)
+        });
+        let d5: Build = Box::new(move |s| {
+            LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).map(Table::D5)
+        });
+        out.push(Entry {
+            of_sub_cell_labels: true,
+            ..Entry::new("6d-sub", "6D of the sub-cell labels (2k)", dense, d6)
+        });
+        out.push(Entry {
+            of_sub_cell_labels: true,
+            ..Entry::new("5d-sub", "5D of the sub-cell labels (2k)", dense, d5)
+        });
     }
     if let Some(thesis) = &l.thesis {
-        let d6: Build = Box::new(move |s| LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::D6));
-        out.push(Entry { certified: false, ..Entry::new("thesis", "thesis-style 6D (r/sqrt 2)", thesis, d6) });
+        let d6: Build = Box::new(move |s| {
+            LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).map(Table::D6)
+        });
+        out.push(Entry {
+            certified: false,
+            ..Entry::new("thesis", "thesis-style 6D (r/sqrt 2)", thesis, d6)
+        });
     }
     out
 }
@@ -552,7 +679,8 @@ impl Run<'_> {
         }
         let is_shared = matches!(table, Table::Shared(_)) && table.sub_levels() == 0;
         let cold = if is_shared { opt.cold_shared } else { opt.cold };
-        let cells: Vec<[u16; 6]> = self.fine.iter().map(|&f| query_cell(table, f, self.fine_levels)).collect();
+        let cells: Vec<[u16; 6]> =
+            self.fine.iter().map(|&f| query_cell(table, f, self.fine_levels)).collect();
         let cold = cold.min(cells.len());
         let peer = match table {
             Table::Shared(t) => Some(SeparateArrays::new(t)),
@@ -562,7 +690,11 @@ impl Run<'_> {
             Some(peer) => {
                 // The separate-arrays peer answers as the table on every configuration.
                 for &c in &cells {
-                    assert_eq!(peer.query(c), table.query(c), "{name} {label}: separate-arrays peer at {c:?}");
+                    assert_eq!(
+                        peer.query(c),
+                        table.query(c),
+                        "{name} {label}: separate-arrays peer at {c:?}"
+                    );
                 }
                 time_with_peer(self.clock, table, peer, &cells, cold)
             }
@@ -590,8 +722,10 @@ impl Run<'_> {
         let own = own_lines_flushed(self.clock, table, &cells[..opt.cold_own.min(cells.len())]);
         if !own.is_empty() {
             let n = own.len().min(cold);
-            let [_, _, all] = timing_cells(&Times { flushed: own.clone(), ..Times::default() }, own.len());
-            let [_, _, first] = timing_cells(&Times { flushed: own[..n].to_vec(), ..Times::default() }, n);
+            let [_, _, all] =
+                timing_cells(&Times { flushed: own.clone(), ..Times::default() }, own.len());
+            let [_, _, first] =
+                timing_cells(&Times { flushed: own[..n].to_vec(), ..Times::default() }, n);
             notes.push(format!(
                 "{label}: flushed with only its own lines evicted: {all}; its first {n} queries: {first} \
                  (the whole table evicted: {f})"
@@ -599,7 +733,14 @@ impl Run<'_> {
         }
         if opt.slowest > 0 {
             notes.extend(slowest_report(self.clock, table, &cells, &times.hot, "hot", opt.slowest));
-            notes.extend(slowest_report(self.clock, table, &cells, &times.streamed, "streamed", opt.slowest));
+            notes.extend(slowest_report(
+                self.clock,
+                table,
+                &cells,
+                &times.streamed,
+                "streamed",
+                opt.slowest,
+            ));
         }
     }
 
@@ -615,17 +756,29 @@ impl Run<'_> {
 
     /// The notes on the lower bounds of the 4-D tables of the sub-cell labels, for when
     /// building them would take hours ([`SliceBound`]).
-    fn slice_bounds(&self, fine: &SubdividedLabels, symmetric: bool, sub_table: Option<&Table>, wants: &dyn Fn(&str) -> bool) -> Vec<String> {
-        let bounds = [("4d-yy-sub-bound", SliceAxes::YY, "yy"), ("4d-zz-sub-bound", SliceAxes::ZZ, "zz")];
+    fn slice_bounds(
+        &self,
+        fine: &SubdividedLabels,
+        symmetric: bool,
+        sub_table: Option<&Table>,
+        wants: &dyn Fn(&str) -> bool,
+    ) -> Vec<String> {
+        let bounds =
+            [("4d-yy-sub-bound", SliceAxes::YY, "yy"), ("4d-zz-sub-bound", SliceAxes::ZZ, "zz")];
         let mut notes = vec![];
         for (_, axes, axes_name) in bounds.into_iter().filter(|b| wants(b.0)) {
             let start = Instant::now();
             let mut bound = SliceBound::new(fine.grid_a.levels, symmetric, axes);
-            subdivided_slices(fine, symmetric, axes, |_, s, care| bound.add(s, care)).expect("slices");
-            let ((groups, (r0, c0, side)), bytes) = (bound.groups_at_least(), bound.bytes_at_least());
+            subdivided_slices(fine, symmetric, axes, |_, s, care| bound.add(s, care))
+                .expect("slices");
+            let ((groups, (r0, c0, side)), bytes) =
+                (bound.groups_at_least(), bound.bytes_at_least());
             let ratio = sub_table.map_or(String::new(), |t| {
                 let b = t.memory_bytes();
-                format!("; `6D-shared/sub` ({b} bytes) is {:.1} % of that", 100.0 * b as f64 / bytes as f64)
+                format!(
+                    "; `6D-shared/sub` ({b} bytes) is {:.1} % of that",
+                    100.0 * b as f64 / bytes as f64
+                )
             });
             notes.push(format!(
                 "4D/{axes_name} t=0 of the sub-cell labels (2k), bounded in {:.0} s: {} codes, at least {groups} \
@@ -657,19 +810,25 @@ fn main() {
         let configs = configurations(&cell, labellings.grids(), opt.random, &ws);
         let fine: Vec<[u16; 6]> = configs.iter().filter_map(|c| c.fine).collect();
         let outside = configs.len() - fine.len();
-        let run = Run { name, opt: &opt, clock, configs, fine, fine_levels: opt.k.trailing_zeros() + 1 };
+        let run =
+            Run { name, opt: &opt, clock, configs, fine, fine_levels: opt.k.trailing_zeros() + 1 };
         for c in [Some(Clock::Instant), tsc].into_iter().flatten() {
             let (hot, _) = hottest_of_passes(&run.fine, |f| c.time(f, |f| f), None);
             let streamed = fastest_of_passes(&run.fine, |f| c.time(f, |f| f));
             let [h, s, _] = timing_cells(&Times { hot, streamed, flushed: vec![] }, 0);
-            println!("| {name} | {} | timer: {} (two reads) | | | | {h} | {s} | | | | | | |", opt.k, c.name());
+            println!(
+                "| {name} | {} | timer: {} (two reads) | | | | {h} | {s} | | | | | | |",
+                opt.k,
+                c.name()
+            );
         }
         let shared_wanted = wants("shared") || wants("shared-sub");
         let (mut d6, mut sub_table): (Option<Table>, Option<Table>) = (None, None);
         let mut notes = vec![];
         let t_lossy = if opt.k >= 64 { 545 } else { 150 };
         for entry in entries(&labellings, symmetric, t_lossy) {
-            // The 6-D table is the shared tables' reference: built (not reported) when only they are asked for.
+            // The 6-D table is the shared tables' reference: built (not reported) when only they
+            // are asked for.
             let report = wants(entry.key);
             if !(report || entry.key == "6d" && shared_wanted) {
                 continue;

@@ -26,13 +26,19 @@ fn main() {
     let mut exact = ExactChecker::new(cell.clone());
     let hits: Vec<bool> = run.iter().map(|t| exact.check(t).unwrap().collides()).collect();
     let mut table = (mode == "table").then(|| {
-        let built =
-            build_bundle(&line(4), k, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
-                .unwrap();
+        let built = build_bundle(
+            &line(4),
+            k,
+            &Workspace::THESIS,
+            Variant::Shared,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap();
         BundleChecker::new(cell.clone(), &built.bytes, Confirmation::Exact).unwrap()
     });
-    let mut protective =
-        (mode == "protective").then(|| ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false));
+    let mut protective = (mode == "protective")
+        .then(|| ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false));
     // Ticks per protective verdict (FREE, WARN, STOP), over every pass.
     let mut verdicts = [0u64; 3];
     eprintln!("start");

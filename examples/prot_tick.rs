@@ -1,9 +1,9 @@
 //! Per-tick medians of the protective verdict and the exact query over the practical and
-//! collision runs, for profiling: `prot_tick [stiff|default] [verdict|limits] [repeats] [T1practical|...]`
-//! (the last argument keeps one run). With `COMPONENTS` set in the environment it times only the
-//! parts of a tick that reuses a kept proof: the boxes, the clearance, the closest box pair alone.
-//! `LIMIT_TESTS=n` caps the speeds tested per robot and tick by the speed-limit search
-//! (`ProtectiveChecker::with_limit_tests`; `4294967295`: not capped).
+//! collision runs, for profiling: `prot_tick [stiff|default] [verdict|limits] [repeats]
+//! [T1practical|...]` (the last argument keeps one run). With `COMPONENTS` set in the environment
+//! it times only the parts of a tick that reuses a kept proof: the boxes, the clearance, the
+//! closest box pair alone. `LIMIT_TESTS=n` caps the speeds tested per robot and tick by the
+//! speed-limit search (`ProtectiveChecker::with_limit_tests`; `4294967295`: not capped).
 
 use delta_collide::cell::protective::{Protective, ProtectiveChecker};
 use delta_collide::cell::reference::reference_cell;
@@ -22,7 +22,12 @@ fn main() {
     let repeats: usize = args.get(3).map_or(1, |a| a.parse().unwrap());
     let only = args.get(4).cloned();
     let stop = if stiff {
-        StopModel { reaction_ms: 2.0, decel_mm_s2: 120_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 }
+        StopModel {
+            reaction_ms: 2.0,
+            decel_mm_s2: 120_000.0,
+            max_accel_mm_s2: 130_000.0,
+            max_speed_mm_s: 4_600.0,
+        }
     } else {
         StopModel::DEFAULT
     };
@@ -50,7 +55,8 @@ fn main() {
         // hashes say two builds gave the same answers; the verdicts alone, likewise (the
         // limiting pair is any pair not proved, and may change with the order of the tests);
         // and the first WARN and STOP ticks.
-        let (mut answers, mut verdicts): (u64, u64) = (0xcbf2_9ce4_8422_2325, 0xcbf2_9ce4_8422_2325);
+        let (mut answers, mut verdicts): (u64, u64) =
+            (0xcbf2_9ce4_8422_2325, 0xcbf2_9ce4_8422_2325);
         let (mut first_warn, mut first_stop) = (None, None);
         for rep in 0..repeats * usize::from(std::env::var("COMPONENTS").is_err()) {
             c.reset();
@@ -72,7 +78,9 @@ fn main() {
                 te.push((t2 - t1).as_secs_f64() * 1e6);
                 if rep == 0 {
                     let r = c.report();
-                    let limiting = r.limiting.map_or(0, |p| 1 + p.a * 1000 + p.b * 100 + p.box_a * 10 + p.box_b);
+                    let limiting = r
+                        .limiting
+                        .map_or(0, |p| 1 + p.a * 1000 + p.b * 100 + p.box_a * 10 + p.box_b);
                     for x in [v as u64, limiting as u64] {
                         answers = (answers ^ x).wrapping_mul(0x0100_0000_01b3);
                     }
@@ -98,8 +106,10 @@ fn main() {
             let t1 = Instant::now();
             let c = memory.boxes_clearance(exact.boxes(0).as_slice(), exact.boxes(1).as_slice());
             let t2 = Instant::now();
-            let (ba, bb) =
-                (&exact.boxes(0).as_slice()[c.box_a..c.box_a + 1], &exact.boxes(1).as_slice()[c.box_b..c.box_b + 1]);
+            let (ba, bb) = (
+                &exact.boxes(0).as_slice()[c.box_a..c.box_a + 1],
+                &exact.boxes(1).as_slice()[c.box_b..c.box_b + 1],
+            );
             let t3 = Instant::now();
             std::hint::black_box(singles[c.box_a * 3 + c.box_b].boxes_clearance(ba, bb));
             let t4 = Instant::now();
@@ -124,14 +134,22 @@ fn main() {
         // than the median of all times on a shared machine.
         let least = |t: &[f64]| {
             let mut m: Vec<f64> = (0..RUN_TICKS as usize)
-                .map(|i| t.iter().skip(i).step_by(RUN_TICKS as usize).copied().fold(f64::INFINITY, f64::min))
+                .map(|i| {
+                    t.iter()
+                        .skip(i)
+                        .step_by(RUN_TICKS as usize)
+                        .copied()
+                        .fold(f64::INFINITY, f64::min)
+                })
                 .collect();
             let median = q(&mut m).0;
             (median, m[m.len() - 1])
         };
         let ((pl, worst), (el, _)) = (least(&tp), least(&te));
         let ((pm, p99, pmean), (em, _, _)) = (q(&mut tp), q(&mut te));
-        for (name, t) in ["FREE", "WARN", "STOP"].iter().zip(&mut by_verdict).filter(|(_, t)| !t.is_empty()) {
+        for (name, t) in
+            ["FREE", "WARN", "STOP"].iter().zip(&mut by_verdict).filter(|(_, t)| !t.is_empty())
+        {
             let (m, p, _) = q(t);
             let under = t.iter().filter(|&&x| x < 1.0).count();
             println!(

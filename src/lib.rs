@@ -7,7 +7,8 @@
 //! | module | what | thesis | SPEC |
 //! |---|---|---|---|
 //! | [`math`] | scalar and vector aliases, named tolerances | | §1 |
-//! | [`geometry`] | oriented boxes, separating axis test, witness cache, box distance | 2.4, 3.1 | §3 |
+//! | [`geometry`] | oriented boxes, separating axis test, witness cache, box distance | 2.4, 3.1 |
+//! §3 |
 //! | [`robot`] | Delta3 kinematics, the box model of one robot | 2.2, 2.5, 2.6 | §2, §3 |
 //! | [`cell`] | robots, placements, the exact check of a whole cell | 2.3, 3.1.4 | §1, §5 |
 //! | [`ffi`] | the only `extern "C"` surface (opaque handle, POU lifecycle) | App. A | |

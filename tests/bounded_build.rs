@@ -11,15 +11,26 @@ use std::process::{Command, Output};
 const BIN: &str = env!("CARGO_BIN_EXE_delta-collide");
 
 fn cli(args: &[&str]) -> Output {
-    Command::new(BIN).arg("--quiet").args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+    Command::new(BIN)
+        .arg("--quiet")
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
 }
 
 /// The table file of the one-shot library build of `cell` at k = 16.
 fn one_shot(cell: &str) -> Vec<u8> {
     let cell = reference_cell(cell).unwrap();
-    let (header, table, _) =
-        build_table(&cell, 16, &Workspace::THESIS, Variant::SharedSubdivided, Labelling::Certified, Progress::Silent)
-            .unwrap();
+    let (header, table, _) = build_table(
+        &cell,
+        16,
+        &Workspace::THESIS,
+        Variant::SharedSubdivided,
+        Labelling::Certified,
+        Progress::Silent,
+    )
+    .unwrap();
     to_bytes(&table, &header)
 }
 
@@ -27,8 +38,11 @@ fn one_shot(cell: &str) -> Vec<u8> {
 /// 4^3 x 4^3 cells and a sub-octant cache of 8 MiB, dropped again and again.
 fn tight(cell: &str) -> u64 {
     let c = reference_cell(cell).unwrap();
-    let plan = memory_plan(&c, 16, &Workspace::THESIS, Variant::SharedSubdivided, u64::MAX).unwrap();
-    let tight = memory_plan(&c, 16, &Workspace::THESIS, Variant::SharedSubdivided, plan.fixed + (16 << 20)).unwrap();
+    let plan =
+        memory_plan(&c, 16, &Workspace::THESIS, Variant::SharedSubdivided, u64::MAX).unwrap();
+    let tight =
+        memory_plan(&c, 16, &Workspace::THESIS, Variant::SharedSubdivided, plan.fixed + (16 << 20))
+            .unwrap();
     assert_eq!(tight.block_depth, 2, "{cell}: {tight:?}");
     plan.fixed + (16 << 20)
 }
@@ -39,7 +53,8 @@ fn streamed_matches_one_shot(cell: &str) {
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("t.dct");
     let max = tight(cell).to_string();
-    let args = ["build", "--cell", cell, "--k", "16", "--variant", "shared-sub", "--max-memory", &max];
+    let args =
+        ["build", "--cell", cell, "--k", "16", "--variant", "shared-sub", "--max-memory", &max];
     let out = cli(&[&args[..], &["--output", file.to_str().unwrap()]].concat());
     assert!(out.status.success(), "{cell}: {}", String::from_utf8_lossy(&out.stderr));
     assert!(std::fs::read(&file).unwrap() == one_shot(cell), "{cell}: the streamed table differs");
@@ -61,7 +76,19 @@ fn streamed_sub_cells_give_the_one_shot_table_t2() {
 #[test]
 fn an_impossible_bound_is_refused_up_front() {
     let start = std::time::Instant::now();
-    let out = cli(&["build", "--cell", "T1", "--k", "32", "--variant", "6d", "--max-memory", "64M", "--output", "x"]);
+    let out = cli(&[
+        "build",
+        "--cell",
+        "T1",
+        "--k",
+        "32",
+        "--variant",
+        "6d",
+        "--max-memory",
+        "64M",
+        "--output",
+        "x",
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("more than the 0.07 GB allowed") && err.contains("labels"), "{err}");

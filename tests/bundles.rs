@@ -8,7 +8,8 @@ use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::bundle::{build_bundle, plan, BUNDLE_VERSION};
 use delta_collide::table::{
-    bundle_from_bytes, bundle_to_bytes, BundleChecker, Confirmation, Labelling, TableAnswer, TableError, Variant,
+    bundle_from_bytes, bundle_to_bytes, BundleChecker, Confirmation, Labelling, TableAnswer,
+    TableError, Variant,
 };
 use std::sync::OnceLock;
 
@@ -40,15 +41,23 @@ fn line(n: usize, spacing: f64, shift: Vec3) -> Cell {
 /// relative placement matters.
 fn skewed() -> Cell {
     let mut cell = line(3, 450.0, Vec3::zeros());
-    cell.robots[1].placement = Placement { alpha: std::f64::consts::FRAC_PI_6, t: Vec3::new(430.0, 150.0, 0.0) };
+    cell.robots[1].placement =
+        Placement { alpha: std::f64::consts::FRAC_PI_6, t: Vec3::new(430.0, 150.0, 0.0) };
     cell.robots[2].placement = Placement { alpha: -0.9, t: Vec3::new(820.0, -120.0, 0.0) };
     cell
 }
 
 fn bundle_of(cell: &Cell) -> Vec<u8> {
-    build_bundle(cell, K, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
-        .unwrap_or_else(|e| panic!("building the bundle of {}: {e}", cell.name))
-        .bytes
+    build_bundle(
+        cell,
+        K,
+        &Workspace::THESIS,
+        Variant::Shared,
+        Labelling::Certified,
+        Progress::Silent,
+    )
+    .unwrap_or_else(|e| panic!("building the bundle of {}: {e}", cell.name))
+    .bytes
 }
 
 fn line4_bundle() -> &'static [u8] {
@@ -75,7 +84,11 @@ impl Rng {
 #[test]
 fn a_line_needs_one_table_per_spacing_that_can_meet() {
     let (cells, pairs) = plan(&line4());
-    assert_eq!((cells.len(), pairs.len()), (3, 6), "spacings 450, 900 and 1350 mm; every pair of four");
+    assert_eq!(
+        (cells.len(), pairs.len()),
+        (3, 6),
+        "spacings 450, 900 and 1350 mm; every pair of four"
+    );
     for p in &pairs {
         assert_eq!(p.table, p.b - p.a - 1, "pair {p:?}: its table is its spacing's");
     }
@@ -93,9 +106,16 @@ fn a_line_needs_one_table_per_spacing_that_can_meet() {
 /// Every pair's label (no confirmation) against the exact model of the whole cell: never FREE
 /// where that pair's boxes intersect; with the exact confirmation, every pair's answer is the
 /// exact model's. Returns the colliding pair answers seen.
-fn agrees_with_the_exact_model(cell: &Cell, bytes: &[u8], configurations: usize, seed: u64) -> usize {
-    let mut labels = BundleChecker::new(cell.clone(), bytes, Confirmation::None).expect("bundle loads");
-    let mut confirmed = BundleChecker::new(cell.clone(), bytes, Confirmation::Exact).expect("bundle loads");
+fn agrees_with_the_exact_model(
+    cell: &Cell,
+    bytes: &[u8],
+    configurations: usize,
+    seed: u64,
+) -> usize {
+    let mut labels =
+        BundleChecker::new(cell.clone(), bytes, Confirmation::None).expect("bundle loads");
+    let mut confirmed =
+        BundleChecker::new(cell.clone(), bytes, Confirmation::Exact).expect("bundle loads");
     let mut exact = ExactChecker::new(cell.clone());
     let mut rng = Rng(seed);
     let (mut collisions, mut false_alarms) = (0, 0);
@@ -111,7 +131,10 @@ fn agrees_with_the_exact_model(cell: &Cell, bytes: &[u8], configurations: usize,
                 PairState::Collides(..) => TableAnswer::Collision,
                 PairState::Free => TableAnswer::Free,
                 PairState::Undecided => {
-                    assert!(matches!(pl.answer, TableAnswer::Unreachable(_)), "configuration {i}: {tcps:?}");
+                    assert!(
+                        matches!(pl.answer, TableAnswer::Unreachable(_)),
+                        "configuration {i}: {tcps:?}"
+                    );
                     continue;
                 }
             };
@@ -123,8 +146,13 @@ fn agrees_with_the_exact_model(cell: &Cell, bytes: &[u8], configurations: usize,
                 pl.a,
                 pl.b
             );
-            false_alarms += usize::from(want == TableAnswer::Free && pl.answer == TableAnswer::Collision);
-            assert_eq!(pc.answer, want, "{}: confirmed pair {}-{} at {tcps:?}", cell.name, pc.a, pc.b);
+            false_alarms +=
+                usize::from(want == TableAnswer::Free && pl.answer == TableAnswer::Collision);
+            assert_eq!(
+                pc.answer, want,
+                "{}: confirmed pair {}-{} at {tcps:?}",
+                cell.name, pc.a, pc.b
+            );
         }
         let whole = match (v.unreachable_mask, v.collides()) {
             (0, true) => TableAnswer::Collision,
@@ -134,14 +162,21 @@ fn agrees_with_the_exact_model(cell: &Cell, bytes: &[u8], configurations: usize,
         assert_eq!(c, whole, "{}: configuration {i}", cell.name);
         assert!(!(l == TableAnswer::Free && whole == TableAnswer::Collision));
     }
-    println!("{}: {collisions} colliding pair answers, {false_alarms} false alarms of the labels", cell.name);
-    assert!(false_alarms > 0, "the labels are coarser than the exact model, so the confirmation is exercised");
+    println!(
+        "{}: {collisions} colliding pair answers, {false_alarms} false alarms of the labels",
+        cell.name
+    );
+    assert!(
+        false_alarms > 0,
+        "the labels are coarser than the exact model, so the confirmation is exercised"
+    );
     collisions
 }
 
 #[test]
 fn each_pair_is_answered_where_it_stands() {
-    let collisions = agrees_with_the_exact_model(&line4(), line4_bundle(), 100_000, 0x9e37_79b9_7f4a_7c15);
+    let collisions =
+        agrees_with_the_exact_model(&line4(), line4_bundle(), 100_000, 0x9e37_79b9_7f4a_7c15);
     assert!(collisions > 1000, "the configurations bring neighbours into contact: {collisions}");
     // The same tables serve a line moved as a whole.
     let moved = line(4, 450.0, Vec3::new(-2000.0, 730.0, 0.0));
@@ -168,48 +203,72 @@ fn a_damaged_bundle_is_a_specific_error() {
     let directory = 40 + 32 * 3 + 16 * 6;
     for len in (0..directory + 16).chain([good.len() / 2, good.len() - 9, good.len() - 1]) {
         let e = bundle_from_bytes(&good[..len]).unwrap_err();
-        let ok = matches!(e, TableError::Truncated { .. }) || (len < 8 && matches!(e, TableError::BadMagic { .. }));
+        let ok = matches!(e, TableError::Truncated { .. })
+            || (len < 8 && matches!(e, TableError::BadMagic { .. }));
         assert!(ok, "truncated to {len}: {e}");
     }
     for at in [20, 41, 60, directory + 3, directory + 500, good.len() - 20] {
         let mut b = good.to_vec();
         b[at] ^= 0x10;
-        assert!(matches!(bundle_from_bytes(&b), Err(TableError::Corrupt { .. })), "bit flipped at {at}");
+        assert!(
+            matches!(bundle_from_bytes(&b), Err(TableError::Corrupt { .. })),
+            "bit flipped at {at}"
+        );
     }
     // A table's byte changed with the whole checksum recomputed: the table's own catches it.
     let e = bundle_from_bytes(&edited(|b| b[directory + 300] ^= 1)).unwrap_err();
     assert!(e.to_string().contains("bundle table 0: checksum"), "{e}");
-    let e = bundle_from_bytes(&edited(|b| b[12..16].copy_from_slice(&(BUNDLE_VERSION + 1).to_le_bytes()))).unwrap_err();
-    assert_eq!(e, TableError::UnsupportedVersion { found: BUNDLE_VERSION + 1, supported: BUNDLE_VERSION });
+    let e = bundle_from_bytes(&edited(|b| {
+        b[12..16].copy_from_slice(&(BUNDLE_VERSION + 1).to_le_bytes())
+    }))
+    .unwrap_err();
+    assert_eq!(
+        e,
+        TableError::UnsupportedVersion { found: BUNDLE_VERSION + 1, supported: BUNDLE_VERSION }
+    );
     let e = bundle_from_bytes(&edited(|b| b[8..12].reverse())).unwrap_err();
     assert_eq!(e, TableError::WrongEndianness);
     let e = bundle_from_bytes(&edited(|b| b[..8].copy_from_slice(b"DCBUNDLX"))).unwrap_err();
     assert!(matches!(e, TableError::BadMagic { .. }), "{e}");
     // A pair naming a table the bundle does not have.
-    let e =
-        bundle_from_bytes(&edited(|b| b[40 + 96 + 8..40 + 96 + 12].copy_from_slice(&7u32.to_le_bytes()))).unwrap_err();
-    assert!(matches!(e, TableError::Corrupt { .. }) && e.to_string().contains("out of range"), "{e}");
+    let e = bundle_from_bytes(&edited(|b| {
+        b[40 + 96 + 8..40 + 96 + 12].copy_from_slice(&7u32.to_le_bytes())
+    }))
+    .unwrap_err();
+    assert!(
+        matches!(e, TableError::Corrupt { .. }) && e.to_string().contains("out of range"),
+        "{e}"
+    );
 }
 
 #[test]
 fn a_bundle_for_another_spacing_or_without_a_pair_is_refused_naming_the_pair() {
     // The line 460 mm apart: the bundle's table for R1-R2 was built 450 mm apart.
-    let e = BundleChecker::new(line(4, 460.0, Vec3::zeros()), line4_bundle(), Confirmation::Exact).unwrap_err();
+    let e = BundleChecker::new(line(4, 460.0, Vec3::zeros()), line4_bundle(), Confirmation::Exact)
+        .unwrap_err();
     let text = e.to_string();
     assert!(matches!(e, TableError::WrongPair { .. }), "{text}");
     assert!(
-        text.contains("R1-R2") && text.contains("placement.translation.x is 450") && text.contains("460"),
+        text.contains("R1-R2")
+            && text.contains("placement.translation.x is 450")
+            && text.contains("460"),
         "{text}"
     );
     assert!(text.contains("rebuild the bundle"), "{text}");
     // Without the table of the spacing 1350 mm (R1-R4): that pair is missing.
     let b = bundle_from_bytes(line4_bundle()).unwrap();
-    let files: Vec<Vec<u8>> = b.tables[..2].iter().map(|(h, t)| delta_collide::table::to_bytes(t, h)).collect();
+    let files: Vec<Vec<u8>> =
+        b.tables[..2].iter().map(|(h, t)| delta_collide::table::to_bytes(t, h)).collect();
     let pairs: Vec<_> = b.pairs.iter().copied().filter(|p| p.table < 2).collect();
     let short = bundle_to_bytes(b.cell_fingerprint, 4, &files, &pairs).unwrap();
     let e = BundleChecker::new(line4(), &short, Confirmation::Exact).unwrap_err();
     let text = e.to_string();
-    assert!(matches!(e, TableError::MissingPair { .. }) && text.contains("R1-R4") && text.contains("1350"), "{text}");
+    assert!(
+        matches!(e, TableError::MissingPair { .. })
+            && text.contains("R1-R4")
+            && text.contains("1350"),
+        "{text}"
+    );
     // That bundle still serves a line of three.
     assert!(BundleChecker::new(line(3, 450.0, Vec3::zeros()), &short, Confirmation::Exact).is_ok());
 }
@@ -235,38 +294,86 @@ fn build_inspect_and_check_a_line_with_its_bundle() {
     std::fs::create_dir_all(&dir).unwrap();
     let bundle = dir.join("line4.dcb");
     let b = bundle.to_str().unwrap();
-    let built = cli(&["-q", "build", "--cell", "cells/line4.toml", "--k", "16", "--variant", "shared", "--output", b]);
+    let built = cli(&[
+        "-q",
+        "build",
+        "--cell",
+        "cells/line4.toml",
+        "--k",
+        "16",
+        "--variant",
+        "shared",
+        "--output",
+        b,
+    ]);
     assert!(built.contains("6 pairs that can meet, 3 tables"), "{built}");
-    assert_eq!(std::fs::read(&bundle).unwrap(), line4_bundle(), "the CLI writes the library's bundle");
+    assert_eq!(
+        std::fs::read(&bundle).unwrap(),
+        line4_bundle(),
+        "the CLI writes the library's bundle"
+    );
     let inspected = cli(&["inspect", b]);
     for (pair, table) in [("0-1", 0), ("0-2", 1), ("0-3", 2), ("1-2", 0), ("1-3", 1), ("2-3", 0)] {
-        assert!(inspected.contains(&format!("pair robots {pair}: table {table}")), "{pair}: {inspected}");
+        assert!(
+            inspected.contains(&format!("pair robots {pair}: table {table}")),
+            "{pair}: {inspected}"
+        );
     }
     assert!(inspected.contains("second robot at (900, 0, 0) mm"), "{inspected}");
-    let scenarios =
-        delta_collide::cell::trajectory::parse_scenarios(include_str!("../c_harness/line_scenarios.txt")).unwrap();
+    let scenarios = delta_collide::cell::trajectory::parse_scenarios(include_str!(
+        "../c_harness/line_scenarios.txt"
+    ))
+    .unwrap();
     let mut rows = String::from("x1,y1,z1,x2,y2,z2,x3,y3,z3,x4,y4,z4\n");
     let mut tcps = vec![Vec3::zeros(); 4];
     for s in &scenarios {
         for tick in 0..delta_collide::cell::trajectory::RUN_TICKS {
             s.tcps_at(tick, &mut tcps);
-            rows += &tcps.iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(",");
+            rows += &tcps
+                .iter()
+                .map(|p| format!("{},{},{}", p.x, p.y, p.z))
+                .collect::<Vec<_>>()
+                .join(",");
             rows.push('\n');
         }
     }
     let mut rng = Rng(3);
     for _ in 0..20_000 {
-        rows += &(0..4).map(|_| rng.tcp()).map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(",");
+        rows += &(0..4)
+            .map(|_| rng.tcp())
+            .map(|p| format!("{},{},{}", p.x, p.y, p.z))
+            .collect::<Vec<_>>()
+            .join(",");
         rows.push('\n');
     }
     let input = dir.join("rows.csv");
     std::fs::write(&input, rows).unwrap();
     let i = input.to_str().unwrap();
     let exact = cli(&["check", "--cell", "cells/line4.toml", "--input", i, "--pairs"]);
-    let table =
-        cli(&["check", "--cell", "cells/line4.toml", "--table", b, "--confirm", "exact", "--input", i, "--pairs"]);
-    let labels =
-        cli(&["check", "--cell", "cells/line4.toml", "--table", b, "--confirm", "none", "--input", i, "--pairs"]);
+    let table = cli(&[
+        "check",
+        "--cell",
+        "cells/line4.toml",
+        "--table",
+        b,
+        "--confirm",
+        "exact",
+        "--input",
+        i,
+        "--pairs",
+    ]);
+    let labels = cli(&[
+        "check",
+        "--cell",
+        "cells/line4.toml",
+        "--table",
+        b,
+        "--confirm",
+        "none",
+        "--input",
+        i,
+        "--pairs",
+    ]);
     let count = |text: &str, what: &str| text.lines().filter(|l| l.starts_with(what)).count();
     assert_eq!(exact.lines().count(), 1 + 12_000 + 20_000);
     assert!(
@@ -289,20 +396,28 @@ fn eval_counts_every_pair_of_a_line() {
     let bundle = dir.join("line4.dcb");
     std::fs::write(&bundle, line4_bundle()).unwrap();
     let b = bundle.to_str().unwrap();
-    let out = cli(&["eval", "--cell", "cells/line4.toml", "--table", b, "--random", "3000", "--pairs"]);
+    let out =
+        cli(&["eval", "--cell", "cells/line4.toml", "--table", b, "--random", "3000", "--pairs"]);
     assert!(out.contains("6 pairs that can meet, 3 tables"), "{out}");
     let field = |line: &str, name: &str| -> u64 {
         let words: Vec<&str> = line.split_whitespace().collect();
-        let at = words.iter().position(|w| *w == name).unwrap_or_else(|| panic!("{name} in {line}"));
+        let at =
+            words.iter().position(|w| *w == name).unwrap_or_else(|| panic!("{name} in {line}"));
         words[at + 1].parse().unwrap()
     };
     let counted: Vec<&str> = out.lines().filter(|l| l.contains(" TP ")).collect();
-    assert_eq!(counted.len(), 3 * 7, "practical, collision, random: the tick and six pairs each\n{out}");
+    assert_eq!(
+        counted.len(),
+        3 * 7,
+        "practical, collision, random: the tick and six pairs each\n{out}"
+    );
     assert!(counted.iter().all(|l| field(l, "FN") == 0), "{out}");
     let mut labels = BundleChecker::new(line4(), line4_bundle(), Confirmation::None).unwrap();
     let mut exact = ExactChecker::new(line4());
-    let scenarios =
-        delta_collide::cell::trajectory::parse_scenarios(include_str!("../c_harness/line_scenarios.txt")).unwrap();
+    let scenarios = delta_collide::cell::trajectory::parse_scenarios(include_str!(
+        "../c_harness/line_scenarios.txt"
+    ))
+    .unwrap();
     let mut tcps = vec![Vec3::zeros(); 4];
     for (s, block) in scenarios.iter().zip(counted.chunks(7)) {
         assert!(block[0].starts_with(&format!("line4 {}", s.case)), "{}", block[0]);
@@ -334,7 +449,15 @@ fn replay_a_line_in_table_mode() {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bundles_replay");
     std::fs::create_dir_all(&dir).unwrap();
     let variant = Variant::Clearance(delta_collide::table::Ladder::default_ladder());
-    let built = build_bundle(&line4(), K, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent).unwrap();
+    let built = build_bundle(
+        &line4(),
+        K,
+        &Workspace::THESIS,
+        variant,
+        Labelling::Certified,
+        Progress::Silent,
+    )
+    .unwrap();
     let bundle = dir.join("line4-clearance.dcb");
     std::fs::write(&bundle, &built.bytes).unwrap();
     let stop = "stop = { reaction_ms = 2.0, decel_mm_s2 = 120000.0, max_accel_mm_s2 = 130000.0, max_speed_mm_s = 4600.0 }";
@@ -342,26 +465,31 @@ fn replay_a_line_in_table_mode() {
     let cell = format!("tick_ms = 1.0\n{cell}");
     let cell_path = dir.join("line4-stiff.toml");
     std::fs::write(&cell_path, &cell).unwrap();
-    let scenario = &delta_collide::cell::trajectory::parse_scenarios(include_str!("../c_harness/line_scenarios.txt"))
-        .unwrap()[0];
+    let scenario = &delta_collide::cell::trajectory::parse_scenarios(include_str!(
+        "../c_harness/line_scenarios.txt"
+    ))
+    .unwrap()[0];
     let mut rows = String::from("tick,x,y,z,x2,y2,z2,x3,y3,z3,x4,y4,z4\n");
     let mut tcps = vec![Vec3::zeros(); 4];
     for tick in 0..6_000 {
         scenario.tcps_at(tick, &mut tcps);
         rows += &format!("{tick},");
-        rows += &tcps.iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(",");
+        rows +=
+            &tcps.iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(",");
         rows.push('\n');
     }
     let input = dir.join("line.csv");
     std::fs::write(&input, rows).unwrap();
-    let (c, i, b) = (cell_path.to_str().unwrap(), input.to_str().unwrap(), bundle.to_str().unwrap());
+    let (c, i, b) =
+        (cell_path.to_str().unwrap(), input.to_str().unwrap(), bundle.to_str().unwrap());
     let exact = cli(&["replay", "--cell", c, "--input", i]);
     let run = std::process::Command::new(env!("CARGO_BIN_EXE_delta-collide"))
         .args(["replay", "--cell", c, "--input", i, "--table", b])
         .output()
         .unwrap();
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let (table, note) = (String::from_utf8(run.stdout).unwrap(), String::from_utf8(run.stderr).unwrap());
+    let (table, note) =
+        (String::from_utf8(run.stdout).unwrap(), String::from_utf8(run.stderr).unwrap());
     assert_eq!(table.lines().count(), 1 + 6_000);
     let mut stops = [0; 2];
     for (e, t) in exact.lines().zip(table.lines()).skip(1) {
@@ -369,7 +497,11 @@ fn replay_a_line_in_table_mode() {
         assert_eq!((e[0], e[2]), (t[0], t[2]), "tick and exact clearance");
         stops[0] += usize::from(e[1] == "stop");
         stops[1] += usize::from(t[1] == "stop");
-        assert!(t[1] != "stop" || e[1] == "stop", "table mode stops at tick {} where exact mode does not", t[0]);
+        assert!(
+            t[1] != "stop" || e[1] == "stop",
+            "table mode stops at tick {} where exact mode does not",
+            t[0]
+        );
     }
     assert!(stops[0] > 0, "the line's neighbours come close enough to stop");
     let pairs: usize = note

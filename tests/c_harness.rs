@@ -12,9 +12,9 @@
 //! The static library is the one cargo builds in the same run: the test executable is
 //! `target/<profile>/deps/c_harness-HASH` and the library lies next to it in `deps/`.
 
+use delta_collide::cell::parse_cell;
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::{Progress, Workspace};
-use delta_collide::cell::parse_cell;
 use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::{build_tables, to_bytes, Labelling, Ladder, Variant};
 use std::path::{Path, PathBuf};
@@ -47,7 +47,9 @@ fn static_lib() -> PathBuf {
     candidates
         .iter()
         .find(|p| p.is_file())
-        .unwrap_or_else(|| panic!("static library not found at {candidates:?} (crate-type staticlib?)"))
+        .unwrap_or_else(|| {
+            panic!("static library not found at {candidates:?} (crate-type staticlib?)")
+        })
         .clone()
 }
 
@@ -91,20 +93,34 @@ fn clearance_table_file(c: usize) -> &'static Path {
         let dir = scratch_dir("c_harness_tables");
         let path = dir.join(format!("{name}_k{CLEARANCE_K}_clearance.dct"));
         let stamp = dir.join(format!("{name}_k{CLEARANCE_K}_clearance.builder"));
-        let exe = std::fs::metadata(std::env::current_exe().expect("test executable")).expect("stat test executable");
-        let modified = exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
-        let builder = format!("{} bytes, modified {:?}, k = {CLEARANCE_K}", exe.len(), modified.unwrap_or_default());
+        let exe = std::fs::metadata(std::env::current_exe().expect("test executable"))
+            .expect("stat test executable");
+        let modified =
+            exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+        let builder = format!(
+            "{} bytes, modified {:?}, k = {CLEARANCE_K}",
+            exe.len(),
+            modified.unwrap_or_default()
+        );
         if path.is_file() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder) {
             return path;
         }
         let cell = reference_cell(name).expect("reference cell");
         let variant = Variant::Clearance(Ladder::default_ladder());
-        let (header, tables, _) =
-            build_tables(&cell, CLEARANCE_K, &Workspace::THESIS, &[variant], Labelling::Certified, Progress::Silent)
-                .unwrap_or_else(|e| panic!("building the {name} clearance table: {e}"));
+        let (header, tables, _) = build_tables(
+            &cell,
+            CLEARANCE_K,
+            &Workspace::THESIS,
+            &[variant],
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap_or_else(|e| panic!("building the {name} clearance table: {e}"));
         let _ = std::fs::remove_file(&stamp);
-        std::fs::write(&path, to_bytes(&tables[0], &header)).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
-        std::fs::write(&stamp, builder).unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
+        std::fs::write(&path, to_bytes(&tables[0], &header))
+            .unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+        std::fs::write(&stamp, builder)
+            .unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
         path
     })
 }
@@ -120,29 +136,47 @@ fn table_files(c: usize) -> &'static [PathBuf] {
     FILES[c].get_or_init(|| {
         let name = CELLS[c];
         let dir = scratch_dir("c_harness_tables");
-        let paths: Vec<PathBuf> =
-            KINDS.iter().map(|(kind, _)| dir.join(format!("{name}_k{TABLE_K}_{kind}.dct"))).collect();
+        let paths: Vec<PathBuf> = KINDS
+            .iter()
+            .map(|(kind, _)| dir.join(format!("{name}_k{TABLE_K}_{kind}.dct")))
+            .collect();
         let stamp = dir.join(format!("{name}_k{TABLE_K}.builder"));
-        let exe = std::fs::metadata(std::env::current_exe().expect("test executable")).expect("stat test executable");
-        let modified = exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
-        let builder = format!("{} bytes, modified {:?}, k = {TABLE_K}", exe.len(), modified.unwrap_or_default());
-        if paths.iter().all(|p| p.is_file()) && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder) {
+        let exe = std::fs::metadata(std::env::current_exe().expect("test executable"))
+            .expect("stat test executable");
+        let modified =
+            exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+        let builder = format!(
+            "{} bytes, modified {:?}, k = {TABLE_K}",
+            exe.len(),
+            modified.unwrap_or_default()
+        );
+        if paths.iter().all(|p| p.is_file())
+            && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder)
+        {
             println!("{name}: tables reused from {} (same test executable)", dir.display());
             return paths;
         }
         let cell = reference_cell(name).expect("reference cell");
         let start = std::time::Instant::now();
         let variants: Vec<Variant> = KINDS.iter().map(|&(_, v)| v).collect();
-        let (header, tables, _) =
-            build_tables(&cell, TABLE_K, &Workspace::THESIS, &variants, Labelling::Certified, Progress::Silent)
-                .unwrap_or_else(|e| panic!("building the {name} tables: {e}"));
+        let (header, tables, _) = build_tables(
+            &cell,
+            TABLE_K,
+            &Workspace::THESIS,
+            &variants,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap_or_else(|e| panic!("building the {name} tables: {e}"));
         let _ = std::fs::remove_file(&stamp);
         for (path, table) in paths.iter().zip(&tables) {
             let bytes = to_bytes(table, &header);
-            std::fs::write(path, &bytes).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+            std::fs::write(path, &bytes)
+                .unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
             println!("{name}: {} table k = {TABLE_K}, {} bytes", table.name(), bytes.len());
         }
-        std::fs::write(&stamp, builder).unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
+        std::fs::write(&stamp, builder)
+            .unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
         println!("{name}: tables built in {:.1} s", start.elapsed().as_secs_f64());
         paths
     })
@@ -157,22 +191,39 @@ fn line_bundle_file() -> &'static Path {
         let dir = scratch_dir("c_harness_tables");
         let path = dir.join(format!("line4_k{CLEARANCE_K}_clearance.dcb"));
         let stamp = dir.join(format!("line4_k{CLEARANCE_K}.builder"));
-        let exe = std::fs::metadata(std::env::current_exe().expect("test executable")).expect("stat test executable");
-        let modified = exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
-        let builder = format!("{} bytes, modified {:?}, k = {CLEARANCE_K}", exe.len(), modified.unwrap_or_default());
+        let exe = std::fs::metadata(std::env::current_exe().expect("test executable"))
+            .expect("stat test executable");
+        let modified =
+            exe.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+        let builder = format!(
+            "{} bytes, modified {:?}, k = {CLEARANCE_K}",
+            exe.len(),
+            modified.unwrap_or_default()
+        );
         if path.is_file() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == builder) {
             return path;
         }
-        let cell = parse_cell(&std::fs::read_to_string(repo_root().join("cells/line4.toml")).unwrap()).unwrap();
+        let cell =
+            parse_cell(&std::fs::read_to_string(repo_root().join("cells/line4.toml")).unwrap())
+                .unwrap();
         let start = std::time::Instant::now();
-        // Clearance tables: the POU's lookups read their labels, the protective verdict their bounds.
+        // Clearance tables: the POU's lookups read their labels, the protective verdict their
+        // bounds.
         let variant = Variant::Clearance(Ladder::default_ladder());
-        let built =
-            build_bundle(&cell, CLEARANCE_K, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent)
-                .unwrap_or_else(|e| panic!("building the line4 bundle: {e}"));
+        let built = build_bundle(
+            &cell,
+            CLEARANCE_K,
+            &Workspace::THESIS,
+            variant,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap_or_else(|e| panic!("building the line4 bundle: {e}"));
         let _ = std::fs::remove_file(&stamp);
-        std::fs::write(&path, &built.bytes).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
-        std::fs::write(&stamp, builder).unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
+        std::fs::write(&path, &built.bytes)
+            .unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+        std::fs::write(&stamp, builder)
+            .unwrap_or_else(|e| panic!("writing {}: {e}", stamp.display()));
         println!(
             "line4: bundle of {} tables k = {CLEARANCE_K}, {} bytes, built in {:.1} s",
             built.tables.len(),
@@ -193,7 +244,9 @@ fn table_file(c: usize) -> &'static Path {
 fn table_args_of(cells: &[usize], kind: usize) -> Vec<String> {
     cells
         .iter()
-        .flat_map(|&c| ["--table".to_string(), format!("{}={}", CELLS[c], table_files(c)[kind].display())])
+        .flat_map(|&c| {
+            ["--table".to_string(), format!("{}={}", CELLS[c], table_files(c)[kind].display())]
+        })
         .collect()
 }
 
@@ -207,7 +260,8 @@ fn assert_harness_passed(what: &str, out: &Output) -> String {
     let stdout = text(&out.stdout);
     println!("{what}:\n{stdout}");
     eprintln!("{}", text(&out.stderr));
-    let (passed, failed) = verdict_line(&stdout).unwrap_or_else(|| panic!("{what}: no `N passed, N failed` line"));
+    let (passed, failed) =
+        verdict_line(&stdout).unwrap_or_else(|| panic!("{what}: no `N passed, N failed` line"));
     assert!(passed > 0, "{what}: the harness ran no checks");
     assert_eq!(failed, 0, "{what}: the harness reported failures (see above)");
     assert!(out.status.success(), "{what}: exit status {:?} with 0 failures", out.status);
@@ -226,21 +280,33 @@ fn number(line: &str, before: &str) -> f64 {
 /// STOP ticks than in exact mode, and the share of ticks answered by the lookup alone is
 /// printed.
 fn assert_protective_table_mode(stdout: &str) {
-    let runs: Vec<&str> = stdout.lines().filter(|l| l.starts_with("protective T") && l.contains(" table mode: first")).collect();
+    let runs: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("protective T") && l.contains(" table mode: first"))
+        .collect();
     assert_eq!(runs.len(), 18, "three table-mode protective runs per cell and case: {runs:?}");
     // `protective T1 practical stiff   with paths table mode: first ...` and its exact-mode
     // run `protective T1 practical stiff   with paths: first ...` have the same key.
-    let key = |l: &str| l.split(": first").next().unwrap().replace(" table mode", "").trim_end().to_string();
+    let key = |l: &str| {
+        l.split(": first").next().unwrap().replace(" table mode", "").trim_end().to_string()
+    };
     for l in &runs {
         assert_eq!(number(l, "contacts "), 0.0, "{l}");
         let exact = stdout
             .lines()
-            .find(|e| e.starts_with("protective T") && !e.contains(" table mode") && key(e) == key(l))
+            .find(|e| {
+                e.starts_with("protective T") && !e.contains(" table mode") && key(e) == key(l)
+            })
             .unwrap_or_else(|| panic!("no exact-mode run for {l}"));
-        assert!(number(l, ", STOP ") <= number(exact, ", STOP "), "table mode stops more often:\n{l}\n{exact}");
+        assert!(
+            number(l, ", STOP ") <= number(exact, ", STOP "),
+            "table mode stops more often:\n{l}\n{exact}"
+        );
     }
-    let shares: Vec<&str> =
-        stdout.lines().filter(|l| l.starts_with("protective T") && l.contains("answered by the lookup alone")).collect();
+    let shares: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("protective T") && l.contains("answered by the lookup alone"))
+        .collect();
     assert_eq!(shares.len(), 18, "{shares:?}");
 }
 
@@ -250,15 +316,25 @@ fn assert_protective_table_mode(stdout: &str) {
 fn assert_speed_override(stdout: &str) {
     for cell in ["T1", "T2", "T3"] {
         let prefix = format!("speed override {cell} practical: ");
-        let line = stdout.lines().find(|l| l.starts_with(&prefix)).unwrap_or_else(|| panic!("no `{prefix}` line"));
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with(&prefix))
+            .unwrap_or_else(|| panic!("no `{prefix}` line"));
         assert!(!line.contains("NOT COMPLETED"), "{line}");
         let (cycle, unscaled) = (number(line, "cycle "), number(line, "unscaled "));
         assert!(cycle >= unscaled && unscaled > 1000.0, "{line}");
         assert_eq!(number(line, "ticks touching "), 0.0, "{line}");
         assert_eq!(number(line, "contacts "), 0.0, "{line}");
         let (stops, unscaled_stops) = (number(line, "STOP "), number(line, "(unscaled "));
-        assert!(stops < unscaled_stops, "the override needs fewer stops than the unscaled run: {line}");
-        assert_eq!(number(line, "stops simulated "), stops, "a stop is simulated at every STOP: {line}");
+        assert!(
+            stops < unscaled_stops,
+            "the override needs fewer stops than the unscaled run: {line}"
+        );
+        assert_eq!(
+            number(line, "stops simulated "),
+            stops,
+            "a stop is simulated at every STOP: {line}"
+        );
     }
 }
 
@@ -271,19 +347,33 @@ fn assert_speed_override(stdout: &str) {
 /// collision case stops at the same tick on the same pair. T1's table alone is refused.
 fn assert_line(stdout: &str) {
     let line = |prefix: &str| -> &str {
-        stdout.lines().find(|l| l.starts_with(prefix)).unwrap_or_else(|| panic!("no `{prefix}` line"))
+        stdout
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no `{prefix}` line"))
     };
     let practical = line("line4 practical");
-    assert!(practical.contains("POU stop tick none, first exact collision none, FREE ticks 6000/6000"), "{practical}");
+    assert!(
+        practical.contains("POU stop tick none, first exact collision none, FREE ticks 6000/6000"),
+        "{practical}"
+    );
     let collision = line("line4 collision");
-    let (stop, first) = (number(collision, "POU stop tick "), number(collision, "first exact collision "));
+    let (stop, first) =
+        (number(collision, "POU stop tick "), number(collision, "first exact collision "));
     assert!(stop > 3000.0 && stop == first, "{collision}");
     assert!(collision.ends_with("colliding pairs at the stop 2-3"), "{collision}");
     assert!(number(collision, "pairs that can meet ") >= 5.0, "{collision}");
     let t1_alone = line("line4 T1's table alone");
-    assert!(t1_alone.contains("holds no table for R1-R3"), "T1's table refused for the line: {t1_alone}");
+    assert!(
+        t1_alone.contains("holds no table for R1-R3"),
+        "T1's table refused for the line: {t1_alone}"
+    );
     let table_practical = line("line4 table practical");
-    assert!(table_practical.contains("POU stop tick none, first exact collision none, FREE ticks 6000/6000"), "{table_practical}");
+    assert!(
+        table_practical
+            .contains("POU stop tick none, first exact collision none, FREE ticks 6000/6000"),
+        "{table_practical}"
+    );
     let table_collision = line("line4 table collision");
     assert_eq!(number(table_collision, "POU stop tick "), stop, "{table_collision}");
     assert!(table_collision.contains("colliding pairs at the stop 2-3,"), "{table_collision}");
@@ -291,17 +381,26 @@ fn assert_line(stdout: &str) {
     assert!(number(table_collision, "lookups confirmed ") > 0.0, "{table_collision}");
     let protective: Vec<&str> = stdout
         .lines()
-        .filter(|l| l.starts_with("protective line4 ") && !l.contains("answered by the lookup alone"))
+        .filter(|l| {
+            l.starts_with("protective line4 ") && !l.contains("answered by the lookup alone")
+        })
         .collect();
     assert_eq!(protective.len(), 8, "four protective runs per case: {protective:?}");
-    assert_eq!(protective.iter().filter(|l| l.contains(" table mode:")).count(), 2, "{protective:?}");
+    assert_eq!(
+        protective.iter().filter(|l| l.contains(" table mode:")).count(),
+        2,
+        "{protective:?}"
+    );
     for l in protective {
         assert_eq!(number(l, "contacts "), 0.0, "{l}");
         assert_eq!(number(l, "statuses not OK "), 0.0, "{l}");
         assert!(number(l, "smallest clearance ") > 10.0, "{l}");
         if l.starts_with("protective line4 collision") {
             let first_stop = number(l, "first STOP ");
-            assert!(first_stop >= 0.0 && first_stop <= first, "STOP after the first collision tick {first}: {l}");
+            assert!(
+                first_stop >= 0.0 && first_stop <= first,
+                "STOP after the first collision tick {first}: {l}"
+            );
             assert!(number(l, ", stop ") > 0.0, "the stop was simulated: {l}");
         }
     }
@@ -314,16 +413,25 @@ fn assert_line(stdout: &str) {
 /// per cell, case and schedule: every status as the timing rules say, no stop after FREE or
 /// WARN touches, and over all schedules every timing fault was provoked.
 fn assert_timing(stdout: &str) {
-    let twice: Vec<&str> = stdout.lines().filter(|l| l.contains(" collision twice per cycle: ")).collect();
+    let twice: Vec<&str> =
+        stdout.lines().filter(|l| l.contains(" collision twice per cycle: ")).collect();
     assert_eq!(twice.len(), 3, "one twice-per-cycle line per cell: {twice:?}");
     let mut touching = 0.0;
     for l in &twice {
-        assert_eq!(number(l, "twice per cycle: "), number(l, "second timed call unchanged on "), "{l}");
+        assert_eq!(
+            number(l, "twice per cycle: "),
+            number(l, "second timed call unchanged on "),
+            "{l}"
+        );
         assert_eq!(number(l, "untimed once per tick differs on "), 0.0, "{l}");
         touching += number(l, "of which a stop from the true motion touches on ");
     }
-    assert!(touching > 0.0, "the untimed call twice per tick never answered a touching FREE: {twice:?}");
-    let runs: Vec<&str> = stdout.lines().filter(|l| l.starts_with("timing T") && l.contains(" calls (")).collect();
+    assert!(
+        touching > 0.0,
+        "the untimed call twice per tick never answered a touching FREE: {twice:?}"
+    );
+    let runs: Vec<&str> =
+        stdout.lines().filter(|l| l.starts_with("timing T") && l.contains(" calls (")).collect();
     assert_eq!(runs.len(), 3 * 2 * 8, "eight schedules per cell and case: {runs:?}");
     for l in &runs {
         assert_eq!(number(l, "statuses not as the rules "), 0.0, "{l}");
@@ -344,9 +452,11 @@ fn summaries(stdout: &str) -> Vec<(String, String, Option<u64>, Option<u64>)> {
         .lines()
         .filter_map(|l| {
             let w: Vec<&str> = l.split_whitespace().collect();
-            // summary T1 collision: stop tick table 3691, exact POU 3711, first exact collision 3711
-            (w.len() == 14 && w[0] == "summary")
-                .then(|| (w[1].to_string(), w[2].trim_end_matches(':').to_string(), tick(w[6]), tick(w[13])))
+            // summary T1 collision: stop tick table 3691, exact POU 3711, first exact collision
+            // 3711
+            (w.len() == 14 && w[0] == "summary").then(|| {
+                (w[1].to_string(), w[2].trim_end_matches(':').to_string(), tick(w[6]), tick(w[13]))
+            })
         })
         .collect()
 }
@@ -368,16 +478,25 @@ fn harness_passes_with_tables(kind: usize) {
     let mut args = table_args_of(&[0, 1, 2], kind);
     if kind == 0 {
         for (c, cell) in CELLS.iter().enumerate() {
-            args.extend(["--clearance-table".to_string(), format!("{cell}={}", clearance_table_file(c).display())]);
+            args.extend([
+                "--clearance-table".to_string(),
+                format!("{cell}={}", clearance_table_file(c).display()),
+            ]);
         }
     }
     args.extend(["--line-bundle".to_string(), line_bundle_file().display().to_string()]);
     let out = run(Command::new(exe).arg("--tmp").arg(&tmp).args(&args).current_dir(repo_root()));
-    let stdout = assert_harness_passed(&format!("c_harness (exact and {} table mode, T1 T2 T3)", KINDS[kind].0), &out);
+    let stdout = assert_harness_passed(
+        &format!("c_harness (exact and {} table mode, T1 T2 T3)", KINDS[kind].0),
+        &out,
+    );
     if kind == 0 {
         assert_protective_table_mode(&stdout);
     }
-    assert!(stdout.contains("bad input: done (exact and table mode)"), "table-mode bad inputs did not run");
+    assert!(
+        stdout.contains("bad input: done (exact and table mode)"),
+        "table-mode bad inputs did not run"
+    );
     assert_speed_override(&stdout);
     assert_timing(&stdout);
     assert_line(&stdout);
@@ -385,9 +504,15 @@ fn harness_passes_with_tables(kind: usize) {
     assert_eq!(runs.len(), 6, "one table-mode summary per cell and case: {runs:?}");
     for (cell, case, table_stop, exact_first) in &runs {
         if case == "collision" {
-            let (t, e) = (table_stop.expect("the table stops"), exact_first.expect("the exact model collides"));
+            let (t, e) = (
+                table_stop.expect("the table stops"),
+                exact_first.expect("the exact model collides"),
+            );
             assert!(t <= e, "{cell}: table stop tick {t} after the exact first collision tick {e}");
-            assert!(t > 3000, "{cell}: table stop tick {t} in the collision-free first half of the run");
+            assert!(
+                t > 3000,
+                "{cell}: table stop tick {t} in the collision-free first half of the run"
+            );
         } else {
             assert_eq!(*exact_first, None, "{cell} practical: the exact model collides");
         }
@@ -397,7 +522,8 @@ fn harness_passes_with_tables(kind: usize) {
 /// Whether LeakSanitizer can run here: it needs ptrace-like access that some containers deny.
 /// Ok(()) when a leaking probe is reported; Err(why) when LSan reports it cannot run.
 fn leak_sanitizer_works(dir: &Path) -> Result<(), String> {
-    let out = run(Command::new(dir.join("probe")).arg("leak").env("ASAN_OPTIONS", "detect_leaks=1"));
+    let out =
+        run(Command::new(dir.join("probe")).arg("leak").env("ASAN_OPTIONS", "detect_leaks=1"));
     let stderr = text(&out.stderr);
     if stderr.contains("detected memory leaks") {
         assert!(!out.status.success(), "LSan found the probe's leak but the run succeeded");
@@ -430,7 +556,12 @@ int main(int argc, char **argv) {
 fn compile_probe(dir: &Path, flags: &[&str]) {
     let src = dir.join("probe.c");
     std::fs::write(&src, PROBE_C).unwrap();
-    let out = run(Command::new("cc").args(["-std=c99", "-O0"]).args(flags).arg(&src).arg("-o").arg(dir.join("probe")));
+    let out = run(Command::new("cc")
+        .args(["-std=c99", "-O0"])
+        .args(flags)
+        .arg(&src)
+        .arg("-o")
+        .arg(dir.join("probe")));
     assert!(out.status.success(), "cc probe failed:\n{}", text(&out.stderr));
 }
 
@@ -439,9 +570,17 @@ fn c_harness_is_clean_under_address_and_undefined_behavior_sanitizers() {
     let probe_dir = scratch_dir("c_harness_asan_probe");
     compile_probe(&probe_dir, SANITIZE_FLAGS);
     // The sanitizers are live: each probe's fault is reported and ends the run.
-    for (arg, report) in [("overflow", "heap-buffer-overflow"), ("signed", "signed integer overflow")] {
-        let out = run(Command::new(probe_dir.join("probe")).arg(arg).env("ASAN_OPTIONS", "detect_leaks=0"));
-        assert!(!out.status.success() && text(&out.stderr).contains(report), "probe {arg}: {}", text(&out.stderr));
+    for (arg, report) in
+        [("overflow", "heap-buffer-overflow"), ("signed", "signed integer overflow")]
+    {
+        let out = run(Command::new(probe_dir.join("probe"))
+            .arg(arg)
+            .env("ASAN_OPTIONS", "detect_leaks=0"));
+        assert!(
+            !out.status.success() && text(&out.stderr).contains(report),
+            "probe {arg}: {}",
+            text(&out.stderr)
+        );
     }
     let detect_leaks = match leak_sanitizer_works(&probe_dir) {
         Ok(()) => true,
@@ -460,7 +599,10 @@ fn c_harness_is_clean_under_address_and_undefined_behavior_sanitizers() {
         .arg(&tmp)
         .args(table_args(&[0, 1, 2]))
         .current_dir(repo_root())
-        .env("ASAN_OPTIONS", format!("detect_leaks={}:abort_on_error=0:exitcode=98", u8::from(detect_leaks)))
+        .env(
+            "ASAN_OPTIONS",
+            format!("detect_leaks={}:abort_on_error=0:exitcode=98", u8::from(detect_leaks)),
+        )
         .env("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1"));
     let stderr = text(&out.stderr);
     for report in ["AddressSanitizer", "LeakSanitizer", "runtime error:"] {
@@ -481,17 +623,29 @@ fn in_ci() -> bool {
 fn c_harness_is_clean_under_valgrind_memcheck() {
     let version = Command::new("valgrind").arg("--version").output();
     let Ok(version) = version.map(|o| text(&o.stdout)) else {
-        assert!(!in_ci(), "valgrind is not installed: .ci/run installs it (apt-get install valgrind)");
+        assert!(
+            !in_ci(),
+            "valgrind is not installed: .ci/run installs it (apt-get install valgrind)"
+        );
         println!("SKIPPED: valgrind is not installed (outside CI; under CI=true this test fails)");
         return;
     };
-    let memcheck =
-        ["--tool=memcheck", "--error-exitcode=99", "--leak-check=full", "--errors-for-leak-kinds=definite,possible"];
+    let memcheck = [
+        "--tool=memcheck",
+        "--error-exitcode=99",
+        "--leak-check=full",
+        "--errors-for-leak-kinds=definite,possible",
+    ];
     // The flags catch a leak: the probe's exit code becomes 99.
     let probe_dir = scratch_dir("c_harness_valgrind_probe");
     compile_probe(&probe_dir, &[]);
     let out = run(Command::new("valgrind").args(memcheck).arg(probe_dir.join("probe")).arg("leak"));
-    assert_eq!(out.status.code(), Some(99), "valgrind missed the probe's leak:\n{}", text(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(99),
+        "valgrind missed the probe's leak:\n{}",
+        text(&out.stderr)
+    );
     // The harness: the T1 collision scenario in both modes, all bad inputs, T1's table, the
     // line's collision case in exact mode.
     let tmp = scratch_dir("c_harness");
@@ -505,10 +659,20 @@ fn c_harness_is_clean_under_valgrind_memcheck() {
     let stderr = text(&out.stderr);
     assert_ne!(out.status.code(), Some(99), "valgrind {} found errors:\n{stderr}", version.trim());
     assert!(stderr.contains("ERROR SUMMARY: 0 errors"), "valgrind summary:\n{stderr}");
-    let stdout = assert_harness_passed(&format!("c_harness --quick under {}", version.trim()), &out);
-    assert!(stdout.contains("T1 collision table: stop tick"), "the table-mode scenario did not run under valgrind");
-    assert!(stdout.contains("bad input: done (exact and table mode)"), "bad inputs did not all run under valgrind");
-    assert!(stdout.contains("colliding pairs at the stop 2-3"), "the line's collision case did not run under valgrind");
+    let stdout =
+        assert_harness_passed(&format!("c_harness --quick under {}", version.trim()), &out);
+    assert!(
+        stdout.contains("T1 collision table: stop tick"),
+        "the table-mode scenario did not run under valgrind"
+    );
+    assert!(
+        stdout.contains("bad input: done (exact and table mode)"),
+        "bad inputs did not all run under valgrind"
+    );
+    assert!(
+        stdout.contains("colliding pairs at the stop 2-3"),
+        "the line's collision case did not run under valgrind"
+    );
 }
 
 #[test]
@@ -594,8 +758,10 @@ fn header_as_c89_is_recorded() {
 #[test]
 fn readme_table_mode_example_compiles_and_runs() {
     let readme = std::fs::read_to_string(repo_root().join("README.md")).expect("README.md");
-    let section = readme.split("### Table mode").nth(1).expect("README has a `### Table mode` section");
-    let snippet = section.split("```c\n").nth(1).and_then(|s| s.split("```").next()).expect("a ```c block");
+    let section =
+        readme.split("### Table mode").nth(1).expect("README has a `### Table mode` section");
+    let snippet =
+        section.split("```c\n").nth(1).and_then(|s| s.split("```").next()).expect("a ```c block");
     let program = format!(
         r#"#include <stdio.h>
 #include <stdlib.h>
@@ -639,9 +805,18 @@ int main(int argc, char **argv)
     let stdout = text(&out.stdout);
     assert!(out.status.success(), "README example failed: {stdout}");
     assert!(stdout.contains("delta-collide: the table is truncated"), "error line: {stdout}");
-    assert!(stdout.contains("section 0 (codes) needs"), "dc_last_init_error names the field: {stdout}");
-    assert!(stdout.contains("bytes, the buffer has 4096; copy the whole table file again"), "{stdout}");
+    assert!(
+        stdout.contains("section 0 (codes) needs"),
+        "dc_last_init_error names the field: {stdout}"
+    );
+    assert!(
+        stdout.contains("bytes, the buffer has 4096; copy the whole table file again"),
+        "{stdout}"
+    );
     // The failed init leaves h NULL, so the example's query returns DC_STATUS_NULL_POINTER (1)
     // with STOP: the collision and the failed init both stop the robots.
-    assert!(stdout.contains("whole 0, cut 1, stops 2"), "a collision and an error both stop: {stdout}");
+    assert!(
+        stdout.contains("whole 0, cut 1, stops 2"),
+        "a collision and an error both stop: {stdout}"
+    );
 }

@@ -15,8 +15,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use delta_collide::geometry::{
-    boxes_clearance, boxes_clearance_lower_bound, obb_clearance, obb_clearance_lower_bound, separating_axis,
-    CoherentClearance, Obb,
+    boxes_clearance, boxes_clearance_lower_bound, obb_clearance, obb_clearance_lower_bound,
+    separating_axis, CoherentClearance, Obb,
 };
 use delta_collide::math::{Mat3, Real, Vec3, CROSS_AXIS_MIN_NORM};
 use delta_collide::robot::RobotModel;
@@ -34,7 +34,11 @@ const TOL: Real = 1e-6;
 // The oracle.
 
 fn corners(o: &Obb) -> [Vec3; 8] {
-    let u = [o.axes.column(0).into_owned(), o.axes.column(1).into_owned(), o.axes.column(2).into_owned()];
+    let u = [
+        o.axes.column(0).into_owned(),
+        o.axes.column(1).into_owned(),
+        o.axes.column(2).into_owned(),
+    ];
     std::array::from_fn(|v| {
         let s = |k: usize| if v & (1 << k) != 0 { o.half[k] } else { -o.half[k] };
         o.center + u[0] * s(0) + u[1] * s(1) + u[2] * s(2)
@@ -105,7 +109,9 @@ fn axes15(a: &Obb, b: &Obb) -> [(Vec3, Real); 15] {
 }
 
 fn interval(v: &[Vec3; 8], n: &Vec3) -> (Real, Real) {
-    v.iter().map(|p| p.dot(n)).fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)))
+    v.iter()
+        .map(|p| p.dot(n))
+        .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)))
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -186,7 +192,8 @@ fn random_rotation(rng: &mut StdRng) -> Mat3 {
         let q: [Real; 4] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
         let n2: Real = q.iter().map(|v| v * v).sum();
         if n2 > 1e-4 && n2 <= 1.0 {
-            let uq = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]));
+            let uq =
+                UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]));
             return *uq.to_rotation_matrix().matrix();
         }
     }
@@ -204,7 +211,8 @@ fn random_unit(rng: &mut StdRng) -> Vec3 {
 
 /// A rotation by a multiple of 90 degrees (axes permuted, signs flipped, determinant +1).
 fn right_angle_rotation(rng: &mut StdRng) -> Mat3 {
-    let perm = [[0, 1, 2], [1, 2, 0], [2, 0, 1], [0, 2, 1], [2, 1, 0], [1, 0, 2]][rng.random_range(0..6)];
+    let perm =
+        [[0, 1, 2], [1, 2, 0], [2, 0, 1], [0, 2, 1], [2, 1, 0], [1, 0, 2]][rng.random_range(0..6)];
     let mut m = Mat3::zeros();
     for (c, &r) in perm.iter().enumerate() {
         m[(r, c)] = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
@@ -221,7 +229,11 @@ fn random_half(rng: &mut StdRng) -> Vec3 {
         0 => Vec3::new(200.0, 70.0, 17.5),
         1 => Vec3::repeat(scale),
         2 => Vec3::from_fn(|_, _| rng.random_range(0.05..1.0) * scale),
-        _ => Vec3::new(scale, rng.random_range(0.01..0.3) * scale, rng.random_range(0.01..0.3) * scale),
+        _ => Vec3::new(
+            scale,
+            rng.random_range(0.01..0.3) * scale,
+            rng.random_range(0.01..0.3) * scale,
+        ),
     }
 }
 
@@ -271,7 +283,10 @@ fn random_pair(rng: &mut StdRng, kind: usize) -> (Obb, Obb) {
                 .filter(|&m| m != k)
                 .map(|m| ra.column(m) * rng.random_range(-1.0..1.0) * (a.half[m] + b0.half.max()))
                 .sum();
-            Obb { center: a.center + n * (a.half[k] + support(&b0, &n) + signed_gap(rng)) + side, ..b0 }
+            Obb {
+                center: a.center + n * (a.half[k] + support(&b0, &n) + signed_gap(rng)) + side,
+                ..b0
+            }
         }
         // Edge on edge: see `edge_on_edge`.
         3 => {
@@ -299,11 +314,18 @@ fn random_pair(rng: &mut StdRng, kind: usize) -> (Obb, Obb) {
         _ => {
             let axis = Unit::new_normalize(random_unit(rng));
             let tilt = Rotation3::from_axis_angle(&axis, 10f64.powf(rng.random_range(-10.0..-2.0)));
-            let b0 = Obb::new(Vec3::zeros(), tilt.matrix() * ra * right_angle_rotation(rng), random_half(rng));
+            let b0 = Obb::new(
+                Vec3::zeros(),
+                tilt.matrix() * ra * right_angle_rotation(rng),
+                random_half(rng),
+            );
             let k = rng.random_range(0..3);
             let n = ra.column(k).into_owned();
             let side = ra.column((k + 1) % 3) * rng.random_range(-1.0..1.0) * a.half[(k + 1) % 3];
-            Obb { center: a.center + n * (a.half[k] + support(&b0, &n) + signed_gap(rng)) + side, ..b0 }
+            Obb {
+                center: a.center + n * (a.half[k] + support(&b0, &n) + signed_gap(rng)) + side,
+                ..b0
+            }
         }
     };
     (a, b)
@@ -324,10 +346,17 @@ fn edge_on_edge(rng: &mut StdRng, a: &Obb, g: Real) -> (Obb, Real) {
     let b1 = n * chi.cos() + w * chi.sin();
     let b2 = b0.cross(&b1);
     let hb = random_half(rng);
-    let p = a.center + u(0) * rng.random_range(-0.9..0.9) * a.half[0] + u(1) * a.half[1] + u(2) * a.half[2];
+    let p = a.center
+        + u(0) * rng.random_range(-0.9..0.9) * a.half[0]
+        + u(1) * a.half[1]
+        + u(2) * a.half[2];
     // B's supporting edge in -n passes through p + g n.
     let s = |v: &Vec3| if v.dot(&n) > 0.0 { 1.0 } else { -1.0 };
-    let c = p + n * g + b1 * (s(&b1) * hb[1]) + b2 * (s(&b2) * hb[2]) + b0 * rng.random_range(-0.9..0.9) * hb[0];
+    let c = p
+        + n * g
+        + b1 * (s(&b1) * hb[1])
+        + b2 * (s(&b2) * hb[2])
+        + b0 * rng.random_range(-0.9..0.9) * hb[0];
     (Obb::new(c, Mat3::from_columns(&[b0, b1, b2]), hb), g)
 }
 
@@ -350,7 +379,9 @@ fn check_pair(a: &Obb, b: &Obb) -> Result<(Real, Truth), String> {
     if (d > 0.0) != separating_axis(a, b).is_some() {
         return Err(format!("sign differs from the SAT: {}", case()));
     }
-    if !(dist_to_box(a, &ours.point_a) <= TOL && ((ours.point_b - ours.point_a).norm() - d.abs()).abs() <= TOL) {
+    if !(dist_to_box(a, &ours.point_a) <= TOL
+        && ((ours.point_b - ours.point_a).norm() - d.abs()).abs() <= TOL)
+    {
         return Err(format!("witness: {}", case()));
     }
     if d > 0.0 && !(dist_to_box(b, &ours.point_b) <= TOL) {
@@ -380,7 +411,10 @@ fn random_box_pairs_of_seven_kinds_match_the_oracle() {
     }
     println!("apart by kind {apart:?}, intersecting by kind {inside:?}, exactly 0: {touching}");
     assert!(inside.iter().all(|&n| n > 500), "every kind has intersecting pairs");
-    assert!(apart.iter().enumerate().all(|(k, &n)| k == 4 || n > 50_000), "every kind but 'inside' has apart pairs");
+    assert!(
+        apart.iter().enumerate().all(|(k, &n)| k == 4 || n > 50_000),
+        "every kind but 'inside' has apart pairs"
+    );
 }
 
 #[test]
@@ -391,7 +425,10 @@ fn crossing_edges_are_at_exactly_their_constructed_gap() {
         let g = 10f64.powf(rng.random_range(-6.0..2.0));
         let (b, g) = edge_on_edge(&mut rng, &a, g);
         let c = obb_clearance(&a, &b);
-        assert!((c.distance - g).abs() <= 1e-9 * (1.0 + g), "case {i}: {c:?} vs {g}; a = {a:?}; b = {b:?}");
+        assert!(
+            (c.distance - g).abs() <= 1e-9 * (1.0 + g),
+            "case {i}: {c:?} vs {g}; a = {a:?}; b = {b:?}"
+        );
     }
 }
 
@@ -423,7 +460,8 @@ fn random_tcp(rng: &mut StdRng) -> Vec3 {
     loop {
         let (x, y) = (rng.random_range(-225.0..225.0), rng.random_range(-225.0..225.0));
         let depth = rng.random_range(365.0..530.0);
-        let radius = if depth <= 500.0 { 225.0 } else { 225.0 - (depth - 500.0) / 30.0 * (225.0 - 173.0) };
+        let radius =
+            if depth <= 500.0 { 225.0 } else { 225.0 - (depth - 500.0) / 30.0 * (225.0 - 173.0) };
         if Real::hypot(x, y) <= radius {
             return Vec3::new(x, y, -depth);
         }
@@ -438,11 +476,14 @@ fn random_configurations_of_cell_t1_match_the_oracle() {
     let mut rng = StdRng::seed_from_u64(0xc1ea_0003);
     let (mut done, mut colliding, mut pairs_checked) = (0, 0, 0);
     while done < N {
-        let (Ok(ra), Ok(rb)) = (model.boxes(&random_tcp(&mut rng)), model.boxes(&random_tcp(&mut rng))) else {
+        let (Ok(ra), Ok(rb)) =
+            (model.boxes(&random_tcp(&mut rng)), model.boxes(&random_tcp(&mut rng)))
+        else {
             continue;
         };
         let a = ra.as_slice();
-        let b: Vec<Obb> = rb.as_slice().iter().map(|o| o.transformed(&Mat3::identity(), &shift)).collect();
+        let b: Vec<Obb> =
+            rb.as_slice().iter().map(|o| o.transformed(&Mat3::identity(), &shift)).collect();
         let ours = boxes_clearance(a, &b);
         let (truth, checked) = oracle_over_pairs(a, &b);
         pairs_checked += checked;
@@ -455,7 +496,9 @@ fn random_configurations_of_cell_t1_match_the_oracle() {
         colliding += (ours.distance <= 0.0) as usize;
         done += 1;
     }
-    println!("{N} configurations, {colliding} colliding, {pairs_checked} pairs through the full oracle");
+    println!(
+        "{N} configurations, {colliding} colliding, {pairs_checked} pairs through the full oracle"
+    );
     assert!(colliding > 10_000 && colliding < N / 2);
 }
 
@@ -515,12 +558,19 @@ fn runs_of_cell_t1_tick_by_tick_match_the_oracle() {
             }
             let (Ok(ra), Ok(rb)) = (model.boxes(&tcp[0]), model.boxes(&tcp[1])) else { continue };
             let a = ra.as_slice();
-            let b: Vec<Obb> = rb.as_slice().iter().map(|o| o.transformed(&Mat3::identity(), &shift)).collect();
+            let b: Vec<Obb> =
+                rb.as_slice().iter().map(|o| o.transformed(&Mat3::identity(), &shift)).collect();
             let ours = memory.boxes_clearance(a, &b);
             let (truth, _) = oracle_over_pairs(a, &b);
-            assert!((ours.distance - truth).abs() <= TOL, "tick {ticks}: a = {a:?}; b = {b:?}; ours {ours:?}, oracle {truth}");
+            assert!(
+                (ours.distance - truth).abs() <= TOL,
+                "tick {ticks}: a = {a:?}; b = {b:?}; ours {ours:?}, oracle {truth}"
+            );
             let pair = obb_clearance(&a[ours.box_a], &b[ours.box_b]).distance;
-            assert!((pair - ours.distance).abs() <= TOL, "tick {ticks}: the pair named gives {pair}, {ours:?}");
+            assert!(
+                (pair - ours.distance).abs() <= TOL,
+                "tick {ticks}: the pair named gives {pair}, {ours:?}"
+            );
             close += usize::from(ours.distance < 20.0);
             ticks += 1;
         }
@@ -547,8 +597,10 @@ fn axis_gap_only(a: &Obb, b: &Obb) -> Real {
 
 fn parry_parts(o: &Obb) -> (Pose, Cuboid) {
     let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(o.axes));
-    let pose =
-        Pose::from_parts(Vector::new(o.center.x, o.center.y, o.center.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w));
+    let pose = Pose::from_parts(
+        Vector::new(o.center.x, o.center.y, o.center.z),
+        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
+    );
     (pose, Cuboid::new(Vector::new(o.half.x, o.half.y, o.half.z)))
 }
 
@@ -571,11 +623,16 @@ fn parry_distance_against_the_oracle() {
         apart += 1;
         let ((pa, sa), (pb, sb)) = (parry_parts(&a), parry_parts(&b));
         let parry = query::distance(&pa, &sa, &pb, &sb).unwrap().distance;
-        let case = format!("pair {i}, kind {kind}: a = {a:?}; b = {b:?}; oracle {truth:?}, parry {parry:e}");
+        let case = format!(
+            "pair {i}, kind {kind}: a = {a:?}; b = {b:?}; oracle {truth:?}, parry {parry:e}"
+        );
         assert!(parry >= truth.distance - TOL, "parry below the oracle: {case}");
         if parry > truth.distance + TOL {
             // The oracle's points are on the boxes and realise its distance: it is right.
-            assert!(dist_to_box(&a, &truth.p) <= 1e-9 && dist_to_box(&b, &truth.q) <= 1e-9, "{case}");
+            assert!(
+                dist_to_box(&a, &truth.p) <= 1e-9 && dist_to_box(&b, &truth.q) <= 1e-9,
+                "{case}"
+            );
             assert!(((truth.p - truth.q).norm() - truth.distance).abs() <= 1e-9, "{case}");
             parry_above += 1;
             worst = worst.max(parry - truth.distance);
@@ -591,7 +648,11 @@ fn parry_distance_against_the_oracle() {
 // Properties.
 
 fn obb() -> impl Strategy<Value = Obb> {
-    (prop::array::uniform3(-300.0..300.0f64), prop::array::uniform4(-1.0..1.0f64), prop::array::uniform3(0.5..250.0f64))
+    (
+        prop::array::uniform3(-300.0..300.0f64),
+        prop::array::uniform4(-1.0..1.0f64),
+        prop::array::uniform3(0.5..250.0f64),
+    )
         .prop_filter_map("degenerate rotation", |(c, q, h)| {
             let q = nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]);
             (q.norm() > 1e-3).then(|| {

@@ -89,7 +89,11 @@ struct Tally {
 
 impl Tally {
     fn new(levels: usize) -> Tally {
-        Tally { per_level: vec![0; levels + 1], slack: vec![f64::INFINITY; levels + 1], ..Tally::default() }
+        Tally {
+            per_level: vec![0; levels + 1],
+            slack: vec![f64::INFINITY; levels + 1],
+            ..Tally::default()
+        }
     }
 
     fn merge(&mut self, o: &Tally) {
@@ -109,8 +113,15 @@ impl Tally {
 /// boolean one (the size target of clearance tables).
 fn checkers(cell: &Cell, ladder: Ladder) -> (TableChecker, TableChecker) {
     let variants = [Variant::Clearance(ladder), Variant::Shared];
-    let (header, tables, _) =
-        build_tables(cell, K, &Workspace::THESIS, &variants, Labelling::Certified, Progress::Silent).unwrap();
+    let (header, tables, _) = build_tables(
+        cell,
+        K,
+        &Workspace::THESIS,
+        &variants,
+        Labelling::Certified,
+        Progress::Silent,
+    )
+    .unwrap();
     assert_eq!(TableKind::of(&tables[0]), TableKind::Clearance);
     let files: Vec<Vec<u8>> = tables.iter().map(|t: &Table| to_bytes(t, &header)).collect();
     let (clearance, boolean) = (files[0].len(), files[1].len());
@@ -170,7 +181,8 @@ fn run(
             if !(b <= exact_mm) {
                 t.violations += 1;
                 if t.first_violation.is_none() {
-                    t.first_violation = Some(format!("bound {b} mm, exact {exact_mm} mm at {tcps:?}"));
+                    t.first_violation =
+                        Some(format!("bound {b} mm, exact {exact_mm} mm at {tcps:?}"));
                 }
             }
         }
@@ -202,7 +214,8 @@ fn clearance_bound_never_exceeds_the_exact_clearance() {
         let start = std::time::Instant::now();
         let cell = reference_cell(name).unwrap();
         let (clearance, boolean) = checkers(&cell, ladder);
-        let grid = |j: usize| SampleGrid::new(&Workspace::THESIS, K, &cell.robots[j].model.delta).unwrap();
+        let grid =
+            |j: usize| SampleGrid::new(&Workspace::THESIS, K, &cell.robots[j].model.delta).unwrap();
         let grids = [grid(0), grid(1)];
         let near = near_contact(&grids, clearance.table());
         assert!(near.len() > 1000, "{name}: {} near-contact pairs", near.len());
@@ -212,8 +225,11 @@ fn clearance_bound_never_exceeds_the_exact_clearance() {
             let runs: Vec<_> = (0..threads)
                 .map(|j| {
                     let n = PER_CELL / threads + u64::from(j < PER_CELL % threads);
-                    let (cell, grids, near, clearance, boolean) = (&cell, &grids, &near, &clearance, &boolean);
-                    s.spawn(move || run(cell, grids, near, clearance, boolean, n, 0x5eed ^ (j << 32)))
+                    let (cell, grids, near, clearance, boolean) =
+                        (&cell, &grids, &near, &clearance, &boolean);
+                    s.spawn(move || {
+                        run(cell, grids, near, clearance, boolean, n, 0x5eed ^ (j << 32))
+                    })
                 })
                 .collect();
             runs.into_iter().for_each(|r| total.merge(&r.join().unwrap()));
@@ -231,10 +247,21 @@ fn clearance_bound_never_exceeds_the_exact_clearance() {
             total.free_set_mismatches
         );
         assert_eq!(checked, PER_CELL);
-        assert_eq!(total.violations, 0, "{name}: the bound exceeds the exact clearance: {:?}", total.first_violation);
-        assert_eq!(total.free_set_mismatches, 0, "{name}: levels and the boolean table's free set differ");
+        assert_eq!(
+            total.violations, 0,
+            "{name}: the bound exceeds the exact clearance: {:?}",
+            total.first_violation
+        );
+        assert_eq!(
+            total.free_set_mismatches, 0,
+            "{name}: levels and the boolean table's free set differ"
+        );
         // The sample reaches every level the ladder has below the top, and the collisions.
-        assert!(total.per_level[0] > 10_000, "{name}: few configurations without a level: {:?}", total.per_level);
+        assert!(
+            total.per_level[0] > 10_000,
+            "{name}: few configurations without a level: {:?}",
+            total.per_level
+        );
         let levelled = total.per_level[1..ladder.len()].iter().filter(|&&c| c > 1000).count();
         assert!(levelled >= 4, "{name}: few levels reached: {:?}", total.per_level);
     }

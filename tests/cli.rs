@@ -39,7 +39,8 @@ fn stdout(out: &Output) -> String {
 
 /// A new empty directory of this test process.
 fn fresh_dir(name: &str) -> PathBuf {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-cli-{name}-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("dc-cli-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -47,8 +48,10 @@ fn fresh_dir(name: &str) -> PathBuf {
 
 /// The names of the files in `dir`, sorted.
 fn names_in(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> =
-        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
     names.sort();
     names
 }
@@ -62,12 +65,24 @@ fn demo_runs_the_line_of_four_robots() {
     let out = cli(&["demo", "--cell", "cells/line4.toml"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let text = stdout(&out);
-    let rows: Vec<Vec<&str>> =
-        text.lines().filter(|l| l.starts_with("line4")).map(|l| l.split_whitespace().collect()).collect();
-    let firsts: Vec<_> = rows.iter().filter(|r| r[2].starts_with("SAT")).map(|r| (r[1], r[3])).collect();
-    let expected = [("practical", "none"), ("practical", "none"), ("collision", "tick"), ("collision", "tick")];
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .filter(|l| l.starts_with("line4"))
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    let firsts: Vec<_> =
+        rows.iter().filter(|r| r[2].starts_with("SAT")).map(|r| (r[1], r[3])).collect();
+    let expected = [
+        ("practical", "none"),
+        ("practical", "none"),
+        ("collision", "tick"),
+        ("collision", "tick"),
+    ];
     assert_eq!(firsts, expected, "{text}");
-    let at_3810 = text.lines().filter(|l| l.starts_with("line4 collision") && l.contains("tick 3810")).count();
+    let at_3810 = text
+        .lines()
+        .filter(|l| l.starts_with("line4 collision") && l.contains("tick 3810"))
+        .count();
     assert_eq!(at_3810, 2, "SAT and SAT-cache: R3-R4 meet at tick 3810\n{text}");
     let protective: Vec<&Vec<&str>> = rows.iter().filter(|r| r.len() == 10).collect();
     assert_eq!(protective.len(), 2, "{text}");
@@ -78,41 +93,61 @@ fn demo_runs_the_line_of_four_robots() {
 }
 
 #[test]
-fn demo_reports_no_collision_when_practical_the_same_first_tick_for_both_methods_and_a_clear_stop() {
+fn demo_reports_no_collision_when_practical_the_same_first_tick_for_both_methods_and_a_clear_stop()
+{
     let out = cli(&["demo", "--cell", "all"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8(out.stdout).unwrap();
     println!("{text}");
     for cell in ["T1", "T2", "T3"] {
-        let all: Vec<Vec<&str>> =
-            text.lines().filter(|l| l.starts_with(cell)).map(|l| l.split_whitespace().collect()).collect();
+        let all: Vec<Vec<&str>> = text
+            .lines()
+            .filter(|l| l.starts_with(cell))
+            .map(|l| l.split_whitespace().collect())
+            .collect();
         let rows: Vec<&Vec<&str>> = all.iter().filter(|r| r[2].starts_with("SAT")).collect();
         assert_eq!(rows.len(), 4, "{cell}: practical and collision, SAT and SAT-cache");
         for r in rows.iter().filter(|r| r[1] == "practical") {
             assert_eq!((r[3], r[4]), ("none", "0"), "{cell} practical never collides");
         }
-        let ticks: Vec<u32> = rows.iter().filter(|r| r[1] == "collision").map(|r| r[4].parse().unwrap()).collect();
+        let ticks: Vec<u32> =
+            rows.iter().filter(|r| r[1] == "collision").map(|r| r[4].parse().unwrap()).collect();
         assert_eq!(ticks.len(), 2);
         assert_eq!(ticks[0], ticks[1], "{cell}: SAT and SAT-cache stop at the same tick");
         assert!(ticks[0] > 3000 && ticks[0] < 6000, "{cell}: the last part of the run collides");
-        // The protective rows: cell case firstWARN firstSTOP WARN STOP stop stop_ms closest median_us.
+        // The protective rows: cell case firstWARN firstSTOP WARN STOP stop stop_ms closest
+        // median_us.
         let protective: Vec<&Vec<&str>> = all.iter().filter(|r| r.len() == 10).collect();
         assert_eq!(protective.len(), 2, "{cell}: one protective row per scenario");
         for r in protective {
-            let first_stop: u32 = r[3].parse().expect("the scenarios come close enough to need a STOP");
-            assert!(first_stop < ticks[0], "{cell} {}: STOP at {first_stop}, before the contact at {}", r[1], ticks[0]);
+            let first_stop: u32 =
+                r[3].parse().expect("the scenarios come close enough to need a STOP");
+            assert!(
+                first_stop < ticks[0],
+                "{cell} {}: STOP at {first_stop}, before the contact at {}",
+                r[1],
+                ticks[0]
+            );
             let (warn, stop): (u32, u32) = (r[4].parse().unwrap(), r[5].parse().unwrap());
             assert!(stop > 0 && warn + stop <= 6000, "{r:?}");
             assert_eq!(r[6], "clear", "{cell} {}: the simulated stop never touches", r[1]);
-            assert!(r[7].parse::<f64>().unwrap() > 0.0 && r[8].parse::<f64>().unwrap() > 0.0, "{r:?}");
-            assert!(r[9].parse::<f64>().unwrap() > 0.0, "{cell} {}: a tick takes some time: {r:?}", r[1]);
+            assert!(
+                r[7].parse::<f64>().unwrap() > 0.0 && r[8].parse::<f64>().unwrap() > 0.0,
+                "{r:?}"
+            );
+            assert!(
+                r[9].parse::<f64>().unwrap() > 0.0,
+                "{cell} {}: a tick takes some time: {r:?}",
+                r[1]
+            );
         }
     }
 }
 
 #[test]
 fn check_writes_one_line_per_row_matching_the_exact_checker() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-cli-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("dc-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (input, output) = (dir.join("in.csv"), dir.join("out.csv"));
     let mut rows = vec!["x,y,z,x2,y2,z2".to_string()];
@@ -121,8 +156,12 @@ fn check_writes_one_line_per_row_matching_the_exact_checker() {
     for i in 0..501 {
         let s = i as f64 / 500.0;
         let z = if i == 500 { -900.0 } else { -450.0 - 60.0 * s };
-        let tcps = [Vec3::new(-200.0 + 400.0 * s, 20.0, z), Vec3::new(180.0 - 380.0 * s, -10.0, -470.0)];
-        rows.push(format!("{},{},{},{},{},{}", tcps[0].x, tcps[0].y, tcps[0].z, tcps[1].x, tcps[1].y, tcps[1].z));
+        let tcps =
+            [Vec3::new(-200.0 + 400.0 * s, 20.0, z), Vec3::new(180.0 - 380.0 * s, -10.0, -470.0)];
+        rows.push(format!(
+            "{},{},{},{},{},{}",
+            tcps[0].x, tcps[0].y, tcps[0].z, tcps[1].x, tcps[1].y, tcps[1].z
+        ));
         let v = checker.check(&tcps).unwrap();
         expected.push(
             match (v.all_reachable(), v.collides()) {
@@ -159,7 +198,8 @@ fn bad_arguments_and_rows_fail_with_a_message() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("nope.toml"));
     let out = cli(&["demo", "--cel", "T1"]);
     assert_eq!(out.status.code(), Some(2));
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-cli-bad-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("dc-cli-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("bad.csv");
     std::fs::write(&input, "1,2,3,4,5,6\n1,2,three,4,5,6\n").unwrap();
@@ -170,13 +210,17 @@ fn bad_arguments_and_rows_fail_with_a_message() {
 
 #[test]
 fn build_inspect_eval_and_check_with_a_table() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-cli-table-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("dc-cli-table-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let table = dir.join("t3.dct");
     let table = table.to_str().unwrap();
     let out = cli(&["build", "--cell", "T3", "--k", "16", "--variant", "5d", "--output", table]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(String::from_utf8_lossy(&out.stdout).contains("symmetric: false"), "T3 has no symmetry");
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("symmetric: false"),
+        "T3 has no symmetry"
+    );
     let out = cli(&["inspect", table]);
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(out.status.success() && text.contains("5D") && text.contains("SweptBound"), "{text}");
@@ -184,19 +228,35 @@ fn build_inspect_eval_and_check_with_a_table() {
     let text = String::from_utf8(out.stdout).unwrap();
     println!("{text}");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let fns: Vec<&str> =
-        text.lines().filter_map(|l| l.split("FN").nth(1)).map(|r| r.split_whitespace().next().unwrap()).collect();
+    let fns: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.split("FN").nth(1))
+        .map(|r| r.split_whitespace().next().unwrap())
+        .collect();
     assert_eq!(fns, vec!["0", "0", "0"], "practical, collision and random: no false negative");
     let out = cli(&["eval", "--cell", "T1", "--table", table, "--random", "10"]);
     assert_eq!(out.status.code(), Some(1), "a T3 table is refused for T1");
     assert!(String::from_utf8_lossy(&out.stderr).contains("rebuild"));
     let input = dir.join("in.csv");
     // Robots reaching toward each other (B's MCS is turned by 30 degrees), apart, unreachable.
-    std::fs::write(&input, "190,70,-450,-200,-20,-450\n-150,0,-450,150,0,-450\n0,0,-900,0,0,-450\n").unwrap();
+    std::fs::write(
+        &input,
+        "190,70,-450,-200,-20,-450\n-150,0,-450,150,0,-450\n0,0,-900,0,0,-450\n",
+    )
+    .unwrap();
     let out = cli(&["check", "--cell", "T3", "--table", table, "--input", input.to_str().unwrap()]);
     assert_eq!(String::from_utf8(out.stdout).unwrap(), "reachable,collide\n1,1\n1,0\n0,NA\n");
     // --clearance in table mode: the exact signed clearance beside the table's answer.
-    let out = cli(&["check", "--cell", "T3", "--table", table, "--clearance", "--input", input.to_str().unwrap()]);
+    let out = cli(&[
+        "check",
+        "--cell",
+        "T3",
+        "--table",
+        table,
+        "--clearance",
+        "--input",
+        input.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let text = stdout(&out);
     let rows: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split(',').collect()).collect();
@@ -223,21 +283,48 @@ fn clearance_table_through_build_inspect_eval_and_check() {
     let dir = fresh_dir("clearance-table");
     let table = dir.join("t1c.dct");
     let table = table.to_str().unwrap();
-    let out = cli(&["build", "--cell", "T1", "--k", "16", "--variant", "clearance", "--levels", "0,10,30,90", "--output", table]);
+    let out = cli(&[
+        "build",
+        "--cell",
+        "T1",
+        "--k",
+        "16",
+        "--variant",
+        "clearance",
+        "--levels",
+        "0,10,30,90",
+        "--output",
+        table,
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stdout(&out).contains("sample pairs per level: no level"), "{}", stdout(&out));
     let out = cli(&["inspect", table]);
     let text = stdout(&out);
-    assert!(out.status.success() && text.contains("6D-clearance") && text.contains("[0.0, 10.0, 30.0, 90.0]"), "{text}");
-    assert!(text.contains(">= 90 mm") && text.contains("grid cells (all k^6, as stored) per level"), "{text}");
+    assert!(
+        out.status.success()
+            && text.contains("6D-clearance")
+            && text.contains("[0.0, 10.0, 30.0, 90.0]"),
+        "{text}"
+    );
+    assert!(
+        text.contains(">= 90 mm") && text.contains("grid cells (all k^6, as stored) per level"),
+        "{text}"
+    );
     let out = cli(&["eval", "--cell", "T1", "--table", table, "--random", "20000"]);
     let text = stdout(&out);
     assert!(out.status.success(), "{}", stderr(&out));
-    let fns: Vec<&str> =
-        text.lines().filter_map(|l| l.split("FN").nth(1)).map(|r| r.split_whitespace().next().unwrap()).collect();
+    let fns: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.split("FN").nth(1))
+        .map(|r| r.split_whitespace().next().unwrap())
+        .collect();
     assert_eq!(fns, vec!["0", "0", "0"], "practical, collision and random: no false negative");
-    // T1's collision scenario every 20 ticks (far apart, then intersecting), and one unreachable row.
-    let scenarios = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt")).unwrap();
+    // T1's collision scenario every 20 ticks (far apart, then intersecting), and one unreachable
+    // row.
+    let scenarios = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt"),
+    )
+    .unwrap();
     let scenarios = delta_collide::cell::trajectory::parse_scenarios(&scenarios).unwrap();
     let s = scenarios.iter().find(|s| s.cell == "T1" && s.case == "collision").unwrap();
     let mut configs: Vec<Vec<Vec3>> = (0..6000)
@@ -275,7 +362,17 @@ fn clearance_table_through_build_inspect_eval_and_check() {
     // clearance agree with exact mode's, and table mode never stops where exact mode does not.
     let ladder_table = dir.join("t1d.dct");
     let ladder_table = ladder_table.to_str().unwrap();
-    let out = cli(&["build", "--cell", "T1", "--k", "16", "--variant", "clearance", "--output", ladder_table]);
+    let out = cli(&[
+        "build",
+        "--cell",
+        "T1",
+        "--k",
+        "16",
+        "--variant",
+        "clearance",
+        "--output",
+        ladder_table,
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let cell = dir.join("t1_stiff.toml");
     let stop = "stop = { reaction_ms = 2.0, decel_mm_s2 = 120000.0, max_accel_mm_s2 = 130000.0, max_speed_mm_s = 4600.0 }";
@@ -289,17 +386,35 @@ fn clearance_table_through_build_inspect_eval_and_check() {
     let exact = cli_stdin(&["replay", "--cell", cell], &rows);
     let table_mode = cli_stdin(&["replay", "--cell", cell, "--table", ladder_table], &rows);
     assert!(exact.status.success() && table_mode.status.success(), "{}", stderr(&table_mode));
-    assert!(stderr(&table_mode).contains(" of 6000 ticks"), "no lookup share: {}", stderr(&table_mode));
+    assert!(
+        stderr(&table_mode).contains(" of 6000 ticks"),
+        "no lookup share: {}",
+        stderr(&table_mode)
+    );
     let (exact, table_mode) = (stdout(&exact), stdout(&table_mode));
     assert_eq!(exact.lines().count(), table_mode.lines().count());
     for (e, t) in exact.lines().zip(table_mode.lines()).skip(1) {
         let (e, t): (Vec<&str>, Vec<&str>) = (e.split(',').collect(), t.split(',').collect());
         assert_eq!((e[0], e[2], e[3]), (t[0], t[2], t[3]), "tick, status and clearance");
-        assert!(t[1] != "stop" || e[1] == "stop", "table mode stops at tick {} where exact mode does not", t[0]);
+        assert!(
+            t[1] != "stop" || e[1] == "stop",
+            "table mode stops at tick {} where exact mode does not",
+            t[0]
+        );
     }
     // quilt shades free cells by level: the middle levels' blues cover many cells.
     let png = dir.join("quilt.png");
-    let out = cli(&["quilt", "--cell", "T1", "--table", table, "--axes", "zz", "--output", png.to_str().unwrap()]);
+    let out = cli(&[
+        "quilt",
+        "--cell",
+        "T1",
+        "--table",
+        table,
+        "--axes",
+        "zz",
+        "--output",
+        png.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let (_, _, pixels) = read_png(&png);
     // The quilt's level colours for 4 levels: white, two blues between, the top's dark blue.
@@ -311,7 +426,8 @@ fn clearance_table_through_build_inspect_eval_and_check() {
 /// Signed clearance of the cell `cell` at `tcps` computed here, apart from
 /// `geometry::clearance`: apart, the smallest box distance of `geometry::distance` (vertex and
 /// edge distances); intersecting, minus the smallest overlap (the shift that separates them)
-/// of the 8-vertex projections of two boxes over their 15 normalised axes. `None` when a TCP is unreachable.
+/// of the 8-vertex projections of two boxes over their 15 normalised axes. `None` when a TCP is
+/// unreachable.
 fn oracle_clearance(cell: &str, tcps: &[Vec3]) -> Option<f64> {
     use delta_collide::geometry::{obb_distance, Obb};
     let mut exact = ExactChecker::new(reference_cell(cell).unwrap());
@@ -319,7 +435,8 @@ fn oracle_clearance(cell: &str, tcps: &[Vec3]) -> Option<f64> {
         return None;
     }
     let overlap = |a: &Obb, b: &Obb| -> f64 {
-        let mut axes: Vec<Vec3> = (0..3).flat_map(|i| [a.axes.column(i).into(), b.axes.column(i).into()]).collect();
+        let mut axes: Vec<Vec3> =
+            (0..3).flat_map(|i| [a.axes.column(i).into(), b.axes.column(i).into()]).collect();
         for i in 0..3 {
             for j in 0..3 {
                 let c: Vec3 = a.axes.column(i).cross(&b.axes.column(j));
@@ -358,11 +475,14 @@ fn oracle_clearance(cell: &str, tcps: &[Vec3]) -> Option<f64> {
 /// written into `dir`) and returns its output, after checking that it succeeded and that
 /// its header names the clearance column.
 fn check_clearance(dir: &Path, args: &[&str], configs: &[Vec<Vec3>]) -> String {
-    let rows: Vec<String> =
-        configs.iter().map(|t| format!("{},{},{},{},{},{}", t[0].x, t[0].y, t[0].z, t[1].x, t[1].y, t[1].z)).collect();
+    let rows: Vec<String> = configs
+        .iter()
+        .map(|t| format!("{},{},{},{},{},{}", t[0].x, t[0].y, t[0].z, t[1].x, t[1].y, t[1].z))
+        .collect();
     let input = dir.join("in.csv");
     std::fs::write(&input, rows.join("\n")).unwrap();
-    let out = cli(&[&["check"], args, &["--clearance", "--input", input.to_str().unwrap()]].concat());
+    let out =
+        cli(&[&["check"], args, &["--clearance", "--input", input.to_str().unwrap()]].concat());
     assert!(out.status.success(), "{}", stderr(&out));
     let text = stdout(&out);
     assert_eq!(text.lines().next(), Some("reachable,collide,clearance_mm"));
@@ -374,7 +494,10 @@ fn check_clearance(dir: &Path, args: &[&str], configs: &[Vec<Vec3>]) -> String {
 #[test]
 fn check_clearance_matches_an_independent_signed_distance() {
     let dir = fresh_dir("clearance");
-    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt")).unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt"),
+    )
+    .unwrap();
     let scenarios = delta_collide::cell::trajectory::parse_scenarios(&text).unwrap();
     let s = scenarios.iter().find(|s| s.cell == "T1" && s.case == "collision").unwrap();
     let mut configs = Vec::new();
@@ -404,7 +527,8 @@ fn check_clearance_matches_an_independent_signed_distance() {
 
 /// The fenced block after "delta-collide --help" in the README's "Command line" section.
 fn readme_help_block() -> String {
-    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
     let section = readme.split("\n## Command line\n").nth(1).expect("a \"Command line\" section");
     let section = section.split("\n## ").next().unwrap();
     let block = section.split("```text\n").nth(1).expect("a ```text block in \"Command line\"");
@@ -414,7 +538,8 @@ fn readme_help_block() -> String {
 /// The README is a manual read in one sitting; measurements belong in `docs/record/`.
 #[test]
 fn readme_stays_a_manual_under_25_kb() {
-    let bytes = std::fs::metadata(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap().len();
+    let bytes =
+        std::fs::metadata(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap().len();
     assert!(bytes < 25_000, "README.md is {bytes} bytes: move detail to docs/ or docs/record/");
 }
 
@@ -427,7 +552,18 @@ fn help_lists_every_command_and_the_readme_shows_it() {
     let out = cli(&["--help"]);
     assert_eq!(out.status.code(), Some(0));
     let help = stdout(&out);
-    let commands = ["demo", "check", "build", "merge", "inspect", "eval", "render", "quilt", "completions", "man"];
+    let commands = [
+        "demo",
+        "check",
+        "build",
+        "merge",
+        "inspect",
+        "eval",
+        "render",
+        "quilt",
+        "completions",
+        "man",
+    ];
     for command in commands.into_iter().chain(["--quiet"]) {
         assert!(help.contains(command), "{command} in\n{help}");
     }
@@ -454,12 +590,26 @@ fn each_command_explains_its_flags_units_and_defaults() {
     }
     assert!(help("demo").contains("T1, T2, T3, all"));
     let build = help("build");
-    let parts = ["[default: 32]", "power of two from 2 to 256", "[default: 6d]", "4d-yy", "shared-sub", "[default: 0]"];
-    let shards = ["--shard <I/N|auto>", "every variant shards", "JOB_COMPLETION_INDEX", "DELTA_COLLIDE_SHARDS"];
+    let parts = [
+        "[default: 32]",
+        "power of two from 2 to 256",
+        "[default: 6d]",
+        "4d-yy",
+        "shared-sub",
+        "[default: 0]",
+    ];
+    let shards = [
+        "--shard <I/N|auto>",
+        "every variant shards",
+        "JOB_COMPLETION_INDEX",
+        "DELTA_COLLIDE_SHARDS",
+    ];
     for part in parts.into_iter().chain(shards) {
         assert!(build.contains(part), "build --help: {part}\n{build}");
     }
-    assert!(help("render").contains("own MCS (mm)") && help("render").contains("[default: render.png]"));
+    assert!(
+        help("render").contains("own MCS (mm)") && help("render").contains("[default: render.png]")
+    );
     assert!(help("eval").contains("[default: 1000000]") && help("eval").contains("pixels"));
     assert!(help("quilt").contains("[default: yy]") && help("quilt").contains("[default: 1200]"));
 }
@@ -484,7 +634,10 @@ fn usage_errors_exit_with_2_and_say_what_is_wrong() {
         (&["frobnicate"], "unrecognized subcommand"),
         (&["demo", "--cel", "T1"], "unexpected argument '--cel'"),
         (&["check"], "--cell <CELL>"),
-        (&["build", "--cell", "T1", "--output", table, "--k", "16", "--k", "32"], "cannot be used multiple times"),
+        (
+            &["build", "--cell", "T1", "--output", table, "--k", "16", "--k", "32"],
+            "cannot be used multiple times",
+        ),
         (&["build", "--cell", "T1", "--output", table, "--k", "512"], "power of two from 2 to 256"),
         (&["build", "--cell", "T1", "--output", table, "--k", "48"], "power of two"),
         (&["build", "--cell", "T1", "--output", table, "--k", "lots"], "power of two"),
@@ -498,14 +651,63 @@ fn usage_errors_exit_with_2_and_say_what_is_wrong() {
         ),
         (&["build", "--cell", "T1", "--output", table, "--t", "5"], "not to --variant 6d"),
         (
-            &["build", "--cell", "T1", "--output", table, "--variant", "shared-sub", "--labelling", "thesis"],
+            &[
+                "build",
+                "--cell",
+                "T1",
+                "--output",
+                table,
+                "--variant",
+                "shared-sub",
+                "--labelling",
+                "thesis",
+            ],
             "certified",
         ),
-        (&["build", "--cell", "T1", "--output", table, "--levels", "0,5"], "--variant clearance only"),
-        (&["build", "--cell", "T1", "--output", table, "--variant", "clearance", "--levels", "5,5"], "must increase"),
-        (&["build", "--cell", "T1", "--output", table, "--variant", "clearance", "--levels", "0,x"], "'0,x'"),
         (
-            &["build", "--cell", "T1", "--output", table, "--variant", "clearance", "--labelling", "thesis"],
+            &["build", "--cell", "T1", "--output", table, "--levels", "0,5"],
+            "--variant clearance only",
+        ),
+        (
+            &[
+                "build",
+                "--cell",
+                "T1",
+                "--output",
+                table,
+                "--variant",
+                "clearance",
+                "--levels",
+                "5,5",
+            ],
+            "must increase",
+        ),
+        (
+            &[
+                "build",
+                "--cell",
+                "T1",
+                "--output",
+                table,
+                "--variant",
+                "clearance",
+                "--levels",
+                "0,x",
+            ],
+            "'0,x'",
+        ),
+        (
+            &[
+                "build",
+                "--cell",
+                "T1",
+                "--output",
+                table,
+                "--variant",
+                "clearance",
+                "--labelling",
+                "thesis",
+            ],
             "certified",
         ),
         (&["build", "--cell", "T9", "--output", table], "T1, T2, T3"),
@@ -517,8 +719,14 @@ fn usage_errors_exit_with_2_and_say_what_is_wrong() {
         (&["eval", "--cell", "T1", "--table", table, "--random", "-3"], "'-3'"),
         (&["render", "--cell", "T1", "--tcp", "1,2", "--tcp", "0,0,-450"], "three numbers"),
         (&["render", "--cell", "T1", "--tcp", "0,0,-450"], "one --tcp x,y,z per robot"),
-        (&["quilt", "--cell", "T1", "--table", table, "--a", "1,2,3", "--axes", "zz"], "cannot be used with"),
-        (&["quilt", "--cell", "T1", "--table", table, "--a", "1,2,3", "--fix", "1,2"], "cannot be used with"),
+        (
+            &["quilt", "--cell", "T1", "--table", table, "--a", "1,2,3", "--axes", "zz"],
+            "cannot be used with",
+        ),
+        (
+            &["quilt", "--cell", "T1", "--table", table, "--a", "1,2,3", "--fix", "1,2"],
+            "cannot be used with",
+        ),
         (&["completions", "tcsh"], "use bash"),
     ];
     for (args, what) in cases {
@@ -537,7 +745,11 @@ fn the_unknown_cell_error_names_the_built_in_cells() {
     let err = stderr(&out);
     assert!(err.contains("'T9'") && err.contains("T1, T2, T3") && err.contains(".toml"), "{err}");
     let out = cli(&["demo", "--cell", "T9"]);
-    assert!(stderr(&out).contains("T1, T2, T3") && stderr(&out).contains("all"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("T1, T2, T3") && stderr(&out).contains("all"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 /// Failures (a file that cannot be read, a table that is not one): exit code 1.
@@ -575,7 +787,11 @@ fn completions_and_man_pages_are_generated_from_the_definition() {
     let out = cli(&["man"]);
     assert_eq!(out.status.code(), Some(0));
     let page = stdout(&out);
-    assert!(page.starts_with(".ie") && page.contains(".TH delta-collide 1"), "{}", &page[..page.len().min(300)]);
+    assert!(
+        page.starts_with(".ie") && page.contains(".TH delta-collide 1"),
+        "{}",
+        &page[..page.len().min(300)]
+    );
     for word in ["build", "check", "quilt", "completions", "quiet"] {
         assert!(page.contains(word), "man page: {word}");
     }
@@ -583,7 +799,12 @@ fn completions_and_man_pages_are_generated_from_the_definition() {
     let out = cli(&["man", "--output", dir.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let names = names_in(&dir);
-    for name in ["delta-collide.1", "delta-collide-build.1", "delta-collide-check.1", "delta-collide-quilt.1"] {
+    for name in [
+        "delta-collide.1",
+        "delta-collide-build.1",
+        "delta-collide-check.1",
+        "delta-collide-quilt.1",
+    ] {
         assert!(names.contains(&name.to_string()), "{name} in {names:?}");
     }
     let build = std::fs::read_to_string(dir.join("delta-collide-build.1")).unwrap();
@@ -635,9 +856,18 @@ fn errors_echo_at_most_a_few_dozen_characters_of_the_input() {
 fn check_output_is_untouched_when_a_row_fails() {
     let dir = fresh_dir("check-output");
     let (input, output) = (dir.join("in.csv"), dir.join("out.csv"));
-    std::fs::write(&input, "-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n1,2,three,4,5,6\n").unwrap();
+    std::fs::write(&input, "-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n1,2,three,4,5,6\n")
+        .unwrap();
     std::fs::write(&output, "the previous answers\n").unwrap();
-    let args = ["check", "--cell", "T1", "--input", input.to_str().unwrap(), "--output", output.to_str().unwrap()];
+    let args = [
+        "check",
+        "--cell",
+        "T1",
+        "--input",
+        input.to_str().unwrap(),
+        "--output",
+        output.to_str().unwrap(),
+    ];
     let out = cli(&args);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("line 3"));
@@ -672,12 +902,16 @@ fn a_build_stopped_mid_write_leaves_the_old_table_intact() {
     let dir = fresh_dir("build-output");
     let table = dir.join("t1.dct");
     let t = table.to_str().unwrap();
-    let out = cli(&["build", "--quiet", "--cell", "T1", "--k", "16", "--variant", "5d", "--output", t]);
+    let out =
+        cli(&["build", "--quiet", "--cell", "T1", "--k", "16", "--variant", "5d", "--output", t]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     assert!(out.stderr.is_empty(), "--quiet: {}", stderr(&out));
     let good = std::fs::read(&table).unwrap();
     assert!(good.len() > 8 * 1024, "the table is bigger than the limit below");
-    let out = cli_with_file_limit(8, &["build", "--cell", "T1", "--k", "16", "--variant", "6d", "--output", t]);
+    let out = cli_with_file_limit(
+        8,
+        &["build", "--cell", "T1", "--k", "16", "--variant", "6d", "--output", t],
+    );
     assert!(!out.status.success(), "the limit stops the write");
     assert_eq!(std::fs::read(&table).unwrap(), good, "the old table is intact");
     assert!(cli(&["inspect", t]).status.success());
@@ -685,8 +919,10 @@ fn a_build_stopped_mid_write_leaves_the_old_table_intact() {
     let picture = dir.join("render.png");
     std::fs::write(&picture, "the previous picture").unwrap();
     let p = picture.to_str().unwrap();
-    let out =
-        cli_with_file_limit(8, &["render", "--cell", "T1", "--tcp", "0,0,-450", "--tcp", "0,0,-450", "--output", p]);
+    let out = cli_with_file_limit(
+        8,
+        &["render", "--cell", "T1", "--tcp", "0,0,-450", "--tcp", "0,0,-450", "--output", p],
+    );
     assert!(!out.status.success());
     assert_eq!(std::fs::read_to_string(&picture).unwrap(), "the previous picture");
 }
@@ -708,7 +944,12 @@ fn a_k_beyond_the_format_or_the_memory_is_refused_before_allocating() {
         let out = cli(&["build", "--cell", "T1", "--k", "256", "--output", t]);
         assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
         let err = stderr(&out);
-        assert!(err.contains("needs about") && err.contains("GB of memory") && err.contains("smaller k"), "{err}");
+        assert!(
+            err.contains("needs about")
+                && err.contains("GB of memory")
+                && err.contains("smaller k"),
+            "{err}"
+        );
         assert!(!err.contains("panicked") && !err.contains("backtrace"), "{err}");
         assert!(start.elapsed().as_secs() < 60, "refused before labelling");
     }
@@ -719,10 +960,23 @@ fn a_k_beyond_the_format_or_the_memory_is_refused_before_allocating() {
 fn progress_never_goes_into_the_data() {
     let dir = fresh_dir("progress");
     let table = dir.join("t.dct");
-    let out = cli(&["build", "--cell", "T1", "--k", "16", "--variant", "5d", "--output", table.to_str().unwrap()]);
+    let out = cli(&[
+        "build",
+        "--cell",
+        "T1",
+        "--k",
+        "16",
+        "--variant",
+        "5d",
+        "--output",
+        table.to_str().unwrap(),
+    ]);
     assert_eq!(out.status.code(), Some(0));
     let text = stdout(&out);
-    assert!(!text.contains("rows of A") && !text.contains('\r') && !text.contains('\u{1b}'), "{text}");
+    assert!(
+        !text.contains("rows of A") && !text.contains('\r') && !text.contains('\u{1b}'),
+        "{text}"
+    );
     let out = cli_stdin(&["check", "--quiet", "--cell", "T1"], "-150,0,-450,150,0,-450\n");
     assert_eq!((stdout(&out).as_str(), stderr(&out).as_str()), ("reachable,collide\n1,0\n", ""));
 }
@@ -739,7 +993,9 @@ fn replay_writes_one_verdict_per_tick() {
     let text = stdout(&out);
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 4, "{text}");
-    assert!(lines[0].starts_with("tick,verdict,clearance_mm,status,protective_mm_A,protective_mm_B,speed_limit_mm_s_A"));
+    assert!(lines[0].starts_with(
+        "tick,verdict,clearance_mm,status,protective_mm_A,protective_mm_B,speed_limit_mm_s_A"
+    ));
     assert!(lines[1].starts_with("7,stop,") && lines[1].split(',').nth(3) == Some("ok"), "{text}");
     assert!(lines[2].starts_with("8,free,") && lines[3].starts_with("9,free,"), "{text}");
     let clearance: f64 = lines[2].split(',').nth(2).unwrap().parse().unwrap();
@@ -748,10 +1004,16 @@ fn replay_writes_one_verdict_per_tick() {
     let swapped = "x2,y2,z2,x,y,z,tick\n150,0,-450,-150,0,-450,1\n150,0,-450,-150,0,-450,2\n";
     let out = cli_stdin(&["replay", "--cell", "T1"], swapped);
     let swapped_lines: Vec<String> = stdout(&out).lines().map(str::to_string).collect();
-    assert_eq!(swapped_lines[2].split_once(',').unwrap().1, lines[2].split_once(',').unwrap().1, "{swapped_lines:?}");
-    let out = cli_stdin(&["replay", "--cell", "T1"], "-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n");
+    assert_eq!(
+        swapped_lines[2].split_once(',').unwrap().1,
+        lines[2].split_once(',').unwrap().1,
+        "{swapped_lines:?}"
+    );
+    let out =
+        cli_stdin(&["replay", "--cell", "T1"], "-150,0,-450,150,0,-450\n-150,0,-450,150,0,-450\n");
     assert!(stdout(&out).lines().nth(2).unwrap().starts_with("1,free,"), "{}", stdout(&out));
-    for (bad, line) in [("1,2,3\n", "line 1"), ("tick,x,y,z,x2,y2,z2\n0,1,2,3,4,5,six\n", "line 2")] {
+    for (bad, line) in [("1,2,3\n", "line 1"), ("tick,x,y,z,x2,y2,z2\n0,1,2,3,4,5,six\n", "line 2")]
+    {
         let out = cli_stdin(&["replay", "--cell", "T1"], bad);
         assert_eq!(out.status.code(), Some(1));
         assert!(stderr(&out).contains(line), "{}", stderr(&out));
@@ -798,15 +1060,24 @@ fn replay_runs_a_line_of_four_robots() {
     let text = stdout(&out);
     let lines: Vec<&str> = text.lines().collect();
     let header: Vec<&str> = lines[0].split(',').skip(12).collect();
-    assert!(header.len() >= 3 && header.contains(&"clearance_mm_R1_R2") && header.contains(&"clearance_mm_R3_R4"), "{text}");
-    let row: Vec<f64> = lines[2].split(',').skip(2).map(|f| f.parse().unwrap_or(f64::NAN)).collect();
+    assert!(
+        header.len() >= 3
+            && header.contains(&"clearance_mm_R1_R2")
+            && header.contains(&"clearance_mm_R3_R4"),
+        "{text}"
+    );
+    let row: Vec<f64> =
+        lines[2].split(',').skip(2).map(|f| f.parse().unwrap_or(f64::NAN)).collect();
     let smallest = row[10..].iter().copied().fold(f64::INFINITY, f64::min);
     assert!((smallest - row[0]).abs() < 2e-3 && row[0] > 0.0, "{text}");
 }
 
 /// The rows of a scenario of `c_harness/scenarios.txt` for its first `ticks` ticks, as CSV.
 fn scenario_rows(cell: &str, case: &str, ticks: u32) -> String {
-    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt")).unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("c_harness/scenarios.txt"),
+    )
+    .unwrap();
     let scenarios = delta_collide::cell::trajectory::parse_scenarios(&text).unwrap();
     let s = scenarios.iter().find(|s| s.cell == cell && s.case == case).unwrap();
     let mut rows = String::from("x,y,z,x2,y2,z2\n");
@@ -834,17 +1105,30 @@ fn read_png(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
 #[test]
 fn replay_plot_writes_a_png_of_the_requested_size() {
     let dir = fresh_dir("replay-plot");
-    let (input, output, plot) = (dir.join("run.csv"), dir.join("verdicts.csv"), dir.join("run.png"));
+    let (input, output, plot) =
+        (dir.join("run.csv"), dir.join("verdicts.csv"), dir.join("run.png"));
     std::fs::write(&input, scenario_rows("T1", "collision", 4000)).unwrap();
-    let args = ["replay", "--cell", "T1", "--input", input.to_str().unwrap(), "--output", output.to_str().unwrap()];
-    let out = cli(&[&args[..], &["--plot", plot.to_str().unwrap(), "--width", "900", "--height", "450"]].concat());
+    let args = [
+        "replay",
+        "--cell",
+        "T1",
+        "--input",
+        input.to_str().unwrap(),
+        "--output",
+        output.to_str().unwrap(),
+    ];
+    let out =
+        cli(&[&args[..], &["--plot", plot.to_str().unwrap(), "--width", "900", "--height", "450"]]
+            .concat());
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("900 x 450 pixels, 4000 ticks"), "{}", stderr(&out));
     let verdicts = std::fs::read_to_string(&output).unwrap();
     assert_eq!(verdicts.lines().count(), 4001);
     let (w, h, pixels) = read_png(&plot);
     assert_eq!((w, h), (900, 450));
-    for (name, colour) in [("free", [120, 200, 120]), ("warn", [240, 170, 60]), ("stop", [220, 30, 30])] {
+    for (name, colour) in
+        [("free", [120, 200, 120]), ("warn", [240, 170, 60]), ("stop", [220, 30, 30])]
+    {
         assert!(verdicts.contains(&format!(",{name},")), "the run has {name} ticks");
         assert!(pixels.iter().filter(|&&p| p == colour).count() > 20, "{name} band missing");
     }
@@ -875,7 +1159,8 @@ fn replay_plot_refuses_bad_arguments_with_a_clear_message() {
         assert!(stderr(&out).contains(message), "{extra:?}: {}", stderr(&out));
     }
     let missing = dir.join("no-such-dir").join("p.png");
-    let out = cli(&["replay", "--cell", "T1", "--input", input, "--plot", missing.to_str().unwrap()]);
+    let out =
+        cli(&["replay", "--cell", "T1", "--input", input, "--plot", missing.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     assert!(stderr(&out).contains("no-such-dir"), "{}", stderr(&out));
     let out = cli_stdin(&["replay", "--cell", "T1", "--plot", plot], "x,y,z,x2,y2,z2\n");
@@ -905,7 +1190,11 @@ fn check_on_a_line_of_four_answers_as_its_pairs_one_by_one() {
     while rows.len() < 400 {
         let tcps: Vec<Vec3> = (0..4)
             .map(|_| {
-                Vec3::new(rng.random_range(-250.0..250.0), rng.random_range(-150.0..150.0), rng.random_range(-560.0..-360.0))
+                Vec3::new(
+                    rng.random_range(-250.0..250.0),
+                    rng.random_range(-150.0..150.0),
+                    rng.random_range(-560.0..-360.0),
+                )
             })
             .collect();
         let mut reachable = true;
@@ -924,7 +1213,9 @@ fn check_on_a_line_of_four_answers_as_its_pairs_one_by_one() {
         }
         truth.push(collide);
         pair_truth.push(flags);
-        rows.push(tcps.iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(","));
+        rows.push(
+            tcps.iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect::<Vec<_>>().join(","),
+        );
     }
     let out = cli_stdin(&["check", "--cell", "cells/line4.toml"], &rows.join("\n"));
     assert!(out.status.success(), "{}", stderr(&out));
@@ -970,16 +1261,28 @@ fn check_with_a_table_confirmed_answers_row_for_row_as_check_without_one() {
         let raw = run(&["--table", table, "--confirm", "none"]);
         assert_eq!(exact.lines().count(), 6001, "a header and one row per tick");
         for (tick, (e, c)) in exact.lines().zip(confirmed.lines()).enumerate().skip(1) {
-            assert_eq!(c, e, "T1 {case} tick {}: --confirm exact and the exact check differ", tick - 1);
+            assert_eq!(
+                c,
+                e,
+                "T1 {case} tick {}: --confirm exact and the exact check differ",
+                tick - 1
+            );
         }
         assert_eq!(run(&["--table", table]), confirmed, "--confirm exact is the default");
         for (tick, (e, r)) in exact.lines().zip(raw.lines()).enumerate().skip(1) {
-            assert!(r == e || r == "1,1", "T1 {case} tick {}: the table says {r}, the exact check {e}", tick - 1);
+            assert!(
+                r == e || r == "1,1",
+                "T1 {case} tick {}: the table says {r}, the exact check {e}",
+                tick - 1
+            );
             false_alarms += usize::from(r != e);
         }
         assert_eq!(exact.contains("1,1"), case == "collision", "T1 {case}");
     }
-    assert!(false_alarms > 0, "the k = 16 table raises false alarms, so the comparison above can fail");
+    assert!(
+        false_alarms > 0,
+        "the k = 16 table raises false alarms, so the comparison above can fail"
+    );
     let out = cli(&["check", "--cell", "T1", "--confirm", "exact"]);
     assert_eq!(out.status.code(), Some(2), "--confirm without --table is a usage error");
     assert!(stderr(&out).contains("--confirm applies to --table"), "{}", stderr(&out));
@@ -999,16 +1302,26 @@ fn replay_with_stop_paths_from_the_rows_ahead_stops_less() {
         assert!(out.status.success(), "{}", stderr(&out));
         stdout(&out).lines().skip(1).map(|l| l.split(',').nth(1).unwrap().to_string()).collect()
     };
-    let (without, with) = (verdicts(&[]), verdicts(&["--stop-path-mm", "400", "--path-tolerance-mm", "0.5"]));
+    let (without, with) =
+        (verdicts(&[]), verdicts(&["--stop-path-mm", "400", "--path-tolerance-mm", "0.5"]));
     assert_eq!(without.len(), with.len());
     let rank = |v: &str| ["free", "warn", "stop"].iter().position(|x| *x == v).unwrap();
     for (tick, (a, b)) in without.iter().zip(&with).enumerate() {
         assert!(rank(b) <= rank(a), "tick {tick}: {b} with paths, {a} without");
     }
     let stops = |v: &[String]| v.iter().filter(|x| *x == "stop").count();
-    assert!(stops(&with) < stops(&without), "{} STOP ticks with paths, {} without", stops(&with), stops(&without));
+    assert!(
+        stops(&with) < stops(&without),
+        "{} STOP ticks with paths, {} without",
+        stops(&with),
+        stops(&without)
+    );
     for bad in [["--stop-path-mm", "0"], ["--stop-path-mm", "nan"]] {
-        assert_eq!(cli(&[&["replay", "--cell", "T1"][..], &bad[..]].concat()).status.code(), Some(2), "{bad:?}");
+        assert_eq!(
+            cli(&[&["replay", "--cell", "T1"][..], &bad[..]].concat()).status.code(),
+            Some(2),
+            "{bad:?}"
+        );
     }
     let tolerance_alone = cli(&["replay", "--cell", "T1", "--path-tolerance-mm", "1"]);
     assert_eq!(tolerance_alone.status.code(), Some(2), "--path-tolerance-mm needs --stop-path-mm");

@@ -76,20 +76,26 @@ fn tool(program: &str, install: &str) -> Result<(), String> {
 /// `Err(what to install)` unless the Rust standard library for `triple` is installed.
 fn rust_target(triple: &str) -> Result<(), String> {
     let out = Command::new("rustc").args(["--print", "target-libdir", "--target", triple]).output();
-    let dir = out.ok().filter(|o| o.status.success()).map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned());
+    let dir = out
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned());
     let has_core = dir.and_then(|d| std::fs::read_dir(d).ok()).is_some_and(|mut entries| {
         entries.any(|e| e.is_ok_and(|e| e.file_name().to_string_lossy().starts_with("libcore-")))
     });
     if has_core {
         Ok(())
     } else {
-        Err(format!("the Rust target {triple} is missing: install it with `rustup target add {triple}`"))
+        Err(format!(
+            "the Rust target {triple} is missing: install it with `rustup target add {triple}`"
+        ))
     }
 }
 
 /// Whether the test may go on: every requirement met, or (outside CI) a note and a skip.
 fn requirements_met(test: &str, checks: &[Result<(), String>]) -> bool {
-    let missing: Vec<&str> = checks.iter().filter_map(|c| c.as_ref().err().map(String::as_str)).collect();
+    let missing: Vec<&str> =
+        checks.iter().filter_map(|c| c.as_ref().err().map(String::as_str)).collect();
     if missing.is_empty() {
         return true;
     }
@@ -116,17 +122,37 @@ fn cross_library(t: &Target) -> PathBuf {
     let out = run(Command::new(env!("CARGO"))
         .current_dir(&root)
         .env(linker_var, t.cc)
-        .args(["rustc", "--release", "--lib", "--no-default-features", "--features", "std", "--target", t.triple])
+        .args([
+            "rustc",
+            "--release",
+            "--lib",
+            "--no-default-features",
+            "--features",
+            "std",
+            "--target",
+            t.triple,
+        ])
         .arg("--target-dir")
         .arg(root.join("target/cross"))
         .args(["--", "--print", "native-static-libs"]));
     let log = both(&out);
     assert!(out.status.success(), "cross build for {} failed:\n{log}", t.triple);
     println!("{}: library built in {:.1} s", t.triple, start.elapsed().as_secs_f64());
-    let pinned = CROSS_NATIVE_LIBS.iter().find(|(triple, _)| *triple == t.triple).expect("pinned libs").1;
-    assert_eq!(native_static_libs(&log), pinned, "{}: the static library's native libs changed:\n{log}", t.triple);
+    let pinned =
+        CROSS_NATIVE_LIBS.iter().find(|(triple, _)| *triple == t.triple).expect("pinned libs").1;
+    assert_eq!(
+        native_static_libs(&log),
+        pinned,
+        "{}: the static library's native libs changed:\n{log}",
+        t.triple
+    );
     let dir = root.join("target/cross").join(t.triple).join("release");
-    assert_eq!(elf_machine(&dir.join("libdelta_collide.so")), t.elf_machine, "{}: cdylib machine", t.triple);
+    assert_eq!(
+        elf_machine(&dir.join("libdelta_collide.so")),
+        t.elf_machine,
+        "{}: cdylib machine",
+        t.triple
+    );
     dir.join("libdelta_collide.a")
 }
 
@@ -142,9 +168,15 @@ fn table_args() -> &'static [String] {
         let mut args = vec!["--protective-quick".to_string()];
         for (name, variant) in [("T1", Variant::D6), ("T2", Variant::Shared), ("T3", Variant::D6)] {
             let cell = reference_cell(name).expect("reference cell");
-            let (header, tables, _) =
-                build_tables(&cell, TABLE_K, &Workspace::THESIS, &[variant], Labelling::Certified, Progress::Silent)
-                    .unwrap_or_else(|e| panic!("building the {name} table: {e}"));
+            let (header, tables, _) = build_tables(
+                &cell,
+                TABLE_K,
+                &Workspace::THESIS,
+                &[variant],
+                Labelling::Certified,
+                Progress::Silent,
+            )
+            .unwrap_or_else(|e| panic!("building the {name} table: {e}"));
             let path = dir.join(format!("{name}_k{TABLE_K}.dct"));
             std::fs::write(&path, to_bytes(&tables[0], &header)).expect("write table");
             args.extend(["--table".to_string(), format!("{name}={}", path.display())]);
@@ -164,8 +196,12 @@ fn outcome(what: &str, out: &Output) -> Vec<String> {
         String::from_utf8_lossy(&out.stderr)
     );
     let last = stdout.lines().last().unwrap_or_default();
-    assert!(last.ends_with(" passed, 0 failed") && !last.starts_with("0 "), "{what}: verdict line `{last}`");
-    let summaries: Vec<String> = stdout.lines().filter(|l| l.starts_with("summary ")).map(str::to_owned).collect();
+    assert!(
+        last.ends_with(" passed, 0 failed") && !last.starts_with("0 "),
+        "{what}: verdict line `{last}`"
+    );
+    let summaries: Vec<String> =
+        stdout.lines().filter(|l| l.starts_with("summary ")).map(str::to_owned).collect();
     assert_eq!(summaries.len(), 6, "{what}: a table-mode summary per cell and case:\n{stdout}");
     summaries.into_iter().chain([last.to_owned()]).collect()
 }
@@ -174,10 +210,13 @@ fn outcome(what: &str, out: &Output) -> Vec<String> {
 fn host_static_lib() -> PathBuf {
     let exe = std::env::current_exe().expect("path of the test executable");
     let deps = exe.parent().expect("deps dir");
-    [deps.join("libdelta_collide.a"), deps.parent().expect("profile dir").join("libdelta_collide.a")]
-        .into_iter()
-        .find(|p| p.is_file())
-        .expect("the static library of this cargo run")
+    [
+        deps.join("libdelta_collide.a"),
+        deps.parent().expect("profile dir").join("libdelta_collide.a"),
+    ]
+    .into_iter()
+    .find(|p| p.is_file())
+    .expect("the static library of this cargo run")
 }
 
 /// The harness for the host, compiled once per test process.
@@ -195,7 +234,11 @@ fn host_outcome() -> &'static [String] {
     static OUTCOME: OnceLock<Vec<String>> = OnceLock::new();
     OUTCOME.get_or_init(|| {
         let tmp = scratch_dir("cross_host_tmp");
-        let out = run(Command::new(host_harness()).arg("--tmp").arg(&tmp).args(table_args()).current_dir(repo_root()));
+        let out = run(Command::new(host_harness())
+            .arg("--tmp")
+            .arg(&tmp)
+            .args(table_args())
+            .current_dir(repo_root()));
         outcome("host harness", &out)
     })
 }
@@ -206,14 +249,19 @@ fn harness_runs_under_qemu(t: &Target) {
     let sysroot = if Path::new(t.sysroot).join("lib").is_dir() {
         Ok(())
     } else {
-        Err(format!("the C library for qemu under {} is missing: install {}", t.sysroot, t.packages))
+        Err(format!(
+            "the C library for qemu under {} is missing: install {}",
+            t.sysroot, t.packages
+        ))
     };
-    let checks = [rust_target(t.triple), tool(t.cc, t.packages), tool(t.qemu, "qemu-user"), sysroot];
+    let checks =
+        [rust_target(t.triple), tool(t.cc, t.packages), tool(t.qemu, "qemu-user"), sysroot];
     if !requirements_met(&test, &checks) {
         return;
     }
     let lib = cross_library(t);
-    let pinned = CROSS_NATIVE_LIBS.iter().find(|(triple, _)| *triple == t.triple).expect("pinned libs").1;
+    let pinned =
+        CROSS_NATIVE_LIBS.iter().find(|(triple, _)| *triple == t.triple).expect("pinned libs").1;
     let exe = scratch_dir(&format!("cross_{}", t.triple)).join("c_harness");
     compile_harness(t.cc, &[], &lib, pinned, &exe);
     assert_eq!(elf_machine(&exe), t.elf_machine, "{}: harness machine", t.triple);
@@ -276,7 +324,10 @@ fn c_harness_runs_on_x86_64_baseline_without_avx() {
     let max = run(Command::new("qemu-x86_64").args(["-cpu", "max"]).arg(&probe));
     assert!(max.status.success(), "the AVX probe fails on qemu's `max` CPU:\n{}", both(&max));
     let baseline = run(Command::new("qemu-x86_64").args(["-cpu", "qemu64"]).arg(&probe));
-    assert!(!baseline.status.success(), "qemu64 ran AVX code, so it cannot show that AVX is not needed");
+    assert!(
+        !baseline.status.success(),
+        "qemu64 ran AVX code, so it cannot show that AVX is not needed"
+    );
     let tmp = scratch_dir("cross_x86_64_baseline_tmp");
     let start = Instant::now();
     let out = run(Command::new("qemu-x86_64")
@@ -294,7 +345,8 @@ fn c_harness_runs_on_x86_64_baseline_without_avx() {
 /// docs/PORTABILITY.md lists each cross target's native libraries as pinned here.
 #[test]
 fn portability_doc_lists_the_native_libs_of_every_target() {
-    let doc = std::fs::read_to_string(repo_root().join("docs/PORTABILITY.md")).expect("docs/PORTABILITY.md");
+    let doc = std::fs::read_to_string(repo_root().join("docs/PORTABILITY.md"))
+        .expect("docs/PORTABILITY.md");
     let rows = CROSS_NATIVE_LIBS.iter().chain([&("x86_64-unknown-linux-gnu", NATIVE_LIBS)]);
     for (triple, libs) in rows {
         let row = format!("| `{triple}` | `{}` |", libs.join(" "));

@@ -38,7 +38,8 @@ fn scalars(text: &str, file: &str) -> BTreeMap<String, String> {
             while stack.last().is_some_and(|(i, _)| *i > indent) {
                 stack.pop();
             }
-            let (top, parent) = stack.last().cloned().unwrap_or_else(|| panic!("{at}: outside the document"));
+            let (top, parent) =
+                stack.last().cloned().unwrap_or_else(|| panic!("{at}: outside the document"));
             assert_eq!(top, indent, "{at}: indented by {indent} where {top} is expected");
             let Some(rest) = content.strip_prefix("- ") else { break };
             let count = counts.entry(parent.clone()).or_insert(0);
@@ -72,7 +73,8 @@ fn scalars(text: &str, file: &str) -> BTreeMap<String, String> {
 }
 
 fn get<'a>(doc: &'a BTreeMap<String, String>, path: &str, file: &str) -> &'a str {
-    doc.get(path).unwrap_or_else(|| panic!("{file}: no {path}; found {:#?}", doc.keys().collect::<Vec<_>>()))
+    doc.get(path)
+        .unwrap_or_else(|| panic!("{file}: no {path}; found {:#?}", doc.keys().collect::<Vec<_>>()))
 }
 
 #[test]
@@ -83,22 +85,39 @@ fn the_indexed_job_gives_each_pod_its_shard_and_the_shared_volume() {
     assert_eq!(get(&doc, ".spec.completionMode", file), "Indexed");
     let completions = get(&doc, ".spec.completions", file);
     let c = ".spec.template.spec.containers.0";
-    let args: Vec<&str> = (0..).map_while(|i| doc.get(&format!("{c}.args.{i}")).map(String::as_str)).collect();
+    let args: Vec<&str> =
+        (0..).map_while(|i| doc.get(&format!("{c}.args.{i}")).map(String::as_str)).collect();
     let flag = |name: &str| args.iter().position(|a| *a == name).map(|i| args[i + 1]);
     assert_eq!(flag("--shard"), Some("auto"), "{args:?}");
-    assert!(flag("--output").is_some_and(|o| o.starts_with("/shards/") && o.contains("{index}")), "{args:?}");
+    assert!(
+        flag("--output").is_some_and(|o| o.starts_with("/shards/") && o.contains("{index}")),
+        "{args:?}"
+    );
     assert_eq!(get(&doc, &format!("{c}.env.0.name"), file), "DELTA_COLLIDE_SHARDS");
-    assert_eq!(get(&doc, &format!("{c}.env.0.value"), file), completions, "the pods' shard count is completions");
+    assert_eq!(
+        get(&doc, &format!("{c}.env.0.value"), file),
+        completions,
+        "the pods' shard count is completions"
+    );
     assert_eq!(get(&doc, &format!("{c}.volumeMounts.0.mountPath"), file), "/shards");
-    assert_eq!(get(&doc, ".spec.template.spec.volumes.0.persistentVolumeClaim.claimName", file), "dc-shards");
+    assert_eq!(
+        get(&doc, ".spec.template.spec.volumes.0.persistentVolumeClaim.claimName", file),
+        "dc-shards"
+    );
     assert_eq!(get(&doc, ".spec.template.spec.restartPolicy", file), "Never");
 
     let merge_file = "k8s/merge-table-job.yaml";
     let merge = scalars(&read(merge_file), merge_file);
     let script = get(&merge, &format!("{c}.args.0"), merge_file);
     assert!(script.contains("delta-collide merge --output /shards/"), "{script}");
-    assert!(script.contains(&format!("-of-{completions}.dcs")), "the merge reads the {completions} shards: {script}");
-    assert_eq!(get(&merge, ".spec.template.spec.volumes.0.persistentVolumeClaim.claimName", merge_file), "dc-shards");
+    assert!(
+        script.contains(&format!("-of-{completions}.dcs")),
+        "the merge reads the {completions} shards: {script}"
+    );
+    assert_eq!(
+        get(&merge, ".spec.template.spec.volumes.0.persistentVolumeClaim.claimName", merge_file),
+        "dc-shards"
+    );
     let volume_file = "k8s/shards-volume.yaml";
     let volume = scalars(&read(volume_file), volume_file);
     assert_eq!(get(&volume, ".kind", volume_file), "PersistentVolumeClaim");
@@ -109,7 +128,8 @@ fn the_indexed_job_gives_each_pod_its_shard_and_the_shared_volume() {
 #[test]
 fn the_manifests_parse_as_yaml_where_python3_has_it() {
     let check = "import sys, yaml\nfor f in sys.argv[1:]:\n    assert yaml.safe_load(open(f)), f\n";
-    let files = ["k8s/build-table-job.yaml", "k8s/merge-table-job.yaml", "k8s/shards-volume.yaml"].map(deploy);
+    let files = ["k8s/build-table-job.yaml", "k8s/merge-table-job.yaml", "k8s/shards-volume.yaml"]
+        .map(deploy);
     match Command::new("python3").args(["-c", "import yaml"]).status() {
         Ok(s) if s.success() => {
             let out = Command::new("python3").arg("-c").arg(check).args(&files).output().unwrap();
@@ -124,11 +144,16 @@ fn the_slurm_scripts_parse_and_submit_an_array_and_a_merge_after_it() {
     for f in ["slurm/submit.sh", "slurm/build-table.sbatch", "slurm/merge-table.sbatch"] {
         let out = Command::new("bash").arg("-n").arg(deploy(f)).output().unwrap();
         assert!(out.status.success(), "deploy/{f}: {}", String::from_utf8_lossy(&out.stderr));
-        let mode = std::os::unix::fs::PermissionsExt::mode(&std::fs::metadata(deploy(f)).unwrap().permissions());
+        let mode = std::os::unix::fs::PermissionsExt::mode(
+            &std::fs::metadata(deploy(f)).unwrap().permissions(),
+        );
         assert!(mode & 0o111 != 0, "deploy/{f} is executable");
     }
     let submit = read("slurm/submit.sh");
-    assert!(submit.contains("--array=\"0-$((shards - 1))\"") && submit.contains("--dependency=\"afterok:$array_id\""));
+    assert!(
+        submit.contains("--array=\"0-$((shards - 1))\"")
+            && submit.contains("--dependency=\"afterok:$array_id\"")
+    );
     let build = read("slurm/build-table.sbatch");
     assert!(build.contains("--shard auto") && build.contains("shard-{index}-of-{count}.dcs"));
     assert!(read("slurm/merge-table.sbatch").contains("shard-$i-of-$DC_SHARDS.dcs"));

@@ -80,7 +80,10 @@ fn query_does_not_allocate_over_a_million_ticks() {
             .collect();
         let (free, hit, allocated) = query_million_ticks(h, &ring);
         assert_eq!(allocated, 0, "dc_query allocated");
-        assert!(free > 0 && hit > 0, "the ring covers both verdicts ({free} free, {hit} collisions)");
+        assert!(
+            free > 0 && hit > 0,
+            "the ring covers both verdicts ({free} free, {hit} collisions)"
+        );
         // SAFETY: live handle, destroyed once.
         unsafe { dc_destroy(h) };
     }
@@ -104,14 +107,24 @@ fn table_mode_query_does_not_allocate_over_a_million_ticks() {
         assert_eq!(unsafe { dc_set_table_confirmation(h, confirmation) }, DC_STATUS_OK);
         let (free, hit, allocated) = query_million_ticks(h, &ring);
         assert_eq!(allocated, 0, "dc_query allocated in table mode (confirmation {confirmation})");
-        assert!(free > 0 && hit > 0, "the ring covers both verdicts ({free} free, {hit} collisions)");
+        assert!(
+            free > 0 && hit > 0,
+            "the ring covers both verdicts ({free} free, {hit} collisions)"
+        );
         // SAFETY: live handle.
-        let (fallbacks, confirmations) = unsafe { (dc_table_fallbacks(h), dc_table_confirmations(h)) };
+        let (fallbacks, confirmations) =
+            unsafe { (dc_table_fallbacks(h), dc_table_confirmations(h)) };
         assert_eq!(fallbacks, 1_000_000 / 16, "one exact fallback per out-of-grid tick");
         if confirmation == DC_CONFIRMATION_EXACT {
             // A COLLISION verdict comes from a confirmed lookup or from a fallback.
-            assert!(confirmations + fallbacks >= u64::from(hit), "{confirmations} confirmed, {hit} collisions");
-            assert!(confirmations > 0 && confirmations < 1_000_000 - fallbacks, "{confirmations} confirmed");
+            assert!(
+                confirmations + fallbacks >= u64::from(hit),
+                "{confirmations} confirmed, {hit} collisions"
+            );
+            assert!(
+                confirmations > 0 && confirmations < 1_000_000 - fallbacks,
+                "{confirmations} confirmed"
+            );
         } else {
             assert_eq!(confirmations, 0, "nothing is confirmed with DC_CONFIRMATION_NONE");
         }
@@ -122,8 +135,12 @@ fn table_mode_query_does_not_allocate_over_a_million_ticks() {
 
 #[test]
 fn line_table_mode_query_does_not_allocate_over_a_million_ticks() {
-    let line: Vec<DcRobotConfig> =
-        (0..4).map(|j| DcRobotConfig { translation: v(450.0 * j as f64, 0.0, 0.0), ..dc_robot_config_thesis() }).collect();
+    let line: Vec<DcRobotConfig> = (0..4)
+        .map(|j| DcRobotConfig {
+            translation: v(450.0 * j as f64, 0.0, 0.0),
+            ..dc_robot_config_thesis()
+        })
+        .collect();
     let config = DcCellConfig { robots: line.as_ptr(), n_robots: 4, method: DC_METHOD_SAT };
     let (s, h) = init_table(&config, line4_bundle_bytes());
     assert_eq!(s, DC_STATUS_OK, "{}", last_init_error());
@@ -133,7 +150,12 @@ fn line_table_mode_query_does_not_allocate_over_a_million_ticks() {
         .map(|i| {
             let s = i as f64 / 127.0;
             let z = if i % 16 == 0 { -340.0 } else { -450.0 };
-            [v(-150.0 + 330.0 * s, 30.0, -450.0), v(150.0 - 330.0 * s, -20.0, z), v(0.0, 0.0, -450.0), v(-150.0 + 330.0 * s, 0.0, -430.0)]
+            [
+                v(-150.0 + 330.0 * s, 30.0, -450.0),
+                v(150.0 - 330.0 * s, -20.0, z),
+                v(0.0, 0.0, -450.0),
+                v(-150.0 + 330.0 * s, 0.0, -430.0),
+            ]
         })
         .collect();
     let mut verdict = DC_VERDICT_STOP;
@@ -143,14 +165,24 @@ fn line_table_mode_query_does_not_allocate_over_a_million_ticks() {
     for i in 0..1_000_000 {
         let tcps = &ring[i % ring.len()];
         // SAFETY: live handle, valid slices and outputs.
-        assert_eq!(unsafe { dc_query(h, tcps.as_ptr(), 4, &mut verdict, &mut report) }, DC_STATUS_OK);
-        if verdict == DC_VERDICT_FREE { free += 1 } else { hit += 1 }
+        assert_eq!(
+            unsafe { dc_query(h, tcps.as_ptr(), 4, &mut verdict, &mut report) },
+            DC_STATUS_OK
+        );
+        if verdict == DC_VERDICT_FREE {
+            free += 1
+        } else {
+            hit += 1
+        }
     }
     assert_eq!(allocations() - before, 0, "dc_query allocated on a bundle");
     assert!(free > 0 && hit > 0, "the ring covers both verdicts ({free} free, {hit} collisions)");
     // SAFETY: live handle.
     let (fallbacks, confirmations) = unsafe { (dc_table_fallbacks(h), dc_table_confirmations(h)) };
-    assert!(fallbacks > 0 && confirmations > 0, "{fallbacks} fallbacks, {confirmations} confirmations");
+    assert!(
+        fallbacks > 0 && confirmations > 0,
+        "{fallbacks} fallbacks, {confirmations} confirmations"
+    );
     // SAFETY: live handle, destroyed once.
     unsafe { dc_destroy(h) };
 }
@@ -198,7 +230,8 @@ fn init_rejects_bad_configs_and_clears_the_handle() {
     ] {
         let config = DcCellConfig { robots: robots.as_ptr(), n_robots: robots.len(), method };
         let mut h: *mut DcCollider = 8 as *mut DcCollider; // garbage that must be overwritten
-                                                           // SAFETY: valid pointers; the config content is what is under test.
+                                                           // SAFETY: valid pointers; the config
+                                                           // content is what is under test.
         assert_eq!(unsafe { dc_init(&config, &mut h) }, want);
         assert!(h.is_null());
     }
@@ -216,7 +249,8 @@ fn init_rejects_bad_configs_and_clears_the_handle() {
 
 #[test]
 fn cell_files_init_the_same_checker_as_configs() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-ffi-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("dc-ffi-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, "[[robot]]\nmodel = { margn = 1 }\n").unwrap();
@@ -246,7 +280,10 @@ fn cell_files_init_the_same_checker_as_configs() {
     unsafe {
         let mut h = std::ptr::null_mut();
         assert_eq!(dc_init_from_cell_file(std::ptr::null(), &mut h), DC_STATUS_NULL_POINTER);
-        assert_eq!(dc_init_from_cell_file(c"\xff\xfe.toml".as_ptr(), &mut h), DC_STATUS_INVALID_ARGUMENT);
+        assert_eq!(
+            dc_init_from_cell_file(c"\xff\xfe.toml".as_ptr(), &mut h),
+            DC_STATUS_INVALID_ARGUMENT
+        );
         dc_destroy(from_config);
     }
 }
@@ -268,7 +305,13 @@ fn reports_name_the_colliding_boxes_and_pair_results_match() {
     }
     assert_eq!(
         out[0],
-        DcPairResult { robot_a: 0, robot_b: 1, collides: 1, box_a: r.first_box_a, box_b: r.first_box_b }
+        DcPairResult {
+            robot_a: 0,
+            robot_b: 1,
+            collides: 1,
+            box_a: r.first_box_a,
+            box_b: r.first_box_b
+        }
     );
     let (s, verdict, r) = query(h, &[v(-150.0, 0.0, -450.0), v(150.0, 0.0, -450.0)]);
     assert_eq!((s, verdict, r.first_box_a), (DC_STATUS_OK, DC_VERDICT_FREE, DC_BOX_NONE));
@@ -285,15 +328,24 @@ fn status_strings_cover_every_code_and_kinematics_round_trip() {
         assert_eq!(text == "unknown status", s == 26, "code {s}");
     }
     // SAFETY: static NUL-terminated string.
-    assert_eq!(unsafe { CStr::from_ptr(dc_version()) }.to_str().unwrap(), env!("CARGO_PKG_VERSION"));
+    assert_eq!(
+        unsafe { CStr::from_ptr(dc_version()) }.to_str().unwrap(),
+        env!("CARGO_PKG_VERSION")
+    );
     let g = dc_robot_config_thesis().geometry;
     let mut theta = [0.0; 3];
     let mut back = v(0.0, 0.0, 0.0);
     // SAFETY: valid geometry and buffers.
     unsafe {
-        assert_eq!(dc_delta3_inverse_kinematics(&g, v(30.0, -20.0, -460.0), theta.as_mut_ptr()), DC_STATUS_OK);
+        assert_eq!(
+            dc_delta3_inverse_kinematics(&g, v(30.0, -20.0, -460.0), theta.as_mut_ptr()),
+            DC_STATUS_OK
+        );
         assert_eq!(dc_delta3_forward_kinematics(&g, theta.as_ptr(), &mut back), DC_STATUS_OK);
-        assert_eq!(dc_delta3_inverse_kinematics(&g, v(0.0, 0.0, -900.0), theta.as_mut_ptr()), DC_STATUS_UNREACHABLE);
+        assert_eq!(
+            dc_delta3_inverse_kinematics(&g, v(0.0, 0.0, -900.0), theta.as_mut_ptr()),
+            DC_STATUS_UNREACHABLE
+        );
         assert_eq!(
             dc_delta3_inverse_kinematics(&g, v(0.0, f64::NAN, -400.0), theta.as_mut_ptr()),
             DC_STATUS_NON_FINITE
@@ -303,5 +355,9 @@ fn status_strings_cover_every_code_and_kinematics_round_trip() {
             DC_STATUS_NULL_POINTER
         );
     }
-    assert!((back.x - 30.0).abs() < 1e-9 && (back.y + 20.0).abs() < 1e-9 && (back.z + 460.0).abs() < 1e-9);
+    assert!(
+        (back.x - 30.0).abs() < 1e-9
+            && (back.y + 20.0).abs() < 1e-9
+            && (back.z + 460.0).abs() < 1e-9
+    );
 }

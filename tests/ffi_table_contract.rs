@@ -21,7 +21,12 @@ fn table_init_gives_each_table_error_its_own_status_and_no_handle() {
         b
     };
     let mut cases: Vec<(String, Vec<u8>, DcStatus, &str)> = vec![
-        ("T2's table for T1".into(), table_bytes("T2").to_vec(), DC_STATUS_TABLE_WRONG_CELL, "built for cell"),
+        (
+            "T2's table for T1".into(),
+            table_bytes("T2").to_vec(),
+            DC_STATUS_TABLE_WRONG_CELL,
+            "built for cell",
+        ),
         ("bad magic".into(), with(&|b| b[0] = b'X'), DC_STATUS_TABLE_BAD_MAGIC, "magic"),
         (
             "byte-swapped endianness marker".into(),
@@ -29,7 +34,12 @@ fn table_init_gives_each_table_error_its_own_status_and_no_handle() {
             DC_STATUS_TABLE_WRONG_ENDIANNESS,
             "big-endian",
         ),
-        ("version 99".into(), with(&|b| b[12] = 99), DC_STATUS_TABLE_UNSUPPORTED_VERSION, "version 99"),
+        (
+            "version 99".into(),
+            with(&|b| b[12] = 99),
+            DC_STATUS_TABLE_UNSUPPORTED_VERSION,
+            "version 99",
+        ),
         ("one trailing byte".into(), with(&|b| b.push(0)), DC_STATUS_TABLE_CORRUPT, "trailing"),
         (
             "flipped bit in the checksum".into(),
@@ -39,10 +49,20 @@ fn table_init_gives_each_table_error_its_own_status_and_no_handle() {
         ),
     ];
     for at in [200, t1.len() / 2, t1.len() - 9] {
-        cases.push((format!("bit flipped at {at}"), with(&|b| b[at] ^= 1), DC_STATUS_TABLE_CORRUPT, "corrupt"));
+        cases.push((
+            format!("bit flipped at {at}"),
+            with(&|b| b[at] ^= 1),
+            DC_STATUS_TABLE_CORRUPT,
+            "corrupt",
+        ));
     }
     for len in [0, 1, 7, 8, 100, 183, 184, 191, t1.len() / 2, t1.len() - 8, t1.len() - 1] {
-        cases.push((format!("truncated to {len} bytes"), t1[..len].to_vec(), DC_STATUS_TABLE_TRUNCATED, "truncated"));
+        cases.push((
+            format!("truncated to {len} bytes"),
+            t1[..len].to_vec(),
+            DC_STATUS_TABLE_TRUNCATED,
+            "truncated",
+        ));
     }
     for (what, bytes, want, says) in &cases {
         let (s, h) = init_table(&config, bytes);
@@ -60,9 +80,11 @@ fn table_init_gives_each_table_error_its_own_status_and_no_handle() {
     }
     // A table needs two robots; three 450 mm apart need the pair 900 mm apart too, which
     // T1's table is not; a bad config is reported before the table is read.
-    for (n, want) in
-        [(1, DC_STATUS_TABLE_NOT_TWO_ROBOTS), (3, DC_STATUS_TABLE_MISSING_PAIR), (0, DC_STATUS_INVALID_CONFIG)]
-    {
+    for (n, want) in [
+        (1, DC_STATUS_TABLE_NOT_TWO_ROBOTS),
+        (3, DC_STATUS_TABLE_MISSING_PAIR),
+        (0, DC_STATUS_INVALID_CONFIG),
+    ] {
         let (s, h) = init_table(&Config::cell(450.0, n).c(), t1);
         assert_eq!((s, h.is_null()), (want, true), "{n} robots");
     }
@@ -70,10 +92,19 @@ fn table_init_gives_each_table_error_its_own_status_and_no_handle() {
     let mut h = std::ptr::null_mut();
     // SAFETY: NULL config, NULL table and NULL out_handle are the inputs under test.
     unsafe {
-        assert_eq!(dc_init_with_table(std::ptr::null(), t1.as_ptr(), t1.len(), &mut h), DC_STATUS_NULL_POINTER);
-        assert_eq!(dc_init_with_table(&config, std::ptr::null(), 0, &mut h), DC_STATUS_NULL_POINTER);
+        assert_eq!(
+            dc_init_with_table(std::ptr::null(), t1.as_ptr(), t1.len(), &mut h),
+            DC_STATUS_NULL_POINTER
+        );
+        assert_eq!(
+            dc_init_with_table(&config, std::ptr::null(), 0, &mut h),
+            DC_STATUS_NULL_POINTER
+        );
         assert!(last_init_error().contains("table is NULL"));
-        assert_eq!(dc_init_with_table(&config, t1.as_ptr(), t1.len(), std::ptr::null_mut()), DC_STATUS_NULL_POINTER);
+        assert_eq!(
+            dc_init_with_table(&config, t1.as_ptr(), t1.len(), std::ptr::null_mut()),
+            DC_STATUS_NULL_POINTER
+        );
         assert!(last_init_error().contains("out_handle"));
         // Asking for the length only, and a buffer too small: cut, NUL-terminated.
         let n = dc_last_init_error(std::ptr::null_mut(), 0);
@@ -107,7 +138,13 @@ fn table_mode_reports_fail_closed_and_pair_results() {
         assert_eq!(len, 1);
         out[0]
     };
-    let none = |collides| DcPairResult { robot_a: 0, robot_b: 1, collides, box_a: DC_BOX_NONE, box_b: DC_BOX_NONE };
+    let none = |collides| DcPairResult {
+        robot_a: 0,
+        robot_b: 1,
+        collides,
+        box_a: DC_BOX_NONE,
+        box_b: DC_BOX_NONE,
+    };
     let crossed = [v(180.0, 0.0, -450.0), v(-180.0, 0.0, -450.0)];
     let (s, verdict, r) = query(h, &crossed);
     assert_eq!(
@@ -118,18 +155,27 @@ fn table_mode_reports_fail_closed_and_pair_results() {
     let (_, exact_verdict, e) = query(exact, &crossed);
     assert_eq!(exact_verdict, DC_VERDICT_COLLISION);
     assert_ne!(e.first_box_a, DC_BOX_NONE);
-    assert_eq!((r.first_box_a, r.first_box_b, r.unreachable_mask), (e.first_box_a, e.first_box_b, 0));
+    assert_eq!(
+        (r.first_box_a, r.first_box_b, r.unreachable_mask),
+        (e.first_box_a, e.first_box_b, 0)
+    );
     assert_eq!(pair(h), DcPairResult { box_a: e.first_box_a, box_b: e.first_box_b, ..none(1) });
     // Without confirmation the lookup alone answers: the cell, not the boxes.
     // SAFETY: live handle.
     assert_eq!(unsafe { dc_set_table_confirmation(h, DC_CONFIRMATION_NONE) }, DC_STATUS_OK);
     let (_, verdict, r) = query(h, &crossed);
-    assert_eq!((verdict, r.first_box_a, r.first_box_b), (DC_VERDICT_COLLISION, DC_BOX_NONE, DC_BOX_NONE));
+    assert_eq!(
+        (verdict, r.first_box_a, r.first_box_b),
+        (DC_VERDICT_COLLISION, DC_BOX_NONE, DC_BOX_NONE)
+    );
     assert_eq!(pair(h), none(1));
     // SAFETY: live handle.
     assert_eq!(unsafe { dc_set_table_confirmation(h, DC_CONFIRMATION_EXACT) }, DC_STATUS_OK);
     let (s, verdict, r) = query(h, &[v(-150.0, 0.0, -450.0), v(150.0, 0.0, -450.0)]);
-    assert_eq!((s, verdict, r.colliding_pairs, r.first_robot_a), (DC_STATUS_OK, DC_VERDICT_FREE, 0, DC_BOX_NONE));
+    assert_eq!(
+        (s, verdict, r.colliding_pairs, r.first_robot_a),
+        (DC_STATUS_OK, DC_VERDICT_FREE, 0, DC_BOX_NONE)
+    );
     assert_eq!(pair(h), none(0));
     let home = v(0.0, 0.0, -450.0);
     assert_eq!(query(h, &[v(180.0, 0.0, -450.0), v(-180.0, 0.0, -450.0)]).1, DC_VERDICT_COLLISION);
@@ -154,7 +200,8 @@ fn table_mode_reports_fail_closed_and_pair_results() {
 }
 
 #[test]
-fn table_mode_never_answers_free_where_the_exact_model_collides_and_confirmed_answers_as_exact_mode() {
+fn table_mode_never_answers_free_where_the_exact_model_collides_and_confirmed_answers_as_exact_mode(
+) {
     let raw = t1_table_handle();
     // SAFETY: live handle.
     assert_eq!(unsafe { dc_set_table_confirmation(raw, DC_CONFIRMATION_NONE) }, DC_STATUS_OK);
@@ -177,22 +224,35 @@ fn table_mode_never_answers_free_where_the_exact_model_collides_and_confirmed_an
         let (se, ve, _) = query(exact, &tcps);
         let (sc, vc, _) = query(confirmed, &tcps);
         assert_eq!(st, se, "case {i}: {tcps:?}: both modes agree on reachability");
-        assert_eq!((sc, vc), (se, ve), "case {i}: {tcps:?}: the confirmed table answers as exact mode");
+        assert_eq!(
+            (sc, vc),
+            (se, ve),
+            "case {i}: {tcps:?}: the confirmed table answers as exact mode"
+        );
         lookup_hits += u64::from(vt == DC_VERDICT_COLLISION && !fell_back);
         match (se, ve, vt) {
             (DC_STATUS_UNREACHABLE, ..) => unreachable += 1,
             (_, DC_VERDICT_COLLISION, DC_VERDICT_COLLISION) => both += 1,
-            (_, DC_VERDICT_COLLISION, _) => panic!("case {i}: the table says FREE, the exact model collides: {tcps:?}"),
+            (_, DC_VERDICT_COLLISION, _) => {
+                panic!("case {i}: the table says FREE, the exact model collides: {tcps:?}")
+            }
             (_, _, DC_VERDICT_COLLISION) => table_only += 1,
             _ => free += 1,
         }
     }
     println!("100,000 configurations: {both} collide, {table_only} only the table stops, {free} free, {unreachable} unreachable");
     assert!(both > 1000 && free > 1000 && unreachable > 0, "the sample covers every outcome");
-    assert!(table_only > 100, "the unconfirmed table stops where the robots are apart ({table_only})");
+    assert!(
+        table_only > 100,
+        "the unconfirmed table stops where the robots are apart ({table_only})"
+    );
     // SAFETY: live handles.
     unsafe {
-        assert_eq!(dc_table_confirmations(confirmed), lookup_hits, "one confirmation per COLLISION lookup");
+        assert_eq!(
+            dc_table_confirmations(confirmed),
+            lookup_hits,
+            "one confirmation per COLLISION lookup"
+        );
         assert_eq!(dc_table_confirmations(raw), 0);
         dc_destroy(raw);
         dc_destroy(confirmed);
@@ -209,10 +269,17 @@ fn table_confirmation_is_chosen_per_handle_checked_and_read_from_the_cell_file()
     unsafe {
         assert_eq!(query(h, &colliding).1, DC_VERDICT_COLLISION);
         assert_eq!(dc_table_confirmations(h), 1, "new handles confirm");
-        assert_eq!(dc_set_table_confirmation(std::ptr::null_mut(), DC_CONFIRMATION_NONE), DC_STATUS_NULL_POINTER);
+        assert_eq!(
+            dc_set_table_confirmation(std::ptr::null_mut(), DC_CONFIRMATION_NONE),
+            DC_STATUS_NULL_POINTER
+        );
         for bad in [2, 7, u32::MAX] {
             assert_eq!(dc_set_table_confirmation(h, bad), DC_STATUS_INVALID_ARGUMENT, "{bad}");
-            assert!(last_init_error().contains(&format!("confirmation = {bad}")), "{}", last_init_error());
+            assert!(
+                last_init_error().contains(&format!("confirmation = {bad}")),
+                "{}",
+                last_init_error()
+            );
         }
         assert_eq!(query(h, &colliding).1, DC_VERDICT_COLLISION);
         assert_eq!(dc_table_confirmations(h), 2, "a refused value keeps the setting");
@@ -220,18 +287,27 @@ fn table_confirmation_is_chosen_per_handle_checked_and_read_from_the_cell_file()
         assert_eq!(last_init_error(), "");
         assert_eq!(query(h, &colliding).1, DC_VERDICT_COLLISION);
         assert_eq!(dc_table_confirmations(h), 2, "not confirmed once switched off");
-        assert_eq!(dc_set_table_confirmation(exact, DC_CONFIRMATION_NONE), DC_STATUS_OK, "exact mode: no effect");
+        assert_eq!(
+            dc_set_table_confirmation(exact, DC_CONFIRMATION_NONE),
+            DC_STATUS_OK,
+            "exact mode: no effect"
+        );
         assert_eq!(query(exact, &colliding).1, DC_VERDICT_COLLISION);
-        assert_eq!((dc_table_confirmations(exact), dc_table_confirmations(std::ptr::null())), (0, 0));
+        assert_eq!(
+            (dc_table_confirmations(exact), dc_table_confirmations(std::ptr::null())),
+            (0, 0)
+        );
         dc_destroy(h);
         dc_destroy(exact);
     }
     // The cell file's table_confirm, read by dc_init_from_files.
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-ffi-confirm-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("dc-ffi-confirm-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let table_path = dir.join("t1_k16.dct");
     std::fs::write(&table_path, table_bytes("T1")).unwrap();
-    let t1 = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cells/t1.toml")).unwrap();
+    let t1 =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cells/t1.toml")).unwrap();
     let table = format!("{}\0", table_path.display());
     for (key, want_status, want_confirmations) in [
         ("", DC_STATUS_OK, 1),
@@ -261,7 +337,8 @@ fn table_confirmation_is_chosen_per_handle_checked_and_read_from_the_cell_file()
 
 #[test]
 fn table_files_init_the_same_checker_as_buffers() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-ffi-table-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("dc-ffi-table-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let table_path = dir.join("t1_k16.dct");
     std::fs::write(&table_path, table_bytes("T1")).unwrap();
@@ -283,9 +360,18 @@ fn table_files_init_the_same_checker_as_buffers() {
         let mut h = 8 as *mut DcCollider;
         // SAFETY: NUL-terminated paths, valid out pointer.
         let s = unsafe { dc_init_from_files(cell.as_ptr().cast(), table.as_ptr().cast(), &mut h) };
-        assert_eq!((s, h.is_null()), (*want, *want != DC_STATUS_OK), "{cell} {table}: {}", last_init_error());
+        assert_eq!(
+            (s, h.is_null()),
+            (*want, *want != DC_STATUS_OK),
+            "{cell} {table}: {}",
+            last_init_error()
+        );
         if *want == DC_STATUS_IO {
-            assert!(last_init_error().contains("missing"), "the message names the file: {}", last_init_error());
+            assert!(
+                last_init_error().contains("missing"),
+                "the message names the file: {}",
+                last_init_error()
+            );
         }
         if s == DC_STATUS_OK {
             // SAFETY: live handle.
@@ -302,14 +388,27 @@ fn table_files_init_the_same_checker_as_buffers() {
     let mut h = std::ptr::null_mut();
     // SAFETY: NULL and non-UTF-8 paths are the inputs under test.
     unsafe {
-        assert_eq!(dc_init_from_files(std::ptr::null(), cases[0].1.as_ptr().cast(), &mut h), DC_STATUS_NULL_POINTER);
+        assert_eq!(
+            dc_init_from_files(std::ptr::null(), cases[0].1.as_ptr().cast(), &mut h),
+            DC_STATUS_NULL_POINTER
+        );
         assert!(last_init_error().contains("cell_path"));
-        assert_eq!(dc_init_from_files(t1_cell.as_ptr().cast(), std::ptr::null(), &mut h), DC_STATUS_NULL_POINTER);
+        assert_eq!(
+            dc_init_from_files(t1_cell.as_ptr().cast(), std::ptr::null(), &mut h),
+            DC_STATUS_NULL_POINTER
+        );
         assert!(last_init_error().contains("table_path"));
         let not_utf8 = c"/tmp/\xff\xfe.dct";
-        assert_eq!(dc_init_from_files(t1_cell.as_ptr().cast(), not_utf8.as_ptr(), &mut h), DC_STATUS_INVALID_ARGUMENT);
         assert_eq!(
-            dc_init_from_files(t1_cell.as_ptr().cast(), cases[0].1.as_ptr().cast(), std::ptr::null_mut()),
+            dc_init_from_files(t1_cell.as_ptr().cast(), not_utf8.as_ptr(), &mut h),
+            DC_STATUS_INVALID_ARGUMENT
+        );
+        assert_eq!(
+            dc_init_from_files(
+                t1_cell.as_ptr().cast(),
+                cases[0].1.as_ptr().cast(),
+                std::ptr::null_mut()
+            ),
             DC_STATUS_NULL_POINTER
         );
         assert!(h.is_null());
@@ -328,11 +427,12 @@ fn clearance_bound_through_the_c_abi_matches_the_table_and_stays_under_the_exact
     use delta_collide::cell::ExactChecker;
     use delta_collide::cspace::{Progress, Workspace};
     use delta_collide::math::Vec3;
-    use delta_collide::table::{build_table, to_bytes, Ladder, Labelling, TableChecker, Variant};
+    use delta_collide::table::{build_table, to_bytes, Labelling, Ladder, TableChecker, Variant};
     let cell = reference_cell("T1").unwrap();
     let variant = Variant::Clearance(Ladder::default_ladder());
     let (header, table, _) =
-        build_table(&cell, 16, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent).unwrap();
+        build_table(&cell, 16, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent)
+            .unwrap();
     let bytes = to_bytes(&table, &header);
     let checker = TableChecker::new(cell.clone(), &bytes).unwrap();
     let config = Config::cell(450.0, 2);
@@ -349,7 +449,11 @@ fn clearance_bound_through_the_c_abi_matches_the_table_and_stays_under_the_exact
     let (mut levelled, mut none) = (0, 0);
     for _ in 0..50_000 {
         let p = |rng: &mut StdRng| {
-            v(rng.random_range(-230.0..230.0), rng.random_range(-230.0..230.0), rng.random_range(-530.0..-365.0))
+            v(
+                rng.random_range(-230.0..230.0),
+                rng.random_range(-230.0..230.0),
+                rng.random_range(-530.0..-365.0),
+            )
         };
         let tcps = [p(&mut rng), p(&mut rng)];
         let rust: Vec<Vec3> = tcps.iter().map(|t| Vec3::new(t.x, t.y, t.z)).collect();
@@ -371,10 +475,16 @@ fn clearance_bound_through_the_c_abi_matches_the_table_and_stays_under_the_exact
     assert!(levelled > 1000 && none > 100, "{levelled} with a level, {none} without");
     let home = [v(150.0, 0.0, -450.0), v(-150.0, 0.0, -450.0)];
     assert_eq!(bound(h, &home[..1]), (DC_STATUS_WRONG_ROBOT_COUNT, f64::NEG_INFINITY));
-    assert_eq!(bound(h, &[v(f64::NAN, 0.0, -450.0), home[1]]), (DC_STATUS_NON_FINITE, f64::NEG_INFINITY));
+    assert_eq!(
+        bound(h, &[v(f64::NAN, 0.0, -450.0), home[1]]),
+        (DC_STATUS_NON_FINITE, f64::NEG_INFINITY)
+    );
     assert_eq!(bound(std::ptr::null_mut(), &home), (DC_STATUS_NULL_POINTER, f64::NEG_INFINITY));
     // SAFETY: a live handle, readable TCPs; a NULL output is refused, not written.
-    assert_eq!(unsafe { dc_table_clearance_bound(h, home.as_ptr(), 2, std::ptr::null_mut()) }, DC_STATUS_NULL_POINTER);
+    assert_eq!(
+        unsafe { dc_table_clearance_bound(h, home.as_ptr(), 2, std::ptr::null_mut()) },
+        DC_STATUS_NULL_POINTER
+    );
     // An exact-mode handle and a boolean table prove no bound.
     let exact_handle = two_robot_cell(450.0, DC_METHOD_SAT);
     assert_eq!(bound(exact_handle, &home), (DC_STATUS_OK, f64::NEG_INFINITY));
@@ -407,26 +517,41 @@ fn a_line_in_table_mode_answers_per_pair_as_exact_mode_from_its_bundle() {
     // SAFETY: valid config and out pointer; live handles.
     unsafe {
         assert_eq!(dc_init(&line.c(), &mut exact), DC_STATUS_OK);
-        assert_eq!((dc_mode(h), dc_robot_count(h), dc_pair_count(h)), (DC_MODE_TABLE, 4, dc_pair_count(exact)));
+        assert_eq!(
+            (dc_mode(h), dc_robot_count(h), dc_pair_count(h)),
+            (DC_MODE_TABLE, 4, dc_pair_count(exact))
+        );
         assert_eq!(dc_pair_count(h), 6);
     }
     let mut rng = StdRng::seed_from_u64(0x5eed_11fe);
     let mut uniform = |lo: f64, hi: f64| rng.random_range(lo..hi);
     let (mut collisions, mut unreachable) = (0, 0);
     for i in 0..50_000 {
-        let tcps: Vec<DcVec3> =
-            (0..4).map(|_| v(uniform(-240.0, 240.0), uniform(-200.0, 200.0), uniform(-545.0, -355.0))).collect();
+        let tcps: Vec<DcVec3> = (0..4)
+            .map(|_| v(uniform(-240.0, 240.0), uniform(-200.0, 200.0), uniform(-545.0, -355.0)))
+            .collect();
         let (st, vt, rt) = query(h, &tcps);
         let (se, ve, re) = query(exact, &tcps);
-        assert_eq!((st, vt, rt.colliding_pairs, rt.unreachable_mask), (se, ve, re.colliding_pairs, re.unreachable_mask), "case {i}: {tcps:?}");
-        assert_eq!((rt.first_robot_a, rt.first_robot_b), (re.first_robot_a, re.first_robot_b), "case {i}");
+        assert_eq!(
+            (st, vt, rt.colliding_pairs, rt.unreachable_mask),
+            (se, ve, re.colliding_pairs, re.unreachable_mask),
+            "case {i}: {tcps:?}"
+        );
+        assert_eq!(
+            (rt.first_robot_a, rt.first_robot_b),
+            (re.first_robot_a, re.first_robot_b),
+            "case {i}"
+        );
         // Each pair as the exact model answers it; the boxes of a confirmed collision too.
         let (pt, pe) = (pair_results(h), pair_results(exact));
         assert_eq!(pt, pe, "case {i}: {tcps:?}");
         collisions += usize::from(ve == DC_VERDICT_COLLISION);
         unreachable += usize::from(se == DC_STATUS_UNREACHABLE);
     }
-    assert!(collisions > 1000 && unreachable > 1000, "{collisions} collisions, {unreachable} unreachable");
+    assert!(
+        collisions > 1000 && unreachable > 1000,
+        "{collisions} collisions, {unreachable} unreachable"
+    );
     // SAFETY: live handles.
     unsafe {
         assert!(dc_table_confirmations(h) > 0, "COLLISION lookups were confirmed");
@@ -447,7 +572,11 @@ fn a_bundle_for_another_spacing_or_missing_a_pair_is_its_own_init_error() {
         let (s, h) = init_table(&config.c(), line4_bundle_bytes());
         let message = last_init_error();
         assert_eq!(s, want, "{} robots: {message}", config.robots.len());
-        assert!(message.contains(says) && (want == DC_STATUS_OK || message.contains("rebuild the bundle")), "{message}");
+        assert!(
+            message.contains(says)
+                && (want == DC_STATUS_OK || message.contains("rebuild the bundle")),
+            "{message}"
+        );
         // SAFETY: the handle is NULL or live, destroyed once.
         unsafe { dc_destroy(h) };
     }

@@ -44,7 +44,10 @@ unsafe impl Sync for Shared {}
 /// T1's robots, 450 mm apart, with the default stopping model.
 fn t1_handle() -> *mut DcCollider {
     let a = dc_robot_config_thesis();
-    let b = DcRobotConfig { translation: DcVec3 { x: 450.0, y: 0.0, z: 0.0 }, ..dc_robot_config_thesis() };
+    let b = DcRobotConfig {
+        translation: DcVec3 { x: 450.0, y: 0.0, z: 0.0 },
+        ..dc_robot_config_thesis()
+    };
     let robots = [a, b];
     let config = DcCellConfig { robots: robots.as_ptr(), n_robots: 2, method: DC_METHOD_SAT_CACHE };
     let mut h = std::ptr::null_mut();
@@ -59,15 +62,22 @@ fn t1_handle() -> *mut DcCollider {
 fn tcps(cycle: u64) -> [DcVec3; 2] {
     let phase = cycle as f64 * 5e-4;
     let (s, c) = phase.sin_cos();
-    [DcVec3 { x: -120.0 + 20.0 * c, y: 20.0 * s, z: -450.0 }, DcVec3 { x: 120.0 - 20.0 * c, y: 20.0 * s, z: -450.0 }]
+    [
+        DcVec3 { x: -120.0 + 20.0 * c, y: 20.0 * s, z: -450.0 },
+        DcVec3 { x: 120.0 - 20.0 * c, y: 20.0 * s, z: -450.0 },
+    ]
 }
 
 /// One timed call at `cycle` with the TCPs of `at`; the outputs start as FREE so that a call
 /// which forgot to write them would show.
 fn timed(h: *mut DcCollider, cycle: u64, at: u64) -> (DcStatus, DcVerdict, DcProtectiveReport) {
     let points = tcps(at);
-    let request =
-        DcProtectiveRequest { time: cycle, tcps_mcs: points.as_ptr(), n_tcps: 2, ..dc_protective_request_default() };
+    let request = DcProtectiveRequest {
+        time: cycle,
+        tcps_mcs: points.as_ptr(),
+        n_tcps: 2,
+        ..dc_protective_request_default()
+    };
     let mut verdict = DC_VERDICT_FREE;
     // SAFETY: all-zero is a valid report (numbers and integers only).
     let mut report: DcProtectiveReport = unsafe { std::mem::zeroed() };
@@ -108,7 +118,9 @@ fn two_threads_on_one_handle_get_busy_and_stop_and_leave_it_working() {
                     let mut cycle = 1_000 + 3 * (1 - t);
                     let more = |s: &Seen| {
                         let answered = s.calls - s.by_status[DC_STATUS_BUSY as usize];
-                        s.calls < MIN_CALLS || answered < MIN_ANSWERED || !busy_seen.load(Ordering::Relaxed)
+                        s.calls < MIN_CALLS
+                            || answered < MIN_ANSWERED
+                            || !busy_seen.load(Ordering::Relaxed)
                     };
                     while more(&seen) && seen.calls < MAX_CALLS {
                         let (status, verdict, report) = timed(h.0, cycle, cycle);
@@ -117,11 +129,14 @@ fn two_threads_on_one_handle_get_busy_and_stop_and_leave_it_working() {
                         if !ALLOWED.contains(&status) {
                             seen.not_allowed.push(status);
                         }
-                        if status != DC_STATUS_OK && (verdict != DC_VERDICT_STOP || report.verdict != DC_VERDICT_STOP) {
+                        if status != DC_STATUS_OK
+                            && (verdict != DC_VERDICT_STOP || report.verdict != DC_VERDICT_STOP)
+                        {
                             seen.open += 1;
                         }
                         let whole = report.verdict == verdict
-                            && [DC_VERDICT_FREE, DC_VERDICT_WARN, DC_VERDICT_STOP].contains(&verdict)
+                            && [DC_VERDICT_FREE, DC_VERDICT_WARN, DC_VERDICT_STOP]
+                                .contains(&verdict)
                             && report.n_robots == 2
                             && report.clearance_mm.is_finite()
                             && report.protective_mm[..2].iter().all(|s| s.is_finite() && *s > 0.0);
@@ -166,14 +181,22 @@ fn two_threads_on_one_handle_get_busy_and_stop_and_leave_it_working() {
     // Two threads on two cores overlap within a few hundred calls; on one core they may take
     // turns for good, and then there is nothing to refuse.
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    assert!(busy > 0 || cores < 2, "no BUSY in {} calls on {cores} cores", seen[0].calls + seen[1].calls);
+    assert!(
+        busy > 0 || cores < 2,
+        "no BUSY in {} calls on {cores} cores",
+        seen[0].calls + seen[1].calls
+    );
 
     // The handle afterwards: a cycle well after every one the threads sent is a gap (JUMP), and
     // from the next cycle on it answers as a new handle given the same calls after its first.
     let fresh = t1_handle();
     let next = highest.load(Ordering::Relaxed) + 100;
     let (status, verdict, _) = timed(h, next, next);
-    assert_eq!((status, verdict), (DC_STATUS_TIME_JUMP, DC_VERDICT_STOP), "the first call after the threads");
+    assert_eq!(
+        (status, verdict),
+        (DC_STATUS_TIME_JUMP, DC_VERDICT_STOP),
+        "the first call after the threads"
+    );
     for k in 1..=200 {
         let (s, v, r) = timed(h, next + k, k);
         let (s_new, v_new, r_new) = timed(fresh, 5_000 + k, k);
@@ -186,7 +209,11 @@ fn two_threads_on_one_handle_get_busy_and_stop_and_leave_it_working() {
     let last = timed(h, next + 200, 200);
     let again = timed(h, next + 200, 200);
     assert_eq!((last.0, last.1), (again.0, again.1));
-    assert_eq!(format!("{:?}", last.2), format!("{:?}", again.2), "a repeat answers the same report");
+    assert_eq!(
+        format!("{:?}", last.2),
+        format!("{:?}", again.2),
+        "a repeat answers the same report"
+    );
     // SAFETY: live handles, destroyed once; the threads are joined.
     unsafe {
         dc_destroy(h);

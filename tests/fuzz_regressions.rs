@@ -11,7 +11,10 @@ use delta_collide::table::*;
 use std::path::Path;
 
 fn data(target: &str, name: &str) -> Vec<u8> {
-    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz").join(target).join(name)).unwrap()
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz").join(target).join(name),
+    )
+    .unwrap()
 }
 
 /// c_abi, `fk_huge_re_nan_tcp.bin`: with `re = f64::MAX` (then accepted: finite and
@@ -39,8 +42,10 @@ fn a_nonzero_slice_axes_field_outside_4d_tables_is_corrupt() {
     assert!(corrupt_axes(from_bytes(&data("table_bytes", "slice_axes_nonzero_6d.dct"))));
     let s = space(2, Pattern::Noise { p: 0.3, seed: 4 });
     let header = Header::for_space(&s, 1, Workspace::THESIS, Certification::SweptBound);
-    let tables =
-        [Table::D6(LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap()), Table::D5(LinearQuadtree5d::build(&s, Symmetry::MirrorY).unwrap())];
+    let tables = [
+        Table::D6(LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap()),
+        Table::D5(LinearQuadtree5d::build(&s, Symmetry::MirrorY).unwrap()),
+    ];
     for t in tables {
         for axes in [1u32, 2, 3, 0x7a00, u32::MAX] {
             let mut b = to_bytes(&t, &header);

@@ -16,12 +16,12 @@
 #[path = "../fuzz/src/lib.rs"]
 mod targets;
 
+use delta_collide::cell::parse_cell;
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::{Progress, Symmetry, Workspace};
+use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::format::to_bytes;
 use delta_collide::table::synthetic::{space, Pattern};
-use delta_collide::cell::parse_cell;
-use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
@@ -60,11 +60,19 @@ fn committed_seeds_replay_without_a_finding() {
     let mut findings = Vec::new();
     for (name, target) in targets::TARGETS {
         let files = seed_files(name);
-        assert!(files.len() >= 5, "{name}: only {} seeds in {}", files.len(), seed_dir(name).display());
+        assert!(
+            files.len() >= 5,
+            "{name}: only {} seeds in {}",
+            files.len(),
+            seed_dir(name).display()
+        );
         for file in files {
             let data = std::fs::read(&file).unwrap();
             if let Err(e) = catch_unwind(AssertUnwindSafe(|| target(&data))) {
-                let msg = e.downcast_ref::<String>().cloned().or(e.downcast_ref::<&str>().map(|s| s.to_string()));
+                let msg = e
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .or(e.downcast_ref::<&str>().map(|s| s.to_string()));
                 findings.push(format!("{name}: {}: {}", file.display(), msg.unwrap_or_default()));
             }
         }
@@ -73,8 +81,8 @@ fn committed_seeds_replay_without_a_finding() {
 }
 
 /// T1's and T3's real tables at k = 16 cut down to their first codes or nodes (a few hundred
-/// bytes that load and pass `TableChecker::new`), the whole 4D yy' and clearance tables of T1, synthetic
-/// k = 4 tables of every variant, and the corrupted files of `tests/data/`.
+/// bytes that load and pass `TableChecker::new`), the whole 4D yy' and clearance tables of T1,
+/// synthetic k = 4 tables of every variant, and the corrupted files of `tests/data/`.
 fn table_seeds() -> Vec<(String, Vec<u8>)> {
     let mut out = Vec::new();
     for (cell_name, kinds) in [("t1", &TableKind::ALL[..]), ("t3", &[TableKind::D6][..])] {
@@ -83,8 +91,15 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
             // Seed file names spell a kind with '_' (`4d_yy`) where the CLI writes '-'.
             let v = kind.name().replace('-', "_");
             let variant = kind.variant(if kind == TableKind::D4zz { 2 } else { 0 });
-            let (header, table, _) =
-                build_table(&cell, 16, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent).unwrap();
+            let (header, table, _) = build_table(
+                &cell,
+                16,
+                &Workspace::THESIS,
+                variant,
+                Labelling::Certified,
+                Progress::Silent,
+            )
+            .unwrap();
             if let Some(small) = cut(&table, 24) {
                 out.push((format!("{cell_name}_k16_{v}_cut.dct"), to_bytes(&small, &header)));
             }
@@ -94,13 +109,20 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
         }
     }
     let s = space(2, Pattern::Noise { p: 0.3, seed: 4 });
-    let header = Header::for_space(&s, 0x0123_4567_89ab_cdef, Workspace::THESIS, Certification::SweptBound);
+    let header =
+        Header::for_space(&s, 0x0123_4567_89ab_cdef, Workspace::THESIS, Certification::SweptBound);
     let synthetic = [
         ("6d", Table::D6(LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap())),
         ("6d_symmetric", Table::D6(LinearQuadtree6d::build(&s, Symmetry::MirrorY).unwrap())),
         ("5d", Table::D5(LinearQuadtree5d::build(&s, Symmetry::Whole).unwrap())),
-        ("4d_yy", Table::D4(LinearQuadtree4d::build(&s, Symmetry::MirrorY, SliceAxes::YY, 0).unwrap())),
-        ("4d_zz", Table::D4(LinearQuadtree4d::build(&s, Symmetry::Whole, SliceAxes::ZZ, 3).unwrap())),
+        (
+            "4d_yy",
+            Table::D4(LinearQuadtree4d::build(&s, Symmetry::MirrorY, SliceAxes::YY, 0).unwrap()),
+        ),
+        (
+            "4d_zz",
+            Table::D4(LinearQuadtree4d::build(&s, Symmetry::Whole, SliceAxes::ZZ, 3).unwrap()),
+        ),
         ("shared", Table::Shared(SharedQuadtree6d::build(&s, Symmetry::MirrorY).unwrap())),
     ];
     for (v, t) in synthetic {
@@ -109,7 +131,10 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
     for entry in std::fs::read_dir(root().join("tests/data")).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "dctable") {
-            out.push((path.file_name().unwrap().to_str().unwrap().into(), std::fs::read(&path).unwrap()));
+            out.push((
+                path.file_name().unwrap().to_str().unwrap().into(),
+                std::fs::read(&path).unwrap(),
+            ));
         }
     }
     out
@@ -119,22 +144,37 @@ fn table_seeds() -> Vec<(String, Vec<u8>)> {
 /// with its tables cut to their first nodes; one without its last pair and table, which the
 /// line must refuse; a bundle of one table for T1.
 fn bundle_seeds() -> Vec<(String, Vec<u8>)> {
-    let line = parse_cell(&std::fs::read_to_string(root().join("cells/line4.toml")).unwrap()).unwrap();
-    let built = build_bundle(&line, 16, &Workspace::THESIS, Variant::Shared, Labelling::Certified, Progress::Silent)
-        .expect("the line's bundle");
+    let line =
+        parse_cell(&std::fs::read_to_string(root().join("cells/line4.toml")).unwrap()).unwrap();
+    let built = build_bundle(
+        &line,
+        16,
+        &Workspace::THESIS,
+        Variant::Shared,
+        Labelling::Certified,
+        Progress::Silent,
+    )
+    .expect("the line's bundle");
     let (fingerprint, robots) = (line.fingerprint(), line.robots.len());
-    let cut_files: Vec<Vec<u8>> = built.tables.iter().map(|(h, t, _, _)| to_bytes(&cut(t, 24).unwrap(), h)).collect();
-    let bundle = |files: &[Vec<u8>], pairs: &[BundlePair]| bundle_to_bytes(fingerprint, robots, files, pairs).unwrap();
+    let cut_files: Vec<Vec<u8>> =
+        built.tables.iter().map(|(h, t, _, _)| to_bytes(&cut(t, 24).unwrap(), h)).collect();
+    let bundle = |files: &[Vec<u8>], pairs: &[BundlePair]| {
+        bundle_to_bytes(fingerprint, robots, files, pairs).unwrap()
+    };
     let short: Vec<BundlePair> = built.pairs.iter().copied().filter(|p| p.table < 2).collect();
     let t1 = reference_cell("t1").unwrap();
-    let (t1_files, t1_pairs) = (vec![cut_files[0].clone()], vec![BundlePair { a: 0, b: 1, table: 0 }]);
+    let (t1_files, t1_pairs) =
+        (vec![cut_files[0].clone()], vec![BundlePair { a: 0, b: 1, table: 0 }]);
     let cut_bundle = bundle(&cut_files, &built.pairs);
     vec![
         ("line4_k16_shared_whole.dcb".into(), built.bytes.clone()),
         ("line4_k16_shared_cut_truncated.dcb".into(), cut_bundle[..cut_bundle.len() / 2].to_vec()),
         ("line4_k16_shared_cut.dcb".into(), cut_bundle),
         ("line4_k16_shared_cut_short.dcb".into(), bundle(&cut_files[..2], &short)),
-        ("t1_spacing_one_table.dcb".into(), bundle_to_bytes(t1.fingerprint(), 2, &t1_files, &t1_pairs).unwrap()),
+        (
+            "t1_spacing_one_table.dcb".into(),
+            bundle_to_bytes(t1.fingerprint(), 2, &t1_files, &t1_pairs).unwrap(),
+        ),
     ]
 }
 
@@ -142,13 +182,15 @@ fn bundle_seeds() -> Vec<(String, Vec<u8>)> {
 /// without its last table is refused for the line's farthest pairs.
 #[test]
 fn bundle_seeds_load_for_the_line() {
-    let line = parse_cell(&std::fs::read_to_string(root().join("cells/line4.toml")).unwrap()).unwrap();
+    let line =
+        parse_cell(&std::fs::read_to_string(root().join("cells/line4.toml")).unwrap()).unwrap();
     let seed = |name: &str| std::fs::read(seed_dir("bundle_bytes").join(name)).unwrap();
     for name in ["line4_k16_shared_whole.dcb", "line4_k16_shared_cut.dcb"] {
         let checker = BundleChecker::new(line.clone(), &seed(name), Confirmation::Exact);
         assert_eq!(checker.map(|c| c.table_count()).map_err(|e| e.to_string()), Ok(3), "{name}");
     }
-    let short = BundleChecker::new(line, &seed("line4_k16_shared_cut_short.dcb"), Confirmation::Exact);
+    let short =
+        BundleChecker::new(line, &seed("line4_k16_shared_cut_short.dcb"), Confirmation::Exact);
     assert!(matches!(short, Err(TableError::MissingPair { .. })), "{:?}", short.map(|_| ()));
 }
 
@@ -165,7 +207,10 @@ fn cut(table: &Table, n: usize) -> Option<Table> {
             let n = n.min(codes.len());
             let ivs = ivs[..offsets[n] as usize].to_vec();
             let parts = (codes[..n].to_vec(), offsets[..=n].to_vec(), ivs);
-            Table::D5(LinearQuadtree5d::from_parts(q.levels(), q.symmetric(), parts.0, parts.1, parts.2).unwrap())
+            Table::D5(
+                LinearQuadtree5d::from_parts(q.levels(), q.symmetric(), parts.0, parts.1, parts.2)
+                    .unwrap(),
+            )
         }
         Table::D4(q) => {
             let (codes, slice_of, slices) = q.parts();
@@ -174,11 +219,24 @@ fn cut(table: &Table, n: usize) -> Option<Table> {
             let mut kept: Vec<u32> = slice_of[..n].to_vec();
             kept.sort_unstable();
             kept.dedup();
-            let new_slice_of = slice_of[..n].iter().map(|s| kept.binary_search(s).unwrap() as u32).collect();
-            let words = kept.iter().flat_map(|&s| slices[s as usize * wps..][..wps].iter().copied()).collect();
+            let new_slice_of =
+                slice_of[..n].iter().map(|s| kept.binary_search(s).unwrap() as u32).collect();
+            let words = kept
+                .iter()
+                .flat_map(|&s| slices[s as usize * wps..][..wps].iter().copied())
+                .collect();
             let (levels, sym, axes, t) = (q.levels(), q.symmetric(), q.axes(), q.threshold());
             Table::D4(
-                LinearQuadtree4d::from_parts(levels, sym, axes, t, codes[..n].to_vec(), new_slice_of, words).unwrap(),
+                LinearQuadtree4d::from_parts(
+                    levels,
+                    sym,
+                    axes,
+                    t,
+                    codes[..n].to_vec(),
+                    new_slice_of,
+                    words,
+                )
+                .unwrap(),
             )
         }
         Table::Shared(q) => Table::Shared(prune_shared(q, n)),
@@ -203,7 +261,9 @@ fn prune_shared(q: &SharedQuadtree6d, budget: usize) -> SharedQuadtree6d {
             let node = p.depth_start[d] as usize + old as usize;
             let [mut nonuniform, mut collision] = p.masks[node];
             bases.push(new_children.len() as u32);
-            for (rank, bit) in (0..64).map(|i| 1u64 << i).filter(|b| p.masks[node][0] & b != 0).enumerate() {
+            for (rank, bit) in
+                (0..64).map(|i| 1u64 << i).filter(|b| p.masks[node][0] & b != 0).enumerate()
+            {
                 let child = children[p.bases[node] as usize + rank];
                 let id = next.iter().position(|&c| c == child).or_else(|| {
                     (next.len() < budget).then(|| {
@@ -239,7 +299,9 @@ fn prune_shared(q: &SharedQuadtree6d, budget: usize) -> SharedQuadtree6d {
 fn cell_seeds() -> Vec<(String, Vec<u8>)> {
     let mut out: Vec<(String, Vec<u8>)> = ["t1", "t2", "t3"]
         .iter()
-        .map(|n| (format!("{n}.toml"), std::fs::read(root().join(format!("cells/{n}.toml"))).unwrap()))
+        .map(|n| {
+            (format!("{n}.toml"), std::fs::read(root().join(format!("cells/{n}.toml"))).unwrap())
+        })
         .collect();
     let every_key = r#"name = "every key"
 method = "sat"
@@ -254,15 +316,19 @@ model = { tool = { half = [25.0, 25.0, 80.0] } }
 "#;
     out.push(("every_key.toml".into(), every_key.into()));
     let line = |n: usize, dx: f64| {
-        let robots: String =
-            (0..n).map(|i| format!("[[robot]]\nplacement = {{ t = [{:.1}, 0.0, 0.0] }}\n", dx * i as f64)).collect();
+        let robots: String = (0..n)
+            .map(|i| format!("[[robot]]\nplacement = {{ t = [{:.1}, 0.0, 0.0] }}\n", dx * i as f64))
+            .collect();
         format!("name = \"line\"\n{robots}").into_bytes()
     };
     out.push(("three_robots_close.toml".into(), line(3, 300.0)));
     out.push(("thirty_two_robots.toml".into(), line(32, 450.0)));
     out.push(("thirty_three_robots_refused.toml".into(), line(33, 450.0)));
     out.push(("typo_refused.toml".into(), b"[[robot]]\nmodel = { margn = 3.0 }\n".to_vec()));
-    out.push(("negative_margin_refused.toml".into(), b"[[robot]]\nmodel = { margin = -1.0 }\n".to_vec()));
+    out.push((
+        "negative_margin_refused.toml".into(),
+        b"[[robot]]\nmodel = { margin = -1.0 }\n".to_vec(),
+    ));
     out.push(("no_robot_refused.toml".into(), b"name = \"empty\"\nrobot = []\n".to_vec()));
     out.push(("huge_lengths.toml".into(), b"[[robot]]\ngeometry = { f = 1e300, rf = 1e300, re = 1e300, e = 1e-300, theta_min_deg = -90.0, theta_max_deg = 120.0 }\n[[robot]]\n".to_vec()));
     out
@@ -293,7 +359,12 @@ fn seeds_are_committed() {
     }
     for (name, bytes) in generated_seeds("c_abi") {
         let path = seed_dir("c_abi").join(&name);
-        assert_eq!(std::fs::read(&path).ok(), Some(bytes), "{} is stale; regenerate (module doc)", path.display());
+        assert_eq!(
+            std::fs::read(&path).ok(),
+            Some(bytes),
+            "{} is stale; regenerate (module doc)",
+            path.display()
+        );
     }
 }
 
@@ -334,10 +405,12 @@ fn each_target_fuzzes_briefly_without_a_finding() {
     assert!(out.status.success(), "cargo fuzz build failed:\n{}", output_text(&out));
     println!("cargo fuzz build: {:.1} s", start.elapsed().as_secs_f64());
     for (name, _) in targets::TARGETS {
-        let scratch = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("fuzz-corpus-{name}"));
+        let scratch =
+            PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("fuzz-corpus-{name}"));
         let _ = std::fs::remove_dir_all(&scratch);
         std::fs::create_dir_all(&scratch).unwrap();
-        let artifacts = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("fuzz-artifacts-{name}/"));
+        let artifacts =
+            PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("fuzz-artifacts-{name}/"));
         std::fs::create_dir_all(&artifacts).unwrap();
         let mut cmd = cargo_fuzz("run");
         // New inputs go to the first corpus folder (scratch), so the seeds stay as committed.
@@ -351,7 +424,11 @@ fn each_target_fuzzes_briefly_without_a_finding() {
         let start = Instant::now();
         let out = cmd.output().expect("cargo fuzz run");
         let text = output_text(&out);
-        assert!(out.status.success(), "{name}: a finding (input kept in {}):\n{text}", artifacts.display());
+        assert!(
+            out.status.success(),
+            "{name}: a finding (input kept in {}):\n{text}",
+            artifacts.display()
+        );
         let done = text.lines().find(|l| l.starts_with("Done ")).unwrap_or("no `Done` line");
         println!("{name}: {done} ({:.1} s wall)", start.elapsed().as_secs_f64());
         assert!(done.starts_with(&format!("Done {SHORT_RUNS} runs")), "{name}: {done}\n{text}");

@@ -6,7 +6,9 @@
 //! they may disagree only inside a thin band around touching, measured by an independent
 //! gap computed from the boxes' vertices.
 
-use delta_collide::geometry::{first_intersecting_pair, obbs_intersect, separating_axis, Obb, WitnessCache};
+use delta_collide::geometry::{
+    first_intersecting_pair, obbs_intersect, separating_axis, Obb, WitnessCache,
+};
 use delta_collide::math::{Mat3, Real, Vec3};
 use nalgebra::Rotation3;
 use proptest::prelude::*;
@@ -54,7 +56,8 @@ fn near_pair() -> impl Strategy<Value = (Obb, Obb)> {
             } else {
                 Vec3::x()
             };
-            let support = |b: &Obb| (0..3).map(|k| b.axes.column(k).dot(&n).abs() * b.half[k]).sum::<Real>();
+            let support =
+                |b: &Obb| (0..3).map(|k| b.axes.column(k).dot(&n).abs() * b.half[k]).sum::<Real>();
             let b = Obb::new(Vec3::zeros(), axes, half);
             let center = a.center + n * (support(&a) + support(&b) + gap);
             (a, Obb { center, ..b })
@@ -83,7 +86,9 @@ fn vertex_gap(a: &Obb, b: &Obb) -> Real {
     }
     let (va, vb) = (a.vertices(), b.vertices());
     let range = |vs: &[Vec3; 8], l: &Vec3| {
-        vs.iter().map(|v| v.dot(l)).fold((Real::MAX, Real::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)))
+        vs.iter()
+            .map(|v| v.dot(l))
+            .fold((Real::MAX, Real::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)))
     };
     axes.iter()
         .map(|l| {
@@ -94,7 +99,13 @@ fn vertex_gap(a: &Obb, b: &Obb) -> Real {
 }
 
 /// Two verdicts on the same geometry may differ only near touching.
-fn assert_same_or_near_touching(a: &Obb, b: &Obb, first: bool, second: bool, what: &str) -> Result<(), TestCaseError> {
+fn assert_same_or_near_touching(
+    a: &Obb,
+    b: &Obb,
+    first: bool,
+    second: bool,
+    what: &str,
+) -> Result<(), TestCaseError> {
     if first != second {
         let gap = vertex_gap(a, b);
         prop_assert!(

@@ -45,7 +45,11 @@ fn workspace_point(rng: &mut StdRng) -> Vec3 {
 
 /// A uniform random point of a box well around the workspace (most of it unreachable).
 fn wide_point(rng: &mut StdRng) -> Vec3 {
-    Vec3::new(rng.random_range(-500.0..=500.0), rng.random_range(-500.0..=500.0), rng.random_range(-800.0..=0.0))
+    Vec3::new(
+        rng.random_range(-500.0..=500.0),
+        rng.random_range(-500.0..=500.0),
+        rng.random_range(-800.0..=0.0),
+    )
 }
 
 /// `t` wrapped to (-pi, pi].
@@ -87,7 +91,10 @@ fn oracle_elbow_out(d: &Delta3, arm: usize, tcp: &Vec3) -> Option<(Real, Real)> 
 fn loop_error(d: &Delta3, tcp: &Vec3) -> Real {
     let sol = d.inverse_kinematics(tcp).unwrap();
     (0..3)
-        .map(|arm| ((d.elbow(arm, sol.cos[arm], sol.sin[arm]) - d.platform_joint(arm, tcp)).norm() - d.re).abs())
+        .map(|arm| {
+            ((d.elbow(arm, sol.cos[arm], sol.sin[arm]) - d.platform_joint(arm, tcp)).norm() - d.re)
+                .abs()
+        })
         .fold(0.0, Real::max)
 }
 
@@ -95,7 +102,9 @@ fn loop_error(d: &Delta3, tcp: &Vec3) -> Real {
 /// singularity, where the spheres meet at a grazing angle and the FK is ill-conditioned.
 fn link_determinant(d: &Delta3, tcp: &Vec3) -> Real {
     let sol = d.inverse_kinematics(tcp).unwrap();
-    let n: [Vec3; 3] = std::array::from_fn(|i| (d.platform_joint(i, tcp) - d.elbow(i, sol.cos[i], sol.sin[i])) / d.re);
+    let n: [Vec3; 3] = std::array::from_fn(|i| {
+        (d.platform_joint(i, tcp) - d.elbow(i, sol.cos[i], sol.sin[i])) / d.re
+    });
     n[0].dot(&n[1].cross(&n[2])).abs()
 }
 
@@ -103,8 +112,10 @@ fn link_determinant(d: &Delta3, tcp: &Vec3) -> Real {
 fn fk_of_ik_returns_the_tcp_on_100k_random_reachable_points() {
     let d = Delta3::THESIS;
     let mut rng = StdRng::seed_from_u64(0x5eed_0001);
-    let (mut reachable, mut drawn, mut worst, mut worst_loop) = (0usize, 0usize, 0.0 as Real, 0.0 as Real);
-    let (mut wide_reachable, mut wide_drawn, mut singular, mut worst_singular) = (0usize, 0usize, 0usize, 0.0 as Real);
+    let (mut reachable, mut drawn, mut worst, mut worst_loop) =
+        (0usize, 0usize, 0.0 as Real, 0.0 as Real);
+    let (mut wide_reachable, mut wide_drawn, mut singular, mut worst_singular) =
+        (0usize, 0usize, 0usize, 0.0 as Real);
     while reachable < 100_000 || wide_reachable < 50_000 {
         let from_workspace = reachable < 100_000;
         let p = if from_workspace { workspace_point(&mut rng) } else { wide_point(&mut rng) };
@@ -158,7 +169,11 @@ fn ik_picks_the_elbow_out_branch_of_the_spec_formula() {
                 ties += 1; // cosines tie: either branch is "the larger".
                 continue;
             }
-            assert!(angle_gap(sol.theta[arm], out) < 1e-9, "arm {arm} of {p:?}: {} vs oracle {out}", sol.theta[arm]);
+            assert!(
+                angle_gap(sol.theta[arm], out) < 1e-9,
+                "arm {arm} of {p:?}: {} vs oracle {out}",
+                sol.theta[arm]
+            );
             assert!(sol.theta[arm] > -PI && sol.theta[arm] <= PI);
             assert!(sol.cos[arm] > other.cos());
             checked += 1;
@@ -219,12 +234,19 @@ fn unreachable_points_are_reported_with_their_reason() {
     let mut rng = StdRng::seed_from_u64(0x5eed_0004);
     for _ in 0..10_000 {
         // Beyond |p| > rf + re + |e - f| no arm can close: arm 0 fails first.
-        let dir = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..-0.01));
+        let dir = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..-0.01),
+        );
         let p = dir.normalize() * rng.random_range(611.0..5_000.0);
         assert_eq!(d.inverse_kinematics(&p), Err(Unreachable::OutOfReach { arm: 0 }), "{p:?}");
         // Above (or on) the base plane.
-        let q =
-            Vec3::new(rng.random_range(-300.0..300.0), rng.random_range(-300.0..300.0), rng.random_range(0.0..400.0));
+        let q = Vec3::new(
+            rng.random_range(-300.0..300.0),
+            rng.random_range(-300.0..300.0),
+            rng.random_range(0.0..400.0),
+        );
         assert_eq!(d.inverse_kinematics(&q), Err(Unreachable::AboveBase), "{q:?}");
     }
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
@@ -232,7 +254,10 @@ fn unreachable_points_are_reported_with_their_reason() {
             let mut p = Vec3::new(10.0, 20.0, -450.0);
             p[k] = bad;
             assert_eq!(d.inverse_kinematics(&p), Err(Unreachable::NonFinite));
-            assert!(RobotModel::THESIS.boxes(&p).is_err() && RobotModel::THESIS.boxes_chain(&p).is_err());
+            assert!(
+                RobotModel::THESIS.boxes(&p).is_err()
+                    && RobotModel::THESIS.boxes_chain(&p).is_err()
+            );
         }
     }
     // One arm out of reach along its own radial line, the others fine: that arm is named.
@@ -311,8 +336,14 @@ fn full_options(margin: Real) -> ModelOptions {
     ModelOptions {
         margin,
         upper_links: Some((25.0, 20.0)),
-        platform: Some(ToolBox { offset: Vec3::new(0.0, 0.0, 15.0), half: Vec3::new(70.0, 70.0, 15.0) }),
-        tool: Some(ToolBox { offset: Vec3::new(5.0, -5.0, -60.0), half: Vec3::new(30.0, 30.0, 60.0) }),
+        platform: Some(ToolBox {
+            offset: Vec3::new(0.0, 0.0, 15.0),
+            half: Vec3::new(70.0, 70.0, 15.0),
+        }),
+        tool: Some(ToolBox {
+            offset: Vec3::new(5.0, -5.0, -60.0),
+            half: Vec3::new(30.0, 30.0, 60.0),
+        }),
         ..ModelOptions::THESIS
     }
 }
@@ -322,7 +353,10 @@ fn chain_and_direct_models_give_the_same_boxes() {
     let mut rng = StdRng::seed_from_u64(0x5eed_0007);
     let models = [
         RobotModel::THESIS,
-        RobotModel { delta: Delta3::THESIS, options: ModelOptions { margin: 8.28, ..ModelOptions::THESIS } },
+        RobotModel {
+            delta: Delta3::THESIS,
+            options: ModelOptions { margin: 8.28, ..ModelOptions::THESIS },
+        },
         RobotModel { delta: Delta3::THESIS, options: full_options(0.0) },
         RobotModel { delta: Delta3::THESIS, options: full_options(11.0) },
     ];
@@ -338,9 +372,20 @@ fn chain_and_direct_models_give_the_same_boxes() {
             assert_eq!(direct.len, model.box_count());
             assert_eq!(chain.len, direct.len);
             for (k, (a, b)) in direct.as_slice().iter().zip(chain.as_slice()).enumerate() {
-                let gaps = [(a.center - b.center).norm(), (a.axes - b.axes).norm(), (a.half - b.half).norm()];
-                assert!(gaps.iter().all(|g| *g < 1e-9), "box {k} of {p:?} ({:?}): {gaps:?}", model.box_kind(k));
-                assert!((a.axes.transpose() * a.axes - delta_collide::math::Mat3::identity()).norm() < 1e-12);
+                let gaps = [
+                    (a.center - b.center).norm(),
+                    (a.axes - b.axes).norm(),
+                    (a.half - b.half).norm(),
+                ];
+                assert!(
+                    gaps.iter().all(|g| *g < 1e-9),
+                    "box {k} of {p:?} ({:?}): {gaps:?}",
+                    model.box_kind(k)
+                );
+                assert!(
+                    (a.axes.transpose() * a.axes - delta_collide::math::Mat3::identity()).norm()
+                        < 1e-12
+                );
                 assert!(a.axes.determinant() > 0.0, "right-handed axes");
             }
             compared += 1;
@@ -387,7 +432,9 @@ fn workspace_point_beyond_the_default_motor_limit() {
     let p = Vec3::new(120.46024704435666, -181.9955806661595, -474.4);
     assert!(workspace_radius(-p.z).is_some_and(|r| p.x.hypot(p.y) <= r));
     match Delta3::THESIS.inverse_kinematics(&p) {
-        Err(Unreachable::MotorLimit { theta, .. }) => assert!(theta > 2.0 * PI / 3.0 && theta < 2.12, "{theta}"),
+        Err(Unreachable::MotorLimit { theta, .. }) => {
+            assert!(theta > 2.0 * PI / 3.0 && theta < 2.12, "{theta}")
+        }
         other => panic!("expected a motor limit, got {other:?}"),
     }
     let free = Delta3 { theta_max: 2.2, ..Delta3::THESIS };

@@ -52,9 +52,17 @@ fn run(case: &str) -> Run {
         s.tcps_at(tick, &mut tcps);
         let v = exact.check(&tcps).unwrap().clone();
         // Every waypoint is the TCP at its tick, so this covers them all.
-        assert!(v.all_reachable(), "{case} tick {tick}: unreachable TCP {:?} ({tcps:?})", v.first_unreachable);
-        let now: Vec<(usize, usize)> =
-            v.pairs.iter().filter(|p| matches!(p.state, PairState::Collides(..))).map(|p| (p.a, p.b)).collect();
+        assert!(
+            v.all_reachable(),
+            "{case} tick {tick}: unreachable TCP {:?} ({tcps:?})",
+            v.first_unreachable
+        );
+        let now: Vec<(usize, usize)> = v
+            .pairs
+            .iter()
+            .filter(|p| matches!(p.state, PairState::Collides(..)))
+            .map(|p| (p.a, p.b))
+            .collect();
         if !now.is_empty() && out.first_collision.is_none() {
             out.first_collision = Some((tick, now.clone()));
         }
@@ -64,12 +72,16 @@ fn run(case: &str) -> Run {
             }
         }
         for ((a, b), min) in &mut out.min_clearance {
-            let c = boxes_clearance(exact.boxes(*a).as_slice(), exact.boxes(*b).as_slice()).distance;
+            let c =
+                boxes_clearance(exact.boxes(*a).as_slice(), exact.boxes(*b).as_slice()).distance;
             *min = min.min(c);
         }
     }
     println!("line4 {case}: smallest clearance per pair {:?}", out.min_clearance);
-    println!("line4 {case}: first collision {:?}, colliding pairs {:?}", out.first_collision, out.colliding_pairs);
+    println!(
+        "line4 {case}: first collision {:?}, colliding pairs {:?}",
+        out.first_collision, out.colliding_pairs
+    );
     out
 }
 
@@ -79,7 +91,10 @@ fn line_practical_case_never_collides_and_brings_every_neighbour_pair_close() {
     assert_eq!(r.first_collision, None, "the practical case collides");
     for &((a, b), min) in &r.min_clearance {
         if b == a + 1 {
-            assert!(min > 10.0 && min < 100.0, "neighbours ({a}, {b}): smallest clearance {min:.1} mm, not 10-100 mm");
+            assert!(
+                min > 10.0 && min < 100.0,
+                "neighbours ({a}, {b}): smallest clearance {min:.1} mm, not 10-100 mm"
+            );
         } else {
             assert!(min > 10.0, "pair ({a}, {b}): smallest clearance {min:.1} mm");
         }
@@ -90,9 +105,16 @@ fn line_practical_case_never_collides_and_brings_every_neighbour_pair_close() {
 fn line_collision_case_collides_late_and_between_neighbours_only() {
     let r = run("collision");
     let (first, pairs) = r.first_collision.expect("the collision case collides");
-    assert!(first > COLLISION_AFTER_TICK, "first collision at tick {first}, in the first half of the run");
+    assert!(
+        first > COLLISION_AFTER_TICK,
+        "first collision at tick {first}, in the first half of the run"
+    );
     assert_eq!(pairs, vec![(2, 3)], "R3 and R4 collide first, alone");
     let mut all = r.colliding_pairs.clone();
     all.sort_unstable();
-    assert_eq!(all, vec![(0, 1), (1, 2), (2, 3)], "every neighbour pair collides at some tick, no other pair");
+    assert_eq!(
+        all,
+        vec![(0, 1), (1, 2), (2, 3)],
+        "every neighbour pair collides at some tick, no other pair"
+    );
 }

@@ -38,7 +38,10 @@ fn random_box(rng: &mut StdRng, spread: Real) -> (Obb, [Real; 4]) {
 
 fn parry_distance(a: &Obb, qa: &[Real; 4], b: &Obb, qb: &[Real; 4]) -> (bool, Real) {
     let pose = |o: &Obb, q: &[Real; 4]| {
-        Pose::from_parts(Vector::new(o.center.x, o.center.y, o.center.z), Rotation::from_xyzw(q[0], q[1], q[2], q[3]))
+        Pose::from_parts(
+            Vector::new(o.center.x, o.center.y, o.center.z),
+            Rotation::from_xyzw(q[0], q[1], q[2], q[3]),
+        )
     };
     let cuboid = |o: &Obb| Cuboid::new(Vector::new(o.half.x, o.half.y, o.half.z));
     let (pa, pb, sa, sb) = (pose(a, qa), pose(b, qb), cuboid(a), cuboid(b));
@@ -49,7 +52,8 @@ fn parry_distance(a: &Obb, qa: &[Real; 4], b: &Obb, qb: &[Real; 4]) -> (bool, Re
 /// The largest gap between the projections of the two boxes on the 15 candidate axes: a lower
 /// bound on their distance.
 fn axis_gap_lower_bound(a: &Obb, b: &Obb) -> Real {
-    let cols = |m: &Mat3| [m.column(0).into_owned(), m.column(1).into_owned(), m.column(2).into_owned()];
+    let cols =
+        |m: &Mat3| [m.column(0).into_owned(), m.column(1).into_owned(), m.column(2).into_owned()];
     let (ua, ub) = (cols(&a.axes), cols(&b.axes));
     let mut axes: Vec<Vec3> = ua.iter().chain(ub.iter()).copied().collect();
     for u in &ua {
@@ -60,9 +64,12 @@ fn axis_gap_lower_bound(a: &Obb, b: &Obb) -> Real {
             }
         }
     }
-    let radius = |u: &[Vec3; 3], h: &Vec3, l: &Vec3| (0..3).map(|k| h[k] * u[k].dot(l).abs()).sum::<Real>();
+    let radius =
+        |u: &[Vec3; 3], h: &Vec3, l: &Vec3| (0..3).map(|k| h[k] * u[k].dot(l).abs()).sum::<Real>();
     let t = b.center - a.center;
-    axes.iter().map(|l| t.dot(l).abs() - radius(&ua, &a.half, l) - radius(&ub, &b.half, l)).fold(Real::MIN, Real::max)
+    axes.iter()
+        .map(|l| t.dot(l).abs() - radius(&ua, &a.half, l) - radius(&ub, &b.half, l))
+        .fold(Real::MIN, Real::max)
 }
 
 #[test]
@@ -74,7 +81,9 @@ fn random_box_pairs_match_parry_and_the_axis_lower_bound() {
         let ((a, qa), (b, qb)) = (random_box(&mut rng, spread), random_box(&mut rng, spread));
         let ours = obb_distance(&a, &b);
         let (parry_hit, parry) = parry_distance(&a, &qa, &b, &qb);
-        let case = format!("case {i}: a {a:?} qa {qa:?} b {b:?} qb {qb:?}: ours {ours:e}, parry {parry:e}");
+        let case = format!(
+            "case {i}: a {a:?} qa {qa:?} b {b:?} qb {qb:?}: ours {ours:e}, parry {parry:e}"
+        );
         if parry_hit {
             assert_eq!(ours, 0.0, "parry intersects, {case}");
             hit += 1;
@@ -92,7 +101,10 @@ fn random_box_pairs_match_parry_and_the_axis_lower_bound() {
     }
     println!("{free} separated, {hit} intersecting, {stalls} where parry's GJK stayed above ours");
     assert!(free > 20_000 && hit > 20_000, "both outcomes are exercised");
-    assert!(stalls * 1000 < free, "parry disagrees on {stalls} of {free}: more than GJK stalls explain");
+    assert!(
+        stalls * 1000 < free,
+        "parry disagrees on {stalls} of {free}: more than GJK stalls explain"
+    );
 }
 
 #[test]
@@ -116,7 +128,10 @@ fn robot_boxes_along_reach_in_cell_t2_match_parry() {
         }
         let collides = checker.verdict().collides();
         let (ba, bb) = (checker.boxes(0).as_slice(), checker.boxes(1).as_slice());
-        let ours = ba.iter().flat_map(|a| bb.iter().map(move |b| obb_distance(a, b))).fold(Real::INFINITY, Real::min);
+        let ours = ba
+            .iter()
+            .flat_map(|a| bb.iter().map(move |b| obb_distance(a, b)))
+            .fold(Real::INFINITY, Real::min);
         let q = |o: &Obb| {
             let uq = UnitQuaternion::from_matrix(&o.axes);
             [uq.i, uq.j, uq.k, uq.w]
@@ -125,7 +140,11 @@ fn robot_boxes_along_reach_in_cell_t2_match_parry() {
             .iter()
             .flat_map(|a| bb.iter().map(move |b| parry_distance(a, &q(a), b, &q(b)).1))
             .fold(Real::INFINITY, Real::min);
-        assert_eq!(ours == 0.0, collides, "zero distance exactly when the exact check collides: {tcps:?}");
+        assert_eq!(
+            ours == 0.0,
+            collides,
+            "zero distance exactly when the exact check collides: {tcps:?}"
+        );
         assert!(
             (ours - parry).abs() <= 1e-4 * (1.0 + parry) || (collides && parry <= BAND),
             "{tcps:?}: ours {ours} parry {parry}"

@@ -17,14 +17,20 @@ fn cli(args: &[&str]) -> Output {
 }
 
 fn ok(out: &Output) -> String {
-    assert!(out.status.success(), "{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 fn temp_dir() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("dc-pictures-{}", std::process::id()));
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("dc-pictures-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         dir
     })
@@ -56,11 +62,16 @@ struct Picture {
 
 impl Picture {
     fn read(file: &str) -> Picture {
-        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(file).unwrap()));
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(file).unwrap()));
         let mut reader = decoder.read_info().unwrap();
         let mut rgb = vec![0; reader.output_buffer_size().unwrap()];
         let info = reader.next_frame(&mut rgb).unwrap();
-        assert_eq!((info.color_type, info.bit_depth), (png::ColorType::Rgb, png::BitDepth::Eight), "{file}");
+        assert_eq!(
+            (info.color_type, info.bit_depth),
+            (png::ColorType::Rgb, png::BitDepth::Eight),
+            "{file}"
+        );
         rgb.truncate(info.buffer_size());
         Picture { width: info.width, height: info.height, rgb }
     }
@@ -101,7 +112,11 @@ fn assert_picture(file: &str, width: u32, height: u32) -> Picture {
     assert!(meta.len() > 1000, "{file}: only {} bytes", meta.len());
     let pic = Picture::read(file);
     assert_eq!((pic.width, pic.height), (width, height), "{file}: requested size");
-    assert!(pic.distinct_colours() > 10, "{file}: {} colours, a blank picture", pic.distinct_colours());
+    assert!(
+        pic.distinct_colours() > 10,
+        "{file}: {} colours, a blank picture",
+        pic.distinct_colours()
+    );
     pic
 }
 
@@ -141,24 +156,35 @@ fn render_marks_colliding_boxes_red_and_a_free_configuration_has_none() {
     let free = assert_picture(&free, 1400, 700);
     // The legend's swatch is red in both; only the colliding boxes add thousands of red pixels.
     let (red_hit, red_free) = (collision.count(reddish), free.count(reddish));
-    assert!(red_hit > 5_000 && red_free < 1_000, "red pixels: collision {red_hit}, free {red_free}");
+    assert!(
+        red_hit > 5_000 && red_free < 1_000,
+        "red pixels: collision {red_hit}, free {red_free}"
+    );
     // Both robots' colours are drawn (blue A, green B).
-    assert!(free.count(|p| p[2] > 150 && p[0] < 120) > 1_000 && free.count(|p| p[1] > 120 && p[0] < 100) > 1_000);
+    assert!(
+        free.count(|p| p[2] > 150 && p[0] < 120) > 1_000
+            && free.count(|p| p[1] > 120 && p[0] < 100) > 1_000
+    );
 }
 
 #[test]
 fn render_of_an_unreachable_tcp_and_bad_arguments() {
     let file = path("render-unreachable.png");
-    let text = ok(&cli(&["render", "--cell", "T2", "--tcp", "0,0,-900", "--tcp", "0,0,-450", "--output", &file]));
+    let text = ok(&cli(&[
+        "render", "--cell", "T2", "--tcp", "0,0,-900", "--tcp", "0,0,-450", "--output", &file,
+    ]));
     assert!(text.contains("unreachable: robot A"), "{text}");
     assert_picture(&file, 1400, 700);
     let out = cli(&["render", "--cell", "T1", "--tcp", "0,0,-450", "--output", &file]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("one --tcp x,y,z per robot"));
-    let out = cli(&["render", "--cell", "T1", "--tcp", "0,0", "--tcp", "0,0,-450", "--output", &file]);
-    assert!(String::from_utf8_lossy(&out.stderr).contains("three numbers"));
     let out =
-        cli(&["render", "--cell", "T1", "--tcp", "0,0,-450", "--tcp", "0,0,-450", "--width", "10", "--output", &file]);
+        cli(&["render", "--cell", "T1", "--tcp", "0,0", "--tcp", "0,0,-450", "--output", &file]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("three numbers"));
+    let out = cli(&[
+        "render", "--cell", "T1", "--tcp", "0,0,-450", "--tcp", "0,0,-450", "--width", "10",
+        "--output", &file,
+    ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("at least"));
 }
@@ -166,13 +192,15 @@ fn render_of_an_unreachable_tcp_and_bad_arguments() {
 #[test]
 fn quilt_of_a_6d_table_shows_collision_free_and_unreachable_cells() {
     let table = t1_table("6d");
-    for (axes, slices) in
-        [("yy", "25 slices of 14 x 14"), ("zz", "196 slices of 5 x 5"), ("xx", "25 slices of 14 x 14")]
-    {
+    for (axes, slices) in [
+        ("yy", "25 slices of 14 x 14"),
+        ("zz", "196 slices of 5 x 5"),
+        ("xx", "25 slices of 14 x 14"),
+    ] {
         let file = path(&format!("quilt-{axes}.png"));
         let text = ok(&cli(&[
-            "quilt", "--cell", "T1", "--table", &table, "--axes", axes, "--output", &file, "--width", "640",
-            "--height", "700",
+            "quilt", "--cell", "T1", "--table", &table, "--axes", axes, "--output", &file,
+            "--width", "640", "--height", "700",
         ]));
         assert!(text.contains(slices), "{axes}: {text}");
         let pic = assert_picture(&file, 640, 700);
@@ -194,7 +222,8 @@ fn quilt_of_a_6d_table_shows_collision_free_and_unreachable_cells() {
         "--output",
         &path("q.png"),
     ]));
-    let free: usize = text.split(" collision, ").nth(1).unwrap().split(" free").next().unwrap().parse().unwrap();
+    let free: usize =
+        text.split(" collision, ").nth(1).unwrap().split(" free").next().unwrap().parse().unwrap();
     assert!(free > 1_000, "{text}");
 }
 
@@ -203,8 +232,8 @@ fn quilt_with_a_fixed_cell_of_a_shows_b_slices_per_depth_and_works_on_a_4d_table
     let table = t1_table("4d-yy");
     let file = path("quilt-a.png");
     let text = ok(&cli(&[
-        "quilt", "--cell", "T1", "--table", &table, "--a", "12,8,3", "--output", &file, "--width", "500", "--height",
-        "520",
+        "quilt", "--cell", "T1", "--table", &table, "--a", "12,8,3", "--output", &file, "--width",
+        "500", "--height", "520",
     ]));
     assert!(text.contains("5 slices of 14 x 14"), "{text}");
     let pic = assert_picture(&file, 500, 520);
@@ -214,15 +243,22 @@ fn quilt_with_a_fixed_cell_of_a_shows_b_slices_per_depth_and_works_on_a_4d_table
     let out = cli(&["quilt", "--cell", "T1", "--table", &table, "--a", "12,8", "--output", &file]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("expected 3 grid indices"));
     let out = cli(&[
-        "quilt", "--cell", "T1", "--table", &table, "--axes", "zz", "--width", "200", "--height", "200", "--output",
-        &file,
+        "quilt", "--cell", "T1", "--table", &table, "--axes", "zz", "--width", "200", "--height",
+        "200", "--output", &file,
     ]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("too small"), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("too small"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = cli(&["quilt", "--cell", "T1", "--table", &table, "--axes", "xy", "--output", &file]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("use yy"));
     let out = cli(&["quilt", "--cell", "T3", "--table", &table, "--output", &file]);
-    assert!(String::from_utf8_lossy(&out.stderr).contains("rebuild"), "a T1 table is refused for T3");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("rebuild"),
+        "a T1 table is refused for T3"
+    );
 }
 
 #[test]
@@ -230,8 +266,8 @@ fn eval_plots_distance_and_labels_along_both_scenarios() {
     let table = t1_table("6d");
     let file = path("eval.png");
     let text = ok(&cli(&[
-        "eval", "--cell", "T1", "--table", &table, "--random", "200", "--plot", &file, "--width", "1000", "--height",
-        "640",
+        "eval", "--cell", "T1", "--table", &table, "--random", "200", "--plot", &file, "--width",
+        "1000", "--height", "640",
     ]));
     assert!(text.contains("1000 x 640 pixels, 2 scenarios"), "{text}");
     let pic = assert_picture(&file, 1000, 640);
@@ -239,6 +275,9 @@ fn eval_plots_distance_and_labels_along_both_scenarios() {
     assert!(pic.count(exactly(FREE_TICK)) > 10_000);
     assert!(pic.count(reddish) > 1_000);
     assert!(pic.count(|p| p[2] > 150 && p[0] < 100 && p[1] < 140) > 1_000);
-    let out = cli(&["eval", "--cell", "T1", "--table", &table, "--random", "10", "--plot", &file, "--height", "100"]);
+    let out = cli(&[
+        "eval", "--cell", "T1", "--table", &table, "--random", "10", "--plot", &file, "--height",
+        "100",
+    ]);
     assert_eq!(out.status.code(), Some(2));
 }

@@ -64,25 +64,42 @@ fn static_library_needs_exactly_the_pinned_native_libs() {
     let out = cargo_rustc(&["--crate-type", "staticlib", "--", "--print", "native-static-libs"]);
     let log = text(&out);
     assert!(out.status.success(), "staticlib build failed:\n{log}");
-    assert_eq!(native_static_libs(&log), NATIVE_LIBS, "the static library's native libs changed:\n{log}");
+    assert_eq!(
+        native_static_libs(&log),
+        NATIVE_LIBS,
+        "the static library's native libs changed:\n{log}"
+    );
     let readme = std::fs::read_to_string(repo_root().join("README.md")).expect("README.md");
-    assert!(readme.contains(&NATIVE_LIBS.join(" ")), "README.md must list `{}`", NATIVE_LIBS.join(" "));
+    assert!(
+        readme.contains(&NATIVE_LIBS.join(" ")),
+        "README.md must list `{}`",
+        NATIVE_LIBS.join(" ")
+    );
 }
 
 /// Without the `std` feature the library (math, geometry, robot, the exact check, table
-/// loading and queries) compiles as `#![no_std]` with `alloc`. On the host target std exists, so a dependency could pull it
-/// in unnoticed; the staticlib build proves it does not: with std anywhere in the graph it
-/// would link, without it rustc asks for the `#[panic_handler]` and allocator that a
-/// firmware provides.
+/// loading and queries) compiles as `#![no_std]` with `alloc`. On the host target std exists, so a
+/// dependency could pull it in unnoticed; the staticlib build proves it does not: with std anywhere
+/// in the graph it would link, without it rustc asks for the `#[panic_handler]` and allocator that
+/// a firmware provides.
 #[test]
 fn per_tick_code_builds_without_std() {
     let out = cargo_rustc(&["--no-default-features", "--crate-type", "rlib"]);
     assert!(out.status.success(), "no_std rlib build failed:\n{}", text(&out));
     let out = cargo_rustc(&["--no-default-features", "--crate-type", "staticlib"]);
     let log = text(&out);
-    assert!(!out.status.success(), "a no_std staticlib linked, so std is in the dependency graph:\n{log}");
-    assert!(log.contains("`#[panic_handler]` function required"), "expected the missing panic handler:\n{log}");
-    assert!(log.contains("no global memory allocator found"), "expected the missing allocator:\n{log}");
+    assert!(
+        !out.status.success(),
+        "a no_std staticlib linked, so std is in the dependency graph:\n{log}"
+    );
+    assert!(
+        log.contains("`#[panic_handler]` function required"),
+        "expected the missing panic handler:\n{log}"
+    );
+    assert!(
+        log.contains("no global memory allocator found"),
+        "expected the missing allocator:\n{log}"
+    );
 }
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -104,11 +121,21 @@ fn library_has_no_simd_or_target_feature_code() {
     let mut files = Vec::new();
     rust_files(&repo_root().join("src"), &mut files);
     assert!(files.len() > 30, "found only {} source files", files.len());
-    let markers = ["arch::", "target_feature", "is_x86_feature_detected", "is_aarch64_feature_detected", "simd"];
+    let markers = [
+        "arch::",
+        "target_feature",
+        "is_x86_feature_detected",
+        "is_aarch64_feature_detected",
+        "simd",
+    ];
     for f in files {
         let src = std::fs::read_to_string(&f).expect("readable source");
         for m in markers {
-            assert!(!src.contains(m), "{} contains `{m}`: give it a scalar twin and a test", f.display());
+            assert!(
+                !src.contains(m),
+                "{} contains `{m}`: give it a scalar twin and a test",
+                f.display()
+            );
         }
     }
 }
@@ -130,7 +157,9 @@ fn rust_target(triple: &str) -> Result<(), String> {
     let has_core = dir.and_then(|d| std::fs::read_dir(d).ok()).is_some_and(|mut entries| {
         entries.any(|e| e.is_ok_and(|e| e.file_name().to_string_lossy().starts_with("libcore-")))
     });
-    has_core.then_some(()).ok_or(format!("`rustup target add {triple}` (its standard library is missing)"))
+    has_core
+        .then_some(())
+        .ok_or(format!("`rustup target add {triple}` (its standard library is missing)"))
 }
 
 /// The `--no-default-features` library for `triple`, release with `panic = "abort"` (a
@@ -142,7 +171,16 @@ fn no_std_rlib(triple: &str) -> PathBuf {
     let out = Command::new(env!("CARGO"))
         .current_dir(&root)
         .env("CARGO_PROFILE_RELEASE_PANIC", "abort")
-        .args(["rustc", "--release", "--lib", "--crate-type", "rlib", "--no-default-features", "--target", triple])
+        .args([
+            "rustc",
+            "--release",
+            "--lib",
+            "--crate-type",
+            "rlib",
+            "--no-default-features",
+            "--target",
+            triple,
+        ])
         .arg("--target-dir")
         .arg(root.join("target/cross"))
         .output()
@@ -167,8 +205,15 @@ fn consumer_tables() -> &'static (PathBuf, Vec<Vec<u8>>) {
         ];
         let cell = reference_cell("T1").expect("T1");
         let kinds: Vec<Variant> = variants.iter().map(|v| v.1).collect();
-        let (header, tables, _) = build_tables(&cell, 16, &Workspace::THESIS, &kinds, Labelling::Certified, Progress::Silent)
-            .unwrap_or_else(|e| panic!("building the T1 tables: {e}"));
+        let (header, tables, _) = build_tables(
+            &cell,
+            16,
+            &Workspace::THESIS,
+            &kinds,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap_or_else(|e| panic!("building the T1 tables: {e}"));
         let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("no_std_tables");
         std::fs::create_dir_all(&dir).expect("create the table dir");
         let bytes: Vec<Vec<u8>> = tables.iter().map(|t| to_bytes(t, &header)).collect();
@@ -182,11 +227,19 @@ fn consumer_tables() -> &'static (PathBuf, Vec<Vec<u8>>) {
 /// `tests/no_std_consumer/consumer.rs` as a static library for `triple` against the
 /// `no_std` library in `rlib_dir`; asserts that it needs no native library.
 fn consumer_staticlib(triple: &str, rlib_dir: &Path) -> PathBuf {
-    let out_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("no_std_consumer_{triple}"));
+    let out_dir =
+        PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("no_std_consumer_{triple}"));
     std::fs::create_dir_all(&out_dir).expect("create the consumer dir");
     let out = Command::new("rustc")
         .env("DC_NOSTD_TABLES", &consumer_tables().0)
-        .args(["--edition", "2021", "--crate-type", "staticlib", "--crate-name", "dc_nostd_consumer"])
+        .args([
+            "--edition",
+            "2021",
+            "--crate-type",
+            "staticlib",
+            "--crate-name",
+            "dc_nostd_consumer",
+        ])
         .args(["-C", "panic=abort", "-C", "opt-level=2", "--target", triple, "--extern"])
         .arg(format!("delta_collide={}", rlib_dir.join("libdelta_collide.rlib").display()))
         .arg("-L")
@@ -199,7 +252,11 @@ fn consumer_staticlib(triple: &str, rlib_dir: &Path) -> PathBuf {
         .expect("rustc runs");
     let log = text(&out);
     assert!(out.status.success(), "the no_std consumer for {triple} does not compile:\n{log}");
-    assert_eq!(native_static_libs(&log), Vec::<String>::new(), "a no_std library needs no native library:\n{log}");
+    assert_eq!(
+        native_static_libs(&log),
+        Vec::<String>::new(),
+        "a no_std library needs no native library:\n{log}"
+    );
     out_dir.join("libdc_nostd_consumer.a")
 }
 
@@ -208,7 +265,8 @@ fn consumer_staticlib(triple: &str, rlib_dir: &Path) -> PathBuf {
 /// the std build's (maths from libm against std's), and its queries allocate nothing.
 #[test]
 fn table_queries_without_std_answer_as_with_std() {
-    let host = rustc_print(&["-vV"]).and_then(|v| v.lines().find_map(|l| l.strip_prefix("host: ").map(str::to_owned)));
+    let host = rustc_print(&["-vV"])
+        .and_then(|v| v.lines().find_map(|l| l.strip_prefix("host: ").map(str::to_owned)));
     let host = host.expect("rustc -vV names the host");
     let lib = consumer_staticlib(&host, &no_std_rlib(&host));
     let driver = lib.with_file_name("driver");
@@ -223,9 +281,13 @@ fn table_queries_without_std_answer_as_with_std() {
     assert!(out.status.success(), "cc driver.c failed:\n{}", text(&out));
     let (seed, n) = (0x5eed_u64, 20_000u32);
     for (i, bytes) in consumer_tables().1.iter().enumerate() {
-        let out = Command::new(&driver).args([i.to_string(), seed.to_string(), n.to_string()]).output().unwrap();
+        let out = Command::new(&driver)
+            .args([i.to_string(), seed.to_string(), n.to_string()])
+            .output()
+            .unwrap();
         assert!(out.status.success(), "driver {i}: {:?}\n{}", out.status, text(&out));
-        let f: Vec<u64> = text(&out).split_whitespace().map(|v| v.parse().expect("a number")).collect();
+        let f: Vec<u64> =
+            text(&out).split_whitespace().map(|v| v.parse().expect("a number")).collect();
         assert_eq!(f.len(), 7, "driver {i} printed {f:?}");
         let no_std = workload::Summary {
             status: f[0] as u32,
@@ -240,8 +302,14 @@ fn table_queries_without_std_answer_as_with_std() {
         println!("table {i}: no_std {no_std:?}");
         assert_eq!(std.status, 0, "table {i} does not load with std: {std:?}");
         let lookups = n - std.unreachable - std.fallbacks;
-        assert!(std.collision > 0 && std.free > 0 && std.fallbacks > 0 && lookups > n / 4, "weak workload: {std:?}");
-        assert_eq!(no_std, std, "table {i}: the no_std build answers differently (or its queries allocate)");
+        assert!(
+            std.collision > 0 && std.free > 0 && std.fallbacks > 0 && lookups > n / 4,
+            "weak workload: {std:?}"
+        );
+        assert_eq!(
+            no_std, std,
+            "table {i}: the no_std build answers differently (or its queries allocate)"
+        );
     }
 }
 
@@ -259,21 +327,42 @@ fn table_queries_link_for_bare_metal_arm() {
     }
     let lib = consumer_staticlib(triple, &no_std_rlib(triple));
     let sysroot = rustc_print(&["--print", "sysroot"]).expect("rustc --print sysroot");
-    let host = rustc_print(&["-vV"]).and_then(|v| v.lines().find_map(|l| l.strip_prefix("host: ").map(str::to_owned)));
-    let lld = Path::new(&sysroot).join("lib/rustlib").join(host.expect("host triple")).join("bin/rust-lld");
+    let host = rustc_print(&["-vV"])
+        .and_then(|v| v.lines().find_map(|l| l.strip_prefix("host: ").map(str::to_owned)));
+    let lld = Path::new(&sysroot)
+        .join("lib/rustlib")
+        .join(host.expect("host triple"))
+        .join("bin/rust-lld");
     assert!(lld.is_file(), "rust-lld ships with rustc, but {} is missing", lld.display());
     let elf = lib.with_file_name("consumer.elf");
     let out = Command::new(&lld)
-        .args(["-flavor", "gnu", "--gc-sections", "-u", "dc_nostd_run", "--entry", "dc_nostd_run", "-o"])
+        .args([
+            "-flavor",
+            "gnu",
+            "--gc-sections",
+            "-u",
+            "dc_nostd_run",
+            "--entry",
+            "dc_nostd_run",
+            "-o",
+        ])
         .arg(&elf)
         .arg(&lib)
         .output()
         .expect("rust-lld runs");
-    assert!(out.status.success(), "rust-lld cannot link the no_std consumer for {triple}:\n{}", text(&out));
+    assert!(
+        out.status.success(),
+        "rust-lld cannot link the no_std consumer for {triple}:\n{}",
+        text(&out)
+    );
     let bytes = std::fs::read(&elf).expect("the linked executable");
     assert_eq!(&bytes[..5], b"\x7fELF\x01", "not a 32-bit ELF file");
     assert_eq!(u16::from_le_bytes([bytes[18], bytes[19]]), 40, "not an ARM executable (EM_ARM)");
-    assert_ne!(u32::from_le_bytes([bytes[24], bytes[25], bytes[26], bytes[27]]), 0, "no entry point");
+    assert_ne!(
+        u32::from_le_bytes([bytes[24], bytes[25], bytes[26], bytes[27]]),
+        0,
+        "no entry point"
+    );
     let has = |name: &str| bytes.windows(name.len()).any(|w| w == name.as_bytes());
     for symbol in ["dc_nostd_run", "5table6format10from_bytes", "12ExactChecker5check"] {
         assert!(has(symbol), "the {triple} executable lacks `{symbol}`");

@@ -4,7 +4,9 @@
 //! fail-closed rules (first tick, implausible jumps, unreachable TCPs), the WARN threshold's
 //! monotonicity, the speed limit, no allocation per tick, and the counts on the scenarios.
 
-use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveReport, ProtectiveStatus};
+use delta_collide::cell::protective::{
+    Protective, ProtectiveChecker, ProtectiveReport, ProtectiveStatus,
+};
 use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::ExactChecker;
 use delta_collide::math::{Real, Vec3};
@@ -14,15 +16,24 @@ use rand::{RngExt, SeedableRng};
 
 mod protective_common;
 use protective_common::{
-    allocations, assert_stops_never_touch, cell, tcp_near_reach_boundary, tcp_toward_other, unit, STIFF,
+    allocations, assert_stops_never_touch, cell, tcp_near_reach_boundary, tcp_toward_other, unit,
+    STIFF,
 };
 
 /// Random states near each other; for each FREE one, random stops are simulated.
 /// `precise`: the second tier's splits (0: the motor-angle table alone); `edge`: TCPs near the
 /// reach boundary.
-fn brute_force(name: &str, stop: StopModel, states: usize, seed: u64, precise: u32, edge: bool) -> (usize, usize) {
+fn brute_force(
+    name: &str,
+    stop: StopModel,
+    states: usize,
+    seed: u64,
+    precise: u32,
+    edge: bool,
+) -> (usize, usize) {
     let cell = cell(name, stop);
-    let mut checker = ProtectiveChecker::new(cell.clone(), 5.0).unwrap().with_precise_splits(precise);
+    let mut checker =
+        ProtectiveChecker::new(cell.clone(), 5.0).unwrap().with_precise_splits(precise);
     let mut rng = StdRng::seed_from_u64(seed);
     let (mut free, mut steps) = (0, 0);
     let tick = cell.tick_ms * 1e-3;
@@ -30,8 +41,9 @@ fn brute_force(name: &str, stop: StopModel, states: usize, seed: u64, precise: u
     for _ in 0..states {
         let tcps = [sample(&cell, 0, &mut rng), sample(&cell, 1, &mut rng)];
         // Speeds mostly low (else nothing near is FREE), directions random.
-        let v_fd: [Vec3; 2] =
-            std::array::from_fn(|_| unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3));
+        let v_fd: [Vec3; 2] = std::array::from_fn(|_| {
+            unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3)
+        });
         let prev = [tcps[0] - v_fd[0] * tick, tcps[1] - v_fd[1] * tick];
         checker.reset();
         checker.check(&prev).unwrap();
@@ -59,7 +71,8 @@ fn free_verdicts_survive_simulated_stops() {
     let mut total = 0;
     for (i, name) in ["T1", "T2", "T3"].iter().enumerate() {
         for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
-            let (free, steps) = brute_force(name, stop, 150, 100 + 10 * i as u64 + k as u64, 2, false);
+            let (free, steps) =
+                brute_force(name, stop, 150, 100 + 10 * i as u64 + k as u64, 2, false);
             println!("{name} model {k}: {free} FREE/WARN states of 150, {steps} exact checks of simulated stops");
             total += free;
         }
@@ -77,13 +90,18 @@ fn free_verdicts_of_the_table_tier_survive_simulated_stops_near_the_reach_bounda
             for edge in [false, true] {
                 let seed = 500 + 10 * i as u64 + k as u64 + 100 * edge as u64;
                 let (free, steps) = brute_force(name, stop, 150, seed, 0, edge);
-                println!("{name} model {k} edge {edge}: {free} FREE/WARN of 150, {steps} exact checks");
+                println!(
+                    "{name} model {k} edge {edge}: {free} FREE/WARN of 150, {steps} exact checks"
+                );
                 total += free;
                 edge_total += free * edge as usize;
             }
         }
     }
-    assert!(total >= 60 && edge_total >= 20, "too few FREE states to test: {total}, {edge_total} near the edge");
+    assert!(
+        total >= 60 && edge_total >= 20,
+        "too few FREE states to test: {total}, {edge_total} near the edge"
+    );
 }
 
 /// FREE by a proof kept from an earlier tick (or made for wider balls) survives simulated
@@ -92,14 +110,17 @@ fn free_verdicts_of_the_table_tier_survive_simulated_stops_near_the_reach_bounda
 /// finite difference moved within `a_max T`).
 #[test]
 fn free_verdicts_of_kept_proofs_survive_simulated_stops() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
     let mut rng = StdRng::seed_from_u64(7);
     let (mut kept_total, mut tested) = (0, 0);
     for s in parse_scenarios(&text).unwrap() {
         for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
             let cell = cell(&s.cell, stop);
             let tick = cell.tick_ms * 1e-3;
-            let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let mut checker =
+                ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
             let (mut tcps, mut prev) = ([Vec3::zeros(); 2], [Vec3::zeros(); 2]);
             let mut kept = 0;
             for t in 0..RUN_TICKS {
@@ -110,7 +131,11 @@ fn free_verdicts_of_kept_proofs_survive_simulated_stops() {
                     kept += 1;
                     if kept % 3 == 0 {
                         let vel = std::array::from_fn(|j| {
-                            let w = (tcps[j] - prev[j]) / tick + unit(&mut rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
+                            let w = (tcps[j] - prev[j]) / tick
+                                + unit(&mut rng)
+                                    * stop.max_accel_mm_s2
+                                    * tick
+                                    * rng.random::<Real>();
                             w * (stop.max_speed_mm_s / w.norm()).min(1.0)
                         });
                         assert_stops_never_touch(&cell, &tcps, &vel, 4, &mut rng);
@@ -145,7 +170,10 @@ fn first_tick_assumes_full_speed_and_close_robots_are_never_free() {
             let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
             c.reset();
             let first = c.check(&tcps).unwrap().clone();
-            assert!(first.robots.iter().all(|r| r.speed_bound_mm_s == 4_600.0 && r.speed_mm_s.is_infinite()));
+            assert!(first
+                .robots
+                .iter()
+                .all(|r| r.speed_bound_mm_s == 4_600.0 && r.speed_mm_s.is_infinite()));
             let full = c.check_at_speeds(&tcps, &[Real::INFINITY; 2]).unwrap().clone();
             assert_eq!(first.verdict, full.verdict);
             if first.clearance_mm < 100.0 {
@@ -188,15 +216,22 @@ fn a_larger_warn_threshold_never_warns_less() {
     let mut rng = StdRng::seed_from_u64(11);
     for name in ["T1", "T2", "T3"] {
         let cell = cell(name, STIFF);
-        let mut checkers: Vec<ProtectiveChecker> =
-            [0.0, 2.0, 10.0, 40.0].iter().map(|&w| ProtectiveChecker::new(cell.clone(), w).unwrap()).collect();
+        let mut checkers: Vec<ProtectiveChecker> = [0.0, 2.0, 10.0, 40.0]
+            .iter()
+            .map(|&w| ProtectiveChecker::new(cell.clone(), w).unwrap())
+            .collect();
         let mut counts = [0usize; 4];
         for _ in 0..150 {
             let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
             let speeds = [rng.random_range(0.0..1_500.0), rng.random_range(0.0..1_500.0)];
-            let ranks: Vec<u8> =
-                checkers.iter_mut().map(|c| verdict_rank(c.check_at_speeds(&tcps, &speeds).unwrap().verdict)).collect();
-            assert!(ranks.windows(2).all(|w| w[0] <= w[1]), "{name} {tcps:?} {speeds:?}: {ranks:?}");
+            let ranks: Vec<u8> = checkers
+                .iter_mut()
+                .map(|c| verdict_rank(c.check_at_speeds(&tcps, &speeds).unwrap().verdict))
+                .collect();
+            assert!(
+                ranks.windows(2).all(|w| w[0] <= w[1]),
+                "{name} {tcps:?} {speeds:?}: {ranks:?}"
+            );
             for (k, r) in ranks.iter().enumerate() {
                 counts[k] += (*r > 0) as usize;
             }
@@ -212,11 +247,13 @@ fn at_the_speed_limit_the_verdict_holds_and_ten_percent_above_it_does_not() {
     for name in ["T1", "T2", "T3"] {
         for stop in [STIFF, StopModel::DEFAULT] {
             let cell = cell(name, stop);
-            let mut c = ProtectiveChecker::new(cell.clone(), 0.0).unwrap().with_precise_limits(true);
+            let mut c =
+                ProtectiveChecker::new(cell.clone(), 0.0).unwrap().with_precise_limits(true);
             let mut cheap = ProtectiveChecker::new(cell.clone(), 0.0).unwrap();
             let resolution = stop.max_speed_mm_s / 256.0;
             for _ in 0..40 {
-                let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
+                let tcps =
+                    [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
                 let speeds = [rng.random_range(0.0..800.0), rng.random_range(0.0..800.0)];
                 let r: ProtectiveReport = c.check_at_speeds(&tcps, &speeds).unwrap().clone();
                 let fast = cheap.check_at_speeds(&tcps, &speeds).unwrap().clone();
@@ -224,11 +261,17 @@ fn at_the_speed_limit_the_verdict_holds_and_ten_percent_above_it_does_not() {
                 for j in 0..2 {
                     // The table tier's limit: never above the precise one, and FREE at it.
                     let low = fast.robots[j].speed_limit_mm_s;
-                    assert!(low <= r.robots[j].speed_limit_mm_s, "{name} {tcps:?} {speeds:?}: {low} > {r:?}");
+                    assert!(
+                        low <= r.robots[j].speed_limit_mm_s,
+                        "{name} {tcps:?} {speeds:?}: {low} > {r:?}"
+                    );
                     if low > 0.0 {
                         let mut at = speeds;
                         at[j] = low;
-                        assert_ne!(cheap.check_at_speeds(&tcps, &at).unwrap().verdict, Protective::Stop);
+                        assert_ne!(
+                            cheap.check_at_speeds(&tcps, &at).unwrap().verdict,
+                            Protective::Stop
+                        );
                     }
                     let limit = r.robots[j].speed_limit_mm_s;
                     let mut at = speeds;
@@ -279,8 +322,9 @@ fn a_tick_never_allocates() {
     let cell = cell("T2", STIFF);
     let mut c = ProtectiveChecker::new(cell.clone(), 5.0).unwrap();
     let mut rng = StdRng::seed_from_u64(17);
-    let states: Vec<[Vec3; 2]> =
-        (0..64).map(|_| [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)]).collect();
+    let states: Vec<[Vec3; 2]> = (0..64)
+        .map(|_| [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)])
+        .collect();
     let before = allocations();
     for k in 0..2_000 {
         let s = &states[k % states.len()];
@@ -301,17 +345,24 @@ fn a_tick_never_allocates() {
 /// Per scenario of `c_harness/scenarios.txt`: ticks with WARN and STOP, the first of each,
 /// the smallest clearance, and that the first STOP comes before the first contact.
 fn scenario_counts(stop: StopModel, label: &str) {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
     for s in parse_scenarios(&text).unwrap() {
         let cell = cell(&s.cell, stop);
         let mut c = ProtectiveChecker::new(cell.clone(), 10.0).unwrap();
-        let mut verdict_only = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
-        let mut precise = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_precise_limits(true);
+        let mut verdict_only =
+            ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+        let mut precise =
+            ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_precise_limits(true);
         let (mut limit_ratio, mut limited) = (0.0, 0);
         let mut exact = ExactChecker::new(cell);
         let mut tcps = vec![Vec3::zeros(); s.robots.len()];
-        let (mut t_full, mut t_verdict, mut t_exact) =
-            (Vec::with_capacity(RUN_TICKS as usize), Vec::with_capacity(RUN_TICKS as usize), Vec::with_capacity(RUN_TICKS as usize));
+        let (mut t_full, mut t_verdict, mut t_exact) = (
+            Vec::with_capacity(RUN_TICKS as usize),
+            Vec::with_capacity(RUN_TICKS as usize),
+            Vec::with_capacity(RUN_TICKS as usize),
+        );
         let (mut warn, mut stops, mut implausible) = (0, 0, 0);
         let (mut first_warn, mut first_stop, mut first_contact) = (None, None, None);
         let mut min_clear = Real::INFINITY;
@@ -328,14 +379,21 @@ fn scenario_counts(stop: StopModel, label: &str) {
             let p = precise.check(&tcps).unwrap();
             assert_eq!(p.verdict, r.verdict);
             for (fast, slow) in r.robots.iter().zip(&p.robots) {
-                assert!(fast.speed_limit_mm_s <= slow.speed_limit_mm_s, "tick {tick}: {fast:?} {slow:?}");
+                assert!(
+                    fast.speed_limit_mm_s <= slow.speed_limit_mm_s,
+                    "tick {tick}: {fast:?} {slow:?}"
+                );
                 if slow.speed_limit_mm_s > 0.0 {
-                    (limit_ratio, limited) = (limit_ratio + fast.speed_limit_mm_s / slow.speed_limit_mm_s, limited + 1);
+                    (limit_ratio, limited) =
+                        (limit_ratio + fast.speed_limit_mm_s / slow.speed_limit_mm_s, limited + 1);
                 }
             }
             t_verdict.push((t1 - t0).as_secs_f64() * 1e6);
             t_exact.push((t2 - t1).as_secs_f64() * 1e6);
-            assert_eq!(v, r.verdict, "tick {tick}: the verdict does not depend on the speed limits");
+            assert_eq!(
+                v, r.verdict,
+                "tick {tick}: the verdict does not depend on the speed limits"
+            );
             min_clear = min_clear.min(r.clearance_mm);
             implausible += matches!(r.status, ProtectiveStatus::ImplausibleMotion(_)) as u32;
             match r.verdict {
@@ -407,15 +465,23 @@ fn the_c_entry_point_never_allocates_and_fills_the_report() {
     let before = allocations();
     for _ in 0..1_000 {
         // SAFETY: live handle, two readable TCPs, writable outputs.
-        let s = unsafe { dc_protective_query(h, tcps.as_ptr(), 2, &mut verdict, report.as_mut_ptr()) };
+        let s =
+            unsafe { dc_protective_query(h, tcps.as_ptr(), 2, &mut verdict, report.as_mut_ptr()) };
         assert_eq!(s, DC_STATUS_OK);
     }
     assert_eq!(allocations(), before);
     // SAFETY: written by every call above.
     let report = unsafe { report.assume_init() };
     assert_eq!((verdict, report.verdict, report.n_robots), (DC_VERDICT_FREE, DC_VERDICT_FREE, 2));
-    assert!(report.clearance_mm > 100.0 && report.protective_mm[0] > 0.0 && report.speed_limit_mm_s[1] > 0.0);
-    assert_eq!((report.closest_robot_a, report.closest_robot_b, report.limiting_robot_a), (0, 1, DC_BOX_NONE));
+    assert!(
+        report.clearance_mm > 100.0
+            && report.protective_mm[0] > 0.0
+            && report.speed_limit_mm_s[1] > 0.0
+    );
+    assert_eq!(
+        (report.closest_robot_a, report.closest_robot_b, report.limiting_robot_a),
+        (0, 1, DC_BOX_NONE)
+    );
     // SAFETY: live handle, destroyed once.
     unsafe { dc_destroy(h) };
 }
@@ -426,8 +492,14 @@ fn the_c_entry_point_never_allocates_and_fills_the_report() {
 #[test]
 fn speed_limits_off_give_the_same_verdicts_and_nan_limits() {
     use delta_collide::ffi::*;
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
-    let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
+    let s = parse_scenarios(&text)
+        .unwrap()
+        .into_iter()
+        .find(|s| s.cell == "T1" && s.case == "practical")
+        .unwrap();
     let (on, off) = (t1_handle_with_default_stops(), t1_handle_with_default_stops());
     // SAFETY: live handles (and NULL, rejected).
     unsafe {
@@ -448,9 +520,15 @@ fn speed_limits_off_give_the_same_verdicts_and_nan_limits() {
         let c = tcps.map(|t| DcVec3 { x: t.x, y: t.y, z: t.z });
         // SAFETY: live handles, two readable TCPs, writable outputs.
         unsafe {
-            assert_eq!(dc_protective_query(on, c.as_ptr(), 2, &mut verdict_on, &mut report_on), DC_STATUS_OK);
+            assert_eq!(
+                dc_protective_query(on, c.as_ptr(), 2, &mut verdict_on, &mut report_on),
+                DC_STATUS_OK
+            );
             let before = allocations();
-            assert_eq!(dc_protective_query(off, c.as_ptr(), 2, &mut verdict_off, &mut report_off), DC_STATUS_OK);
+            assert_eq!(
+                dc_protective_query(off, c.as_ptr(), 2, &mut verdict_off, &mut report_off),
+                DC_STATUS_OK
+            );
             allocated += allocations() - before;
         }
         assert_eq!(verdict_off, verdict_on, "tick {tick}");
@@ -474,9 +552,19 @@ fn speed_limits_off_give_the_same_verdicts_and_nan_limits() {
 #[test]
 fn the_c_abi_caps_the_limit_tests_without_changing_the_verdicts() {
     use delta_collide::ffi::*;
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
-    let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
-    let handles = [t1_handle_with_default_stops(), t1_handle_with_default_stops(), t1_handle_with_default_stops()];
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
+    let s = parse_scenarios(&text)
+        .unwrap()
+        .into_iter()
+        .find(|s| s.cell == "T1" && s.case == "practical")
+        .unwrap();
+    let handles = [
+        t1_handle_with_default_stops(),
+        t1_handle_with_default_stops(),
+        t1_handle_with_default_stops(),
+    ];
     // SAFETY: live handles (and NULL, rejected).
     unsafe {
         assert_eq!(dc_set_limit_tests(std::ptr::null_mut(), 0), DC_STATUS_NULL_POINTER);
@@ -511,7 +599,10 @@ fn the_c_abi_caps_the_limit_tests_without_changing_the_verdicts() {
         }
     }
     assert_eq!(allocated, 0);
-    assert!(lower > 1_000, "the default budget finds higher limits than the floor on {lower} robot ticks");
+    assert!(
+        lower > 1_000,
+        "the default budget finds higher limits than the floor on {lower} robot ticks"
+    );
     assert!(sums[0] < sums[1] && sums[1] <= sums[2], "mean limits: none, default, full {sums:?}");
     // SAFETY: live handles, destroyed once.
     handles.iter().for_each(|&h| unsafe { dc_destroy(h) });
@@ -525,14 +616,35 @@ fn the_c_entry_point_with_paths_never_allocates_and_names_a_bad_path() {
     use delta_collide::ffi::*;
     let h = t1_handle_with_default_stops();
     let at = |k: f64| {
-        [DcVec3 { x: -100.0 + 0.5 * k, y: 20.0, z: -450.0 }, DcVec3 { x: 100.0 - 0.5 * k, y: -20.0, z: -450.0 }]
+        [
+            DcVec3 { x: -100.0 + 0.5 * k, y: 20.0, z: -450.0 },
+            DcVec3 { x: 100.0 - 0.5 * k, y: -20.0, z: -450.0 },
+        ]
     };
     // Each robot's path: straight on toward the other for 60 mm, then back up.
-    let path_of = |p: DcVec3, dx: f64| [p, DcVec3 { x: p.x + dx, ..p }, DcVec3 { x: p.x + dx, z: p.z + 80.0, ..p }];
-    let (mut verdict, mut report) = (DC_VERDICT_STOP, std::mem::MaybeUninit::<DcProtectiveReport>::zeroed());
-    let query = |h, tcps: &[DcVec3; 2], paths: &[DcStopPath], verdict: &mut DcVerdict, report: *mut DcProtectiveReport| {
-        // SAFETY: live handle, readable TCPs and paths (whose points outlive the call), writable outputs.
-        unsafe { dc_protective_query_with_paths(h, tcps.as_ptr(), 2, paths.as_ptr(), paths.len(), verdict, report) }
+    let path_of = |p: DcVec3, dx: f64| {
+        [p, DcVec3 { x: p.x + dx, ..p }, DcVec3 { x: p.x + dx, z: p.z + 80.0, ..p }]
+    };
+    let (mut verdict, mut report) =
+        (DC_VERDICT_STOP, std::mem::MaybeUninit::<DcProtectiveReport>::zeroed());
+    let query = |h,
+                 tcps: &[DcVec3; 2],
+                 paths: &[DcStopPath],
+                 verdict: &mut DcVerdict,
+                 report: *mut DcProtectiveReport| {
+        // SAFETY: live handle, readable TCPs and paths (whose points outlive the call), writable
+        // outputs.
+        unsafe {
+            dc_protective_query_with_paths(
+                h,
+                tcps.as_ptr(),
+                2,
+                paths.as_ptr(),
+                paths.len(),
+                verdict,
+                report,
+            )
+        }
     };
     let (mut seen, before) = ([0u32; 3], allocations());
     for k in 0..160 {
@@ -542,7 +654,11 @@ fn the_c_entry_point_with_paths_never_allocates_and_names_a_bad_path() {
             DcStopPath { points: pa.as_ptr(), n_points: 3, tolerance_mm: 0.5 },
             DcStopPath { points: pb.as_ptr(), n_points: 3, tolerance_mm: 0.5 },
         ];
-        assert_eq!(query(h, &tcps, &paths, &mut verdict, report.as_mut_ptr()), DC_STATUS_OK, "call {k}");
+        assert_eq!(
+            query(h, &tcps, &paths, &mut verdict, report.as_mut_ptr()),
+            DC_STATUS_OK,
+            "call {k}"
+        );
         seen[verdict as usize] += 1;
     }
     assert_eq!(allocations(), before, "verdicts seen (free, warn, stop): {seen:?}");
@@ -553,23 +669,52 @@ fn the_c_entry_point_with_paths_never_allocates_and_names_a_bad_path() {
     let off = [DcVec3 { y: 60.0, ..tcps[0] }, DcVec3 { x: 0.0, y: 60.0, z: -450.0 }];
     let many = [tcps[1]; DC_MAX_PATH_POINTS + 1];
     let cases = [
-        ([none, DcStopPath { points: std::ptr::null(), n_points: 2, tolerance_mm: 1.0 }], DC_STATUS_NULL_POINTER, 2),
-        ([DcStopPath { points: off.as_ptr(), n_points: 2, tolerance_mm: 1.0 }, none], DC_STATUS_INVALID_ARGUMENT, 1),
+        (
+            [none, DcStopPath { points: std::ptr::null(), n_points: 2, tolerance_mm: 1.0 }],
+            DC_STATUS_NULL_POINTER,
+            2,
+        ),
+        (
+            [DcStopPath { points: off.as_ptr(), n_points: 2, tolerance_mm: 1.0 }, none],
+            DC_STATUS_INVALID_ARGUMENT,
+            1,
+        ),
         ([DcStopPath { tolerance_mm: f64::NAN, ..good }, none], DC_STATUS_INVALID_ARGUMENT, 1),
         ([DcStopPath { tolerance_mm: -1.0, ..good }, none], DC_STATUS_INVALID_ARGUMENT, 1),
-        ([good, DcStopPath { points: many.as_ptr(), n_points: many.len(), tolerance_mm: 1.0 }], DC_STATUS_INVALID_ARGUMENT, 2),
+        (
+            [good, DcStopPath { points: many.as_ptr(), n_points: many.len(), tolerance_mm: 1.0 }],
+            DC_STATUS_INVALID_ARGUMENT,
+            2,
+        ),
     ];
     for (i, (paths, status, mask)) in cases.iter().enumerate() {
         verdict = DC_VERDICT_FREE;
         assert_eq!(query(h, &tcps, paths, &mut verdict, report.as_mut_ptr()), *status, "case {i}");
         // SAFETY: written by the call.
         let r = unsafe { report.assume_init_ref() };
-        assert_eq!((verdict, r.verdict, r.unreachable_mask), (DC_VERDICT_STOP, DC_VERDICT_STOP, *mask), "case {i}");
+        assert_eq!(
+            (verdict, r.verdict, r.unreachable_mask),
+            (DC_VERDICT_STOP, DC_VERDICT_STOP, *mask),
+            "case {i}"
+        );
     }
     // One path per robot, and the paths array itself.
-    assert_eq!(query(h, &tcps, &[good], &mut verdict, report.as_mut_ptr()), DC_STATUS_WRONG_ROBOT_COUNT);
+    assert_eq!(
+        query(h, &tcps, &[good], &mut verdict, report.as_mut_ptr()),
+        DC_STATUS_WRONG_ROBOT_COUNT
+    );
     // SAFETY: live handle, readable TCPs; a NULL paths pointer is the case under test.
-    let s = unsafe { dc_protective_query_with_paths(h, tcps.as_ptr(), 2, std::ptr::null(), 2, &mut verdict, report.as_mut_ptr()) };
+    let s = unsafe {
+        dc_protective_query_with_paths(
+            h,
+            tcps.as_ptr(),
+            2,
+            std::ptr::null(),
+            2,
+            &mut verdict,
+            report.as_mut_ptr(),
+        )
+    };
     assert_eq!((s, verdict), (DC_STATUS_NULL_POINTER, DC_VERDICT_STOP));
     // SAFETY: live handle, destroyed once.
     unsafe { dc_destroy(h) };
@@ -585,7 +730,9 @@ fn the_c_entry_point_with_paths_never_allocates_and_names_a_bad_path() {
 /// 0 at a STOP). Prints how far below the uncapped search's limits the capped ones are.
 #[test]
 fn capped_speed_limits_are_proved_when_checked_again_by_another_checker() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
     let (mut rechecked, mut lower, mut compared) = (0, 0, 0);
     for s in parse_scenarios(&text).unwrap() {
         for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
@@ -606,9 +753,19 @@ fn capped_speed_limits_are_proved_when_checked_again_by_another_checker() {
                 for j in 0..2 {
                     let (limit, v) = (r.robots[j].speed_limit_mm_s, r.robots[j].speed_mm_s);
                     assert!((0.0..=stop.max_speed_mm_s).contains(&limit), "tick {t}: {r:?}");
-                    let floor = if r.verdict != Protective::Stop && v <= stop.max_speed_mm_s { v } else { 0.0 };
-                    assert!(limit >= floor, "tick {t} robot {j}: limit {limit} below the proved {floor}");
-                    assert_eq!(z.robots[j].speed_limit_mm_s, floor, "tick {t} robot {j}: no tests, {z:?}");
+                    let floor = if r.verdict != Protective::Stop && v <= stop.max_speed_mm_s {
+                        v
+                    } else {
+                        0.0
+                    };
+                    assert!(
+                        limit >= floor,
+                        "tick {t} robot {j}: limit {limit} below the proved {floor}"
+                    );
+                    assert_eq!(
+                        z.robots[j].speed_limit_mm_s, floor,
+                        "tick {t} robot {j}: no tests, {z:?}"
+                    );
                     let uncapped = f.robots[j].speed_limit_mm_s;
                     if uncapped > 0.0 {
                         (ratio, ratios) = (ratio + limit / uncapped, ratios + 1);

@@ -38,9 +38,14 @@ use protective_common::{cell, tcp_near_reach_boundary, tcp_toward_other, unit, S
 /// The least clearance over as many stops drawn at random (each number uniform in its range)
 /// as [`worst_stop`] evaluates: what the search adds over random stops.
 fn random_stops(cell: &Cell, robots: &[Robot; 2], evaluations: usize, rng: &mut StdRng) -> Real {
-    let mut f =
-        Objective { exact: ExactChecker::new(cell.clone()), robots, boxes: [RobotBoxes::empty(), RobotBoxes::empty()] };
-    (0..4 * (evaluations + 1)).map(|_| f.clearance(&random_stop(rng))).fold(Real::INFINITY, Real::min)
+    let mut f = Objective {
+        exact: ExactChecker::new(cell.clone()),
+        robots,
+        boxes: [RobotBoxes::empty(), RobotBoxes::empty()],
+    };
+    (0..4 * (evaluations + 1))
+        .map(|_| f.clearance(&random_stop(rng)))
+        .fold(Real::INFINITY, Real::min)
 }
 
 /// A tick of `cell` from `tcps` and the finite differences `v_fd`: the verdict (after a first
@@ -56,7 +61,16 @@ fn tick_of(
     checker.check(&[tcps[0] - v_fd[0] * tick_s, tcps[1] - v_fd[1] * tick_s]).unwrap();
     let r = checker.check(&tcps).unwrap();
     (r.status == ProtectiveStatus::Ok).then(|| {
-        (r.verdict, std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd[j], stop: cell.stops[j], tick_s, interval_s: tick_s }))
+        (
+            r.verdict,
+            std::array::from_fn(|j| Robot {
+                tcp: tcps[j],
+                v_fd: v_fd[j],
+                stop: cell.stops[j],
+                tick_s,
+                interval_s: tick_s,
+            }),
+        )
     })
 }
 
@@ -81,7 +95,14 @@ impl Tally {
     }
 
     /// Searches the stops of one tick; panics when a FREE or WARN tick's stop touches.
-    fn search(&mut self, cell: &Cell, verdict: Protective, robots: &[Robot; 2], evaluations: usize, rng: &mut StdRng) {
+    fn search(
+        &mut self,
+        cell: &Cell,
+        verdict: Protective,
+        robots: &[Robot; 2],
+        evaluations: usize,
+        rng: &mut StdRng,
+    ) {
         let (least, tcps) = worst_stop(cell, robots, evaluations, rng);
         if verdict == Protective::Stop {
             self.stops += 1;
@@ -130,7 +151,8 @@ impl Tally {
 
 /// Evaluations per start of the search on random ticks: 400, or `ADVERSARY_EVALUATIONS`.
 fn evaluations() -> usize {
-    std::env::var("ADVERSARY_EVALUATIONS").map_or(400, |v| v.parse().expect("ADVERSARY_EVALUATIONS: a count"))
+    std::env::var("ADVERSARY_EVALUATIONS")
+        .map_or(400, |v| v.parse().expect("ADVERSARY_EVALUATIONS: a count"))
 }
 
 /// Random ticks with the robots reaching toward each other (and near their reach boundary,
@@ -141,16 +163,22 @@ fn no_stop_the_model_allows_touches_after_a_free_verdict() {
     for (i, name) in ["T1", "T2", "T3"].iter().enumerate() {
         for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
             let cell = cell(name, stop);
-            let mut checker = ProtectiveChecker::new(cell.clone(), 5.0).unwrap().with_speed_limits(false);
+            let mut checker =
+                ProtectiveChecker::new(cell.clone(), 5.0).unwrap().with_speed_limits(false);
             let mut rng = StdRng::seed_from_u64(900 + 10 * i as u64 + k as u64);
             // The search draws from its own stream: the ticks do not depend on its budget.
             let mut search = StdRng::seed_from_u64(1900 + 10 * i as u64 + k as u64);
             let mut tally = Tally::new();
             for state in 0..120 {
-                let sample = if state % 2 == 0 { tcp_toward_other } else { tcp_near_reach_boundary };
+                let sample =
+                    if state % 2 == 0 { tcp_toward_other } else { tcp_near_reach_boundary };
                 let tcps = [sample(&cell, 0, &mut rng), sample(&cell, 1, &mut rng)];
-                let v_fd = std::array::from_fn(|_| unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3));
-                let Some((verdict, robots)) = tick_of(&mut checker, &cell, tcps, v_fd) else { continue };
+                let v_fd = std::array::from_fn(|_| {
+                    unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3)
+                });
+                let Some((verdict, robots)) = tick_of(&mut checker, &cell, tcps, v_fd) else {
+                    continue;
+                };
                 // Every FREE and WARN tick; one STOP tick in four (to show the search's teeth).
                 if verdict != Protective::Stop || state % 4 == 0 {
                     tally.search_and_draw(&cell, verdict, &robots, evaluations(), &mut search);
@@ -173,7 +201,12 @@ fn no_stop_the_model_allows_touches_after_a_free_verdict() {
         all.proved, all.least, all.random
     );
     assert!(all.proved >= 60, "too few FREE ticks to search: {}", all.proved);
-    assert!(all.least < all.random, "the search gets no closer than random stops: {} {}", all.least, all.random);
+    assert!(
+        all.least < all.random,
+        "the search gets no closer than random stops: {} {}",
+        all.least,
+        all.random
+    );
     assert!(
         all.touched * 4 >= all.stops,
         "the search finds contact in too few STOP ticks: {} of {}",
@@ -189,14 +222,17 @@ fn no_stop_the_model_allows_touches_after_a_free_verdict() {
 /// nothing but bounds what a tighter proof could gain).
 #[test]
 fn no_stop_the_model_allows_touches_along_the_scenarios() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
     let mut rng = StdRng::seed_from_u64(31);
     let mut all = Tally::new();
     for s in parse_scenarios(&text).unwrap() {
         for (k, stop) in [STIFF, StopModel::DEFAULT].into_iter().enumerate() {
             let cell = cell(&s.cell, stop);
             let tick_s = cell.tick_ms * 1e-3;
-            let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let mut checker =
+                ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
             let (mut tcps, mut prev) = ([Vec3::zeros(); 2], [Vec3::zeros(); 2]);
             let mut tally = Tally::new();
             let mut seen = [0; 2];
@@ -207,8 +243,13 @@ fn no_stop_the_model_allows_touches_along_the_scenarios() {
                 *count += 1;
                 if t > 0 && *count % 25 == 0 {
                     let v_fd = |j: usize| (tcps[j] - prev[j]) / tick_s;
-                    let robots: [Robot; 2] =
-                        std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd(j), stop, tick_s, interval_s: tick_s });
+                    let robots: [Robot; 2] = std::array::from_fn(|j| Robot {
+                        tcp: tcps[j],
+                        v_fd: v_fd(j),
+                        stop,
+                        tick_s,
+                        interval_s: tick_s,
+                    });
                     tally.search(&cell, verdict, &robots, 300, &mut rng);
                 }
                 prev = tcps;
@@ -224,6 +265,9 @@ fn no_stop_the_model_allows_touches_along_the_scenarios() {
             all.least = all.least.min(tally.least);
         }
     }
-    println!("{} FREE/WARN ticks of the runs searched, least clearance reached {:.3} mm", all.proved, all.least);
+    println!(
+        "{} FREE/WARN ticks of the runs searched, least clearance reached {:.3} mm",
+        all.proved, all.least
+    );
     assert!(all.proved >= 200, "too few FREE ticks to search: {}", all.proved);
 }

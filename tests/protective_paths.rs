@@ -33,8 +33,11 @@ fn along(points: &[Vec3], s: Real) -> Vec3 {
 /// A random stop path from `tcp`: along `velocity` (or anywhere), with one or two corners,
 /// each vertex moved by up to the tolerance; the TCP stays within the tolerance of it.
 fn random_path(tcp: &Vec3, velocity: &Vec3, tol: Real, rng: &mut StdRng) -> Vec<Vec3> {
-    let mut dir =
-        if velocity.norm() > 0.0 && rng.random_range(0.0..1.0) < 0.7 { velocity.normalize() } else { unit(rng) };
+    let mut dir = if velocity.norm() > 0.0 && rng.random_range(0.0..1.0) < 0.7 {
+        velocity.normalize()
+    } else {
+        unit(rng)
+    };
     let mut points = vec![tcp + unit(rng) * rng.random_range(0.0..=tol)];
     for _ in 0..rng.random_range(1..=3) {
         let last = *points.last().unwrap();
@@ -87,9 +90,12 @@ fn brute_force(name: &str, stop: StopModel, ticks: usize, seed: u64) -> (usize, 
     let (mut gained, mut checked) = (0, 0);
     for t in 0..ticks {
         let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
-        let vel: [Vec3; 2] = std::array::from_fn(|_| unit(&mut rng) * rng.random_range(0.0..stop.max_speed_mm_s * 0.9));
+        let vel: [Vec3; 2] = std::array::from_fn(|_| {
+            unit(&mut rng) * rng.random_range(0.0..stop.max_speed_mm_s * 0.9)
+        });
         let tol = rng.random_range(0.0..3.0);
-        let paths: Vec<Vec<Vec3>> = (0..2).map(|j| random_path(&tcps[j], &vel[j], tol, &mut rng)).collect();
+        let paths: Vec<Vec<Vec3>> =
+            (0..2).map(|j| random_path(&tcps[j], &vel[j], tol, &mut rng)).collect();
         c.reset();
         let prev = [tcps[0] - vel[0] * tick_s, tcps[1] - vel[1] * tick_s];
         if c.check(&prev).unwrap().status != ProtectiveStatus::Ok {
@@ -128,7 +134,9 @@ fn brute_force(name: &str, stop: StopModel, ticks: usize, seed: u64) -> (usize, 
 fn verdicts_proved_along_paths_survive_every_position_the_paths_allow() {
     for (name, stop, seed) in [("T1", STIFF, 1), ("T2", StopModel::DEFAULT, 2), ("T3", STIFF, 3)] {
         let (gained, checked) = brute_force(name, stop, 1_500, seed);
-        println!("{name}: {checked} ticks proved with paths, {gained} of them only thanks to the paths");
+        println!(
+            "{name}: {checked} ticks proved with paths, {gained} of them only thanks to the paths"
+        );
         assert!(gained >= 50, "{name}: the paths should prove ticks the ball cannot ({gained})");
     }
 }
@@ -144,7 +152,11 @@ fn a_broken_path_is_a_status_with_stop_and_the_history_is_forgotten() {
     for (path, why) in [(&far[..], "the TCP is 40 mm from the path"), (&[][..], "no point")] {
         let paths = [Some(StopPath { points: path, tolerance_mm: 1.0 }), None];
         let r = c.check_with_paths(&[a, b], &paths).unwrap();
-        assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::InvalidPath(0)), "{why}");
+        assert_eq!(
+            (r.verdict, r.status),
+            (Protective::Stop, ProtectiveStatus::InvalidPath(0)),
+            "{why}"
+        );
         // Forgotten: the next tick assumes full speed, so it is not the FREE of a still robot.
         assert_eq!(c.check(&[a, b]).unwrap().robots[0].speed_bound_mm_s, 4_600.0, "{why}");
         c.check(&[a, b]).unwrap();
@@ -159,7 +171,9 @@ fn a_broken_path_is_a_status_with_stop_and_the_history_is_forgotten() {
 /// path: never more STOPs than without, and on the practical runs at least a tenth fewer.
 #[test]
 fn programmed_paths_ahead_bring_the_stops_of_the_scenarios_down() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
     for (s, (stop, model)) in parse_scenarios(&text)
         .unwrap()
         .iter()
@@ -175,10 +189,12 @@ fn programmed_paths_ahead_bring_the_stops_of_the_scenarios_down() {
         for tick in 0..RUN_TICKS {
             s.tcps_at(tick, &mut tcps);
             let v0 = without.check(&tcps).unwrap().verdict;
-            let lens: Vec<usize> =
-                (0..tcps.len()).map(|j| path_ahead(&s.robots[j], tick, 400.0, &mut points[j])).collect();
-            let paths: Vec<Option<StopPath>> =
-                (0..tcps.len()).map(|j| Some(StopPath { points: &points[j][..lens[j]], tolerance_mm: 0.1 })).collect();
+            let lens: Vec<usize> = (0..tcps.len())
+                .map(|j| path_ahead(&s.robots[j], tick, 400.0, &mut points[j]))
+                .collect();
+            let paths: Vec<Option<StopPath>> = (0..tcps.len())
+                .map(|j| Some(StopPath { points: &points[j][..lens[j]], tolerance_mm: 0.1 }))
+                .collect();
             let r = with.check_with_paths(&tcps, &paths).unwrap();
             assert!(r.verdict <= v0, "{} {} tick {tick}: worse with paths", s.cell, s.case);
             stops_with += (r.verdict == Protective::Stop) as u32;
@@ -193,7 +209,11 @@ fn programmed_paths_ahead_bring_the_stops_of_the_scenarios_down() {
             started.elapsed().as_secs_f64() * 1e6 / RUN_TICKS as f64
         );
         if s.case == "practical" && model == "default" {
-            assert!(stops_with * 10 <= stops_without * 9, "{} practical: {stops_with} of {stops_without}", s.cell);
+            assert!(
+                stops_with * 10 <= stops_without * 9,
+                "{} practical: {stops_with} of {stops_without}",
+                s.cell
+            );
         }
     }
 }

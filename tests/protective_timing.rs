@@ -18,7 +18,8 @@
 //! answers FREE or WARN where that stop of the true motion touches.
 
 use delta_collide::cell::protective::{
-    Protective, ProtectiveChecker, ProtectiveReport, ProtectiveRequest, ProtectiveStatus, TickTime, TimingFault,
+    Protective, ProtectiveChecker, ProtectiveReport, ProtectiveRequest, ProtectiveStatus, TickTime,
+    TimingFault,
 };
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, Waypoint, RUN_TICKS};
@@ -34,8 +35,12 @@ use protective_common::{allocations, toward_other};
 
 /// The stopping model of the dense runs that found the hazard: 3 ms reaction, 40 m/s^2
 /// braking, 150 m/s^2 and 5 m/s at most.
-const MODEL: StopModel =
-    StopModel { reaction_ms: 3.0, decel_mm_s2: 40_000.0, max_accel_mm_s2: 150_000.0, max_speed_mm_s: 5_000.0 };
+const MODEL: StopModel = StopModel {
+    reaction_ms: 3.0,
+    decel_mm_s2: 40_000.0,
+    max_accel_mm_s2: 150_000.0,
+    max_speed_mm_s: 5_000.0,
+};
 
 /// Tick (ms) of every run.
 const TICK_MS: Real = 1.0;
@@ -110,9 +115,22 @@ fn programme(cell: &Cell, collide: bool, rng: &mut StdRng) -> Vec<Vec<Waypoint>>
         w.push(Waypoint { tick: 0, tcp: reachable(cell, j, -100.0, 0.0, -460.0) });
         let mut cycle = 0;
         while tick < RUN_TICKS - 400 {
-            let radius = if collide && cycle >= 3 { spacing / 2.0 } else { rng.random_range(150.0..190.0) };
-            let pick = reachable(cell, j, rng.random_range(-140.0..-90.0), rng.random_range(-60.0..60.0), -480.0);
-            let place = reachable(cell, j, radius, rng.random_range(-40.0..40.0), rng.random_range(-490.0..-450.0));
+            let radius =
+                if collide && cycle >= 3 { spacing / 2.0 } else { rng.random_range(150.0..190.0) };
+            let pick = reachable(
+                cell,
+                j,
+                rng.random_range(-140.0..-90.0),
+                rng.random_range(-60.0..60.0),
+                -480.0,
+            );
+            let place = reachable(
+                cell,
+                j,
+                radius,
+                rng.random_range(-40.0..40.0),
+                rng.random_range(-490.0..-450.0),
+            );
             let hop = (pick + place) / 2.0 + Vec3::new(0.0, 0.0, 50.0);
             let leg = rng.random_range(95..125);
             for p in [hop, place, hop, pick] {
@@ -260,7 +278,11 @@ impl<'a> Driver<'a> {
             run,
             checker: ProtectiveChecker::new(run.cell.clone(), 10.0).unwrap(),
             exact: ExactChecker::new(run.cell.clone()),
-            tally: Tally { least_true: Real::INFINITY, least_worst: Real::INFINITY, ..Default::default() },
+            tally: Tally {
+                least_true: Real::INFINITY,
+                least_worst: Real::INFINITY,
+                ..Default::default()
+            },
             history: None,
             last: None,
             evaluations,
@@ -275,7 +297,13 @@ impl<'a> Driver<'a> {
 
     /// One call at true time `t` (ticks) with `time` and `tcps`; `fault` is the fault the
     /// schedule injected (if any). Checks the answer; returns the report.
-    fn call(&mut self, time: TickTime, t: Real, tcps: [Vec3; 2], fault: Option<TimingFault>) -> ProtectiveReport {
+    fn call(
+        &mut self,
+        time: TickTime,
+        t: Real,
+        tcps: [Vec3; 2],
+        fault: Option<TimingFault>,
+    ) -> ProtectiveReport {
         let name = &self.run.name;
         let r = self.checker.check(ProtectiveRequest::new(&tcps).at(time)).unwrap().clone();
         self.tally.calls += 1;
@@ -284,14 +312,21 @@ impl<'a> Driver<'a> {
             let first = &self.last.as_ref().unwrap().2;
             // Compared as printed: a NaN clearance (a STOP without a proof) equals itself there.
             let (got, want) = (format!("{r:?}"), format!("{first:?}"));
-            assert_eq!(got, want, "{name}: a repeated cycle must answer the first call's report, at {time:?}");
+            assert_eq!(
+                got, want,
+                "{name}: a repeated cycle must answer the first call's report, at {time:?}"
+            );
             self.tally.repeats += 1;
             return r;
         }
         let previous = self.history;
         if let Some(f) = fault {
             let (verdict, status) = (r.verdict, r.status);
-            assert_eq!((verdict, status), (Protective::Stop, ProtectiveStatus::Timing(f)), "{name} at {time:?}");
+            assert_eq!(
+                (verdict, status),
+                (Protective::Stop, ProtectiveStatus::Timing(f)),
+                "{name} at {time:?}"
+            );
             self.tally.faults += 1;
             self.history = None;
         } else {
@@ -337,16 +372,30 @@ impl<'a> Driver<'a> {
                 Some((t0, p0)) => {
                     let want = (tcps[j] - p0[j]).norm() / (t * TICK_MS * 1e-3 - t0);
                     let name = &self.run.name;
-                    assert!((got - want).abs() <= 1e-6 * want.max(1.0), "{name}: speed {got} != {want} at {time:?}");
+                    assert!(
+                        (got - want).abs() <= 1e-6 * want.max(1.0),
+                        "{name}: speed {got} != {want} at {time:?}"
+                    );
                 }
-                None => assert_eq!(got, Real::INFINITY, "{}: no previous TCP, at {time:?}", self.run.name),
+                None => assert_eq!(
+                    got,
+                    Real::INFINITY,
+                    "{}: no previous TCP, at {time:?}",
+                    self.run.name
+                ),
             }
         }
     }
 
     /// A FREE or WARN call: its true stop, and on a sample the worst stop the model allows
     /// from what the checker measured, never touch.
-    fn check_stop(&mut self, r: &ProtectiveReport, t: Real, tcps: &[Vec3; 2], previous: Option<(Real, [Vec3; 2])>) {
+    fn check_stop(
+        &mut self,
+        r: &ProtectiveReport,
+        t: Real,
+        tcps: &[Vec3; 2],
+        previous: Option<(Real, [Vec3; 2])>,
+    ) {
         // Every call near the other robot; one in ten farther out (the oracle's budget).
         if r.clearance_mm > 120.0 && self.rng.random_range(0..10) != 0 {
             return;
@@ -356,7 +405,11 @@ impl<'a> Driver<'a> {
         self.tally.simulated += 1;
         self.tally.least_true = self.tally.least_true.min(least);
         self.tally.touched += usize::from(least <= 0.0);
-        assert!(least > 0.0, "{name}: {:?} at t = {t} ticks, yet its true stop reaches {least} mm", r.verdict);
+        assert!(
+            least > 0.0,
+            "{name}: {:?} at t = {t} ticks, yet its true stop reaches {least} mm",
+            r.verdict
+        );
         if r.clearance_mm > 60.0 || self.search_budget == 0 || self.rng.random_range(0..4) != 0 {
             return;
         }
@@ -374,7 +427,11 @@ impl<'a> Driver<'a> {
         let (worst, at) = worst_stop(&self.run.cell, &robots, self.evaluations, &mut self.rng);
         self.tally.searched += 1;
         self.tally.least_worst = self.tally.least_worst.min(worst);
-        assert!(worst > 0.0, "{name}: {:?} at t = {t}, yet a stop the model allows reaches {worst} mm at {at:?}", r.verdict);
+        assert!(
+            worst > 0.0,
+            "{name}: {:?} at t = {t}, yet a stop the model allows reaches {worst} mm at {at:?}",
+            r.verdict
+        );
     }
 }
 
@@ -426,7 +483,8 @@ fn drive(run: &Run, schedule: Schedule, seed: u64, evaluations: usize) -> Tally 
             }
             Jitter | Early => {
                 // Whole nanoseconds, so that the test's intervals are the checker's.
-                let t_true = ((t + rng.random_range(-0.2..0.2)).max(t_last + 0.6) * 1e6).round() / 1e6;
+                let t_true =
+                    ((t + rng.random_range(-0.2..0.2)).max(t_last + 0.6) * 1e6).round() / 1e6;
                 d.call(nanos(t_true), t_true, d.tcps(t_true), fault.take());
                 t_last = t_true;
                 if schedule == Early && rng.random_range(0..100) == 0 {
@@ -504,11 +562,13 @@ fn timing_faults_fail_closed_on_runs_of_cells_of_our_own() {
 /// true motion touches (on the collision runs, where the robots close in at full speed).
 #[test]
 fn the_untimed_call_twice_per_cycle_answers_free_where_a_stop_touches() {
-    let mut runs: Vec<Run> = reference_runs().into_iter().filter(|r| r.name.ends_with("collision")).collect();
+    let mut runs: Vec<Run> =
+        reference_runs().into_iter().filter(|r| r.name.ends_with("collision")).collect();
     runs.extend(own_runs(46).into_iter().filter(|r| r.name.ends_with("collision")));
     let mut touched_total = 0;
     for run in &runs {
-        let mut checker = ProtectiveChecker::new(run.cell.clone(), 10.0).unwrap().with_speed_limits(false);
+        let mut checker =
+            ProtectiveChecker::new(run.cell.clone(), 10.0).unwrap().with_speed_limits(false);
         let exact = ExactChecker::new(run.cell.clone());
         let (mut better, mut touched) = (0, 0);
         for c in 0..RUN_TICKS {
@@ -517,7 +577,9 @@ fn the_untimed_call_twice_per_cycle_answers_free_where_a_stop_touches() {
             let second = checker.check(&p).unwrap().clone();
             if second.status == ProtectiveStatus::Ok && second.verdict < first {
                 better += 1;
-                if second.clearance_mm < 150.0 && true_stop_clearance(run, &exact, Real::from(c)) <= 0.0 {
+                if second.clearance_mm < 150.0
+                    && true_stop_clearance(run, &exact, Real::from(c)) <= 0.0
+                {
                     touched += 1;
                 }
             }
@@ -558,8 +620,12 @@ fn timed_calls_at_the_nominal_timing_answer_as_the_untimed_calls() {
             assert_eq!((first, allocations() - before), (0, 0), "{}: tick {c} allocated", run.name);
             assert_eq!(format!("{:?}", timed.report()), want, "{} tick {c}, again", run.name);
         }
-        let p: Vec<Vec3> = (0..n).map(|j| position(&run.robots[j], Real::from(RUN_TICKS))).collect();
+        let p: Vec<Vec3> =
+            (0..n).map(|j| position(&run.robots[j], Real::from(RUN_TICKS))).collect();
         let r = timed.check(ProtectiveRequest::new(&p).at(TickTime::Cycle(3))).unwrap();
-        assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Timing(TimingFault::Backwards)));
+        assert_eq!(
+            (r.verdict, r.status),
+            (Protective::Stop, ProtectiveStatus::Timing(TimingFault::Backwards))
+        );
     }
 }

@@ -46,7 +46,8 @@ fn pose(q: &[Real; 4], c: &[Real; 3]) -> Pose {
 
 impl Case {
     fn ours_free(&self) -> bool {
-        separating_axis(&obb(&self.qa, &self.ca, &self.ha), &obb(&self.qb, &self.cb, &self.hb)).is_some()
+        separating_axis(&obb(&self.qa, &self.ca, &self.ha), &obb(&self.qb, &self.cb, &self.hb))
+            .is_some()
     }
 
     fn parry_parts(&self) -> (Pose, Cuboid, Pose, Cuboid) {
@@ -98,7 +99,9 @@ fn point_box_distance(p: &Vec3, b: &Obb) -> Real {
 
 /// The 12 edges of a box from its vertices (indexed by sign bits, as `Obb::vertices`).
 fn box_edges(v: &[Vec3; 8]) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
-    (0..8).flat_map(move |i| (0..3).filter(move |k| i >> k & 1 == 0).map(move |k| (v[i], v[i | 1 << k])))
+    (0..8).flat_map(move |i| {
+        (0..3).filter(move |k| i >> k & 1 == 0).map(move |k| (v[i], v[i | 1 << k]))
+    })
 }
 
 /// Distance between segments `p0 p1` and `q0 q1` (Ericson, Real-Time Collision Detection 5.1.9).
@@ -156,7 +159,11 @@ fn axis_quat(k: usize, angle: Real) -> [Real; 4] {
 
 fn random_unit(rng: &mut StdRng) -> Vec3 {
     loop {
-        let v = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let v = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
         let n = v.norm();
         if n > 1e-3 && n <= 1.0 {
             return v / n;
@@ -172,8 +179,16 @@ fn random_half(rng: &mut StdRng) -> [Real; 3] {
             [200.0 * s, 70.0 * s, 17.5 * s]
         }
         1 => std::array::from_fn(|_| rng.random_range(1.0..300.0)),
-        2 => [rng.random_range(10.0..300.0), rng.random_range(10.0..300.0), rng.random_range(0.01..1.0)],
-        _ => [rng.random_range(10.0..300.0), rng.random_range(0.01..1.0), rng.random_range(0.01..1.0)],
+        2 => [
+            rng.random_range(10.0..300.0),
+            rng.random_range(10.0..300.0),
+            rng.random_range(0.01..1.0),
+        ],
+        _ => [
+            rng.random_range(10.0..300.0),
+            rng.random_range(0.01..1.0),
+            rng.random_range(0.01..1.0),
+        ],
     };
     let k = rng.random_range(0..3);
     h.swap(0, k);
@@ -197,7 +212,12 @@ fn uniform_case(rng: &mut StdRng) -> Case {
 
 /// B placed at a controlled gap `+-10^log10_gap` mm from A along a direction that is random,
 /// a face normal of A or B, or the cross product of an edge of each, with a lateral offset.
-fn near_touching(rng: &mut StdRng, qa: [Real; 4], qb: [Real; 4], log10_gap: std::ops::Range<Real>) -> Case {
+fn near_touching(
+    rng: &mut StdRng,
+    qa: [Real; 4],
+    qb: [Real; 4],
+    log10_gap: std::ops::Range<Real>,
+) -> Case {
     let (ha, hb) = (random_half(rng), random_half(rng));
     let (ma, mb) = (matrix(&qa), matrix(&qb));
     let sign = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
@@ -214,7 +234,8 @@ fn near_touching(rng: &mut StdRng, qa: [Real; 4], qb: [Real; 4], log10_gap: std:
             }
         }
     };
-    let gap = 10f64.powf(rng.random_range(log10_gap)) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    let gap =
+        10f64.powf(rng.random_range(log10_gap)) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
     let ca: [Real; 3] = std::array::from_fn(|_| rng.random_range(-1000.0..1000.0));
     // A lateral shift orthogonal to n, up to a fraction of the smaller box.
     let lateral = {
@@ -329,7 +350,11 @@ impl Tally {
         for (case, why) in self.failures.iter().take(20) {
             println!("    // {why}\n    {case:?},");
         }
-        assert!(self.failures.is_empty(), "{name}: {} disagreements outside the policy", self.failures.len());
+        assert!(
+            self.failures.is_empty(),
+            "{name}: {} disagreements outside the policy",
+            self.failures.len()
+        );
     }
 }
 
@@ -408,7 +433,12 @@ fn regressions() {
             qa: [0.43259627381925025, -0.256195703428533, 0.04268114038697688, -0.8633669820405031],
             ca: [-711.3121573668058, -977.959802334337, -577.9318842893724],
             ha: [128.53829367670915, 110.70228415126523, 217.22105916965006],
-            qb: [0.6395188695689836, -0.6030284929141175, -0.03894701330515094, 0.47524244586689185],
+            qb: [
+                0.6395188695689836,
+                -0.6030284929141175,
+                -0.03894701330515094,
+                0.47524244586689185,
+            ],
             cb: [-1220.9420474569777, -1162.7152436951196, -605.8336859246883],
             hb: [259.05881398088934, 235.25881787681757, 197.60835048338032],
         },
@@ -426,8 +456,11 @@ fn regressions() {
 #[test]
 fn very_near_touching_pairs_err_toward_collision() {
     run("very near", 5, 50_000, |rng| {
-        let (qa, qb) =
-            if rng.random_bool(0.5) { parallel_orientations(rng) } else { (random_quat(rng), random_quat(rng)) };
+        let (qa, qb) = if rng.random_bool(0.5) {
+            parallel_orientations(rng)
+        } else {
+            (random_quat(rng), random_quat(rng))
+        };
         near_touching(rng, qa, qb, -9.0..-4.0)
     });
 }

@@ -10,12 +10,18 @@ fn boxed(c: [Real; 3], m: Mat3, h: [Real; 3]) -> Obb {
 }
 
 fn assert_collide(a: &Obb, b: &Obb, what: &str) {
-    assert!(separating_axis(a, b).is_none(), "{what}: touching boxes must collide\n    a = {a:?}\n    b = {b:?}");
+    assert!(
+        separating_axis(a, b).is_none(),
+        "{what}: touching boxes must collide\n    a = {a:?}\n    b = {b:?}"
+    );
     assert!(separating_axis(b, a).is_none(), "{what} (swapped): touching boxes must collide");
 }
 
 fn assert_free(a: &Obb, b: &Obb, what: &str) {
-    assert!(separating_axis(a, b).is_some(), "{what}: separated boxes must be free\n    a = {a:?}\n    b = {b:?}");
+    assert!(
+        separating_axis(a, b).is_some(),
+        "{what}: separated boxes must be free\n    a = {a:?}\n    b = {b:?}"
+    );
 }
 
 /// All 48 signed permutation matrices: exact rotations (and reflections, harmless here).
@@ -81,9 +87,17 @@ fn exactly_touching_faces_with_rotated_box_collide() {
             m[(k2, k2)] = angle.cos();
             let mut c = [0.0; 3];
             c[k] = ha[k] + hb[k];
-            assert_collide(&boxed([0.0; 3], Mat3::identity(), ha), &boxed(c, m, hb), "face-face rotated");
+            assert_collide(
+                &boxed([0.0; 3], Mat3::identity(), ha),
+                &boxed(c, m, hb),
+                "face-face rotated",
+            );
             c[k] += 1.0 / 1024.0;
-            assert_free(&boxed([0.0; 3], Mat3::identity(), ha), &boxed(c, m, hb), "face-face rotated, apart");
+            assert_free(
+                &boxed([0.0; 3], Mat3::identity(), ha),
+                &boxed(c, m, hb),
+                "face-face rotated, apart",
+            );
         }
     }
 }
@@ -101,20 +115,30 @@ fn rotation(roll: Real, pitch: Real, yaw: Real) -> Mat3 {
 fn crossed_edges_touching_collide() {
     let q = std::f64::consts::FRAC_PI_4;
     for (s, &(ha, hb)) in
-        [([200.0, 70.0, 70.0], [17.5, 200.0, 17.5]), ([50.0, 3.0, 8.0], [2.0, 90.0, 11.0])].iter().enumerate()
+        [([200.0, 70.0, 70.0], [17.5, 200.0, 17.5]), ([50.0, 3.0, 8.0], [2.0, 90.0, 11.0])]
+            .iter()
+            .enumerate()
     {
         let ma = rotation(q, 0.0, 0.0);
         let mb = rotation(0.0, q, 0.0);
         let top_a = (ha[1] + ha[2]) * q.sin();
         let bottom_b = (hb[0] + hb[2]) * q.sin();
         for step in 0..50 {
-            let scene = rotation(step as Real * 0.37, step as Real * 0.11 - 1.0, step as Real * 0.23);
+            let scene =
+                rotation(step as Real * 0.37, step as Real * 0.11 - 1.0, step as Real * 0.23);
             let shift = Vec3::new(step as Real * 13.0, -500.0, 250.0);
             let a = Obb::new(shift, scene * ma, Vec3::from(ha));
-            let b = Obb::new(scene * Vec3::new(3.0, -5.0, top_a + bottom_b) + shift, scene * mb, Vec3::from(hb));
+            let b = Obb::new(
+                scene * Vec3::new(3.0, -5.0, top_a + bottom_b) + shift,
+                scene * mb,
+                Vec3::from(hb),
+            );
             assert_collide(&a, &b, &format!("crossed edges, set {s}, step {step}"));
-            let b_up =
-                Obb::new(scene * Vec3::new(3.0, -5.0, top_a + bottom_b + 1e-3) + shift, scene * mb, Vec3::from(hb));
+            let b_up = Obb::new(
+                scene * Vec3::new(3.0, -5.0, top_a + bottom_b + 1e-3) + shift,
+                scene * mb,
+                Vec3::from(hb),
+            );
             assert_free(&a, &b_up, "crossed edges 1e-3 mm apart");
         }
     }
@@ -136,7 +160,9 @@ fn vertex_on_face_touching_collides() {
         let scene = rotation(step as Real * 0.05, -0.7, step as Real * 0.013);
         let shift = Vec3::new(-300.0, 400.0 + step as Real, 10.0);
         let a = Obb::new(shift, scene, Vec3::from(ha));
-        let place = |dz: Real| Obb::new(scene * Vec3::new(-50.0, 20.0, ha[2] + lowest + dz) + shift, scene * mb, hb);
+        let place = |dz: Real| {
+            Obb::new(scene * Vec3::new(-50.0, 20.0, ha[2] + lowest + dz) + shift, scene * mb, hb)
+        };
         assert_collide(&a, &place(0.0), &format!("vertex on face, step {step}"));
         assert_collide(&a, &place(-1e-3), "vertex 1e-3 mm into the face");
         assert_free(&a, &place(1e-3), "vertex 1e-3 mm above the face");
@@ -149,7 +175,8 @@ fn vertex_on_face_touching_collides() {
 /// asserting every step: collision exactly when `|offset| <= touch`, touching included.
 fn sweep(a: &Obb, hb: Vec3, mb: Mat3, k: usize, touch: Real, lateral: Vec3) {
     let mut offsets: Vec<Real> = (-2000..=2000).map(|i| i as Real / 4.0).collect();
-    offsets.extend((-256..=256).flat_map(|i| [touch + i as Real / 64.0, -touch + i as Real / 64.0]));
+    offsets
+        .extend((-256..=256).flat_map(|i| [touch + i as Real / 64.0, -touch + i as Real / 64.0]));
     offsets.extend([touch, -touch]);
     for off in offsets {
         let mut c = lateral;
@@ -168,9 +195,10 @@ fn sweep(a: &Obb, hb: Vec3, mb: Mat3, k: usize, touch: Real, lateral: Vec3) {
 fn sweeps_through_a_box_along_each_axis() {
     let ha = Vec3::new(200.0, 70.0, 17.5);
     let hb = Vec3::new(10.0, 5.0, 2.0);
-    for (frame, center) in
-        [(Mat3::identity(), Vec3::zeros()), (rotation(0.4, -1.2, 2.5), Vec3::new(812.0, -97.5, -430.25))]
-    {
+    for (frame, center) in [
+        (Mat3::identity(), Vec3::zeros()),
+        (rotation(0.4, -1.2, 2.5), Vec3::new(812.0, -97.5, -430.25)),
+    ] {
         let a = Obb::new(center, frame, ha);
         for k in 0..3 {
             // B axis-aligned with A: exact touching offsets.

@@ -12,7 +12,12 @@ const BIN: &str = env!("CARGO_BIN_EXE_delta-collide");
 const K: &str = "16";
 
 fn cli(args: &[&str]) -> Output {
-    Command::new(BIN).arg("--quiet").args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+    Command::new(BIN)
+        .arg("--quiet")
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
 }
 
 fn ok(args: &[&str]) -> Output {
@@ -56,7 +61,8 @@ fn shards(cell: &str, extra: &[&str], n: u32, dir: &Path, tag: &str) -> Vec<Path
         .map(|i| {
             let path = dir.join(format!("{tag}-{i}-of-{n}.dcs"));
             let shard = format!("{i}/{n}");
-            let mut args = vec!["build", "--cell", cell, "--k", K, "--shard", &shard, "--output", s(&path)];
+            let mut args =
+                vec!["build", "--cell", cell, "--k", K, "--shard", &shard, "--output", s(&path)];
             args.extend_from_slice(extra);
             ok(&args);
             path
@@ -147,12 +153,32 @@ fn more_shards_than_rows_leave_some_empty_and_the_index_must_be_below_the_count(
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("shard 999/1000, rows 0 of"), "{text}");
     // Alone it is one shard of 1000: the others are missing, and the message counts them.
-    fails(&["merge", "--output", s(&dir.join("t.dct")), s(&path)], &["999 of 1000 shards missing: 0, 1, 2"]);
+    fails(
+        &["merge", "--output", s(&dir.join("t.dct")), s(&path)],
+        &["999 of 1000 shards missing: 0, 1, 2"],
+    );
     for bad in ["3/3", "1/0", "x/2", "2"] {
         let out = cli(&["build", "--cell", "T3", "--k", K, "--shard", bad, "--output", s(&path)]);
-        assert_eq!(out.status.code(), Some(2), "--shard {bad}: {}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "--shard {bad}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
-    let out = cli(&["build", "--cell", "T3", "--k", K, "--shard", "0/2", "--shards", "2", "--output", s(&path)]);
+    let out = cli(&[
+        "build",
+        "--cell",
+        "T3",
+        "--k",
+        K,
+        "--shard",
+        "0/2",
+        "--shards",
+        "2",
+        "--output",
+        s(&path),
+    ]);
     assert_eq!(out.status.code(), Some(2), "--shards goes with --shard auto only");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -162,20 +188,46 @@ fn shard_auto_reads_the_schedulers_environment() {
     let dir = fresh_dir("auto");
     let run = |vars: &[(&str, &str)], extra: &[&str]| {
         let mut c = Command::new(BIN);
-        for v in ["SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_COUNT", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_STEP"] {
+        for v in [
+            "SLURM_ARRAY_TASK_ID",
+            "SLURM_ARRAY_TASK_COUNT",
+            "SLURM_ARRAY_TASK_MIN",
+            "SLURM_ARRAY_TASK_STEP",
+        ] {
             c.env_remove(v);
         }
-        for v in
-            ["JOB_COMPLETION_INDEX", "AWS_BATCH_JOB_ARRAY_INDEX", "AWS_BATCH_JOB_ARRAY_SIZE", "DELTA_COLLIDE_SHARDS"]
-        {
+        for v in [
+            "JOB_COMPLETION_INDEX",
+            "AWS_BATCH_JOB_ARRAY_INDEX",
+            "AWS_BATCH_JOB_ARRAY_SIZE",
+            "DELTA_COLLIDE_SHARDS",
+        ] {
             c.env_remove(v);
         }
         c.envs(vars.iter().copied());
         let out_path = dir.join("auto-{index}-of-{count}.dcs");
-        c.args(["-q", "build", "--cell", "T3", "--k", K, "--shard", "auto", "--output", s(&out_path)]);
+        c.args([
+            "-q",
+            "build",
+            "--cell",
+            "T3",
+            "--k",
+            K,
+            "--shard",
+            "auto",
+            "--output",
+            s(&out_path),
+        ]);
         c.args(extra).output().unwrap()
     };
-    let out = run(&[("SLURM_ARRAY_TASK_ID", "5"), ("SLURM_ARRAY_TASK_COUNT", "4"), ("SLURM_ARRAY_TASK_MIN", "3")], &[]);
+    let out = run(
+        &[
+            ("SLURM_ARRAY_TASK_ID", "5"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+            ("SLURM_ARRAY_TASK_MIN", "3"),
+        ],
+        &[],
+    );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(dir.join("auto-2-of-4.dcs").exists(), "Slurm task 5 of the array 3-6 is shard 2 of 4");
     let out = run(&[("JOB_COMPLETION_INDEX", "1")], &["--shards", "7"]);
@@ -206,7 +258,10 @@ fn missing_duplicate_foreign_truncated_and_corrupt_shards_are_refused_naming_the
     fails(&["merge", "--output", o, a, b, c, s(&copy)], &["both hold shard 0", a, "copy-of-0.dcs"]);
     // Another N, another cell, another variant, another labelling.
     let two = shards("T3", &[], 2, &dir, "t3two");
-    fails(&["merge", "--output", o, a, b, s(&two[1])], &["t3two-1-of-2.dcs", "one of 2 shards, not of 3"]);
+    fails(
+        &["merge", "--output", o, a, b, s(&two[1])],
+        &["t3two-1-of-2.dcs", "one of 2 shards, not of 3"],
+    );
     let t1 = shards("T1", &[], 3, &dir, "t1");
     fails(&["merge", "--output", o, a, b, s(&t1[2])], &["t1-2-of-3.dcs", "another build", "cell"]);
     let other = shards("T3", &["--variant", "5d"], 3, &dir, "t35d");

@@ -78,7 +78,8 @@ fn shrunk(g: &Vec3, e: &Vec3, by: f64) -> (Vec3, Vec3) {
 /// meet (must collide), `Some(false)` when the enclosing capsules are apart (must be free).
 fn oracle(cell: &Cell, tcps: [Vec3; 2]) -> Option<Option<bool>> {
     let links = [lower_links(tcps[0])?, lower_links(tcps[1])?];
-    let placed = |j: usize, p: &Vec3| cell.robots[j].placement.rotation() * p + cell.robots[j].placement.t;
+    let placed =
+        |j: usize, p: &Vec3| cell.robots[j].placement.rotation() * p + cell.robots[j].placement.t;
     let (rho, outer) = (17.5f64, 70f64.hypot(17.5));
     let (mut inner_min, mut outer_min) = (f64::INFINITY, f64::INFINITY);
     for (ga, ea) in &links[0] {
@@ -128,7 +129,10 @@ fn singular_tcps() -> Vec<(&'static str, Vec3)> {
                     let tube = (RE * RE - b * b).sqrt();
                     for s in [-0.99, 0.0, 0.99] {
                         let r = rf + s * tube;
-                        out.push(("link nearly along motor axis", tcp(r * psi.cos(), sign * b, r * psi.sin())));
+                        out.push((
+                            "link nearly along motor axis",
+                            tcp(r * psi.cos(), sign * b, r * psi.sin()),
+                        ));
                     }
                 }
             }
@@ -136,7 +140,10 @@ fn singular_tcps() -> Vec<(&'static str, Vec3)> {
         for s in -10..=10 {
             for zi in 0..=10 {
                 // TCP in the arm's plane: P . t_i = 0.
-                out.push(("tcp in arm plane", tcp(24.0 * s as f64, 0.0, -300.0 - 24.0 * zi as f64)));
+                out.push((
+                    "tcp in arm plane",
+                    tcp(24.0 * s as f64, 0.0, -300.0 - 24.0 * zi as f64),
+                ));
             }
         }
     }
@@ -196,7 +203,9 @@ fn the_reported_singular_pose_collides() {
     assert!(moved, "and so must its neighbour");
     for (j, b) in checker.boxes(0).as_slice().iter().enumerate() {
         assert!(b.axes.iter().all(|v| v.is_finite()), "box {j} of A has a finite frame");
-        assert!((b.axes.transpose() * b.axes - delta_collide::math::Mat3::identity()).norm() < 1e-9);
+        assert!(
+            (b.axes.transpose() * b.axes - delta_collide::math::Mat3::identity()).norm() < 1e-9
+        );
     }
 }
 
@@ -222,8 +231,9 @@ fn singular_families_agree_with_the_brute_force_in_every_reference_cell() {
                     let Some(expect) = oracle(&cell, pair) else { continue };
                     let v = checker.check(&pair).unwrap();
                     if !v.all_reachable() {
-                        // Every family but the last lies on or within rounding of the reach boundary (K = R),
-                        // where the two IKs' rounding may differ; the arm plane is well inside it.
+                        // Every family but the last lies on or within rounding of the reach
+                        // boundary (K = R), where the two IKs' rounding may differ; the arm plane
+                        // is well inside it.
                         assert!(
                             *family != "tcp in arm plane",
                             "{name} {family}: {pair:?} reachable for the oracle, not for us"
@@ -233,11 +243,17 @@ fn singular_families_agree_with_the_brute_force_in_every_reference_cell() {
                     match expect {
                         Some(true) => {
                             must_collide += 1;
-                            assert!(v.collides(), "{name} {family}: {pair:?} must collide (inscribed balls meet)");
+                            assert!(
+                                v.collides(),
+                                "{name} {family}: {pair:?} must collide (inscribed balls meet)"
+                            );
                         }
                         Some(false) => {
                             must_free += 1;
-                            assert!(!v.collides(), "{name} {family}: {pair:?} must be free (capsules apart)");
+                            assert!(
+                                !v.collides(),
+                                "{name} {family}: {pair:?} must be free (capsules apart)"
+                            );
                         }
                         None => {}
                     }

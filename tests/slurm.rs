@@ -18,7 +18,10 @@ const TIMEOUT: Duration = Duration::from_secs(120);
 /// The path of program `name` on `PATH` or in the sbin directories (root's daemons).
 fn find(name: &str) -> Option<PathBuf> {
     let path = std::env::var("PATH").unwrap_or_default();
-    let dirs = path.split(':').map(PathBuf::from).chain(["/usr/sbin", "/sbin", "/usr/local/sbin"].map(PathBuf::from));
+    let dirs = path
+        .split(':')
+        .map(PathBuf::from)
+        .chain(["/usr/sbin", "/sbin", "/usr/local/sbin"].map(PathBuf::from));
     dirs.map(|d| d.join(name)).find(|p| p.is_file())
 }
 
@@ -59,7 +62,11 @@ impl Cluster {
     /// `program args` must succeed; its stdout.
     fn run(&self, program: &str, args: &[&str]) -> String {
         let out = self.command(program).args(args).output().unwrap();
-        assert!(out.status.success(), "{program} {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{program} {args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         String::from_utf8_lossy(&out.stdout).into_owned()
     }
 
@@ -161,7 +168,10 @@ fn start_cluster() -> Cluster {
 fn job_states(cluster: &Cluster, id: &str) -> Vec<String> {
     let out = cluster.command("scontrol").args(["show", "job", id]).output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
-    text.split_whitespace().filter_map(|w| w.strip_prefix("JobState=")).map(str::to_string).collect()
+    text.split_whitespace()
+        .filter_map(|w| w.strip_prefix("JobState="))
+        .map(str::to_string)
+        .collect()
 }
 
 #[test]
@@ -179,20 +189,34 @@ fn a_slurm_array_and_its_dependent_merge_build_the_one_shot_table() {
     let work = cluster.dir.join("work");
     let table = work.join("t1.dct");
     let submit = Path::new(env!("CARGO_MANIFEST_DIR")).join("deploy/slurm/submit.sh");
-    let args = ["--cell", "T1", "--k", "16", "--shards", &SHARDS.to_string(), "--cpus-per-task", "1"];
-    let paths = ["--dir", work.to_str().unwrap(), "--output", table.to_str().unwrap(), "--bin", BIN];
+    let args =
+        ["--cell", "T1", "--k", "16", "--shards", &SHARDS.to_string(), "--cpus-per-task", "1"];
+    let paths =
+        ["--dir", work.to_str().unwrap(), "--output", table.to_str().unwrap(), "--bin", BIN];
     let out = cluster.command(submit.to_str().unwrap()).args(args).args(paths).output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(out.status.success(), "submit.sh: {text}{}", String::from_utf8_lossy(&out.stderr));
     let id = |what: &str| {
-        let line = text.lines().find_map(|l| l.strip_prefix(what)).unwrap_or_else(|| panic!("no {what}in {text}"));
+        let line = text
+            .lines()
+            .find_map(|l| l.strip_prefix(what))
+            .unwrap_or_else(|| panic!("no {what}in {text}"));
         line.trim().to_string()
     };
     let (array, merge) = (id("array "), id("merge "));
     // The one-shot build while the cluster works.
     let one_shot = cluster.dir.join("one-shot.dct");
     let built = Command::new(BIN)
-        .args(["--quiet", "build", "--cell", "T1", "--k", "16", "--output", one_shot.to_str().unwrap()])
+        .args([
+            "--quiet",
+            "build",
+            "--cell",
+            "T1",
+            "--k",
+            "16",
+            "--output",
+            one_shot.to_str().unwrap(),
+        ])
         .output()
         .unwrap();
     assert!(built.status.success(), "{}", String::from_utf8_lossy(&built.stderr));
@@ -204,23 +228,40 @@ fn a_slurm_array_and_its_dependent_merge_build_the_one_shot_table() {
             Some("PENDING" | "RUNNING" | "CONFIGURING" | "COMPLETING") | None => {}
             Some(other) => break other.to_string(),
         }
-        assert!(Instant::now() < deadline, "merge job {merge} not done in {TIMEOUT:?}: {states:?}\n{}", cluster.logs());
+        assert!(
+            Instant::now() < deadline,
+            "merge job {merge} not done in {TIMEOUT:?}: {states:?}\n{}",
+            cluster.logs()
+        );
         std::thread::sleep(Duration::from_millis(500));
     };
     let logs = || {
         let mut s = cluster.logs();
         for e in std::fs::read_dir(work.join("logs")).into_iter().flatten().flatten() {
-            s += &format!("--- {}\n{}", e.path().display(), std::fs::read_to_string(e.path()).unwrap_or_default());
+            s += &format!(
+                "--- {}\n{}",
+                e.path().display(),
+                std::fs::read_to_string(e.path()).unwrap_or_default()
+            );
         }
         s
     };
     assert_eq!(merged_state, "COMPLETED", "merge job {merge}\n{}", logs());
     let tasks = job_states(&cluster, &array);
-    assert_eq!(tasks, vec!["COMPLETED"; SHARDS as usize], "array {array}: every task done\n{}", logs());
+    assert_eq!(
+        tasks,
+        vec!["COMPLETED"; SHARDS as usize],
+        "array {array}: every task done\n{}",
+        logs()
+    );
     for i in 0..SHARDS {
         assert!(work.join(format!("shard-{i}-of-{SHARDS}.dcs")).is_file(), "shard {i} written");
     }
     let (got, want) = (std::fs::read(&table).unwrap(), std::fs::read(&one_shot).unwrap());
-    assert!(got == want, "the table merged under Slurm differs from the one-shot build\n{}", logs());
+    assert!(
+        got == want,
+        "the table merged under Slurm differs from the one-shot build\n{}",
+        logs()
+    );
     println!("Slurm array of {SHARDS} and merge: {:.1} s in all", start.elapsed().as_secs_f64());
 }

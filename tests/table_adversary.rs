@@ -38,7 +38,8 @@ fn sub_cell_bit(i: usize, j: usize) -> u64 {
 
 /// Evaluations per start of the search: 200, or `ADVERSARY_EVALUATIONS`.
 fn evaluations() -> usize {
-    std::env::var("ADVERSARY_EVALUATIONS").map_or(200, |v| v.parse().expect("ADVERSARY_EVALUATIONS: a count"))
+    std::env::var("ADVERSARY_EVALUATIONS")
+        .map_or(200, |v| v.parse().expect("ADVERSARY_EVALUATIONS: a count"))
 }
 
 /// One region: each robot's cube (centre, half-side), MCS.
@@ -57,7 +58,9 @@ struct Objective {
 
 impl Objective {
     fn tcps(r: &Region, x: &[Real; 6]) -> [Vec3; 2] {
-        let at = |(c, h): (Vec3, Real), o: usize| c + Vec3::new(x[o], x[o + 1], x[o + 2]).map(|t| t.sin() * h);
+        let at = |(c, h): (Vec3, Real), o: usize| {
+            c + Vec3::new(x[o], x[o + 1], x[o + 2]).map(|t| t.sin() * h)
+        };
         [at(r.a, 0), at(r.b, 3)]
     }
 
@@ -70,8 +73,10 @@ impl Objective {
 fn worst_in(f: &mut Objective, region: &Region, rng: &mut StdRng) -> (Real, [Vec3; 2]) {
     let mut worst = (Real::INFINITY, [0.0; 6]);
     for start in 0..4 {
-        let x: Vec<Real> = (0..6).map(|_| if start == 0 { 0.0 } else { rng.random_range(-1.0..1.0) }).collect();
-        let (best, x) = descend(|x| f.clearance(region, &std::array::from_fn(|i| x[i])), x, evaluations(), rng);
+        let x: Vec<Real> =
+            (0..6).map(|_| if start == 0 { 0.0 } else { rng.random_range(-1.0..1.0) }).collect();
+        let (best, x) =
+            descend(|x| f.clearance(region, &std::array::from_fn(|i| x[i])), x, evaluations(), rng);
         if best < worst.0 {
             worst = (best, std::array::from_fn(|i| x[i]));
         }
@@ -82,12 +87,18 @@ fn worst_in(f: &mut Objective, region: &Region, rng: &mut StdRng) -> (Real, [Vec
 /// The regions to search: free sub-cells of pairs labelled collision (`free_subs` of them)
 /// and sub-cells left collision (`stop_subs`), then the free cell pairs with the closest
 /// centres (`close` of `drawn`).
-fn regions(space: &CertifiedSpace, cell: &Cell, rng: &mut StdRng) -> (Vec<Region>, Vec<Region>, Vec<Region>) {
+fn regions(
+    space: &CertifiedSpace,
+    cell: &Cell,
+    rng: &mut StdRng,
+) -> (Vec<Region>, Vec<Region>, Vec<Region>) {
     let s = &space.space;
     let (ga, gb) = (&s.grid_a, &s.grid_b);
     let nb = gb.cells.len() as u64;
     let (cell_half, oct_half) = (0.5 * ga.r - 1e-9, 0.25 * ga.r - 1e-9);
-    let octant = |c: Vec3, o: usize| c + Vec3::from_fn(|a, _| if o >> a & 1 == 1 { 0.25 * ga.r } else { -0.25 * ga.r });
+    let octant = |c: Vec3, o: usize| {
+        c + Vec3::from_fn(|a, _| if o >> a & 1 == 1 { 0.25 * ga.r } else { -0.25 * ga.r })
+    };
     let sub = space.sub.as_ref().expect("subdivided labels");
     let (mut free, mut stop) = (Vec::new(), Vec::new());
     for _ in 0..200_000 {
@@ -101,7 +112,8 @@ fn regions(space: &CertifiedSpace, cell: &Cell, rng: &mut StdRng) -> (Vec<Region
         if care & bit == 0 {
             continue;
         }
-        let (ca, cb) = (ga.sample_center((pair / nb) as usize), gb.sample_center((pair % nb) as usize));
+        let (ca, cb) =
+            (ga.sample_center((pair / nb) as usize), gb.sample_center((pair % nb) as usize));
         let region = Region { a: (octant(ca, i), oct_half), b: (octant(cb, j), oct_half) };
         match (collision & bit != 0, free.len() < 1500, stop.len() < 300) {
             (false, true, _) => free.push(region),
@@ -110,12 +122,16 @@ fn regions(space: &CertifiedSpace, cell: &Cell, rng: &mut StdRng) -> (Vec<Region
         }
     }
     // The free cell pairs whose centres are closest, among 200,000 drawn.
-    let mut f = Objective { exact: ExactChecker::new(cell.clone()), boxes: [RobotBoxes::empty(), RobotBoxes::empty()] };
+    let mut f = Objective {
+        exact: ExactChecker::new(cell.clone()),
+        boxes: [RobotBoxes::empty(), RobotBoxes::empty()],
+    };
     let mut drawn: Vec<(Real, Region)> = (0..200_000)
         .filter_map(|_| {
             let i = rng.random_range(0..s.labels.len());
             (s.labels[i] == Label::Free).then(|| {
-                let (ca, cb) = (ga.sample_center(i / nb as usize), gb.sample_center(i % nb as usize));
+                let (ca, cb) =
+                    (ga.sample_center(i / nb as usize), gb.sample_center(i % nb as usize));
                 let region = Region { a: (ca, cell_half), b: (cb, cell_half) };
                 (f.clearance(&region, &[0.0; 6]), region)
             })
@@ -133,7 +149,10 @@ fn search(cell: &Cell, regions: &[Region], free: bool, seed: u64) -> (Real, usiz
         .par_iter()
         .enumerate()
         .map_init(
-            || Objective { exact: ExactChecker::new(cell.clone()), boxes: [RobotBoxes::empty(), RobotBoxes::empty()] },
+            || Objective {
+                exact: ExactChecker::new(cell.clone()),
+                boxes: [RobotBoxes::empty(), RobotBoxes::empty()],
+            },
             |f, (n, region)| {
                 let mut rng = StdRng::seed_from_u64(seed * 1_000_003 + n as u64);
                 let (least, tcps) = worst_in(f, region, &mut rng);
@@ -165,8 +184,17 @@ fn check_cell(name: &str, seed: u64) {
         close.len(),
         stop.len()
     );
-    assert!(free.len() >= 500 && close.len() >= 500, "too few regions: {} {}", free.len(), close.len());
-    assert!(touched * 4 >= stop.len(), "the search finds too few collisions: {touched} of {}", stop.len());
+    assert!(
+        free.len() >= 500 && close.len() >= 500,
+        "too few regions: {} {}",
+        free.len(),
+        close.len()
+    );
+    assert!(
+        touched * 4 >= stop.len(),
+        "the search finds too few collisions: {touched} of {}",
+        stop.len()
+    );
 }
 
 #[test]

@@ -10,7 +10,9 @@ use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::{CellVerdict, ExactChecker};
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::Vec3;
-use delta_collide::table::{build_table, to_bytes, Confirmation, Labelling, TableAnswer, TableChecker, Variant};
+use delta_collide::table::{
+    build_table, to_bytes, Confirmation, Labelling, TableAnswer, TableChecker, Variant,
+};
 
 /// The exact verdict in the table's terms.
 fn exact_answer(v: &CellVerdict) -> TableAnswer {
@@ -23,20 +25,37 @@ fn exact_answer(v: &CellVerdict) -> TableAnswer {
 
 #[test]
 fn confirmed_table_mode_answers_as_exact_mode_on_every_scenario_tick() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
     let scenarios = parse_scenarios(&text).unwrap();
     let mut false_alarms_cleared = 0;
     for name in ["T1", "T2", "T3"] {
         let cell = reference_cell(name).unwrap();
-        let (header, table, _) =
-            build_table(&cell, 16, &Workspace::THESIS, Variant::D6, Labelling::Certified, Progress::Silent).unwrap();
+        let (header, table, _) = build_table(
+            &cell,
+            16,
+            &Workspace::THESIS,
+            Variant::D6,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap();
         let bytes = to_bytes(&table, &header);
         for case in ["practical", "collision"] {
-            let s = scenarios.iter().find(|s| s.cell == name && s.case == case).expect("scenario in the file");
+            let s = scenarios
+                .iter()
+                .find(|s| s.cell == name && s.case == case)
+                .expect("scenario in the file");
             let mut exact = ExactChecker::new(cell.clone());
-            let mut raw = TableChecker::with_confirmation(cell.clone(), &bytes, Confirmation::None).unwrap();
-            let mut confirmed = TableChecker::with_confirmation(cell.clone(), &bytes, Confirmation::Exact).unwrap();
-            assert_eq!(TableChecker::new(cell.clone(), &bytes).unwrap().confirmation(), Confirmation::None);
+            let mut raw =
+                TableChecker::with_confirmation(cell.clone(), &bytes, Confirmation::None).unwrap();
+            let mut confirmed =
+                TableChecker::with_confirmation(cell.clone(), &bytes, Confirmation::Exact).unwrap();
+            assert_eq!(
+                TableChecker::new(cell.clone(), &bytes).unwrap().confirmation(),
+                Confirmation::None
+            );
             let (mut lookup_hits, mut collisions, mut alarms) = (0u64, 0, 0);
             let mut tcps = [Vec3::zeros(); 2];
             for tick in 0..RUN_TICKS {
@@ -46,18 +65,31 @@ fn confirmed_table_mode_answers_as_exact_mode_on_every_scenario_tick() {
                 let label = raw.check(&tcps).unwrap();
                 let answer = confirmed.check(&tcps).unwrap();
                 assert_eq!(answer, truth, "{name} {case} tick {tick}: {tcps:?}");
-                assert!(label == truth || label == TableAnswer::Collision, "{name} {case} tick {tick}: {label:?}");
-                lookup_hits += u64::from(label == TableAnswer::Collision && raw.fallbacks() == fallbacks);
+                assert!(
+                    label == truth || label == TableAnswer::Collision,
+                    "{name} {case} tick {tick}: {label:?}"
+                );
+                lookup_hits +=
+                    u64::from(label == TableAnswer::Collision && raw.fallbacks() == fallbacks);
                 collisions += usize::from(truth == TableAnswer::Collision);
-                alarms += usize::from(label == TableAnswer::Collision && truth == TableAnswer::Free);
+                alarms +=
+                    usize::from(label == TableAnswer::Collision && truth == TableAnswer::Free);
             }
             println!(
                 "{name} {case}: {collisions} collision ticks, {lookup_hits} COLLISION lookups confirmed, \
                  {alarms} false alarms cleared, {} fallbacks",
                 confirmed.fallbacks()
             );
-            assert_eq!(confirmed.confirmations(), lookup_hits, "{name} {case}: one confirmation per COLLISION lookup");
-            assert_eq!((raw.confirmations(), confirmed.fallbacks()), (0, raw.fallbacks()), "{name} {case}");
+            assert_eq!(
+                confirmed.confirmations(),
+                lookup_hits,
+                "{name} {case}: one confirmation per COLLISION lookup"
+            );
+            assert_eq!(
+                (raw.confirmations(), confirmed.fallbacks()),
+                (0, raw.fallbacks()),
+                "{name} {case}"
+            );
             assert_eq!(
                 case == "collision",
                 collisions > 0,
@@ -66,13 +98,18 @@ fn confirmed_table_mode_answers_as_exact_mode_on_every_scenario_tick() {
             false_alarms_cleared += alarms;
         }
     }
-    assert!(false_alarms_cleared > 0, "the k = 16 tables raise false alarms on these runs, so the test can fail");
+    assert!(
+        false_alarms_cleared > 0,
+        "the k = 16 tables raise false alarms on these runs, so the test can fail"
+    );
 }
 
 #[test]
 fn confirmation_can_be_switched_on_a_loaded_checker() {
     let cell = reference_cell("T1").unwrap();
-    let bytes = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/golden/t1_k16_6d.dct")).unwrap();
+    let bytes =
+        std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/golden/t1_k16_6d.dct"))
+            .unwrap();
     let mut checker = TableChecker::new(cell.clone(), &bytes).unwrap();
     let mut exact = ExactChecker::new(cell);
     // Robots reaching toward each other: apart, until the table's first false alarm.
@@ -90,7 +127,10 @@ fn confirmation_can_be_switched_on_a_loaded_checker() {
     checker.set_confirmation(Confirmation::Exact);
     assert_eq!((checker.check(&tcps).unwrap(), checker.confirmations()), (TableAnswer::Free, 1));
     checker.set_confirmation(Confirmation::None);
-    assert_eq!((checker.check(&tcps).unwrap(), checker.confirmations()), (TableAnswer::Collision, 1));
+    assert_eq!(
+        (checker.check(&tcps).unwrap(), checker.confirmations()),
+        (TableAnswer::Collision, 1)
+    );
     for (name, c) in Confirmation::ALL {
         assert_eq!((Confirmation::from_name(name), c.name()), (Some(c), name));
     }

@@ -21,15 +21,24 @@ fn tables(s: &LabelledSpace) -> Vec<Table> {
         Table::D4(LinearQuadtree4d::build(s, Symmetry::MirrorY, SliceAxes::YY, 0).unwrap()),
         Table::D4(LinearQuadtree4d::build(s, Symmetry::Whole, SliceAxes::ZZ, 3).unwrap()),
         Table::Shared(SharedQuadtree6d::build(s, Symmetry::MirrorY).unwrap()),
-        Table::Shared(SharedQuadtree6d::build_subdivided(s, &sub_cells(s), Symmetry::Whole).unwrap()),
-        Table::Clearance(Box::new(ClearanceTable::build(s, &level_counts(s), Ladder::default_ladder(), Symmetry::MirrorY).unwrap())),
+        Table::Shared(
+            SharedQuadtree6d::build_subdivided(s, &sub_cells(s), Symmetry::Whole).unwrap(),
+        ),
+        Table::Clearance(Box::new(
+            ClearanceTable::build(s, &level_counts(s), Ladder::default_ladder(), Symmetry::MirrorY)
+                .unwrap(),
+        )),
     ]
 }
 
 /// Clearance level counts of every pair: 0 unless free, else 1 to 7 from the pair's number.
 fn level_counts(s: &LabelledSpace) -> Vec<u8> {
     let free = |l: delta_collide::cspace::Label| l == delta_collide::cspace::Label::Free;
-    s.labels.iter().enumerate().map(|(i, l)| if free(l) { 1 + (i * 7 / 3 % 7) as u8 } else { 0 }).collect()
+    s.labels
+        .iter()
+        .enumerate()
+        .map(|(i, l)| if free(l) { 1 + (i * 7 / 3 % 7) as u8 } else { 0 })
+        .collect()
 }
 
 /// Sub-cells of every collision pair: every other sub-cell a collision, some "don't care".
@@ -79,7 +88,9 @@ fn truncation_at_every_offset_is_an_error() {
         let bytes = to_bytes(&t, &header(&s));
         for n in 0..bytes.len() {
             match from_bytes(&bytes[..n]) {
-                Err(TableError::Truncated { needed, have, .. }) => assert!(needed > have && have == n),
+                Err(TableError::Truncated { needed, have, .. }) => {
+                    assert!(needed > have && have == n)
+                }
                 Err(TableError::Corrupt { .. }) => {}
                 other => panic!("{}: truncated to {n} bytes gave {other:?}", t.name()),
             }
@@ -113,15 +124,23 @@ fn magic_endianness_version_and_cell_give_their_errors() {
     assert_eq!(from_bytes(&b).unwrap_err(), TableError::WrongEndianness);
     let mut b = good.clone();
     b[12..16].copy_from_slice(&1u32.to_le_bytes());
-    assert_eq!(from_bytes(&b).unwrap_err(), TableError::UnsupportedVersion { found: 1, supported: format::VERSION });
+    assert_eq!(
+        from_bytes(&b).unwrap_err(),
+        TableError::UnsupportedVersion { found: 1, supported: format::VERSION }
+    );
     let e = from_bytes_for_cell(&good, 42).unwrap_err();
     assert_eq!(e, TableError::WrongCell { expected: 42, found: FINGERPRINT, differs: None });
     let msg = e.to_string();
-    assert!(msg.contains("0x0123456789abcdef") && msg.contains("delta-collide build --cell"), "{msg}");
+    assert!(
+        msg.contains("0x0123456789abcdef") && msg.contains("delta-collide build --cell"),
+        "{msg}"
+    );
     let mut b = good.clone();
     let last = b.len() - 1;
     b[last] ^= 1;
-    assert!(matches!(from_bytes(&b), Err(TableError::Corrupt { what }) if what.contains("checksum")));
+    assert!(
+        matches!(from_bytes(&b), Err(TableError::Corrupt { what }) if what.contains("checksum"))
+    );
 }
 
 /// Checksum-valid files whose fields break an invariant (what a bad writer could produce).
@@ -152,13 +171,16 @@ fn corrupted_files(s: &LabelledSpace) -> Vec<(&'static str, Vec<u8>, &'static st
     out.push(("interval_beyond_k_5d.dctable", b, "intervals[0]"));
     // Shared 6-D: the first child index set past the nodes of its depth.
     let mut b = to_bytes(&ts[5], &header(s));
-    let count = |i: usize| u64::from_le_bytes(b[160 + 8 * i..168 + 8 * i].try_into().unwrap()) as usize;
+    let count =
+        |i: usize| u64::from_le_bytes(b[160 + 8 * i..168 + 8 * i].try_into().unwrap()) as usize;
     let at = SECTIONS + 8 * count(0) + 4 * count(1);
     b[at..at + 4].copy_from_slice(&60_000u32.to_le_bytes());
     reseal(&mut b);
     out.push(("child_index_out_of_range_shared.dctable", b, "child index"));
     // Clearance: the level tree's first leaf set to a word that is no level's.
-    let Table::Clearance(t) = &ts[7] else { unreachable!("tables() ends with the clearance table") };
+    let Table::Clearance(t) = &ts[7] else {
+        unreachable!("tables() ends with the clearance table")
+    };
     let mut b = to_bytes(&ts[7], &header(s));
     let (e, l) = t.parts();
     assert!(!l.leaves.is_empty(), "the synthetic clearance table has level leaves");
@@ -180,7 +202,8 @@ fn corrupted_files(s: &LabelledSpace) -> Vec<(&'static str, Vec<u8>, &'static st
 /// `bytes` of a clearance table rewritten as files without flag bit 2 hold it: section 2 the
 /// trees' child indices as u32 each.
 fn with_wide_children(bytes: &[u8], t: &ClearanceTable) -> Vec<u8> {
-    let count = |i: usize| u64::from_le_bytes(bytes[160 + 8 * i..168 + 8 * i].try_into().unwrap()) as usize;
+    let count =
+        |i: usize| u64::from_le_bytes(bytes[160 + 8 * i..168 + 8 * i].try_into().unwrap()) as usize;
     let start = SECTIONS + 8 * count(0) + 4 * count(1);
     let (e, l) = t.parts();
     let mut out = bytes[..start].to_vec();
@@ -208,10 +231,15 @@ fn clearance_files_with_packed_or_wide_child_indices_load_alike() {
     assert!(packed.len() < wide.len(), "packed {} bytes, wide {}", packed.len(), wide.len());
     assert_eq!(from_bytes(&wide).unwrap().1, t);
     assert_eq!(from_bytes(&packed).unwrap().1, t);
-    let kept_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/clearance_wide_children.dct");
+    let kept_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/clearance_wide_children.dct");
     let kept = std::fs::read(kept_path).unwrap();
     let (h, old) = from_bytes(&kept).unwrap();
-    assert_eq!(u32::from_le_bytes(kept[28..32].try_into().unwrap()) & 4, 0, "the kept file is of the wide form");
+    assert_eq!(
+        u32::from_le_bytes(kept[28..32].try_into().unwrap()) & 4,
+        0,
+        "the kept file is of the wide form"
+    );
     let again = to_bytes(&old, &h);
     assert!(again.len() < kept.len());
     assert_eq!(from_bytes(&again).unwrap().1, old);
@@ -233,7 +261,9 @@ fn checksum_valid_but_inconsistent_files_are_corrupt() {
         }
         for bytes in [fresh, std::fs::read(&path).unwrap()] {
             match from_bytes(&bytes) {
-                Err(TableError::Corrupt { what }) => assert!(what.contains(needle), "{name}: {what}"),
+                Err(TableError::Corrupt { what }) => {
+                    assert!(what.contains(needle), "{name}: {what}")
+                }
                 other => panic!("{name}: {other:?}"),
             }
         }
@@ -273,13 +303,21 @@ fn golden_variants() -> Vec<(&'static str, Variant)> {
 /// Compares `fresh` with the committed file `tests/data/golden/{name}.dct` byte for byte
 /// (or writes it under `DC_REGENERATE_TABLE_DATA`).
 fn assert_golden(name: &str, fresh: &[u8]) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/golden").join(format!("{name}.dct"));
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/golden")
+        .join(format!("{name}.dct"));
     if std::env::var_os("DC_REGENERATE_TABLE_DATA").is_some() {
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
         std::fs::write(&path, fresh).unwrap();
     }
     let kept = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    assert!(kept == fresh, "{name}: the table built now differs from {} ({} bytes now, {} kept)", path.display(), fresh.len(), kept.len());
+    assert!(
+        kept == fresh,
+        "{name}: the table built now differs from {} ({} bytes now, {} kept)",
+        path.display(),
+        fresh.len(),
+        kept.len()
+    );
 }
 
 /// Every table kind built from fixed synthetic labels is byte for byte the committed file:
@@ -301,12 +339,28 @@ fn reference_cell_tables_are_byte_identical_to_the_kept_files() {
     for cell_name in ["T1", "T3"] {
         let cell = reference_cell(cell_name).unwrap();
         let (names, variants): (Vec<_>, Vec<_>) = golden_variants().into_iter().unzip();
-        let (h, ts, _) = build_tables(&cell, 16, &Workspace::THESIS, &variants, Labelling::Certified, Progress::Silent).unwrap();
+        let (h, ts, _) = build_tables(
+            &cell,
+            16,
+            &Workspace::THESIS,
+            &variants,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap();
         for (t, name) in ts.iter().zip(names) {
             assert_golden(&format!("{}_k16_{name}", cell_name.to_lowercase()), &to_bytes(t, &h));
         }
     }
     let cell = reference_cell("T1").unwrap();
-    let (h, t, _) = build_table(&cell, 16, &Workspace::THESIS, Variant::Shared, Labelling::ThesisMargin, Progress::Silent).unwrap();
+    let (h, t, _) = build_table(
+        &cell,
+        16,
+        &Workspace::THESIS,
+        Variant::Shared,
+        Labelling::ThesisMargin,
+        Progress::Silent,
+    )
+    .unwrap();
     assert_golden("t1_k16_shared_thesis", &to_bytes(&t, &h));
 }

@@ -10,7 +10,10 @@
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::ExactChecker;
 use delta_collide::cspace::symmetry::{grid_is_y_symmetric, mirror_cell, reflection_y};
-use delta_collide::cspace::{label_space, label_space_certified, label_space_thesis, Label, LabelledSpace, Progress, Workspace};
+use delta_collide::cspace::{
+    label_space, label_space_certified, label_space_thesis, Label, LabelledSpace, Progress,
+    Workspace,
+};
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::Delta3;
 use rand::{rngs::StdRng, RngExt, SeedableRng};
@@ -24,8 +27,11 @@ const CHUNK: usize = 10_000;
 fn random_tcp(rng: &mut StdRng, ws: &Workspace, delta: &Delta3) -> Vec3 {
     let r = ws.max_radius();
     loop {
-        let p =
-            Vec3::new(rng.random_range(-r..=r), rng.random_range(-r..=r), -rng.random_range(ws.zu..=ws.max_depth()));
+        let p = Vec3::new(
+            rng.random_range(-r..=r),
+            rng.random_range(-r..=r),
+            -rng.random_range(ws.zu..=ws.max_depth()),
+        );
         if ws.contains(&p) && delta.inverse_kinematics(&p).is_ok() {
             return p;
         }
@@ -112,10 +118,12 @@ fn hunt_thesis_false_negatives(
         .map_init(
             || ExactChecker::new(cell.clone()),
             |checker, &i| {
-                let (ca, cb) = (thesis.grid_a.sample_center(i / nb), thesis.grid_b.sample_center(i % nb));
+                let (ca, cb) =
+                    (thesis.grid_a.sample_center(i / nb), thesis.grid_b.sample_center(i % nb));
                 (0..64u32).find_map(|corner| {
                     let s = |bit: u32| if corner >> bit & 1 == 1 { half } else { -half };
-                    let (pa, pb) = (ca + Vec3::new(s(0), s(1), s(2)), cb + Vec3::new(s(3), s(4), s(5)));
+                    let (pa, pb) =
+                        (ca + Vec3::new(s(0), s(1), s(2)), cb + Vec3::new(s(3), s(4), s(5)));
                     let v = checker.check(&[pa, pb]).unwrap();
                     (v.all_reachable() && v.collides()).then_some((pa, pb))
                 })
@@ -171,7 +179,9 @@ fn evaluate(name: &str, seed: u64) -> (Confusion, Confusion) {
 
 fn check_cell(name: &str, seed: u64) {
     let (ours, theirs) = evaluate(name, seed);
-    println!("{name}, k = {K}, {CONFIGS} random reachable configurations vs the exact model (margin 0):");
+    println!(
+        "{name}, k = {K}, {CONFIGS} random reachable configurations vs the exact model (margin 0):"
+    );
     ours.print("certified per-box bounds");
     theirs.print("thesis margin r/sqrt(2)");
     assert_eq!(ours.total(), CONFIGS as u64);
@@ -212,7 +222,8 @@ fn t1_certified_labels_are_mirror_symmetric_at_k32() {
     let s = label_space_certified(&cell, K, &Workspace::THESIS, Progress::Silent).unwrap().space;
     let (ga, gb) = (&s.grid_a, &s.grid_b);
     assert!(grid_is_y_symmetric(ga) && grid_is_y_symmetric(gb));
-    let mb: Vec<usize> = gb.cells.iter().map(|&c| gb.index_of(mirror_cell(gb, c)).unwrap()).collect();
+    let mb: Vec<usize> =
+        gb.cells.iter().map(|&c| gb.index_of(mirror_cell(gb, c)).unwrap()).collect();
     let nb = gb.cells.len();
     let bad: usize = (0..ga.cells.len())
         .into_par_iter()
@@ -244,8 +255,11 @@ fn sample_counts_and_unreachable_volume() {
     let (mut inside, mut unreachable) = (0u32, 0u32);
     while inside < 200_000 {
         let r = ws.max_radius();
-        let p =
-            Vec3::new(rng.random_range(-r..=r), rng.random_range(-r..=r), -rng.random_range(ws.zu..=ws.max_depth()));
+        let p = Vec3::new(
+            rng.random_range(-r..=r),
+            rng.random_range(-r..=r),
+            -rng.random_range(ws.zu..=ws.max_depth()),
+        );
         if ws.contains(&p) {
             inside += 1;
             unreachable += d.inverse_kinematics(&p).is_err() as u32;

@@ -32,8 +32,15 @@ fn files(cell: &Cell) -> Vec<(Variant, Vec<u8>)> {
     static T1: OnceLock<Files> = OnceLock::new();
     static T3: OnceLock<Files> = OnceLock::new();
     let build = || {
-        let (header, tables, _) =
-            build_tables(cell, 16, &Workspace::THESIS, &VARIANTS, Labelling::Certified, Progress::Silent).unwrap();
+        let (header, tables, _) = build_tables(
+            cell,
+            16,
+            &Workspace::THESIS,
+            &VARIANTS,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap();
         VARIANTS.iter().copied().zip(tables.iter().map(|t| to_bytes(t, &header))).collect()
     };
     match cell.name.as_str() {
@@ -57,7 +64,10 @@ fn resealed(bytes: &[u8], edit: impl Fn(&mut [u8])) -> Vec<u8> {
 fn a_cleared_symmetric_flag_is_refused_for_a_symmetric_cell() {
     let t1 = reference_cell("T1").unwrap();
     for (variant, bytes) in files(&t1) {
-        assert!(TableChecker::new(t1.clone(), &bytes).is_ok(), "{variant:?}: the built table loads");
+        assert!(
+            TableChecker::new(t1.clone(), &bytes).is_ok(),
+            "{variant:?}: the built table loads"
+        );
         let edited = resealed(&bytes, |b| b[FLAGS] &= !1);
         // A 4D/yy' table's slices change length with the flag; others load and would answer.
         let err = TableChecker::new(t1.clone(), &edited).map(|_| ()).unwrap_err();
@@ -78,7 +88,10 @@ fn a_set_symmetric_flag_on_an_asymmetric_table_is_refused() {
             // The codes in the half a symmetric table does not store give it away.
             assert!(matches!(e, TableError::Corrupt { .. }), "{variant:?}: {e}");
         }
-        assert!(TableChecker::new(t3.clone(), &edited).is_err(), "{variant:?}: loaded as symmetric");
+        assert!(
+            TableChecker::new(t3.clone(), &edited).is_err(),
+            "{variant:?}: loaded as symmetric"
+        );
     }
     // At least the 6-D file is refused as corrupt by itself, before any cell is known.
     let six = &files(&t3)[0].1;
@@ -124,7 +137,10 @@ fn another_cell_is_refused_naming_the_parameter_that_differs() {
     let mut margin = t1.clone();
     margin.robots[0].model.options.margin = 2.5;
     let text = TableChecker::new(margin, bytes).map(|_| ()).unwrap_err().to_string();
-    assert!(text.contains("robot 0: model.margin is 0 in the table's cell and 2.5 in this one"), "{text}");
+    assert!(
+        text.contains("robot 0: model.margin is 0 in the table's cell and 2.5 in this one"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -134,5 +150,8 @@ fn stored_parameters_that_do_not_give_the_fingerprint_are_corrupt() {
     // The first stored parameter (the robot count, at offset 192) changed from 2 to 3.
     let edited = resealed(bytes, |b| b[192..200].copy_from_slice(&3.0f64.to_le_bytes()));
     let err = from_bytes(&edited).unwrap_err();
-    assert!(matches!(err, TableError::Corrupt { .. }) && err.to_string().contains("fingerprint"), "{err}");
+    assert!(
+        matches!(err, TableError::Corrupt { .. }) && err.to_string().contains("fingerprint"),
+        "{err}"
+    );
 }

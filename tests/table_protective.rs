@@ -10,17 +10,20 @@
 //! k = 16 (a few seconds per cell, built once per test process and shared by the tests; at
 //! k = 32 the clearance labelling takes a minute per cell).
 
-use delta_collide::cell::protective::{ClearanceBound, Protective, ProtectiveChecker, ProtectiveStatus};
+use delta_collide::cell::parse_cell;
+use delta_collide::cell::protective::{
+    ClearanceBound, Protective, ProtectiveChecker, ProtectiveStatus,
+};
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
-use delta_collide::cell::parse_cell;
 use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::{
-    build_table, pair_cell, to_bytes, BundleChecker, Confirmation, Labelling, Ladder, TableChecker, Variant,
+    build_table, pair_cell, to_bytes, BundleChecker, Confirmation, Labelling, Ladder, TableChecker,
+    Variant,
 };
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -28,7 +31,9 @@ use std::sync::OnceLock;
 
 mod protective_common;
 use protective_common::adversary::{worst_stop, Robot};
-use protective_common::{allocations, assert_stops_never_touch, cell, tcp_toward_other, unit, STIFF};
+use protective_common::{
+    allocations, assert_stops_never_touch, cell, tcp_toward_other, unit, STIFF,
+};
 
 /// Resolution of the tables built here (SPEC §4: r = 33.125 mm).
 const K: u32 = 16;
@@ -42,8 +47,15 @@ fn table_bytes(name: &str) -> &'static [Vec<u8>; 2] {
     BYTES[c].get_or_init(|| {
         let cell = reference_cell(name).unwrap();
         let build = |variant| {
-            let (header, table, _) =
-                build_table(&cell, K, &Workspace::THESIS, variant, Labelling::Certified, Progress::Silent).unwrap();
+            let (header, table, _) = build_table(
+                &cell,
+                K,
+                &Workspace::THESIS,
+                variant,
+                Labelling::Certified,
+                Progress::Silent,
+            )
+            .unwrap();
             to_bytes(&table, &header)
         };
         [build(Variant::Clearance(Ladder::default_ladder())), build(Variant::Shared)]
@@ -124,16 +136,19 @@ fn brute_force(
     seed: u64,
 ) -> (usize, usize) {
     let bound = |_: usize, _: usize, t: &[Vec3]| table.clearance_bound(t);
-    let mut checker = ProtectiveChecker::new(cell.clone(), warn_mm).unwrap().with_speed_limits(false);
+    let mut checker =
+        ProtectiveChecker::new(cell.clone(), warn_mm).unwrap().with_speed_limits(false);
     let mut exact = ExactChecker::new(cell.clone());
     let mut rng = StdRng::seed_from_u64(seed);
     let stop = cell.stops[0];
     let tick = cell.tick_ms * 1e-3;
     let (mut lookups, mut steps) = (0, 0);
     for _ in 0..states {
-        let tcps = [sample(cell, table, 0, place, &mut rng), sample(cell, table, 1, place, &mut rng)];
-        let v_fd: [Vec3; 2] =
-            std::array::from_fn(|_| unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3));
+        let tcps =
+            [sample(cell, table, 0, place, &mut rng), sample(cell, table, 1, place, &mut rng)];
+        let v_fd: [Vec3; 2] = std::array::from_fn(|_| {
+            unit(&mut rng) * stop.max_speed_mm_s * rng.random::<Real>().powi(3)
+        });
         let prev = [tcps[0] - v_fd[0] * tick, tcps[1] - v_fd[1] * tick];
         checker.reset();
         checker.check_with_table(&prev, &bound).unwrap();
@@ -157,9 +172,18 @@ fn brute_force(
         });
         steps += assert_stops_never_touch(cell, &tcps, &vel, 8, &mut rng);
         // The stop that comes closest, searched (`tests/protective_adversary.rs`).
-        let robots = std::array::from_fn(|j| Robot { tcp: tcps[j], v_fd: v_fd[j], stop, tick_s: tick, interval_s: tick });
+        let robots = std::array::from_fn(|j| Robot {
+            tcp: tcps[j],
+            v_fd: v_fd[j],
+            stop,
+            tick_s: tick,
+            interval_s: tick,
+        });
         let (least, at) = worst_stop(cell, &robots, 100, &mut rng);
-        assert!(least > 0.0, "a stop after a lookup FREE reaches clearance {least} mm at {at:?} from {tcps:?}");
+        assert!(
+            least > 0.0,
+            "a stop after a lookup FREE reaches clearance {least} mm at {at:?} from {tcps:?}"
+        );
     }
     (lookups, steps)
 }
@@ -194,7 +218,10 @@ fn lookup_free_verdicts_survive_simulated_stops() {
         }
     }
     println!("FREE by the lookup (open, reach boundary, cell faces): {total:?}");
-    assert!(total[0] >= 50 && total[1] >= 5 && total[2] >= 50, "too few lookup states to test: {total:?}");
+    assert!(
+        total[0] >= 50 && total[1] >= 5 && total[2] >= 50,
+        "too few lookup states to test: {total:?}"
+    );
 }
 
 /// One run in exact and table mode side by side: verdict counts of each, ticks FREE by the
@@ -233,7 +260,13 @@ impl SideBySide {
 /// pair that can meet checked as its pair cell (the two robots where they stand relative to
 /// each other: a two-robot cell's own pair, a line's as its bundle reduces it, whose soundness
 /// `tests/bundles.rs` checks against the whole line).
-fn side_by_side(cell: &Cell, bound: ClearanceBound, s: &Scenario, stop: StopModel, rng: &mut StdRng) -> SideBySide {
+fn side_by_side(
+    cell: &Cell,
+    bound: ClearanceBound,
+    s: &Scenario,
+    stop: StopModel,
+    rng: &mut StdRng,
+) -> SideBySide {
     let n = cell.robots.len();
     let tick = cell.tick_ms * 1e-3;
     let mut exact = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
@@ -260,17 +293,27 @@ fn side_by_side(cell: &Cell, bound: ClearanceBound, s: &Scenario, stop: StopMode
             if candidates % 5 == 0 {
                 let vel: Vec<Vec3> = (0..n)
                     .map(|j| {
-                        let w = (tcps[j] - prev[j]) / tick + unit(rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
+                        let w = (tcps[j] - prev[j]) / tick
+                            + unit(rng) * stop.max_accel_mm_s2 * tick * rng.random::<Real>();
                         w * (stop.max_speed_mm_s / w.norm()).min(1.0)
                     })
                     .collect();
                 for (a, b) in cell.pairs_that_can_meet() {
                     let pair = pair_cell(cell, a, b);
                     assert_stops_never_touch(&pair, &[tcps[a], tcps[b]], &[vel[a], vel[b]], 4, rng);
-                    let robot = |j: usize| Robot { tcp: tcps[j], v_fd: (tcps[j] - prev[j]) / tick, stop, tick_s: tick, interval_s: tick };
+                    let robot = |j: usize| Robot {
+                        tcp: tcps[j],
+                        v_fd: (tcps[j] - prev[j]) / tick,
+                        stop,
+                        tick_s: tick,
+                        interval_s: tick,
+                    };
                     let (least, at) = worst_stop(&pair, &[robot(a), robot(b)], 100, rng);
                     let (name, case) = (&cell.name, &s.case);
-                    assert!(least > 0.0, "{name} {case} tick {t}: a stop reaches clearance {least} mm at {at:?}");
+                    assert!(
+                        least > 0.0,
+                        "{name} {case} tick {t}: a stop reaches clearance {least} mm at {at:?}"
+                    );
                 }
                 out.tested += 1;
             }
@@ -283,7 +326,9 @@ fn side_by_side(cell: &Cell, bound: ClearanceBound, s: &Scenario, stop: StopMode
 /// Per reference run (T1-T3, practical and collision) and model: [`side_by_side`]. Returns
 /// the ticks FREE by the lookup alone and the ticks tested with simulated stops.
 fn runs(stop: StopModel, label: &str) -> (u64, u64) {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
     let scenarios = parse_scenarios(&text).unwrap();
     let mut rng = StdRng::seed_from_u64(11);
     let (mut lookups, mut tested) = (0, 0);
@@ -294,7 +339,10 @@ fn runs(stop: StopModel, label: &str) -> (u64, u64) {
         for s in scenarios.iter().filter(|s| s.cell == name) {
             let run = side_by_side(&cell, &bound, s, stop, &mut rng);
             println!("{label} {name} {:<9}: {}", s.case, run.line());
-            assert!(run.counts[1][2] <= run.counts[0][2], "table mode stops more often than exact mode");
+            assert!(
+                run.counts[1][2] <= run.counts[0][2],
+                "table mode stops more often than exact mode"
+            );
             (lookups, tested) = (lookups + run.lookups, tested + run.tested);
         }
     }
@@ -316,8 +364,14 @@ fn lookup_ticks_of_the_reference_runs_are_sound() {
 /// with no lookup tick.
 #[test]
 fn a_boolean_table_changes_nothing() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt")).unwrap();
-    let s = parse_scenarios(&text).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
+    let s = parse_scenarios(&text)
+        .unwrap()
+        .into_iter()
+        .find(|s| s.cell == "T1" && s.case == "practical")
+        .unwrap();
     let cell = cell("T1", STIFF);
     let table = table(&cell, false);
     let bound = |_: usize, _: usize, t: &[Vec3]| table.clearance_bound(t);
@@ -344,7 +398,9 @@ fn a_table_mode_tick_never_allocates() {
     let states: Vec<[[Vec3; 2]; 2]> = (0..2_000)
         .map(|_| {
             let tcps = [0, 1].map(|j| sample(&cell, &table, j, Place::CellFaces, &mut rng));
-            let v = [0, 1].map(|_| unit(&mut rng) * STIFF.max_speed_mm_s * rng.random::<Real>().powi(3) * tick);
+            let v = [0, 1].map(|_| {
+                unit(&mut rng) * STIFF.max_speed_mm_s * rng.random::<Real>().powi(3) * tick
+            });
             [[tcps[0] - v[0], tcps[1] - v[1]], tcps]
         })
         .collect();
@@ -372,9 +428,14 @@ fn the_c_counter_reads_zero_for_null() {
 /// whole ticks; table mode never stops more often than exact mode.
 #[test]
 fn a_line_in_table_mode_stops_in_time() {
-    let line = parse_cell(include_str!("../cells/line4.toml")).unwrap().with_stopping(1.0, vec![STIFF; 4]).unwrap();
+    let line = parse_cell(include_str!("../cells/line4.toml"))
+        .unwrap()
+        .with_stopping(1.0, vec![STIFF; 4])
+        .unwrap();
     let ladder = Variant::Clearance(Ladder::default_ladder());
-    let built = build_bundle(&line, K, &Workspace::THESIS, ladder, Labelling::Certified, Progress::Silent).unwrap();
+    let built =
+        build_bundle(&line, K, &Workspace::THESIS, ladder, Labelling::Certified, Progress::Silent)
+            .unwrap();
     let bundle = BundleChecker::new(line.clone(), &built.bytes, Confirmation::Exact).unwrap();
     assert!(bundle.has_clearance());
     let bound = |a: usize, b: usize, t: &[Vec3]| bundle.clearance_bound(a, b, t);
@@ -383,7 +444,10 @@ fn a_line_in_table_mode_stops_in_time() {
     for s in &parse_scenarios(include_str!("../c_harness/line_scenarios.txt")).unwrap() {
         let run = side_by_side(&line, &bound, s, STIFF, &mut rng);
         println!("line4 {:<9}: {}", s.case, run.line());
-        assert!(run.counts[1][2] <= run.counts[0][2], "table mode stops more often than exact mode");
+        assert!(
+            run.counts[1][2] <= run.counts[0][2],
+            "table mode stops more often than exact mode"
+        );
         (pairs, tested) = (pairs + run.pairs, tested + run.tested);
     }
     println!("{tested} ticks tested with simulated stops");

@@ -25,7 +25,11 @@ pub fn line(n: usize) -> Cell {
 
 /// The ticks of the run for `n` robots, each robot's TCP in its own MCS.
 pub fn ticks(n: usize) -> Vec<Vec<Vec3>> {
-    let s = parse_scenarios(SCENARIOS).unwrap().into_iter().find(|s| s.cell == "T1" && s.case == "practical").unwrap();
+    let s = parse_scenarios(SCENARIOS)
+        .unwrap()
+        .into_iter()
+        .find(|s| s.cell == "T1" && s.case == "practical")
+        .unwrap();
     (0..RUN_TICKS)
         .map(|tick| {
             let mut pair = [Vec3::zeros(); 2];

@@ -64,7 +64,11 @@ impl SeparateArrays {
                 ChildIndices::Narrow(v) => usize::from(v[i]),
                 ChildIndices::Wide(v) => v[i] as usize,
             };
-            node = if d + 1 < depths { self.depth_start[d as usize + 1] as usize + child } else { child };
+            node = if d + 1 < depths {
+                self.depth_start[d as usize + 1] as usize + child
+            } else {
+                child
+            };
         }
         self.leaves[node] >> child_index(&c, 0) & 1 == 1
     }
@@ -91,6 +95,12 @@ impl SeparateArrays {
             ChildIndices::Narrow(v) => region(v),
             ChildIndices::Wide(v) => region(v),
         };
-        vec![region(&self.masks), region(&self.bases), region(&self.depth_start), children, region(&self.leaves)]
+        vec![
+            region(&self.masks),
+            region(&self.bases),
+            region(&self.depth_start),
+            children,
+            region(&self.leaves),
+        ]
     }
 }

@@ -169,7 +169,12 @@ pub fn hottest_of_passes(
     mut a: impl FnMut([u16; 6]) -> u64,
     mut b: Option<&mut dyn FnMut([u16; 6]) -> u64>,
 ) -> (Vec<u64>, Vec<u64>) {
-    fn block(best: &mut [u64], cells: &[[u16; 6]], backwards: bool, time: &mut dyn FnMut([u16; 6]) -> u64) {
+    fn block(
+        best: &mut [u64],
+        cells: &[[u16; 6]],
+        backwards: bool,
+        time: &mut dyn FnMut([u16; 6]) -> u64,
+    ) {
         cells.iter().for_each(|&c| _ = black_box(time(c)));
         let pairs = best.iter_mut().zip(cells);
         if backwards {
@@ -181,7 +186,10 @@ pub fn hottest_of_passes(
     let n = HOT_BLOCK.load(Relaxed).max(1);
     let with_b = b.is_some();
     let (mut best_a, mut best_b) = (vec![u64::MAX; cells.len()], vec![u64::MAX; cells.len()]);
-    let mut run = |blocks: &mut dyn Iterator<Item = usize>, best_a: &mut [u64], best_b: &mut [u64], backwards| {
+    let mut run = |blocks: &mut dyn Iterator<Item = usize>,
+                   best_a: &mut [u64],
+                   best_b: &mut [u64],
+                   backwards| {
         for i in blocks {
             let range = i * n..((i + 1) * n).min(cells.len());
             block(&mut best_a[range.clone()], &cells[range.clone()], backwards, &mut a);

@@ -71,8 +71,13 @@ pub fn sealed(data: &[u8]) -> Vec<u8> {
         else {
             break;
         };
-        let (Ok(start), Ok(len)) = (usize::try_from(offset), usize::try_from(len)) else { continue };
-        if entry + ENTRY > body_end || len < TABLE_FINGERPRINT_AT + 16 || start.saturating_add(len) > body_end {
+        let (Ok(start), Ok(len)) = (usize::try_from(offset), usize::try_from(len)) else {
+            continue;
+        };
+        if entry + ENTRY > body_end
+            || len < TABLE_FINGERPRINT_AT + 16
+            || start.saturating_add(len) > body_end
+        {
             continue;
         }
         let table = &mut bytes[start..start + len];
@@ -107,7 +112,10 @@ fn load_and_probe(bytes: &[u8], rng: &mut Rng, origin: Origin) {
         Err(e) => return drop(e.to_string()),
     };
     if is_bundle(bytes) {
-        assert!(reserialised(&bundle).as_deref() == Some(bytes), "a loaded bundle re-serialises to other bytes");
+        assert!(
+            reserialised(&bundle).as_deref() == Some(bytes),
+            "a loaded bundle re-serialises to other bytes"
+        );
     }
     for cell in cells() {
         match BundleChecker::from_bundle(cell.clone(), &bundle, Confirmation::Exact) {
@@ -127,7 +135,9 @@ fn reserialised(bundle: &Bundle) -> Option<Vec<u8>> {
 fn probe_checker(checker: &mut BundleChecker, cell: &Cell, rng: &mut Rng, origin: Origin) {
     let agrees = |answer: TableAnswer, want: TableAnswer| match origin {
         Origin::AsGiven => answer == want,
-        Origin::Sealed => answer == want || (answer, want) == (TableAnswer::Free, TableAnswer::Collision),
+        Origin::Sealed => {
+            answer == want || (answer, want) == (TableAnswer::Free, TableAnswer::Collision)
+        }
     };
     let n = cell.robots.len();
     let mut exact = ExactChecker::new(cell.clone());
@@ -135,7 +145,9 @@ fn probe_checker(checker: &mut BundleChecker, cell: &Cell, rng: &mut Rng, origin
     for i in 0..CONFIGURATIONS + 2 {
         let tcps: Vec<Vec3> = match i {
             0 => vec![home; n],
-            1 => (0..n).map(|j| if j == 1 { Vec3::new(f64::NAN, 0.0, -450.0) } else { home }).collect(),
+            1 => (0..n)
+                .map(|j| if j == 1 { Vec3::new(f64::NAN, 0.0, -450.0) } else { home })
+                .collect(),
             _ => (0..n).map(|_| rng.tcp()).collect(),
         };
         let answer = checker.check(&tcps).expect("one TCP per robot is accepted");
@@ -145,7 +157,11 @@ fn probe_checker(checker: &mut BundleChecker, cell: &Cell, rng: &mut Rng, origin
             (0, false) => TableAnswer::Free,
             (m, _) => TableAnswer::Unreachable(m),
         };
-        assert!(agrees(answer, whole), "{}: {answer:?}, exact mode {whole:?} at {tcps:?}", cell.name);
+        assert!(
+            agrees(answer, whole),
+            "{}: {answer:?}, exact mode {whole:?} at {tcps:?}",
+            cell.name
+        );
         assert_eq!(checker.pairs().len(), v.pairs.len(), "one answer per pair that can meet");
         for (p, e) in checker.pairs().iter().zip(&v.pairs) {
             assert_eq!((p.a, p.b), (e.a, e.b));

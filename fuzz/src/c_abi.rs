@@ -239,14 +239,30 @@ fn query(input: &mut Input, live: &[Live]) {
         )
     };
     assert_ne!(status, DC_STATUS_PANIC, "dc_query panicked");
-    clearance_bound(l, tcps_ptr, count, (status == DC_STATUS_OK && nulls & 2 == 0).then_some(verdict));
+    clearance_bound(
+        l,
+        tcps_ptr,
+        count,
+        (status == DC_STATUS_OK && nulls & 2 == 0).then_some(verdict),
+    );
     if nulls & 2 == 0 {
         assert!(verdict <= DC_VERDICT_COLLISION, "verdict {verdict}");
-        assert_eq!(status == DC_STATUS_OK, verdict != DC_VERDICT_STOP, "status {status} with verdict {verdict}");
+        assert_eq!(
+            status == DC_STATUS_OK,
+            verdict != DC_VERDICT_STOP,
+            "status {status} with verdict {verdict}"
+        );
     }
     if nulls & 4 == 0 {
-        assert!(nulls & 2 != 0 || report.verdict == verdict, "report {report:?}, verdict {verdict}");
-        assert_eq!(status == DC_STATUS_OK, report.verdict != DC_VERDICT_STOP, "status {status}, report {report:?}");
+        assert!(
+            nulls & 2 != 0 || report.verdict == verdict,
+            "report {report:?}, verdict {verdict}"
+        );
+        assert_eq!(
+            status == DC_STATUS_OK,
+            report.verdict != DC_VERDICT_STOP,
+            "status {status}, report {report:?}"
+        );
     }
     let Some(l) = l.filter(|_| nulls & 3 == 0) else {
         return assert_eq!(status, DC_STATUS_NULL_POINTER);
@@ -255,7 +271,8 @@ fn query(input: &mut Input, live: &[Live]) {
         return assert_eq!(status, DC_STATUS_WRONG_ROBOT_COUNT);
     }
     let not_finite = |p: &DcVec3| !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite());
-    let mask_of = |bad: &dyn Fn(usize) -> bool| (0..n).fold(0u32, |m, j| m | u32::from(bad(j)) << j);
+    let mask_of =
+        |bad: &dyn Fn(usize) -> bool| (0..n).fold(0u32, |m, j| m | u32::from(bad(j)) << j);
     let non_finite = mask_of(&|j| not_finite(&tcps[j]));
     let unreachable = mask_of(&|j| !reachable(&l.robots[j].geometry, tcps[j]));
     let expected = match (non_finite, unreachable) {
@@ -277,13 +294,21 @@ fn query(input: &mut Input, live: &[Live]) {
 /// `dc_table_clearance_bound` on the TCPs of a `dc_query` (no input read): never a panic,
 /// `-inf` unless OK and always in exact mode, and a bound only where that query answered FREE
 /// (`verdict`: the query's, when it was OK and written).
-fn clearance_bound(l: Option<&Live>, tcps: *const DcVec3, count: usize, verdict: Option<DcVerdict>) {
+fn clearance_bound(
+    l: Option<&Live>,
+    tcps: *const DcVec3,
+    count: usize,
+    verdict: Option<DcVerdict>,
+) {
     let mut mm = f64::NAN;
     // SAFETY: the handle is NULL or live; `tcps` is NULL or holds `count` points; `mm` is
     // writable.
     let status = unsafe { dc_table_clearance_bound(handle_of(l), tcps, count, &mut mm) };
     assert_ne!(status, DC_STATUS_PANIC, "dc_table_clearance_bound panicked");
-    assert!(!mm.is_nan() && (status == DC_STATUS_OK || mm == f64::NEG_INFINITY), "status {status}, {mm} mm");
+    assert!(
+        !mm.is_nan() && (status == DC_STATUS_OK || mm == f64::NEG_INFINITY),
+        "status {status}, {mm} mm"
+    );
     // SAFETY: NULL or live.
     if unsafe { dc_mode(handle_of(l)) } != DC_MODE_TABLE {
         assert_eq!(mm, f64::NEG_INFINITY);
@@ -322,7 +347,8 @@ fn protective(input: &mut Input, live: &[Live]) {
     let mut report: DcProtectiveReport = unsafe { std::mem::zeroed() };
     report.verdict = 7;
     let tcps_ptr = if nulls & 1 != 0 { std::ptr::null() } else { tcps.as_ptr() };
-    let (out_verdict, out_report) = (null_if(nulls & 2 != 0, &mut verdict), null_if(nulls & 4 != 0, &mut report));
+    let (out_verdict, out_report) =
+        (null_if(nulls & 2 != 0, &mut verdict), null_if(nulls & 4 != 0, &mut report));
     // SAFETY: NULL or live.
     let lookups_before = unsafe { dc_table_protective_lookups(handle_of(l)) };
     // SAFETY: the handle is NULL or live; `tcps` holds `count` points, `paths` one path per
@@ -330,7 +356,15 @@ fn protective(input: &mut Input, live: &[Live]) {
     let status = unsafe {
         if with_paths {
             let paths_ptr = if null_paths { std::ptr::null() } else { paths.as_ptr() };
-            dc_protective_query_with_paths(handle_of(l), tcps_ptr, count, paths_ptr, count, out_verdict, out_report)
+            dc_protective_query_with_paths(
+                handle_of(l),
+                tcps_ptr,
+                count,
+                paths_ptr,
+                count,
+                out_verdict,
+                out_report,
+            )
         } else {
             dc_protective_query(handle_of(l), tcps_ptr, count, out_verdict, out_report)
         }
@@ -338,18 +372,42 @@ fn protective(input: &mut Input, live: &[Live]) {
     assert_ne!(status, DC_STATUS_PANIC, "the protective query panicked");
     // A query answered by the clearance table alone is one more lookup, and only a FREE one.
     // SAFETY: NULL or live.
-    let (lookups, mode) = unsafe { (dc_table_protective_lookups(handle_of(l)), dc_mode(handle_of(l))) };
+    let (lookups, mode) =
+        unsafe { (dc_table_protective_lookups(handle_of(l)), dc_mode(handle_of(l))) };
     let looked_up = lookups.checked_sub(lookups_before).expect("the lookup count never falls");
-    assert!(looked_up <= 1 && (mode == DC_MODE_TABLE || lookups == 0), "{looked_up} lookups in one query, mode {mode}");
-    assert!(looked_up == 0 || status == DC_STATUS_OK, "a lookup answered a query with status {status}");
-    assert!(looked_up == 0 || nulls & 2 != 0 || verdict == DC_VERDICT_FREE, "a lookup answered verdict {verdict}");
+    assert!(
+        looked_up <= 1 && (mode == DC_MODE_TABLE || lookups == 0),
+        "{looked_up} lookups in one query, mode {mode}"
+    );
+    assert!(
+        looked_up == 0 || status == DC_STATUS_OK,
+        "a lookup answered a query with status {status}"
+    );
+    assert!(
+        looked_up == 0 || nulls & 2 != 0 || verdict == DC_VERDICT_FREE,
+        "a lookup answered verdict {verdict}"
+    );
     if nulls & 2 == 0 {
-        assert!([DC_VERDICT_FREE, DC_VERDICT_WARN, DC_VERDICT_STOP].contains(&verdict), "verdict {verdict}");
-        assert!(status == DC_STATUS_OK || verdict == DC_VERDICT_STOP, "status {status} with verdict {verdict}");
+        assert!(
+            [DC_VERDICT_FREE, DC_VERDICT_WARN, DC_VERDICT_STOP].contains(&verdict),
+            "verdict {verdict}"
+        );
+        assert!(
+            status == DC_STATUS_OK || verdict == DC_VERDICT_STOP,
+            "status {status} with verdict {verdict}"
+        );
     }
     if nulls & 4 == 0 {
-        assert!(nulls & 2 != 0 || report.verdict == verdict, "report {}, verdict {verdict}", report.verdict);
-        assert!(status == DC_STATUS_OK || report.verdict == DC_VERDICT_STOP, "status {status}, report verdict {}", report.verdict);
+        assert!(
+            nulls & 2 != 0 || report.verdict == verdict,
+            "report {}, verdict {verdict}",
+            report.verdict
+        );
+        assert!(
+            status == DC_STATUS_OK || report.verdict == DC_VERDICT_STOP,
+            "status {status}, report verdict {}",
+            report.verdict
+        );
     }
     if l.is_none() || nulls & 3 != 0 || null_paths {
         return assert_eq!(status, DC_STATUS_NULL_POINTER);
@@ -359,10 +417,16 @@ fn protective(input: &mut Input, live: &[Live]) {
     }
     // A path too long for the call is refused before the TCPs are read.
     if paths.iter().any(|p| p.n_points > DC_MAX_PATH_POINTS) {
-        return assert_eq!(status, DC_STATUS_INVALID_ARGUMENT, "a path of more than {DC_MAX_PATH_POINTS} points");
+        return assert_eq!(
+            status, DC_STATUS_INVALID_ARGUMENT,
+            "a path of more than {DC_MAX_PATH_POINTS} points"
+        );
     }
     let tcp_finite = tcps.iter().all(|p| p.x.is_finite() && p.y.is_finite() && p.z.is_finite());
-    assert!(tcp_finite || status == DC_STATUS_NON_FINITE, "non-finite TCPs {tcps:?}: status {status}");
+    assert!(
+        tcp_finite || status == DC_STATUS_NON_FINITE,
+        "non-finite TCPs {tcps:?}: status {status}"
+    );
 }
 
 /// `Op::ProtectiveTimed` (encoding in [`Op`], properties in the module doc).
@@ -414,7 +478,9 @@ fn protective_timed(input: &mut Input, live: &[Live]) {
     };
     let time = match (input.byte() % 4, aim) {
         (1, Some((_, t))) => t,
-        (2, Some((DC_CLOCK_NANOS, t))) => t.wrapping_add(u64::from(u16::from_le_bytes(input.bytes())) * 128),
+        (2, Some((DC_CLOCK_NANOS, t))) => {
+            t.wrapping_add(u64::from(u16::from_le_bytes(input.bytes())) * 128)
+        }
         (2, Some((_, t))) => t.wrapping_add(u64::from(input.byte() % 8)),
         (3, Some((_, t))) => t.wrapping_sub(1 + u64::from(input.byte() % 8)),
         _ => input.u64(),
@@ -429,25 +495,41 @@ fn protective_timed(input: &mut Input, live: &[Live]) {
         paths: if null_paths { std::ptr::null() } else { paths.as_ptr() },
         n_paths: if with_paths { count } else { 0 },
     };
-    let request_ptr: *const DcProtectiveRequest = if nulls & 1 != 0 { std::ptr::null() } else { &request };
+    let request_ptr: *const DcProtectiveRequest =
+        if nulls & 1 != 0 { std::ptr::null() } else { &request };
     let mut verdict = DC_VERDICT_COLLISION;
     // SAFETY: all-zero is a valid `DcProtectiveReport` (numbers and integers only).
     let mut report: DcProtectiveReport = unsafe { std::mem::zeroed() };
     report.verdict = 7;
-    let (out_verdict, out_report) = (null_if(nulls & 4 != 0, &mut verdict), null_if(nulls & 8 != 0, &mut report));
+    let (out_verdict, out_report) =
+        (null_if(nulls & 4 != 0, &mut verdict), null_if(nulls & 8 != 0, &mut report));
     // SAFETY: the handle is NULL or live; the request is NULL or readable, its TCPs hold
     // `count` points and its paths one path per TCP whose points they hold (or NULL);
     // outputs are NULL or writable.
-    let status = unsafe { dc_protective_query_timed(handle_of(l), request_ptr, out_verdict, out_report) };
+    let status =
+        unsafe { dc_protective_query_timed(handle_of(l), request_ptr, out_verdict, out_report) };
     assert_ne!(status, DC_STATUS_PANIC, "the timed protective query panicked");
     assert_ne!(status, DC_STATUS_BUSY, "a handle busy with no other thread");
     if nulls & 4 == 0 {
-        assert!([DC_VERDICT_FREE, DC_VERDICT_WARN, DC_VERDICT_STOP].contains(&verdict), "verdict {verdict}");
-        assert!(status == DC_STATUS_OK || verdict == DC_VERDICT_STOP, "status {status} with verdict {verdict}");
+        assert!(
+            [DC_VERDICT_FREE, DC_VERDICT_WARN, DC_VERDICT_STOP].contains(&verdict),
+            "verdict {verdict}"
+        );
+        assert!(
+            status == DC_STATUS_OK || verdict == DC_VERDICT_STOP,
+            "status {status} with verdict {verdict}"
+        );
     }
     if nulls & 8 == 0 {
-        assert!(nulls & 4 != 0 || report.verdict == verdict, "report {}, verdict {verdict}", report.verdict);
-        assert!(status == DC_STATUS_OK || report.verdict == DC_VERDICT_STOP, "status {status}, report {report:?}");
+        assert!(
+            nulls & 4 != 0 || report.verdict == verdict,
+            "report {}, verdict {verdict}",
+            report.verdict
+        );
+        assert!(
+            status == DC_STATUS_OK || report.verdict == DC_VERDICT_STOP,
+            "status {status}, report {report:?}"
+        );
     }
     // Which checks refuse the call before the checker sees it: from here on the call is the
     // handle's last, so the rules compare with it only if it reaches the checker.
@@ -458,7 +540,10 @@ fn protective_timed(input: &mut Input, live: &[Live]) {
         return assert_eq!(status, DC_STATUS_NULL_POINTER, "a NULL request, TCPs or verdict");
     }
     if struct_size != size || clock > DC_CLOCK_NANOS {
-        return assert_eq!(status, DC_STATUS_INVALID_ARGUMENT, "struct_size {struct_size} (not {size}), clock {clock}");
+        return assert_eq!(
+            status, DC_STATUS_INVALID_ARGUMENT,
+            "struct_size {struct_size} (not {size}), clock {clock}"
+        );
     }
     // No paths (`n_paths` 0) are not read at all, NULL or not.
     if null_paths && count > 0 {
@@ -468,7 +553,10 @@ fn protective_timed(input: &mut Input, live: &[Live]) {
         return assert_eq!(status, DC_STATUS_WRONG_ROBOT_COUNT);
     }
     if paths.iter().any(|p| p.n_points > DC_MAX_PATH_POINTS) {
-        return assert_eq!(status, DC_STATUS_INVALID_ARGUMENT, "a path of more than {DC_MAX_PATH_POINTS} points");
+        return assert_eq!(
+            status, DC_STATUS_INVALID_ARGUMENT,
+            "a path of more than {DC_MAX_PATH_POINTS} points"
+        );
     }
     let timing = [
         DC_STATUS_TIME_REPEATED,
@@ -486,7 +574,10 @@ fn protective_timed(input: &mut Input, live: &[Live]) {
     ];
     assert!(allowed.contains(&status) || timing.contains(&status), "status {status}");
     let tcp_finite = tcps.iter().all(|p| p.x.is_finite() && p.y.is_finite() && p.z.is_finite());
-    assert!(tcp_finite || status == DC_STATUS_NON_FINITE || timing.contains(&status), "TCPs {tcps:?}: status {status}");
+    assert!(
+        tcp_finite || status == DC_STATUS_NON_FINITE || timing.contains(&status),
+        "TCPs {tcps:?}: status {status}"
+    );
     let answer = if nulls & 8 == 0 { Some(report) } else { None };
     if let Some(last) = last {
         let same_tcps = tcps.iter().zip(&last.tcps).all(|(a, b)| bits(a) == bits(b));
@@ -504,7 +595,11 @@ fn protective_timed(input: &mut Input, live: &[Live]) {
             None
         };
         if let Some(expected) = expected {
-            assert_eq!(status, expected, "clock {clock} time {time} after clock {} time {}", last.clock, last.time);
+            assert_eq!(
+                status, expected,
+                "clock {clock} time {time} after clock {} time {}",
+                last.clock, last.time
+            );
         }
         if time == last.time && clock == last.clock && same_tcps {
             assert_eq!(verdict, last.verdict, "a repeated call's verdict");
@@ -541,8 +636,14 @@ fn check_ok_report(l: &Live, report: &DcQueryReport) {
     assert_eq!(colliding.len(), report.colliding_pairs as usize, "{report:?} vs {pairs:?}");
     if let Some(first) = colliding.first() {
         let (a, b) = (report.first_robot_a, report.first_robot_b);
-        assert!((a, b) == (first.robot_a, first.robot_b) && a < b && b < n, "{report:?} vs {first:?}");
-        assert!((report.first_box_a, report.first_box_b) == (first.box_a, first.box_b), "{report:?} vs {first:?}");
+        assert!(
+            (a, b) == (first.robot_a, first.robot_b) && a < b && b < n,
+            "{report:?} vs {first:?}"
+        );
+        assert!(
+            (report.first_box_a, report.first_box_b) == (first.box_a, first.box_b),
+            "{report:?} vs {first:?}"
+        );
     }
 }
 
@@ -566,11 +667,19 @@ fn pair_results(input: &mut Input, live: &[Live]) {
     let nulls = input.byte();
     let h = handle_of(l);
     if nulls & 3 != 0 {
-        let mut out = vec![DcPairResult { robot_a: 0, robot_b: 0, collides: 0, box_a: 0, box_b: 0 }; capacity];
+        let mut out = vec![
+            DcPairResult { robot_a: 0, robot_b: 0, collides: 0, box_a: 0, box_b: 0 };
+            capacity
+        ];
         let mut len = usize::MAX;
         // SAFETY: `h` is NULL or live; `out` NULL or `capacity` elements; `len` NULL or writable.
         let status = unsafe {
-            dc_pair_results(h, null_if(nulls & 1 != 0, out.as_mut_ptr()), capacity, null_if(nulls & 2 != 0, &mut len))
+            dc_pair_results(
+                h,
+                null_if(nulls & 1 != 0, out.as_mut_ptr()),
+                capacity,
+                null_if(nulls & 2 != 0, &mut len),
+            )
         };
         return assert_eq!(status, DC_STATUS_NULL_POINTER);
     }
@@ -581,7 +690,11 @@ fn pair_results(input: &mut Input, live: &[Live]) {
     if capacity < count {
         return assert_eq!(status, DC_STATUS_INVALID_ARGUMENT);
     }
-    assert!(status == DC_STATUS_OK && pairs.len() == count, "status {status}, {} pairs of {count}", pairs.len());
+    assert!(
+        status == DC_STATUS_OK && pairs.len() == count,
+        "status {status}, {} pairs of {count}",
+        pairs.len()
+    );
     let n = l.robots.len() as u32;
     for p in pairs {
         assert!(p.robot_a < p.robot_b && p.robot_b < n && p.collides <= 1, "{p:?}");
@@ -590,7 +703,10 @@ fn pair_results(input: &mut Input, live: &[Live]) {
         let no_boxes = p.box_a == DC_BOX_NONE && p.box_b == DC_BOX_NONE;
         // Table mode names boxes only when the exact check answered the collision.
         assert_eq!(p.box_a == DC_BOX_NONE, p.box_b == DC_BOX_NONE, "{p:?}");
-        assert!(if exact { (p.collides == 0) == no_boxes } else { p.collides == 1 || no_boxes }, "{p:?}");
+        assert!(
+            if exact { (p.collides == 0) == no_boxes } else { p.collides == 1 || no_boxes },
+            "{p:?}"
+        );
     }
 }
 
@@ -602,15 +718,22 @@ fn counts(input: &mut Input, live: &[Live]) {
         (dc_robot_count(h), dc_pair_count(h), dc_mode(h), dc_table_fallbacks(h))
     };
     let n = l.map_or(0, |l| l.robots.len());
-    assert!(robots == n && pairs <= n * n.saturating_sub(1) / 2, "{robots} robots, {pairs} pairs, n = {n}");
-    let expected_mode = if l.is_none() { DC_MODE_NONE } else { mode.clamp(DC_MODE_EXACT, DC_MODE_TABLE) };
+    assert!(
+        robots == n && pairs <= n * n.saturating_sub(1) / 2,
+        "{robots} robots, {pairs} pairs, n = {n}"
+    );
+    let expected_mode =
+        if l.is_none() { DC_MODE_NONE } else { mode.clamp(DC_MODE_EXACT, DC_MODE_TABLE) };
     assert_eq!(mode, expected_mode, "dc_mode");
     assert!(mode == DC_MODE_TABLE || fallbacks == 0, "{fallbacks} table fallbacks in mode {mode}");
     // Then switches the table confirmation by the counts seen so far (no input read), with a
     // value that is no DcConfirmation one time in three.
     // SAFETY: NULL or live.
     let confirmations = unsafe { dc_table_confirmations(handle_of(l)) };
-    assert!(mode == DC_MODE_TABLE || confirmations == 0, "{confirmations} confirmations in mode {mode}");
+    assert!(
+        mode == DC_MODE_TABLE || confirmations == 0,
+        "{confirmations} confirmations in mode {mode}"
+    );
     let value = ((fallbacks + confirmations) % 3) as DcConfirmation;
     // SAFETY: NULL or live.
     let status = unsafe { dc_set_table_confirmation(handle_of(l), value) };
@@ -657,8 +780,13 @@ fn inverse(input: &mut Input) {
     let mut theta = [f64::NAN; 3];
     let g_ptr: *const DcDelta3 = if nulls & 1 != 0 { std::ptr::null() } else { &g };
     // SAFETY: geometry NULL or valid; `theta` NULL or 3 writable doubles.
-    let status =
-        unsafe { dc_delta3_inverse_kinematics(g_ptr, DcVec3 { x, y, z }, null_if(nulls & 2 != 0, theta.as_mut_ptr())) };
+    let status = unsafe {
+        dc_delta3_inverse_kinematics(
+            g_ptr,
+            DcVec3 { x, y, z },
+            null_if(nulls & 2 != 0, theta.as_mut_ptr()),
+        )
+    };
     assert_ne!(status, DC_STATUS_PANIC, "dc_delta3_inverse_kinematics panicked");
     if nulls & 3 != 0 {
         return assert_eq!(status, DC_STATUS_NULL_POINTER);
@@ -670,7 +798,8 @@ fn inverse(input: &mut Input) {
     if thesis {
         let mut back = DcVec3 { x: f64::NAN, y: 0.0, z: 0.0 };
         // SAFETY: valid geometry, 3 readable doubles, writable output.
-        assert_eq!(unsafe { dc_delta3_forward_kinematics(&g, theta.as_ptr(), &mut back) }, DC_STATUS_OK);
+        let status = unsafe { dc_delta3_forward_kinematics(&g, theta.as_ptr(), &mut back) };
+        assert_eq!(status, DC_STATUS_OK);
         let err = (back.x - x).hypot(back.y - y).hypot(back.z - z);
         assert!(err < 1e-6, "FK(IK({:?})) = {back:?}, {err} mm off", (x, y, z));
     }
@@ -684,13 +813,17 @@ fn forward(input: &mut Input) {
     let g_ptr: *const DcDelta3 = if nulls & 1 != 0 { std::ptr::null() } else { &g };
     let t_ptr = if nulls & 2 != 0 { std::ptr::null() } else { theta.as_ptr() };
     // SAFETY: each pointer NULL or valid for its use.
-    let status = unsafe { dc_delta3_forward_kinematics(g_ptr, t_ptr, null_if(nulls & 4 != 0, &mut tcp)) };
+    let status =
+        unsafe { dc_delta3_forward_kinematics(g_ptr, t_ptr, null_if(nulls & 4 != 0, &mut tcp)) };
     assert_ne!(status, DC_STATUS_PANIC, "dc_delta3_forward_kinematics panicked");
     if nulls & 7 != 0 {
         return assert_eq!(status, DC_STATUS_NULL_POINTER);
     }
     if status == DC_STATUS_OK {
-        assert!(tcp.x.is_finite() && tcp.y.is_finite() && tcp.z.is_finite(), "FK({theta:?}) = {tcp:?} with {g:?}");
+        assert!(
+            tcp.x.is_finite() && tcp.y.is_finite() && tcp.z.is_finite(),
+            "FK({theta:?}) = {tcp:?} with {g:?}"
+        );
     }
 }
 
@@ -753,17 +886,31 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     init(&mut e, 2, 1, 0);
     // Protective: handle 0, two TCPs, no paths, no NULLs; twice (speeds from the first).
     for _ in 0..2 {
-        e.byte(Op::Protective as u8).byte(0).byte(0).point([-150.0, 0.0, -450.0]).point([150.0, 0.0, -450.0]);
+        e.byte(Op::Protective as u8)
+            .byte(0)
+            .byte(0)
+            .point([-150.0, 0.0, -450.0])
+            .point([150.0, 0.0, -450.0]);
         e.byte(0).byte(0);
     }
     // With paths: robot 0 along x for 50 mm (tolerance 1), robot 1 none.
-    e.byte(Op::Protective as u8).byte(0).byte(0).point([-150.0, 0.0, -450.0]).point([150.0, 0.0, -450.0]).byte(1);
+    e.byte(Op::Protective as u8)
+        .byte(0)
+        .byte(0)
+        .point([-150.0, 0.0, -450.0])
+        .point([150.0, 0.0, -450.0])
+        .byte(1);
     e.byte(2).point([-150.0, 0.0, -450.0]).point([-100.0, 0.0, -450.0]).byte(0);
     e.f64(1.0).f64(0.0).byte(0).byte(0);
     out.push(("protective", e.bytes));
     // The timed protective query on handle 0: TCPs (None: the last call's again), no paths,
     // then struct_size, clock and time bytes, and the NULL flags.
-    let timed = |e: &mut Encoder, tcps: Option<[[f64; 3]; 2]>, size: u8, clock: u8, time: &[u8], nulls: u8| {
+    let timed = |e: &mut Encoder,
+                 tcps: Option<[[f64; 3]; 2]>,
+                 size: u8,
+                 clock: u8,
+                 time: &[u8],
+                 nulls: u8| {
         e.byte(Op::ProtectiveTimed as u8).byte(0);
         match tcps {
             None => e.byte(1),
@@ -809,7 +956,16 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.byte(0);
     out.push(("protective_timed", e.bytes));
     let mut e = Encoder::default();
-    e.byte(Op::Init as u8).byte(2).byte(0).byte(0).byte(1).byte(0).byte(0).f64(-100.0).byte(0).byte(8);
+    e.byte(Op::Init as u8)
+        .byte(2)
+        .byte(0)
+        .byte(0)
+        .byte(1)
+        .byte(0)
+        .byte(0)
+        .f64(-100.0)
+        .byte(0)
+        .byte(8);
     init(&mut e, 0, 0, 0);
     init(&mut e, 33, 0, 0);
     e.byte(Op::Init as u8).byte(2).byte(3).u32(7).byte(0).byte(0).byte(0).byte(0);
@@ -860,18 +1016,40 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
         e.byte(Op::PairResults as u8).byte(0).byte(1).byte(0).byte(Op::Counts as u8).byte(0);
         // The protective verdict in table mode, twice (speeds from the first).
         for _ in 0..2 {
-            e.byte(Op::Protective as u8).byte(0).byte(0).point([-150.0, 0.0, -450.0]).point([150.0, 0.0, -450.0]);
+            e.byte(Op::Protective as u8)
+                .byte(0)
+                .byte(0)
+                .point([-150.0, 0.0, -450.0])
+                .point([150.0, 0.0, -450.0]);
             e.byte(0).byte(0);
         }
         out.push((name, e.bytes));
     }
     let mut e = Encoder::default();
-    e.byte(Op::InitWithTable as u8).byte(3).byte(1).byte(0).byte(0).byte(0).byte(0).byte(0).byte(0).byte(0).byte(9);
+    e.byte(Op::InitWithTable as u8)
+        .byte(3)
+        .byte(1)
+        .byte(0)
+        .byte(0)
+        .byte(0)
+        .byte(0)
+        .byte(0)
+        .byte(0)
+        .byte(0)
+        .byte(9);
     // Robot 1 with a margin of 1 mm, the table resealed with that cell's fingerprint: loads.
     e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(1).byte(1).byte(8).f64(1.0);
     e.byte(0).byte(0).byte(1).byte(0).byte(0).byte(200);
     // One byte of the table changed (offset 48, r), not resealed: the checksum fails.
-    e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0).byte(0).byte(1).u16(48).byte(0x10);
+    e.byte(Op::InitWithTable as u8)
+        .byte(2)
+        .byte(1)
+        .byte(0)
+        .byte(0)
+        .byte(0)
+        .byte(1)
+        .u16(48)
+        .byte(0x10);
     e.byte(0).byte(0).byte(0).byte(200);
     // A table of 16 bytes from the input: truncated.
     e.byte(Op::InitWithTable as u8).byte(2).byte(1).byte(0).byte(0).byte(5).u16(16);

@@ -35,11 +35,17 @@ pub fn cell_toml(data: &[u8]) {
             let expected = if v.collides() { DC_VERDICT_COLLISION } else { DC_VERDICT_FREE };
             assert_eq!((status, verdict), (DC_STATUS_OK, expected), "C ABI disagrees at {tcps:?}");
         } else {
-            assert!(status != DC_STATUS_OK && verdict == DC_VERDICT_STOP, "status {status}, verdict {verdict}");
+            assert!(
+                status != DC_STATUS_OK && verdict == DC_VERDICT_STOP,
+                "status {status}, verdict {verdict}"
+            );
         }
     }
     let home = vec![Vec3::new(0.0, 0.0, -450.0); n + 1];
-    assert!(exact.check(&home).is_err() && exact.check(&home[..n - 1]).is_err(), "wrong TCP count accepted");
+    assert!(
+        exact.check(&home).is_err() && exact.check(&home[..n - 1]).is_err(),
+        "wrong TCP count accepted"
+    );
 }
 
 /// TCP sets, one TCP per robot (each in its own MCS): everyone at a few common points, every
@@ -48,12 +54,19 @@ pub fn cell_toml(data: &[u8]) {
 fn probes(cell: &Cell) -> Vec<Vec<Vec3>> {
     let n = cell.robots.len();
     let home = Vec3::new(0.0, 0.0, -450.0);
-    let common = [home, Vec3::new(150.0, 0.0, -400.0), Vec3::new(-120.0, 90.0, -500.0), Vec3::new(0.0, 0.0, -1e6)];
+    let common = [
+        home,
+        Vec3::new(150.0, 0.0, -400.0),
+        Vec3::new(-120.0, 90.0, -500.0),
+        Vec3::new(0.0, 0.0, -1e6),
+    ];
     let mut out: Vec<Vec<Vec3>> = common.iter().map(|&p| vec![p; n]).collect();
     let t1 = cell.robots.get(1).map_or(Vec3::zeros(), |r| r.placement.t);
     let mid = (cell.robots[0].placement.t + t1) * 0.5 + Vec3::new(0.0, 0.0, -450.0);
     out.push(cell.robots.iter().map(|r| r.placement.to_mcs(&mid)).collect());
-    for odd in [Vec3::new(f64::NAN, 0.0, -450.0), Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 0.0, -2000.0)] {
+    for odd in
+        [Vec3::new(f64::NAN, 0.0, -450.0), Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 0.0, -2000.0)]
+    {
         let mut tcps = vec![home; n];
         tcps[n - 1] = odd;
         out.push(tcps);
@@ -67,7 +80,8 @@ struct CHandle(*mut DcCollider);
 impl CHandle {
     fn new(cell: &Cell) -> Self {
         let robots: Vec<DcRobotConfig> = cell.robots.iter().map(DcRobotConfig::from_spec).collect();
-        let method = if cell.method == SatMethod::Sat { DC_METHOD_SAT } else { DC_METHOD_SAT_CACHE };
+        let method =
+            if cell.method == SatMethod::Sat { DC_METHOD_SAT } else { DC_METHOD_SAT_CACHE };
         let config = DcCellConfig { robots: robots.as_ptr(), n_robots: robots.len(), method };
         let mut h = std::ptr::null_mut();
         // SAFETY: `config` points to `n_robots` robots; `h` is writable.
@@ -80,7 +94,9 @@ impl CHandle {
         let tcps: Vec<DcVec3> = tcps.iter().map(DcVec3::from_vec3).collect();
         let mut verdict = DC_VERDICT_FREE;
         // SAFETY: live handle; `tcps` holds `len` points; `verdict` is writable.
-        let status = unsafe { dc_query(self.0, tcps.as_ptr(), tcps.len(), &mut verdict, std::ptr::null_mut()) };
+        let status = unsafe {
+            dc_query(self.0, tcps.as_ptr(), tcps.len(), &mut verdict, std::ptr::null_mut())
+        };
         (status, verdict)
     }
 }

@@ -131,7 +131,8 @@ pub fn exact_oracle(data: &[u8]) {
     if !v.all_reachable() {
         return; // the two inverse kinematics round differently on the reach boundary
     }
-    let placed = |j: usize, p: &Vec3| cell.robots[j].placement.rotation() * p + cell.robots[j].placement.t;
+    let placed =
+        |j: usize, p: &Vec3| cell.robots[j].placement.rotation() * p + cell.robots[j].placement.t;
     let (rho, outer) = (17.5f64, 70f64.hypot(17.5));
     let (mut inner, mut apart) = (f64::INFINITY, f64::INFINITY);
     for (ga, ea) in &la {
@@ -147,10 +148,18 @@ pub fn exact_oracle(data: &[u8]) {
         }
     }
     if inner < 2.0 * rho - 1e-6 {
-        assert!(v.collides(), "{}: inscribed balls meet ({inner} mm) but the check says free: {tcps:?}", cell.name);
+        assert!(
+            v.collides(),
+            "{}: inscribed balls meet ({inner} mm) but the check says free: {tcps:?}",
+            cell.name
+        );
     }
     if apart > 2.0 * outer + 1e-6 {
-        assert!(!v.collides(), "{}: capsules apart ({apart} mm) but the check says collision: {tcps:?}", cell.name);
+        assert!(
+            !v.collides(),
+            "{}: capsules apart ({apart} mm) but the check says collision: {tcps:?}",
+            cell.name
+        );
     }
 }
 

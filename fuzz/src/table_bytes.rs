@@ -70,12 +70,20 @@ fn load_and_probe(bytes: &[u8], rng: &mut Rng) {
             if again != bytes {
                 // A clearance file with u32 child indices (variant 8, flag bit 2 clear) is
                 // written back with them packed: the same table in fewer bytes.
-                let field = |at: usize| bytes.get(at..at + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+                let field = |at: usize| {
+                    bytes.get(at..at + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                };
                 let wide_clearance = field(16) == Some(8) && field(28).is_some_and(|f| f & 4 == 0);
                 assert!(wide_clearance, "a loaded table re-serialises to other bytes");
                 let back = from_bytes(&again).expect("a clearance table written back packed loads");
-                assert!(back == (header.clone(), table.clone()), "a clearance table written back packed differs");
-                assert!(again.len() <= bytes.len(), "packed child indices take more bytes than u32 ones");
+                assert!(
+                    back == (header.clone(), table.clone()),
+                    "a clearance table written back packed differs"
+                );
+                assert!(
+                    again.len() <= bytes.len(),
+                    "packed child indices take more bytes than u32 ones"
+                );
             }
             probe_table(&table, &header, rng);
         }
@@ -116,7 +124,8 @@ fn probe_checker(checker: &mut TableChecker, cell: &Cell, rng: &mut Rng) {
     let h = checker.header().clone();
     let k = 1u32 << checker.table().levels();
     let origins = [Vec3::from(h.origin_a), Vec3::from(h.origin_b)];
-    let centre = |j: usize, c: [u32; 3]| origins[j] + Vec3::from(c.map(|i| (f64::from(i) + 0.5) * h.r));
+    let centre =
+        |j: usize, c: [u32; 3]| origins[j] + Vec3::from(c.map(|i| (f64::from(i) + 0.5) * h.r));
     let mut pairs: Vec<[Vec3; 2]> = (0..24)
         .map(|_| {
             [
@@ -146,11 +155,17 @@ fn probe_checker(checker: &mut TableChecker, cell: &Cell, rng: &mut Rng) {
             }
             TableAnswer::Unreachable(mask) => {
                 assert!(mask != 0 && mask < 4, "mask {mask:#b}");
-                assert!((0..2).all(|j| (mask >> j & 1 == 0) == reachable(j)), "mask {mask:#b} for {tcps:?}");
+                assert!(
+                    (0..2).all(|j| (mask >> j & 1 == 0) == reachable(j)),
+                    "mask {mask:#b} for {tcps:?}"
+                );
             }
         }
     }
-    assert!(checker.check(&[home]).is_err() && checker.check(&[home; 3]).is_err(), "wrong TCP count accepted");
+    assert!(
+        checker.check(&[home]).is_err() && checker.check(&[home; 3]).is_err(),
+        "wrong TCP count accepted"
+    );
 }
 
 /// xorshift64: query cells that vary with the input, reproducibly.

@@ -14,20 +14,20 @@
 //! name = "B"
 //! placement = { alpha_deg = 0.0, t = [450.0, 0.0, 0.0] }
 //! model = { margin = 5.0, upper_links = { half_height = 30.0, half_depth = 15.0 } }
-//! stop = { reaction_ms = 4.0, decel_mm_s2 = 40000.0, max_accel_mm_s2 = 130000.0, max_speed_mm_s = 4600.0 }
+//! stop = { reaction_ms = 4.0, decel_mm_s2 = 40000.0, max_accel_mm_s2 = 130000.0, max_speed_mm_s =
+//! 4600.0 }
 //! ```
 //!
 //! The top-level `tick_ms` (default 1) and each robot's `stop` (SPEC §8; defaults in
 //! [`StopModel::DEFAULT`]) serve the protective verdict only; the top-level `table_confirm`
 //! (`"exact"`, the default, or `"none"`) serves table mode only ([`Confirmation`]).
 
+use super::Confirmation;
 use crate::cell::placement::Placement;
 use crate::cell::{Cell, CellError, RobotSpec, SatMethod};
-use super::Confirmation;
 use crate::math::{Real, Vec3};
 use crate::robot::{Delta3, ModelOptions, RobotModel, StopModel, ToolBox, DEFAULT_TICK_MS};
 use serde::Deserialize;
-
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -184,14 +184,18 @@ pub fn parse_cell_file(text: &str) -> Result<CellFileContents, CellError> {
     let table_confirmation = match file.table_confirm.as_deref() {
         None => Confirmation::default(),
         Some(name) => Confirmation::from_name(name).ok_or_else(|| {
-            CellError::Parse(format!("table_confirm = \"{name}\" is unknown; use \"exact\" or \"none\""))
+            CellError::Parse(format!(
+                "table_confirm = \"{name}\" is unknown; use \"exact\" or \"none\""
+            ))
         })?,
     };
     let method = match file.method.as_deref() {
         None | Some("sat-cache") => SatMethod::SatCache,
         Some("sat") => SatMethod::Sat,
         Some(other) => {
-            return Err(CellError::Parse(format!("method = \"{other}\" is unknown; use \"sat\" or \"sat-cache\"")))
+            return Err(CellError::Parse(format!(
+                "method = \"{other}\" is unknown; use \"sat\" or \"sat-cache\""
+            )))
         }
     };
     let robots = file
@@ -213,12 +217,19 @@ pub fn parse_cell_file(text: &str) -> Result<CellFileContents, CellError> {
                     half_height: r.model.half_height,
                     half_depth: r.model.half_depth,
                     margin: r.model.margin,
-                    upper_links: r.model.upper_links.as_ref().map(|u| (u.half_height, u.half_depth)),
+                    upper_links: r
+                        .model
+                        .upper_links
+                        .as_ref()
+                        .map(|u| (u.half_height, u.half_depth)),
                     platform: r.model.platform.as_ref().map(tool_box),
                     tool: r.model.tool.as_ref().map(tool_box),
                 },
             },
-            placement: Placement { alpha: r.placement.alpha_deg.to_radians(), t: Vec3::from(r.placement.t) },
+            placement: Placement {
+                alpha: r.placement.alpha_deg.to_radians(),
+                t: Vec3::from(r.placement.t),
+            },
         })
         .collect();
     let stops = file
@@ -242,7 +253,8 @@ mod tests {
 
     #[test]
     fn defaults_are_the_thesis_robot() {
-        let cell = parse_cell("[[robot]]\n[[robot]]\nplacement = { t = [450.0, 0.0, 0.0] }\n").unwrap();
+        let cell =
+            parse_cell("[[robot]]\n[[robot]]\nplacement = { t = [450.0, 0.0, 0.0] }\n").unwrap();
         assert_eq!(cell.robots.len(), 2);
         assert_eq!(cell.robots[0].model, RobotModel::THESIS);
         assert_eq!(cell.robots[1].placement.t, Vec3::new(450.0, 0.0, 0.0));
@@ -261,7 +273,9 @@ mod tests {
 
     #[test]
     fn stop_models_and_tick_are_read_defaulted_and_checked() {
-        let cell = parse_cell("tick_ms = 2.0\n[[robot]]\nstop = { reaction_ms = 6.0 }\n[[robot]]\n").unwrap();
+        let cell =
+            parse_cell("tick_ms = 2.0\n[[robot]]\nstop = { reaction_ms = 6.0 }\n[[robot]]\n")
+                .unwrap();
         assert_eq!(cell.tick_ms, 2.0);
         assert_eq!(cell.stops[0], StopModel { reaction_ms: 6.0, ..StopModel::DEFAULT });
         assert_eq!(cell.stops[1], StopModel::DEFAULT);

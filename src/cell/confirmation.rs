@@ -16,7 +16,8 @@ pub enum Confirmation {
 
 impl Confirmation {
     /// Every setting, by its name in cell files and on the command line.
-    pub const ALL: [(&'static str, Confirmation); 2] = [("exact", Confirmation::Exact), ("none", Confirmation::None)];
+    pub const ALL: [(&'static str, Confirmation); 2] =
+        [("exact", Confirmation::Exact), ("none", Confirmation::None)];
 
     /// The setting named `name` (`"exact"` or `"none"`).
     pub fn from_name(name: &str) -> Option<Confirmation> {

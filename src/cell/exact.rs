@@ -121,7 +121,11 @@ impl ExactChecker {
             .map(|(a, b)| PairVerdict { a, b, state: PairState::Undecided })
             .collect();
         ExactChecker {
-            at_origin: cell.robots.iter().map(|r| r.placement.alpha == 0.0 && r.placement.t == Vec3::zeros()).collect(),
+            at_origin: cell
+                .robots
+                .iter()
+                .map(|r| r.placement.alpha == 0.0 && r.placement.t == Vec3::zeros())
+                .collect(),
             translated_only: cell.robots.iter().map(|r| r.placement.alpha == 0.0).collect(),
             rotations: cell.robots.iter().map(|r| r.placement.rotation()).collect(),
             boxes: vec![RobotBoxes::empty(); n],
@@ -149,7 +153,12 @@ impl ExactChecker {
     ///
     /// # Errors
     /// Why the TCP is unreachable (`out` then holds no usable boxes).
-    pub fn boxes_in_wcs(&self, i: usize, tcp_mcs: &Vec3, out: &mut RobotBoxes) -> Result<(), Unreachable> {
+    pub fn boxes_in_wcs(
+        &self,
+        i: usize,
+        tcp_mcs: &Vec3,
+        out: &mut RobotBoxes,
+    ) -> Result<(), Unreachable> {
         let robot = &self.cell.robots[i];
         robot.model.boxes_into(tcp_mcs, out)?;
         for b in &mut out.boxes[..out.len] {
@@ -183,7 +192,8 @@ impl ExactChecker {
             pair.state = if self.verdict.unreachable_mask & (1 << a | 1 << b) != 0 {
                 PairState::Undecided
             } else {
-                let robot = |j: usize| RobotInWcs { boxes: self.boxes[j].as_slice(), aabb: &self.aabb[j] };
+                let robot =
+                    |j: usize| RobotInWcs { boxes: self.boxes[j].as_slice(), aabb: &self.aabb[j] };
                 let cache = match self.cell.method {
                     SatMethod::Sat => None,
                     SatMethod::SatCache => Some(&mut self.caches[k]),
@@ -283,7 +293,8 @@ pub fn pair_state(a: &RobotInWcs, b: &RobotInWcs, cache: Option<&mut WitnessCach
 
 /// The index of the first box holding a non-finite value (0 when all are finite).
 fn first_non_finite(boxes: &[Obb]) -> usize {
-    let finite = |b: &Obb| b.center.iter().chain(b.axes.iter()).chain(b.half.iter()).all(|v| v.is_finite());
+    let finite =
+        |b: &Obb| b.center.iter().chain(b.axes.iter()).chain(b.half.iter()).all(|v| v.is_finite());
     boxes.iter().position(|b| !finite(b)).unwrap_or(0)
 }
 
@@ -338,14 +349,18 @@ mod tests {
             .map(|i| RobotSpec {
                 name: format!("R{i}"),
                 model: RobotModel::THESIS,
-                placement: Placement { alpha: 0.0, t: Vec3::new(450.0 * i as f64 + 0.37, -31.3 * i as f64, 0.0) },
+                placement: Placement {
+                    alpha: 0.0,
+                    t: Vec3::new(450.0 * i as f64 + 0.37, -31.3 * i as f64, 0.0),
+                },
             })
             .collect();
         let cell = Cell::new("row".into(), robots, SatMethod::SatCache).unwrap();
         let mut checker = ExactChecker::new(cell.clone());
         let (mut rng, mut collisions) = (TestRng(0x2545_f491_4f6c_dd1d), 0);
         for _ in 0..5_000 {
-            let mut tcp = || Vec3::new(250.0 * rng.unit(), 250.0 * rng.unit(), -450.0 - 100.0 * rng.unit());
+            let mut tcp =
+                || Vec3::new(250.0 * rng.unit(), 250.0 * rng.unit(), -450.0 - 100.0 * rng.unit());
             let tcps: Vec<Vec3> = (0..4).map(|_| tcp()).collect();
             let verdict = checker.check(&tcps).unwrap().clone();
             collisions += verdict.colliding_pairs();
@@ -355,7 +370,8 @@ mod tests {
                     continue;
                 };
                 let (rot, t) = (robot.placement.rotation(), robot.placement.t);
-                let want: Vec<Obb> = mcs.as_slice().iter().map(|b| b.transformed(&rot, &t)).collect();
+                let want: Vec<Obb> =
+                    mcs.as_slice().iter().map(|b| b.transformed(&rot, &t)).collect();
                 assert_eq!(checker.boxes(j).as_slice(), &want[..], "robot {j} at {tcp:?}");
             }
             for p in &verdict.pairs {
@@ -363,12 +379,19 @@ mod tests {
                     continue;
                 }
                 let boxes = |j: usize| {
-                    let (rot, t) = (cell.robots[j].placement.rotation(), cell.robots[j].placement.t);
+                    let (rot, t) =
+                        (cell.robots[j].placement.rotation(), cell.robots[j].placement.t);
                     let b = RobotModel::THESIS.boxes(&tcps[j]).unwrap();
                     b.as_slice().iter().map(|b| b.transformed(&rot, &t)).collect::<Vec<Obb>>()
                 };
                 let hit = first_intersecting_pair(&boxes(p.a), &boxes(p.b)).is_some();
-                assert_eq!(matches!(p.state, PairState::Collides(..)), hit, "pair {}-{} at {tcps:?}", p.a, p.b);
+                assert_eq!(
+                    matches!(p.state, PairState::Collides(..)),
+                    hit,
+                    "pair {}-{} at {tcps:?}",
+                    p.a,
+                    p.b
+                );
             }
         }
         assert!(collisions > 100, "{collisions} colliding pairs: the test must see some");
@@ -376,13 +399,22 @@ mod tests {
 
     #[test]
     fn far_pairs_are_pruned_and_middle_robot_meets_one_neighbour() {
-        assert_eq!(row_of_robots(3, 800.0, SatMethod::Sat).pairs_that_can_meet(), vec![(0, 1), (1, 2)]);
+        assert_eq!(
+            row_of_robots(3, 800.0, SatMethod::Sat).pairs_that_can_meet(),
+            vec![(0, 1), (1, 2)]
+        );
         let mut checker = ExactChecker::new(row_of_robots(3, 450.0, SatMethod::Sat));
         let home = Vec3::new(0.0, 0.0, -450.0);
         // Robot 1 reaches back toward robot 0 while robot 0 reaches forward: only (0, 1) meets.
-        let v = checker.check(&[Vec3::new(180.0, 0.0, -450.0), Vec3::new(-180.0, 0.0, -450.0), home]).unwrap();
+        let v = checker
+            .check(&[Vec3::new(180.0, 0.0, -450.0), Vec3::new(-180.0, 0.0, -450.0), home])
+            .unwrap();
         assert!(v.all_reachable());
-        let states: Vec<_> = v.pairs.iter().map(|p| (p.a, p.b, matches!(p.state, PairState::Collides(..)))).collect();
+        let states: Vec<_> = v
+            .pairs
+            .iter()
+            .map(|p| (p.a, p.b, matches!(p.state, PairState::Collides(..))))
+            .collect();
         assert_eq!(states, vec![(0, 1, true), (0, 2, false), (1, 2, false)]);
     }
 
@@ -392,8 +424,15 @@ mod tests {
         let home = Vec3::new(0.0, 0.0, -450.0);
         let v = checker.check(&[home, Vec3::new(0.0, 0.0, 100.0), home]).unwrap();
         assert_eq!(v.unreachable_mask, 0b010);
-        assert!(v.pairs.iter().filter(|p| p.a == 1 || p.b == 1).all(|p| p.state == PairState::Undecided));
-        assert_eq!(checker.check(&[home]).unwrap_err(), QueryError::WrongRobotCount { expected: 3, found: 1 });
+        assert!(v
+            .pairs
+            .iter()
+            .filter(|p| p.a == 1 || p.b == 1)
+            .all(|p| p.state == PairState::Undecided));
+        assert_eq!(
+            checker.check(&[home]).unwrap_err(),
+            QueryError::WrongRobotCount { expected: 3, found: 1 }
+        );
     }
 
     /// A NaN in any quantity between the TCP and the verdict (a motor cosine or sine, any
@@ -417,23 +456,29 @@ mod tests {
         for (ta, tb) in configs {
             let ik = |p: &Vec3| model.delta.inverse_kinematics_cos_sin(p).unwrap();
             let sol = [ik(&ta), ik(&tb)];
-            let mut check = |sol: &[MotorCosSin; 2], edit_boxes: BoxEdit, edit_aabb: AabbEdit, what: &str| {
-                let mut boxes = [model.boxes_from_cos_sin(&ta, &sol[0]), model.boxes_from_cos_sin(&tb, &sol[1])];
-                for b in &mut boxes[1].boxes[..3] {
-                    *b = b.transformed(&rot, &t);
-                }
-                edit_boxes(&mut boxes);
-                let mut aabb = [aabb_of(&boxes[0]), aabb_of(&boxes[1])];
-                edit_aabb(&mut aabb);
-                let robot = |j: usize| RobotInWcs { boxes: boxes[j].as_slice(), aabb: &aabb[j] };
-                let mut cache = WitnessCache::new();
-                for state in
-                    [pair_state(&robot(0), &robot(1), None), pair_state(&robot(0), &robot(1), Some(&mut cache))]
-                {
-                    assert_ne!(state, PairState::Free, "NaN in {what} at {ta:?} {tb:?}");
-                }
-                injected += 1;
-            };
+            let mut check =
+                |sol: &[MotorCosSin; 2], edit_boxes: BoxEdit, edit_aabb: AabbEdit, what: &str| {
+                    let mut boxes = [
+                        model.boxes_from_cos_sin(&ta, &sol[0]),
+                        model.boxes_from_cos_sin(&tb, &sol[1]),
+                    ];
+                    for b in &mut boxes[1].boxes[..3] {
+                        *b = b.transformed(&rot, &t);
+                    }
+                    edit_boxes(&mut boxes);
+                    let mut aabb = [aabb_of(&boxes[0]), aabb_of(&boxes[1])];
+                    edit_aabb(&mut aabb);
+                    let robot =
+                        |j: usize| RobotInWcs { boxes: boxes[j].as_slice(), aabb: &aabb[j] };
+                    let mut cache = WitnessCache::new();
+                    for state in [
+                        pair_state(&robot(0), &robot(1), None),
+                        pair_state(&robot(0), &robot(1), Some(&mut cache)),
+                    ] {
+                        assert_ne!(state, PairState::Free, "NaN in {what} at {ta:?} {tb:?}");
+                    }
+                    injected += 1;
+                };
             for robot in 0..2 {
                 for arm in 0..3 {
                     let (mut c, mut s) = (sol, sol);
@@ -452,7 +497,12 @@ mod tests {
                                 _ => b.half[k - 12] = f64::NAN,
                             }
                         };
-                        check(&sol, &edit, &|_| {}, &format!("scalar {k} of box {bi} of robot {robot}"));
+                        check(
+                            &sol,
+                            &edit,
+                            &|_| {},
+                            &format!("scalar {k} of box {bi} of robot {robot}"),
+                        );
                     }
                 }
                 for k in 0..6 {
@@ -477,7 +527,10 @@ mod tests {
         let mut collisions = 0;
         for k in 0..2000 {
             let s = k as f64 / 2000.0;
-            let tcps = [Vec3::new(-150.0 + 350.0 * s, 40.0 * s, -450.0), Vec3::new(150.0 - 350.0 * s, -30.0, -420.0)];
+            let tcps = [
+                Vec3::new(-150.0 + 350.0 * s, 40.0 * s, -450.0),
+                Vec3::new(150.0 - 350.0 * s, -30.0, -420.0),
+            ];
             let p = plain.check(&tcps).unwrap().collides();
             assert_eq!(p, cached.check(&tcps).unwrap().collides(), "step {k}");
             collisions += p as usize;

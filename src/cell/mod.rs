@@ -91,7 +91,9 @@ fn check_length(what: &str, v: Real, allow_zero: bool) -> Result<(), CellError> 
         Ok(())
     } else {
         let need = if allow_zero { ">= 0" } else { "> 0" };
-        Err(CellError::Invalid(format!("{what} = {v} must be finite, {need} and <= {MAX_LENGTH:e} (mm)")))
+        Err(CellError::Invalid(format!(
+            "{what} = {v} must be finite, {need} and <= {MAX_LENGTH:e} (mm)"
+        )))
     }
 }
 
@@ -99,7 +101,9 @@ fn check_coordinate(what: &str, v: Real) -> Result<(), CellError> {
     if v.is_finite() && v.abs() <= MAX_LENGTH {
         Ok(())
     } else {
-        Err(CellError::Invalid(format!("{what} = {v} must be finite with |value| <= {MAX_LENGTH:e} (mm)")))
+        Err(CellError::Invalid(format!(
+            "{what} = {v} must be finite with |value| <= {MAX_LENGTH:e} (mm)"
+        )))
     }
 }
 
@@ -124,7 +128,10 @@ fn validate_robot(i: usize, r: &RobotSpec) -> Result<(), CellError> {
     }
     let p = &r.placement;
     if !p.alpha.is_finite() {
-        return Err(CellError::Invalid(format!("{name}: placement.alpha = {} rad must be finite", p.alpha)));
+        return Err(CellError::Invalid(format!(
+            "{name}: placement.alpha = {} rad must be finite",
+            p.alpha
+        )));
     }
     for (k, axis) in ["x", "y", "z"].iter().enumerate() {
         check_coordinate(&format!("{name}: placement.translation.{axis}"), p.t[k])?;
@@ -190,7 +197,8 @@ impl Cell {
     /// UTF-8 text, else as [`parse_cell_file`].
     #[cfg(feature = "std")]
     pub fn read_file(path: &std::path::Path) -> Result<CellFileContents, CellError> {
-        let bytes = std::fs::read(path).map_err(|e| CellError::Io(format!("{}: {e}", path.display())))?;
+        let bytes =
+            std::fs::read(path).map_err(|e| CellError::Io(format!("{}: {e}", path.display())))?;
         // A file that was read but is not text is a parse error (not TOML), not an I/O error.
         let text = String::from_utf8(bytes).map_err(|e| {
             CellError::Parse(format!(
@@ -208,8 +216,11 @@ impl Cell {
     pub fn reach_radius(&self, i: usize) -> Real {
         let m = &self.robots[i].model;
         let (d, o) = (&m.delta, &m.options);
-        let lower = d.f + d.rf + d.re + float::hypot(o.half_height + o.margin, o.half_depth + o.margin);
-        let upper = o.upper_links.map_or(0.0, |(h, dz)| d.f + d.rf + float::hypot(h + o.margin, dz + o.margin));
+        let lower =
+            d.f + d.rf + d.re + float::hypot(o.half_height + o.margin, o.half_depth + o.margin);
+        let upper = o
+            .upper_links
+            .map_or(0.0, |(h, dz)| d.f + d.rf + float::hypot(h + o.margin, dz + o.margin));
         let extra = [o.platform, o.tool]
             .into_iter()
             .flatten()
@@ -247,10 +258,14 @@ impl Cell {
         for (i, r) in self.robots.iter().enumerate() {
             let (d, o, p) = (&r.model.delta, &r.model.options, &r.placement);
             let geometry = [("f", d.f), ("rf", d.rf), ("re", d.re), ("e", d.e)];
-            for (key, v) in geometry.into_iter().chain([("theta_min", d.theta_min), ("theta_max", d.theta_max)]) {
+            for (key, v) in
+                geometry.into_iter().chain([("theta_min", d.theta_min), ("theta_max", d.theta_max)])
+            {
                 put(format!("robot {i}: geometry.{key}"), v);
             }
-            for (key, v) in [("half_height", o.half_height), ("half_depth", o.half_depth), ("margin", o.margin)] {
+            for (key, v) in
+                [("half_height", o.half_height), ("half_depth", o.half_depth), ("margin", o.margin)]
+            {
                 put(format!("robot {i}: model.{key}"), v);
             }
             let (uh, ud) = o.upper_links.unwrap_or((-1.0, -1.0));
@@ -292,5 +307,7 @@ pub fn fingerprint_of(values: impl Iterator<Item = Real>) -> u64 {
 
 /// FNV-1a 64 of `bytes` (cell fingerprints, table checksums).
 pub fn fnv1a64(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+    bytes
+        .iter()
+        .fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
 }

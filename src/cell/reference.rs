@@ -29,13 +29,17 @@ mod tests {
 
     #[test]
     fn reference_cells_follow_spec_section_5() {
-        let expect = [("T1", 450.0, 0.0, 0.0), ("T2", 400.0, 0.0, 0.0), ("T3", 430.0, 150.0, PI / 6.0)];
+        let expect =
+            [("T1", 450.0, 0.0, 0.0), ("T2", 400.0, 0.0, 0.0), ("T3", 430.0, 150.0, PI / 6.0)];
         for (name, x, y, alpha) in expect {
             let cell = reference_cell(name).unwrap();
             assert_eq!(cell.robots.len(), 2);
             assert_eq!(cell.robots[0].placement, Placement::IDENTITY);
             let b = &cell.robots[1].placement;
-            assert!((b.t - Vec3::new(x, y, 0.0)).norm() < 1e-12 && (b.alpha - alpha).abs() < 1e-15, "{name}");
+            assert!(
+                (b.t - Vec3::new(x, y, 0.0)).norm() < 1e-12 && (b.alpha - alpha).abs() < 1e-15,
+                "{name}"
+            );
             assert!(cell.robots.iter().all(|r| r.model == RobotModel::THESIS));
             assert_eq!(cell.pairs_that_can_meet(), vec![(0, 1)]);
         }

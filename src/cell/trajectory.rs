@@ -96,13 +96,19 @@ pub fn parse_scenarios(text: &str) -> Result<Vec<Scenario>, String> {
             continue;
         }
         let f: Vec<&str> = line.split_whitespace().collect();
-        let bad = || format!("scenario line {}: expected `CELL CASE ROBOT TICK X Y Z`, got `{line}`", n + 1);
+        let bad = || {
+            format!("scenario line {}: expected `CELL CASE ROBOT TICK X Y Z`, got `{line}`", n + 1)
+        };
         if f.len() != 7 {
             return Err(bad());
         }
         let robot: usize = f[2].parse().map_err(|_| bad())?;
         let tick: u32 = f[3].parse().map_err(|_| bad())?;
-        let xyz: Vec<Real> = f[4..].iter().map(|v| v.parse::<Real>()).collect::<Result<_, _>>().map_err(|_| bad())?;
+        let xyz: Vec<Real> = f[4..]
+            .iter()
+            .map(|v| v.parse::<Real>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad())?;
         if robot >= 32 || !xyz.iter().all(|v| v.is_finite()) {
             return Err(bad());
         }
@@ -138,8 +144,13 @@ mod tests {
         assert_eq!((minimum_jerk(0.0), minimum_jerk(1.0)), (0.0, 1.0));
         assert!((minimum_jerk(0.5) - 0.5).abs() < 1e-15);
         let h = 1e-6;
-        assert!(minimum_jerk(h) < 1e-15 && (1.0 - minimum_jerk(1.0 - h)) < 1e-15, "zero velocity at the ends");
-        assert!((0..100).all(|i| minimum_jerk(i as f64 / 100.0) < minimum_jerk((i + 1) as f64 / 100.0)));
+        assert!(
+            minimum_jerk(h) < 1e-15 && (1.0 - minimum_jerk(1.0 - h)) < 1e-15,
+            "zero velocity at the ends"
+        );
+        assert!(
+            (0..100).all(|i| minimum_jerk(i as f64 / 100.0) < minimum_jerk((i + 1) as f64 / 100.0))
+        );
     }
 
     #[test]

@@ -58,7 +58,10 @@ mod tests {
                 }
                 Some(_) if grid.reachable[s] => {
                     let half_diagonal = 0.5 * grid.r * 3f64.sqrt();
-                    assert!(radii.iter().all(|&r| r.is_finite() && r >= half_diagonal), "sample {s}: {radii:?}");
+                    assert!(
+                        radii.iter().all(|&r| r.is_finite() && r >= half_diagonal),
+                        "sample {s}: {radii:?}"
+                    );
                     bounded += 1;
                 }
                 Some(_) => {}

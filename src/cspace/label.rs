@@ -22,13 +22,13 @@
 use crate::cell::{Cell, Placement};
 use crate::cspace::guarantee::thesis_margin;
 use crate::cspace::sampler::{SampleGrid, Workspace};
+use crate::cspace::swept_sat::{swept_apart, SweptFrame, TableSweep};
 use crate::cspace::{Label, LabelledSpace, PairLabels};
 use crate::geometry::sat::separating_axis;
-use crate::cspace::swept_sat::{swept_apart, SweptFrame, TableSweep};
 use crate::geometry::sweep::{swept_aabb_half, Sweep};
-use crate::robot::MAX_BOXES;
 use crate::geometry::Obb;
 use crate::math::{max_or_nan, min_or_nan, Mat3, Real, Vec3};
+use crate::robot::MAX_BOXES;
 use crate::robot::{ModelOptions, RobotModel};
 use core::sync::atomic::{AtomicU64, Ordering};
 use rayon::prelude::*;
@@ -163,7 +163,12 @@ impl SweptBox {
     /// leaves it out, would not cover it.
     pub fn new(b: Obb, sweep: Sweep) -> SweptBox {
         let table = TableSweep::of(&sweep).expect("a table's sweep has no segment");
-        SweptBox { center: b.center, frame: SweptFrame::new(&b, &table), sweep: table, exact: sweep.is_zero() }
+        SweptBox {
+            center: b.center,
+            frame: SweptFrame::new(&b, &table),
+            sweep: table,
+            exact: sweep.is_zero(),
+        }
     }
 
     /// The box at the entry's centre: the centre, and the frame's axes (as columns) and
@@ -171,7 +176,11 @@ impl SweptBox {
     #[inline]
     pub fn obb(&self) -> Obb {
         let (u, h) = (&self.frame.u, &self.frame.h);
-        Obb { center: self.center, axes: Mat3::from_fn(|r, k| u[k][r]), half: Vec3::new(h[0], h[1], h[2]) }
+        Obb {
+            center: self.center,
+            axes: Mat3::from_fn(|r, k| u[k][r]),
+            half: Vec3::new(h[0], h[1], h[2]),
+        }
     }
 }
 
@@ -200,7 +209,12 @@ type EntryBoxes = (Slot, Vec<(SweptBox, SweptBounds)>, [Real; 3], [Real; 3]);
 impl SampleBoxes {
     /// The boxes of `model` placed by `placement` with the TCP at each of `centres` (MCS),
     /// enlarged as `inflate(s)` says; an unreachable centre gives [`Slot::Unreachable`].
-    pub fn new<F>(model: &RobotModel, placement: &Placement, centres: &[Vec3], inflate: F) -> SampleBoxes
+    pub fn new<F>(
+        model: &RobotModel,
+        placement: &Placement,
+        centres: &[Vec3],
+        inflate: F,
+    ) -> SampleBoxes
     where
         F: Fn(usize) -> Inflation + Sync,
     {
@@ -220,7 +234,10 @@ impl SampleBoxes {
                     (Inflation::Swept(sweeps), Ok(boxes)) => {
                         let rot = placement.rotation();
                         let b = boxes.as_slice().iter().zip(sweeps);
-                        (Slot::Boxes, b.map(|(b, s)| (placement.obb_to_wcs(b), s.rotated(&rot))).collect())
+                        (
+                            Slot::Boxes,
+                            b.map(|(b, s)| (placement.obb_to_wcs(b), s.rotated(&rot))).collect(),
+                        )
                     }
                 };
                 let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
@@ -286,7 +303,12 @@ impl SampleBoxes {
 
 /// Whether the closed boxes `[alo, ahi]` and `[blo, bhi]` are apart by more than the slack.
 #[inline]
-pub(crate) fn aabbs_apart(alo: &[Real; 3], ahi: &[Real; 3], blo: &[Real; 3], bhi: &[Real; 3]) -> bool {
+pub(crate) fn aabbs_apart(
+    alo: &[Real; 3],
+    ahi: &[Real; 3],
+    blo: &[Real; 3],
+    bhi: &[Real; 3],
+) -> bool {
     (0..3).any(|k| blo[k] > ahi[k] + AABB_SLACK || alo[k] > bhi[k] + AABB_SLACK)
 }
 
@@ -366,7 +388,13 @@ pub fn all_box_pairs(na: usize, nb: usize) -> u64 {
 /// centre is unreachable, `Collision` when either is `Unknown` or some pair of boxes
 /// intersects and `second_look(ia, ib)` (called only then) confirms it, else `Free`.
 /// Rows are labelled in parallel, each reported to `progress`.
-pub fn label_pairs<F>(a: &SampleBoxes, b: &SampleBoxes, second_look: F, rows: Rows, progress: Progress) -> PairLabels
+pub fn label_pairs<F>(
+    a: &SampleBoxes,
+    b: &SampleBoxes,
+    second_look: F,
+    rows: Rows,
+    progress: Progress,
+) -> PairLabels
 where
     F: Fn(usize, usize) -> bool + Sync,
 {
@@ -426,10 +454,12 @@ impl RowLabeller {
                 Slot::Unknown => Label::Collision,
             })
             .collect();
-        let mut order: Vec<u32> = (0..b.len() as u32).filter(|&i| b.slot[i as usize] == Slot::Boxes).collect();
+        let mut order: Vec<u32> =
+            (0..b.len() as u32).filter(|&i| b.slot[i as usize] == Slot::Boxes).collect();
         order.sort_by(|&i, &j| b.lo[i as usize][0].total_cmp(&b.lo[j as usize][0]));
         let keys: Vec<Real> = order.iter().map(|&i| b.lo[i as usize][0]).collect();
-        let widest = order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
+        let widest =
+            order.iter().map(|&i| b.hi[i as usize][0] - b.lo[i as usize][0]).fold(0.0, Real::max);
         let sorted = b.subset(&order);
         RowLabeller { base, order, keys, widest, sorted }
     }
@@ -446,10 +476,9 @@ impl RowLabeller {
                 .iter_mut()
                 .zip(base)
                 .for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Free }),
-            Slot::Unknown => row
-                .iter_mut()
-                .zip(base)
-                .for_each(|(l, &bl)| *l = if bl == Label::Unreachable { bl } else { Label::Collision }),
+            Slot::Unknown => row.iter_mut().zip(base).for_each(|(l, &bl)| {
+                *l = if bl == Label::Unreachable { bl } else { Label::Collision }
+            }),
             Slot::Boxes => {
                 row.copy_from_slice(base);
                 let (lo, hi) = (a.lo[ia][0], a.hi[ia][0]);
@@ -473,7 +502,11 @@ pub(crate) fn robot_with_margin(cell: &Cell, i: usize, margin: Real) -> (RobotMo
     (RobotModel { options, ..r.model }, r.placement)
 }
 
-pub(crate) fn two_robot_grids(cell: &Cell, k: u32, ws: &Workspace) -> Result<(SampleGrid, SampleGrid), String> {
+pub(crate) fn two_robot_grids(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+) -> Result<(SampleGrid, SampleGrid), String> {
     if cell.robots.len() != 2 {
         return Err(format!(
             "cell '{}' has {} robots; tables are built for two-robot cells (split the cell into pairs)",
@@ -481,7 +514,10 @@ pub(crate) fn two_robot_grids(cell: &Cell, k: u32, ws: &Workspace) -> Result<(Sa
             cell.robots.len()
         ));
     }
-    Ok((SampleGrid::new(ws, k, &cell.robots[0].model.delta)?, SampleGrid::new(ws, k, &cell.robots[1].model.delta)?))
+    Ok((
+        SampleGrid::new(ws, k, &cell.robots[0].model.delta)?,
+        SampleGrid::new(ws, k, &cell.robots[1].model.delta)?,
+    ))
 }
 
 /// Labels every sample pair of the two-robot `cell` (robots 0 and 1) at `k` cells per axis,
@@ -519,8 +555,12 @@ pub(crate) fn label_space_rows(
     let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
     let (ma, pa) = robot_with_margin(cell, 0, margin);
     let (mb, pb) = robot_with_margin(cell, 1, margin);
-    let a = SampleBoxes::new(&ma, &pa, &centres(&grid_a), |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]));
-    let b = SampleBoxes::new(&mb, &pb, &centres(&grid_b), |_| Inflation::Swept([Sweep::ZERO; MAX_BOXES]));
+    let a = SampleBoxes::new(&ma, &pa, &centres(&grid_a), |_| {
+        Inflation::Swept([Sweep::ZERO; MAX_BOXES])
+    });
+    let b = SampleBoxes::new(&mb, &pb, &centres(&grid_b), |_| {
+        Inflation::Swept([Sweep::ZERO; MAX_BOXES])
+    });
     let labels = label_pairs(&a, &b, |_, _| true, rows, progress);
     Ok(LabelledSpace { grid_a, grid_b, labels, margin })
 }
@@ -530,7 +570,12 @@ pub(crate) fn label_space_rows(
 ///
 /// # Errors
 /// As [`label_space`].
-pub fn label_space_thesis(cell: &Cell, k: u32, ws: &Workspace, progress: Progress) -> Result<LabelledSpace, String> {
+pub fn label_space_thesis(
+    cell: &Cell,
+    k: u32,
+    ws: &Workspace,
+    progress: Progress,
+) -> Result<LabelledSpace, String> {
     label_space_thesis_rows(cell, k, ws, Rows::ALL, progress)
 }
 
@@ -560,8 +605,9 @@ mod tests {
     use crate::geometry::sweep::tests::{any_box, any_sweep};
     use proptest::prelude::*;
 
-    /// `index_of` inverts `row` on the rows labelled and names no other of the `na` rows: checked against
-    /// the list of rows written out, for shards 0..n of n = 1..6 (and a step of 0, read as 1).
+    /// `index_of` inverts `row` on the rows labelled and names no other of the `na` rows: checked
+    /// against the list of rows written out, for shards 0..n of n = 1..6 (and a step of 0, read as
+    /// 1).
     #[test]
     fn rows_index_of_finds_exactly_the_labelled_rows() {
         let na = 50;
@@ -570,7 +616,11 @@ mod tests {
                 let rows = Rows { first, step: n };
                 let listed: Vec<usize> = (0..rows.count(na)).map(|j| rows.row(j)).collect();
                 for ia in 0..na {
-                    assert_eq!(rows.index_of(ia), listed.iter().position(|&r| r == ia), "{rows:?} row {ia}");
+                    assert_eq!(
+                        rows.index_of(ia),
+                        listed.iter().position(|&r| r == ia),
+                        "{rows:?} row {ia}"
+                    );
                 }
             }
         }

@@ -20,13 +20,13 @@ pub mod sampler;
 pub(crate) mod swept_sat;
 pub mod symmetry;
 
-#[cfg(feature = "std")]
-pub use certify::{
-    label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace, CertifyConfig, Refinement,
-    SubCells,
-};
 #[cfg(feature = "eval")]
 pub use certify::SubdividedLabels;
+#[cfg(feature = "std")]
+pub use certify::{
+    label_space_certified, label_space_certified_with, label_space_subdivided, CertifiedSpace,
+    CertifyConfig, Refinement, SubCells,
+};
 #[cfg(feature = "std")]
 pub use label::{label_space, label_space_thesis, Progress, Rows};
 pub use pair_labels::PairLabels;

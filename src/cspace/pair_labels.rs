@@ -51,7 +51,8 @@ impl PairLabels {
 
     /// The labels of `labels`, `nb` a row (`labels.len()` a multiple of `nb`).
     pub fn from_labels(nb: usize, labels: &[Label]) -> PairLabels {
-        let mut out = PairLabels { nb, len: labels.len(), bytes: vec![0; labels.len().div_ceil(4)] };
+        let mut out =
+            PairLabels { nb, len: labels.len(), bytes: vec![0; labels.len().div_ceil(4)] };
         labels.iter().enumerate().for_each(|(p, &l)| out.set(p, l));
         out
     }
@@ -119,7 +120,11 @@ impl PairLabels {
 impl PairLabels {
     /// `rows` rows of `nb` labels, row `j` written by `write(j, row)` into a row of `Collision`
     /// labels, in parallel (four rows per task: their bytes are theirs alone).
-    pub fn from_rows(rows: usize, nb: usize, write: impl Fn(usize, &mut [Label]) + Sync) -> PairLabels {
+    pub fn from_rows(
+        rows: usize,
+        nb: usize,
+        write: impl Fn(usize, &mut [Label]) + Sync,
+    ) -> PairLabels {
         // Zeroed by the kernel as both threads first touch their rows' pages.
         let mut out = PairLabels { nb, len: rows * nb, bytes: vec![0; (rows * nb).div_ceil(4)] };
         out.each_row(false, write);
@@ -194,7 +199,9 @@ mod tests {
                 let mut packed = PairLabels::from_labels(nb, &plain);
                 assert_eq!(packed.len(), plain.len());
                 assert!(packed.iter().eq(plain.iter().copied()));
-                assert!((0..plain.len()).all(|p| packed[p] == plain[p] && packed.get(p) == plain[p]));
+                assert!(
+                    (0..plain.len()).all(|p| packed[p] == plain[p] && packed.get(p) == plain[p])
+                );
                 let built = PairLabels::from_rows(rows, nb, |j, row| {
                     assert!(row.iter().all(|&l| l == Label::Collision), "rows start as collisions");
                     row.copy_from_slice(&plain[j * nb..(j + 1) * nb]);

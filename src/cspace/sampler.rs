@@ -42,7 +42,8 @@ pub struct Workspace {
 
 impl Workspace {
     /// The thesis's values: Zu 365, Hcy 135, Rcy 225, Hco 30, Rco 173.
-    pub const THESIS: Workspace = Workspace { zu: 365.0, hcy: 135.0, rcy: 225.0, hco: 30.0, rco: 173.0 };
+    pub const THESIS: Workspace =
+        Workspace { zu: 365.0, hcy: 135.0, rcy: 225.0, hco: 30.0, rco: 173.0 };
 
     /// The workspace the tables of `cell` sample: thesis 3.2.2's, for every cell. The CLI
     /// builds with it and [`crate::table::TableChecker`] refuses a table that records another,
@@ -94,13 +95,22 @@ impl Workspace {
     }
 
     fn validate(&self) -> Result<(), String> {
-        for (name, v) in [("Zu", self.zu), ("Hcy", self.hcy), ("Rcy", self.rcy), ("Hco", self.hco), ("Rco", self.rco)] {
+        for (name, v) in [
+            ("Zu", self.zu),
+            ("Hcy", self.hcy),
+            ("Rcy", self.rcy),
+            ("Hco", self.hco),
+            ("Rco", self.rco),
+        ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("workspace {name} = {v} must be a finite length >= 0 (mm)"));
             }
         }
         if !(self.zu > 0.0 && self.rcy > 0.0 && self.hcy + self.hco > 0.0) {
-            return Err("workspace needs Zu > 0, Rcy > 0 and Hcy + Hco > 0 (the TCP works below the base)".into());
+            return Err(
+                "workspace needs Zu > 0, Rcy > 0 and Hcy + Hco > 0 (the TCP works below the base)"
+                    .into(),
+            );
         }
         Ok(())
     }
@@ -136,7 +146,9 @@ impl SampleGrid {
     pub fn new(ws: &Workspace, k: u32, delta: &Delta3) -> Result<SampleGrid, String> {
         ws.validate()?;
         if !(k >= 2 && k.is_power_of_two() && k <= 1 << 15) {
-            return Err(format!("k = {k} must be a power of two between 2 and 32768 (for example 32)"));
+            return Err(format!(
+                "k = {k} must be a power of two between 2 and 32768 (for example 32)"
+            ));
         }
         let side = ws.max_radius().max(ws.max_depth());
         let r = side / k as Real;
@@ -303,7 +315,10 @@ mod tests {
             for (i, c) in g.cells.iter().enumerate() {
                 let m = [c[0], (k - 1) as u16 - c[1], c[2]];
                 let j = g.index_of(m).expect("mirror cell sampled");
-                assert_eq!(g.sample_center(j), g.sample_center(i).component_mul(&Vec3::new(1.0, -1.0, 1.0)));
+                assert_eq!(
+                    g.sample_center(j),
+                    g.sample_center(i).component_mul(&Vec3::new(1.0, -1.0, 1.0))
+                );
                 assert_eq!(g.reachable[i], g.reachable[j]);
             }
         }

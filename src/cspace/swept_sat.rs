@@ -103,7 +103,11 @@ impl SweptFrame {
     pub fn new(b: &Obb, s: &TableSweep) -> SweptFrame {
         let m = &b.axes;
         let u: [[Real; 3]; 3] = core::array::from_fn(|k| [m[(0, k)], m[(1, k)], m[(2, k)]]);
-        SweptFrame { u, h: [b.half.x, b.half.y, b.half.z], face_support: u.map(|n| support(s, &n, 1.0)) }
+        SweptFrame {
+            u,
+            h: [b.half.x, b.half.y, b.half.z],
+            face_support: u.map(|n| support(s, &n, 1.0)),
+        }
     }
 }
 
@@ -126,7 +130,12 @@ fn support(s: &TableSweep, n: &[Real; 3], norm: Real) -> Real {
 /// separates the swept boxes, the sweeps' supports `sweeps()` found only when the boxes
 /// alone come apart by the gap.
 #[inline(always)]
-fn separates(dn: Real, boxes: Real, len: impl Fn() -> Real, sweeps: impl FnOnce(Real) -> Real) -> bool {
+fn separates(
+    dn: Real,
+    boxes: Real,
+    len: impl Fn() -> Real,
+    sweeps: impl FnOnce(Real) -> Real,
+) -> bool {
     let apart = dn - boxes;
     // The boxes alone overlap along the axis (or a value is NaN): not apart.
     if apart.is_nan() || apart <= 0.0 {
@@ -156,7 +165,12 @@ impl Pair<'_> {
     fn face_a(&self, k: usize) -> bool {
         let (ar, hb, fa) = (&self.ar, &self.fb.h, self.fa);
         let rb = hb[0] * ar[k][0] + hb[1] * ar[k][1] + hb[2] * ar[k][2];
-        separates(self.t[k].abs(), fa.h[k] + rb, || 1.0, |l| fa.face_support[k] + support(self.sb, &fa.u[k], l))
+        separates(
+            self.t[k].abs(),
+            fa.h[k] + rb,
+            || 1.0,
+            |l| fa.face_support[k] + support(self.sb, &fa.u[k], l),
+        )
     }
 
     /// Whether B's face axis `k` separates.
@@ -165,7 +179,12 @@ impl Pair<'_> {
         let (ar, ha, fb) = (&self.ar, &self.fa.h, self.fb);
         let ra = ha[0] * ar[0][k] + ha[1] * ar[1][k] + ha[2] * ar[2][k];
         let n = &fb.u[k];
-        separates(dot(n, &self.d).abs(), ra + fb.h[k], || 1.0, |l| support(self.sa, n, l) + fb.face_support[k])
+        separates(
+            dot(n, &self.d).abs(),
+            ra + fb.h[k],
+            || 1.0,
+            |l| support(self.sa, n, l) + fb.face_support[k],
+        )
     }
 
     /// Whether the edge axis `a_i x b_j` separates.
@@ -180,10 +199,12 @@ impl Pair<'_> {
         }
         let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
         let dn = (t[i2] * r[i1][j] - t[i1] * r[i2][j]).abs();
-        let boxes = ha[i1] * ar[i2][j] + ha[i2] * ar[i1][j] + hb[j1] * ar[i][j2] + hb[j2] * ar[i][j1];
+        let boxes =
+            ha[i1] * ar[i2][j] + ha[i2] * ar[i1][j] + hb[j1] * ar[i][j2] + hb[j2] * ar[i][j1];
         let sweeps = |l: Real| {
             let (x, y) = (&self.fa.u[i], &self.fb.u[j]);
-            let n = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+            let n =
+                [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
             support(self.sa, &n, l) + support(self.sb, &n, l)
         };
         separates(dn, boxes, || float::sqrt(len2), sweeps)
@@ -195,7 +216,14 @@ impl Pair<'_> {
 /// proved". The axes are read in the order of the module doc, "Order of the axes", each
 /// stopping the test when it separates.
 #[inline]
-pub fn swept_apart(ca: &Vec3, fa: &SweptFrame, sa: &TableSweep, cb: &Vec3, fb: &SweptFrame, sb: &TableSweep) -> bool {
+pub fn swept_apart(
+    ca: &Vec3,
+    fa: &SweptFrame,
+    sa: &TableSweep,
+    cb: &Vec3,
+    fb: &SweptFrame,
+    sb: &TableSweep,
+) -> bool {
     let dv = cb - ca;
     let d = [dv.x, dv.y, dv.z];
     let (ua, ub) = (&fa.u, &fb.u);
@@ -232,7 +260,9 @@ mod tests {
     use super::*;
     use crate::geometry::sat::separating_axis;
     use crate::geometry::sweep::swept_boxes_apart;
-    use crate::geometry::sweep::tests::{any_box, any_sweep, any_sweep_with_line, proved_and_stay_apart, rot};
+    use crate::geometry::sweep::tests::{
+        any_box, any_sweep, any_sweep_with_line, proved_and_stay_apart, rot,
+    };
     use crate::math::Mat3;
     use proptest::prelude::*;
 
@@ -260,14 +290,20 @@ mod tests {
             t[k] = dot(&ua[k], &d);
             let rb = hb[0] * ar[k][0] + hb[1] * ar[k][1] + hb[2] * ar[k][2];
             let n = &ua[k];
-            if separates(t[k].abs(), ha[k] + rb, || 1.0, |l| fa.face_support[k] + support(sb, n, l)) {
+            if separates(t[k].abs(), ha[k] + rb, || 1.0, |l| fa.face_support[k] + support(sb, n, l))
+            {
                 return true;
             }
         }
         for k in 0..3 {
             let ra = ha[0] * ar[0][k] + ha[1] * ar[1][k] + ha[2] * ar[2][k];
             let n = &ub[k];
-            if separates(dot(n, &d).abs(), ra + hb[k], || 1.0, |l| support(sa, n, l) + fb.face_support[k]) {
+            if separates(
+                dot(n, &d).abs(),
+                ra + hb[k],
+                || 1.0,
+                |l| support(sa, n, l) + fb.face_support[k],
+            ) {
                 return true;
             }
         }
@@ -281,10 +317,17 @@ mod tests {
                 }
                 let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
                 let dn = (t[i2] * r[i1][j] - t[i1] * r[i2][j]).abs();
-                let boxes = ha[i1] * ar[i2][j] + ha[i2] * ar[i1][j] + hb[j1] * ar[i][j2] + hb[j2] * ar[i][j1];
+                let boxes = ha[i1] * ar[i2][j]
+                    + ha[i2] * ar[i1][j]
+                    + hb[j1] * ar[i][j2]
+                    + hb[j2] * ar[i][j1];
                 let sweeps = |l: Real| {
                     let (x, y) = (&ua[i], &ub[j]);
-                    let n = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+                    let n = [
+                        x[1] * y[2] - x[2] * y[1],
+                        x[2] * y[0] - x[0] * y[2],
+                        x[0] * y[1] - x[1] * y[0],
+                    ];
                     support(sa, &n, l) + support(sb, &n, l)
                 };
                 if separates(dn, boxes, || float::sqrt(len2), sweeps) {
@@ -301,7 +344,11 @@ mod tests {
         let (ta, tb) = (TableSweep::of(sa).unwrap(), TableSweep::of(sb).unwrap());
         let (fa, fb) = (SweptFrame::new(a, &ta), SweptFrame::new(b, &tb));
         let proved = swept_apart(&a.center, &fa, &ta, &b.center, &fb, &tb);
-        assert_eq!(proved, swept_apart_in_first_order(a, &fa, &ta, b, &fb, &tb), "{a:?} {sa:?} {b:?} {sb:?}");
+        assert_eq!(
+            proved,
+            swept_apart_in_first_order(a, &fa, &ta, b, &fb, &tb),
+            "{a:?} {sa:?} {b:?} {sb:?}"
+        );
         proved
     }
 
@@ -410,7 +457,8 @@ mod tests {
     #[test]
     fn face_touching_boxes_are_not_apart_and_a_gap_is() {
         let a = Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::new(1.0, 1.0, 1.0));
-        let at = |x: Real| Obb::new(Vec3::new(x, 0.0, 0.0), Mat3::identity(), Vec3::new(1.0, 1.0, 1.0));
+        let at =
+            |x: Real| Obb::new(Vec3::new(x, 0.0, 0.0), Mat3::identity(), Vec3::new(1.0, 1.0, 1.0));
         assert!(!apart(&a, &Sweep::ZERO, &at(2.0), &Sweep::ZERO));
         assert!(apart(&a, &Sweep::ZERO, &at(2.001), &Sweep::ZERO));
         let ball = Sweep { ball: 0.01, ..Sweep::ZERO };

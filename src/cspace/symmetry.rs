@@ -19,8 +19,8 @@
 use crate::cell::Cell;
 use crate::cspace::sampler::{CellIndex, SampleGrid};
 use crate::math::{float, Real};
-use core::f64::consts::PI;
 use alloc::vec::Vec;
+use core::f64::consts::PI;
 
 /// How far `alpha` may be from 0 or pi (rad) and still count as symmetric.
 pub const ALPHA_TOLERANCE: Real = 1e-12;
@@ -31,8 +31,12 @@ pub fn reflection_y(cell: &Cell) -> bool {
     cell.robots.iter().all(|r| {
         let p = &r.placement;
         let a = float::rem_euclid(p.alpha, 2.0 * PI);
-        let alpha_ok = a.min(2.0 * PI - a) <= ALPHA_TOLERANCE || (a - PI).max(PI - a) <= ALPHA_TOLERANCE;
-        let extras_ok = [r.model.options.platform, r.model.options.tool].iter().flatten().all(|b| b.offset.y == 0.0);
+        let alpha_ok =
+            a.min(2.0 * PI - a) <= ALPHA_TOLERANCE || (a - PI).max(PI - a) <= ALPHA_TOLERANCE;
+        let extras_ok = [r.model.options.platform, r.model.options.tool]
+            .iter()
+            .flatten()
+            .all(|b| b.offset.y == 0.0);
         p.t.y == 0.0 && alpha_ok && extras_ok
     })
 }
@@ -115,12 +119,17 @@ mod tests {
         };
         assert!(with(Placement { alpha: PI, t: Vec3::new(450.0, 0.0, 0.0) }));
         assert!(with(Placement { alpha: -PI, t: Vec3::new(450.0, 0.0, 30.0) }));
-        assert!(!with(Placement { alpha: PI / 3.0, t: Vec3::new(450.0, 0.0, 0.0) }), "arms map, MCS mirror does not");
+        assert!(
+            !with(Placement { alpha: PI / 3.0, t: Vec3::new(450.0, 0.0, 0.0) }),
+            "arms map, MCS mirror does not"
+        );
         assert!(!with(Placement { alpha: 0.0, t: Vec3::new(450.0, 1e-9, 0.0) }));
         assert!(!with(Placement { alpha: 1e-6, t: Vec3::new(450.0, 0.0, 0.0) }));
         let mut tool = base.clone();
-        tool.robots[0].model.options.tool =
-            Some(crate::robot::ToolBox { offset: Vec3::new(0.0, 5.0, -30.0), half: Vec3::repeat(10.0) });
+        tool.robots[0].model.options.tool = Some(crate::robot::ToolBox {
+            offset: Vec3::new(0.0, 5.0, -30.0),
+            half: Vec3::repeat(10.0),
+        });
         assert!(!reflection_y(&tool));
     }
 
@@ -128,11 +137,14 @@ mod tests {
     fn mirror_mismatches(space: &crate::cspace::LabelledSpace) -> usize {
         let (ga, gb) = (&space.grid_a, &space.grid_b);
         assert!(grid_is_y_symmetric(ga) && grid_is_y_symmetric(gb));
-        let mb: Vec<usize> = gb.cells.iter().map(|&c| gb.index_of(mirror_cell(gb, c)).unwrap()).collect();
+        let mb: Vec<usize> =
+            gb.cells.iter().map(|&c| gb.index_of(mirror_cell(gb, c)).unwrap()).collect();
         let mut bad = 0;
         for (ia, &c) in ga.cells.iter().enumerate() {
             let ma = ga.index_of(mirror_cell(ga, c)).unwrap();
-            bad += (0..gb.cells.len()).filter(|&ib| space.label(ia, ib) != space.label(ma, mb[ib])).count();
+            bad += (0..gb.cells.len())
+                .filter(|&ib| space.label(ia, ib) != space.label(ma, mb[ib]))
+                .count();
         }
         bad
     }

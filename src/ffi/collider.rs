@@ -7,8 +7,8 @@
 
 use crate::cell::exact::PairState;
 use crate::cell::protective::{
-    BoxPair, Protective, ProtectiveChecker, ProtectiveReport, ProtectiveRequest, ProtectiveStatus, StopPath,
-    TickTime, TimingFault, DEFAULT_WARN_MM,
+    BoxPair, Protective, ProtectiveChecker, ProtectiveReport, ProtectiveRequest, ProtectiveStatus,
+    StopPath, TickTime, TimingFault, DEFAULT_WARN_MM,
 };
 use crate::cell::{Cell, ExactChecker, MAX_ROBOTS};
 use crate::ffi::convert::{cell_error_status, table_error_status};
@@ -61,7 +61,8 @@ pub(crate) struct Collider {
 /// The protective checker of a handle until `dc_set_stop_model` sets one: without the motor-angle
 /// tables, so that `dc_init` builds nothing a caller of `dc_query` alone would not use.
 fn protective_for(cell: &Cell) -> ProtectiveChecker {
-    ProtectiveChecker::without_motor_tables(cell.clone(), DEFAULT_WARN_MM).expect("the default warn_mm is valid")
+    ProtectiveChecker::without_motor_tables(cell.clone(), DEFAULT_WARN_MM)
+        .expect("the default warn_mm is valid")
 }
 
 impl Collider {
@@ -81,7 +82,11 @@ impl Collider {
     /// A table-mode collider for the two-robot `cell` from a table file's bytes, validated
     /// and copied here (the caller's buffer is not kept), answering a COLLISION lookup as
     /// `confirmation` says.
-    pub(crate) fn table(cell: Cell, bytes: &[u8], confirmation: Confirmation) -> Result<Collider, InitError> {
+    pub(crate) fn table(
+        cell: Cell,
+        bytes: &[u8],
+        confirmation: Confirmation,
+    ) -> Result<Collider, InitError> {
         if cell.robots.len() < 2 {
             return Err(InitError::new(
                 DC_STATUS_TABLE_NOT_TWO_ROBOTS,
@@ -128,9 +133,13 @@ impl Collider {
     /// A table-mode collider from a TOML cell file and a table file, each read once, here;
     /// the cell file's `table_confirm` chooses the confirmation.
     pub(crate) fn from_files(cell_path: &Path, table_path: &Path) -> Result<Collider, InitError> {
-        let file = Cell::read_file(cell_path).map_err(|e| InitError::new(cell_error_status(&e), e.to_string()))?;
+        let file = Cell::read_file(cell_path)
+            .map_err(|e| InitError::new(cell_error_status(&e), e.to_string()))?;
         let bytes = std::fs::read(table_path).map_err(|e| {
-            InitError::new(DC_STATUS_IO, format!("cannot read table file {}: {e}", table_path.display()))
+            InitError::new(
+                DC_STATUS_IO,
+                format!("cannot read table file {}: {e}", table_path.display()),
+            )
         })?;
         Collider::table(file.cell, &bytes, file.table_confirmation)
     }
@@ -214,7 +223,8 @@ impl Collider {
             Checker::Exact(c) => query_exact(c, &self.tcps, report),
             Checker::Table(t) => {
                 let status = query_table(t, &self.tcps, report);
-                self.table_collides = status == DC_STATUS_OK && report.verdict == DC_VERDICT_COLLISION;
+                self.table_collides =
+                    status == DC_STATUS_OK && report.verdict == DC_VERDICT_COLLISION;
                 status
             }
             Checker::Bundle(b) => query_bundle(b, &self.tcps, report),
@@ -238,7 +248,13 @@ impl Collider {
             *dst = src.to_vec3();
         }
         match &self.checker {
-            Checker::Exact(c) if c.cell().robots.iter().zip(&self.tcps).any(|(r, t)| !r.model.delta.is_reachable(t)) => {
+            Checker::Exact(c)
+                if c.cell()
+                    .robots
+                    .iter()
+                    .zip(&self.tcps)
+                    .any(|(r, t)| !r.model.delta.is_reachable(t)) =>
+            {
                 (DC_STATUS_UNREACHABLE, none)
             }
             Checker::Exact(_) => (DC_STATUS_OK, none),
@@ -246,16 +262,25 @@ impl Collider {
                 Ok(bound) => (DC_STATUS_OK, bound.unwrap_or(none)),
                 Err(_) => (DC_STATUS_UNREACHABLE, none),
             },
-            Checker::Bundle(b) if b.unreachable_mask(&self.tcps) != 0 => (DC_STATUS_UNREACHABLE, none),
+            Checker::Bundle(b) if b.unreachable_mask(&self.tcps) != 0 => {
+                (DC_STATUS_UNREACHABLE, none)
+            }
             Checker::Bundle(_) => (DC_STATUS_OK, none),
         }
     }
 
     /// Replaces the tick, WARN threshold and stopping models of the protective verdict (and
     /// forgets the previous TCPs).
-    pub(crate) fn set_stopping(&mut self, tick_ms: f64, warn_mm: f64, stops: &[DcStopConfig]) -> Result<(), InitError> {
+    pub(crate) fn set_stopping(
+        &mut self,
+        tick_ms: f64,
+        warn_mm: f64,
+        stops: &[DcStopConfig],
+    ) -> Result<(), InitError> {
         let invalid = |m: String| InitError::new(DC_STATUS_INVALID_CONFIG, m);
-        if let Some((i, c)) = stops.iter().enumerate().find(|(_, c)| c.struct_size != size_of::<DcStopConfig>()) {
+        if let Some((i, c)) =
+            stops.iter().enumerate().find(|(_, c)| c.struct_size != size_of::<DcStopConfig>())
+        {
             return Err(InitError::new(
                 DC_STATUS_INVALID_ARGUMENT,
                 format!(
@@ -275,7 +300,12 @@ impl Collider {
                 max_speed_mm_s: c.max_speed_mm_s,
             })
             .collect();
-        let cell = self.protective.cell().clone().with_stopping(tick_ms, models).map_err(|e| invalid(e.to_string()))?;
+        let cell = self
+            .protective
+            .cell()
+            .clone()
+            .with_stopping(tick_ms, models)
+            .map_err(|e| invalid(e.to_string()))?;
         let (limits, tests) = (self.protective.speed_limits(), self.protective.limit_tests());
         self.protective = ProtectiveChecker::new(cell, warn_mm)
             .map_err(|e| invalid(e.to_string()))?
@@ -327,17 +357,21 @@ impl Collider {
         let n_paths = paths.len();
         for (j, (points, tolerance_mm)) in paths.iter().enumerate() {
             if !points.is_empty() {
-                stop_paths[j] = Some(StopPath { points: &self.path_points[j][..points.len()], tolerance_mm: *tolerance_mm });
+                stop_paths[j] = Some(StopPath {
+                    points: &self.path_points[j][..points.len()],
+                    tolerance_mm: *tolerance_mm,
+                });
             }
         }
-        let request = ProtectiveRequest::new(&self.tcps).at(time).with_paths(&stop_paths[..n_paths]);
+        let request =
+            ProtectiveRequest::new(&self.tcps).at(time).with_paths(&stop_paths[..n_paths]);
         let r = match &self.checker {
             Checker::Table(t) if t.table().as_clearance().is_some() => {
                 self.protective.check(request.with_table(&|_, _, tcps| t.clearance_bound(tcps)))
             }
-            Checker::Bundle(b) if b.has_clearance() => {
-                self.protective.check(request.with_table(&|i, j, tcps| b.clearance_bound(i, j, tcps)))
-            }
+            Checker::Bundle(b) if b.has_clearance() => self
+                .protective
+                .check(request.with_table(&|i, j, tcps| b.clearance_bound(i, j, tcps))),
             _ => self.protective.check(request),
         };
         let Ok(r) = r else { return DC_STATUS_WRONG_ROBOT_COUNT };
@@ -355,7 +389,13 @@ impl Collider {
                         PairState::Collides(a, b) => (1, a as u32, b as u32),
                         _ => (0, DC_BOX_NONE, DC_BOX_NONE),
                     };
-                    *o = DcPairResult { robot_a: p.a as u32, robot_b: p.b as u32, collides, box_a, box_b };
+                    *o = DcPairResult {
+                        robot_a: p.a as u32,
+                        robot_b: p.b as u32,
+                        collides,
+                        box_a,
+                        box_b,
+                    };
                 }
             }
             Checker::Table(t) => {
@@ -368,9 +408,16 @@ impl Collider {
                 for (o, p) in out.iter_mut().zip(b.pairs()) {
                     let collides = p.answer == TableAnswer::Collision;
                     let boxes = p.boxes.filter(|_| collides);
-                    let [box_a, box_b] = boxes.map_or([DC_BOX_NONE; 2], |(a, b)| [a as u32, b as u32]);
+                    let [box_a, box_b] =
+                        boxes.map_or([DC_BOX_NONE; 2], |(a, b)| [a as u32, b as u32]);
                     let (robot_a, robot_b) = (p.a as u32, p.b as u32);
-                    *o = DcPairResult { robot_a, robot_b, collides: u32::from(collides), box_a, box_b };
+                    *o = DcPairResult {
+                        robot_a,
+                        robot_b,
+                        collides: u32::from(collides),
+                        box_a,
+                        box_b,
+                    };
                 }
             }
         }
@@ -382,14 +429,20 @@ fn write_protective(r: &ProtectiveReport, report: &mut DcProtectiveReport) -> Dc
     report.n_robots = r.robots.len() as u32;
     report.clearance_mm = r.clearance_mm;
     for (j, robot) in r.robots.iter().enumerate() {
-        (report.protective_mm[j], report.speed_limit_mm_s[j]) = (robot.protective_mm, robot.speed_limit_mm_s);
+        (report.protective_mm[j], report.speed_limit_mm_s[j]) =
+            (robot.protective_mm, robot.speed_limit_mm_s);
     }
     let ids = |p: Option<BoxPair>| {
         p.map_or([DC_BOX_NONE; 4], |p| [p.a as u32, p.b as u32, p.box_a as u32, p.box_b as u32])
     };
-    [report.closest_robot_a, report.closest_robot_b, report.closest_box_a, report.closest_box_b] = ids(r.closest);
-    [report.limiting_robot_a, report.limiting_robot_b, report.limiting_box_a, report.limiting_box_b] =
-        ids(r.limiting);
+    [report.closest_robot_a, report.closest_robot_b, report.closest_box_a, report.closest_box_b] =
+        ids(r.closest);
+    [
+        report.limiting_robot_a,
+        report.limiting_robot_b,
+        report.limiting_box_a,
+        report.limiting_box_b,
+    ] = ids(r.limiting);
     let (status, robot) = match r.status {
         ProtectiveStatus::Ok => (DC_STATUS_OK, None),
         ProtectiveStatus::NonFinite(j) => (DC_STATUS_NON_FINITE, Some(j)),
@@ -463,7 +516,11 @@ fn query_table(checker: &mut TableChecker, tcps: &[Vec3], report: &mut DcQueryRe
 
 /// A bundle's answer in the report: as exact mode's, with the first colliding pair's robots,
 /// and its boxes when the exact check answered it.
-fn query_bundle(checker: &mut BundleChecker, tcps: &[Vec3], report: &mut DcQueryReport) -> DcStatus {
+fn query_bundle(
+    checker: &mut BundleChecker,
+    tcps: &[Vec3],
+    report: &mut DcQueryReport,
+) -> DcStatus {
     let Ok(answer) = checker.check(tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };
     let colliding = checker.pairs().iter().filter(|p| p.answer == TableAnswer::Collision);
     report.colliding_pairs = colliding.clone().count() as u32;

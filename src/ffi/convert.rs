@@ -72,7 +72,8 @@ pub(crate) fn robot_spec(index: usize, r: &DcRobotConfig) -> RobotSpec {
                 half_height: r.half_height,
                 half_depth: r.half_depth,
                 margin: r.margin,
-                upper_links: (r.has_upper_links != 0).then_some((r.upper_half_height, r.upper_half_depth)),
+                upper_links: (r.has_upper_links != 0)
+                    .then_some((r.upper_half_height, r.upper_half_depth)),
                 platform: tool_box(r.has_platform, &r.platform),
                 tool: tool_box(r.has_tool, &r.tool),
             },
@@ -94,7 +95,8 @@ pub(crate) fn cell_from_c(robots: &[DcRobotConfig], method: u32) -> Result<Cell,
         }
     };
     let specs = robots.iter().enumerate().map(|(i, r)| robot_spec(i, r)).collect();
-    Cell::new("C config".into(), specs, method).map_err(|e| InitError::new(cell_error_status(&e), e.to_string()))
+    Cell::new("C config".into(), specs, method)
+        .map_err(|e| InitError::new(cell_error_status(&e), e.to_string()))
 }
 
 impl DcRobotConfig {
@@ -108,7 +110,14 @@ impl DcRobotConfig {
             DcBox { offset: DcVec3::from_vec3(&b.offset), half: DcVec3::from_vec3(&b.half) }
         };
         DcRobotConfig {
-            geometry: DcDelta3 { f: d.f, rf: d.rf, re: d.re, e: d.e, theta_min: d.theta_min, theta_max: d.theta_max },
+            geometry: DcDelta3 {
+                f: d.f,
+                rf: d.rf,
+                re: d.re,
+                e: d.e,
+                theta_min: d.theta_min,
+                theta_max: d.theta_max,
+            },
             half_height: o.half_height,
             half_depth: o.half_depth,
             margin: o.margin,
@@ -152,12 +161,16 @@ mod tests {
 
     #[test]
     fn from_spec_is_the_inverse_of_robot_spec() {
-        let tool = ToolBox { offset: Vec3::new(1.0, -2.0, -30.0), half: Vec3::new(20.0, 25.0, 30.0) };
-        let mut specs: Vec<RobotSpec> =
-            ["T1", "T2", "T3"].iter().flat_map(|n| crate::cell::reference::reference_cell(n).unwrap().robots).collect();
+        let tool =
+            ToolBox { offset: Vec3::new(1.0, -2.0, -30.0), half: Vec3::new(20.0, 25.0, 30.0) };
+        let mut specs: Vec<RobotSpec> = ["T1", "T2", "T3"]
+            .iter()
+            .flat_map(|n| crate::cell::reference::reference_cell(n).unwrap().robots)
+            .collect();
         let mut full = specs[1].clone();
         full.model.options.upper_links = Some((12.0, 9.0));
-        full.model.options.platform = Some(ToolBox { offset: Vec3::zeros(), half: Vec3::new(45.0, 45.0, 8.0) });
+        full.model.options.platform =
+            Some(ToolBox { offset: Vec3::zeros(), half: Vec3::new(45.0, 45.0, 8.0) });
         full.model.options.tool = Some(tool);
         specs.push(full);
         for (i, r) in specs.iter().enumerate() {

@@ -21,7 +21,11 @@ pub struct DcCollider {
 impl DcCollider {
     /// A handle for `inner`, not busy, not poisoned.
     pub(super) fn new(inner: Collider) -> DcCollider {
-        DcCollider { inner: UnsafeCell::new(inner), poisoned: AtomicBool::new(false), busy: AtomicBool::new(false) }
+        DcCollider {
+            inner: UnsafeCell::new(inner),
+            poisoned: AtomicBool::new(false),
+            busy: AtomicBool::new(false),
+        }
     }
 }
 
@@ -31,7 +35,10 @@ impl DcCollider {
 ///
 /// # Safety
 /// `handle` must be NULL or a live handle from `dc_init*`.
-pub(super) unsafe fn live<R>(handle: *const DcCollider, f: impl FnOnce(&mut Collider) -> R) -> Result<R, DcStatus> {
+pub(super) unsafe fn live<R>(
+    handle: *const DcCollider,
+    f: impl FnOnce(&mut Collider) -> R,
+) -> Result<R, DcStatus> {
     // SAFETY: the caller guarantees NULL or live; only shared references to the handle are
     // made, and its collider is reached through the cell below while `busy` is ours.
     let Some(h) = (unsafe { handle.as_ref() }) else { return Err(DC_STATUS_NULL_POINTER) };

@@ -34,7 +34,10 @@ unsafe fn init_handle(
             // SAFETY: checked non-null above; the caller guarantees it is writable.
             unsafe { *out_handle = std::ptr::null_mut() };
             catch_unwind(AssertUnwindSafe(make)).unwrap_or_else(|_| {
-                Err(InitError::new(DC_STATUS_PANIC, "internal error (a panic) caught during init; please report it"))
+                Err(InitError::new(
+                    DC_STATUS_PANIC,
+                    "internal error (a panic) caught during init; please report it",
+                ))
             })
         };
         let (status, message) = match result {
@@ -62,11 +65,17 @@ unsafe fn cell_from_config(config: *const DcCellConfig) -> Result<crate::cell::C
         return Err(InitError::new(DC_STATUS_NULL_POINTER, "config is NULL: pass a DcCellConfig"));
     };
     if config.robots.is_null() {
-        return Err(InitError::new(DC_STATUS_NULL_POINTER, "config->robots is NULL: point it at n_robots robots"));
+        return Err(InitError::new(
+            DC_STATUS_NULL_POINTER,
+            "config->robots is NULL: point it at n_robots robots",
+        ));
     }
     if config.n_robots == 0 || config.n_robots > crate::cell::MAX_ROBOTS {
-        let message =
-            format!("config->n_robots = {}: a cell has 1 to {} robots", config.n_robots, crate::cell::MAX_ROBOTS);
+        let message = format!(
+            "config->n_robots = {}: a cell has 1 to {} robots",
+            config.n_robots,
+            crate::cell::MAX_ROBOTS
+        );
         return Err(InitError::new(DC_STATUS_INVALID_CONFIG, message));
     }
     // SAFETY: non-null, and the caller guarantees `n_robots` valid elements.
@@ -80,11 +89,17 @@ unsafe fn cell_from_config(config: *const DcCellConfig) -> Result<crate::cell::C
 /// `path` must be NULL or a NUL-terminated string that outlives `'a`.
 unsafe fn path_arg<'a>(path: *const c_char, what: &str) -> Result<&'a Path, InitError> {
     if path.is_null() {
-        return Err(InitError::new(DC_STATUS_NULL_POINTER, format!("{what} is NULL: pass a NUL-terminated path")));
+        return Err(InitError::new(
+            DC_STATUS_NULL_POINTER,
+            format!("{what} is NULL: pass a NUL-terminated path"),
+        ));
     }
     // SAFETY: non-null, and the caller guarantees NUL termination.
     let Ok(text) = unsafe { CStr::from_ptr(path) }.to_str() else {
-        return Err(InitError::new(DC_STATUS_INVALID_ARGUMENT, format!("{what} is not UTF-8: rename the file")));
+        return Err(InitError::new(
+            DC_STATUS_INVALID_ARGUMENT,
+            format!("{what} is not UTF-8: rename the file"),
+        ));
     };
     Ok(Path::new(text))
 }
@@ -110,7 +125,10 @@ pub extern "C" fn dc_robot_config_thesis() -> DcRobotConfig {
 /// `config` must be NULL or point to a valid `DcCellConfig` whose `robots` points to
 /// `n_robots` valid `DcRobotConfig`; `out_handle` must be NULL or writable.
 #[no_mangle]
-pub unsafe extern "C" fn dc_init(config: *const DcCellConfig, out_handle: *mut *mut DcCollider) -> DcStatus {
+pub unsafe extern "C" fn dc_init(
+    config: *const DcCellConfig,
+    out_handle: *mut *mut DcCollider,
+) -> DcStatus {
     let make = || {
         // SAFETY: the caller guarantees `config` is NULL or valid.
         let cell = unsafe { cell_from_config(config) }?;
@@ -130,7 +148,10 @@ pub unsafe extern "C" fn dc_init(config: *const DcCellConfig, out_handle: *mut *
 /// # Safety
 /// `path` must be NULL or a NUL-terminated string; `out_handle` must be NULL or writable.
 #[no_mangle]
-pub unsafe extern "C" fn dc_init_from_cell_file(path: *const c_char, out_handle: *mut *mut DcCollider) -> DcStatus {
+pub unsafe extern "C" fn dc_init_from_cell_file(
+    path: *const c_char,
+    out_handle: *mut *mut DcCollider,
+) -> DcStatus {
     let make = || {
         // SAFETY: the caller guarantees `path` is NULL or NUL-terminated.
         let path = unsafe { path_arg(path, "path") }?;
@@ -175,7 +196,10 @@ pub unsafe extern "C" fn dc_init_with_table(
         // SAFETY: the caller guarantees `config` is NULL or valid.
         let cell = unsafe { cell_from_config(config) }?;
         if table.is_null() {
-            return Err(InitError::new(DC_STATUS_NULL_POINTER, "table is NULL: pass the table file's bytes"));
+            return Err(InitError::new(
+                DC_STATUS_NULL_POINTER,
+                "table is NULL: pass the table file's bytes",
+            ));
         }
         // SAFETY: non-null, and the caller guarantees `table_len` readable bytes.
         let bytes = unsafe { std::slice::from_raw_parts(table, table_len) };

@@ -24,10 +24,11 @@ pub unsafe extern "C" fn dc_protective_reset(handle: *mut DcCollider) {
 /// tick of `dc_set_stop_model` earlier. Correct only when called exactly once per cycle, at
 /// the cycle's nominal time: called twice in one cycle it reads a moving robot as standing.
 /// `dc_protective_query_timed` takes the cycle and fails closed on every timing fault: use
-/// it in the tick loop. Works in exact and table mode (it reads the exact boxes). In table mode with a clearance table, a tick whose certified clearance bound
-/// exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup,
-/// without the box-pair proof (`dc_table_protective_lookups`); every other tick takes the
-/// exact protective check, as in exact mode. The report is filled alike in both modes.
+/// it in the tick loop. Works in exact and table mode (it reads the exact boxes). In table mode
+/// with a clearance table, a tick whose certified clearance bound exceeds both robots' motion
+/// bounds over their stops plus `warn_mm` is FREE by the lookup, without the box-pair proof
+/// (`dc_table_protective_lookups`); every other tick takes the exact protective check, as in exact
+/// mode. The report is filled alike in both modes.
 ///
 /// Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
 /// `DC_VERDICT_FREE` (proved: every stop the models allow keeps the boxes apart),
@@ -63,9 +64,9 @@ pub unsafe extern "C" fn dc_protective_query(
 /// `dc_protective_query` (untimed: exactly once per cycle, at its nominal time; the timed
 /// call takes the paths in its request) for a controller that knows the path each robot's
 /// stop will follow (a path-maintaining stop: its next set-points), which brings STOPs down
-/// toward the ticks where a stop really cannot avoid contact. `paths[j]` is robot `j`'s `DcStopPath`
-/// (`n_points` 0: not known; that robot is then bounded as by `dc_protective_query`). The
-/// verdict is the better of the proof without paths and the proof along them; the speed
+/// toward the ticks where a stop really cannot avoid contact. `paths[j]` is robot `j`'s
+/// `DcStopPath` (`n_points` 0: not known; that robot is then bounded as by `dc_protective_query`).
+/// The verdict is the better of the proof without paths and the proof along them; the speed
 /// limits are those without paths. Statuses: those of `dc_protective_query`, and
 /// `DC_STATUS_NULL_POINTER` (paths NULL, or a path's points NULL with `n_points` > 0),
 /// `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths` differs from the robot count),
@@ -135,9 +136,9 @@ pub extern "C" fn dc_protective_request_default() -> DcProtectiveRequest {
 /// Statuses: those of `dc_protective_query_with_paths`, the timing statuses above,
 /// `DC_STATUS_NULL_POINTER` (request NULL, or paths NULL with `n_paths` > 0),
 /// `DC_STATUS_INVALID_ARGUMENT` (a `struct_size` that is not this header's
-/// `sizeof(DcProtectiveRequest)`, an unknown `clock`), `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths` neither 0 nor the robot
-/// count), `DC_STATUS_BUSY` (the handle is in another call). `*out_verdict` and
-/// `*out_report` are written on every call. Never allocates, locks or does I/O.
+/// `sizeof(DcProtectiveRequest)`, an unknown `clock`), `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths`
+/// neither 0 nor the robot count), `DC_STATUS_BUSY` (the handle is in another call). `*out_verdict`
+/// and `*out_report` are written on every call. Never allocates, locks or does I/O.
 ///
 /// # Safety
 /// `handle` must be NULL or a live handle from `dc_init*`; `request` must be NULL or point
@@ -154,23 +155,34 @@ pub unsafe extern "C" fn dc_protective_query_timed(
     // SAFETY: the caller guarantees `request` is NULL or readable.
     let request = match unsafe { request.as_ref() } {
         Some(r) => *r,
-        None => DcProtectiveRequest { tcps_mcs: std::ptr::null(), ..dc_protective_request_default() },
+        None => {
+            DcProtectiveRequest { tcps_mcs: std::ptr::null(), ..dc_protective_request_default() }
+        }
     };
     let time = request_time(&request);
     let (paths, n_paths) = (request.paths, request.n_paths);
     // SAFETY: the caller's guarantees on `handle`, the request's TCPs and the outputs are
     // passed on; a NULL request reads as NULL TCPs.
     unsafe {
-        protective_entry(handle, request.tcps_mcs, request.n_tcps, out_verdict, out_report, |c, tcps, report| {
-            match (time, n_paths) {
-                (Err(status), _) => status,
-                (Ok(time), 0) => c.protective_query(time, tcps, None, report),
-                // SAFETY: the caller guarantees `n_paths` readable paths when not NULL.
-                (Ok(time), _) => with_path_views(c, paths, n_paths, report, |c, views, report| {
-                    c.protective_query(time, tcps, Some(views), report)
-                }),
-            }
-        })
+        protective_entry(
+            handle,
+            request.tcps_mcs,
+            request.n_tcps,
+            out_verdict,
+            out_report,
+            |c, tcps, report| {
+                match (time, n_paths) {
+                    (Err(status), _) => status,
+                    (Ok(time), 0) => c.protective_query(time, tcps, None, report),
+                    // SAFETY: the caller guarantees `n_paths` readable paths when not NULL.
+                    (Ok(time), _) => {
+                        with_path_views(c, paths, n_paths, report, |c, views, report| {
+                            c.protective_query(time, tcps, Some(views), report)
+                        })
+                    }
+                }
+            },
+        )
     }
 }
 
@@ -207,7 +219,8 @@ unsafe fn with_path_views(
     }
     // SAFETY: non-null, and the caller guarantees `n_paths` readable elements.
     let paths = unsafe { std::slice::from_raw_parts(paths, n_paths) };
-    let mut views: [(&[DcVec3], f64); crate::cell::MAX_ROBOTS] = [(&[], 0.0); crate::cell::MAX_ROBOTS];
+    let mut views: [(&[DcVec3], f64); crate::cell::MAX_ROBOTS] =
+        [(&[], 0.0); crate::cell::MAX_ROBOTS];
     for (j, (view, path)) in views.iter_mut().zip(paths).enumerate() {
         if path.n_points == 0 {
             continue;
@@ -215,10 +228,15 @@ unsafe fn with_path_views(
         if path.points.is_null() || path.n_points > DC_MAX_PATH_POINTS {
             report.unreachable_mask = 1 << j;
             c.reset_protective();
-            return if path.points.is_null() { DC_STATUS_NULL_POINTER } else { DC_STATUS_INVALID_ARGUMENT };
+            return if path.points.is_null() {
+                DC_STATUS_NULL_POINTER
+            } else {
+                DC_STATUS_INVALID_ARGUMENT
+            };
         }
         // SAFETY: non-null, and the caller guarantees `n_points` readable elements.
-        *view = (unsafe { std::slice::from_raw_parts(path.points, path.n_points) }, path.tolerance_mm);
+        *view =
+            (unsafe { std::slice::from_raw_parts(path.points, path.n_points) }, path.tolerance_mm);
     }
     query(c, &views[..n_paths], report)
 }

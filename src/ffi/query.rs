@@ -137,7 +137,8 @@ pub unsafe extern "C" fn dc_table_clearance_bound(
         // SAFETY: non-null, and the caller guarantees `n_tcps` readable elements.
         let tcps = unsafe { std::slice::from_raw_parts(tcps_mcs, n_tcps) };
         // SAFETY: the caller guarantees `handle` is NULL or live.
-        let (status, mm) = unsafe { live(handle, |c| c.clearance_bound(tcps)) }.unwrap_or_else(|s| (s, f64::NEG_INFINITY));
+        let (status, mm) = unsafe { live(handle, |c| c.clearance_bound(tcps)) }
+            .unwrap_or_else(|s| (s, f64::NEG_INFINITY));
         bound = mm;
         status
     });

@@ -73,7 +73,10 @@ pub unsafe extern "C" fn dc_set_stop_model(
 /// # Safety
 /// `handle` must be NULL or a live handle not used by another thread.
 #[no_mangle]
-pub unsafe extern "C" fn dc_set_table_confirmation(handle: *mut DcCollider, confirmation: DcConfirmation) -> DcStatus {
+pub unsafe extern "C" fn dc_set_table_confirmation(
+    handle: *mut DcCollider,
+    confirmation: DcConfirmation,
+) -> DcStatus {
     // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
     unsafe {
         set_on_handle(handle, |c| match convert::confirmation_from_c(confirmation) {
@@ -81,7 +84,9 @@ pub unsafe extern "C" fn dc_set_table_confirmation(handle: *mut DcCollider, conf
                 c.set_table_confirmation(value);
                 Ok(())
             }
-            None => Err(format!("confirmation = {confirmation}: use DC_CONFIRMATION_EXACT or DC_CONFIRMATION_NONE")),
+            None => Err(format!(
+                "confirmation = {confirmation}: use DC_CONFIRMATION_EXACT or DC_CONFIRMATION_NONE"
+            )),
         })
     }
 }
@@ -92,7 +97,10 @@ pub unsafe extern "C" fn dc_set_table_confirmation(handle: *mut DcCollider, conf
 ///
 /// # Safety
 /// `handle` must be NULL or a live handle not used by another thread.
-unsafe fn set_on_handle(handle: *mut DcCollider, set: impl FnOnce(&mut Collider) -> Result<(), String>) -> DcStatus {
+unsafe fn set_on_handle(
+    handle: *mut DcCollider,
+    set: impl FnOnce(&mut Collider) -> Result<(), String>,
+) -> DcStatus {
     let apply = |c: &mut Collider| {
         let (status, message) = match set(c) {
             Ok(()) => (DC_STATUS_OK, String::new()),

@@ -45,7 +45,9 @@ pub fn point_obb_distance(p: &Vec3, b: &Obb) -> Real {
 
 /// The 12 edges of a box from its vertices, indexed by sign bits as [`Obb::vertices`] does.
 fn box_edges(v: &[Vec3; 8]) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
-    (0..8).flat_map(move |i| (0..3).filter(move |k| i >> k & 1 == 0).map(move |k| (v[i], v[i | 1 << k])))
+    (0..8).flat_map(move |i| {
+        (0..3).filter(move |k| i >> k & 1 == 0).map(move |k| (v[i], v[i | 1 << k]))
+    })
 }
 
 /// The distance between segments `p0 p1` and `q0 q1` (Ericson, *Real-Time Collision

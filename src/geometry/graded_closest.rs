@@ -115,7 +115,9 @@ impl GradedBox {
         let h = &self.half;
         let (x1, x2) = (y.y.clamp(-h.y, h.y), y.z.clamp(-h.z, h.z));
         let t = match self.lean {
-            Some(lean) => y.x + lean * float::sqrt((x1 - y.y) * (x1 - y.y) + (x2 - y.z) * (x2 - y.z)),
+            Some(lean) => {
+                y.x + lean * float::sqrt((x1 - y.y) * (x1 - y.y) + (x2 - y.z) * (x2 - y.z))
+            }
             None => self.sign * h.x,
         };
         Vec3::new(t.clamp(-h.x, h.x), x1, x2)
@@ -133,7 +135,13 @@ impl GradedBox {
 /// frame, where a box is three intervals: `x` in `a`'s, `y` in `b`'s, each read in the other's
 /// frame through `M = R_a^T R_b`.
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // written so that NaN stops the steps
-pub fn graded_closest(a: &Obb, ra: [Real; 2], b: &Obb, rb: [Real; 2], from: &Vec3) -> GradedClosest {
+pub fn graded_closest(
+    a: &Obb,
+    ra: [Real; 2],
+    b: &Obb,
+    rb: [Real; 2],
+    from: &Vec3,
+) -> GradedClosest {
     let (ga, gb) = (GradedBox::new(a, ra), GradedBox::new(b, rb));
     let m = a.axes.tr_mul(&b.axes);
     let offset = a.axes.tr_mul(&(b.center - a.center));
@@ -181,7 +189,10 @@ mod tests {
             let at = |i: usize, h: Real| h * (i as Real / 4.0 - 1.0);
             let mut v = Vec::with_capacity(729);
             for (i, j, k) in (0..729).map(|n| (n / 81, n / 9 % 9, n % 9)) {
-                v.push(o.center + o.axes * Vec3::new(at(i, o.half.x), at(j, o.half.y), at(k, o.half.z)));
+                v.push(
+                    o.center
+                        + o.axes * Vec3::new(at(i, o.half.x), at(j, o.half.y), at(k, o.half.z)),
+                );
             }
             v
         };
@@ -204,8 +215,9 @@ mod tests {
     }
 
     proptest! {
-        /// The points lie in their boxes, `margin` is `F` there (to rounding), and where the swept sets are
-        /// apart it is no more than the least `F` over a grid of each box (brute force) plus
+        /// The points lie in their boxes, `margin` is `F` there (to rounding), and where the swept
+        /// sets are apart it is no more than the least `F` over a grid of each box (brute force)
+        /// plus
         /// 0.5 mm: the minimisation finds the minimum within what the oracle can tell. With
         /// parallel boxes (the slowest case of alternating steps) and zero radii. (Where the
         /// sets overlap, alternating steps stop at the first point the boxes share: `F` is not
@@ -279,7 +291,8 @@ mod tests {
     fn balls_meeting_at_round_numbers() {
         let turned = rot((0.0, 0.0, core::f64::consts::FRAC_PI_4));
         for origin in [Vec3::zeros(), Vec3::new(1e4, -1e4, 1e4)] {
-            for (axes, gap_scale) in [(Mat3::identity(), 1.0), (turned, core::f64::consts::SQRT_2)] {
+            for (axes, gap_scale) in [(Mat3::identity(), 1.0), (turned, core::f64::consts::SQRT_2)]
+            {
                 let a = Obb::new(origin, axes, Vec3::new(20.0, 20.0, 20.0));
                 let at = |gap: Real| {
                     // B's nearest face (or edge) `gap` from A's along x.
@@ -289,13 +302,26 @@ mod tests {
                 let near = origin + Vec3::new(20.0 * gap_scale, 0.0, 0.0);
                 // The radii where the boxes face each other (A's face or edge at `+half_0 u_0`,
                 // B's at `-half_0 u_0`): 4 mm and 6 mm, graded or not.
-                for (ra, rb) in [([4.0; 2], [6.0; 2]), ([8.0, 4.0], [6.0, 6.0]), ([0.0, 4.0], [6.0, 0.0])] {
-                    assert!(!graded_closest(&a, ra, &at(10.0), rb, &near).meet(), "{origin} {gap_scale}");
+                for (ra, rb) in
+                    [([4.0; 2], [6.0; 2]), ([8.0, 4.0], [6.0, 6.0]), ([0.0, 4.0], [6.0, 0.0])]
+                {
+                    assert!(
+                        !graded_closest(&a, ra, &at(10.0), rb, &near).meet(),
+                        "{origin} {gap_scale}"
+                    );
                     let b = at(10.0 - 1e-5);
                     assert!(graded_closest(&a, ra, &b, rb, &near).meet(), "{origin} {gap_scale}");
                     let (fa, fb) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb));
                     for also in [Vec3::zeros(), Vec3::x(), Vec3::new(1.0, 1.0, 0.0)] {
-                        assert!(!balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::FifteenAnd(&also)));
+                        assert!(!balls_swept_apart_with(
+                            &a,
+                            ra,
+                            &fa,
+                            &b,
+                            rb,
+                            &fb,
+                            Axes::FifteenAnd(&also)
+                        ));
                     }
                 }
             }

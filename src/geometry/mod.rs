@@ -10,7 +10,8 @@ pub mod sweep;
 pub mod witness;
 
 pub use clearance::{
-    boxes_clearance, boxes_clearance_lower_bound, obb_clearance, CoherentClearance, obb_clearance_lower_bound, Clearance, PairClearance,
+    boxes_clearance, boxes_clearance_lower_bound, obb_clearance, obb_clearance_lower_bound,
+    Clearance, CoherentClearance, PairClearance,
 };
 pub use distance::obb_distance;
 pub use obb::Obb;

@@ -57,7 +57,11 @@ fn flat(b: &Obb) -> Flat {
     let m = &b.axes;
     Flat {
         c: [b.center.x, b.center.y, b.center.z],
-        u: [[m[(0, 0)], m[(1, 0)], m[(2, 0)]], [m[(0, 1)], m[(1, 1)], m[(2, 1)]], [m[(0, 2)], m[(1, 2)], m[(2, 2)]]],
+        u: [
+            [m[(0, 0)], m[(1, 0)], m[(2, 0)]],
+            [m[(0, 1)], m[(1, 1)], m[(2, 1)]],
+            [m[(0, 2)], m[(1, 2)], m[(2, 2)]],
+        ],
         h: [b.half.x, b.half.y, b.half.z],
     }
 }
@@ -68,7 +72,8 @@ fn flat(b: &Obb) -> Flat {
 pub fn aabb_half_rounded_up(b: &Obb) -> [Real; 3] {
     let m = &b.axes;
     core::array::from_fn(|k| {
-        (m[(k, 0)].abs() * b.half.x + m[(k, 1)].abs() * b.half.y + m[(k, 2)].abs() * b.half.z) * (1.0 + 1e-12)
+        (m[(k, 0)].abs() * b.half.x + m[(k, 1)].abs() * b.half.y + m[(k, 2)].abs() * b.half.z)
+            * (1.0 + 1e-12)
     })
 }
 
@@ -108,7 +113,13 @@ fn relative(a: &Flat, b: &Flat) -> Relative {
 
 /// Face axis `A_i`: `|t_i| > a_i + sum_j b_j |R_ij|` (the optimised form of thesis 3.1.3).
 #[inline(always)]
-fn face_a_separates(i: usize, t: &[Real; 3], ar_i: &[Real; 3], a: &[Real; 3], b: &[Real; 3]) -> bool {
+fn face_a_separates(
+    i: usize,
+    t: &[Real; 3],
+    ar_i: &[Real; 3],
+    a: &[Real; 3],
+    b: &[Real; 3],
+) -> bool {
     t[i].abs() > a[i] + b[0] * ar_i[0] + b[1] * ar_i[1] + b[2] * ar_i[2] + SAT_TOUCH_TOLERANCE
 }
 
@@ -121,14 +132,20 @@ fn face_b_separates(j: usize, a: &[Real; 3], b: &[Real; 3], rel: &Relative) -> b
 }
 
 /// Edge axis `A_i x B_j`, with `(i, i1, i2)` and `(j, j1, j2)` cyclic; left side by
-/// Observation 3.1.2: `|t_i2 R_i1j - t_i1 R_i2j| > a_i1 |R_i2j| + a_i2 |R_i1j| + b_j1 |R_ij2| + b_j2 |R_ij1|`.
+/// Observation 3.1.2: `|t_i2 R_i1j - t_i1 R_i2j| > a_i1 |R_i2j| + a_i2 |R_i1j| + b_j1 |R_ij2| +
+/// b_j2 |R_ij1|`.
 #[inline(always)]
 fn edge_separates(i: usize, j: usize, a: &[Real; 3], b: &[Real; 3], rel: &Relative) -> bool {
     let (r, ar, t) = (&rel.r, &rel.ar, &rel.t);
     let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
     let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
     let s = t[i2] * r[i1][j] - t[i1] * r[i2][j];
-    s.abs() > a[i1] * ar[i2][j] + a[i2] * ar[i1][j] + b[j1] * ar[i][j2] + b[j2] * ar[i][j1] + SAT_TOUCH_TOLERANCE
+    s.abs()
+        > a[i1] * ar[i2][j]
+            + a[i2] * ar[i1][j]
+            + b[j1] * ar[i][j2]
+            + b[j2] * ar[i][j1]
+            + SAT_TOUCH_TOLERANCE
 }
 
 /// Whether the single axis `axis` separates the boxes (beyond the touch tolerance).
@@ -320,18 +337,24 @@ mod tests {
         let mut next = move || rng.unit();
         let mut seen = [0usize; 16];
         for _ in 0..200_000 {
-            let rot =
-                |x: Real, y: Real, z: Real| *nalgebra::Rotation3::from_euler_angles(x * 3.2, y * 3.2, z * 3.2).matrix();
+            let rot = |x: Real, y: Real, z: Real| {
+                *nalgebra::Rotation3::from_euler_angles(x * 3.2, y * 3.2, z * 3.2).matrix()
+            };
             let a = Obb::new(
                 Vec3::zeros(),
                 rot(next(), next(), next()),
                 Vec3::new(3.0 + next(), 2.0 + next(), 1.5 + next()),
             );
             let c = Vec3::new(next(), next(), next()) * 6.0;
-            let b = Obb::new(c, rot(next(), next(), next()), Vec3::new(3.0 + next(), 2.0 + next(), 1.5 + next()));
+            let b = Obb::new(
+                c,
+                rot(next(), next(), next()),
+                Vec3::new(3.0 + next(), 2.0 + next(), 1.5 + next()),
+            );
             let (pa, pb) = (flat(&a), flat(&b));
             let rel = relative(&pa, &pb);
-            let generic = (0..Axis::COUNT).find(|&k| generic_separates(k, &pa.h, &pb.h, &rel)).map(Axis);
+            let generic =
+                (0..Axis::COUNT).find(|&k| generic_separates(k, &pa.h, &pb.h, &rel)).map(Axis);
             let got = separating_axis(&a, &b);
             assert_eq!(got, generic, "{a:?} {b:?}");
             seen[got.map_or(15, |k| k.0 as usize)] += 1;
@@ -347,7 +370,8 @@ mod tests {
         let a = unit_box(Vec3::zeros());
         let rot = *nalgebra::Rotation3::from_euler_angles(0.3, 0.2, 0.9).matrix();
         for k in 0..200 {
-            let b = Obb::new(Vec3::new(k as Real * 0.02, 0.3, -0.1), rot, Vec3::new(1.0, 0.5, 0.25));
+            let b =
+                Obb::new(Vec3::new(k as Real * 0.02, 0.3, -0.1), rot, Vec3::new(1.0, 0.5, 0.25));
             if aabbs_disjoint(&a, &aabb_half_rounded_up(&a), &b, &aabb_half_rounded_up(&b)) {
                 assert!(separating_axis(&a, &b).is_some());
             }

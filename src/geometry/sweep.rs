@@ -5,8 +5,8 @@
 //! # The displacement set
 //! A [`Sweep`] is the convex, centrally symmetric set
 //! `S = ball(c) + [-l, l] + hull(E_1 u E_2)`, `E_k = e_k Z + d_k A`, where `[-l, l]` is a
-//! segment (a lower link's turn along its own axis, `robot::motion_bound` steps 10-11), `Z` is the box
-//! `[-w_0, w_0] + [-w_1, w_1] + [-w_2, w_2]` plus the ball of radius `r` (the TCP's cell: `w_a`
+//! segment (a lower link's turn along its own axis, `robot::motion_bound` steps 10-11), `Z` is the
+//! box `[-w_0, w_0] + [-w_1, w_1] + [-w_2, w_2]` plus the ball of radius `r` (the TCP's cell: `w_a`
 //! is its half-edge along axis `a`, `r = 0`; or the TCP's ball: `w = 0`, `r` its radius) and
 //! `A` the rectangle `[-v_0, v_0] + [-v_1, v_1]` (around the arc an elbow moves on:
 //! `v_0` along the arc's tangent, `v_1` toward its centre). Its support function, for any
@@ -149,7 +149,10 @@ impl Sweep {
     /// `E_2` on `n`, of norm `norm`.
     #[inline(always)]
     fn end_terms(&self, n: &Vec3, norm: Real) -> [Real; 2] {
-        let z = self.cube[0].dot(n).abs() + self.cube[1].dot(n).abs() + self.cube[2].dot(n).abs() + self.round * norm;
+        let z = self.cube[0].dot(n).abs()
+            + self.cube[1].dot(n).abs()
+            + self.cube[2].dot(n).abs()
+            + self.round * norm;
         let a = self.arc[0].dot(n).abs() + self.arc[1].dot(n).abs();
         let [(e1, d1), (e2, d2)] = self.ends;
         [e1 * z + d1 * a, e2 * z + d2 * a]
@@ -182,7 +185,12 @@ impl Sweep {
 
     /// The set rotated by `rot` (a rotation matrix).
     pub fn rotated(&self, rot: &Mat3) -> Sweep {
-        Sweep { cube: self.cube.map(|w| rot * w), arc: self.arc.map(|v| rot * v), line: rot * self.line, ..*self }
+        Sweep {
+            cube: self.cube.map(|w| rot * w),
+            arc: self.arc.map(|v| rot * v),
+            line: rot * self.line,
+            ..*self
+        }
     }
 }
 
@@ -310,13 +318,19 @@ pub fn balls_swept_apart_with(
 /// `half` along it: `(m, |m|, sign)` to `g(sign m)`.
 #[inline(always)]
 fn graded_ball_support(r: [Real; 2], x: Vec3, half: Real) -> impl Fn(&Vec3, Real, Real) -> Real {
-    move |n: &Vec3, len: Real, sign: Real| graded_ends([r[0] * len, r[1] * len], half * (sign * x.dot(n)))
+    move |n: &Vec3, len: Real, sign: Real| {
+        graded_ends([r[0] * len, r[1] * len], half * (sign * x.dot(n)))
+    }
 }
 
 /// The smaller graded support of two sweeps of a box with axis 0 `x` and half-extent `half`
 /// along it: `(m, |m|, sign)` to `min_f g_f(sign m)`.
 #[inline(always)]
-fn least_graded_support<'a>(s: [&'a Sweep; 2], x: Vec3, half: Real) -> impl Fn(&Vec3, Real, Real) -> Real + 'a {
+fn least_graded_support<'a>(
+    s: [&'a Sweep; 2],
+    x: Vec3,
+    half: Real,
+) -> impl Fn(&Vec3, Real, Real) -> Real + 'a {
     move |n: &Vec3, len: Real, sign: Real| {
         let half_s = half * (sign * x.dot(n));
         s[0].graded_support(n, len, half_s).min(s[1].graded_support(n, len, half_s))
@@ -344,7 +358,14 @@ pub fn swept_boxes_apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
 /// (`fa = FaceTerms::new(a, sa)`, `fb = FaceTerms::new(b, sb)`): the same answer, cheaper when
 /// a box meets many others.
 #[inline]
-pub fn swept_boxes_apart_with(a: &Obb, sa: &Sweep, fa: &FaceTerms, b: &Obb, sb: &Sweep, fb: &FaceTerms) -> bool {
+pub fn swept_boxes_apart_with(
+    a: &Obb,
+    sa: &Sweep,
+    fa: &FaceTerms,
+    b: &Obb,
+    sb: &Sweep,
+    fb: &FaceTerms,
+) -> bool {
     let (ha, hb) = (|k: usize, _| fa.support[k], |k: usize, _| fb.support[k]);
     apart_on_an_axis(
         Axes::FifteenAnd(&Vec3::zeros()),
@@ -467,13 +488,24 @@ fn apart_on_an_axis(
         }
         let len = || float::sqrt(len2);
         let (ra, rb) = (radius(ua, &a.half, n), radius(ub, &b.half, n));
-        separates(&d, n, len, ra, rb, |sign| a_support(n, len(), sign), |sign| b_support(n, len(), sign))
+        separates(
+            &d,
+            n,
+            len,
+            ra,
+            rb,
+            |sign| a_support(n, len(), sign),
+            |sign| b_support(n, len(), sign),
+        )
     };
     let edge = |i: usize, j: usize| any(&ua[i].cross(&ub[j]));
     match axes {
         Axes::Only(n) => any(n),
         Axes::FifteenAnd(also) => {
-            any(also) || (0..3).any(face_a) || (0..3).any(face_b) || (0..3).any(|i| (0..3).any(|j| edge(i, j)))
+            any(also)
+                || (0..3).any(face_a)
+                || (0..3).any(face_b)
+                || (0..3).any(|i| (0..3).any(|j| edge(i, j)))
         }
     }
 }
@@ -494,9 +526,11 @@ pub fn boxes_overlap_deeply(a: &Obb, b: &Obb) -> bool {
     let overlaps = |n: &Vec3| {
         let len2 = n.norm_squared();
         len2 >= 1e-10
-            && radius(&ua, &a.half, n) + radius(&ub, &b.half, n) - d.dot(n).abs() > MEET_DEPTH * float::sqrt(len2)
+            && radius(&ua, &a.half, n) + radius(&ub, &b.half, n) - d.dot(n).abs()
+                > MEET_DEPTH * float::sqrt(len2)
     };
-    ua.iter().chain(&ub).all(overlaps) && ua.iter().all(|x| ub.iter().all(|y| overlaps(&x.cross(y))))
+    ua.iter().chain(&ub).all(overlaps)
+        && ua.iter().all(|x| ub.iter().all(|y| overlaps(&x.cross(y))))
 }
 
 /// Whether `a` moved by any displacements within `sa` and `b` by any within `sb` (each point
@@ -571,7 +605,12 @@ pub(crate) mod tests {
     /// A point of `E_end` plus one of the ball `c`, from `t[1..8]`: a point of the box `Z` and
     /// one of its rounding ball (from the same parameters), one of the rectangle `A`; `into_ball`
     /// maps `[-1, 1]^3` into the unit ball.
-    fn end_set_point(s: &Sweep, end: usize, t: &[Real; 8], into_ball: impl Fn(Vec3) -> Vec3) -> Vec3 {
+    fn end_set_point(
+        s: &Sweep,
+        end: usize,
+        t: &[Real; 8],
+        into_ball: impl Fn(Vec3) -> Vec3,
+    ) -> Vec3 {
         let (e, d) = s.ends[end];
         let cube = s.cube[0] * t[1] + s.cube[1] * t[2] + s.cube[2] * t[3];
         let z = cube + into_ball(Vec3::new(t[1], t[2], t[3])) * s.round;
@@ -608,12 +647,16 @@ pub(crate) mod tests {
         let (ua, ub) = (axes(a), axes(b));
         let apart = |n: &Vec3| {
             let range = |p: &[Vec3; 8]| {
-                p.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), q| (lo.min(q.dot(n)), hi.max(q.dot(n))))
+                p.iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), q| {
+                    (lo.min(q.dot(n)), hi.max(q.dot(n)))
+                })
             };
             let ((alo, ahi), (blo, bhi)) = (range(pa), range(pb));
             ahi < blo || bhi < alo
         };
-        apart(also) || ua.iter().chain(&ub).any(apart) || ua.iter().any(|x| ub.iter().any(|y| apart(&x.cross(y))))
+        apart(also)
+            || ua.iter().chain(&ub).any(apart)
+            || ua.iter().any(|x| ub.iter().any(|y| apart(&x.cross(y))))
     }
 
     prop_compose! {
@@ -626,10 +669,19 @@ pub(crate) mod tests {
     /// [`swept_boxes_apart_either`] with one sweep per box, given as both forms.
     fn graded_apart(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep, also: &Vec3) -> bool {
         let (fa, fb) = (FaceTerms::new(a, sa), FaceTerms::new(b, sb));
-        swept_boxes_apart_either(a, [sa, sa], [&fa, &fa], b, [sb, sb], [&fb, &fb], Axes::FifteenAnd(also))
+        swept_boxes_apart_either(
+            a,
+            [sa, sa],
+            [&fa, &fa],
+            b,
+            [sb, sb],
+            [&fb, &fb],
+            Axes::FifteenAnd(also),
+        )
     }
 
-    /// Displacement parameters for [`point_of`], one per robot box, as the property tests draw them.
+    /// Displacement parameters for [`point_of`], one per robot box, as the property tests draw
+    /// them.
     pub(crate) type Moves = Vec<([Real; 8], [Real; 8])>;
 
     /// Whether `apart` proves `a` swept by `sa` and `b` swept by `sb` apart; fails the case when
@@ -657,14 +709,25 @@ pub(crate) mod tests {
     /// prepared form must answer as it does, to the bit.
     fn swept_boxes_apart_as_written(a: &Obb, sa: &Sweep, b: &Obb, sb: &Sweep) -> bool {
         let d = b.center - a.center;
-        let ua = [a.axes.column(0).into_owned(), a.axes.column(1).into_owned(), a.axes.column(2).into_owned()];
-        let ub = [b.axes.column(0).into_owned(), b.axes.column(1).into_owned(), b.axes.column(2).into_owned()];
+        let ua = [
+            a.axes.column(0).into_owned(),
+            a.axes.column(1).into_owned(),
+            a.axes.column(2).into_owned(),
+        ];
+        let ub = [
+            b.axes.column(0).into_owned(),
+            b.axes.column(1).into_owned(),
+            b.axes.column(2).into_owned(),
+        ];
         let radius = |u: &[Vec3; 3], half: &Vec3, n: &Vec3| {
             half.x * u[0].dot(n).abs() + half.y * u[1].dot(n).abs() + half.z * u[2].dot(n).abs()
         };
         let support = |s: &Sweep, n: &Vec3| {
             let norm = float::sqrt(n.norm_squared());
-            let z = s.cube[0].dot(n).abs() + s.cube[1].dot(n).abs() + s.cube[2].dot(n).abs() + s.round * norm;
+            let z = s.cube[0].dot(n).abs()
+                + s.cube[1].dot(n).abs()
+                + s.cube[2].dot(n).abs()
+                + s.round * norm;
             let a = s.arc[0].dot(n).abs() + s.arc[1].dot(n).abs();
             let [(e1, d1), (e2, d2)] = s.ends;
             s.ball * norm + s.line.dot(n).abs() + (e1 * z + d1 * a).max(e2 * z + d2 * a)
@@ -674,10 +737,12 @@ pub(crate) mod tests {
             if len2 < 1e-10 {
                 return false;
             }
-            let reach = radius(&ua, &a.half, n) + radius(&ub, &b.half, n) + support(sa, n) + support(sb, n);
+            let reach =
+                radius(&ua, &a.half, n) + radius(&ub, &b.half, n) + support(sa, n) + support(sb, n);
             d.dot(n).abs() - reach > SWEEP_GAP * float::sqrt(len2)
         };
-        ua.iter().chain(&ub).any(separates) || ua.iter().any(|x| ub.iter().any(|y| separates(&x.cross(y))))
+        ua.iter().chain(&ub).any(separates)
+            || ua.iter().any(|x| ub.iter().any(|y| separates(&x.cross(y))))
     }
 
     /// Checks `same(t)` (whether two tests agree with B moved by `t` mm, and the reference
@@ -871,12 +936,14 @@ pub(crate) mod tests {
         let f = |p: Vec3| pivot + rot * (p - pivot) + t;
         let d = b.vertices().map(|v| f(v) - v);
         let up = |x: Real| x + 1e-9;
-        let ball = Sweep { ball: up(d.iter().map(|v| v.norm()).fold(0.0, Real::max)), ..Sweep::ZERO };
+        let ball =
+            Sweep { ball: up(d.iter().map(|v| v.norm()).fold(0.0, Real::max)), ..Sweep::ZERO };
         let along = |k: usize| {
             let u = b.axes.column(k).into_owned();
             u * up(d.iter().map(|v| u.dot(v).abs()).fold(0.0, Real::max))
         };
-        let cube = Sweep { cube: [along(0), along(1), along(2)], ends: [(1.0, 0.0); 2], ..Sweep::ZERO };
+        let cube =
+            Sweep { cube: [along(0), along(1), along(2)], ends: [(1.0, 0.0); 2], ..Sweep::ZERO };
         (Obb { center: f(b.center), axes: rot * b.axes, half: b.half }, ball, cube)
     }
 
@@ -915,14 +982,20 @@ pub(crate) mod tests {
     #[test]
     fn crossing_plates_always_meet_under_small_displacements() {
         let a = Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::new(200.0, 70.0, 17.5));
-        let b = Obb::new(Vec3::new(50.0, 0.0, 0.0), rot((0.0, 1.2, 0.3)), Vec3::new(200.0, 70.0, 17.5));
+        let b =
+            Obb::new(Vec3::new(50.0, 0.0, 0.0), rot((0.0, 1.2, 0.3)), Vec3::new(200.0, 70.0, 17.5));
         let ball = |r: Real| Sweep { ball: r, ..Sweep::ZERO };
         assert!(swept_boxes_always_meet(&a, &ball(8.0), &b, &ball(8.0)));
         assert!(!swept_boxes_always_meet(&a, &ball(17.5), &b, &ball(1.0)));
-        let touching = Obb::new(Vec3::new(400.0, 0.0, 0.0), Mat3::identity(), Vec3::new(200.0, 70.0, 17.5));
+        let touching =
+            Obb::new(Vec3::new(400.0, 0.0, 0.0), Mat3::identity(), Vec3::new(200.0, 70.0, 17.5));
         assert!(!swept_boxes_always_meet(&a, &Sweep::ZERO, &touching, &Sweep::ZERO));
-        let parallel = Obb::new(Vec3::new(10.0, 5.0, 1.0), Mat3::identity(), Vec3::new(200.0, 70.0, 17.5));
-        assert!(!boxes_overlap_deeply(&a, &parallel), "parallel edges: degenerate axes, not certain");
+        let parallel =
+            Obb::new(Vec3::new(10.0, 5.0, 1.0), Mat3::identity(), Vec3::new(200.0, 70.0, 17.5));
+        assert!(
+            !boxes_overlap_deeply(&a, &parallel),
+            "parallel edges: degenerate axes, not certain"
+        );
     }
 
     /// Over many random cases the test is not vacuous: it proves a good share of the pairs
@@ -937,11 +1010,24 @@ pub(crate) mod tests {
             let v = |i: usize| Vec3::new(x[i], x[i + 1], x[i + 2]);
             let rnd_box = |c: Vec3, i: usize| {
                 let r = rot((3.2 * x[i], 3.2 * x[i + 1], 3.2 * x[i + 2]));
-                Obb::new(c, r, Vec3::new(100.0 + 99.0 * x[i + 3], 40.0 + 30.0 * x[i + 4], 20.0 + 10.0 * x[i + 5]))
+                Obb::new(
+                    c,
+                    r,
+                    Vec3::new(
+                        100.0 + 99.0 * x[i + 3],
+                        40.0 + 30.0 * x[i + 4],
+                        20.0 + 10.0 * x[i + 5],
+                    ),
+                )
             };
             let (a, b) = (rnd_box(Vec3::zeros(), 0), rnd_box(v(6) * 150.0, 9));
-            let motion =
-                |i: usize| (rot((0.05 * x[i], 0.05 * x[i + 1], 0.05 * x[i + 2])), v(i + 3) * 200.0, v(i + 6) * 3.0);
+            let motion = |i: usize| {
+                (
+                    rot((0.05 * x[i], 0.05 * x[i + 1], 0.05 * x[i + 2])),
+                    v(i + 3) * 200.0,
+                    v(i + 6) * 3.0,
+                )
+            };
             let ((fa, sa, _), (fb, sb, _)) = (moved(&a, &motion(15)), moved(&b, &motion(21)));
             let meet = swept_boxes_always_meet(&a, &sa, &b, &sb);
             intersecting += separating_axis(&fa, &fb).is_none() as usize;
@@ -962,11 +1048,35 @@ pub(crate) mod tests {
         let b = Obb::new(Vec3::repeat(2.5), Mat3::identity(), Vec3::repeat(1.0));
         let (fa, fb) = (FaceTerms::ball(&a, [0.3; 2]), FaceTerms::ball(&b, [0.3; 2]));
         let diagonal = Vec3::repeat(1.0);
-        assert!(!balls_swept_apart_with(&a, [0.3; 2], &fa, &b, [0.3; 2], &fb, Axes::FifteenAnd(&Vec3::zeros())));
-        assert!(balls_swept_apart_with(&a, [0.3; 2], &fa, &b, [0.3; 2], &fb, Axes::FifteenAnd(&diagonal)));
+        assert!(!balls_swept_apart_with(
+            &a,
+            [0.3; 2],
+            &fa,
+            &b,
+            [0.3; 2],
+            &fb,
+            Axes::FifteenAnd(&Vec3::zeros())
+        ));
+        assert!(balls_swept_apart_with(
+            &a,
+            [0.3; 2],
+            &fa,
+            &b,
+            [0.3; 2],
+            &fb,
+            Axes::FifteenAnd(&diagonal)
+        ));
         // The corners are 0.866 apart: radii of 0.44 each leave no room on any axis.
         let (ga, gb) = (FaceTerms::ball(&a, [0.44; 2]), FaceTerms::ball(&b, [0.44; 2]));
-        assert!(!balls_swept_apart_with(&a, [0.44; 2], &ga, &b, [0.44; 2], &gb, Axes::FifteenAnd(&diagonal)));
+        assert!(!balls_swept_apart_with(
+            &a,
+            [0.44; 2],
+            &ga,
+            &b,
+            [0.44; 2],
+            &gb,
+            Axes::FifteenAnd(&diagonal)
+        ));
     }
 
     #[test]

@@ -11,7 +11,9 @@
 //! pre-reject (exact-safe: AABBs enclose their boxes), then the 15-axis test.
 
 use crate::geometry::obb::Obb;
-use crate::geometry::sat::{aabb_half_rounded_up, aabbs_disjoint, separating_axis, separating_axis_hinted, Axis};
+use crate::geometry::sat::{
+    aabb_half_rounded_up, aabbs_disjoint, separating_axis, separating_axis_hinted, Axis,
+};
 use crate::geometry::MAX_BOXES;
 use crate::math::Real;
 
@@ -152,7 +154,10 @@ mod tests {
                 }
             }
         }
-        assert!(hits > 5_000 && misses > 5_000, "both answers exercised: {hits} hits, {misses} misses");
+        assert!(
+            hits > 5_000 && misses > 5_000,
+            "both answers exercised: {hits} hits, {misses} misses"
+        );
     }
 
     #[test]
@@ -161,7 +166,8 @@ mod tests {
         for _ in 0..5_000 {
             let a: Vec<Obb> = (0..3).map(|_| link(rng.vec(300.0), rng.vec(3.0))).collect();
             let b: Vec<Obb> = (0..3).map(|_| link(rng.vec(300.0), rng.vec(3.0))).collect();
-            let expected = (0..9).map(|k| (k / 3, k % 3)).find(|&(i, j)| obbs_intersect(&a[i], &b[j]));
+            let expected =
+                (0..9).map(|k| (k / 3, k % 3)).find(|&(i, j)| obbs_intersect(&a[i], &b[j]));
             assert_eq!(first_intersecting_pair(&a, &b), expected);
         }
     }

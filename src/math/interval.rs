@@ -72,7 +72,10 @@ impl Interval {
     /// `self * o`.
     pub fn mul(self, o: Interval) -> Interval {
         let p = [self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi];
-        widen(p.iter().copied().fold(Real::INFINITY, Real::min), p.iter().copied().fold(Real::NEG_INFINITY, Real::max))
+        widen(
+            p.iter().copied().fold(Real::INFINITY, Real::min),
+            p.iter().copied().fold(Real::NEG_INFINITY, Real::max),
+        )
     }
 
     /// `self^2` (tighter than `self * self` when the interval holds 0).
@@ -133,7 +136,8 @@ impl Interval {
         }
         // `y` at which the angle is extreme on the side at `side_x`: `larger` picks the end
         // that makes it grow (`d/dy` has the sign of `x`).
-        let end_y = |side_x: Real, larger: bool| if (side_x >= 0.0) == larger { y.hi } else { y.lo };
+        let end_y =
+            |side_x: Real, larger: bool| if (side_x >= 0.0) == larger { y.hi } else { y.lo };
         let (lo, hi) = if y.hi < 0.0 {
             (end_y(x.lo, false).atan2(x.lo), end_y(x.hi, true).atan2(x.hi))
         } else if y.lo > 0.0 {
@@ -191,7 +195,10 @@ mod tests {
         let ac = Interval::new(-0.5, 3.0).acos().unwrap();
         assert!(ac.contains(0.0) && ac.contains(2.0 * std::f64::consts::FRAC_PI_3) && ac.hi < 2.1);
         assert_eq!(Interval::new(1.5, 3.0).acos(), None);
-        assert!(Interval::atan2(Interval::new(-1.0, 1.0), Interval::new(-2.0, -1.0)).is_none(), "branch cut");
+        assert!(
+            Interval::atan2(Interval::new(-1.0, 1.0), Interval::new(-2.0, -1.0)).is_none(),
+            "branch cut"
+        );
         assert!(Interval::atan2(Interval::new(-1.0, 1.0), Interval::new(1.0, 2.0)).is_some());
     }
 
@@ -223,9 +230,14 @@ mod tests {
             for s in 0..=4 {
                 for u in 0..=4 {
                     // Clamped: the rounded sum may step past the far end.
-                    let at = |i: &Interval, f: usize| (i.lo + (i.hi - i.lo) * f as f64 / 4.0).clamp(i.lo, i.hi);
+                    let at = |i: &Interval, f: usize| {
+                        (i.lo + (i.hi - i.lo) * f as f64 / 4.0).clamp(i.lo, i.hi)
+                    };
                     let (px, py) = (at(&x, s), at(&y, u));
-                    assert!(t.contains(py.atan2(px)), "atan2({py}, {px}) not in {t:?}, box {y:?} x {x:?}");
+                    assert!(
+                        t.contains(py.atan2(px)),
+                        "atan2({py}, {px}) not in {t:?}, box {y:?} x {x:?}"
+                    );
                 }
             }
         }

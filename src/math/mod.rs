@@ -148,7 +148,10 @@ mod tests {
 
     /// Distance in units in the last place between two finite doubles of the same sign.
     fn ulps(a: f64, b: f64) -> u64 {
-        assert!(a.is_finite() && b.is_finite() && (a == b || a.signum() == b.signum()), "{a} vs {b}");
+        assert!(
+            a.is_finite() && b.is_finite() && (a == b || a.signum() == b.signum()),
+            "{a} vs {b}"
+        );
         (a.to_bits() as i64).abs_diff(b.to_bits() as i64)
     }
 
@@ -176,7 +179,11 @@ mod tests {
             assert!(ulps(libm::hypot(a, b), a.hypot(b)) <= 1, "hypot({a}, {b})");
             assert!(ulps(libm::acos(a / 1000.0), (a / 1000.0).acos()) <= 1, "acos({a} / 1000)");
             let (t, (s, c)) = (a / 100.0, libm::sincos(a / 100.0));
-            assert!((s - t.sin()).abs() <= 2.0 * f64::EPSILON && (c - t.cos()).abs() <= 2.0 * f64::EPSILON, "{t}");
+            assert!(
+                (s - t.sin()).abs() <= 2.0 * f64::EPSILON
+                    && (c - t.cos()).abs() <= 2.0 * f64::EPSILON,
+                "{t}"
+            );
             assert_eq!(float::sqrt(a.abs()), a.abs().sqrt());
             assert_eq!(float::atan2(a, b), a.atan2(b));
             assert_eq!(float::sin_cos(t), t.sin_cos());

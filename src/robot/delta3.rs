@@ -66,7 +66,9 @@ impl core::fmt::Display for Unreachable {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Unreachable::NonFinite => write!(f, "TCP has a NaN or infinite coordinate"),
-            Unreachable::AboveBase => write!(f, "TCP is not below the base plane (z must be negative)"),
+            Unreachable::AboveBase => {
+                write!(f, "TCP is not below the base plane (z must be negative)")
+            }
             Unreachable::OutOfReach { arm } => write!(f, "arm {arm} cannot reach the TCP"),
             Unreachable::MotorLimit { arm, theta } => {
                 write!(f, "arm {arm} would need motor angle {theta:.4} rad, outside its limits")
@@ -108,7 +110,8 @@ impl MotorCosSin {
 }
 
 /// Radial unit vectors `u_i` of the three arms.
-pub const ARM_RADIAL: [[Real; 2]; 3] = [[1.0, 0.0], [-0.5, 0.866_025_403_784_438_6], [-0.5, -0.866_025_403_784_438_6]];
+pub const ARM_RADIAL: [[Real; 2]; 3] =
+    [[1.0, 0.0], [-0.5, 0.866_025_403_784_438_6], [-0.5, -0.866_025_403_784_438_6]];
 
 /// Bound on the error of the approximate angle used by the fast motor-limit test (rad).
 pub const APPROX_ANGLE_MAX_ERROR: Real = 2e-3;
@@ -116,7 +119,8 @@ pub const APPROX_ANGLE_MAX_ERROR: Real = 2e-3;
 /// An approximate angle at least this far (rad) inside both limits is accepted without `atan2`.
 pub const LIMIT_FAST_MARGIN: Real = 1e-2;
 
-const _: () = assert!(APPROX_ANGLE_MAX_ERROR < LIMIT_FAST_MARGIN, "the fast limit test must be conservative");
+const _: () =
+    assert!(APPROX_ANGLE_MAX_ERROR < LIMIT_FAST_MARGIN, "the fast limit test must be conservative");
 
 /// `u_i`, the radial unit of arm `i`.
 pub fn radial(arm: usize) -> Vec3 {
@@ -161,8 +165,14 @@ pub fn approx_angle(cos: Real, sin: Real) -> Real {
 
 impl Delta3 {
     /// The robot of the thesis (2.7): f = 100, rf = 150, re = 400, e = 40, default limits.
-    pub const THESIS: Delta3 =
-        Delta3 { f: 100.0, rf: 150.0, re: 400.0, e: 40.0, theta_min: -PI / 2.0, theta_max: 2.0 * PI / 3.0 };
+    pub const THESIS: Delta3 = Delta3 {
+        f: 100.0,
+        rf: 150.0,
+        re: 400.0,
+        e: 40.0,
+        theta_min: -PI / 2.0,
+        theta_max: 2.0 * PI / 3.0,
+    };
 
     /// Checks that lengths are finite and positive and the motor range is a proper arc.
     ///
@@ -171,11 +181,17 @@ impl Delta3 {
     pub fn validate(&self) -> Result<(), String> {
         for (name, v) in [("f", self.f), ("rf", self.rf), ("re", self.re), ("e", self.e)] {
             if !(v.is_finite() && v > 0.0 && v <= MAX_LENGTH) {
-                return Err(format!("Delta3 parameter {name} = {v} must be a length in (0, {MAX_LENGTH:e}] mm"));
+                return Err(format!(
+                    "Delta3 parameter {name} = {v} must be a length in (0, {MAX_LENGTH:e}] mm"
+                ));
             }
         }
         let span = self.theta_max - self.theta_min;
-        if !(self.theta_min.is_finite() && self.theta_max.is_finite() && span > 0.0 && span < 2.0 * PI) {
+        if !(self.theta_min.is_finite()
+            && self.theta_max.is_finite()
+            && span > 0.0
+            && span < 2.0 * PI)
+        {
             return Err(format!(
                 "motor limits [{}, {}] rad must be finite with 0 < theta_max - theta_min < 2 pi",
                 self.theta_min, self.theta_max
@@ -263,7 +279,9 @@ impl Delta3 {
             // sign that makes cos th larger, +/- = sign(c), and c = z < 0 here: minus.
             let s = -float::sqrt(r2 - k * k);
             let (cos_n, sin_n) = (a * k + c * s, a * s - c * k); // R^2 (cos th, sin th)
-            // The approximate angle is scale-free: it needs no 1 / R^2 and runs beside it.
+                                                                 // The approximate angle is
+                                                                 // scale-free: it needs no 1 / R^2
+                                                                 // and runs beside it.
             let fast_ok = self.clearly_within_limits(approx_angle(cos_n, sin_n));
             if OUT || !fast_ok {
                 let inv_r2 = 1.0 / r2;
@@ -364,7 +382,8 @@ mod tests {
             };
             let home = Vec3::new(0.0, 0.0, -450.0);
             for _ in 0..50_000 {
-                let p = Vec3::new(350.0 * rng.unit(), 350.0 * rng.unit(), -350.0 * rng.unit() - 300.0);
+                let p =
+                    Vec3::new(350.0 * rng.unit(), 350.0 * rng.unit(), -350.0 * rng.unit() - 300.0);
                 if agree(&p) {
                     reachable += 1;
                 } else {
@@ -391,7 +410,8 @@ mod tests {
             // A motor exactly at a limit and one ulp either side of it, the others random.
             for i in 0..3000 {
                 let span = d.theta_max - d.theta_min;
-                let mut theta: [Real; 3] = core::array::from_fn(|_| d.theta_min + span * next(&mut rng));
+                let mut theta: [Real; 3] =
+                    core::array::from_fn(|_| d.theta_min + span * next(&mut rng));
                 let limit = if i % 2 == 0 { d.theta_min } else { d.theta_max };
                 for th in [limit, limit.next_up(), limit.next_down()] {
                     theta[i % 3] = th;
@@ -414,7 +434,10 @@ mod tests {
                 assert!(!agree(&p), "{p:?}");
             }
         }
-        assert!(reachable > 2_000 && at_boundary > 2_000, "{reachable} {unreachable} {at_boundary}");
+        assert!(
+            reachable > 2_000 && at_boundary > 2_000,
+            "{reachable} {unreachable} {at_boundary}"
+        );
     }
 
     #[test]
@@ -442,13 +465,20 @@ mod tests {
         let expected = if th1.cos() > th2.cos() { wrap(th1) } else { wrap(th2) };
         let sol = d.inverse_kinematics(&Vec3::new(0.0, 0.0, -450.0)).unwrap();
         assert!((sol.theta[0] - expected).abs() < 1e-12, "{} vs {expected}", sol.theta[0]);
-        assert!((sol.cos[0] - expected.cos()).abs() < 1e-12 && (sol.sin[0] - expected.sin()).abs() < 1e-12);
+        assert!(
+            (sol.cos[0] - expected.cos()).abs() < 1e-12
+                && (sol.sin[0] - expected.sin()).abs() < 1e-12
+        );
     }
 
     #[test]
     fn every_arm_closes_its_loop() {
         let d = Delta3::THESIS;
-        for p in [Vec3::new(120.0, -80.0, -420.0), Vec3::new(-150.0, 30.0, -480.0), Vec3::new(0.0, 210.0, -380.0)] {
+        for p in [
+            Vec3::new(120.0, -80.0, -420.0),
+            Vec3::new(-150.0, 30.0, -480.0),
+            Vec3::new(0.0, 210.0, -380.0),
+        ] {
             let sol = d.inverse_kinematics(&p).unwrap();
             for arm in 0..3 {
                 let g = d.elbow(arm, sol.cos[arm], sol.sin[arm]);
@@ -462,14 +492,29 @@ mod tests {
     #[test]
     fn far_away_tcp_is_out_of_reach() {
         let d = Delta3::THESIS;
-        assert!(matches!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, -900.0)), Err(Unreachable::OutOfReach { .. })));
+        assert!(matches!(
+            d.inverse_kinematics(&Vec3::new(0.0, 0.0, -900.0)),
+            Err(Unreachable::OutOfReach { .. })
+        ));
         assert_eq!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, 0.0)), Err(Unreachable::AboveBase));
         // The loops would close here (elbows down, links pointing up through the base).
         assert_eq!(d.inverse_kinematics(&Vec3::new(0.0, 0.0, 300.0)), Err(Unreachable::AboveBase));
-        assert!(matches!(d.inverse_kinematics(&Vec3::new(1e200, 0.0, -400.0)), Err(Unreachable::OutOfReach { .. })));
-        assert!(matches!(d.inverse_kinematics(&Vec3::new(0.0, -1e200, -1e200)), Err(Unreachable::OutOfReach { .. })));
-        assert_eq!(d.inverse_kinematics(&Vec3::new(f64::NAN, 0.0, -400.0)), Err(Unreachable::NonFinite));
-        assert_eq!(d.inverse_kinematics(&Vec3::new(0.0, f64::INFINITY, -400.0)), Err(Unreachable::NonFinite));
+        assert!(matches!(
+            d.inverse_kinematics(&Vec3::new(1e200, 0.0, -400.0)),
+            Err(Unreachable::OutOfReach { .. })
+        ));
+        assert!(matches!(
+            d.inverse_kinematics(&Vec3::new(0.0, -1e200, -1e200)),
+            Err(Unreachable::OutOfReach { .. })
+        ));
+        assert_eq!(
+            d.inverse_kinematics(&Vec3::new(f64::NAN, 0.0, -400.0)),
+            Err(Unreachable::NonFinite)
+        );
+        assert_eq!(
+            d.inverse_kinematics(&Vec3::new(0.0, f64::INFINITY, -400.0)),
+            Err(Unreachable::NonFinite)
+        );
         assert!(!d.is_reachable(&Vec3::new(0.0, 0.0, -900.0)));
         assert!(d.is_reachable(&Vec3::new(0.0, 0.0, -450.0)));
     }
@@ -484,7 +529,10 @@ mod tests {
             other => panic!("expected a motor limit on arm 0, got {other:?}"),
         }
         let above = Delta3 { theta_min: th + 1e-6, theta_max: th + 1.0, ..Delta3::THESIS };
-        assert!(matches!(above.inverse_kinematics(&p), Err(Unreachable::MotorLimit { arm: 0, .. })));
+        assert!(matches!(
+            above.inverse_kinematics(&p),
+            Err(Unreachable::MotorLimit { arm: 0, .. })
+        ));
         // Exactly on a limit is within it.
         let on = Delta3 { theta_max: th, ..Delta3::THESIS };
         assert!(on.inverse_kinematics(&p).is_ok());
@@ -501,7 +549,13 @@ mod tests {
 
     #[test]
     fn approximate_angle_propagates_nan() {
-        for (c, s) in [(f64::NAN, 1.0), (1.0, f64::NAN), (f64::NAN, 0.0), (0.0, 0.0), (f64::INFINITY, f64::NAN)] {
+        for (c, s) in [
+            (f64::NAN, 1.0),
+            (1.0, f64::NAN),
+            (f64::NAN, 0.0),
+            (0.0, 0.0),
+            (f64::INFINITY, f64::NAN),
+        ] {
             assert!(approx_angle(c, s).is_nan(), "({c}, {s})");
         }
         assert!((approx_angle(-3.0, 4.0) - 4.0f64.atan2(-3.0)).abs() < APPROX_ANGLE_MAX_ERROR);

@@ -75,7 +75,10 @@ impl ModelOptions {
         positive("half_height", self.half_height)?;
         positive("half_depth", self.half_depth)?;
         if !(self.margin.is_finite() && self.margin >= 0.0 && self.margin <= MAX_LENGTH) {
-            return Err(format!("safety margin {} must be a length in [0, {MAX_LENGTH:e}] mm", self.margin));
+            return Err(format!(
+                "safety margin {} must be a length in [0, {MAX_LENGTH:e}] mm",
+                self.margin
+            ));
         }
         if let Some((h, d)) = self.upper_links {
             positive("upper link half height", h)?;
@@ -129,7 +132,10 @@ pub struct RobotBoxes {
 impl RobotBoxes {
     /// No boxes.
     pub fn empty() -> Self {
-        RobotBoxes { boxes: [Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::zeros()); MAX_BOXES], len: 0 }
+        RobotBoxes {
+            boxes: [Obb::new(Vec3::zeros(), Mat3::identity(), Vec3::zeros()); MAX_BOXES],
+            len: 0,
+        }
     }
 
     /// The meaningful boxes.
@@ -154,12 +160,15 @@ pub struct RobotModel {
 
 impl RobotModel {
     /// The thesis robot with the physical box sizes.
-    pub const THESIS: RobotModel = RobotModel { delta: Delta3::THESIS, options: ModelOptions::THESIS };
+    pub const THESIS: RobotModel =
+        RobotModel { delta: Delta3::THESIS, options: ModelOptions::THESIS };
 
     /// How many boxes [`RobotModel::boxes`] returns.
     pub fn box_count(&self) -> usize {
         let o = &self.options;
-        3 + if o.upper_links.is_some() { 3 } else { 0 } + o.platform.is_some() as usize + o.tool.is_some() as usize
+        3 + if o.upper_links.is_some() { 3 } else { 0 }
+            + o.platform.is_some() as usize
+            + o.tool.is_some() as usize
     }
 
     /// What box `index` (< [`RobotModel::box_count`]) models.
@@ -210,8 +219,15 @@ impl RobotModel {
         let elbow = |arm: usize| d.elbow(arm, sol.cos[arm], sol.sin[arm]);
         match self.box_kind(k) {
             BoxKind::LowerLink(arm) => {
-                let (arm, lower_half) = (arm as usize, Vec3::new(0.5 * d.re + m, o.half_height + m, o.half_depth + m));
-                link_box(&elbow(arm), &d.platform_joint(arm, tcp), 1.0 / d.re, &tangent(arm), lower_half)
+                let (arm, lower_half) =
+                    (arm as usize, Vec3::new(0.5 * d.re + m, o.half_height + m, o.half_depth + m));
+                link_box(
+                    &elbow(arm),
+                    &d.platform_joint(arm, tcp),
+                    1.0 / d.re,
+                    &tangent(arm),
+                    lower_half,
+                )
             }
             BoxKind::UpperLink(arm) => {
                 let (h, dz) = o.upper_links.expect("upper link boxes exist");
@@ -232,9 +248,16 @@ impl RobotModel {
         // |E_i - G_i| = re once the loops close (IK: to ~1e-15 relative), so x = (E - G) / re.
         let (inv_re, inv_rf) = (1.0 / d.re, 1.0 / d.rf);
         let lower_half = Vec3::new(0.5 * d.re + m, o.half_height + m, o.half_depth + m);
-        let elbows: [Vec3; 3] = core::array::from_fn(|arm| d.elbow(arm, sol.cos[arm], sol.sin[arm]));
+        let elbows: [Vec3; 3] =
+            core::array::from_fn(|arm| d.elbow(arm, sol.cos[arm], sol.sin[arm]));
         for (arm, slot) in out.boxes[..3].iter_mut().enumerate() {
-            *slot = link_box(&elbows[arm], &d.platform_joint(arm, tcp), inv_re, &tangent(arm), lower_half);
+            *slot = link_box(
+                &elbows[arm],
+                &d.platform_joint(arm, tcp),
+                inv_re,
+                &tangent(arm),
+                lower_half,
+            );
         }
         out.len = 3;
         if let Some((h, dz)) = o.upper_links {
@@ -282,12 +305,18 @@ impl RobotModel {
         if let Some((h, dz)) = o.upper_links {
             let upper_half = Vec3::new(0.5 * d.rf + m, h + m, dz + m);
             for m123 in &motor_frames {
-                out.push(pose_box(&(m123 * homogeneous(0.5 * d.rf, 0.0, 0.0, 0.0, 0.0, 0.0)), upper_half));
+                out.push(pose_box(
+                    &(m123 * homogeneous(0.5 * d.rf, 0.0, 0.0, 0.0, 0.0, 0.0)),
+                    upper_half,
+                ));
             }
         }
         for extra in [o.platform, o.tool].into_iter().flatten() {
             let c = tcp + extra.offset;
-            out.push(pose_box(&(m1 * homogeneous(c.x, c.y, c.z, 0.0, 0.0, 0.0)), extra.half.add_scalar(m)));
+            out.push(pose_box(
+                &(m1 * homogeneous(c.x, c.y, c.z, 0.0, 0.0, 0.0)),
+                extra.half.add_scalar(m),
+            ));
         }
         Ok(out)
     }
@@ -373,7 +402,8 @@ mod tests {
         for model in [RobotModel::THESIS, full_options(5.0)] {
             let mut tried = 0;
             while tried < 500 {
-                let tcp = Vec3::new(400.0 * rng.unit(), 400.0 * rng.unit(), -650.0 + 350.0 * rng.unit());
+                let tcp =
+                    Vec3::new(400.0 * rng.unit(), 400.0 * rng.unit(), -650.0 + 350.0 * rng.unit());
                 let Ok(sol) = model.delta.inverse_kinematics_cos_sin(&tcp) else {
                     assert!(model.boxes(&tcp).is_err());
                     continue;
@@ -415,12 +445,21 @@ mod tests {
             let Ok(sol) = model.delta.inverse_kinematics(&tcp) else { continue };
             let boxes = model.boxes(&tcp).unwrap();
             let b = &boxes.boxes[0];
-            assert!((b.axes.transpose() * b.axes - Mat3::identity()).norm() < 1e-9, "{tcp:?}: {b:?}");
+            assert!(
+                (b.axes.transpose() * b.axes - Mat3::identity()).norm() < 1e-9,
+                "{tcp:?}: {b:?}"
+            );
             let g = model.delta.elbow(0, sol.cos[0], sol.sin[0]);
             assert!((b.center - b.axes.column(0) * b.half.x - g).norm() < 1e-9);
-            assert!(b.axes.column(0).cross(&tangent(0)).norm() < 1e-3, "{tcp:?}: link 0 runs along t_0");
+            assert!(
+                b.axes.column(0).cross(&tangent(0)).norm() < 1e-3,
+                "{tcp:?}: link 0 runs along t_0"
+            );
         }
-        assert!(model.delta.inverse_kinematics(&Vec3::new(60.0, 400.0, -150.0)).is_ok(), "the exact pose is reachable");
+        assert!(
+            model.delta.inverse_kinematics(&Vec3::new(60.0, 400.0, -150.0)).is_ok(),
+            "the exact pose is reachable"
+        );
     }
 
     fn full_options(margin: Real) -> RobotModel {
@@ -429,8 +468,14 @@ mod tests {
             options: ModelOptions {
                 margin,
                 upper_links: Some((30.0, 20.0)),
-                platform: Some(ToolBox { offset: Vec3::new(0.0, 0.0, 10.0), half: Vec3::new(60.0, 60.0, 15.0) }),
-                tool: Some(ToolBox { offset: Vec3::new(0.0, 0.0, -40.0), half: Vec3::new(25.0, 25.0, 40.0) }),
+                platform: Some(ToolBox {
+                    offset: Vec3::new(0.0, 0.0, 10.0),
+                    half: Vec3::new(60.0, 60.0, 15.0),
+                }),
+                tool: Some(ToolBox {
+                    offset: Vec3::new(0.0, 0.0, -40.0),
+                    half: Vec3::new(25.0, 25.0, 40.0),
+                }),
                 ..ModelOptions::THESIS
             },
         }
@@ -446,7 +491,10 @@ mod tests {
             model.options.platform = if mask & 2 != 0 { base.options.platform } else { None };
             model.options.tool = if mask & 4 != 0 { base.options.tool } else { None };
             let n = model.box_count();
-            assert_eq!(n, 3 + 3 * (mask & 1) as usize + (mask >> 1 & 1) as usize + (mask >> 2 & 1) as usize);
+            assert_eq!(
+                n,
+                3 + 3 * (mask & 1) as usize + (mask >> 1 & 1) as usize + (mask >> 2 & 1) as usize
+            );
             assert_eq!(model.boxes(&tcp).unwrap().len, n);
             assert_eq!(model.boxes_chain(&tcp).unwrap().len, n);
             let kinds: Vec<BoxKind> = (0..n).map(|i| model.box_kind(i)).collect();
@@ -468,7 +516,10 @@ mod tests {
     fn options_are_validated() {
         assert!(ModelOptions::THESIS.validate().is_ok());
         assert!(full_options(3.0).options.validate().is_ok());
-        assert!(ModelOptions { margin: -1.0, ..ModelOptions::THESIS }.validate().unwrap_err().contains("margin"));
+        assert!(ModelOptions { margin: -1.0, ..ModelOptions::THESIS }
+            .validate()
+            .unwrap_err()
+            .contains("margin"));
         assert!(ModelOptions { half_depth: f64::NAN, ..ModelOptions::THESIS }.validate().is_err());
         let mut o = full_options(0.0).options;
         o.tool = Some(ToolBox { offset: Vec3::zeros(), half: Vec3::new(1.0, 0.0, 1.0) });
@@ -509,8 +560,11 @@ mod tests {
     fn chain_and_direct_forms_agree() {
         for margin in [0.0, 7.0] {
             let model = full_options(margin);
-            for tcp in [Vec3::new(0.0, 0.0, -450.0), Vec3::new(150.0, -90.0, -410.0), Vec3::new(-120.0, 120.0, -470.0)]
-            {
+            for tcp in [
+                Vec3::new(0.0, 0.0, -450.0),
+                Vec3::new(150.0, -90.0, -410.0),
+                Vec3::new(-120.0, 120.0, -470.0),
+            ] {
                 let (a, b) = (model.boxes(&tcp).unwrap(), model.boxes_chain(&tcp).unwrap());
                 for (x, y) in a.as_slice().iter().zip(b.as_slice()) {
                     assert!((x.center - y.center).norm() < 1e-9, "{x:?} vs {y:?}");

@@ -60,9 +60,11 @@
 //! 8. `z = (x cross t) / |x cross t|`, `|x cross t| = sqrt(1 - (x.t)^2) >= w0 := sqrt(1 - beta^2)`,
 //!    `|(x - x0) cross t| <= dx`, so `|z - z0| <= dx / w0`.
 //! 9. `y = z cross x = (t - (x.t) x) / sqrt(1 - (x.t)^2)`; the numerator changes by
-//!    `(x.t) (x - x0) + ((x - x0).t) x0`, so `|y - y0| <= (beta dx + (h_x |t_x| + h_y |t_y|) / re) / w0`.
+//!    `(x.t) (x - x0) + ((x - x0).t) x0`, so `|y - y0| <= (beta dx + (h_x |t_x| + h_y |t_y|) / re)
+//! / w0`.
 //! 10. (Stops only, [`box_sweep_forms_into`].) The same `y`, written exactly: with `s = x.t`,
-//!     `w = sqrt(1 - s^2)` and `s0, w'` at `p0`, `t - s x = (t - s0 x0) - (s - s0) x0 - s (x - x0)`,
+//!     `w = sqrt(1 - s^2)` and `s0, w'` at `p0`,
+//!     `t - s x = (t - s0 x0) - (s - s0) x0 - s (x - x0)`,
 //!     so `y - y0 = (w'/w - 1) y0 - ((s - s0) / w) x0 - (s / w)(x - x0)`. With `|s| <= beta`
 //!     (`w >= w0`) and `|s - s0| <= (h_x |t_x| + h_y |t_y|) / re =: tt` (step 6): a segment
 //!     along the link's own axis `x0` of half-length `tt / w0`, plus a ball of radius
@@ -86,13 +88,13 @@
 //!
 //! Upper links (`F` to `G`, fixed `F`): `x.t = 0` so `y = t` never turns, `|z - z0| = dG / rf`,
 //! and points move at most `(1 + m/rf) dG + (d_u + m) dG / rf`. Platform and tool boxes
-//! translate with the TCP: `Z`, at most `dp`. Unit vectors differ by at most 2, so every `|.|` above is
-//! capped at 2.
+//! translate with the TCP: `Z`, at most `dp`. Unit vectors differ by at most 2, so every `|.|`
+//! above is capped at 2.
 //!
 //! # Numerics
 //! The cell is widened by a relative 1e-12 before enclosing (so rounding in a table's
-//! `SampleGrid::cell_of` is covered), the interval arithmetic is outward ([`Interval`]), and every bound gets
-//! `BOUND_SLACK` added: all err toward a larger bound, i.e. toward "collision".
+//! `SampleGrid::cell_of` is covered), the interval arithmetic is outward ([`Interval`]), and every
+//! bound gets `BOUND_SLACK` added: all err toward a larger bound, i.e. toward "collision".
 
 use super::delta3::{radial, tangent, ArmSolution};
 use super::{BoxKind, Delta3, RobotModel, MAX_BOXES};
@@ -123,7 +125,9 @@ impl Enclosure {
             (Enclosure::Range(x), Enclosure::Range(y)) if x.lo.max(y.lo) <= x.hi.min(y.hi) => {
                 Enclosure::Range(Interval::new(x.lo.max(y.lo), x.hi.min(y.hi)))
             }
-            (Enclosure::Range(_), Enclosure::Range(_)) | (Enclosure::Empty, _) | (_, Enclosure::Empty) => Enclosure::Empty,
+            (Enclosure::Range(_), Enclosure::Range(_))
+            | (Enclosure::Empty, _)
+            | (_, Enclosure::Empty) => Enclosure::Empty,
             (Enclosure::Unbounded, other) | (other, Enclosure::Unbounded) => other,
         }
     }
@@ -145,7 +149,9 @@ pub fn theta_range(delta: &Delta3, arm: usize, lo: &Vec3, hi: &Vec3, splits: u32
                 match (theta_over_box(delta, &u, &t, x, y, z), out) {
                     (Enclosure::Unbounded, _) => return Enclosure::Unbounded,
                     (Enclosure::Empty, _) => {}
-                    (Enclosure::Range(r), Enclosure::Range(o)) => out = Enclosure::Range(o.hull(&r)),
+                    (Enclosure::Range(r), Enclosure::Range(o)) => {
+                        out = Enclosure::Range(o.hull(&r))
+                    }
                     (Enclosure::Range(r), _) => out = Enclosure::Range(r),
                 }
             }
@@ -179,7 +185,14 @@ pub fn cube_unreachable(delta: &Delta3, c: &Vec3, h: Real) -> bool {
 
 fn box_unreachable(delta: &Delta3, lo: &Vec3, hi: &Vec3, depth: u32) -> bool {
     let iv = |a: usize| Interval::new(lo[a], hi[a]);
-    let arm_excludes = |arm: usize| match theta_over_box(delta, &radial(arm), &tangent(arm), iv(0), iv(1), iv(2)) {
+    let arm_excludes = |arm: usize| match theta_over_box(
+        delta,
+        &radial(arm),
+        &tangent(arm),
+        iv(0),
+        iv(1),
+        iv(2),
+    ) {
         Enclosure::Empty => true,
         Enclosure::Range(th) => outside_limits(delta, th),
         Enclosure::Unbounded => false,
@@ -254,11 +267,19 @@ fn arm_reaches_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: 
 /// as [`Delta3::motor_within_limits`]) with [`REACH_MARGIN`] to spare at both ends.
 fn inside_limits(delta: &Delta3, th: Interval) -> bool {
     let start = (th.lo - delta.theta_min).rem_euclid(std::f64::consts::TAU);
-    start >= REACH_MARGIN && start + (th.hi - th.lo) <= delta.theta_max - delta.theta_min - REACH_MARGIN
+    start >= REACH_MARGIN
+        && start + (th.hi - th.lo) <= delta.theta_max - delta.theta_min - REACH_MARGIN
 }
 
 /// The TCP box in arm `u, t`'s frame: `a = p.u + e - f`, `b^2 = (p.t)^2`, `c = p.z`.
-fn arm_frame(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> (Interval, Interval, Interval) {
+fn arm_frame(
+    d: &Delta3,
+    u: &Vec3,
+    t: &Vec3,
+    x: Interval,
+    y: Interval,
+    z: Interval,
+) -> (Interval, Interval, Interval) {
     let a = x.scale(u.x).add(y.scale(u.y)).shift(d.e - d.f);
     let b = x.scale(t.x).add(y.scale(t.y));
     (a, b.sqr(), z)
@@ -278,7 +299,10 @@ fn cos_ratio_of(d: &Delta3, r2: Interval, r: Interval, b2: Interval) -> Option<I
     if cc.hi <= 0.0 {
         // K/R = R/(2 rf) + C/(2 rf R): increasing in R (C <= 0) and in C (R > 0).
         let g = |rv: Real, cv: Real| {
-            Some(Interval::point(rv / two_rf).add(Interval::point(cv).div(Interval::point(two_rf * rv))?))
+            Some(
+                Interval::point(rv / two_rf)
+                    .add(Interval::point(cv).div(Interval::point(two_rf * rv))?),
+            )
         };
         let (glo, ghi) = (g(r.lo, cc.lo)?, g(r.hi, cc.hi)?);
         Some(Interval::new(glo.lo, ghi.hi))
@@ -288,7 +312,14 @@ fn cos_ratio_of(d: &Delta3, r2: Interval, r: Interval, b2: Interval) -> Option<I
 }
 
 /// `th = -atan2(c, a) - acos(K / R)` over one sub-box (SPEC §2, elbow-out with `c < 0`).
-fn theta_over_box(d: &Delta3, u: &Vec3, t: &Vec3, x: Interval, y: Interval, z: Interval) -> Enclosure {
+fn theta_over_box(
+    d: &Delta3,
+    u: &Vec3,
+    t: &Vec3,
+    x: Interval,
+    y: Interval,
+    z: Interval,
+) -> Enclosure {
     if z.hi >= 0.0 {
         return Enclosure::Unbounded;
     }
@@ -377,7 +408,9 @@ fn wedge_radii(r0: Interval, rho: Real, nearest: Real) -> Interval {
     let (sin, cos) = nearest.sin_cos();
     let along = r0.scale(cos);
     let across = Interval::point(rho).sqr().sub(r0.sqr().scale(sin * sin));
-    let half = Interval::new(across.lo.max(0.0), across.hi.max(0.0)).sqrt().unwrap_or(Interval::point(0.0));
+    let half = Interval::new(across.lo.max(0.0), across.hi.max(0.0))
+        .sqrt()
+        .unwrap_or(Interval::point(0.0));
     Interval::new(along.sub(half).lo, along.add(half).hi)
 }
 
@@ -460,12 +493,21 @@ pub(crate) fn unbounded_sweeps(model: &RobotModel) -> [Sweep; MAX_BOXES] {
 ///
 /// Per box kind (module doc; `Z` is the cube of half-edges `reach`, `D` the disc orthogonal to
 /// the arm's tangent `t` that the elbow moves in):
-/// - lower link: `hull((1 + mu) dG D + mu Z, mu dG D + (1 + mu) Z) + ball((H + m) dy + (D + m) dz)`;
+/// - lower link: `hull((1 + mu) dG D + mu Z, mu dG D + (1 + mu) Z) + ball((H + m) dy + (D + m)
+///   dz)`;
 /// - upper link: `((1 + m/rf) dG + (d_u + m) dG / rf) D`;
 /// - platform and tool: `Z`.
-pub fn cube_box_sweeps(model: &RobotModel, c: &Vec3, h: Real, p0: &Vec3, splits: u32) -> Option<[Sweep; MAX_BOXES]> {
+pub fn cube_box_sweeps(
+    model: &RobotModel,
+    c: &Vec3,
+    h: Real,
+    p0: &Vec3,
+    splits: u32,
+) -> Option<[Sweep; MAX_BOXES]> {
     let d = &model.delta;
-    cube_box_sweeps_with(model, c, h, p0, |lo, hi| core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits)))
+    cube_box_sweeps_with(model, c, h, p0, |lo, hi| {
+        core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits))
+    })
 }
 
 /// As [`cube_box_sweeps`], with the motor angles over the widened cube `[lo, hi]` enclosed by
@@ -510,7 +552,13 @@ pub fn box_sweep_forms_into(
     let Some((angles, h)) = angles_over_cube(model, c, h, p0, enclose) else { return false };
     let motions = [TcpMotion::cube(c, h, p0), TcpMotion::ball(c, h, p0)];
     let swing = angles.map(|(sol, th)| {
-        CubeSwing::new(model, &sol, &narrowed_to_ball(&model.delta, c, h, &th), 0b111, LinkTurn::AlongLink)
+        CubeSwing::new(
+            model,
+            &sol,
+            &narrowed_to_ball(&model.delta, c, h, &th),
+            0b111,
+            LinkTurn::AlongLink,
+        )
     });
     let n = model.box_count();
     for (form, motion) in out.iter_mut().zip(&motions) {
@@ -530,9 +578,11 @@ pub fn box_sweep_forms_into(
 /// reachable TCP of the ball, so does their intersection); `th` as it is where the ball's
 /// enclosure gives nothing.
 fn narrowed_to_ball(delta: &Delta3, c: &Vec3, h: Real, th: &[Interval; 3]) -> [Interval; 3] {
-    core::array::from_fn(|arm| match Enclosure::Range(th[arm]).intersect(ball_theta_range(delta, arm, c, h)) {
-        Enclosure::Range(r) => r,
-        Enclosure::Empty | Enclosure::Unbounded => th[arm],
+    core::array::from_fn(|arm| {
+        match Enclosure::Range(th[arm]).intersect(ball_theta_range(delta, arm, c, h)) {
+            Enclosure::Range(r) => r,
+            Enclosure::Empty | Enclosure::Unbounded => th[arm],
+        }
     })
 }
 
@@ -583,7 +633,8 @@ pub fn box_sweep_forms(
         BoxKind::Platform | BoxKind::Tool => 0,
     };
     let swing = CubeSwing::new(model, sol, th, arms, LinkTurn::AlongLink);
-    [TcpMotion::cube(c, h, p0), TcpMotion::ball(c, h, p0)].map(|motion| swing.box_sweep(model, p0, j, &motion))
+    [TcpMotion::cube(c, h, p0), TcpMotion::ball(c, h, p0)]
+        .map(|motion| swing.box_sweep(model, p0, j, &motion))
 }
 
 /// Where the TCP's displacement `D = p - p0` lies: in the box of half-edges `reach` (per
@@ -624,7 +675,9 @@ impl TcpMotion {
     /// The set of `D` as a sweep's `Z`: its box and its rounding ball.
     fn as_z(&self) -> ([Vec3; 3], Real) {
         match self {
-            TcpMotion::Cube(reach) => ([Vec3::x() * reach.x, Vec3::y() * reach.y, Vec3::z() * reach.z], 0.0),
+            TcpMotion::Cube(reach) => {
+                ([Vec3::x() * reach.x, Vec3::y() * reach.y, Vec3::z() * reach.z], 0.0)
+            }
             TcpMotion::Ball(r) => ([Vec3::zeros(); 3], *r),
         }
     }
@@ -651,12 +704,19 @@ struct CubeSwing {
 }
 
 impl CubeSwing {
-    fn new(model: &RobotModel, sol: &ArmSolution, th: &[Interval; 3], arms: u8, turn: LinkTurn) -> CubeSwing {
+    fn new(
+        model: &RobotModel,
+        sol: &ArmSolution,
+        th: &[Interval; 3],
+        arms: u8,
+        turn: LinkTurn,
+    ) -> CubeSwing {
         let d = &model.delta;
         let (mut dg, mut arcs) = ([0.0; 3], [(Vec3::zeros(), Vec3::zeros(), 0.0, 0.0); 3]);
         for arm in (0..3).filter(|arm| arms >> arm & 1 == 1) {
             let theta0 = sol.theta[arm];
-            let dth = (th[arm].hi - theta0).max(theta0 - th[arm].lo).clamp(0.0, std::f64::consts::PI);
+            let dth =
+                (th[arm].hi - theta0).max(theta0 - th[arm].lo).clamp(0.0, std::f64::consts::PI);
             dg[arm] = 2.0 * d.rf * (0.5 * dth).sin();
             let (s, c) = (theta0.sin(), theta0.cos());
             let u = radial(arm);
@@ -693,10 +753,17 @@ impl CubeSwing {
                             let s0 = p0.dot(&t) / d.re;
                             let w = (1.0 - s0 * s0).max(0.0).sqrt();
                             let (y_ball, y_line) = match dy < 2.0 {
-                                true => (h * (beta * dx / w0 + (1.0 - w).max(w / w0 - 1.0)), h * tt / w0),
+                                true => (
+                                    h * (beta * dx / w0 + (1.0 - w).max(w / w0 - 1.0)),
+                                    h * tt / w0,
+                                ),
                                 false => (h * dy, 0.0),
                             };
-                            let phi = if dz < 2.0 { 2.0 * (0.5 * dz).asin() } else { std::f64::consts::PI };
+                            let phi = if dz < 2.0 {
+                                2.0 * (0.5 * dz).asin()
+                            } else {
+                                std::f64::consts::PI
+                            };
                             let sin = phi.min(std::f64::consts::FRAC_PI_2).sin();
                             let z_ball = depth * (sin * s0.abs() / w + (1.0 - phi.cos()));
                             (y_ball + z_ball, x0 * (y_line + depth * sin / w))
@@ -706,7 +773,14 @@ impl CubeSwing {
                     let arc = [tau0 * (d.rf * along), nu0 * (d.rf * inward)];
                     // The elbow's end (`l = -mu`, the box's face at `-half_0 x`) first.
                     let [elbow_end, joint_end] = tcp_weights(model, j);
-                    Sweep { cube, round, arc, ends: [(elbow_end, joint_end), (joint_end, elbow_end)], ball, line }
+                    Sweep {
+                        cube,
+                        round,
+                        arc,
+                        ends: [(elbow_end, joint_end), (joint_end, elbow_end)],
+                        ball,
+                        line,
+                    }
                 }
             }
             BoxKind::UpperLink(arm) => {
@@ -755,7 +829,11 @@ mod tests {
 
     /// The sweeps of a grid cell, as a table's labelling takes them (its reference point, or
     /// unbounded).
-    fn grid_cell_sweeps(model: &RobotModel, grid: &SampleGrid, sample: usize) -> [Sweep; MAX_BOXES] {
+    fn grid_cell_sweeps(
+        model: &RobotModel,
+        grid: &SampleGrid,
+        sample: usize,
+    ) -> [Sweep; MAX_BOXES] {
         let (c, h) = (grid.sample_center(sample), 0.5 * grid.r);
         reference_point(&model.delta, &c, h)
             .and_then(|p0| cube_box_sweeps(model, &c, h, &p0, SPLITS))
@@ -769,7 +847,9 @@ mod tests {
         let moved = |j: usize| {
             let (v0, v1) = (b0.boxes[j].vertices(), b1.boxes[j].vertices());
             let x = b0.boxes[j].axes.column(0).into_owned();
-            std::array::from_fn(|i| (v1[i] - v0[i], usize::from(x.dot(&(v0[i] - b0.boxes[j].center)) > 0.0)))
+            std::array::from_fn(|i| {
+                (v1[i] - v0[i], usize::from(x.dot(&(v0[i] - b0.boxes[j].center)) > 0.0))
+            })
         };
         Some((0..b0.len).map(moved).collect())
     }
@@ -779,7 +859,13 @@ mod tests {
     /// the end set of the corner's face, for `n` = `v` itself and the 13 axis, face and corner
     /// directions (the corners' displacements bound every point's: it is affine along the box).
     /// Returns the largest `|v| / radius` seen.
-    fn check_bounds_against_brute_force(model: RobotModel, k: u32, cells: usize, points: usize, seed: u64) -> Real {
+    fn check_bounds_against_brute_force(
+        model: RobotModel,
+        k: u32,
+        cells: usize,
+        points: usize,
+        seed: u64,
+    ) -> Real {
         let grid = SampleGrid::new(&Workspace::THESIS, k, &model.delta).unwrap();
         let mut rng = StdRng::seed_from_u64(seed);
         let mut worst_ratio: Real = 0.0;
@@ -805,20 +891,38 @@ mod tests {
             for q in 0..points {
                 // Corners and face centres of the cell first, then random points.
                 let off = if q < 8 {
-                    Vec3::new((q & 1) as Real - 0.5, ((q >> 1) & 1) as Real - 0.5, ((q >> 2) & 1) as Real - 0.5)
+                    Vec3::new(
+                        (q & 1) as Real - 0.5,
+                        ((q >> 1) & 1) as Real - 0.5,
+                        ((q >> 2) & 1) as Real - 0.5,
+                    )
                 } else {
-                    Vec3::new(rng.random::<Real>() - 0.5, rng.random::<Real>() - 0.5, rng.random::<Real>() - 0.5)
+                    Vec3::new(
+                        rng.random::<Real>() - 0.5,
+                        rng.random::<Real>() - 0.5,
+                        rng.random::<Real>() - 0.5,
+                    )
                 };
                 let Some(m) = measured(&model, &p0, &(c + off * grid.r)) else { continue };
                 for (j, corners) in m.iter().enumerate() {
                     for (v, end) in corners {
                         let len = v.norm();
-                        assert!(len <= bounds[j], "sample {s} box {j}: moved {len} > bound {}", bounds[j]);
+                        assert!(
+                            len <= bounds[j],
+                            "sample {s} box {j}: moved {len} > bound {}",
+                            bounds[j]
+                        );
                         let along = if len > 0.0 { v / len } else { Vec3::z() };
                         for n in dirs.iter().chain([&along]) {
                             let (h, g) = (sweeps[j].support(n), sweeps[j].face_support(*end, n));
-                            assert!(v.dot(n) <= h + 1e-9, "sample {s} box {j}: {v:?} . {n:?} > support {h}");
-                            assert!(v.dot(n) <= g + 1e-9, "sample {s} box {j} face {end}: {v:?} . {n:?} > {g}");
+                            assert!(
+                                v.dot(n) <= h + 1e-9,
+                                "sample {s} box {j}: {v:?} . {n:?} > support {h}"
+                            );
+                            assert!(
+                                v.dot(n) <= g + 1e-9,
+                                "sample {s} box {j} face {end}: {v:?} . {n:?} > {g}"
+                            );
                         }
                         worst[j] = Real::max(worst[j], len);
                     }
@@ -845,7 +949,9 @@ mod tests {
     /// The 26 unit directions to the neighbours of a cube lattice point: axes, edges, corners.
     fn lattice_directions() -> Vec<Vec3> {
         (0..27)
-            .map(|i: i32| Vec3::new((i % 3 - 1) as Real, (i / 3 % 3 - 1) as Real, (i / 9 - 1) as Real))
+            .map(|i: i32| {
+                Vec3::new((i % 3 - 1) as Real, (i / 3 % 3 - 1) as Real, (i / 9 - 1) as Real)
+            })
             .filter(|d| *d != Vec3::zeros())
             .map(|d| d.normalize())
             .collect()
@@ -856,7 +962,10 @@ mod tests {
         let options = ModelOptions {
             margin: 5.0,
             upper_links: Some((30.0, 15.0)),
-            platform: Some(crate::robot::ToolBox { offset: Vec3::zeros(), half: Vec3::new(50.0, 50.0, 10.0) }),
+            platform: Some(crate::robot::ToolBox {
+                offset: Vec3::zeros(),
+                half: Vec3::new(50.0, 50.0, 10.0),
+            }),
             tool,
             ..ModelOptions::THESIS
         };
@@ -879,9 +988,14 @@ mod tests {
     /// where the turn of their `y` or `z` axis is most of their motion.
     #[test]
     fn ball_and_cube_forms_hold_every_tcp_of_the_ball() {
-        let tool = crate::robot::ToolBox { offset: Vec3::new(0.0, 0.0, -30.0), half: Vec3::new(20.0, 20.0, 30.0) };
-        let wide =
-            RobotModel { options: ModelOptions { half_height: 280.0, ..ModelOptions::THESIS }, ..RobotModel::THESIS };
+        let tool = crate::robot::ToolBox {
+            offset: Vec3::new(0.0, 0.0, -30.0),
+            half: Vec3::new(20.0, 20.0, 30.0),
+        };
+        let wide = RobotModel {
+            options: ModelOptions { half_height: 280.0, ..ModelOptions::THESIS },
+            ..RobotModel::THESIS
+        };
         let deep = RobotModel {
             options: ModelOptions { half_height: 10.0, half_depth: 280.0, ..ModelOptions::THESIS },
             ..RobotModel::THESIS
@@ -909,17 +1023,23 @@ mod tests {
                 rng.random_range(-1100.0..-300.0),
             );
             let h = rng.random_range(2.0..150.0);
-            let p0 = if balls % 2 == 0 { c } else { c + unit(&mut rng) * (h * rng.random::<Real>()) };
+            let p0 =
+                if balls % 2 == 0 { c } else { c + unit(&mut rng) * (h * rng.random::<Real>()) };
             if !d.is_reachable(&c) || !d.is_reachable(&p0) {
                 continue;
             }
             balls += 1;
-            let enclose = |lo: &Vec3, hi: &Vec3| core::array::from_fn(|arm| theta_range(d, arm, lo, hi, SPLITS));
+            let enclose = |lo: &Vec3, hi: &Vec3| {
+                core::array::from_fn(|arm| theta_range(d, arm, lo, hi, SPLITS))
+            };
             let mut forms = [[Sweep { ball: Real::NAN, ..Sweep::ZERO }; MAX_BOXES]; 2];
             assert!(box_sweep_forms_into(&mut forms, model, &c, h, &p0, enclose));
             let reference = model.boxes(&p0).unwrap();
-            let axes: Vec<Vec3> =
-                reference.as_slice().iter().flat_map(|b| [0, 1, 2].map(|k| b.axes.column(k).into())).collect();
+            let axes: Vec<Vec3> = reference
+                .as_slice()
+                .iter()
+                .flat_map(|b| [0, 1, 2].map(|k| b.axes.column(k).into()))
+                .collect();
             for q in 0..120 {
                 let dir = if q < dirs.len() { dirs[q] } else { unit(&mut rng) };
                 let depth = if q < 60 { 1.0 } else { rng.random::<Real>().cbrt() };
@@ -936,9 +1056,15 @@ mod tests {
                             );
                             for n in dirs.iter().chain(&axes).chain([&along]) {
                                 let (support, graded) = (w.support(n), w.face_support(*end, n));
-                                assert!(v.dot(n) <= support + 1e-9, "form {f} box {j}: {v:?} . {n:?} > {support}");
+                                assert!(
+                                    v.dot(n) <= support + 1e-9,
+                                    "form {f} box {j}: {v:?} . {n:?} > {support}"
+                                );
                                 let at = format_args!("form {f} box {j} face {end}");
-                                assert!(v.dot(n) <= graded + 1e-9, "{at}: {v:?} . {n:?} > {graded}");
+                                assert!(
+                                    v.dot(n) <= graded + 1e-9,
+                                    "{at}: {v:?} . {n:?} > {graded}"
+                                );
                                 tighter_faces += usize::from(graded < support - 1.0);
                             }
                         }
@@ -958,7 +1084,10 @@ mod tests {
     /// of quarter steps (every corner, edge and face among them), then random points.
     fn cube_points(c: &Vec3, h: Real, n: usize, rng: &mut StdRng) -> Vec<Vec3> {
         let off = |q: usize, rng: &mut StdRng| match q < 729 {
-            true => Vec3::new((q % 9) as Real, (q / 9 % 9) as Real, (q / 81) as Real) / 4.0 - Vec3::repeat(1.0),
+            true => {
+                Vec3::new((q % 9) as Real, (q / 9 % 9) as Real, (q / 81) as Real) / 4.0
+                    - Vec3::repeat(1.0)
+            }
             false => Vec3::from_fn(|_, _| rng.random::<Real>()) * 2.0 - Vec3::repeat(1.0),
         };
         (0..n).map(|q| c + off(q, rng) * h).collect()
@@ -970,10 +1099,19 @@ mod tests {
     fn lattice_is_in_key_order() {
         let n = REFERENCE_STEPS;
         for (index, side) in [(0, -1), (1, 1)] {
-            let mut sorted: Vec<[i32; 3]> =
-                (-n..=n).flat_map(|i| (-n..=n).flat_map(move |j| (-n..=n).map(move |l| [i, j, l]))).collect();
+            let mut sorted: Vec<[i32; 3]> = (-n..=n)
+                .flat_map(|i| (-n..=n).flat_map(move |j| (-n..=n).map(move |l| [i, j, l])))
+                .collect();
             sorted.sort_by_key(|o| {
-                (o[0] * o[0] + o[1] * o[1] + o[2] * o[2], o[0].abs(), o[1].abs(), o[2].abs(), o[0], o[2], -side * o[1])
+                (
+                    o[0] * o[0] + o[1] * o[1] + o[2] * o[2],
+                    o[0].abs(),
+                    o[1].abs(),
+                    o[2].abs(),
+                    o[0],
+                    o[2],
+                    -side * o[1],
+                )
             });
             assert_eq!(LATTICE[index].to_vec(), sorted, "side {side}");
         }
@@ -996,7 +1134,10 @@ mod tests {
             }
             proved += 1;
             for p in cube_points(&c, h, 2000, &mut rng) {
-                assert!(!d.is_reachable(&p), "sample {s}: {p:?} is reachable in a cube proved unreachable");
+                assert!(
+                    !d.is_reachable(&p),
+                    "sample {s}: {p:?} is reachable in a cube proved unreachable"
+                );
             }
         }
         println!("{proved} of {tried} cells with an unreachable centre proved unreachable");
@@ -1013,7 +1154,9 @@ mod tests {
     fn cubes_proved_reachable_hold_only_reachable_tcps() {
         let narrow = Delta3 { theta_min: -0.2, theta_max: 0.9, ..Delta3::THESIS };
         let mut rng = StdRng::seed_from_u64(11);
-        for (d, k, points) in [(Delta3::THESIS, 16, 2000), (Delta3::THESIS, 32, 400), (narrow, 32, 400)] {
+        for (d, k, points) in
+            [(Delta3::THESIS, 16, 2000), (Delta3::THESIS, 32, 400), (narrow, 32, 400)]
+        {
             let grid = SampleGrid::new(&Workspace::THESIS, k, &d).unwrap();
             let (mut proved, mut centred) = (0, 0);
             for s in 0..grid.cells.len() {
@@ -1025,7 +1168,10 @@ mod tests {
                 proved += 1;
                 assert!(grid.reachable[s], "a cell proved reachable has an unreachable centre");
                 for p in cube_points(&c, h, points, &mut rng) {
-                    assert!(d.is_reachable(&p), "k = {k}, sample {s}: {p:?} unreachable in a cube proved reachable");
+                    assert!(
+                        d.is_reachable(&p),
+                        "k = {k}, sample {s}: {p:?} unreachable in a cube proved reachable"
+                    );
                 }
             }
             println!("k = {k}: {proved} of {centred} cells with a reachable centre proved wholly reachable");
@@ -1058,17 +1204,29 @@ mod tests {
         let d = Delta3::THESIS;
         let (lo, hi) = (Vec3::new(150.0, -40.0, -520.0), Vec3::new(175.0, -10.0, -500.0));
         for arm in 0..3 {
-            let Enclosure::Range(th) = theta_range(&d, arm, &lo, &hi, 3) else { panic!("arm {arm}") };
+            let Enclosure::Range(th) = theta_range(&d, arm, &lo, &hi, 3) else {
+                panic!("arm {arm}")
+            };
             for s in 0..1000 {
                 let f = |v: u32| (v % 10) as Real / 9.0;
                 let p = lo + (hi - lo).component_mul(&Vec3::new(f(s), f(s / 10), f(s / 100)));
                 if let Ok(sol) = d.inverse_kinematics(&p) {
-                    assert!(th.contains(sol.theta[arm]), "arm {arm} {p:?}: {} not in {th:?}", sol.theta[arm]);
+                    assert!(
+                        th.contains(sol.theta[arm]),
+                        "arm {arm} {p:?}: {} not in {th:?}",
+                        sol.theta[arm]
+                    );
                 }
             }
         }
-        assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -10.0), &Vec3::new(1.0, 1.0, 1.0), 2), Enclosure::Unbounded);
-        assert_eq!(theta_range(&d, 0, &Vec3::new(0.0, 0.0, -990.0), &Vec3::new(1.0, 1.0, -980.0), 2), Enclosure::Empty);
+        assert_eq!(
+            theta_range(&d, 0, &Vec3::new(0.0, 0.0, -10.0), &Vec3::new(1.0, 1.0, 1.0), 2),
+            Enclosure::Unbounded
+        );
+        assert_eq!(
+            theta_range(&d, 0, &Vec3::new(0.0, 0.0, -990.0), &Vec3::new(1.0, 1.0, -980.0), 2),
+            Enclosure::Empty
+        );
     }
 
     /// [`ball_theta_range`] holds the angle of every reachable TCP of the ball: on 3,000 random
@@ -1093,7 +1251,9 @@ mod tests {
                 let mut points = Vec::new();
                 if let Ok(sol) = d.inverse_kinematics(&c) {
                     let u = radial(arm);
-                    let w = c + u * (d.e - d.f - d.rf * sol.cos[arm]) + Vec3::z() * (d.rf * sol.sin[arm]);
+                    let w = c
+                        + u * (d.e - d.f - d.rf * sol.cos[arm])
+                        + Vec3::z() * (d.rf * sol.sin[arm]);
                     points.extend([c, c + w.normalize() * rho, c - w.normalize() * rho]);
                 }
                 for q in 0..200 {
@@ -1105,20 +1265,28 @@ mod tests {
                     let Ok(sol) = d.inverse_kinematics(p) else { continue };
                     match e {
                         Enclosure::Range(th) => {
-                            assert!(th.contains(sol.theta[arm]), "arm {arm} ball {c:?} {rho}: {p:?}")
+                            assert!(
+                                th.contains(sol.theta[arm]),
+                                "arm {arm} ball {c:?} {rho}: {p:?}"
+                            )
                         }
                         Enclosure::Empty => panic!("arm {arm} ball {c:?} {rho}: {p:?} reachable"),
                         Enclosure::Unbounded => {}
                     }
                 }
                 let (lo, hi) = (c.add_scalar(-rho), c.add_scalar(rho));
-                if let (Enclosure::Range(b), Enclosure::Range(q)) = (e, theta_range(&d, arm, &lo, &hi, 2)) {
+                if let (Enclosure::Range(b), Enclosure::Range(q)) =
+                    (e, theta_range(&d, arm, &lo, &hi, 2))
+                {
                     compared += 1;
                     narrower += usize::from(b.hi - b.lo < q.hi - q.lo);
                 }
             }
         }
-        assert!(compared > 1000 && narrower * 10 > compared * 9, "{narrower} of {compared} narrower");
+        assert!(
+            compared > 1000 && narrower * 10 > compared * 9,
+            "{narrower} of {compared} narrower"
+        );
     }
 
     /// The largest [`Sweep::radius`] of [`grid_cell_sweeps`]: no point of the robot's model

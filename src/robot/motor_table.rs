@@ -131,7 +131,14 @@ fn up(x: Real) -> f32 {
     }
 }
 
-const EMPTY: [f32; 6] = [f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY];
+const EMPTY: [f32; 6] = [
+    f32::INFINITY,
+    f32::NEG_INFINITY,
+    f32::INFINITY,
+    f32::NEG_INFINITY,
+    f32::INFINITY,
+    f32::NEG_INFINITY,
+];
 
 fn hull(a: &mut [f32; 6], b: &[f32; 6]) {
     for arm in 0..3 {
@@ -159,11 +166,12 @@ impl MotorTable {
                     let (lo, hi) = (lo.add_scalar(-CELL_SLACK), lo.add_scalar(side + CELL_SLACK));
                     let mut entry = EMPTY;
                     for arm in 0..3 {
-                        (entry[2 * arm], entry[2 * arm + 1]) = match theta_range(delta, arm, &lo, &hi, 1) {
-                            Enclosure::Empty => (f32::INFINITY, f32::NEG_INFINITY),
-                            Enclosure::Unbounded => (f32::NEG_INFINITY, f32::INFINITY),
-                            Enclosure::Range(r) => (down(r.lo), up(r.hi)),
-                        };
+                        (entry[2 * arm], entry[2 * arm + 1]) =
+                            match theta_range(delta, arm, &lo, &hi, 1) {
+                                Enclosure::Empty => (f32::INFINITY, f32::NEG_INFINITY),
+                                Enclosure::Unbounded => (f32::NEG_INFINITY, f32::INFINITY),
+                                Enclosure::Range(r) => (down(r.lo), up(r.hi)),
+                            };
                     }
                     data.push(entry);
                 }
@@ -247,7 +255,10 @@ impl MotorTable {
         let (mut sx, mut sy, mut sz) = ([0; 8], [0; 8], [0; 8]);
         let (nx, ny, nz) = (starts(0, &mut sx), starts(1, &mut sy), starts(2, &mut sz));
         // More than 8 blocks per axis would be needed only past the top level's reach.
-        if (nx == 8 && sx[6] + size < sx[7]) || (ny == 8 && sy[6] + size < sy[7]) || (nz == 8 && sz[6] + size < sz[7]) {
+        if (nx == 8 && sx[6] + size < sx[7])
+            || (ny == 8 && sy[6] + size < sy[7])
+            || (nz == 8 && sz[6] + size < sz[7])
+        {
             return None;
         }
         let mut entry = EMPTY;
@@ -284,13 +295,17 @@ mod tests {
 
     #[test]
     fn outward_rounding_brackets_with_adjacent_f32s() {
-        for x in [1.0 + 1e-10, -1.0 - 1e-10, 1e-50, -1e-50, 0.1, -0.1, 3.4e38 * 1.000_000_1, 2.0, 0.0] {
+        for x in
+            [1.0 + 1e-10, -1.0 - 1e-10, 1e-50, -1e-50, 0.1, -0.1, 3.4e38 * 1.000_000_1, 2.0, 0.0]
+        {
             let (lo, hi) = (down(x), up(x));
             assert!((lo as Real) <= x && x <= hi as Real, "{x}: [{lo}, {hi}]");
             // Equal when `x` is an `f32`, else neighbours: the number line's order is that of
             // the bits for positives and the reverse for negatives.
             let step = |a: f32, b: f32| (a.to_bits() as i64 - b.to_bits() as i64).abs();
-            let adjacent = lo == hi || (lo.is_sign_positive() == hi.is_sign_positive() && step(lo, hi) == 1) || (lo < 0.0 && hi >= 0.0 && step(lo, -0.0) + step(hi, 0.0) <= 1);
+            let adjacent = lo == hi
+                || (lo.is_sign_positive() == hi.is_sign_positive() && step(lo, hi) == 1)
+                || (lo < 0.0 && hi >= 0.0 && step(lo, -0.0) + step(hi, 0.0) <= 1);
             assert!(adjacent, "{x}: [{lo}, {hi}] are not neighbours");
         }
     }
@@ -305,23 +320,43 @@ mod tests {
         let mut rng = StdRng::seed_from_u64(5);
         let (mut tighter, mut compared, mut checked) = (0, 0, 0);
         for _ in 0..3_000 {
-            let c = Vec3::new(rng.random_range(-450.0..450.0), rng.random_range(-450.0..450.0), rng.random_range(-850.0..-250.0));
-            let h: Real = if rng.random::<bool>() { rng.random_range(0.5..20.0) } else { rng.random_range(20.0..300.0) };
+            let c = Vec3::new(
+                rng.random_range(-450.0..450.0),
+                rng.random_range(-450.0..450.0),
+                rng.random_range(-850.0..-250.0),
+            );
+            let h: Real = if rng.random::<bool>() {
+                rng.random_range(0.5..20.0)
+            } else {
+                rng.random_range(20.0..300.0)
+            };
             let (lo, hi) = (c.add_scalar(-h), c.add_scalar(h));
             let Some(th) = table.enclose(&lo, &hi) else { continue };
             for q in 0..200 {
                 let f = |r: &mut StdRng| if q < 8 { (q & 1) as Real } else { r.random::<Real>() };
-                let t = Vec3::new(f(&mut rng), if q < 8 { (q >> 1 & 1) as Real } else { f(&mut rng) }, if q < 8 { (q >> 2 & 1) as Real } else { f(&mut rng) });
+                let t = Vec3::new(
+                    f(&mut rng),
+                    if q < 8 { (q >> 1 & 1) as Real } else { f(&mut rng) },
+                    if q < 8 { (q >> 2 & 1) as Real } else { f(&mut rng) },
+                );
                 let p = lo + (hi - lo).component_mul(&t);
                 let Ok(sol) = d.inverse_kinematics(&p) else { continue };
                 for arm in 0..3 {
-                    let Enclosure::Range(r) = th[arm] else { panic!("{p:?} reachable in a box said empty: {th:?}") };
-                    assert!(r.contains(sol.theta[arm]), "arm {arm} {p:?}: {} not in {r:?}", sol.theta[arm]);
+                    let Enclosure::Range(r) = th[arm] else {
+                        panic!("{p:?} reachable in a box said empty: {th:?}")
+                    };
+                    assert!(
+                        r.contains(sol.theta[arm]),
+                        "arm {arm} {p:?}: {} not in {r:?}",
+                        sol.theta[arm]
+                    );
                     checked += 1;
                 }
             }
             if h > 50.0 {
-                if let (Enclosure::Range(a), Enclosure::Range(b)) = (th[0], theta_range(&d, 0, &lo, &hi, 2)) {
+                if let (Enclosure::Range(a), Enclosure::Range(b)) =
+                    (th[0], theta_range(&d, 0, &lo, &hi, 2))
+                {
                     compared += 1;
                     tighter += (a.hi - a.lo <= b.hi - b.lo) as usize;
                 }
@@ -334,9 +369,16 @@ mod tests {
     #[test]
     fn boxes_outside_or_at_z_zero_fall_back() {
         let table = MotorTable::new(&Delta3::THESIS);
-        assert!(table.enclose(&Vec3::new(-10.0, -10.0, -20.0), &Vec3::new(10.0, 10.0, 5.0)).is_none());
-        assert_eq!(table.enclose(&Vec3::new(2_000.0, 0.0, -500.0), &Vec3::new(2_010.0, 10.0, -490.0)), Some([Enclosure::Empty; 3]));
-        assert!(table.enclose(&Vec3::new(0.0, 0.0, Real::NAN), &Vec3::new(1.0, 1.0, -400.0)).is_none());
+        assert!(table
+            .enclose(&Vec3::new(-10.0, -10.0, -20.0), &Vec3::new(10.0, 10.0, 5.0))
+            .is_none());
+        assert_eq!(
+            table.enclose(&Vec3::new(2_000.0, 0.0, -500.0), &Vec3::new(2_010.0, 10.0, -490.0)),
+            Some([Enclosure::Empty; 3])
+        );
+        assert!(table
+            .enclose(&Vec3::new(0.0, 0.0, Real::NAN), &Vec3::new(1.0, 1.0, -400.0))
+            .is_none());
         let deep = table.enclose(&Vec3::new(-5.0, -5.0, -900.0), &Vec3::new(5.0, 5.0, -890.0));
         assert_eq!(deep, Some([Enclosure::Empty; 3]));
     }

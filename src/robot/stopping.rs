@@ -43,10 +43,15 @@ impl Default for StopModel {
 
 impl StopModel {
     /// The defaults of the module doc.
-    pub const DEFAULT: StopModel =
-        StopModel { reaction_ms: 4.0, decel_mm_s2: 40_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 };
+    pub const DEFAULT: StopModel = StopModel {
+        reaction_ms: 4.0,
+        decel_mm_s2: 40_000.0,
+        max_accel_mm_s2: 130_000.0,
+        max_speed_mm_s: 4_600.0,
+    };
 
-    /// Checks every field; the error names the field (`what` prefixes it, e.g. "robot 1 (B): stop").
+    /// Checks every field; the error names the field (`what` prefixes it, e.g. "robot 1 (B):
+    /// stop").
     ///
     /// # Errors
     /// A message when a field is NaN, infinite or not > 0, or when `decel_mm_s2` exceeds
@@ -116,8 +121,11 @@ mod tests {
     fn bad_fields_are_named() {
         let bad = |m: StopModel| m.validate("robot 0 (A): stop").unwrap_err();
         assert!(bad(StopModel { reaction_ms: 0.0, ..StopModel::DEFAULT }).contains("reaction_ms"));
-        assert!(bad(StopModel { decel_mm_s2: Real::NAN, ..StopModel::DEFAULT }).contains("decel_mm_s2"));
-        assert!(bad(StopModel { max_speed_mm_s: -1.0, ..StopModel::DEFAULT }).contains("max_speed_mm_s"));
+        assert!(
+            bad(StopModel { decel_mm_s2: Real::NAN, ..StopModel::DEFAULT }).contains("decel_mm_s2")
+        );
+        assert!(bad(StopModel { max_speed_mm_s: -1.0, ..StopModel::DEFAULT })
+            .contains("max_speed_mm_s"));
         let e = bad(StopModel { decel_mm_s2: 200_000.0, ..StopModel::DEFAULT });
         assert!(e.contains("decel_mm_s2") && e.contains("max_accel_mm_s2"), "{e}");
         assert!(validate_tick_ms(0.0).unwrap_err().contains("tick_ms"));

@@ -10,8 +10,12 @@ fn variants(s: &LabelledSpace, symmetric: bool, t: u32) -> Vec<Table> {
     vec![
         Table::D6(LinearQuadtree6d::build(s, Symmetry::from_flag(symmetric)).unwrap()),
         Table::D5(LinearQuadtree5d::build(s, Symmetry::from_flag(symmetric)).unwrap()),
-        Table::D4(LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), SliceAxes::YY, t).unwrap()),
-        Table::D4(LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), SliceAxes::ZZ, t).unwrap()),
+        Table::D4(
+            LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), SliceAxes::YY, t).unwrap(),
+        ),
+        Table::D4(
+            LinearQuadtree4d::build(s, Symmetry::from_flag(symmetric), SliceAxes::ZZ, t).unwrap(),
+        ),
     ]
 }
 
@@ -27,7 +31,9 @@ fn check_all(s: &LabelledSpace, tables: &[Table], lossy: bool) -> Vec<(usize, us
             for (t, o) in tables.iter().zip(out.iter_mut()) {
                 let got = t.query(cell);
                 match label {
-                    Label::Collision => assert!(got, "{}: collision {cell:?} reported free", t.name()),
+                    Label::Collision => {
+                        assert!(got, "{}: collision {cell:?} reported free", t.name())
+                    }
                     Label::Free if got => {
                         assert!(lossy, "{}: free {cell:?} reported collision", t.name());
                         o.0 += 1;
@@ -62,7 +68,10 @@ fn exact_variants_answer_every_sample_as_the_labels() {
         for symmetric in [false, true] {
             let tables = variants(&s, symmetric, 0);
             let diffs = check_all(&s, &tables, false);
-            eprintln!("k = {} {pattern:?} symmetric {symmetric}: unreachable differing from 6D {diffs:?}", 1 << levels);
+            eprintln!(
+                "k = {} {pattern:?} symmetric {symmetric}: unreachable differing from 6D {diffs:?}",
+                1 << levels
+            );
         }
     }
 }
@@ -101,7 +110,8 @@ fn lossy_4d_never_loses_a_collision() {
     for t in [0, 5, 25, 150] {
         let yy = LinearQuadtree4d::build(&s, Symmetry::Whole, SliceAxes::YY, t).unwrap();
         let slices = yy.slice_count();
-        let tables = [Table::D6(LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap()), Table::D4(yy)];
+        let tables =
+            [Table::D6(LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap()), Table::D4(yy)];
         let fp = check_all(&s, &tables, t > 0)[1].0;
         eprintln!("k = 16 blobs 4D/yy t = {t}: {slices} slices, {fp} of {nfree} free samples answered collision");
         assert!(slices <= last_slices, "more slices at a larger t");

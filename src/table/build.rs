@@ -13,17 +13,20 @@
 //! cell), so for it the builder turns every `Unreachable` into `Collision` first.
 
 use crate::cell::Cell;
-use crate::cspace::certify::{certify_rows, certify_rows_then, SubCellSource};
 use crate::cspace::certify::clearance::clearance_counts;
+use crate::cspace::certify::{certify_rows, certify_rows_then, SubCellSource};
 use crate::cspace::label::label_space_thesis_rows;
 use crate::cspace::symmetry::Symmetry;
-use crate::cspace::{CertifyConfig, Label, LabelledSpace, PairLabels, Progress, Refinement, Rows, SubCells, Workspace};
-use crate::table::{
-    Certification, ClearanceTable, Header, Ladder, LinearQuadtree4d, LinearQuadtree5d, LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table,
-    TableError,
+use crate::cspace::{
+    CertifyConfig, Label, LabelledSpace, PairLabels, Progress, Refinement, Rows, SubCells,
+    Workspace,
 };
 use crate::table::memory::{plan_memory, MemoryPlan};
 use crate::table::shared6d::SubCellBlocks;
+use crate::table::{
+    Certification, ClearanceTable, Header, Ladder, LinearQuadtree4d, LinearQuadtree5d,
+    LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table, TableError,
+};
 use core::fmt;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -177,7 +180,9 @@ pub fn build_table(
     progress: Progress,
 ) -> Result<(Header, Table, BuildReport), BuildError> {
     let (header, mut tables, report) = build_tables(cell, k, ws, &[variant], labelling, progress)?;
-    let table = tables.pop().ok_or(BuildError::Table(TableError::BadInput { what: "no table built".into() }))?;
+    let table = tables
+        .pop()
+        .ok_or(BuildError::Table(TableError::BadInput { what: "no table built".into() }))?;
     Ok((header, table, report))
 }
 
@@ -205,7 +210,10 @@ pub struct BoundedBuild {
 /// # Errors
 /// As [`build_table`], and [`BuildError::Memory`] when the fixed part of the build alone
 /// needs more than `build.max_memory`, before anything big is allocated.
-pub fn build_table_bounded(cell: &Cell, build: &BoundedBuild) -> Result<(Header, Table, BuildReport), BuildError> {
+pub fn build_table_bounded(
+    cell: &Cell,
+    build: &BoundedBuild,
+) -> Result<(Header, Table, BuildReport), BuildError> {
     let BoundedBuild { k, ref ws, variant, labelling, progress, max_memory } = *build;
     let plan = memory_plan(cell, k, ws, variant, max_memory)?;
     if variant != Variant::SharedSubdivided || labelling != Labelling::Certified {
@@ -226,9 +234,13 @@ pub fn memory_plan(
     max_memory: u64,
 ) -> Result<MemoryPlan, BuildError> {
     if cell.robots.len() != 2 {
-        return Err(BuildError::NotTwoRobots { cell: cell.name.clone(), robots: cell.robots.len() });
+        return Err(BuildError::NotTwoRobots {
+            cell: cell.name.clone(),
+            robots: cell.robots.len(),
+        });
     }
-    let (ga, gb) = crate::cspace::label::two_robot_grids(cell, k, ws).map_err(BuildError::Labelling)?;
+    let (ga, gb) =
+        crate::cspace::label::two_robot_grids(cell, k, ws).map_err(BuildError::Labelling)?;
     plan_memory(ga.cells.len() as u64, gb.cells.len() as u64, k, variant, max_memory)
 }
 
@@ -245,13 +257,16 @@ fn build_streamed(
     let symmetry = Symmetry::of(cell);
     let built = certify_rows_then(cell, k, ws, &config, Rows::ALL, true, |c, source| {
         let label_secs = start.elapsed().as_secs_f64();
-        let no_sub = || BuildError::Table(TableError::BadInput { what: "no sub-cells were labelled".into() });
+        let no_sub = || {
+            BuildError::Table(TableError::BadInput { what: "no sub-cells were labelled".into() })
+        };
         let source = source.ok_or_else(no_sub)?;
         let space = &c.space;
         let header = Header::for_cell(space, cell, *ws, Certification::SweptBound);
         let mut blocks = Blocks { source, cache: plan.cache, secs: 0.0 };
         let built = Instant::now();
-        let (table, waited) = SharedQuadtree6d::build_streamed(space, &mut blocks, plan.block_depth, symmetry)?;
+        let (table, waited) =
+            SharedQuadtree6d::build_streamed(space, &mut blocks, plan.block_depth, symmetry)?;
         let (collisions, unreachable) = collisions_and_unreachable(&space.labels);
         let report = BuildReport {
             samples: (space.grid_a.cells.len(), space.grid_b.cells.len()),
@@ -288,7 +303,8 @@ impl SubCellBlocks for Blocks<'_, '_> {
         let start = Instant::now();
         let source = &*self.source;
         let nb = nb as u64;
-        let masks = pairs.par_iter().map(|&p| source.masks((p / nb) as usize, (p % nb) as usize)).collect();
+        let masks =
+            pairs.par_iter().map(|&p| source.masks((p / nb) as usize, (p % nb) as usize)).collect();
         if source.cached_bytes() as u64 > self.cache {
             self.source.clear_cache();
         }
@@ -318,8 +334,9 @@ pub fn build_tables(
             if labelling != Labelling::Certified {
                 return Err(BuildError::ClearanceNeedsCertified);
             }
-            let counts = clearance_counts(cell, k, ws, &labels.space.labels, ladder.mm(), Rows::ALL)
-                .map_err(BuildError::Labelling)?;
+            let counts =
+                clearance_counts(cell, k, ws, &labels.space.labels, ladder.mm(), Rows::ALL)
+                    .map_err(BuildError::Labelling)?;
             labels.clearance.push((ladder, counts));
         }
     }
@@ -362,7 +379,10 @@ pub(crate) fn label_rows(
     progress: Progress,
 ) -> Result<RowLabels, BuildError> {
     if cell.robots.len() != 2 {
-        return Err(BuildError::NotTwoRobots { cell: cell.name.clone(), robots: cell.robots.len() });
+        return Err(BuildError::NotTwoRobots {
+            cell: cell.name.clone(),
+            robots: cell.robots.len(),
+        });
     }
     let refinement = if subdivide { Refinement::SubCells } else { Refinement::Octants };
     Ok(match labelling {
@@ -370,13 +390,28 @@ pub(crate) fn label_rows(
             let c = certify_rows(cell, k, ws, &CertifyConfig { refinement, progress }, rows)
                 .map_err(BuildError::Labelling)?;
             let certification = Certification::SweptBound;
-            RowLabels { space: c.space, sub: c.sub, sub_secs: c.sub_secs, certification, labelling, clearance: vec![] }
+            RowLabels {
+                space: c.space,
+                sub: c.sub,
+                sub_secs: c.sub_secs,
+                certification,
+                labelling,
+                clearance: vec![],
+            }
         }
         Labelling::ThesisMargin if subdivide => return Err(BuildError::SubCellsNeedCertified),
         Labelling::ThesisMargin => {
-            let space = label_space_thesis_rows(cell, k, ws, rows, progress).map_err(BuildError::Labelling)?;
+            let space = label_space_thesis_rows(cell, k, ws, rows, progress)
+                .map_err(BuildError::Labelling)?;
             let certification = Certification::ThesisBlowUp;
-            RowLabels { space, sub: None, sub_secs: 0.0, certification, labelling, clearance: vec![] }
+            RowLabels {
+                space,
+                sub: None,
+                sub_secs: 0.0,
+                certification,
+                labelling,
+                clearance: vec![],
+            }
         }
     })
 }
@@ -433,4 +468,3 @@ pub(crate) fn assemble(
     report.build_secs = start.elapsed().as_secs_f64();
     Ok((tables, report))
 }
-

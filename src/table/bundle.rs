@@ -58,8 +58,10 @@ pub fn pair_cell(cell: &Cell, a: usize, b: usize) -> Cell {
         cell.robots.len()
     );
     let (ra, rb) = (&cell.robots[a], &cell.robots[b]);
-    let relative =
-        Placement { alpha: rb.placement.alpha - ra.placement.alpha, t: ra.placement.to_mcs(&rb.placement.t) };
+    let relative = Placement {
+        alpha: rb.placement.alpha - ra.placement.alpha,
+        t: ra.placement.to_mcs(&rb.placement.t),
+    };
     let robots = vec![
         RobotSpec { placement: Placement::IDENTITY, ..ra.clone() },
         RobotSpec { placement: relative, ..rb.clone() },
@@ -132,10 +134,18 @@ pub fn bundle_to_bytes(
 ) -> Result<Vec<u8>, TableError> {
     let bad = |what: String| TableError::BadInput { what };
     if tables.len() > MAX_ENTRIES as usize || pairs.len() > MAX_ENTRIES as usize {
-        return Err(bad(format!("{} tables and {} pairs, at most {MAX_ENTRIES} each", tables.len(), pairs.len())));
+        return Err(bad(format!(
+            "{} tables and {} pairs, at most {MAX_ENTRIES} each",
+            tables.len(),
+            pairs.len()
+        )));
     }
     if let Some(p) = pairs.iter().find(|p| p.table >= tables.len() || p.a >= p.b || p.b >= robots) {
-        return Err(bad(format!("pair {p:?} of {robots} robots names table {} of {}", p.table, tables.len())));
+        return Err(bad(format!(
+            "pair {p:?} of {robots} robots names table {} of {}",
+            p.table,
+            tables.len()
+        )));
     }
     let mut out = Vec::new();
     out.extend_from_slice(&BUNDLE_MAGIC);
@@ -196,12 +206,15 @@ pub fn build_bundle(
     for (i, pc) in pair_cells.iter().enumerate() {
         let first = pairs.iter().find(|p| p.table == i).expect("every pair cell comes from a pair");
         let (header, table, report) = super::build_table(pc, k, ws, variant, labelling, progress)
-            .map_err(|e| format!("table {i} for {}: {e}", describe_pair(cell, first.a, first.b)))?;
+            .map_err(|e| {
+            format!("table {i} for {}: {e}", describe_pair(cell, first.a, first.b))
+        })?;
         let bytes = super::to_bytes(&table, &header);
         tables.push((header, table, report, bytes));
     }
     let files: Vec<Vec<u8>> = tables.iter().map(|t| t.3.clone()).collect();
-    let bytes = bundle_to_bytes(cell.fingerprint(), cell.robots.len(), &files, &pairs).map_err(|e| e.to_string())?;
+    let bytes = bundle_to_bytes(cell.fingerprint(), cell.robots.len(), &files, &pairs)
+        .map_err(|e| e.to_string())?;
     Ok(BuiltBundle { tables, pairs, bytes })
 }
 
@@ -232,7 +245,11 @@ pub fn bundle_from_bytes(bytes: &[u8]) -> Result<Bundle, TableError> {
     match r.u32("bundle endianness marker")? {
         ENDIAN_MARK => {}
         m if m == ENDIAN_MARK.swap_bytes() => return Err(TableError::WrongEndianness),
-        m => return Err(corrupt(format!("bundle endianness marker = {m:#010x}, expected 0x01020304"))),
+        m => {
+            return Err(corrupt(format!(
+                "bundle endianness marker = {m:#010x}, expected 0x01020304"
+            )))
+        }
     }
     let version = r.u32("bundle version")?;
     if version != BUNDLE_VERSION {
@@ -244,30 +261,50 @@ pub fn bundle_from_bytes(bytes: &[u8]) -> Result<Bundle, TableError> {
     if r.u32("bundle reserved")? != 0 {
         return Err(corrupt("bundle reserved field is not 0"));
     }
-    if robots as usize > crate::cell::MAX_ROBOTS || n_tables > MAX_ENTRIES || n_pairs > MAX_ENTRIES {
-        return Err(corrupt(format!("bundle of {robots} robots, {n_tables} tables, {n_pairs} pairs: too many")));
+    if robots as usize > crate::cell::MAX_ROBOTS || n_tables > MAX_ENTRIES || n_pairs > MAX_ENTRIES
+    {
+        return Err(corrupt(format!(
+            "bundle of {robots} robots, {n_tables} tables, {n_pairs} pairs: too many"
+        )));
     }
     let mut entries = Vec::with_capacity(n_tables as usize);
     for _ in 0..n_tables {
-        let e = [r.u64("bundle table fingerprint")?, r.u64("bundle table offset")?, r.u64("bundle table length")?];
+        let e = [
+            r.u64("bundle table fingerprint")?,
+            r.u64("bundle table offset")?,
+            r.u64("bundle table length")?,
+        ];
         entries.push((e, r.u64("bundle table checksum")?));
     }
     let mut pairs = Vec::with_capacity(n_pairs as usize);
     for _ in 0..n_pairs {
-        let v = [r.u32("bundle pair robot a")?, r.u32("bundle pair robot b")?, r.u32("bundle pair table")?];
-        if r.u32("bundle pair reserved")? != 0 || !(v[0] < v[1] && v[1] < robots && v[2] < n_tables) {
-            return Err(corrupt(format!("bundle pair (robot {}, robot {}, table {}) out of range", v[0], v[1], v[2])));
+        let v = [
+            r.u32("bundle pair robot a")?,
+            r.u32("bundle pair robot b")?,
+            r.u32("bundle pair table")?,
+        ];
+        if r.u32("bundle pair reserved")? != 0 || !(v[0] < v[1] && v[1] < robots && v[2] < n_tables)
+        {
+            return Err(corrupt(format!(
+                "bundle pair (robot {}, robot {}, table {}) out of range",
+                v[0], v[1], v[2]
+            )));
         }
         pairs.push(BundlePair { a: v[0] as usize, b: v[1] as usize, table: v[2] as usize });
     }
     let mut next = r.pos() as u64;
     for (i, ([_, offset, len], _)) in entries.iter().enumerate() {
         if *offset != next {
-            return Err(corrupt(format!("bundle table {i} starts at {offset}, expected {next} (back to back)")));
+            return Err(corrupt(format!(
+                "bundle table {i} starts at {offset}, expected {next} (back to back)"
+            )));
         }
-        next = offset.checked_add(*len).ok_or_else(|| corrupt(format!("bundle table {i} length overflows")))?;
+        next = offset
+            .checked_add(*len)
+            .ok_or_else(|| corrupt(format!("bundle table {i} length overflows")))?;
     }
-    let body = usize::try_from(next - r.pos() as u64).map_err(|_| corrupt("bundle tables do not fit in memory"))?;
+    let body = usize::try_from(next - r.pos() as u64)
+        .map_err(|_| corrupt("bundle tables do not fit in memory"))?;
     r.take(body, "bundle tables")?;
     r.checksum()?;
     let mut tables = Vec::with_capacity(entries.len());
@@ -330,7 +367,9 @@ impl Bundle {
                 _ => String::from("its pair cell's fingerprint differs"),
             };
             return Err(TableError::WrongPair {
-                what: format!("the bundle's table for {pair} was built for another pair: {differs}"),
+                what: format!(
+                    "the bundle's table for {pair} was built for another pair: {differs}"
+                ),
             });
         }
         Err(TableError::MissingPair {

@@ -71,7 +71,11 @@ impl BundleChecker {
     /// Every [`TableError`] of loading a bundle and its tables; [`TableError::MissingPair`] or
     /// [`TableError::WrongPair`] for the first pair the bundle does not serve;
     /// [`TableError::WrongCell`] when a table disagrees with what its pair cell determines.
-    pub fn new(cell: Cell, bytes: &[u8], confirmation: Confirmation) -> Result<BundleChecker, TableError> {
+    pub fn new(
+        cell: Cell,
+        bytes: &[u8],
+        confirmation: Confirmation,
+    ) -> Result<BundleChecker, TableError> {
         BundleChecker::from_bundle(cell, &bundle_from_bytes(bytes)?, confirmation)
     }
 
@@ -79,7 +83,11 @@ impl BundleChecker {
     ///
     /// # Errors
     /// As [`BundleChecker::new`], apart from reading.
-    pub fn from_bundle(cell: Cell, bundle: &Bundle, confirmation: Confirmation) -> Result<BundleChecker, TableError> {
+    pub fn from_bundle(
+        cell: Cell,
+        bundle: &Bundle,
+        confirmation: Confirmation,
+    ) -> Result<BundleChecker, TableError> {
         let mut used: Vec<(usize, usize)> = Vec::new(); // (bundle table index, our index)
         let mut checkers = Vec::new();
         let mut pairs = Vec::new();
@@ -89,19 +97,31 @@ impl BundleChecker {
                 Some(&(_, ours)) => ours,
                 None => {
                     let (header, table) = bundle.tables[i].clone();
-                    checkers.push(TableChecker::from_loaded(pair_cell(&cell, a, b), header, table, confirmation)?);
+                    checkers.push(TableChecker::from_loaded(
+                        pair_cell(&cell, a, b),
+                        header,
+                        table,
+                        confirmation,
+                    )?);
                     used.push((i, checkers.len() - 1));
                     checkers.len() - 1
                 }
             };
-            pairs.push(PairAnswer { a, b, table, answer: TableAnswer::Unreachable(0), boxes: None });
+            pairs.push(PairAnswer {
+                a,
+                b,
+                table,
+                answer: TableAnswer::Unreachable(0),
+                boxes: None,
+            });
         }
         let mut slots: Vec<GridSlot> = Vec::new();
         let mut pair_slots = Vec::with_capacity(pairs.len());
         for p in &pairs {
             let mut slot_of = |robot: usize, side: usize| {
                 let same = |s: &GridSlot| {
-                    s.robot == robot && checkers[s.checker].same_grid(s.side, &checkers[p.table], side)
+                    s.robot == robot
+                        && checkers[s.checker].same_grid(s.side, &checkers[p.table], side)
                 };
                 slots.iter().position(same).unwrap_or_else(|| {
                     slots.push(GridSlot { robot, checker: p.table, side });
@@ -112,14 +132,26 @@ impl BundleChecker {
         }
         let cells = alloc::vec![None; slots.len()];
         let models = cell.robots.iter().map(|r| r.model).collect();
-        let unpaired = (0..cell.robots.len()).filter(|&j| !slots.iter().any(|s| s.robot == j)).collect();
+        let unpaired =
+            (0..cell.robots.len()).filter(|&j| !slots.iter().any(|s| s.robot == j)).collect();
         let free_cells = alloc::vec![None; pairs.len()];
         let n = cell.robots.len();
         let mut pair_tables = alloc::vec![None; n * n];
         for p in &pairs {
             pair_tables[p.a * n + p.b] = Some(p.table);
         }
-        Ok(BundleChecker { cell, models, checkers, pairs, slots, pair_slots, cells, unpaired, pair_tables, free_cells })
+        Ok(BundleChecker {
+            cell,
+            models,
+            checkers,
+            pairs,
+            slots,
+            pair_slots,
+            cells,
+            unpaired,
+            pair_tables,
+            free_cells,
+        })
     }
 
     /// The cell.
@@ -157,7 +189,8 @@ impl BundleChecker {
     /// Whether every table the pairs use is a clearance table (`build --variant clearance`),
     /// so that [`BundleChecker::clearance_bound`] can prove something for every pair.
     pub fn has_clearance(&self) -> bool {
-        !self.checkers.is_empty() && self.checkers.iter().all(|c| c.table().as_clearance().is_some())
+        !self.checkers.is_empty()
+            && self.checkers.iter().all(|c| c.table().as_clearance().is_some())
     }
 
     /// The certified lower bound on the clearance (mm) of robots `a` and `b` (a pair that can
@@ -185,7 +218,8 @@ impl BundleChecker {
 
     /// Bit j set: robot j's TCP (in its own MCS) is unreachable or not finite.
     pub fn unreachable_mask(&self, tcps_mcs: &[Vec3]) -> u32 {
-        let reachable = |j: usize| tcps_mcs.get(j).is_some_and(|t| self.models[j].delta.is_reachable(t));
+        let reachable =
+            |j: usize| tcps_mcs.get(j).is_some_and(|t| self.models[j].delta.is_reachable(t));
         (0..self.models.len()).fold(0u32, |m, j| m | u32::from(!reachable(j)) << j)
     }
 
@@ -196,7 +230,10 @@ impl BundleChecker {
     /// [`QueryError::WrongRobotCount`] unless one TCP per robot is given.
     pub fn check(&mut self, tcps_mcs: &[Vec3]) -> Result<TableAnswer, QueryError> {
         if tcps_mcs.len() != self.models.len() {
-            return Err(QueryError::WrongRobotCount { expected: self.models.len(), found: tcps_mcs.len() });
+            return Err(QueryError::WrongRobotCount {
+                expected: self.models.len(),
+                found: tcps_mcs.len(),
+            });
         }
         // As the exact check: a pair with an unreachable robot has no answer, every other pair
         // is answered, and the tick's answer is unreachable.
@@ -212,7 +249,9 @@ impl BundleChecker {
             mask |= u32::from(!self.models[j].delta.is_reachable(&tcps_mcs[j])) << j;
         }
         let mut answer = if mask != 0 { TableAnswer::Unreachable(mask) } else { TableAnswer::Free };
-        for ((p, [sa, sb]), free) in self.pairs.iter_mut().zip(&self.pair_slots).zip(&mut self.free_cells) {
+        for ((p, [sa, sb]), free) in
+            self.pairs.iter_mut().zip(&self.pair_slots).zip(&mut self.free_cells)
+        {
             (p.answer, p.boxes) = (TableAnswer::Unreachable(mask), None);
             if mask >> p.a & 1 == 1 || mask >> p.b & 1 == 1 {
                 continue;
@@ -235,8 +274,12 @@ impl BundleChecker {
                 },
             };
             answer = match (answer, p.answer) {
-                (TableAnswer::Unreachable(m), TableAnswer::Unreachable(n)) => TableAnswer::Unreachable(m | n),
-                (TableAnswer::Unreachable(m), _) | (_, TableAnswer::Unreachable(m)) => TableAnswer::Unreachable(m),
+                (TableAnswer::Unreachable(m), TableAnswer::Unreachable(n)) => {
+                    TableAnswer::Unreachable(m | n)
+                }
+                (TableAnswer::Unreachable(m), _) | (_, TableAnswer::Unreachable(m)) => {
+                    TableAnswer::Unreachable(m)
+                }
                 (TableAnswer::Collision, _) | (_, TableAnswer::Collision) => TableAnswer::Collision,
                 _ => TableAnswer::Free,
             };
@@ -274,24 +317,39 @@ mod tests {
     #[test]
     fn a_lines_pairs_share_each_robots_cell_and_answer_as_their_own_checkers() {
         let (variant, labelling) = (Variant::Shared, Labelling::Certified);
-        let built = build_bundle(&line(4), 16, &Workspace::THESIS, variant, labelling, Progress::Silent).unwrap();
+        let built =
+            build_bundle(&line(4), 16, &Workspace::THESIS, variant, labelling, Progress::Silent)
+                .unwrap();
         let cell = line(8);
-        let mut bundle = BundleChecker::new(cell.clone(), &built.bytes, Confirmation::None).unwrap();
+        let mut bundle =
+            BundleChecker::new(cell.clone(), &built.bytes, Confirmation::None).unwrap();
         // Per robot, one cell per query resolution among its tables (the three tables may
         // differ in sub-levels), against one per pair and side (36) taken pair by pair.
-        let mut resolutions = bundle.checkers.iter().map(|c| c.table().sub_levels()).collect::<Vec<_>>();
+        let mut resolutions =
+            bundle.checkers.iter().map(|c| c.table().sub_levels()).collect::<Vec<_>>();
         resolutions.sort_unstable();
         resolutions.dedup();
         let distinct = resolutions.len();
-        assert!(bundle.slots.len() <= 8 * distinct, "{} slots, sub-levels {resolutions:?}", bundle.slots.len());
+        assert!(
+            bundle.slots.len() <= 8 * distinct,
+            "{} slots, sub-levels {resolutions:?}",
+            bundle.slots.len()
+        );
         assert!((0..8).all(|j| bundle.slots.iter().any(|s| s.robot == j)));
         let loaded = bundle_from_bytes(&built.bytes).unwrap();
         let mut alone: Vec<TableChecker> = bundle
             .pairs()
             .iter()
             .map(|p| {
-                let (header, table) = loaded.tables[loaded.table_for(&cell, p.a, p.b).unwrap()].clone();
-                TableChecker::from_loaded(pair_cell(&cell, p.a, p.b), header, table, Confirmation::None).unwrap()
+                let (header, table) =
+                    loaded.tables[loaded.table_for(&cell, p.a, p.b).unwrap()].clone();
+                TableChecker::from_loaded(
+                    pair_cell(&cell, p.a, p.b),
+                    header,
+                    table,
+                    Confirmation::None,
+                )
+                .unwrap()
             })
             .collect();
         let mut state = 0x853c_49e6_748f_ea9bu64;
@@ -309,17 +367,28 @@ mod tests {
                 let jump = next() < 0.02;
                 let step = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 10.0;
                 *t = match jump {
-                    true => Vec3::new(600.0 * next() - 300.0, 600.0 * next() - 300.0, -300.0 - 300.0 * next()),
+                    true => Vec3::new(
+                        600.0 * next() - 300.0,
+                        600.0 * next() - 300.0,
+                        -300.0 - 300.0 * next(),
+                    ),
                     false => *t + step,
                 };
             }
             let cells_of = |b: &BundleChecker| -> Vec<_> {
-                b.pair_slots.iter().zip(&b.pairs).map(|(s, p)| (b.cells[s[0]], b.cells[s[1]], p.answer)).collect()
+                b.pair_slots
+                    .iter()
+                    .zip(&b.pairs)
+                    .map(|(s, p)| (b.cells[s[0]], b.cells[s[1]], p.answer))
+                    .collect()
             };
             let before = cells_of(&bundle);
             bundle.check(&tcps).unwrap();
             for ((ca, cb, was), (na, nb, now)) in before.iter().zip(&cells_of(&bundle)) {
-                if (*was, *now) == (TableAnswer::Free, TableAnswer::Free) && ca.is_some() && cb.is_some() {
+                if (*was, *now) == (TableAnswer::Free, TableAnswer::Free)
+                    && ca.is_some()
+                    && cb.is_some()
+                {
                     let same = (ca, cb) == (na, nb);
                     (kept, moved) = (kept + usize::from(same), moved + usize::from(!same));
                 }
@@ -333,12 +402,19 @@ mod tests {
                     seen[2] += 1;
                     continue;
                 }
-                assert_eq!(p.answer, want, "pair {}-{} at {:?} {:?}", p.a, p.b, tcps[p.a], tcps[p.b]);
+                assert_eq!(
+                    p.answer, want,
+                    "pair {}-{} at {:?} {:?}",
+                    p.a, p.b, tcps[p.a], tcps[p.b]
+                );
                 seen[usize::from(want == TableAnswer::Collision)] += 1;
             }
         }
         assert!(seen.iter().all(|&n| n > 100), "free, collision, unreachable answers: {seen:?}");
-        assert!(kept > 10_000 && moved > 1_000, "FREE pairs that kept their cells {kept}, that left them {moved}");
+        assert!(
+            kept > 10_000 && moved > 1_000,
+            "FREE pairs that kept their cells {kept}, that left them {moved}"
+        );
         assert!(bundle.fallbacks() > 0, "some TCPs lie outside the grid");
     }
 }

@@ -169,7 +169,12 @@ mod tests {
     }
 
     /// Walks the quadtree in preorder (child 0 first) and returns its leaves.
-    fn preorder<const D: usize>(levels: u32, prefix: [u16; D], depth: u32, out: &mut Vec<[u16; D]>) {
+    fn preorder<const D: usize>(
+        levels: u32,
+        prefix: [u16; D],
+        depth: u32,
+        out: &mut Vec<[u16; D]>,
+    ) {
         if depth == levels {
             out.push(prefix);
             return;

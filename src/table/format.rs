@@ -45,12 +45,12 @@
 //! every length with checked arithmetic, the checksum, and finally every field and index
 //! (via the variants' `from_parts`), so a loaded table never panics nor reads out of bounds.
 
+use super::clearance::{ClearanceTable, TreeParts};
 use super::error::{corrupt, TableError};
-use super::reader::Reader;
 use super::quadtree4d::{LinearQuadtree4d, SliceAxes};
 use super::quadtree5d::LinearQuadtree5d;
 use super::quadtree6d::LinearQuadtree6d;
-use super::clearance::{ClearanceTable, TreeParts};
+use super::reader::Reader;
 use super::shared6d::{SharedParts, SharedQuadtree6d};
 use super::{Table, TableKind};
 #[cfg(feature = "std")]
@@ -163,10 +163,16 @@ impl Header {
         let stored = &self.cell_parameters;
         let differs = if stored.is_empty() {
             None
-        } else if let Some(((name, v), t)) = ours.iter().zip(stored).find(|((_, v), t)| v.to_bits() != t.to_bits()) {
+        } else if let Some(((name, v), t)) =
+            ours.iter().zip(stored).find(|((_, v), t)| v.to_bits() != t.to_bits())
+        {
             Some(format!("{name} is {t} in the table's cell and {v} in this one"))
         } else {
-            Some(format!("the table's cell has {} parameters, this one {}", stored.len(), ours.len()))
+            Some(format!(
+                "the table's cell has {} parameters, this one {}",
+                stored.len(),
+                ours.len()
+            ))
         };
         Err(TableError::WrongCell { expected, found: self.cell_fingerprint, differs })
     }
@@ -187,7 +193,13 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
         Table::D4(q) => {
             let (codes, slice_of, words) = q.parts();
             let axes = if q.axes() == SliceAxes::YY { 1 } else { 2 };
-            (axes, q.threshold(), codes, slice_of.to_vec(), words.iter().flat_map(|w| w.to_le_bytes()).collect())
+            (
+                axes,
+                q.threshold(),
+                codes,
+                slice_of.to_vec(),
+                words.iter().flat_map(|w| w.to_le_bytes()).collect(),
+            )
         }
         Table::Shared(q) => {
             let (words, aux, children) = shared_sections(&[], q.parts());
@@ -198,9 +210,22 @@ pub fn to_bytes(table: &Table, header: &Header) -> Vec<u8> {
             let (e, l) = q.parts();
             let mut head: Vec<u64> = q.ladder().mm().iter().map(|v| v.to_bits()).collect();
             let len = |n: usize| n as u64;
-            head.extend([u64::from(q.shift()), len(e.masks.len()), len(e.leaves.len()), len(l.masks.len()), len(l.leaves.len())]);
+            head.extend([
+                u64::from(q.shift()),
+                len(e.masks.len()),
+                len(e.leaves.len()),
+                len(l.masks.len()),
+                len(l.leaves.len()),
+            ]);
             owned = head.into_iter().chain(tree_words(&e)).chain(tree_words(&l)).collect();
-            let aux = e.depth_start.iter().chain(&e.bases).chain(&l.depth_start).chain(&l.bases).copied().collect();
+            let aux = e
+                .depth_start
+                .iter()
+                .chain(&e.bases)
+                .chain(&l.depth_start)
+                .chain(&l.bases)
+                .copied()
+                .collect();
             let children = [e.packed_children(), l.packed_children()].concat();
             (0, q.ladder().len() as u32, &owned[..], aux, children)
         }
@@ -288,9 +313,14 @@ fn read_prefix(r: &mut Reader<TableError>) -> Result<Shape, TableError> {
         return Err(corrupt(format!("variant = {variant}, expected 6, 5, 4, 7 or 8")));
     }
     if levels == 0 || levels > super::code::MAX_LEVELS || k != 1 << levels {
-        return Err(corrupt(format!("levels = {levels}, k = {k}: k must be 2^levels, levels in 1..=8")));
+        return Err(corrupt(format!(
+            "levels = {levels}, k = {k}: k must be 2^levels, levels in 1..=8"
+        )));
     }
-    if flags > 7 || (flags & 2 != 0 && variant != 7) || (flags & PACKED_CHILDREN != 0 && variant != 8) {
+    if flags > 7
+        || (flags & 2 != 0 && variant != 7)
+        || (flags & PACKED_CHILDREN != 0 && variant != 8)
+    {
         return Err(corrupt(format!(
             "flags = {flags:#x}: only bit 0 (symmetric), for variant 7 bit 1 (sub-cells) and for variant 8 bit 2 \
              (packed child indices) are defined"
@@ -298,12 +328,17 @@ fn read_prefix(r: &mut Reader<TableError>) -> Result<Shape, TableError> {
     }
     let rungs = super::clearance::MAX_RUNGS as u32;
     if variant == 8 && (axes != 0 || !(1..=rungs).contains(&t)) {
-        return Err(corrupt(format!("variant 8 with slice axes = {axes}, {t} clearance levels (1 to {rungs})")));
+        return Err(corrupt(format!(
+            "variant 8 with slice axes = {axes}, {t} clearance levels (1 to {rungs})"
+        )));
     }
-    if (variant == 4 && !matches!(axes, 1 | 2)) || (!matches!(variant, 4 | 8) && (axes != 0 || t != 0)) {
+    if (variant == 4 && !matches!(axes, 1 | 2))
+        || (!matches!(variant, 4 | 8) && (axes != 0 || t != 0))
+    {
         return Err(corrupt(format!("variant {variant} with slice axes = {axes}, t = {t}")));
     }
-    let (sub_levels, symmetric, packed) = (flags >> 1 & 1, flags & 1 == 1, flags & PACKED_CHILDREN != 0);
+    let (sub_levels, symmetric, packed) =
+        (flags >> 1 & 1, flags & 1 == 1, flags & PACKED_CHILDREN != 0);
     Ok(Shape { variant, levels, sub_levels, symmetric, packed, axes, t })
 }
 
@@ -334,7 +369,16 @@ fn read_header(r: &mut Reader<TableError>) -> Result<Header, TableError> {
     }
     let workspace = Workspace { zu: ws[0], hcy: ws[1], rcy: ws[2], hco: ws[3], rco: ws[4] };
     let cell_parameters = Vec::new();
-    Ok(Header { cell_fingerprint, r: grid_r, origin_a, origin_b, workspace, margin, certification, cell_parameters })
+    Ok(Header {
+        cell_fingerprint,
+        r: grid_r,
+        origin_a,
+        origin_b,
+        workspace,
+        margin,
+        certification,
+        cell_parameters,
+    })
 }
 
 /// A symmetric table stores only A's half `iy >= k/2` (thesis 3.2.8) and folds every query
@@ -346,17 +390,25 @@ fn read_header(r: &mut Reader<TableError>) -> Result<Header, TableError> {
 /// have no `iy` in their codes: their slices start at row `k/2` by construction.
 fn check_unstored_half(shape: &Shape, words: &[u64]) -> Result<(), TableError> {
     let top = |stride: u32, c: u64| (c >> (stride * (shape.levels - 1))) & ((1 << stride) - 1);
-    let lower = |i: usize| corrupt(format!("symmetric table has codes[{i}] in the half it does not store (iy < k/2)"));
+    let lower = |i: usize| {
+        corrupt(format!("symmetric table has codes[{i}] in the half it does not store (iy < k/2)"))
+    };
     match shape.variant {
-        6 => match words.iter().position(|&c| top(7, c) != super::code::MARK && top(7, c) & 1 << 4 == 0) {
+        6 => match words
+            .iter()
+            .position(|&c| top(7, c) != super::code::MARK && top(7, c) & 1 << 4 == 0)
+        {
             Some(i) => Err(lower(i)),
             None => Ok(()),
         },
         5 => words.iter().position(|&c| top(5, c) & 1 << 3 == 0).map_or(Ok(()), |i| Err(lower(i))),
-        4 if shape.axes == 2 => words.iter().position(|&c| top(4, c) & 1 << 2 == 0).map_or(Ok(()), |i| Err(lower(i))),
+        4 if shape.axes == 2 => {
+            words.iter().position(|&c| top(4, c) & 1 << 2 == 0).map_or(Ok(()), |i| Err(lower(i)))
+        }
         7 | 8 => {
             // The root's 64 children, child index `bx << 5 | by << 4 | ...`: those with by = 0.
-            let lower_children = (0..64u64).filter(|c| c >> 4 & 1 == 0).fold(0u64, |m, c| m | 1 << c);
+            let lower_children =
+                (0..64u64).filter(|c| c >> 4 & 1 == 0).fold(0u64, |m, c| m | 1 << c);
             match words.get(..2) {
                 Some(&[nonuniform, collision]) if (nonuniform | collision) & lower_children != 0 => {
                     Err(corrupt("symmetric shared table has root children in the half it does not store (iy < k/2)"))
@@ -372,7 +424,10 @@ fn check_unstored_half(shape: &Shape, words: &[u64]) -> Result<(), TableError> {
 const MAX_CELL_PARAMETERS: u64 = 4096;
 
 /// The cell parameter values; when present, their fingerprint must be the recorded one.
-fn read_cell_parameters(r: &mut Reader<TableError>, fingerprint: u64) -> Result<Vec<f64>, TableError> {
+fn read_cell_parameters(
+    r: &mut Reader<TableError>,
+    fingerprint: u64,
+) -> Result<Vec<f64>, TableError> {
     let n = r.u64("cell parameter count")?;
     if n > MAX_CELL_PARAMETERS {
         return Err(corrupt(format!("cell parameter count = {n} exceeds {MAX_CELL_PARAMETERS}")));
@@ -407,23 +462,35 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
         7 | 8 => [8, 4, 4],
         _ => [8, 4, 8],
     };
-    let names = ["section 0 (codes)", "section 1 (offsets or slice indices)", "section 2 (intervals or slices)"];
+    let names = [
+        "section 0 (codes)",
+        "section 1 (offsets or slice indices)",
+        "section 2 (intervals or slices)",
+    ];
     let mut lens = [0usize; 3];
     for i in 0..3 {
         let n = usize::try_from(counts[i]).ok().and_then(|n| n.checked_mul(sizes[i]));
-        lens[i] = n.ok_or_else(|| corrupt(format!("{} count = {} overflows", names[i], counts[i])))?;
+        lens[i] =
+            n.ok_or_else(|| corrupt(format!("{} count = {} overflows", names[i], counts[i])))?;
         if sizes[i] == 0 && counts[i] != 0 || shape.variant == 6 && i > 0 && counts[i] != 0 {
-            return Err(corrupt(format!("{} count = {} must be 0 for variant {}", names[i], counts[i], shape.variant)));
+            return Err(corrupt(format!(
+                "{} count = {} must be 0 for variant {}",
+                names[i], counts[i], shape.variant
+            )));
         }
     }
-    let sections = [r.take(lens[0], names[0])?, r.take(lens[1], names[1])?, r.take(lens[2], names[2])?];
+    let sections =
+        [r.take(lens[0], names[0])?, r.take(lens[1], names[1])?, r.take(lens[2], names[2])?];
     r.checksum()?;
     let mut codes = words(sections[0], u64::from_le_bytes);
     let aux = words(sections[1], u32::from_le_bytes);
     if shape.variant == 8 {
         let n = shape.t as usize;
         if codes.len() < n + 5 {
-            return Err(corrupt(format!("section 0 has {} words, fewer than the {n} clearance levels and 5 counts", codes.len())));
+            return Err(corrupt(format!(
+                "section 0 has {} words, fewer than the {n} clearance levels and 5 counts",
+                codes.len()
+            )));
         }
         let ladder: Vec<f64> = codes.drain(..n).map(f64::from_bits).collect();
         let counts: Vec<u64> = codes.drain(..5).collect();
@@ -479,7 +546,15 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(Header, Table), TableError> {
         _ => {
             let axes = if shape.axes == 1 { SliceAxes::YY } else { SliceAxes::ZZ };
             let slices = words(sections[2], u64::from_le_bytes);
-            Table::D4(LinearQuadtree4d::from_parts(shape.levels, shape.symmetric, axes, shape.t, codes, aux, slices)?)
+            Table::D4(LinearQuadtree4d::from_parts(
+                shape.levels,
+                shape.symmetric,
+                axes,
+                shape.t,
+                codes,
+                aux,
+                slices,
+            )?)
         }
     };
     Ok((header, table))
@@ -513,23 +588,29 @@ fn clearance_from_sections(
         return Err(corrupt("clearance table counts"));
     };
     let shift = u32::try_from(shift).ok().filter(|&s| s + 2 <= shape.levels).ok_or_else(|| {
-        corrupt(format!("clearance level tree shift = {shift} with levels = {}: need levels - shift >= 2", shape.levels))
+        corrupt(format!(
+            "clearance level tree shift = {shift} with levels = {}: need levels - shift >= 2",
+            shape.levels
+        ))
     })?;
-    let mut tree = |nodes: u64, leaves: u64, depths: u32, what: &str| -> Result<TreeParts, TableError> {
-        let m = split_front(&mut words, nodes.saturating_mul(2), what)?;
-        let masks: Vec<[u64; 2]> = m.chunks_exact(2).map(|m| [m[0], m[1]]).collect();
-        let leaves = split_front(&mut words, leaves, what)?;
-        let depth_start = split_front(&mut aux, u64::from(depths), what)?;
-        let bases = split_front(&mut aux, nodes, what)?;
-        let children = match &mut children {
-            Children::Packed(bytes) => TreeParts::unpack_children(&masks, &depth_start, leaves.len(), bytes, what)?,
-            Children::Wide(all) => {
-                let n_children: u64 = masks.iter().map(|m| u64::from(m[0].count_ones())).sum();
-                split_front(all, n_children, what)?
-            }
+    let mut tree =
+        |nodes: u64, leaves: u64, depths: u32, what: &str| -> Result<TreeParts, TableError> {
+            let m = split_front(&mut words, nodes.saturating_mul(2), what)?;
+            let masks: Vec<[u64; 2]> = m.chunks_exact(2).map(|m| [m[0], m[1]]).collect();
+            let leaves = split_front(&mut words, leaves, what)?;
+            let depth_start = split_front(&mut aux, u64::from(depths), what)?;
+            let bases = split_front(&mut aux, nodes, what)?;
+            let children = match &mut children {
+                Children::Packed(bytes) => {
+                    TreeParts::unpack_children(&masks, &depth_start, leaves.len(), bytes, what)?
+                }
+                Children::Wide(all) => {
+                    let n_children: u64 = masks.iter().map(|m| u64::from(m[0].count_ones())).sum();
+                    split_front(all, n_children, what)?
+                }
+            };
+            Ok(TreeParts { masks, bases, depth_start, children, leaves })
         };
-        Ok(TreeParts { masks, bases, depth_start, children, leaves })
-    };
     let exact = tree(nodes_e, leaves_e, shape.levels, "clearance exact tree")?;
     let levels = tree(nodes_l, leaves_l, shape.levels - shift + 1, "clearance level tree")?;
     let children_left = match &children {

@@ -58,8 +58,12 @@ impl TableKind {
             TableKind::D4yy => "4-D quadtree of yy'-slices grouped by similarity (thesis 3.2.6)",
             TableKind::D4zz => "4-D quadtree of zz'-slices grouped by similarity (thesis 3.2.6)",
             TableKind::Shared => "6-D quadtree with shared subtrees",
-            TableKind::SharedSub => "As shared, collision cells cut into 64 sub-cells (certified labelling only)",
-            TableKind::Clearance => "Certified clearance levels per grid cell (--levels; certified labelling only)",
+            TableKind::SharedSub => {
+                "As shared, collision cells cut into 64 sub-cells (certified labelling only)"
+            }
+            TableKind::Clearance => {
+                "Certified clearance levels per grid cell (--levels; certified labelling only)"
+            }
         }
     }
 

@@ -12,14 +12,14 @@
 //! tick.
 
 use crate::cell::exact::PairState;
-use crate::cell::{Cell, ExactChecker, QueryError};
 pub use crate::cell::Confirmation;
-#[cfg(feature = "std")]
-use crate::robot::motion_bound::cube_reachable;
+use crate::cell::{Cell, ExactChecker, QueryError};
 use crate::cspace::symmetry::reflection_y;
 use crate::cspace::SampleGrid;
 use crate::cspace::Workspace;
 use crate::math::Vec3;
+#[cfg(feature = "std")]
+use crate::robot::motion_bound::cube_reachable;
 use crate::robot::{Delta3, RobotModel};
 use crate::table::format::from_bytes;
 use crate::table::{Header, Table, TableError};
@@ -43,13 +43,23 @@ pub enum TableAnswer {
 /// a header edited with its checksum recomputed passes every other check.
 fn check_determined_by_cell(header: &Header, table: &Table, cell: &Cell) -> Result<(), TableError> {
     let fingerprint = cell.fingerprint();
-    let wrong =
-        |differs: String| TableError::WrongCell { expected: fingerprint, found: fingerprint, differs: Some(differs) };
+    let wrong = |differs: String| TableError::WrongCell {
+        expected: fingerprint,
+        found: fingerprint,
+        differs: Some(differs),
+    };
     let (w, ours) = (&header.workspace, Workspace::for_cell(cell));
-    let fields = [("zu", w.zu, ours.zu), ("hcy", w.hcy, ours.hcy), ("rcy", w.rcy, ours.rcy), ("hco", w.hco, ours.hco)];
+    let fields = [
+        ("zu", w.zu, ours.zu),
+        ("hcy", w.hcy, ours.hcy),
+        ("rcy", w.rcy, ours.rcy),
+        ("hco", w.hco, ours.hco),
+    ];
     for (name, theirs, ours) in fields.into_iter().chain([("rco", w.rco, ours.rco)]) {
         if theirs.to_bits() != ours.to_bits() {
-            return Err(wrong(format!("workspace.{name} is {theirs} mm in the table and {ours} mm for this cell")));
+            return Err(wrong(format!(
+                "workspace.{name} is {theirs} mm in the table and {ours} mm for this cell"
+            )));
         }
     }
     let symmetric = reflection_y(cell);
@@ -93,7 +103,10 @@ impl CellSet {
     #[cfg(feature = "std")]
     fn reachable(grid: &SampleGrid, delta: &Delta3) -> Self {
         let h = 0.5 * grid.r;
-        CellSet::new(grid.k, grid.cells.iter().filter(|c| cube_reachable(delta, &grid.center(**c), h)))
+        CellSet::new(
+            grid.k,
+            grid.cells.iter().filter(|c| cube_reachable(delta, &grid.center(**c), h)),
+        )
     }
 
     /// Without `std` there is no interval arithmetic to prove a cell: none is, and every TCP
@@ -150,7 +163,11 @@ impl TableChecker {
     /// Every [`TableError`] of loading; [`TableError::WrongCell`] when the table was built for
     /// another cell; [`TableError::BadInput`] when the cell does not have two robots or the
     /// header's grid differs from the one its parameters define.
-    pub fn with_confirmation(cell: Cell, bytes: &[u8], confirmation: Confirmation) -> Result<TableChecker, TableError> {
+    pub fn with_confirmation(
+        cell: Cell,
+        bytes: &[u8],
+        confirmation: Confirmation,
+    ) -> Result<TableChecker, TableError> {
         if cell.robots.len() != 2 {
             return Err(TableError::BadInput {
                 what: format!("tables serve two-robot cells; this one has {}", cell.robots.len()),
@@ -265,13 +282,15 @@ impl TableChecker {
     /// `is_reachable` accept every TCP of the cell) skips the inverse kinematics.
     pub(crate) fn locate(&self, j: usize, tcp: &Vec3) -> Option<Option<[u16; 3]>> {
         let cell = self.cell_of(j, tcp);
-        let proved = cell.is_some_and(|c| self.reachable[j].contains(c.map(|v| v >> self.sub_levels)));
+        let proved =
+            cell.is_some_and(|c| self.reachable[j].contains(c.map(|v| v >> self.sub_levels)));
         (proved || self.models[j].delta.is_reachable(tcp)).then_some(cell)
     }
 
     /// Whether robot `j`'s grid here and robot `i`'s grid in `other` give every TCP the same
-    /// cell (origin, query resolution and sampled cells all equal), so that [`TableChecker::cell_of`]
-    /// of one serves the other (a bundle's pairs share their robots' cells).
+    /// cell (origin, query resolution and sampled cells all equal), so that
+    /// [`TableChecker::cell_of`] of one serves the other (a bundle's pairs share their robots'
+    /// cells).
     pub(crate) fn same_grid(&self, j: usize, other: &TableChecker, i: usize) -> bool {
         self.origins[j] == other.origins[i]
             && self.query_r.to_bits() == other.query_r.to_bits()
@@ -292,7 +311,9 @@ impl TableChecker {
         let located = [self.locate(0, &tcps_mcs[0]), self.locate(1, &tcps_mcs[1])];
         match located {
             [Some(a), Some(b)] => self.check_cells([a, b], tcps_mcs),
-            _ => Ok(TableAnswer::Unreachable(u32::from(located[0].is_none()) | u32::from(located[1].is_none()) << 1)),
+            _ => Ok(TableAnswer::Unreachable(
+                u32::from(located[0].is_none()) | u32::from(located[1].is_none()) << 1,
+            )),
         }
     }
 
@@ -351,10 +372,15 @@ impl TableChecker {
         let cells = [0, 1].map(|j| tcps_mcs.get(j).and_then(|t| self.locate(j, t)));
         match cells {
             [Some(a), Some(b)] => {
-                let (Some(a), Some(b), Some(table)) = (a, b, self.table.as_clearance()) else { return Ok(None) };
+                let (Some(a), Some(b), Some(table)) = (a, b, self.table.as_clearance()) else {
+                    return Ok(None);
+                };
                 Ok(table.bound_mm([a[0], a[1], a[2], b[0], b[1], b[2]]))
             }
-            _ => Err(cells.iter().enumerate().fold(0u32, |m, (j, c)| m | u32::from(c.is_none()) << j)),
+            _ => Err(cells
+                .iter()
+                .enumerate()
+                .fold(0u32, |m, (j, c)| m | u32::from(c.is_none()) << j)),
         }
     }
 

@@ -69,7 +69,13 @@ pub struct MemoryPlan {
 ///
 /// # Errors
 /// [`BuildError::Memory`] when the fixed part alone needs more than `max`.
-pub fn plan_memory(na: u64, nb: u64, k: u32, variant: Variant, max: u64) -> Result<MemoryPlan, BuildError> {
+pub fn plan_memory(
+    na: u64,
+    nb: u64,
+    k: u32,
+    variant: Variant,
+    max: u64,
+) -> Result<MemoryPlan, BuildError> {
     let labels = PairLabels::bytes_for(na.saturating_mul(nb));
     // A clearance build holds one more byte per pair: its proved level count.
     let counts = if matches!(variant, Variant::Clearance(_)) { na.saturating_mul(nb) } else { 0 };
@@ -103,7 +109,9 @@ fn builder_bytes(k: u32) -> u64 {
 fn block_depth(k: u32, bytes: u64) -> u32 {
     let levels = k.max(2).trailing_zeros();
     (0..levels.saturating_sub(1))
-        .find(|&d| u64::from(k >> d).saturating_pow(6).saturating_mul(BLOCK_BYTES_PER_PAIR) <= bytes)
+        .find(|&d| {
+            u64::from(k >> d).saturating_pow(6).saturating_mul(BLOCK_BYTES_PER_PAIR) <= bytes
+        })
         .unwrap_or(levels.saturating_sub(1))
 }
 
@@ -123,10 +131,15 @@ pub fn parse_bytes(s: &str) -> Result<u64, String> {
         "M" => 20,
         "G" => 30,
         "T" => 40,
-        _ => return Err(format!("'{s}': a byte count is digits with an optional K, M, G or T (e.g. 8G)")),
+        _ => {
+            return Err(format!(
+                "'{s}': a byte count is digits with an optional K, M, G or T (e.g. 8G)"
+            ))
+        }
     };
-    let value: f64 =
-        number.parse().map_err(|_| format!("'{s}': a byte count is digits with an optional K, M, G or T"))?;
+    let value: f64 = number
+        .parse()
+        .map_err(|_| format!("'{s}': a byte count is digits with an optional K, M, G or T"))?;
     let bytes = value * (1u64 << shift) as f64;
     if !bytes.is_finite() || bytes < 1.0 || bytes >= u64::MAX as f64 {
         return Err(format!("'{s}': a byte count from 1 byte to 16 EB"));
@@ -144,7 +157,9 @@ mod tests {
         assert_eq!(parse_bytes("512M"), Ok(512 << 20));
         assert_eq!(parse_bytes("1.5GiB"), Ok(3 << 29));
         assert_eq!(parse_bytes("4096"), Ok(4096));
-        assert!(parse_bytes("8X").is_err() && parse_bytes("").is_err() && parse_bytes("0").is_err());
+        assert!(
+            parse_bytes("8X").is_err() && parse_bytes("").is_err() && parse_bytes("0").is_err()
+        );
     }
 
     /// Blocks shrink as the memory left shrinks, down to the grid cells' parents; a fixed
@@ -157,7 +172,10 @@ mod tests {
         assert_eq!(big.block_depth, 1);
         assert!(small.block_depth > 1 && small.block_depth <= 4, "{small:?}");
         assert_eq!(plan_memory(6_000, 6_000, 32, sub, big.fixed).unwrap().block_depth, 4);
-        assert!(matches!(plan_memory(6_000, 6_000, 32, sub, big.fixed - 1), Err(BuildError::Memory { .. })));
+        assert!(matches!(
+            plan_memory(6_000, 6_000, 32, sub, big.fixed - 1),
+            Err(BuildError::Memory { .. })
+        ));
         assert_eq!(plan_memory(6_000, 6_000, 32, Variant::D6, 64 << 30).unwrap().cache, 0);
     }
 
@@ -173,7 +191,9 @@ mod tests {
         assert_eq!(default_max_memory(DEFAULT_MAX_MEMORY + 1, Some(24 << 30)), 24 << 30);
         // T1 at k = 64 (47,548 samples per robot).
         let k64 = plan_memory(47_548, 47_548, 64, sub, u64::MAX).unwrap();
-        let plan = plan_memory(47_548, 47_548, 64, sub, default_max_memory(k64.fixed, Some(24 << 30))).unwrap();
+        let plan =
+            plan_memory(47_548, 47_548, 64, sub, default_max_memory(k64.fixed, Some(24 << 30)))
+                .unwrap();
         assert!(plan.cache > 1 << 30 && plan.block_depth == 3, "{plan:?}");
         let k32 = plan_memory(6_284, 6_284, 32, sub, u64::MAX).unwrap();
         let at_32 = |max| plan_memory(6_284, 6_284, 32, sub, max).unwrap().block_depth;
@@ -188,6 +208,9 @@ mod tests {
         let shared = plan_memory(6_000, 5_000, 32, Variant::Shared, 64 << 30).unwrap();
         let with_levels = plan_memory(6_000, 5_000, 32, clearance, 64 << 30).unwrap();
         assert_eq!(with_levels.fixed, shared.fixed + 30_000_000);
-        assert!(matches!(plan_memory(6_000, 5_000, 32, clearance, shared.fixed), Err(BuildError::Memory { .. })));
+        assert!(matches!(
+            plan_memory(6_000, 5_000, 32, clearance, shared.fixed),
+            Err(BuildError::Memory { .. })
+        ));
     }
 }

@@ -25,16 +25,16 @@ pub mod code;
 pub(crate) mod error;
 pub mod format;
 mod kind;
+pub(crate) mod lookup;
 #[cfg(feature = "std")]
 pub mod memory;
-pub(crate) mod lookup;
 pub(crate) mod quadtree4d;
 pub(crate) mod quadtree5d;
 pub(crate) mod quadtree6d;
+mod reader;
 #[cfg(feature = "std")]
 pub mod shard;
 pub(crate) mod shared6d;
-mod reader;
 mod space;
 #[cfg(feature = "std")]
 pub mod synthetic;
@@ -47,11 +47,9 @@ use alloc::{format, string::String};
 use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
 pub use build::{
-    build_table, build_table_bounded, build_tables, memory_plan, BoundedBuild, BuildError, BuildReport, Labelling,
-    Variant,
+    build_table, build_table_bounded, build_tables, memory_plan, BoundedBuild, BuildError,
+    BuildReport, Labelling, Variant,
 };
-#[cfg(feature = "std")]
-pub use memory::{default_max_memory, parse_bytes, MemoryPlan, DEFAULT_MAX_MEMORY};
 pub use bundle::{bundle_from_bytes, bundle_to_bytes, is_bundle, pair_cell, Bundle, BundlePair};
 pub use bundle_checker::{BundleChecker, PairAnswer};
 pub use clearance::{ClearanceTable, Ladder};
@@ -59,6 +57,8 @@ pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
 pub use kind::{TableKind, UnknownTableKind};
 pub use lookup::{Confirmation, TableAnswer, TableChecker};
+#[cfg(feature = "std")]
+pub use memory::{default_max_memory, parse_bytes, MemoryPlan, DEFAULT_MAX_MEMORY};
 #[cfg(feature = "eval")]
 pub use quadtree4d::{subdivided_slices, SliceBound};
 pub use quadtree4d::{LinearQuadtree4d, SliceAxes};
@@ -111,7 +111,8 @@ impl Table {
     pub fn query_grid_cell(&self, cell: [u16; 6]) -> bool {
         match self.sub_levels() {
             0 => self.query(cell),
-            _ => (0..64u16).any(|c| self.query(core::array::from_fn(|j| 2 * cell[j] + (c >> (5 - j) & 1)))),
+            _ => (0..64u16)
+                .any(|c| self.query(core::array::from_fn(|j| 2 * cell[j] + (c >> (5 - j) & 1)))),
         }
     }
 
@@ -184,7 +185,11 @@ impl Table {
         match self {
             Table::D6(_) => "6D".into(),
             Table::D5(_) => "5D".into(),
-            Table::D4(t) => format!("4D/{} t={}", if t.axes() == SliceAxes::YY { "yy" } else { "zz" }, t.threshold()),
+            Table::D4(t) => format!(
+                "4D/{} t={}",
+                if t.axes() == SliceAxes::YY { "yy" } else { "zz" },
+                t.threshold()
+            ),
             Table::Shared(t) if t.sub_levels() > 0 => "6D-shared/sub".into(),
             Table::Shared(_) => "6D-shared".into(),
             Table::Clearance(_) => "6D-clearance".into(),

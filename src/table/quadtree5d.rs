@@ -59,14 +59,18 @@ impl LinearQuadtree5d {
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or the label count is wrong.
     #[cfg(feature = "std")]
-    pub fn build(space: &LabelledSpace, symmetry: Symmetry) -> Result<LinearQuadtree5d, TableError> {
+    pub fn build(
+        space: &LabelledSpace,
+        symmetry: Symmetry,
+    ) -> Result<LinearQuadtree5d, TableError> {
         let symmetric = symmetry.is_mirrored();
         let view = SpaceView::new(space, symmetric)?;
         let cells_b = &space.grid_b.cells;
         // B's samples in (ix', iy', iz') order, cut into columns of equal (ix', iy').
         let mut order: Vec<usize> = (0..cells_b.len()).collect();
         order.sort_by_key(|&i| cells_b[i]);
-        let columns: Vec<&[usize]> = order.chunk_by(|&i, &j| cells_b[i][..2] == cells_b[j][..2]).collect();
+        let columns: Vec<&[usize]> =
+            order.chunk_by(|&i, &j| cells_b[i][..2] == cells_b[j][..2]).collect();
         let mut nodes: Vec<(u64, Vec<[u8; 2]>)> = Vec::new();
         let mut buf = Vec::new();
         for (ia, a) in space.grid_a.cells.iter().enumerate() {
@@ -75,7 +79,10 @@ impl LinearQuadtree5d {
             }
             for col in &columns {
                 buf.clear();
-                column_intervals(col.iter().map(|&ib| (cells_b[ib][2], view.label(ia, ib))), &mut buf);
+                column_intervals(
+                    col.iter().map(|&ib| (cells_b[ib][2], view.label(ia, ib))),
+                    &mut buf,
+                );
                 if !buf.is_empty() {
                     let b = cells_b[col[0]];
                     nodes.push((encode([a[0], a[1], a[2], b[0], b[1]], 5), buf.clone()));
@@ -83,8 +90,13 @@ impl LinearQuadtree5d {
             }
         }
         nodes.sort_unstable_by_key(|n| n.0);
-        let mut t =
-            LinearQuadtree5d { levels: view.levels, symmetric, codes: vec![], offsets: vec![0], intervals: vec![] };
+        let mut t = LinearQuadtree5d {
+            levels: view.levels,
+            symmetric,
+            codes: vec![],
+            offsets: vec![0],
+            intervals: vec![],
+        };
         for (code, ivs) in nodes {
             t.codes.push(code);
             t.intervals.extend(ivs);
@@ -110,12 +122,21 @@ impl LinearQuadtree5d {
             return Err(corrupt(format!("levels = {levels} must be in 1..={MAX_LEVELS}")));
         }
         if let Some(i) = codes.iter().position(|&c| c >> (5 * levels) != 0) {
-            return Err(corrupt(format!("codes[{i}] = {:#x} has bits above {levels} 5-bit levels", codes[i])));
+            return Err(corrupt(format!(
+                "codes[{i}] = {:#x} has bits above {levels} 5-bit levels",
+                codes[i]
+            )));
         }
         if let Some(i) = codes.windows(2).position(|w| w[0] >= w[1]) {
-            return Err(corrupt(format!("codes[{}] is not greater than codes[{i}]: codes are not sorted", i + 1)));
+            return Err(corrupt(format!(
+                "codes[{}] is not greater than codes[{i}]: codes are not sorted",
+                i + 1
+            )));
         }
-        if offsets.len() != codes.len() + 1 || offsets[0] != 0 || offsets[codes.len()] as usize != intervals.len() {
+        if offsets.len() != codes.len() + 1
+            || offsets[0] != 0
+            || offsets[codes.len()] as usize != intervals.len()
+        {
             return Err(corrupt(format!(
                 "offsets must hold {} entries from 0 to the interval count {}",
                 codes.len() + 1,
@@ -127,7 +148,10 @@ impl LinearQuadtree5d {
         }
         let k = 1u32 << levels;
         if let Some(i) = intervals.iter().position(|iv| iv[0] > iv[1] || u32::from(iv[1]) >= k) {
-            return Err(corrupt(format!("intervals[{i}] = {:?} is not within 0..{k} in order", intervals[i])));
+            return Err(corrupt(format!(
+                "intervals[{i}] = {:?} is not within 0..{k} in order",
+                intervals[i]
+            )));
         }
         Ok(LinearQuadtree5d { levels, symmetric, codes, offsets, intervals })
     }
@@ -143,7 +167,9 @@ impl LinearQuadtree5d {
             return false;
         };
         let (lo, hi) = (self.offsets.get(i), self.offsets.get(i + 1));
-        let Some(ivs) = lo.zip(hi).and_then(|(&lo, &hi)| self.intervals.get(lo as usize..hi as usize)) else {
+        let Some(ivs) =
+            lo.zip(hi).and_then(|(&lo, &hi)| self.intervals.get(lo as usize..hi as usize))
+        else {
             return true;
         };
         let z = c[5];
@@ -167,7 +193,10 @@ impl LinearQuadtree5d {
 
     /// Bytes this table occupies in memory (struct plus its arrays).
     pub fn memory_bytes(&self) -> usize {
-        core::mem::size_of::<Self>() + 8 * self.codes.len() + 4 * self.offsets.len() + 2 * self.intervals.len()
+        core::mem::size_of::<Self>()
+            + 8 * self.codes.len()
+            + 4 * self.offsets.len()
+            + 2 * self.intervals.len()
     }
 
     /// The thesis's figure for the same counts, `12 m + 16 i + 64` (Observation 3.2.2).
@@ -199,10 +228,27 @@ mod tests {
     #[test]
     fn from_parts_rejects_bad_intervals() {
         assert!(LinearQuadtree5d::from_parts(2, false, vec![1], vec![0, 1], vec![[0, 3]]).is_ok());
-        assert!(LinearQuadtree5d::from_parts(2, false, vec![1], vec![0, 1], vec![[0, 4]]).is_err(), "end >= k");
-        assert!(LinearQuadtree5d::from_parts(2, false, vec![1], vec![0, 1], vec![[2, 1]]).is_err(), "reversed");
-        assert!(LinearQuadtree5d::from_parts(2, false, vec![1], vec![0, 2], vec![[0, 1]]).is_err(), "offset");
-        assert!(LinearQuadtree5d::from_parts(2, false, vec![2, 1], vec![0, 0, 1], vec![[0, 1]]).is_err(), "order");
-        assert!(LinearQuadtree5d::from_parts(2, false, vec![1 << 10], vec![0, 1], vec![[0, 1]]).is_err(), "bits");
+        assert!(
+            LinearQuadtree5d::from_parts(2, false, vec![1], vec![0, 1], vec![[0, 4]]).is_err(),
+            "end >= k"
+        );
+        assert!(
+            LinearQuadtree5d::from_parts(2, false, vec![1], vec![0, 1], vec![[2, 1]]).is_err(),
+            "reversed"
+        );
+        assert!(
+            LinearQuadtree5d::from_parts(2, false, vec![1], vec![0, 2], vec![[0, 1]]).is_err(),
+            "offset"
+        );
+        assert!(
+            LinearQuadtree5d::from_parts(2, false, vec![2, 1], vec![0, 0, 1], vec![[0, 1]])
+                .is_err(),
+            "order"
+        );
+        assert!(
+            LinearQuadtree5d::from_parts(2, false, vec![1 << 10], vec![0, 1], vec![[0, 1]])
+                .is_err(),
+            "bits"
+        );
     }
 }

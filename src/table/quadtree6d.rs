@@ -46,9 +46,15 @@ pub const MAX_BUILD_LEVELS_6D: u32 = 6;
 
 /// One bit per node of depth `d`, for `d` in `0..levels`: whether it holds a free sample.
 #[cfg(feature = "std")]
-fn free_maps(view: &SpaceView, plain_a: &[u64], plain_b: &[u64], leaves: &mut Vec<u64>) -> Vec<Vec<u64>> {
+fn free_maps(
+    view: &SpaceView,
+    plain_a: &[u64],
+    plain_b: &[u64],
+    leaves: &mut Vec<u64>,
+) -> Vec<Vec<u64>> {
     let h = view.levels as usize;
-    let mut maps: Vec<Vec<u64>> = (0..h).map(|d| vec![0u64; (1usize << (6 * d)).div_ceil(64)]).collect();
+    let mut maps: Vec<Vec<u64>> =
+        (0..h).map(|d| vec![0u64; (1usize << (6 * d)).div_ceil(64)]).collect();
     let deepest = &mut maps[h - 1];
     for (ia, &ca) in plain_a.iter().enumerate() {
         if !view.stored(ia) {
@@ -76,21 +82,30 @@ fn free_maps(view: &SpaceView, plain_a: &[u64], plain_b: &[u64], leaves: &mut Ve
 
 impl LinearQuadtree6d {
     /// Builds the table of `space` (thesis Algorithm 4 with the condensation of the module
-    /// doc); with [`Symmetry::MirrorY`], only A's upper half `iy >= k/2` is stored (see `space.rs`).
+    /// doc); with [`Symmetry::MirrorY`], only A's upper half `iy >= k/2` is stored (see
+    /// `space.rs`).
     ///
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
     /// `levels <= MAX_BUILD_LEVELS_6D`, or the label count is wrong.
     #[cfg(feature = "std")]
-    pub fn build(space: &LabelledSpace, symmetry: Symmetry) -> Result<LinearQuadtree6d, TableError> {
+    pub fn build(
+        space: &LabelledSpace,
+        symmetry: Symmetry,
+    ) -> Result<LinearQuadtree6d, TableError> {
         let symmetric = symmetry.is_mirrored();
         let view = SpaceView::new(space, symmetric)?;
         if view.levels > MAX_BUILD_LEVELS_6D {
-            return Err(bad_input(format!("6-D builder takes levels <= {MAX_BUILD_LEVELS_6D}, got {}", view.levels)));
+            return Err(bad_input(format!(
+                "6-D builder takes levels <= {MAX_BUILD_LEVELS_6D}, got {}",
+                view.levels
+            )));
         }
         let h = view.levels;
-        let plain_a: Vec<u64> = space.grid_a.cells.iter().map(|c| encode([c[0], c[1], c[2], 0, 0, 0], 6)).collect();
-        let plain_b: Vec<u64> = space.grid_b.cells.iter().map(|c| encode([0, 0, 0, c[0], c[1], c[2]], 6)).collect();
+        let plain_a: Vec<u64> =
+            space.grid_a.cells.iter().map(|c| encode([c[0], c[1], c[2], 0, 0, 0], 6)).collect();
+        let plain_b: Vec<u64> =
+            space.grid_b.cells.iter().map(|c| encode([0, 0, 0, c[0], c[1], c[2]], 6)).collect();
         let mut leaves = Vec::new();
         let maps = free_maps(&view, &plain_a, &plain_b, &mut leaves);
         leaves.sort_unstable();
@@ -115,19 +130,32 @@ impl LinearQuadtree6d {
     /// # Errors
     /// [`TableError::Corrupt`] naming the first bad field: levels out of range, a malformed
     /// code, codes not strictly increasing, or a code inside a condensed node's subtree.
-    pub fn from_parts(levels: u32, symmetric: bool, codes: Vec<u64>) -> Result<LinearQuadtree6d, TableError> {
+    pub fn from_parts(
+        levels: u32,
+        symmetric: bool,
+        codes: Vec<u64>,
+    ) -> Result<LinearQuadtree6d, TableError> {
         if levels == 0 || levels > MAX_LEVELS {
             return Err(corrupt(format!("levels = {levels} must be in 1..={MAX_LEVELS}")));
         }
         if let Some(i) = codes.iter().position(|&c| !valid6(c, levels)) {
-            return Err(corrupt(format!("codes[{i}] = {:#x} is not a 6-D code of {levels} levels", codes[i])));
+            return Err(corrupt(format!(
+                "codes[{i}] = {:#x} is not a 6-D code of {levels} levels",
+                codes[i]
+            )));
         }
         for (i, w) in codes.windows(2).enumerate() {
             if w[0] >= w[1] {
-                return Err(corrupt(format!("codes[{}] is not greater than codes[{i}]: codes are not sorted", i + 1)));
+                return Err(corrupt(format!(
+                    "codes[{}] is not greater than codes[{i}]: codes are not sorted",
+                    i + 1
+                )));
             }
             if covers6(w[1], w[0]) {
-                return Err(corrupt(format!("codes[{i}] lies inside the condensed node codes[{}]", i + 1)));
+                return Err(corrupt(format!(
+                    "codes[{i}] lies inside the condensed node codes[{}]",
+                    i + 1
+                )));
             }
         }
         Ok(LinearQuadtree6d { levels, symmetric, codes })
@@ -195,7 +223,9 @@ mod tests {
 
     #[test]
     fn condensation_never_covers_a_free_sample() {
-        for (pattern, must_condense) in [(Pattern::Noise { p: 0.3, seed: 5 }, false), (Pattern::Blobs, true)] {
+        for (pattern, must_condense) in
+            [(Pattern::Noise { p: 0.3, seed: 5 }, false), (Pattern::Blobs, true)]
+        {
             let s = space(3, pattern);
             let t = LinearQuadtree6d::build(&s, Symmetry::Whole).unwrap();
             let nb = s.grid_b.cells.len();
@@ -204,7 +234,9 @@ mod tests {
                 for (ib, b) in s.grid_b.cells.iter().enumerate() {
                     let got = t.query([a[0], a[1], a[2], b[0], b[1], b[2]]);
                     match s.labels[ia * nb + ib] {
-                        Label::Free => assert!(!got, "free sample {a:?} {b:?} reported as collision"),
+                        Label::Free => {
+                            assert!(!got, "free sample {a:?} {b:?} reported as collision")
+                        }
                         Label::Collision => {
                             collisions += 1;
                             assert!(got, "collision sample {a:?} {b:?} lost");
@@ -235,7 +267,10 @@ mod tests {
     fn from_parts_rejects_nested_and_unsorted_codes() {
         let root = condensed6(0, 2, 2);
         let leaf = code6([1, 0, 0, 0, 0, 0]);
-        assert!(LinearQuadtree6d::from_parts(2, false, vec![leaf, root]).is_err(), "leaf inside the root");
+        assert!(
+            LinearQuadtree6d::from_parts(2, false, vec![leaf, root]).is_err(),
+            "leaf inside the root"
+        );
         assert!(LinearQuadtree6d::from_parts(2, false, vec![leaf, leaf]).is_err(), "duplicate");
         assert!(LinearQuadtree6d::from_parts(9, false, vec![]).is_err(), "levels");
         assert!(LinearQuadtree6d::from_parts(2, false, vec![leaf]).is_ok());

@@ -32,8 +32,12 @@ impl<'a, E: ReadError> Reader<'a, E> {
 
     /// The next `n` bytes.
     pub(crate) fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8], E> {
-        let end = self.pos.checked_add(n).ok_or_else(|| E::corrupt(format!("{what}: length overflows")))?;
-        let bytes = self.buf.get(self.pos..end).ok_or_else(|| E::truncated(what, end, self.buf.len()))?;
+        let end = self
+            .pos
+            .checked_add(n)
+            .ok_or_else(|| E::corrupt(format!("{what}: length overflows")))?;
+        let bytes =
+            self.buf.get(self.pos..end).ok_or_else(|| E::truncated(what, end, self.buf.len()))?;
         self.pos = end;
         Ok(bytes)
     }
@@ -72,18 +76,30 @@ impl<'a, E: ReadError> Reader<'a, E> {
         let body_end = self.pos;
         let stored = self.u64("checksum")?;
         if self.pos != self.buf.len() {
-            return Err(E::corrupt(format!("{} trailing bytes after the checksum", self.buf.len() - self.pos)));
+            return Err(E::corrupt(format!(
+                "{} trailing bytes after the checksum",
+                self.buf.len() - self.pos
+            )));
         }
         let computed = crate::cell::fnv1a64(&self.buf[..body_end]);
         if stored != computed {
-            return Err(E::corrupt(format!("checksum = {stored:#018x}, the bytes give {computed:#018x}")));
+            return Err(E::corrupt(format!(
+                "checksum = {stored:#018x}, the bytes give {computed:#018x}"
+            )));
         }
         Ok(())
     }
 
     /// `n` items of `size` bytes each.
-    pub(crate) fn items(&mut self, n: usize, size: usize, what: &'static str) -> Result<&'a [u8], E> {
-        let len = n.checked_mul(size).ok_or_else(|| E::corrupt(format!("{what}: {n} entries overflow")))?;
+    pub(crate) fn items(
+        &mut self,
+        n: usize,
+        size: usize,
+        what: &'static str,
+    ) -> Result<&'a [u8], E> {
+        let len = n
+            .checked_mul(size)
+            .ok_or_else(|| E::corrupt(format!("{what}: {n} entries overflow")))?;
         self.take(len, what)
     }
 }

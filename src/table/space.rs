@@ -58,7 +58,10 @@ pub(crate) fn reflections(g: &SampleGrid) -> Vec<u32> {
     for (i, c) in g.cells.iter().enumerate() {
         dense[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] = i as u32;
     }
-    g.cells.iter().map(|c| dense[(c[0] as usize * k + (k - 1 - c[1] as usize)) * k + c[2] as usize]).collect()
+    g.cells
+        .iter()
+        .map(|c| dense[(c[0] as usize * k + (k - 1 - c[1] as usize)) * k + c[2] as usize])
+        .collect()
 }
 
 /// Both grids valid (`k = 2^levels`, indices below `k`) and of equal `k`.
@@ -100,9 +103,11 @@ impl<'a> SpaceView<'a> {
                 ga.cells.len()
             )));
         }
-        let (refl_a, refl_b) = if symmetric { (reflections(ga), reflections(gb)) } else { (vec![], vec![]) };
+        let (refl_a, refl_b) =
+            if symmetric { (reflections(ga), reflections(gb)) } else { (vec![], vec![]) };
         let (k, levels) = (ga.k, ga.levels);
-        let mut view = SpaceView { space, k, levels, symmetric, refl_a, refl_b, nb, mirrored_exactly: false };
+        let mut view =
+            SpaceView { space, k, levels, symmetric, refl_a, refl_b, nb, mirrored_exactly: false };
         view.mirrored_exactly = symmetric && view.labels_equal_their_mirrors();
         Ok(view)
     }
@@ -125,7 +130,9 @@ impl<'a> SpaceView<'a> {
         ra.into_iter().flat_map(move |ra| {
             (0..self.nb).filter_map(move |ib| {
                 let rb = self.refl_b[ib];
-                (rb != NONE).then(|| (labels[ia * self.nb + ib], labels[ra as usize * self.nb + rb as usize]))
+                (rb != NONE).then(|| {
+                    (labels[ia * self.nb + ib], labels[ra as usize * self.nb + rb as usize])
+                })
             })
         })
     }
@@ -207,9 +214,10 @@ mod tests {
     /// (labels that are).
     #[test]
     fn stored_labels_merge_with_their_mirrors_read_or_not() {
-        for (pattern, exact) in
-            [(Pattern::Noise { p: 0.3, seed: 5 }, true), (Pattern::AsymmetricNoise { p: 0.3, seed: 5 }, false)]
-        {
+        for (pattern, exact) in [
+            (Pattern::Noise { p: 0.3, seed: 5 }, true),
+            (Pattern::AsymmetricNoise { p: 0.3, seed: 5 }, false),
+        ] {
             let s = space(3, pattern);
             let view = SpaceView::new(&s, true).unwrap();
             assert_eq!(view.mirrored_exactly, exact, "{pattern:?}");
@@ -217,13 +225,18 @@ mod tests {
             for ia in (0..s.grid_a.cells.len()).filter(|&ia| view.stored(ia)) {
                 for ib in 0..s.grid_b.cells.len() {
                     let own = s.label(ia, ib);
-                    let want = view.mirror_pair(ia, ib).map_or(own, |(ra, rb)| merge(own, s.label(ra, rb)));
+                    let want = view
+                        .mirror_pair(ia, ib)
+                        .map_or(own, |(ra, rb)| merge(own, s.label(ra, rb)));
                     assert_eq!(view.label(ia, ib), want, "{pattern:?} ({ia}, {ib})");
                     merged += usize::from(view.mirror_pair(ia, ib).is_some());
                     changed += usize::from(want != own);
                 }
             }
-            assert!(merged > 0 && (changed > 0) != exact, "{pattern:?}: {merged} merged, {changed} changed");
+            assert!(
+                merged > 0 && (changed > 0) != exact,
+                "{pattern:?}: {merged} merged, {changed} changed"
+            );
         }
     }
 }

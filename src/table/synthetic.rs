@@ -46,14 +46,19 @@ pub fn grid(levels: u32) -> SampleGrid {
     for ix in 0..k {
         for iy in 0..k {
             for iz in 0..k {
-                let c = origin + r * Vec3::new(f64::from(ix) + 0.5, f64::from(iy) + 0.5, f64::from(iz) + 0.5);
+                let c = origin
+                    + r * Vec3::new(f64::from(ix) + 0.5, f64::from(iy) + 0.5, f64::from(iz) + 0.5);
                 let (top, bottom) = (-(c.z + r / 2.0), -(c.z - r / 2.0));
                 let deepest = w.zu + w.hcy + w.hco;
                 if bottom < w.zu || top > deepest {
                     continue;
                 }
                 let d = (-c.z).clamp(w.zu, deepest);
-                let cr = if d <= w.zu + w.hcy { w.rcy } else { w.rcy - (w.rcy - w.rco) * (d - w.zu - w.hcy) / w.hco };
+                let cr = if d <= w.zu + w.hcy {
+                    w.rcy
+                } else {
+                    w.rcy - (w.rcy - w.rco) * (d - w.zu - w.hcy) / w.hco
+                };
                 let rho = c.x.hypot(c.y);
                 if rho <= cr + r / std::f64::consts::SQRT_2 {
                     cells.push([ix as u16, iy as u16, iz as u16] as CellIndex);
@@ -82,7 +87,8 @@ fn label_of(pattern: Pattern, cell: [u16; 6], k: u16, pa: Vec3, pb: Vec3) -> boo
     match pattern {
         Pattern::Blobs => {
             let gap = 450.0 + pb.x - pa.x;
-            let reach = 110.0 + 0.25 * ((-pa.z - 365.0) + (-pb.z - 365.0)) - 0.2 * (pa.y - pb.y).abs();
+            let reach =
+                110.0 + 0.25 * ((-pa.z - 365.0) + (-pb.z - 365.0)) - 0.2 * (pa.y - pb.y).abs();
             gap < reach
                 || (pa.y - 120.0).abs() + (pb.y - 120.0).abs() + (gap - 260.0).abs() < 40.0
                 || (pa.y + 120.0).abs() + (pb.y + 120.0).abs() + (gap - 260.0).abs() < 40.0
@@ -108,7 +114,11 @@ pub fn space(levels: u32, pattern: Pattern) -> LabelledSpace {
     // Centres relative to the axis, computed so that iy -> k-1-iy negates y exactly.
     let h = f64::from(g.k) / 2.0;
     let centre = |c: &CellIndex| {
-        g.r * Vec3::new(f64::from(c[0]) - h + 0.5, f64::from(c[1]) - h + 0.5, f64::from(c[2]) - 2.0 * h + 0.5)
+        g.r * Vec3::new(
+            f64::from(c[0]) - h + 0.5,
+            f64::from(c[1]) - h + 0.5,
+            f64::from(c[2]) - 2.0 * h + 0.5,
+        )
     };
     let k = g.k as u16;
     let mut labels = Vec::with_capacity(g.cells.len() * g.cells.len());

@@ -29,8 +29,15 @@ pub fn table_bytes(name: &str) -> &'static [u8] {
     let slot = ["T1", "T2"].iter().position(|n| *n == name).expect("tables of T1 and T2 only");
     TABLES[slot].get_or_init(|| {
         let cell = reference_cell(name).unwrap();
-        let (header, table, _) = build_table(&cell, 16, &Workspace::THESIS, Variant::D6, Labelling::Certified, Progress::Silent)
-            .unwrap_or_else(|e| panic!("building the {name} table: {e}"));
+        let (header, table, _) = build_table(
+            &cell,
+            16,
+            &Workspace::THESIS,
+            Variant::D6,
+            Labelling::Certified,
+            Progress::Silent,
+        )
+        .unwrap_or_else(|e| panic!("building the {name} table: {e}"));
         to_bytes(&table, &header)
     })
 }
@@ -59,7 +66,8 @@ pub fn line4_bundle_bytes() -> &'static [u8] {
 pub fn init_table(config: *const DcCellConfig, bytes: &[u8]) -> (DcStatus, *mut DcCollider) {
     let copy = bytes.to_vec();
     let mut h: *mut DcCollider = 8 as *mut DcCollider; // garbage that must be overwritten
-                                                       // SAFETY: the config is NULL or valid, the buffer holds `copy.len()` bytes.
+                                                       // SAFETY: the config is NULL or valid, the
+                                                       // buffer holds `copy.len()` bytes.
     let s = unsafe { dc_init_with_table(config, copy.as_ptr(), copy.len(), &mut h) };
     drop(copy);
     assert_eq!(s == DC_STATUS_OK, !h.is_null(), "handle set exactly on success (status {s})");
@@ -68,8 +76,10 @@ pub fn init_table(config: *const DcCellConfig, bytes: &[u8]) -> (DcStatus, *mut 
 
 /// A table-mode handle for T1 (thesis robots 450 mm apart) from its table bytes.
 pub fn t1_table_handle() -> *mut DcCollider {
-    let robots =
-        [dc_robot_config_thesis(), DcRobotConfig { translation: v(450.0, 0.0, 0.0), ..dc_robot_config_thesis() }];
+    let robots = [
+        dc_robot_config_thesis(),
+        DcRobotConfig { translation: v(450.0, 0.0, 0.0), ..dc_robot_config_thesis() },
+    ];
     let config = DcCellConfig { robots: robots.as_ptr(), n_robots: 2, method: DC_METHOD_SAT };
     let (s, h) = init_table(&config, table_bytes("T1"));
     assert_eq!(s, DC_STATUS_OK, "{}", last_init_error());
@@ -130,7 +140,10 @@ pub fn assert_null_outputs_rejected(h: *mut DcCollider, home: DcVec3) {
     let mut verdict = DC_VERDICT_FREE;
     // SAFETY: h is live; NULL tcps and NULL out_verdict are the inputs under test.
     unsafe {
-        assert_eq!(dc_query(h, std::ptr::null(), 2, &mut verdict, std::ptr::null_mut()), DC_STATUS_NULL_POINTER);
+        assert_eq!(
+            dc_query(h, std::ptr::null(), 2, &mut verdict, std::ptr::null_mut()),
+            DC_STATUS_NULL_POINTER
+        );
         assert_eq!(verdict, DC_VERDICT_STOP);
         assert_eq!(
             dc_query(h, [home, home].as_ptr(), 2, std::ptr::null_mut(), std::ptr::null_mut()),
@@ -148,12 +161,19 @@ pub struct Config {
 impl Config {
     pub fn cell(dx: f64, n: usize) -> Config {
         let robots = (0..n)
-            .map(|i| DcRobotConfig { translation: v(dx * i as f64, 0.0, 0.0), ..dc_robot_config_thesis() })
+            .map(|i| DcRobotConfig {
+                translation: v(dx * i as f64, 0.0, 0.0),
+                ..dc_robot_config_thesis()
+            })
             .collect();
         Config { robots }
     }
 
     pub fn c(&self) -> DcCellConfig {
-        DcCellConfig { robots: self.robots.as_ptr(), n_robots: self.robots.len(), method: DC_METHOD_SAT }
+        DcCellConfig {
+            robots: self.robots.as_ptr(),
+            n_robots: self.robots.len(),
+            method: DC_METHOD_SAT,
+        }
     }
 }

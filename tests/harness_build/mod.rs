@@ -43,7 +43,8 @@ pub fn harness_sources() -> Vec<PathBuf> {
         .filter(|p| p.extension().is_some_and(|x| x == "c"))
         .collect();
     sources.sort();
-    let names: Vec<_> = sources.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    let names: Vec<_> =
+        sources.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
     let expected = [
         "bad_input.c",
         "harness.c",

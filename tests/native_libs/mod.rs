@@ -11,8 +11,14 @@ pub const NATIVE_LIBS: &[&str] = &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-l
 /// The cross targets `tests/cross.rs` builds (the controller's library,
 /// `--no-default-features --features std`), in rustc's order.
 pub const CROSS_NATIVE_LIBS: &[(&str, &[&str])] = &[
-    ("aarch64-unknown-linux-gnu", &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"]),
-    ("armv7-unknown-linux-gnueabihf", &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"]),
+    (
+        "aarch64-unknown-linux-gnu",
+        &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"],
+    ),
+    (
+        "armv7-unknown-linux-gnueabihf",
+        &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"],
+    ),
 ];
 
 /// The libraries rustc names in its `native-static-libs` note.

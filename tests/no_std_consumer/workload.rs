@@ -59,7 +59,8 @@ pub fn configuration(seed: u64, i: u32) -> [Vec3; 2] {
         state = splitmix(state);
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
-    let mut tcp = || Vec3::new(460.0 * unit() - 230.0, 460.0 * unit() - 230.0, -345.0 - 190.0 * unit());
+    let mut tcp =
+        || Vec3::new(460.0 * unit() - 230.0, 460.0 * unit() - 230.0, -345.0 - 190.0 * unit());
     [tcp(), tcp()]
 }
 

@@ -42,14 +42,19 @@ impl Robot {
     pub fn point(&self, x: &[Real]) -> Vec3 {
         let s = &self.stop;
         let v0 = capped(
-            self.v_fd + capped(Vec3::new(x[0], x[1], x[2]), 1.0) * (s.max_accel_mm_s2 * self.interval_s),
+            self.v_fd
+                + capped(Vec3::new(x[0], x[1], x[2]), 1.0) * (s.max_accel_mm_s2 * self.interval_s),
             s.max_speed_mm_s,
         );
         let push = capped(Vec3::new(x[3], x[4], x[5]), 1.0) * s.max_accel_mm_s2;
         let reaction_s = (s.reaction_ms + self.tick_s * 1e3) * 1e-3;
         // Moment in [0, 2]: below 1 a share of the reaction, above it a share of the braking path.
         let moment = x[9].clamp(0.0, 2.0);
-        let steps = if moment < 1.0 { (moment * REACTION_STEPS as Real).ceil() as usize } else { REACTION_STEPS };
+        let steps = if moment < 1.0 {
+            (moment * REACTION_STEPS as Real).ceil() as usize
+        } else {
+            REACTION_STEPS
+        };
         let dt = reaction_s / REACTION_STEPS as Real;
         let (mut p, mut v) = (self.tcp, v0);
         for _ in 0..steps {
@@ -118,7 +123,13 @@ fn gauss(rng: &mut StdRng) -> Real {
 /// Both robots' numbers drawn at random, each uniform in its range.
 pub fn random_stop(rng: &mut StdRng) -> Vec<Real> {
     (0..2 * PER_ROBOT)
-        .map(|i| if i % PER_ROBOT == 9 { rng.random_range(0.0..2.0) } else { rng.random_range(-1.0..1.0) })
+        .map(|i| {
+            if i % PER_ROBOT == 9 {
+                rng.random_range(0.0..2.0)
+            } else {
+                rng.random_range(-1.0..1.0)
+            }
+        })
         .collect()
 }
 
@@ -134,9 +145,17 @@ pub fn clearance_at(exact: &ExactChecker, boxes: &mut [RobotBoxes; 2], tcps: &[V
 
 /// The least clearance the adversary finds for the robots' stops from this tick, and the
 /// TCPs there.
-pub fn worst_stop(cell: &Cell, robots: &[Robot; 2], evaluations: usize, rng: &mut StdRng) -> (Real, [Vec3; 2]) {
-    let mut f =
-        Objective { exact: ExactChecker::new(cell.clone()), robots, boxes: [RobotBoxes::empty(), RobotBoxes::empty()] };
+pub fn worst_stop(
+    cell: &Cell,
+    robots: &[Robot; 2],
+    evaluations: usize,
+    rng: &mut StdRng,
+) -> (Real, [Vec3; 2]) {
+    let mut f = Objective {
+        exact: ExactChecker::new(cell.clone()),
+        robots,
+        boxes: [RobotBoxes::empty(), RobotBoxes::empty()],
+    };
     let mut starts: Vec<Vec<Real>> = Vec::new();
     // Each robot at full push and braking toward the other, looked at when it stands still.
     starts.push(

@@ -50,8 +50,12 @@ static GLOBAL: Counting = Counting;
 
 /// A stiffer robot than the default (short reaction, hard braking): FREE then happens with
 /// the robots close, where a wrong bound would show.
-pub const STIFF: StopModel =
-    StopModel { reaction_ms: 2.0, decel_mm_s2: 120_000.0, max_accel_mm_s2: 130_000.0, max_speed_mm_s: 4_600.0 };
+pub const STIFF: StopModel = StopModel {
+    reaction_ms: 2.0,
+    decel_mm_s2: 120_000.0,
+    max_accel_mm_s2: 130_000.0,
+    max_speed_mm_s: 4_600.0,
+};
 
 pub fn cell(name: &str, stop: StopModel) -> Cell {
     let c = reference_cell(name).unwrap();
@@ -61,7 +65,11 @@ pub fn cell(name: &str, stop: StopModel) -> Cell {
 
 pub fn unit(rng: &mut StdRng) -> Vec3 {
     loop {
-        let v = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let v = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
         let n = v.norm();
         if n > 1e-3 && n <= 1.0 {
             return v / n;
@@ -112,7 +120,15 @@ pub struct Motion {
 pub const DT: Real = 1e-4;
 
 impl Motion {
-    fn step(&mut self, t: Real, reaction_s: Real, model: &StopModel, rng: &mut StdRng, kind: usize, toward: &Vec3) {
+    fn step(
+        &mut self,
+        t: Real,
+        reaction_s: Real,
+        model: &StopModel,
+        rng: &mut StdRng,
+        kind: usize,
+        toward: &Vec3,
+    ) {
         if self.done {
             return;
         }
@@ -122,7 +138,8 @@ impl Motion {
             if kind == 0 {
                 self.accel = toward * model.max_accel_mm_s2;
             } else if (t / 5e-4).fract() < DT / 5e-4 + 1e-12 {
-                self.accel = unit(rng) * model.max_accel_mm_s2 * rng.random_range(0.0..1.0f64).sqrt();
+                self.accel =
+                    unit(rng) * model.max_accel_mm_s2 * rng.random_range(0.0..1.0f64).sqrt();
             }
             self.v += self.accel * DT;
             let speed = self.v.norm();
@@ -143,7 +160,11 @@ impl Motion {
                 _ => unit(rng),
             };
             self.v = dir * speed;
-            self.decel = if kind == 0 { model.decel_mm_s2 } else { model.decel_mm_s2 * rng.random_range(1.0..1.5) };
+            self.decel = if kind == 0 {
+                model.decel_mm_s2
+            } else {
+                model.decel_mm_s2 * rng.random_range(1.0..1.5)
+            };
             self.turn = if kind == 3 { rng.random_range(-40.0..40.0) } else { 0.0 };
             self.axis = unit(rng);
         }
@@ -155,7 +176,10 @@ impl Motion {
         }
         let mut dir = self.v / speed;
         if self.turn != 0.0 {
-            let rot = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(self.axis), self.turn * DT);
+            let rot = nalgebra::Rotation3::from_axis_angle(
+                &nalgebra::Unit::new_normalize(self.axis),
+                self.turn * DT,
+            );
             dir = rot * dir;
         }
         self.v = dir * new_speed;
@@ -201,7 +225,10 @@ pub fn assert_stops_never_touch(
                 break; // the robot cannot go there: this motion is not physical
             }
             steps += 1;
-            assert!(!v.collides(), "contact at t = {t:.4} s in motion {m} from {tcps:?} with {vel:?}");
+            assert!(
+                !v.collides(),
+                "contact at t = {t:.4} s in motion {m} from {tcps:?} with {vel:?}"
+            );
             assert!(t < 1.0, "a stop lasted a second");
         }
     }

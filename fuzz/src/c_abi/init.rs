@@ -75,7 +75,10 @@ pub(super) fn edit(r: &mut DcRobotConfig, field: u8, input: &mut Input) {
             let [x, y, z] = input.point();
             return r.translation = DcVec3 { x, y, z: z + 450.0 };
         }
-        _ => return r.geometry = DcDelta3 { theta_min: input.f64(), theta_max: input.f64(), ..r.geometry },
+        _ => {
+            return r.geometry =
+                DcDelta3 { theta_min: input.f64(), theta_max: input.f64(), ..r.geometry }
+        }
     };
     *target = input.f64();
 }
@@ -84,13 +87,31 @@ pub(super) fn edit(r: &mut DcRobotConfig, field: u8, input: &mut Input) {
 fn finite(r: &DcRobotConfig) -> bool {
     let g = &r.geometry;
     let b = |on: u32, b: &DcBox| {
-        on == 0 || [b.offset, b.half].iter().all(|v| v.x.is_finite() && v.y.is_finite() && v.z.is_finite())
+        on == 0
+            || [b.offset, b.half]
+                .iter()
+                .all(|v| v.x.is_finite() && v.y.is_finite() && v.z.is_finite())
     };
-    let upper = r.has_upper_links == 0 || r.upper_half_height.is_finite() && r.upper_half_depth.is_finite();
+    let upper =
+        r.has_upper_links == 0 || r.upper_half_height.is_finite() && r.upper_half_depth.is_finite();
     let t = &r.translation;
-    [g.f, g.rf, g.re, g.e, g.theta_min, g.theta_max, r.half_height, r.half_depth, r.margin, r.alpha, t.x, t.y, t.z]
-        .iter()
-        .all(|v| v.is_finite())
+    [
+        g.f,
+        g.rf,
+        g.re,
+        g.e,
+        g.theta_min,
+        g.theta_max,
+        r.half_height,
+        r.half_depth,
+        r.margin,
+        r.alpha,
+        t.x,
+        t.y,
+        t.z,
+    ]
+    .iter()
+    .all(|v| v.is_finite())
         && upper
         && b(r.has_platform, &r.platform)
         && b(r.has_tool, &r.tool)
@@ -104,15 +125,24 @@ fn cell_of(robots: &[DcRobotConfig], method: u32) -> Option<Cell> {
         _ => return None,
     };
     let v = |v: &DcVec3| Vec3::new(v.x, v.y, v.z);
-    let tool = |on: u32, b: &DcBox| (on != 0).then(|| ToolBox { offset: v(&b.offset), half: v(&b.half) });
+    let tool =
+        |on: u32, b: &DcBox| (on != 0).then(|| ToolBox { offset: v(&b.offset), half: v(&b.half) });
     let spec = |(i, r): (usize, &DcRobotConfig)| {
         let g = &r.geometry;
-        let delta = Delta3 { f: g.f, rf: g.rf, re: g.re, e: g.e, theta_min: g.theta_min, theta_max: g.theta_max };
+        let delta = Delta3 {
+            f: g.f,
+            rf: g.rf,
+            re: g.re,
+            e: g.e,
+            theta_min: g.theta_min,
+            theta_max: g.theta_max,
+        };
         let options = ModelOptions {
             half_height: r.half_height,
             half_depth: r.half_depth,
             margin: r.margin,
-            upper_links: (r.has_upper_links != 0).then_some((r.upper_half_height, r.upper_half_depth)),
+            upper_links: (r.has_upper_links != 0)
+                .then_some((r.upper_half_height, r.upper_half_depth)),
             platform: tool(r.has_platform, &r.platform),
             tool: tool(r.has_tool, &r.tool),
         };
@@ -164,7 +194,9 @@ impl Config {
 
     /// The cell `dc_init` would make, when the pointers are given and the config is valid.
     fn cell(&self) -> Option<Cell> {
-        (self.nulls & 3 == 0 && self.n > 0).then(|| cell_of(&self.robots[..self.n], self.method)).flatten()
+        (self.nulls & 3 == 0 && self.n > 0)
+            .then(|| cell_of(&self.robots[..self.n], self.method))
+            .flatten()
     }
 
     /// The status `dc_init` must give when the table (if any) is not the problem.
@@ -185,7 +217,11 @@ impl Config {
 }
 
 /// Checks `*out_handle` and `dc_last_init_error` after a `dc_init*` call; keeps a new handle.
-fn finish(status: DcStatus, out: Option<*mut DcCollider>, input: &mut Input) -> Option<*mut DcCollider> {
+fn finish(
+    status: DcStatus,
+    out: Option<*mut DcCollider>,
+    input: &mut Input,
+) -> Option<*mut DcCollider> {
     assert_ne!(status, DC_STATUS_PANIC, "a dc_init* call panicked");
     // SAFETY: NULL and 0 ask for the length only.
     let len = unsafe { dc_last_init_error(std::ptr::null_mut(), 0) };
@@ -197,7 +233,11 @@ fn finish(status: DcStatus, out: Option<*mut DcCollider>, input: &mut Input) -> 
     if capacity > 0 {
         // SAFETY: `dc_last_init_error` NUL-terminated the buffer within `capacity` bytes.
         let text = unsafe { CStr::from_ptr(buf.as_ptr()) };
-        assert_eq!(text.to_bytes().len(), len.min(capacity - 1), "init error cut wrongly: {text:?}");
+        assert_eq!(
+            text.to_bytes().len(),
+            len.min(capacity - 1),
+            "init error cut wrongly: {text:?}"
+        );
     }
     let out = out?;
     assert!(out != sentinel(), "dc_init* did not write *out_handle");
@@ -216,7 +256,11 @@ pub(super) fn init(input: &mut Input, live: &mut Vec<Live>) {
     assert_eq!(status, expected, "dc_init of {:?}", &config.robots[..config.n]);
     let Some(h) = finish(status, (!null_out).then_some(out), input) else { return };
     let n = config.n;
-    assert!(config.robots[..n].iter().all(finite), "a non-finite config accepted: {:?}", &config.robots[..n]);
+    assert!(
+        config.robots[..n].iter().all(finite),
+        "a non-finite config accepted: {:?}",
+        &config.robots[..n]
+    );
     // SAFETY: `h` is a live handle.
     let (count, pairs, mode) = unsafe { (dc_robot_count(h), dc_pair_count(h), dc_mode(h)) };
     assert!(count == n && pairs <= n * (n - 1) / 2, "{count} robots, {pairs} pairs for n = {n}");
@@ -264,27 +308,35 @@ pub(super) fn init_with_table(input: &mut Input, live: &mut Vec<Live>) {
     let mut out = sentinel();
     // SAFETY: the config is NULL or valid; `table_ptr` NULL or `bytes.len()` readable bytes;
     // `out` NULL or writable.
-    let status =
-        config.with_ptr(|c| unsafe { dc_init_with_table(c, table_ptr, bytes.len(), null_if(null_out, &mut out)) });
+    let status = config.with_ptr(|c| unsafe {
+        dc_init_with_table(c, table_ptr, bytes.len(), null_if(null_out, &mut out))
+    });
     let expected = match (null_out, config.expected_status(), cell) {
         (true, _, _) => DC_STATUS_NULL_POINTER,
         (_, DC_STATUS_OK, _) if null_table => DC_STATUS_NULL_POINTER,
         (_, DC_STATUS_OK, Some(cell)) if cell.robots.len() < 2 => DC_STATUS_TABLE_NOT_TWO_ROBOTS,
         // More robots, or a bundle: one table per pair that can meet, from the bundle.
         (_, DC_STATUS_OK, Some(cell)) if cell.robots.len() > 2 || is_bundle(&bytes) => {
-            BundleChecker::new(cell, &bytes, Confirmation::Exact).map_or_else(|e| table_error_status(&e), |_| DC_STATUS_OK)
+            BundleChecker::new(cell, &bytes, Confirmation::Exact)
+                .map_or_else(|e| table_error_status(&e), |_| DC_STATUS_OK)
         }
-        (_, DC_STATUS_OK, Some(cell)) => {
-            TableChecker::new(cell, &bytes).map_or_else(|e| table_error_status(&e), |_| DC_STATUS_OK)
-        }
+        (_, DC_STATUS_OK, Some(cell)) => TableChecker::new(cell, &bytes)
+            .map_or_else(|e| table_error_status(&e), |_| DC_STATUS_OK),
         (_, s, _) => s,
     };
     assert_eq!(status, expected, "dc_init_with_table");
     let Some(h) = finish(status, (!null_out).then_some(out), input) else { return };
     // SAFETY: `h` is a live handle.
     let (count, pairs, mode) = unsafe { (dc_robot_count(h), dc_pair_count(h), dc_mode(h)) };
-    let expected_pairs = if count == 2 && !is_bundle(&bytes) { 1 } else { config.cell().map_or(0, |c| c.pairs_that_can_meet().len()) };
-    assert!(count >= 2 && pairs == expected_pairs && mode == DC_MODE_TABLE, "{count} robots, {pairs} pairs, mode {mode}");
+    let expected_pairs = if count == 2 && !is_bundle(&bytes) {
+        1
+    } else {
+        config.cell().map_or(0, |c| c.pairs_that_can_meet().len())
+    };
+    assert!(
+        count >= 2 && pairs == expected_pairs && mode == DC_MODE_TABLE,
+        "{count} robots, {pairs} pairs, mode {mode}"
+    );
     keep(live, config.into_live(h));
 }
 
@@ -331,7 +383,10 @@ fn t1_table_path() -> &'static CStr {
 
 /// The two thesis robots of T1 as `dc_init` takes them.
 fn t1_robots() -> Vec<DcRobotConfig> {
-    let b = DcRobotConfig { translation: DcVec3 { x: 450.0, y: 0.0, z: 0.0 }, ..dc_robot_config_thesis() };
+    let b = DcRobotConfig {
+        translation: DcVec3 { x: 450.0, y: 0.0, z: 0.0 },
+        ..dc_robot_config_thesis()
+    };
     vec![dc_robot_config_thesis(), b]
 }
 
@@ -341,8 +396,10 @@ pub(super) fn init_from_file(input: &mut Input, live: &mut Vec<Live>) {
     let null_out = input.flag();
     let mut out = sentinel();
     // SAFETY: the path is NULL or NUL-terminated; `out` NULL or writable.
-    let status = unsafe { dc_init_from_cell_file(path(kind, t1_cell_path()), null_if(null_out, &mut out)) };
-    let expected = if null_out { DC_STATUS_NULL_POINTER } else { path_status(kind).unwrap_or(DC_STATUS_OK) };
+    let status =
+        unsafe { dc_init_from_cell_file(path(kind, t1_cell_path()), null_if(null_out, &mut out)) };
+    let expected =
+        if null_out { DC_STATUS_NULL_POINTER } else { path_status(kind).unwrap_or(DC_STATUS_OK) };
     assert_eq!(status, expected, "dc_init_from_cell_file, path kind {kind}");
     if let Some(h) = finish(status, (!null_out).then_some(out), input) {
         keep(live, Live::new(h, t1_robots()));
@@ -353,7 +410,8 @@ pub(super) fn init_from_file(input: &mut Input, live: &mut Vec<Live>) {
 pub(super) fn init_from_files(input: &mut Input, live: &mut Vec<Live>) {
     let (cell_kind, table_kind, null_out) = (input.byte(), input.byte(), input.flag());
     let mut out = sentinel();
-    let (cell_path, table_path) = (path(cell_kind, t1_cell_path()), path(table_kind, t1_table_path()));
+    let (cell_path, table_path) =
+        (path(cell_kind, t1_cell_path()), path(table_kind, t1_table_path()));
     // SAFETY: both paths NULL or NUL-terminated; `out` NULL or writable.
     let status = unsafe { dc_init_from_files(cell_path, table_path, null_if(null_out, &mut out)) };
     let loaded = || {
@@ -364,7 +422,9 @@ pub(super) fn init_from_files(input: &mut Input, live: &mut Vec<Live>) {
     let expected = match (null_out, path_status(cell_kind), path_status(table_kind)) {
         (true, _, _) => DC_STATUS_NULL_POINTER,
         // Both paths are checked before either file is read.
-        (_, Some(DC_STATUS_NULL_POINTER | DC_STATUS_INVALID_ARGUMENT), _) => path_status(cell_kind).unwrap(),
+        (_, Some(DC_STATUS_NULL_POINTER | DC_STATUS_INVALID_ARGUMENT), _) => {
+            path_status(cell_kind).unwrap()
+        }
         (_, _, Some(s @ (DC_STATUS_NULL_POINTER | DC_STATUS_INVALID_ARGUMENT))) => s,
         (_, Some(s), _) | (_, None, Some(s)) => s,
         (_, None, None) => loaded(),

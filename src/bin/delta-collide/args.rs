@@ -19,7 +19,11 @@ use std::sync::LazyLock;
 
 /// `--version`: the crate's version and the table format version that `build` writes.
 static VERSION_TEXT: LazyLock<String> = LazyLock::new(|| {
-    format!("{} (writes table format version {})", env!("CARGO_PKG_VERSION"), delta_collide::table::format::VERSION)
+    format!(
+        "{} (writes table format version {})",
+        env!("CARGO_PKG_VERSION"),
+        delta_collide::table::format::VERSION
+    )
 });
 
 /// The largest width or height of a picture (pixels).
@@ -383,7 +387,15 @@ impl ValueEnum for KindArg {
     fn value_variants<'a>() -> &'a [Self] {
         const ALL: [KindArg; 7] = {
             let k = TableKind::ALL;
-            [KindArg(k[0]), KindArg(k[1]), KindArg(k[2]), KindArg(k[3]), KindArg(k[4]), KindArg(k[5]), KindArg(k[6])]
+            [
+                KindArg(k[0]),
+                KindArg(k[1]),
+                KindArg(k[2]),
+                KindArg(k[3]),
+                KindArg(k[4]),
+                KindArg(k[5]),
+                KindArg(k[6]),
+            ]
         };
         &ALL
     }
@@ -479,21 +491,26 @@ impl Cli {
                     return Err(usage_error(
                         "build",
                         ErrorKind::ArgumentConflict,
-                        format!("--levels applies to --variant clearance only, not to --variant {}", b.variant.0),
+                        format!(
+                            "--levels applies to --variant clearance only, not to --variant {}",
+                            b.variant.0
+                        ),
                     ));
                 }
                 if b.variant.0 == TableKind::Clearance && b.labelling == LabellingArg::Thesis {
                     return Err(usage_error(
                         "build",
                         ErrorKind::ArgumentConflict,
-                        "--variant clearance proves its levels: it needs --labelling certified".into(),
+                        "--variant clearance proves its levels: it needs --labelling certified"
+                            .into(),
                     ));
                 }
                 if b.variant.0 == TableKind::SharedSub && b.labelling == LabellingArg::Thesis {
                     return Err(usage_error(
                         "build",
                         ErrorKind::ArgumentConflict,
-                        "--variant shared-sub certifies sub-cells: it needs --labelling certified".into(),
+                        "--variant shared-sub certifies sub-cells: it needs --labelling certified"
+                            .into(),
                     ));
                 }
             }
@@ -619,7 +636,8 @@ impl<E: ValueEnum + Clone + Send + Sync + 'static> TypedValueParser for Choice<E
             _ => names.concat(),
         };
         let arg = arg.map_or_else(|| "the value".to_string(), |a| format!("'{a}'"));
-        let message = format!("invalid value '{}' for {arg}: use {list}\n", clip(&value.to_string_lossy()));
+        let message =
+            format!("invalid value '{}' for {arg}: use {list}\n", clip(&value.to_string_lossy()));
         Err(clap::Error::raw(ErrorKind::InvalidValue, message).with_cmd(cmd))
     }
 
@@ -648,7 +666,9 @@ fn parse_cell(s: &str) -> Result<Cell, String> {
 /// As [`parse_cell`], or `all` for the three built-in cells.
 fn parse_cells(s: &str) -> Result<Cells, String> {
     if s.eq_ignore_ascii_case("all") {
-        return Ok(Cells(REFERENCE_CELL_FILES.iter().filter_map(|(n, _)| reference_cell(n)).collect()));
+        return Ok(Cells(
+            REFERENCE_CELL_FILES.iter().filter_map(|(n, _)| reference_cell(n)).collect(),
+        ));
     }
     parse_cell(s).map(|c| Cells(vec![c])).map_err(|e| format!("{e}; or all"))
 }
@@ -731,11 +751,10 @@ fn pixels(min: u32) -> impl TypedValueParser<Value = u32> {
 
 /// Three comma-separated numbers `x,y,z`.
 fn parse_xyz(s: &str) -> Result<Vec3, String> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|f| f.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| "expected three numbers x,y,z (mm, the robot's own MCS), e.g. 150,0,-450".to_string())?;
+    let v: Vec<f64> =
+        s.split(',').map(|f| f.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| {
+            "expected three numbers x,y,z (mm, the robot's own MCS), e.g. 150,0,-450".to_string()
+        })?;
     match v[..] {
         [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
         [_, _, _] => Err("the coordinates must be finite".into()),
@@ -745,8 +764,11 @@ fn parse_xyz(s: &str) -> Result<Vec3, String> {
 
 /// `N` comma-separated grid indices.
 fn parse_indices<const N: usize>(s: &str) -> Result<[u16; N], String> {
-    let v: Vec<u16> = s.split(',').map(|f| f.trim().parse::<u16>()).collect::<Result<_, _>>().unwrap_or_default();
-    <[u16; N]>::try_from(v).map_err(|_| format!("expected {N} grid indices (whole numbers from 0) separated by commas"))
+    let v: Vec<u16> =
+        s.split(',').map(|f| f.trim().parse::<u16>()).collect::<Result<_, _>>().unwrap_or_default();
+    <[u16; N]>::try_from(v).map_err(|_| {
+        format!("expected {N} grid indices (whole numbers from 0) separated by commas")
+    })
 }
 
 #[cfg(test)]

@@ -54,7 +54,9 @@ pub(crate) fn write_bundle(
         println!("pair {}: table {}", describe_pair(cell, p.a, p.b), p.table);
     }
     let bytes = &built.bytes;
-    files::write_file(output, |w| w.write_all(bytes).map_err(|e| format!("{}: {e}", output.display())))?;
+    files::write_file(output, |w| {
+        w.write_all(bytes).map_err(|e| format!("{}: {e}", output.display()))
+    })?;
     let separate: usize = pairs.iter().map(|p| built.tables[p.table].3.len()).sum();
     println!(
         "{}: bundle of {} tables, {} bytes ({} bytes as one table file per pair)",
@@ -85,7 +87,9 @@ pub(crate) fn inspect_bundle(path: &Path, bytes: &[u8]) -> Result<(), Failure> {
         // A pair cell's last four parameters: its second robot's alpha and translation.
         let p = &h.cell_parameters[h.cell_parameters.len().saturating_sub(4)..];
         let at = match p {
-            [alpha, x, y, z] => format!("second robot at ({x}, {y}, {z}) mm, alpha {alpha} rad from the first"),
+            [alpha, x, y, z] => {
+                format!("second robot at ({x}, {y}, {z}) mm, alpha {alpha} rad from the first")
+            }
             _ => "placement not recorded".to_string(),
         };
         println!(

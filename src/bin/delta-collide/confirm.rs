@@ -16,7 +16,12 @@ pub(crate) const ROUNDS: u32 = 50;
 /// Median, p99.9 and max of `ns`, sorted here.
 fn spread(ns: &mut [u64]) -> String {
     ns.sort_unstable();
-    format!("median {} p99.9 {} max {}", percentile(ns, 0.5), percentile(ns, 0.999), ns[ns.len() - 1])
+    format!(
+        "median {} p99.9 {} max {}",
+        percentile(ns, 0.5),
+        percentile(ns, 0.999),
+        ns[ns.len() - 1]
+    )
 }
 
 /// The exact verdict in the table's terms.
@@ -38,7 +43,9 @@ fn exact_answer(exact: &mut ExactChecker, tcps: &[Vec3]) -> Result<TableAnswer, 
 /// A scenario file error, a query error, or a tick on which the two paths answer differently.
 pub(crate) fn report(cell: &Cell, table: &TableChecker, scenarios: &str) -> Result<(), String> {
     let mut tcps = vec![Vec3::zeros(); 2];
-    for scenario in parse_scenarios(scenarios)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)) {
+    for scenario in
+        parse_scenarios(scenarios)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name))
+    {
         let mut confirmed = table.clone();
         confirmed.set_confirmation(Confirmation::Exact);
         let mut exact = ExactChecker::new(cell.clone());

@@ -29,7 +29,11 @@ struct RunResult {
 fn run(cell: &Cell, scenario: &Scenario) -> Result<RunResult, String> {
     let mut checker = ExactChecker::new(cell.clone());
     let mut tcps = vec![Vec3::zeros(); cell.robots.len()];
-    let mut r = RunResult { first_collision: None, collision_ticks: 0, ns: Vec::with_capacity(RUN_TICKS as usize) };
+    let mut r = RunResult {
+        first_collision: None,
+        collision_ticks: 0,
+        ns: Vec::with_capacity(RUN_TICKS as usize),
+    };
     for tick in 0..RUN_TICKS {
         scenario.tcps_at(tick, &mut tcps);
         let start = Instant::now();
@@ -37,7 +41,10 @@ fn run(cell: &Cell, scenario: &Scenario) -> Result<RunResult, String> {
         let (reachable, collides) = (v.all_reachable(), v.collides());
         r.ns.push(start.elapsed().as_nanos() as u64);
         if !reachable {
-            return Err(format!("{} {}: a TCP is unreachable at tick {tick}", scenario.cell, scenario.case));
+            return Err(format!(
+                "{} {}: a TCP is unreachable at tick {tick}",
+                scenario.cell, scenario.case
+            ));
         }
         if collides {
             r.collision_ticks += 1;
@@ -61,12 +68,24 @@ pub fn demo(args: &DemoArgs) -> Result<(), Failure> {
     );
     println!(
         "{:<4} {:<10} {:<9} {:>15} {:>15} {:>10} {:>10} {:>10}",
-        "cell", "case", "method", "first collision", "collision ticks", "median ns", "p99 ns", "max ns"
+        "cell",
+        "case",
+        "method",
+        "first collision",
+        "collision ticks",
+        "median ns",
+        "p99 ns",
+        "max ns"
     );
     for cell in cells {
-        let cases: Vec<&Scenario> = scenarios.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)).collect();
+        let cases: Vec<&Scenario> =
+            scenarios.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)).collect();
         if cases.is_empty() {
-            return Err(format!("no scenario for cell {} in c_harness/scenarios.txt or line_scenarios.txt", cell.name).into());
+            return Err(format!(
+                "no scenario for cell {} in c_harness/scenarios.txt or line_scenarios.txt",
+                cell.name
+            )
+            .into());
         }
         for scenario in cases {
             if scenario.robots.len() != cell.robots.len() {
@@ -111,14 +130,21 @@ struct ProtectiveRun {
 
 fn protective_run(cell: &Cell, scenario: &Scenario) -> Result<ProtectiveRun, String> {
     // The speed limits are not shown here; without them a tick takes under a third of the time.
-    let mut checker =
-        ProtectiveChecker::new(cell.clone(), WARN_MM).map_err(|e| e.to_string())?.with_speed_limits(false);
+    let mut checker = ProtectiveChecker::new(cell.clone(), WARN_MM)
+        .map_err(|e| e.to_string())?
+        .with_speed_limits(false);
     let mut tcps = vec![Vec3::zeros(); cell.robots.len()];
     // Start-up, as in the C harness: the robots stand at their first waypoint, which gives the
     // first tick a measured speed instead of the full speed assumed without history.
     scenario.tcps_at(0, &mut tcps);
     checker.check(&tcps).map_err(|e| e.to_string())?;
-    let mut r = ProtectiveRun { first_warn: None, first_stop: None, warn_ticks: 0, stop_ticks: 0, ns: Vec::new() };
+    let mut r = ProtectiveRun {
+        first_warn: None,
+        first_stop: None,
+        warn_ticks: 0,
+        stop_ticks: 0,
+        ns: Vec::new(),
+    };
     for tick in 0..RUN_TICKS {
         scenario.tcps_at(tick, &mut tcps);
         let start = Instant::now();
@@ -167,8 +193,11 @@ fn protective_table(cells: &[Cell], scenarios: &[Scenario]) -> Result<(), Failur
             let (outcome, stop_ms, closest) = match r.first_stop {
                 Some(t) => {
                     let s = simulate_stop(cell, scenario, t)?;
-                    let outcome =
-                        if s.contacts == 0 { "clear".to_string() } else { format!("TOUCHES({})", s.contacts) };
+                    let outcome = if s.contacts == 0 {
+                        "clear".to_string()
+                    } else {
+                        format!("TOUCHES({})", s.contacts)
+                    };
                     (outcome, format!("{:.1}", s.stop_ms), format!("{:.1}", s.closest_mm))
                 }
                 None => ("none".to_string(), "-".to_string(), "-".to_string()),

@@ -50,7 +50,8 @@ pub(crate) fn eval(args: &EvalArgs) -> Result<(), Failure> {
     if cell.robots.len() > 2 || is_bundle(&bytes) {
         return eval_line(args, &bytes);
     }
-    let mut table = TableChecker::new(cell.clone(), &bytes).map_err(|e| format!("{}: {e}", args.table.display()))?;
+    let mut table = TableChecker::new(cell.clone(), &bytes)
+        .map_err(|e| format!("{}: {e}", args.table.display()))?;
     let (n, seed) = (args.random, args.seed);
     let plot = args.plot.as_deref();
     let plot_size = (args.width, args.height);
@@ -59,21 +60,25 @@ pub(crate) fn eval(args: &EvalArgs) -> Result<(), Failure> {
     let is_clearance = table.table().as_clearance().is_some();
     let mut ns = Vec::new();
     // The table's answer and the exact verdict; counted in `c` unless a TCP is unreachable.
-    let mut compare = |tcps: &[Vec3], c: &mut Confusion, ns: &mut Vec<u64>| -> Result<TableAnswer, String> {
-        let start = Instant::now();
-        let answer = table.check(tcps).map_err(|e| e.to_string())?;
-        ns.push(start.elapsed().as_nanos() as u64);
-        let v = exact.check(tcps).map_err(|e| e.to_string())?;
-        if !matches!(answer, TableAnswer::Unreachable(_)) {
-            c.add(answer == TableAnswer::Collision, v.collides());
-        }
-        Ok(answer)
-    };
+    let mut compare =
+        |tcps: &[Vec3], c: &mut Confusion, ns: &mut Vec<u64>| -> Result<TableAnswer, String> {
+            let start = Instant::now();
+            let answer = table.check(tcps).map_err(|e| e.to_string())?;
+            ns.push(start.elapsed().as_nanos() as u64);
+            let v = exact.check(tcps).map_err(|e| e.to_string())?;
+            if !matches!(answer, TableAnswer::Unreachable(_)) {
+                c.add(answer == TableAnswer::Collision, v.collides());
+            }
+            Ok(answer)
+        };
     let mut tcps = vec![Vec3::zeros(); 2];
     let mut traces = Vec::new();
-    for scenario in parse_scenarios(SCENARIOS)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)) {
+    for scenario in
+        parse_scenarios(SCENARIOS)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name))
+    {
         let mut c = Confusion::default();
-        let mut trace = plot.map(|_| plot::Trace::new(cell, format!("{} {}", scenario.cell, scenario.case)));
+        let mut trace =
+            plot.map(|_| plot::Trace::new(cell, format!("{} {}", scenario.cell, scenario.case)));
         for tick in 0..RUN_TICKS {
             scenario.tcps_at(tick, &mut tcps);
             let answer = compare(&tcps, &mut c, &mut ns)?;
@@ -91,7 +96,13 @@ pub(crate) fn eval(args: &EvalArgs) -> Result<(), Failure> {
             args.table.display()
         );
         plot::draw_plot(path, plot_size, &title, &traces)?;
-        println!("{}: {} x {} pixels, {} scenarios", path.display(), plot_size.0, plot_size.1, traces.len());
+        println!(
+            "{}: {} x {} pixels, {} scenarios",
+            path.display(),
+            plot_size.0,
+            plot_size.1,
+            traces.len()
+        );
     }
     // Random reachable configurations, uniform in the workspace box (xorshift64*, seeded).
     let (mut random, ws) = (RandomTcps(seed), Workspace::THESIS);
@@ -112,14 +123,20 @@ pub(crate) fn eval(args: &EvalArgs) -> Result<(), Failure> {
     }
     println!("{}", c.line(&format!("{n} random configurations")));
     ns.sort_unstable();
-    println!("table query incl. IK reachability: {}; {} exact fallbacks", spread(&ns), table.fallbacks());
+    println!(
+        "table query incl. IK reachability: {}; {} exact fallbacks",
+        spread(&ns),
+        table.fallbacks()
+    );
     if let Some(q) = table.table().as_clearance() {
-        let (mut ns, mut per_level) = (Vec::with_capacity(kept_tcps.len()), vec![0u64; q.ladder().len() + 1]);
+        let (mut ns, mut per_level) =
+            (Vec::with_capacity(kept_tcps.len()), vec![0u64; q.ladder().len() + 1]);
         for tcps in &kept_tcps {
             let start = Instant::now();
             let bound = table.clearance_bound(std::hint::black_box(tcps));
             ns.push(start.elapsed().as_nanos() as u64);
-            per_level[bound.map_or(0, |b| 1 + q.ladder().mm().iter().position(|&l| l == b).unwrap_or(0))] += 1;
+            per_level[bound
+                .map_or(0, |b| 1 + q.ladder().mm().iter().position(|&l| l == b).unwrap_or(0))] += 1;
         }
         ns.sort_unstable();
         println!("clearance bound incl. IK reachability: {}", spread(&ns));
@@ -163,7 +180,10 @@ struct LineConfusion {
 
 impl LineConfusion {
     fn new(pairs: usize) -> LineConfusion {
-        LineConfusion { whole: Confusion::default(), pairs: (0..pairs).map(|_| Confusion::default()).collect() }
+        LineConfusion {
+            whole: Confusion::default(),
+            pairs: (0..pairs).map(|_| Confusion::default()).collect(),
+        }
     }
 
     /// Counts the labels of `table` against the exact verdict `v` of the same TCPs, unless a
@@ -175,7 +195,8 @@ impl LineConfusion {
         for (c, (p, e)) in self.pairs.iter_mut().zip(table.pairs().iter().zip(&v.pairs)) {
             c.add(p.answer == TableAnswer::Collision, matches!(e.state, PairState::Collides(..)));
         }
-        self.whole.add(table.pairs().iter().any(|p| p.answer == TableAnswer::Collision), v.collides());
+        self.whole
+            .add(table.pairs().iter().any(|p| p.answer == TableAnswer::Collision), v.collides());
     }
 
     fn print(&self, what: &str, names: Option<&[String]>) {
@@ -197,8 +218,11 @@ fn eval_line(args: &EvalArgs, bytes: &[u8]) -> Result<(), Failure> {
     let mut labels = BundleChecker::new(cell.clone(), bytes, Confirmation::None).map_err(at)?;
     let mut confirmed = BundleChecker::new(cell.clone(), bytes, Confirmation::Exact).map_err(at)?;
     let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
-    let names: Vec<String> =
-        labels.pairs().iter().map(|p| format!("{}-{}", cell.robots[p.a].name, cell.robots[p.b].name)).collect();
+    let names: Vec<String> = labels
+        .pairs()
+        .iter()
+        .map(|p| format!("{}-{}", cell.robots[p.a].name, cell.robots[p.b].name))
+        .collect();
     let names = args.pairs.then_some(names.as_slice());
     let pair_count = labels.pairs().len();
     println!("{pair_count} pairs that can meet, {} tables", labels.table_count());
@@ -228,7 +252,9 @@ fn eval_line(args: &EvalArgs, bytes: &[u8]) -> Result<(), Failure> {
     };
     let mut tcps = vec![Vec3::zeros(); cell.robots.len()];
     let text = [SCENARIOS, LINE_SCENARIOS].concat();
-    for scenario in parse_scenarios(&text)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name)) {
+    for scenario in
+        parse_scenarios(&text)?.iter().filter(|s| s.cell.eq_ignore_ascii_case(&cell.name))
+    {
         let mut c = LineConfusion::new(pair_count);
         for tick in 0..RUN_TICKS {
             scenario.tcps_at(tick, &mut tcps);
@@ -245,7 +271,9 @@ fn eval_line(args: &EvalArgs, bytes: &[u8]) -> Result<(), Failure> {
         }
     }
     c.print(&format!("{} random configurations", args.random), names);
-    for (what, ns) in ["table labels", "table mode, exact confirmation", "exact mode"].iter().zip(&mut ns) {
+    for (what, ns) in
+        ["table labels", "table mode, exact confirmation", "exact mode"].iter().zip(&mut ns)
+    {
         ns.sort_unstable();
         println!("{what:<32} per tick: {}", spread(ns));
     }

@@ -13,7 +13,10 @@ use std::path::{Path, PathBuf};
 ///
 /// # Errors
 /// The error of `write`, or of creating, writing, syncing or renaming the file, naming it.
-pub fn write_file(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<(), String>) -> Result<(), String> {
+pub fn write_file(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), String>,
+) -> Result<(), String> {
     let shown = path.display();
     if path.metadata().is_ok_and(|m| !m.is_file()) {
         let mut out = BufWriter::new(File::create(path).map_err(|e| format!("{shown}: {e}"))?);
@@ -31,7 +34,10 @@ pub fn write_file(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Resul
     if let Ok(m) = path.metadata() {
         temp.file.set_permissions(m.permissions()).map_err(|e| format!("{shown}: {e}"))?;
     }
-    let mut out = BufWriter::with_capacity(1 << 16, temp.file.try_clone().map_err(|e| format!("{shown}: {e}"))?);
+    let mut out = BufWriter::with_capacity(
+        1 << 16,
+        temp.file.try_clone().map_err(|e| format!("{shown}: {e}"))?,
+    );
     write(&mut out)?;
     out.flush().map_err(|e| format!("{shown}: {e}"))?;
     drop(out);
@@ -48,7 +54,8 @@ struct Temporary {
 
 impl Temporary {
     fn create(target: &Path) -> Result<Temporary, String> {
-        let name = target.file_name().ok_or_else(|| format!("{}: not a file name", target.display()))?;
+        let name =
+            target.file_name().ok_or_else(|| format!("{}: not a file name", target.display()))?;
         let dir = target.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
         let mut last = None;
         for attempt in 0..100u32 {
@@ -59,7 +66,12 @@ impl Temporary {
             match File::options().write(true).create_new(true).open(&path) {
                 Ok(file) => return Ok(Temporary { path, file, keep: false }),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => last = Some(e),
-                Err(e) => return Err(format!("{}: cannot create a file beside it: {e}", target.display())),
+                Err(e) => {
+                    return Err(format!(
+                        "{}: cannot create a file beside it: {e}",
+                        target.display()
+                    ))
+                }
             }
         }
         Err(format!("{}: no free temporary name beside it ({last:?})", target.display()))
@@ -92,8 +104,10 @@ mod tests {
     }
 
     fn names(d: &Path) -> Vec<String> {
-        let mut n: Vec<String> =
-            std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+        let mut n: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
         n.sort();
         n
     }

@@ -35,8 +35,9 @@ use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::cspace::{PairLabels, Progress, SampleGrid, Workspace};
 use delta_collide::math::Vec3;
 use delta_collide::table::{
-    build_table_bounded, default_max_memory, from_bytes, is_bundle, memory_plan, to_bytes, BoundedBuild, BundleChecker,
-    Confirmation, Labelling, Table, TableAnswer, TableChecker, TableKind, Variant,
+    build_table_bounded, default_max_memory, from_bytes, is_bundle, memory_plan, to_bytes,
+    BoundedBuild, BundleChecker, Confirmation, Labelling, Table, TableAnswer, TableChecker,
+    TableKind, Variant,
 };
 use std::io::{BufRead, Write};
 use std::path::Path;
@@ -80,7 +81,8 @@ impl From<clap::Error> for Failure {
 
 fn main() {
     let cli = Cli::parse_checked();
-    let progress = if cli.quiet { Progress::Silent } else { Progress::Rows(progress::labelling_rows) };
+    let progress =
+        if cli.quiet { Progress::Silent } else { Progress::Rows(progress::labelling_rows) };
     let result = match &cli.command {
         Command::Demo(a) => demo::demo(a),
         Command::Check(a) => check(a),
@@ -134,7 +136,9 @@ fn man(dir: Option<&Path>) -> Result<(), Failure> {
         pages.push((format!("{name}.1"), page(sub.clone().name(name))?));
     }
     for (file, bytes) in &pages {
-        files::write_file(&dir.join(file), |w| w.write_all(bytes).map_err(|e| format!("{file}: {e}")))?;
+        files::write_file(&dir.join(file), |w| {
+            w.write_all(bytes).map_err(|e| format!("{file}: {e}"))
+        })?;
     }
     println!("{}: {} man pages", dir.display(), pages.len());
     Ok(())
@@ -153,7 +157,8 @@ pub(crate) fn percentile(sorted: &[u64], p: f64) -> u64 {
 fn check(args: &CheckArgs) -> Result<(), Failure> {
     let cell = &args.cell;
     let confirmation = args.confirm.map_or(Confirmation::Exact, Confirmation::from);
-    let mut table = args.table.as_deref().map(|p| load_table_or_bundle(cell, p, confirmation)).transpose()?;
+    let mut table =
+        args.table.as_deref().map(|p| load_table_or_bundle(cell, p, confirmation)).transpose()?;
     let mut input = open_input(args.input.as_deref())?;
     let columns = Columns { clearance: args.clearance, pairs: args.pairs };
     let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut(), columns);
@@ -221,7 +226,12 @@ fn check_rows(
     let mut checker = ExactChecker::new(cell.clone());
     let write_err = |e: std::io::Error| format!("writing the answers: {e}");
     let name = |j: usize| &cell.robots[j].name;
-    let pair_names: String = checker.verdict().pairs.iter().map(|p| format!(",collide_{}_{}", name(p.a), name(p.b))).collect();
+    let pair_names: String = checker
+        .verdict()
+        .pairs
+        .iter()
+        .map(|p| format!(",collide_{}_{}", name(p.a), name(p.b)))
+        .collect();
     let header = format!(
         "reachable,collide{}{}",
         if columns.clearance { ",clearance_mm" } else { "" },
@@ -257,7 +267,9 @@ fn check_rows(
                 checker.check(tcps).map_err(at_line)?;
             }
             // NA also where the table's reachability and the exact model's differ.
-            match clearance::signed_clearance(&checker).filter(|_| !matches!(answer, TableAnswer::Unreachable(_))) {
+            match clearance::signed_clearance(&checker)
+                .filter(|_| !matches!(answer, TableAnswer::Unreachable(_)))
+            {
                 Some(d) => write!(out, ",{d:.3}"),
                 None => write!(out, ",NA"),
             }
@@ -270,7 +282,8 @@ fn check_rows(
                         write_answer(out, p.answer).map_err(write_err)?;
                     }
                 }
-                t => write_pair_columns(out, &checker, t.is_some().then_some(answer)).map_err(write_err)?,
+                t => write_pair_columns(out, &checker, t.is_some().then_some(answer))
+                    .map_err(write_err)?,
             }
         }
         out.write_all(b"\n").map_err(write_err)
@@ -279,7 +292,11 @@ fn check_rows(
 
 /// One `,0`, `,1` or `,NA` per pair that can meet: the exact checker's last states, or in
 /// table mode (`table_answer`, two robots, one pair) the table's answer.
-fn write_pair_columns(out: &mut dyn Write, exact: &ExactChecker, table_answer: Option<TableAnswer>) -> std::io::Result<()> {
+fn write_pair_columns(
+    out: &mut dyn Write,
+    exact: &ExactChecker,
+    table_answer: Option<TableAnswer>,
+) -> std::io::Result<()> {
     if let Some(answer) = table_answer {
         return write_answer(out, answer);
     }
@@ -350,13 +367,21 @@ pub(crate) fn load_table(cell: &Cell, path: &Path) -> Result<TableChecker, Strin
 }
 
 /// The table or bundle at `path` for `cell`, answering a COLLISION lookup as `confirmation` says.
-pub(crate) fn load_table_or_bundle(cell: &Cell, path: &Path, confirmation: Confirmation) -> Result<Loaded, String> {
+pub(crate) fn load_table_or_bundle(
+    cell: &Cell,
+    path: &Path,
+    confirmation: Confirmation,
+) -> Result<Loaded, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let at = |e: delta_collide::table::TableError| format!("{}: {e}", path.display());
     if cell.robots.len() == 2 && !is_bundle(&bytes) {
-        TableChecker::with_confirmation(cell.clone(), &bytes, confirmation).map(|t| Loaded::Table(Box::new(t))).map_err(at)
+        TableChecker::with_confirmation(cell.clone(), &bytes, confirmation)
+            .map(|t| Loaded::Table(Box::new(t)))
+            .map_err(at)
     } else {
-        BundleChecker::new(cell.clone(), &bytes, confirmation).map(|b| Loaded::Bundle(Box::new(b))).map_err(at)
+        BundleChecker::new(cell.clone(), &bytes, confirmation)
+            .map(|b| Loaded::Bundle(Box::new(b)))
+            .map_err(at)
     }
 }
 
@@ -373,7 +398,8 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
     check_memory(cell, k, &Workspace::THESIS, 1)?;
     let max_memory = args.max_memory.unwrap_or_else(|| {
         // An error of the plan is the build's to report.
-        let fixed = memory_plan(cell, k, &Workspace::THESIS, variant, u64::MAX).map_or(0, |p| p.fixed);
+        let fixed =
+            memory_plan(cell, k, &Workspace::THESIS, variant, u64::MAX).map_or(0, |p| p.fixed);
         default_max_memory(fixed, total_memory())
     });
     let build = BoundedBuild { k, ws: Workspace::THESIS, variant, labelling, progress, max_memory };
@@ -382,8 +408,13 @@ fn build(args: &BuildArgs, progress: Progress) -> Result<(), Failure> {
         eprintln!("sub-cells of {pairs} collision pairs: {secs:.2} s");
     }
     let bytes = to_bytes(&table, &header);
-    files::write_file(output, |w| w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display())))?;
-    println!("cell {} k {k}: {} x {} samples, {} pairs", cell.name, r.samples.0, r.samples.1, r.pairs);
+    files::write_file(output, |w| {
+        w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display()))
+    })?;
+    println!(
+        "cell {} k {k}: {} x {} samples, {} pairs",
+        cell.name, r.samples.0, r.samples.1, r.pairs
+    );
     let unreachable = match labelling {
         Labelling::Certified => "cell proved unreachable (don't care)",
         Labelling::ThesisMargin => "unreachable centre (stored as collision)",
@@ -445,7 +476,8 @@ pub(crate) fn gigabytes(bytes: u64) -> String {
 pub(crate) fn total_memory() -> Option<u64> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
-    let kb: u64 = line.trim_start_matches("MemTotal:").trim().trim_end_matches("kB").trim().parse().ok()?;
+    let kb: u64 =
+        line.trim_start_matches("MemTotal:").trim().trim_end_matches("kB").trim().parse().ok()?;
     kb.checked_mul(1024)
 }
 
@@ -470,15 +502,24 @@ pub(crate) fn describe(table: &Table) -> String {
 }
 
 /// `counts` (index 0: no level, then one per level of `table`) as one line.
-pub(crate) fn levels_line(what: &str, table: &delta_collide::table::ClearanceTable, counts: &[u64]) -> String {
+pub(crate) fn levels_line(
+    what: &str,
+    table: &delta_collide::table::ClearanceTable,
+    counts: &[u64],
+) -> String {
     let mut parts = vec![format!("no level {}", counts[0])];
-    parts.extend(table.ladder().mm().iter().zip(&counts[1..]).map(|(mm, n)| format!(">= {mm} mm {n}")));
+    parts.extend(
+        table.ladder().mm().iter().zip(&counts[1..]).map(|(mm, n)| format!(">= {mm} mm {n}")),
+    );
     format!("{what} per level: {}", parts.join(", "))
 }
 
 /// Sample pairs per level of a clearance table (both TCPs' grid cells sampled; pairs whose
 /// cells are proved unreachable count as what is stored).
-fn sampled_levels(cell: &Cell, table: &delta_collide::table::ClearanceTable) -> Result<Vec<u64>, String> {
+fn sampled_levels(
+    cell: &Cell,
+    table: &delta_collide::table::ClearanceTable,
+) -> Result<Vec<u64>, String> {
     let k = 1u32 << table.levels();
     let grid = |j: usize| SampleGrid::new(&Workspace::THESIS, k, &cell.robots[j].model.delta);
     let (ga, gb) = (grid(0)?, grid(1)?);
@@ -500,15 +541,25 @@ fn inspect(args: &InspectArgs) -> Result<(), Failure> {
     let (h, table) = from_bytes(&bytes).map_err(|e| format!("{path}: {e}"))?;
     println!("{path}: {} bytes", bytes.len());
     println!("table: {}", describe(&table));
-    println!("k {} (levels {}), r {} mm, symmetric {}", 1u32 << table.levels(), table.levels(), h.r, table.symmetric());
-    println!("cell fingerprint {:#018x}, margin {} mm ({:?})", h.cell_fingerprint, h.margin, h.certification);
+    println!(
+        "k {} (levels {}), r {} mm, symmetric {}",
+        1u32 << table.levels(),
+        table.levels(),
+        h.r,
+        table.symmetric()
+    );
+    println!(
+        "cell fingerprint {:#018x}, margin {} mm ({:?})",
+        h.cell_fingerprint, h.margin, h.certification
+    );
     println!("grid origins A {:?} B {:?}; workspace {:?}", h.origin_a, h.origin_b, h.workspace);
     println!("memory {} bytes", table.memory_bytes());
     match table.as_clearance() {
-        Some(q) if q.levels() <= 4 => println!("{}", levels_line("grid cells (all k^6, as stored)", q, &q.cells_per_level())),
+        Some(q) if q.levels() <= 4 => {
+            println!("{}", levels_line("grid cells (all k^6, as stored)", q, &q.cells_per_level()))
+        }
         Some(_) => println!("grid cells per level: k > 16, see build's sample pairs per level"),
         None => {}
     }
     Ok(())
 }
-

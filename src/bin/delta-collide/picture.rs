@@ -111,7 +111,8 @@ pub fn legend(
                 area.draw(&Rectangle::new(square, c.stroke_width(2))).map_err(plot_err)?;
             }
             Swatch::Line(c) => {
-                area.draw(&PathElement::new(vec![(x, y + 7), (x + 14, y + 7)], c.stroke_width(2))).map_err(plot_err)?;
+                area.draw(&PathElement::new(vec![(x, y + 7), (x + 14, y + 7)], c.stroke_width(2)))
+                    .map_err(plot_err)?;
             }
         }
         area.draw(&Text::new(label.to_string(), (x + 20, y), style.clone())).map_err(plot_err)?;
@@ -135,15 +136,20 @@ pub fn colour_strip(
     use plotters::style::text_anchor::{HPos, Pos, VPos};
     let n = colours.len().max(1);
     let label_pos = (left - 6, y + height / 2);
-    area.draw(&Text::new(label.to_string(), label_pos, text(12, BLACK).pos(Pos::new(HPos::Right, VPos::Center))))
-        .map_err(plot_err)?;
+    area.draw(&Text::new(
+        label.to_string(),
+        label_pos,
+        text(12, BLACK).pos(Pos::new(HPos::Right, VPos::Center)),
+    ))
+    .map_err(plot_err)?;
     // One run of equal colour at a time.
     let mut start = 0;
     for t in 1..=colours.len() {
         if t == colours.len() || colours[t] != colours[start] {
             let px = |tick: usize| left + (tick as f64 / n as f64 * width).round() as i32;
             let (a, b) = (px(start), px(t).max(px(start) + 1));
-            area.draw(&Rectangle::new([(a, y), (b, y + height - 2)], colours[start].filled())).map_err(plot_err)?;
+            area.draw(&Rectangle::new([(a, y), (b, y + height - 2)], colours[start].filled()))
+                .map_err(plot_err)?;
             start = t;
         }
     }
@@ -159,14 +165,18 @@ pub fn convex_hull(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     if p.len() < 3 {
         return p;
     }
-    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0);
+    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
     let mut hull: Vec<(f64, f64)> = Vec::with_capacity(2 * p.len());
     for pass in 0..2 {
         let start = hull.len();
         let iter: Box<dyn Iterator<Item = &(f64, f64)>> =
             if pass == 0 { Box::new(p.iter()) } else { Box::new(p.iter().rev()) };
         for &q in iter {
-            while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+            {
                 hull.pop();
             }
             hull.push(q);
@@ -205,7 +215,8 @@ mod tests {
 
     #[test]
     fn hull_of_a_square_with_inner_points() {
-        let pts = [(0.0, 0.0), (1.0, 0.0), (0.5, 0.5), (1.0, 1.0), (0.0, 1.0), (0.2, 0.8), (1.0, 0.5)];
+        let pts =
+            [(0.0, 0.0), (1.0, 0.0), (0.5, 0.5), (1.0, 1.0), (0.0, 1.0), (0.2, 0.8), (1.0, 0.5)];
         assert_eq!(convex_hull(&pts), vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
     }
 }

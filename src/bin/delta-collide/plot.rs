@@ -7,7 +7,9 @@
 //! table tick labelled collision over a positive distance is a false positive; a tick labelled
 //! free at distance 0 would be a false negative.
 
-use crate::picture::{colour_strip, draw_mesh, draw_png, legend, plot_err, text, Swatch, HIT, OUTSIDE, ROBOT};
+use crate::picture::{
+    colour_strip, draw_mesh, draw_png, legend, plot_err, text, Swatch, HIT, OUTSIDE, ROBOT,
+};
 use delta_collide::cell::{Cell, ExactChecker, SatMethod};
 use delta_collide::geometry::obb_distance;
 use delta_collide::math::Vec3;
@@ -44,7 +46,9 @@ impl Trace {
         let (reachable, collides) = (v.all_reachable(), v.collides());
         let distance = if reachable {
             let (a, b) = (self.checker.boxes(0).as_slice(), self.checker.boxes(1).as_slice());
-            a.iter().flat_map(|x| b.iter().map(move |y| obb_distance(x, y))).fold(f64::INFINITY, f64::min)
+            a.iter()
+                .flat_map(|x| b.iter().map(move |y| obb_distance(x, y)))
+                .fold(f64::INFINITY, f64::min)
         } else {
             f64::NAN
         };
@@ -69,7 +73,12 @@ impl Trace {
 }
 
 /// Draws one panel per trace into a PNG.
-pub fn draw_plot(path: &std::path::Path, size: (u32, u32), title: &str, traces: &[Trace]) -> Result<(), String> {
+pub fn draw_plot(
+    path: &std::path::Path,
+    size: (u32, u32),
+    title: &str,
+    traces: &[Trace],
+) -> Result<(), String> {
     if traces.is_empty() {
         return Err("the cell has no scenario in c_harness/scenarios.txt to plot".into());
     }
@@ -93,14 +102,19 @@ fn draw_legend(root: &DrawingArea<BitMapBackend, Shift>) -> Result<(), String> {
         (Swatch::Square(OUTSIDE), "unreachable"),
     ];
     let x = legend(root, (12, 34), &entries)?;
-    root.draw(&Text::new("(strips: table, then exact model)", (x, 34), text(13, RGBColor(90, 90, 90))))
-        .map_err(plot_err)
+    root.draw(&Text::new(
+        "(strips: table, then exact model)",
+        (x, 34),
+        text(13, RGBColor(90, 90, 90)),
+    ))
+    .map_err(plot_err)
 }
 
 fn draw_trace(area: &DrawingArea<BitMapBackend, Shift>, trace: &Trace) -> Result<(), String> {
     let n = trace.distance.len();
     let max = trace.distance.iter().copied().filter(|d| d.is_finite()).fold(0.0, f64::max).max(1.0);
-    let closest = trace.distance.iter().copied().filter(|d| d.is_finite()).fold(f64::INFINITY, f64::min);
+    let closest =
+        trace.distance.iter().copied().filter(|d| d.is_finite()).fold(f64::INFINITY, f64::min);
     let (fp, fneg) = trace.errors();
     let caption = format!(
         "{}: closest {closest:.1} mm; table vs exact: {fp} false positive, {fneg} false negative ticks",
@@ -122,7 +136,10 @@ fn draw_trace(area: &DrawingArea<BitMapBackend, Shift>, trace: &Trace) -> Result
             segment.push((t as f64, d));
         } else if !segment.is_empty() {
             chart
-                .draw_series(LineSeries::new(std::mem::take(&mut segment), ROBOT[0].stroke_width(2)))
+                .draw_series(LineSeries::new(
+                    std::mem::take(&mut segment),
+                    ROBOT[0].stroke_width(2),
+                ))
                 .map_err(plot_err)?;
         }
     }

@@ -13,7 +13,9 @@ pub fn labelling_rows(done: u64, rows: u64) {
     let Ok(mut slot) = BAR.lock() else { return };
     let bar = slot.get_or_insert_with(|| {
         let bar = ProgressBar::new(rows);
-        if let Ok(style) = ProgressStyle::with_template("labelling {bar:40} {pos}/{len} rows of A, {elapsed} (eta {eta})") {
+        if let Ok(style) = ProgressStyle::with_template(
+            "labelling {bar:40} {pos}/{len} rows of A, {elapsed} (eta {eta})",
+        ) {
             bar.set_style(style);
         }
         bar

@@ -18,13 +18,15 @@
 //! dark blue for the top.
 
 use crate::args::{usage_error, QuiltArgs, QuiltAxes};
-use crate::picture::{draw_png, legend, plot_err, text, Swatch, COLLISION, FREE, OUTSIDE, UNREACHABLE};
+use crate::picture::{
+    draw_png, legend, plot_err, text, Swatch, COLLISION, FREE, OUTSIDE, UNREACHABLE,
+};
 use crate::{load_table, Failure};
 use clap::error::ErrorKind;
 use delta_collide::cell::Cell;
-use delta_collide::robot::motion_bound::cube_unreachable;
 use delta_collide::cspace::{SampleGrid, Workspace};
 use delta_collide::math::Vec3;
+use delta_collide::robot::motion_bound::cube_unreachable;
 use delta_collide::robot::Delta3;
 use delta_collide::table::Table;
 use plotters::coord::Shift;
@@ -59,7 +61,8 @@ impl GridMap {
         let mut state = vec![Sampled::Outside; k * k * k];
         let mut range = [(u16::MAX, 0u16); 3];
         for (c, &centre_reachable) in grid.cells.iter().zip(&grid.reachable) {
-            let unreachable = !centre_reachable && cube_unreachable(delta, &grid.center(*c), 0.5 * grid.r);
+            let unreachable =
+                !centre_reachable && cube_unreachable(delta, &grid.center(*c), 0.5 * grid.r);
             state[(c[0] as usize * k + c[1] as usize) * k + c[2] as usize] =
                 if unreachable { Sampled::Unreachable } else { Sampled::Reachable };
             for a in 0..3 {
@@ -108,7 +111,13 @@ pub fn quilt(args: &QuiltArgs) -> Result<(), Failure> {
     };
     let maps = [grid(0)?, grid(1)?];
     let path = args.table.display();
-    let what = format!("cell {}, table {} ({}, k = {k}, r = {:.2} mm)", cell.name, path, table.name(), header.r);
+    let what = format!(
+        "cell {}, table {} ({}, k = {k}, r = {:.2} mm)",
+        cell.name,
+        path,
+        table.name(),
+        header.r
+    );
     let quilt = match args.a {
         Some(a) => b_slices(&maps, within_grid("--a", a, k)?, &what),
         None => {
@@ -170,7 +179,11 @@ fn layout(q: &Quilt, maps: &[GridMap; 2], (w, h): (u32, u32)) -> Result<Layout, 
 }
 
 /// `indices`, when each is below the table's `k` (a usage error otherwise).
-fn within_grid<const N: usize>(name: &str, indices: [u16; N], k: u32) -> Result<[u16; N], clap::Error> {
+fn within_grid<const N: usize>(
+    name: &str,
+    indices: [u16; N],
+    k: u32,
+) -> Result<[u16; N], clap::Error> {
     if indices.iter().all(|&i| u32::from(i) < k) {
         return Ok(indices);
     }
@@ -178,7 +191,11 @@ fn within_grid<const N: usize>(name: &str, indices: [u16; N], k: u32) -> Result<
     Err(usage_error(
         "quilt",
         ErrorKind::ValueValidation,
-        format!("{name} {}: the table has k = {k}, so each grid index must be from 0 to {}", shown.join(","), k - 1),
+        format!(
+            "{name} {}: the table has k = {k}, so each grid index must be from 0 to {}",
+            shown.join(","),
+            k - 1
+        ),
     ))
 }
 
@@ -224,7 +241,10 @@ fn thesis_quilt(
         }
     }
     let labels = |d: usize, r: std::ops::RangeInclusive<u16>| -> (String, Vec<String>) {
-        (format!("{} (mm)", NAMES[d]), r.map(|i| format!("{:.0}", coordinate(maps, d, i))).collect())
+        (
+            format!("{} (mm)", NAMES[d]),
+            r.map(|i| format!("{:.0}", coordinate(maps, d, i))).collect(),
+        )
     };
     let (a, b) = (fixed_idx[0], fixed_idx[1]);
     Quilt {
@@ -318,7 +338,10 @@ fn level_colour(count: usize, n: usize) -> RGBColor {
 }
 
 /// Every cell of every panel: `(panel, i, j, 6-D cell)`.
-fn cells<'a>(q: &'a Quilt, maps: &'a [GridMap; 2]) -> impl Iterator<Item = (&'a Panel, usize, usize, [u16; 6])> + 'a {
+fn cells<'a>(
+    q: &'a Quilt,
+    maps: &'a [GridMap; 2],
+) -> impl Iterator<Item = (&'a Panel, usize, usize, [u16; 6])> + 'a {
     q.panels.iter().flat_map(move |p| {
         span(maps, q.inner[0]).enumerate().flat_map(move |(i, ih)| {
             span(maps, q.inner[1]).enumerate().map(move |(j, iv)| {
@@ -340,13 +363,21 @@ fn count(q: &Quilt, maps: &[GridMap; 2], table: &Table) -> [usize; 4] {
     n
 }
 
-fn draw(root: &DrawingArea<BitMapBackend, Shift>, q: &Quilt, maps: &[GridMap; 2], table: &Table) -> Result<(), String> {
+fn draw(
+    root: &DrawingArea<BitMapBackend, Shift>,
+    q: &Quilt,
+    maps: &[GridMap; 2],
+    table: &Table,
+) -> Result<(), String> {
     root.fill(&WHITE).map_err(plot_err)?;
     let (w, h) = root.dim_in_pixel();
     for (n, line) in q.title.lines().enumerate() {
-        root.draw(&Text::new(line.to_string(), (PAD as i32, 6 + 19 * n as i32), text(15, BLACK))).map_err(plot_err)?;
+        root.draw(&Text::new(line.to_string(), (PAD as i32, 6 + 19 * n as i32), text(15, BLACK)))
+            .map_err(plot_err)?;
     }
-    let top = table.as_clearance().map(|t| (t.ladder().len(), format!("free, >= {} mm", t.ladder().mm()[t.ladder().len() - 1])));
+    let top = table.as_clearance().map(|t| {
+        (t.ladder().len(), format!("free, >= {} mm", t.ladder().mm()[t.ladder().len() - 1]))
+    });
     let mut entries = vec![
         (Swatch::Square(COLLISION), "collision"),
         (Swatch::Square(FREE), if top.is_some() { "free, lowest level" } else { "free" }),
@@ -371,14 +402,16 @@ fn draw(root: &DrawingArea<BitMapBackend, Shift>, q: &Quilt, maps: &[GridMap; 2]
         let frame = [(px(x) - 1, px(y) - 1), (px(x + pw) + 1, px(y + ph) + 1)];
         root.draw(&Rectangle::new(frame, RGBColor(120, 120, 120).filled())).map_err(plot_err)?;
         if let Some(c) = &p.caption {
-            root.draw(&Text::new(c.clone(), (px(x), px(y - caption)), text(13, BLACK))).map_err(plot_err)?;
+            root.draw(&Text::new(c.clone(), (px(x), px(y - caption)), text(13, BLACK)))
+                .map_err(plot_err)?;
         }
     }
     for (p, i, j, c) in cells(q, maps) {
         let (x, y) = panel_origin(p);
         let (x0, x1) = (px(x + i as f64 * s), px(x + (i + 1) as f64 * s));
         let (y0, y1) = (px(y + ph - (j + 1) as f64 * s), px(y + ph - j as f64 * s));
-        root.draw(&Rectangle::new([(x0, y0), (x1, y1)], colour_of(maps, table, c).1.filled())).map_err(plot_err)?;
+        root.draw(&Rectangle::new([(x0, y0), (x1, y1)], colour_of(maps, table, c).1.filled()))
+            .map_err(plot_err)?;
     }
     let (pw, ph, gap, caption) = (pw.round() as i32, ph.round() as i32, gap as i32, caption as i32);
     let bottom = TITLE as i32 + q.rows as i32 * (ph + gap + caption);
@@ -386,20 +419,30 @@ fn draw(root: &DrawingArea<BitMapBackend, Shift>, q: &Quilt, maps: &[GridMap; 2]
         let every = label_stride(pw, 44);
         for (col, l) in labels.iter().enumerate().filter(|(c, _)| c % every == 0) {
             let x = LEFT as i32 + col as i32 * (pw + gap) + pw / 2;
-            root.draw(&Text::new(l.clone(), (x, bottom + 2), text(12, BLACK).pos(centre_top()))).map_err(plot_err)?;
+            root.draw(&Text::new(l.clone(), (x, bottom + 2), text(12, BLACK).pos(centre_top())))
+                .map_err(plot_err)?;
         }
         let x = LEFT as i32 + q.cols as i32 * (pw + gap) / 2;
-        root.draw(&Text::new(format!("{name} →"), (x, bottom + 20), text(14, BLACK).pos(centre_top())))
-            .map_err(plot_err)?;
+        root.draw(&Text::new(
+            format!("{name} →"),
+            (x, bottom + 20),
+            text(14, BLACK).pos(centre_top()),
+        ))
+        .map_err(plot_err)?;
     }
     if let Some((name, labels)) = &q.row_labels {
         let every = label_stride(ph, 16);
         for (row, l) in labels.iter().enumerate().filter(|(r, _)| r % every == 0) {
             let y = TITLE as i32 + (q.rows - 1 - row) as i32 * (ph + gap) + ph / 2;
-            root.draw(&Text::new(l.clone(), (LEFT as i32 - 6, y), text(12, BLACK).pos(right_centre())))
-                .map_err(plot_err)?;
+            root.draw(&Text::new(
+                l.clone(),
+                (LEFT as i32 - 6, y),
+                text(12, BLACK).pos(right_centre()),
+            ))
+            .map_err(plot_err)?;
         }
-        root.draw(&Text::new(format!("{name} ↑"), (4, bottom + 20), text(14, BLACK))).map_err(plot_err)?;
+        root.draw(&Text::new(format!("{name} ↑"), (4, bottom + 20), text(14, BLACK)))
+            .map_err(plot_err)?;
     }
     Ok(())
 }

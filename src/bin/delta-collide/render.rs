@@ -54,7 +54,12 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
 }
 
 /// The drawable state of every robot after the check.
-fn pictures_of(cell: &Cell, checker: &ExactChecker, verdict: &CellVerdict, tcps: &[Vec3]) -> Vec<RobotPicture> {
+fn pictures_of(
+    cell: &Cell,
+    checker: &ExactChecker,
+    verdict: &CellVerdict,
+    tcps: &[Vec3],
+) -> Vec<RobotPicture> {
     let mut robots: Vec<RobotPicture> = cell
         .robots
         .iter()
@@ -62,10 +67,16 @@ fn pictures_of(cell: &Cell, checker: &ExactChecker, verdict: &CellVerdict, tcps:
         .map(|(j, spec)| {
             let (d, pl) = (&spec.model.delta, &spec.placement);
             let reachable = verdict.unreachable_mask & (1 << j) == 0;
-            let boxes: Vec<Obb> = if reachable { checker.boxes(j).as_slice().to_vec() } else { Vec::new() };
+            let boxes: Vec<Obb> =
+                if reachable { checker.boxes(j).as_slice().to_vec() } else { Vec::new() };
             let upper = match d.inverse_kinematics(&tcps[j]) {
                 Ok(sol) => (0..3)
-                    .map(|i| (pl.to_wcs(&d.motor_point(i)), pl.to_wcs(&d.elbow(i, sol.cos[i], sol.sin[i]))))
+                    .map(|i| {
+                        (
+                            pl.to_wcs(&d.motor_point(i)),
+                            pl.to_wcs(&d.elbow(i, sol.cos[i], sol.sin[i])),
+                        )
+                    })
                     .collect(),
                 Err(_) => Vec::new(),
             };
@@ -108,8 +119,11 @@ fn kind_name(k: BoxKind) -> String {
 
 /// The verdict in one line: the colliding boxes, or the smallest distance between robots.
 fn describe(cell: &Cell, verdict: &CellVerdict, robots: &[RobotPicture], tcps: &[Vec3]) -> String {
-    let at: Vec<String> =
-        robots.iter().zip(tcps).map(|(r, t)| format!("{} ({:.0}, {:.0}, {:.0})", r.name, t.x, t.y, t.z)).collect();
+    let at: Vec<String> = robots
+        .iter()
+        .zip(tcps)
+        .map(|(r, t)| format!("{} ({:.0}, {:.0}, {:.0})", r.name, t.x, t.y, t.z))
+        .collect();
     let head = format!("cell {}, TCPs {}: ", cell.name, at.join(", "));
     if let Some((j, why)) = verdict.first_unreachable {
         return format!("{head}unreachable: robot {} ({why})", robots[j].name);
@@ -135,7 +149,9 @@ fn describe(cell: &Cell, verdict: &CellVerdict, robots: &[RobotPicture], tcps: &
         .iter()
         .map(|p| {
             let (a, b) = (&robots[p.a].boxes, &robots[p.b].boxes);
-            a.iter().flat_map(|x| b.iter().map(move |y| obb_distance(x, y))).fold(f64::INFINITY, f64::min)
+            a.iter()
+                .flat_map(|x| b.iter().map(move |y| obb_distance(x, y)))
+                .fold(f64::INFINITY, f64::min)
         })
         .fold(f64::INFINITY, f64::min);
     if gap.is_finite() {
@@ -173,11 +189,15 @@ fn circle(c: &Vec3, r: f64) -> Vec<Vec3> {
 fn workspace_outline(base: &Vec3, view: View) -> Vec<(f64, f64)> {
     let ws = Workspace::THESIS;
     match view {
-        View::Top => circle(&(base - Vec3::new(0.0, 0.0, ws.zu)), ws.rcy).iter().map(|p| view.project(p)).collect(),
+        View::Top => circle(&(base - Vec3::new(0.0, 0.0, ws.zu)), ws.rcy)
+            .iter()
+            .map(|p| view.project(p))
+            .collect(),
         View::Side => {
             let knee = ws.zu + ws.hcy;
             let right = [(ws.rcy, ws.zu), (ws.rcy, knee), (ws.rco, ws.max_depth())];
-            let mut pts: Vec<(f64, f64)> = right.iter().map(|&(r, d)| (base.x + r, base.z - d)).collect();
+            let mut pts: Vec<(f64, f64)> =
+                right.iter().map(|&(r, d)| (base.x + r, base.z - d)).collect();
             pts.extend(right.iter().rev().map(|&(r, d)| (base.x - r, base.z - d)));
             pts.push(pts[0]);
             pts
@@ -208,7 +228,11 @@ fn widen((lo, hi): (f64, f64), span: f64) -> (f64, f64) {
     (mid - 0.5 * span, mid + 0.5 * span)
 }
 
-fn draw(root: &DrawingArea<BitMapBackend, Shift>, robots: &[RobotPicture], title: &str) -> Result<(), String> {
+fn draw(
+    root: &DrawingArea<BitMapBackend, Shift>,
+    robots: &[RobotPicture],
+    title: &str,
+) -> Result<(), String> {
     root.fill(&WHITE).map_err(plot_err)?;
     let (w, h) = root.dim_in_pixel();
     let (head, body) = root.split_vertically(TITLE);
@@ -221,27 +245,41 @@ fn draw(root: &DrawingArea<BitMapBackend, Shift>, robots: &[RobotPicture], title
     let (side_x, side_z) = extent(robots, View::Side);
     let x = (top_x.0.min(side_x.0), top_x.1.max(side_x.1));
     let pad = 1.06;
-    let scale = [(x.1 - x.0) / plot_w, (top_y.1 - top_y.0) / plot_h, (side_z.1 - side_z.0) / plot_h]
-        .into_iter()
-        .fold(0.0, f64::max)
-        * pad;
+    let scale =
+        [(x.1 - x.0) / plot_w, (top_y.1 - top_y.0) / plot_h, (side_z.1 - side_z.0) / plot_h]
+            .into_iter()
+            .fold(0.0, f64::max)
+            * pad;
     let x = widen(x, scale * plot_w);
     draw_view(&left, robots, View::Top, "top view (x-y, WCS)", x, widen(top_y, scale * plot_h))?;
     draw_view(&right, robots, View::Side, "side view (x-z, WCS)", x, widen(side_z, scale * plot_h))
 }
 
-fn draw_title(area: &DrawingArea<BitMapBackend, Shift>, robots: &[RobotPicture], title: &str) -> Result<(), String> {
+fn draw_title(
+    area: &DrawingArea<BitMapBackend, Shift>,
+    robots: &[RobotPicture],
+    title: &str,
+) -> Result<(), String> {
     let hit = robots.iter().any(|r| r.hit.iter().any(|&h| h));
-    area.draw(&Text::new(title.to_string(), (MARGIN as i32, 8), text(18, if hit { HIT } else { BLACK })))
-        .map_err(plot_err)?;
+    area.draw(&Text::new(
+        title.to_string(),
+        (MARGIN as i32, 8),
+        text(18, if hit { HIT } else { BLACK }),
+    ))
+    .map_err(plot_err)?;
     let names: Vec<String> = robots.iter().map(|r| format!("robot {} boxes", r.name)).collect();
     let mut entries: Vec<(Swatch, &str)> = names
         .iter()
         .enumerate()
-        .map(|(j, n)| (Swatch::Outlined(ROBOT[j % ROBOT.len()].mix(0.2), ROBOT[j % ROBOT.len()]), n.as_str()))
+        .map(|(j, n)| {
+            (Swatch::Outlined(ROBOT[j % ROBOT.len()].mix(0.2), ROBOT[j % ROBOT.len()]), n.as_str())
+        })
         .collect();
     entries.push((Swatch::Outlined(HIT.mix(0.45), HIT), "box in collision"));
-    entries.push((Swatch::Line(RGBColor(150, 150, 150)), "base, upper links, platform, workspace (drawn only)"));
+    entries.push((
+        Swatch::Line(RGBColor(150, 150, 150)),
+        "base, upper links, platform, workspace (drawn only)",
+    ));
     legend(area, (MARGIN as i32, 34), &entries).map(|_| ())
 }
 
@@ -277,18 +315,27 @@ fn draw_view(
     let line = |pts: Vec<(f64, f64)>, style: ShapeStyle| PathElement::new(pts, style);
     for (j, r) in robots.iter().enumerate() {
         let c = ROBOT[j % ROBOT.len()];
-        chart.draw_series([line(workspace_outline(&r.base, view), thin.mix(0.5).stroke_width(1))]).map_err(plot_err)?;
-        let base: Vec<(f64, f64)> = circle(&r.base, r.base_radius).iter().map(|p| view.project(p)).collect();
+        chart
+            .draw_series([line(workspace_outline(&r.base, view), thin.mix(0.5).stroke_width(1))])
+            .map_err(plot_err)?;
+        let base: Vec<(f64, f64)> =
+            circle(&r.base, r.base_radius).iter().map(|p| view.project(p)).collect();
         chart.draw_series([line(base, c.stroke_width(2))]).map_err(plot_err)?;
         for (f, g) in &r.upper {
             chart
-                .draw_series([line(vec![view.project(f), view.project(g)], c.mix(0.7).stroke_width(3))])
+                .draw_series([line(
+                    vec![view.project(f), view.project(g)],
+                    c.mix(0.7).stroke_width(3),
+                )])
                 .map_err(plot_err)?;
         }
         if let Some(t) = r.tcp {
-            let platform: Vec<(f64, f64)> = circle(&t, r.platform_radius).iter().map(|p| view.project(p)).collect();
+            let platform: Vec<(f64, f64)> =
+                circle(&t, r.platform_radius).iter().map(|p| view.project(p)).collect();
             chart.draw_series([line(platform, c.stroke_width(1))]).map_err(plot_err)?;
-            chart.draw_series([Cross::new(view.project(&t), 5, c.stroke_width(2))]).map_err(plot_err)?;
+            chart
+                .draw_series([Cross::new(view.project(&t), 5, c.stroke_width(2))])
+                .map_err(plot_err)?;
         }
     }
     // Free boxes first, colliding ones on top.
@@ -296,7 +343,8 @@ fn draw_view(
         for (j, r) in robots.iter().enumerate() {
             let c = ROBOT[j % ROBOT.len()];
             for b in r.boxes.iter().zip(&r.hit).filter(|&(_, &h)| h == hit_pass).map(|(b, _)| b) {
-                let hull = convex_hull(&b.vertices().iter().map(|v| view.project(v)).collect::<Vec<_>>());
+                let hull =
+                    convex_hull(&b.vertices().iter().map(|v| view.project(v)).collect::<Vec<_>>());
                 let (fill, stroke) = if hit_pass { (HIT.mix(0.45), HIT) } else { (c.mix(0.2), c) };
                 chart.draw_series([Polygon::new(hull.clone(), fill.filled())]).map_err(plot_err)?;
                 let mut closed = hull;
@@ -310,12 +358,19 @@ fn draw_view(
             let c = ROBOT[j % ROBOT.len()];
             let (bx, by) = view.project(&r.base);
             chart
-                .draw_series([Text::new(r.name.clone(), (bx, by), text(18, c).pos(text_anchor_centre()))])
+                .draw_series([Text::new(
+                    r.name.clone(),
+                    (bx, by),
+                    text(18, c).pos(text_anchor_centre()),
+                )])
                 .map_err(plot_err)?;
             for (i, b) in r.boxes.iter().enumerate() {
                 if let BoxKind::LowerLink(arm) = r.kinds[i] {
-                    let label =
-                        Text::new(arm.to_string(), view.project(&b.center), text(13, BLACK).pos(text_anchor_centre()));
+                    let label = Text::new(
+                        arm.to_string(),
+                        view.project(&b.center),
+                        text(13, BLACK).pos(text_anchor_centre()),
+                    );
                     chart.draw_series([label]).map_err(plot_err)?;
                 }
             }

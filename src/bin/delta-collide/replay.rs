@@ -7,19 +7,27 @@ use crate::clearance::{pair_clearances, signed_clearance};
 use crate::replay_plot::{draw_replay, ReplayTrace};
 use crate::{load_table_or_bundle, open_input, write_output, Failure, Loaded};
 use delta_collide::cell::protective::{
-    path_through_samples, Protective, ProtectiveChecker, ProtectiveRequest, ProtectiveStatus, StopPath, TickTime,
+    path_through_samples, Protective, ProtectiveChecker, ProtectiveRequest, ProtectiveStatus,
+    StopPath, TickTime,
 };
 use delta_collide::math::Vec3;
 use delta_collide::table::Confirmation;
 use std::io::{BufRead, Write};
 
 pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
-    let mut checker = ProtectiveChecker::new(args.cell.clone(), args.warn_mm).map_err(|e| e.to_string())?;
-    let table = args.table.as_ref().map(|p| load_table_or_bundle(&args.cell, p, Confirmation::Exact)).transpose()?;
+    let mut checker =
+        ProtectiveChecker::new(args.cell.clone(), args.warn_mm).map_err(|e| e.to_string())?;
+    let table = args
+        .table
+        .as_ref()
+        .map(|p| load_table_or_bundle(&args.cell, p, Confirmation::Exact))
+        .transpose()?;
     let mut input = open_input(args.input.as_deref())?;
     let names = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
     let mut trace = args.plot.as_ref().map(|_| ReplayTrace::new(names));
-    let paths = args.stop_path_mm.map(|length_mm| PathsAhead { length_mm, tolerance_mm: args.path_tolerance_mm });
+    let paths = args
+        .stop_path_mm
+        .map(|length_mm| PathsAhead { length_mm, tolerance_mm: args.path_tolerance_mm });
     let mut lookups = Lookups::default();
     write_output(args.output.as_deref(), |out| {
         let columns = Columns { table: table.as_ref(), paths, pairs: args.pairs };
@@ -46,7 +54,13 @@ pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
         );
         draw_replay(path, (args.width, args.height), &title, trace)?;
         // The verdicts may be on stdout: the note on the picture goes to stderr.
-        eprintln!("{}: {} x {} pixels, {} ticks", path.display(), args.width, args.height, trace.len());
+        eprintln!(
+            "{}: {} x {} pixels, {} ticks",
+            path.display(),
+            args.width,
+            args.height,
+            trace.len()
+        );
     }
     Ok(())
 }
@@ -91,7 +105,8 @@ fn replay_rows(
     Columns { table, paths, pairs }: Columns<'_>,
     mut trace: Option<&mut ReplayTrace>,
 ) -> Result<Lookups, String> {
-    let bound = |a: usize, b: usize, tcps: &[Vec3]| table.and_then(|t| t.clearance_bound(a, b, tcps));
+    let bound =
+        |a: usize, b: usize, tcps: &[Vec3]| table.and_then(|t| t.clearance_bound(a, b, tcps));
     let mut lookups = Lookups::default();
     let names: Vec<String> = checker.cell().robots.iter().map(|r| r.name.clone()).collect();
     let n = names.len();
@@ -105,7 +120,8 @@ fn replay_rows(
         false => String::new(),
     };
     let (protective, limits) = (columns("protective_mm"), columns("speed_limit_mm_s"));
-    writeln!(out, "tick,verdict,clearance_mm,status{protective}{limits}{pair_columns}").map_err(write_err)?;
+    writeln!(out, "tick,verdict,clearance_mm,status{protective}{limits}{pair_columns}")
+        .map_err(write_err)?;
     let (mut rows, mut ticks): (Vec<Vec<Vec3>>, Vec<String>) = (Vec::new(), Vec::new());
     // Each row's cycle: its tick when it is a whole number, else its row number.
     let mut cycles: Vec<u64> = Vec::new();
@@ -116,14 +132,24 @@ fn replay_rows(
         Ok(())
     })?;
     // Per robot, its TCPs tick by tick: the samples ahead of a tick are a slice of these.
-    let runs: Vec<Vec<Vec3>> =
-        if paths.is_some() { (0..n).map(|j| rows.iter().map(|r| r[j]).collect()).collect() } else { Vec::new() };
+    let runs: Vec<Vec<Vec3>> = if paths.is_some() {
+        (0..n).map(|j| rows.iter().map(|r| r[j]).collect()).collect()
+    } else {
+        Vec::new()
+    };
     let mut points = vec![[Vec3::zeros(); PATH_POINTS]; n];
     for (tick, tcps) in rows.iter().enumerate() {
         // Robot j's samples ahead: its TCP in this row and the rows that follow.
         let lens: Vec<Option<usize>> = match paths {
             Some(p) => (0..n)
-                .map(|j| path_through_samples(&runs[j][tick..], p.length_mm, p.tolerance_mm, &mut points[j]))
+                .map(|j| {
+                    path_through_samples(
+                        &runs[j][tick..],
+                        p.length_mm,
+                        p.tolerance_mm,
+                        &mut points[j],
+                    )
+                })
                 .collect(),
             None => Vec::new(),
         };
@@ -133,7 +159,8 @@ fn replay_rows(
             .zip(&points)
             .map(|(len, pts)| len.map(|len| StopPath { points: &pts[..len], tolerance_mm }))
             .collect();
-        let mut request = ProtectiveRequest::new(tcps).at(TickTime::Cycle(cycles[tick])).with_paths(&stop_paths);
+        let mut request =
+            ProtectiveRequest::new(tcps).at(TickTime::Cycle(cycles[tick])).with_paths(&stop_paths);
         if table.is_some() {
             request = request.with_table(&bound);
         }

@@ -4,7 +4,9 @@
 //! the protective distances the run is comfortably stoppable; the band shows where the
 //! verdict could not prove it.
 
-use crate::picture::{colour_strip, draw_mesh, draw_png, legend, plot_err, text, Chart, Swatch, HIT, OUTSIDE, ROBOT};
+use crate::picture::{
+    colour_strip, draw_mesh, draw_png, legend, plot_err, text, Chart, Swatch, HIT, OUTSIDE, ROBOT,
+};
 use delta_collide::cell::protective::{Protective, ProtectiveReport, ProtectiveStatus};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -60,9 +62,17 @@ fn verdict_colour((v, ok): (Protective, bool)) -> RGBColor {
 ///
 /// # Errors
 /// An empty run (nothing to draw), or the drawing's or the file's error.
-pub fn draw_replay(path: &std::path::Path, size: (u32, u32), title: &str, trace: &ReplayTrace) -> Result<(), String> {
+pub fn draw_replay(
+    path: &std::path::Path,
+    size: (u32, u32),
+    title: &str,
+    trace: &ReplayTrace,
+) -> Result<(), String> {
     if trace.len() == 0 {
-        return Err(format!("{}: the input has no rows, so there is nothing to plot", path.display()));
+        return Err(format!(
+            "{}: the input has no rows, so there is nothing to plot",
+            path.display()
+        ));
     }
     draw_png(path, size, |root| {
         root.fill(&WHITE).map_err(plot_err)?;
@@ -73,8 +83,12 @@ pub fn draw_replay(path: &std::path::Path, size: (u32, u32), title: &str, trace:
     })
 }
 
-fn draw_legend(root: &DrawingArea<BitMapBackend, Shift>, trace: &ReplayTrace) -> Result<(), String> {
-    let names: Vec<String> = trace.robots.iter().map(|r| format!("protective distance {r}")).collect();
+fn draw_legend(
+    root: &DrawingArea<BitMapBackend, Shift>,
+    trace: &ReplayTrace,
+) -> Result<(), String> {
+    let names: Vec<String> =
+        trace.robots.iter().map(|r| format!("protective distance {r}")).collect();
     let mut entries = vec![(Swatch::Line(ROBOT[0]), "clearance (exact, signed)")];
     for (k, name) in names.iter().enumerate() {
         entries.push((Swatch::Line(ROBOT[1 + k % (ROBOT.len() - 1)]), name.as_str()));
@@ -91,7 +105,9 @@ fn draw_legend(root: &DrawingArea<BitMapBackend, Shift>, trace: &ReplayTrace) ->
 
 /// `(min, max)` of the finite values, with 0 included.
 fn range<'a>(values: impl Iterator<Item = &'a f64>) -> (f64, f64) {
-    values.filter(|v| v.is_finite()).fold((0.0, 0.0), |(lo, hi), &v| (f64::min(lo, v), f64::max(hi, v)))
+    values
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0.0), |(lo, hi), &v| (f64::min(lo, v), f64::max(hi, v)))
 }
 
 fn draw_run(area: &DrawingArea<BitMapBackend, Shift>, trace: &ReplayTrace) -> Result<(), String> {
@@ -130,7 +146,6 @@ fn draw_run(area: &DrawingArea<BitMapBackend, Shift>, trace: &ReplayTrace) -> Re
     let colours: Vec<RGBColor> = trace.verdict.iter().map(|&v| verdict_colour(v)).collect();
     colour_strip(area, "verdict", (left, width), yr.end - by + 36 + 4, STRIP, &colours)
 }
-
 
 /// `values` per tick as line segments between the NaN ticks.
 fn line(chart: &mut Chart, values: &[f64], colour: RGBColor) -> Result<(), String> {

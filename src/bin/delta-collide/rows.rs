@@ -63,19 +63,27 @@ pub fn for_each_row(
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
         values.clear();
         let tick = match &columns {
-            Layout::InOrder if fields.len() == 3 * n => {
-                fields.iter().try_for_each(|f| f.parse::<f64>().map(|v| values.push(v))).ok().map(|()| None)
-            }
+            Layout::InOrder if fields.len() == 3 * n => fields
+                .iter()
+                .try_for_each(|f| f.parse::<f64>().map(|v| values.push(v)))
+                .ok()
+                .map(|()| None),
             Layout::InOrder => None,
             Layout::Named { xyz, tick } => xyz
                 .iter()
-                .try_for_each(|&k| fields.get(k).and_then(|f| f.parse::<f64>().ok()).map(|v| values.push(v)))
+                .try_for_each(|&k| {
+                    fields.get(k).and_then(|f| f.parse::<f64>().ok()).map(|v| values.push(v))
+                })
                 .map(|()| tick.and_then(|k| fields.get(k).copied())),
         };
         let Some(tick) = tick else {
             let expected = match columns {
-                Layout::InOrder => format!("{} numbers (x,y,z per robot) separated by commas", 3 * n),
-                Layout::Named { .. } => "a number in each of the header's x,y,z columns".to_string(),
+                Layout::InOrder => {
+                    format!("{} numbers (x,y,z per robot) separated by commas", 3 * n)
+                }
+                Layout::Named { .. } => {
+                    "a number in each of the header's x,y,z columns".to_string()
+                }
             };
             return Err(format!("line {line_no}: expected {expected}, got `{}`", clip(line)));
         };

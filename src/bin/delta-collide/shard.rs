@@ -26,11 +26,18 @@ pub const SHARDS_VAR: &str = "DELTA_COLLIDE_SHARDS";
 /// # Errors
 /// No scheduler's variable, more than one scheduler's, a value that is not a number, no
 /// count, or an index outside `0..N`: each message names the variable and the fix.
-pub fn shard_from_env(env: &dyn Fn(&str) -> Option<String>, shards: Option<u32>) -> Result<(u32, u32), String> {
+pub fn shard_from_env(
+    env: &dyn Fn(&str) -> Option<String>,
+    shards: Option<u32>,
+) -> Result<(u32, u32), String> {
     let number = |name: &str| -> Result<Option<u32>, String> {
         match env(name) {
             None => Ok(None),
-            Some(v) => v.trim().parse().map(Some).map_err(|_| format!("{name} = {v:?} is not a whole number from 0")),
+            Some(v) => v
+                .trim()
+                .parse()
+                .map(Some)
+                .map_err(|_| format!("{name} = {v:?} is not a whole number from 0")),
         }
     };
     let given = match (shards, number(SHARDS_VAR)?) {
@@ -38,10 +45,11 @@ pub fn shard_from_env(env: &dyn Fn(&str) -> Option<String>, shards: Option<u32>)
         (None, Some(n)) => Some((n, SHARDS_VAR)),
         (None, None) => None,
     };
-    let found: Vec<&str> = ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX", "AWS_BATCH_JOB_ARRAY_INDEX"]
-        .into_iter()
-        .filter(|v| env(v).is_some())
-        .collect();
+    let found: Vec<&str> =
+        ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX", "AWS_BATCH_JOB_ARRAY_INDEX"]
+            .into_iter()
+            .filter(|v| env(v).is_some())
+            .collect();
     let (index, count) = match found[..] {
         [] => {
             return Err("--shard auto: no scheduler's array index in the environment (SLURM_ARRAY_TASK_ID, \
@@ -100,7 +108,9 @@ pub fn shard_from_env(env: &dyn Fn(&str) -> Option<String>, shards: Option<u32>)
         }
     };
     if count == 0 || index >= count {
-        return Err(format!("--shard auto: shard index {index} of {count}: the index must be below the count"));
+        return Err(format!(
+            "--shard auto: shard index {index} of {count}: the index must be below the count"
+        ));
     }
     Ok((index, count))
 }
@@ -108,7 +118,10 @@ pub fn shard_from_env(env: &dyn Fn(&str) -> Option<String>, shards: Option<u32>)
 /// `output` with `{index}` and `{count}` replaced by the shard's index and count.
 fn shard_path(output: &Path, shard: ShardIndex) -> PathBuf {
     let s = output.to_string_lossy();
-    PathBuf::from(s.replace("{index}", &shard.index().to_string()).replace("{count}", &shard.count().to_string()))
+    PathBuf::from(
+        s.replace("{index}", &shard.index().to_string())
+            .replace("{count}", &shard.count().to_string()),
+    )
 }
 
 /// `build --shard`: labels one shard and writes its file.
@@ -126,9 +139,12 @@ pub fn build(args: &BuildArgs, shard: &ShardArg, progress: Progress) -> Result<(
         (kind, _) => kind.variant(args.t.unwrap_or(0)),
     };
     let labelling = Labelling::from(args.labelling);
-    let (bytes, r) = build_shard_of(cell, k, &Workspace::THESIS, variant, labelling, shard, progress)?;
+    let (bytes, r) =
+        build_shard_of(cell, k, &Workspace::THESIS, variant, labelling, shard, progress)?;
     let output = shard_path(&args.output, shard);
-    files::write_file(&output, |w| w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display())))?;
+    files::write_file(&output, |w| {
+        w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display()))
+    })?;
     println!(
         "cell {} k {k} variant {}: shard {index}/{count}, rows {} of {}, {} pairs, labelling {:.2} s",
         cell.name, kind.0, r.rows, r.samples.0, r.pairs, r.label_secs
@@ -143,8 +159,9 @@ pub fn merge(args: &MergeArgs) -> Result<(), Failure> {
     let mut read = |name: &str| std::fs::read(name).map_err(|e| e.to_string());
     // The merge holds 2 bits per pair: refuse, before allocating, what the memory cannot hold.
     if let (Some(first), Some(total)) = (names.first(), crate::total_memory()) {
-        if let Ok((na, nb)) =
-            read(first).and_then(|b| read_shard_info(&b).map_err(|e| e.to_string())).map(|i| i.samples)
+        if let Ok((na, nb)) = read(first)
+            .and_then(|b| read_shard_info(&b).map_err(|e| e.to_string()))
+            .map(|i| i.samples)
         {
             let needed = PairLabels::bytes_for((na as u64).saturating_mul(nb as u64));
             if needed > total {
@@ -160,7 +177,9 @@ pub fn merge(args: &MergeArgs) -> Result<(), Failure> {
     let (header, table, r) = merge_shards(&names, &mut read).map_err(|e| e.to_string())?;
     let bytes = to_bytes(&table, &header);
     let output = &args.output;
-    files::write_file(output, |w| w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display())))?;
+    files::write_file(output, |w| {
+        w.write_all(&bytes).map_err(|e| format!("{}: {e}", output.display()))
+    })?;
     println!(
         "{} shards: {} x {} samples, {} pairs, {} collision, {} unreachable, symmetric: {}",
         args.shards.len(),
@@ -182,25 +201,45 @@ mod tests {
     use std::collections::HashMap;
 
     fn from(vars: &[(&str, &str)], shards: Option<u32>) -> Result<(u32, u32), String> {
-        let env: HashMap<String, String> = vars.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+        let env: HashMap<String, String> =
+            vars.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
         shard_from_env(&|name| env.get(name).cloned(), shards)
     }
 
     #[test]
     fn slurm_arrays_give_index_and_count_with_the_minimum_subtracted() {
-        assert_eq!(from(&[("SLURM_ARRAY_TASK_ID", "2"), ("SLURM_ARRAY_TASK_COUNT", "5")], None), Ok((2, 5)));
-        let one_based = [("SLURM_ARRAY_TASK_ID", "3"), ("SLURM_ARRAY_TASK_COUNT", "3"), ("SLURM_ARRAY_TASK_MIN", "1")];
+        assert_eq!(
+            from(&[("SLURM_ARRAY_TASK_ID", "2"), ("SLURM_ARRAY_TASK_COUNT", "5")], None),
+            Ok((2, 5))
+        );
+        let one_based = [
+            ("SLURM_ARRAY_TASK_ID", "3"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ("SLURM_ARRAY_TASK_MIN", "1"),
+        ];
         assert_eq!(from(&one_based, None), Ok((2, 3)));
         assert_eq!(from(&one_based, Some(3)), Ok((2, 3)));
         let e = from(&one_based, Some(4)).unwrap_err();
         assert!(e.contains("--shards = 4") && e.contains("SLURM_ARRAY_TASK_COUNT = 3"), "{e}");
         let e = from(&[("SLURM_ARRAY_TASK_ID", "1")], None).unwrap_err();
         assert!(e.contains("SLURM_ARRAY_TASK_COUNT"), "{e}");
-        let stepped = [("SLURM_ARRAY_TASK_ID", "2"), ("SLURM_ARRAY_TASK_COUNT", "3"), ("SLURM_ARRAY_TASK_STEP", "2")];
+        let stepped = [
+            ("SLURM_ARRAY_TASK_ID", "2"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ("SLURM_ARRAY_TASK_STEP", "2"),
+        ];
         assert!(from(&stepped, None).unwrap_err().contains("SLURM_ARRAY_TASK_STEP"));
-        let beyond = [("SLURM_ARRAY_TASK_ID", "7"), ("SLURM_ARRAY_TASK_COUNT", "3"), ("SLURM_ARRAY_TASK_MIN", "4")];
+        let beyond = [
+            ("SLURM_ARRAY_TASK_ID", "7"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ("SLURM_ARRAY_TASK_MIN", "4"),
+        ];
         assert!(from(&beyond, None).unwrap_err().contains("index 3 of 3"));
-        let below = [("SLURM_ARRAY_TASK_ID", "0"), ("SLURM_ARRAY_TASK_COUNT", "3"), ("SLURM_ARRAY_TASK_MIN", "1")];
+        let below = [
+            ("SLURM_ARRAY_TASK_ID", "0"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ("SLURM_ARRAY_TASK_MIN", "1"),
+        ];
         assert!(from(&below, None).unwrap_err().contains("below SLURM_ARRAY_TASK_MIN"));
     }
 
@@ -208,7 +247,11 @@ mod tests {
     fn kubernetes_and_aws_take_the_count_from_the_flag_or_the_variable() {
         assert_eq!(from(&[("JOB_COMPLETION_INDEX", "4")], Some(5)), Ok((4, 5)));
         assert_eq!(from(&[("JOB_COMPLETION_INDEX", "0"), (SHARDS_VAR, "2")], None), Ok((0, 2)));
-        assert_eq!(from(&[("JOB_COMPLETION_INDEX", "1"), (SHARDS_VAR, "2")], Some(3)), Ok((1, 3)), "the flag wins");
+        assert_eq!(
+            from(&[("JOB_COMPLETION_INDEX", "1"), (SHARDS_VAR, "2")], Some(3)),
+            Ok((1, 3)),
+            "the flag wins"
+        );
         assert_eq!(from(&[("AWS_BATCH_JOB_ARRAY_INDEX", "9")], Some(10)), Ok((9, 10)));
         let aws = [("AWS_BATCH_JOB_ARRAY_INDEX", "2"), ("AWS_BATCH_JOB_ARRAY_SIZE", "6")];
         assert_eq!(from(&aws, None), Ok((2, 6)));
@@ -216,9 +259,15 @@ mod tests {
         assert!(from(&aws, Some(5)).unwrap_err().contains("AWS_BATCH_JOB_ARRAY_SIZE = 6"));
         let e = from(&[("AWS_BATCH_JOB_ARRAY_INDEX", "9")], None).unwrap_err();
         assert!(e.contains("--shards N") && e.contains(SHARDS_VAR), "{e}");
-        assert!(from(&[("JOB_COMPLETION_INDEX", "5")], Some(5)).unwrap_err().contains("index 5 of 5"));
-        assert!(from(&[("JOB_COMPLETION_INDEX", "x")], Some(5)).unwrap_err().contains("JOB_COMPLETION_INDEX"));
-        assert!(from(&[("JOB_COMPLETION_INDEX", "1"), (SHARDS_VAR, "two")], None).unwrap_err().contains(SHARDS_VAR));
+        assert!(from(&[("JOB_COMPLETION_INDEX", "5")], Some(5))
+            .unwrap_err()
+            .contains("index 5 of 5"));
+        assert!(from(&[("JOB_COMPLETION_INDEX", "x")], Some(5))
+            .unwrap_err()
+            .contains("JOB_COMPLETION_INDEX"));
+        assert!(from(&[("JOB_COMPLETION_INDEX", "1"), (SHARDS_VAR, "two")], None)
+            .unwrap_err()
+            .contains(SHARDS_VAR));
     }
 
     #[test]
@@ -232,7 +281,10 @@ mod tests {
     #[test]
     fn output_names_take_the_shard_index_and_count() {
         let s = ShardIndex::new(3, 8).unwrap();
-        assert_eq!(shard_path(Path::new("out/t1-{index}-of-{count}.dcs"), s), PathBuf::from("out/t1-3-of-8.dcs"));
+        assert_eq!(
+            shard_path(Path::new("out/t1-{index}-of-{count}.dcs"), s),
+            PathBuf::from("out/t1-3-of-8.dcs")
+        );
         assert_eq!(shard_path(Path::new("plain.dcs"), s), PathBuf::from("plain.dcs"));
     }
 }

@@ -43,7 +43,9 @@ fn segment(w: &[Waypoint], t: f64) -> Option<(&Waypoint, &Waypoint)> {
 pub fn path_at(w: &[Waypoint], t: f64) -> Vec3 {
     match segment(w, t) {
         Some((a, b)) => a.tcp + (b.tcp - a.tcp) * minimum_jerk(tau(a, b, t)),
-        None if t < f64::from(w.first().map_or(0, |p| p.tick)) => w.first().map_or(Vec3::zeros(), |p| p.tcp),
+        None if t < f64::from(w.first().map_or(0, |p| p.tick)) => {
+            w.first().map_or(Vec3::zeros(), |p| p.tcp)
+        }
         None => w.last().map_or(Vec3::zeros(), |p| p.tcp),
     }
 }
@@ -86,12 +88,15 @@ impl<'a> Robot<'a> {
     /// Advances the stop by `dt_ms`; `elapsed_ms` is the time since the STOP after the step.
     fn step(&mut self, dt_ms: f64, elapsed_ms: f64, tick_ms: f64) {
         self.phase = match self.phase {
-            Phase::Reacting(t) if elapsed_ms <= self.stop.reaction_ms => Phase::Reacting(t + dt_ms / tick_ms),
+            Phase::Reacting(t) if elapsed_ms <= self.stop.reaction_ms => {
+                Phase::Reacting(t + dt_ms / tick_ms)
+            }
             Phase::Reacting(t) => match segment(self.path, t) {
                 // Braking starts at the commanded speed of that instant.
                 Some((a, b)) => {
                     let u = tau(a, b, t);
-                    let ds_dtick = 30.0 * u * u * (1.0 - u) * (1.0 - u) / f64::from(b.tick - a.tick);
+                    let ds_dtick =
+                        30.0 * u * u * (1.0 - u) * (1.0 - u) / f64::from(b.tick - a.tick);
                     let speed = (b.tcp - a.tcp).norm() * ds_dtick / (tick_ms * 1e-3);
                     let braking = Phase::Braking { a, b, s: minimum_jerk(u), speed };
                     Robot { phase: braking, ..*self }.braked(dt_ms)
@@ -122,7 +127,11 @@ impl<'a> Robot<'a> {
 ///
 /// # Errors
 /// A scenario whose robot count differs from the cell's.
-pub fn simulate_stop(cell: &Cell, scenario: &Scenario, stop_tick: u32) -> Result<StopOutcome, String> {
+pub fn simulate_stop(
+    cell: &Cell,
+    scenario: &Scenario,
+    stop_tick: u32,
+) -> Result<StopOutcome, String> {
     let n = cell.robots.len();
     if scenario.robots.len() != n {
         return Err(format!(
@@ -136,7 +145,11 @@ pub fn simulate_stop(cell: &Cell, scenario: &Scenario, stop_tick: u32) -> Result
         .robots
         .iter()
         .zip(&cell.stops)
-        .map(|(path, stop)| Robot { path, stop: *stop, phase: Phase::Reacting(f64::from(stop_tick)) })
+        .map(|(path, stop)| Robot {
+            path,
+            stop: *stop,
+            phase: Phase::Reacting(f64::from(stop_tick)),
+        })
         .collect();
     let mut exact = ExactChecker::new(cell.clone());
     let mut tcps = vec![Vec3::zeros(); n];
@@ -198,7 +211,9 @@ mod tests {
         let stop = cell.stops[0];
         // Mid-segment (A moves from tick 400 to 800), the speeds from the path at a fine step.
         let tick = 600;
-        let speed = |w: &[Waypoint]| (path_at(w, f64::from(tick) + 1e-3) - path_at(w, f64::from(tick))).norm() * 1e6;
+        let speed = |w: &[Waypoint]| {
+            (path_at(w, f64::from(tick) + 1e-3) - path_at(w, f64::from(tick))).norm() * 1e6
+        };
         let vmax = s.robots.iter().map(|w| speed(w)).fold(0.0, f64::max);
         assert!(vmax > 100.0, "the robots move at tick {tick}: {vmax} mm/s");
         let out = simulate_stop(&cell, &s, tick).unwrap();

@@ -7,12 +7,12 @@
 
 use super::stop_sweeps::{graded_points, pair_apart_in_some_form, GradedRadii};
 use super::{BoxPair, ProtectiveChecker};
-use crate::math::interval::Interval;
-use crate::robot::motion_bound::{box_sweep_forms, tcp_weights};
 use crate::geometry::sweep::{balls_swept_apart_with, Axes, FaceTerms};
 use crate::geometry::{Obb, Sweep};
+use crate::math::interval::Interval;
 use crate::math::{Real, Vec3};
 use crate::robot::delta3::{ArmSolution, MotorCosSin};
+use crate::robot::motion_bound::{box_sweep_forms, tcp_weights};
 use crate::robot::{BoxKind, RobotModel};
 
 /// How far (rad) each sampled motor angle of [`ProtectiveChecker::least_sweeps`] is taken
@@ -29,10 +29,10 @@ impl ProtectiveChecker {
     /// both forms, WCS) from the motor angles of the centre and of the two points of the
     /// ball along the gradient of its arm's angle alone, each angle `ANGLE_SLACK` toward the
     /// centre's and each ball `LEAST_SLACK` smaller: on every axis no larger than the sweeps
-    /// of any tier (module doc, step 7). `None` when the centre is unreachable or a point's angle lies more than a
-    /// right angle from the centre's (a range across the branch cut at `+-pi`, which no motor
-    /// limit of a Delta robot allows): nothing learned. `at_centre`: the centre's inverse
-    /// kinematics, when the caller has it.
+    /// of any tier (module doc, step 7). `None` when the centre is unreachable or a point's angle
+    /// lies more than a right angle from the centre's (a range across the branch cut at `+-pi`,
+    /// which no motor limit of a Delta robot allows): nothing learned. `at_centre`: the centre's
+    /// inverse kinematics, when the caller has it.
     fn least_sweeps(
         &self,
         j: usize,
@@ -57,7 +57,9 @@ impl ProtectiveChecker {
             // `w = E_i - G_i`: the platform joint `p + e u_i` less the elbow
             // `(f + rf cos th) u_i - rf sin th z`.
             let u = crate::robot::delta3::radial(i);
-            let w = centre + u * (d.e - d.f - d.rf * at_centre.cos[i]) + Vec3::z() * (d.rf * at_centre.sin[i]);
+            let w = centre
+                + u * (d.e - d.f - d.rf * at_centre.cos[i])
+                + Vec3::z() * (d.rf * at_centre.sin[i]);
             let toward = w * (s / w.norm());
             let (mut lo, mut hi) = (theta0, theta0);
             for point in [centre + toward, centre - toward] {
@@ -74,14 +76,26 @@ impl ProtectiveChecker {
         }
         let rot = self.exact.rotation(j);
         let forms = box_sweep_forms(&robot.model, &centre, s, &centre, &sol, &th, k);
-        Some(forms.map(|form| Sweep { ball: (form.ball - LEAST_SLACK).max(0.0), ..form.rotated(rot) }))
+        Some(
+            forms.map(|form| Sweep {
+                ball: (form.ball - LEAST_SLACK).max(0.0),
+                ..form.rotated(rot)
+            }),
+        )
     }
 
     /// Whether box pair `p` is certain not to be proved apart (with `extra` mm added to the
     /// first robot's sweeps) by the sweeps of any tier (module doc, step 7); `false` when that
     /// is not known.
     pub(super) fn beyond_every_tier(&self, p: BoxPair, extra: Real) -> bool {
-        let reference = |j: usize, k: usize| (self.robots[j].reference.boxes.as_slice()[k], self.robots[j].reference.centre, self.robots[j].reference.radius, None);
+        let reference = |j: usize, k: usize| {
+            (
+                self.robots[j].reference.boxes.as_slice()[k],
+                self.robots[j].reference.centre,
+                self.robots[j].reference.radius,
+                None,
+            )
+        };
         self.beyond_every_tier_at(p, [reference(p.a, p.box_a), reference(p.b, p.box_b)], extra)
     }
 
@@ -94,12 +108,14 @@ impl ProtectiveChecker {
         [(box_a, ca, sa, ika), (box_b, cb, sb, ikb)]: [(Obb, Vec3, Real, Option<MotorCosSin>); 2],
         extra: Real,
     ) -> bool {
-        let (Some(la), Some(lb)) =
-            (self.least_sweeps(p.a, p.box_a, ca, sa, ika), self.least_sweeps(p.b, p.box_b, cb, sb, ikb))
-        else {
+        let (Some(la), Some(lb)) = (
+            self.least_sweeps(p.a, p.box_a, ca, sa, ika),
+            self.least_sweeps(p.b, p.box_b, cb, sb, ikb),
+        ) else {
             return false;
         };
-        let (ra, rb) = (self.graded_ball_radii(p.a, p.box_a, sa), self.graded_ball_radii(p.b, p.box_b, sb));
+        let (ra, rb) =
+            (self.graded_ball_radii(p.a, p.box_a, sa), self.graded_ball_radii(p.b, p.box_b, sb));
         let (a, b) = ((&box_a, [&la[0], &la[1]], ra), (&box_b, [&lb[0], &lb[1]], rb));
         !pair_apart_in_some_form(a, b, extra, &self.pair_axis(p))
     }
@@ -108,16 +124,27 @@ impl ProtectiveChecker {
     /// each box pair (`pair_axes`); none for a pair that cannot meet.
     fn pair_axis(&self, p: BoxPair) -> Vec3 {
         let pairs = &self.exact.verdict().pairs;
-        pairs.iter().position(|q| (q.a, q.b) == (p.a, p.b)).map_or(Vec3::zeros(), |k| self.pairs[k].axis)
+        pairs
+            .iter()
+            .position(|q| (q.a, q.b) == (p.a, p.b))
+            .map_or(Vec3::zeros(), |k| self.pairs[k].axis)
     }
 
     /// The certain STOPs of steps 6 and 7 on box pair `p` before the references are set
     /// (step 8): its two reference boxes built as [`ProtectiveChecker::reference_at`] builds
     /// them (the same operations, so the same answers), from this tick's stop balls; step 7
     /// only when `also_least`.
-    pub(super) fn reference_pair_stops(&self, tcps_mcs: &[Vec3], p: BoxPair, also_least: bool) -> bool {
+    pub(super) fn reference_pair_stops(
+        &self,
+        tcps_mcs: &[Vec3],
+        p: BoxPair,
+        also_least: bool,
+    ) -> bool {
         let refs = self.reference_pair(tcps_mcs, p);
-        let (ra, rb) = (self.graded_ball_radii(p.a, p.box_a, refs[0].2), self.graded_ball_radii(p.b, p.box_b, refs[1].2));
+        let (ra, rb) = (
+            self.graded_ball_radii(p.a, p.box_a, refs[0].2),
+            self.graded_ball_radii(p.b, p.box_b, refs[1].2),
+        );
         !balls_apart((&refs[0].0, ra), (&refs[1].0, rb), &self.pair_axis(p))
             || (also_least && self.beyond_every_tier_at(p, refs, 0.0))
     }
@@ -125,14 +152,23 @@ impl ProtectiveChecker {
     /// Box pair `p`'s reference boxes (WCS) as [`ProtectiveChecker::reference_at`] builds them
     /// (the same operations, so the same values) from this tick's stop balls, each with its
     /// reference centre (MCS), radius and, at a ball's centre, the inverse kinematics there.
-    fn reference_pair(&self, tcps_mcs: &[Vec3], p: BoxPair) -> [(Obb, Vec3, Real, Option<MotorCosSin>); 2] {
+    fn reference_pair(
+        &self,
+        tcps_mcs: &[Vec3],
+        p: BoxPair,
+    ) -> [(Obb, Vec3, Real, Option<MotorCosSin>); 2] {
         let reference = |j: usize, k: usize| {
             let robot = &self.exact.cell().robots[j];
             let (tcp, (s, (centre, radius))) = (&tcps_mcs[j], self.robots[j].stop_ball);
             match robot.model.delta.inverse_kinematics_cos_sin(&centre) {
                 Ok(sol) if centre != *tcp => {
                     let b = robot.model.box_from_cos_sin(&centre, &sol, k);
-                    (b.transformed(self.exact.rotation(j), &robot.placement.t), centre, radius, Some(sol))
+                    (
+                        b.transformed(self.exact.rotation(j), &robot.placement.t),
+                        centre,
+                        radius,
+                        Some(sol),
+                    )
                 }
                 _ => (self.exact.boxes(j).as_slice()[k], *tcp, s, None),
             }
@@ -148,8 +184,14 @@ impl ProtectiveChecker {
     /// Whether box pair `p`'s reference boxes swept by their stop balls alone are not proved
     /// apart: step 6 for one pair, as the speed limits' search asks it before each test's sweeps.
     pub(super) fn ball_swept_meet(&self, p: BoxPair) -> bool {
-        let (box_a, box_b) = (&self.robots[p.a].reference.boxes.as_slice()[p.box_a], &self.robots[p.b].reference.boxes.as_slice()[p.box_b]);
-        let (ra, rb) = (self.robots[p.a].reference.graded[p.box_a], self.robots[p.b].reference.graded[p.box_b]);
+        let (box_a, box_b) = (
+            &self.robots[p.a].reference.boxes.as_slice()[p.box_a],
+            &self.robots[p.b].reference.boxes.as_slice()[p.box_b],
+        );
+        let (ra, rb) = (
+            self.robots[p.a].reference.graded[p.box_a],
+            self.robots[p.b].reference.graded[p.box_b],
+        );
         !balls_apart((box_a, ra), (box_b, rb), &self.pair_axis(p))
     }
 }
@@ -163,7 +205,13 @@ fn least_radii(model: &RobotModel, k: usize, reach: Real) -> [Real; 2] {
 
 /// [`least_radii`] of every box of a robot of `model` for reference radius `reach`.
 pub(super) fn graded_radii(model: &RobotModel, reach: Real) -> GradedRadii {
-    core::array::from_fn(|k| if k < model.box_count() { least_radii(model, k, reach) } else { [0.0; 2] })
+    core::array::from_fn(|k| {
+        if k < model.box_count() {
+            least_radii(model, k, reach)
+        } else {
+            [0.0; 2]
+        }
+    })
 }
 
 /// Whether box `a` swept by the graded ball of radii `ra` and box `b` by that of `rb` are
@@ -196,7 +244,10 @@ mod tests {
         let text = include_str!("../../../c_harness/scenarios.txt");
         let (mut settled, mut separated) = (0, 0);
         for s in crate::cell::trajectory::parse_scenarios(text).unwrap().iter() {
-            let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, vec![StopModel::DEFAULT; 2]).unwrap();
+            let cell = reference_cell(&s.cell)
+                .unwrap()
+                .with_stopping(1.0, vec![StopModel::DEFAULT; 2])
+                .unwrap();
             let mut c = ProtectiveChecker::new(cell, 10.0).unwrap().with_speed_limits(false);
             let (mut tcps, mut unproved, mut found, mut along) = ([Vec3::zeros(); 2], 0, 0, 0);
             for tick in 0..crate::cell::trajectory::RUN_TICKS {
@@ -204,11 +255,17 @@ mod tests {
                 c.check(&tcps).unwrap();
                 let Some(p) = c.report.closest else { continue };
                 let [(a, _, reach_a, _), (b, _, reach_b, _)] = c.reference_pair(&tcps, p);
-                let (ra, rb) = (c.graded_ball_radii(p.a, p.box_a, reach_a), c.graded_ball_radii(p.b, p.box_b, reach_b));
-                let (fa, fb, axis) = (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb), c.pair_axis(p));
+                let (ra, rb) = (
+                    c.graded_ball_radii(p.a, p.box_a, reach_a),
+                    c.graded_ball_radii(p.b, p.box_b, reach_b),
+                );
+                let (fa, fb, axis) =
+                    (FaceTerms::ball(&a, ra), FaceTerms::ball(&b, rb), c.pair_axis(p));
                 let points = graded_points((&a, ra), (&b, rb), 0.0);
-                let apart = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::FifteenAnd(&axis));
-                let graded = balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::Only(&points.axis()));
+                let apart =
+                    balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::FifteenAnd(&axis));
+                let graded =
+                    balls_swept_apart_with(&a, ra, &fa, &b, rb, &fb, Axes::Only(&points.axis()));
                 assert!(!(points.meet() && (apart || graded)), "{} {} tick {tick}", s.cell, s.case);
                 assert_eq!(balls_apart((&a, ra), (&b, rb), &axis), apart || graded);
                 unproved += usize::from(!apart);

@@ -118,7 +118,10 @@ mod tests {
         let at = |before, now| interval(Some(Cycle(before)), Cycle(now), T);
         assert_eq!(at(7, 8), Interval::Seconds(T));
         assert_eq!(at(7, 9), Interval::Seconds(2.0 * T));
-        assert_eq!(at(7, 7 + MAX_INTERVAL_TICKS), Interval::Seconds(MAX_INTERVAL_TICKS as Real * T));
+        assert_eq!(
+            at(7, 7 + MAX_INTERVAL_TICKS),
+            Interval::Seconds(MAX_INTERVAL_TICKS as Real * T)
+        );
         assert_eq!(at(7, 8 + MAX_INTERVAL_TICKS), Interval::Fault(TimingFault::Jump));
         assert_eq!(at(7, 7), Interval::Same);
         assert_eq!(at(7, 6), Interval::Fault(TimingFault::Backwards));
@@ -145,7 +148,13 @@ mod tests {
         assert_eq!(interval(None, Nominal, T), Interval::Seconds(T));
         assert_eq!(interval(None, Cycle(3), T), Interval::Unknown);
         assert_eq!(interval(Some(Nominal), Nanos(3), T), Interval::Unknown);
-        assert_eq!(interval(Some(Cycle(3)), Nanos(3), T), Interval::Fault(TimingFault::ClockChanged));
-        assert_eq!(interval(Some(Nanos(3)), Cycle(4), T), Interval::Fault(TimingFault::ClockChanged));
+        assert_eq!(
+            interval(Some(Cycle(3)), Nanos(3), T),
+            Interval::Fault(TimingFault::ClockChanged)
+        );
+        assert_eq!(
+            interval(Some(Nanos(3)), Cycle(4), T),
+            Interval::Fault(TimingFault::ClockChanged)
+        );
     }
 }

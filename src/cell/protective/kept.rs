@@ -82,9 +82,11 @@ impl Kept {
     /// Records whether robot `j`'s stop, held by each of `balls` (centre MCS, radius), lies
     /// in its kept ball; returns that.
     pub(super) fn set_inside(&mut self, j: usize, balls: &[(Vec3, Real)]) -> bool {
-        let inside = self.balls[j]
-            .as_ref()
-            .is_some_and(|k| balls.iter().any(|(c, r)| r.is_finite() && (c - k.ball.centre).norm() + r <= k.ball.radius));
+        let inside = self.balls[j].as_ref().is_some_and(|k| {
+            balls
+                .iter()
+                .any(|(c, r)| r.is_finite() && (c - k.ball.centre).norm() + r <= k.ball.radius)
+        });
         self.inside[j] = inside;
         inside
     }
@@ -104,7 +106,9 @@ impl Kept {
     fn pair_free(&self, k: usize, a: usize, b: usize) -> bool {
         match (&self.balls[a], &self.balls[b], self.pairs[k]) {
             (Some(ka), Some(kb), Some((ga, gb, free))) => {
-                free && self.inside[a] && self.inside[b] && (ga, gb) == (ka.generation, kb.generation)
+                free && self.inside[a]
+                    && self.inside[b]
+                    && (ga, gb) == (ka.generation, kb.generation)
             }
             _ => false,
         }
@@ -140,11 +144,16 @@ impl ProtectiveChecker {
         let extra = self.model.warn_mm;
         let pairs = &self.exact.verdict().pairs;
         for (k, p) in pairs.iter().enumerate() {
-            let (Some(ka), Some(kb)) = (&self.kept.balls[p.a], &self.kept.balls[p.b]) else { continue };
-            if self.kept.pairs[k].is_some_and(|(ga, gb, _)| (ga, gb) == (ka.generation, kb.generation)) {
+            let (Some(ka), Some(kb)) = (&self.kept.balls[p.a], &self.kept.balls[p.b]) else {
+                continue;
+            };
+            if self.kept.pairs[k]
+                .is_some_and(|(ga, gb, _)| (ga, gb) == (ka.generation, kb.generation))
+            {
                 continue;
             }
-            let free = first_unproved_between(&ka.ball, &kb.ball, extra, &self.pairs[k].axis).is_none();
+            let free =
+                first_unproved_between(&ka.ball, &kb.ball, extra, &self.pairs[k].axis).is_none();
             self.kept.pairs[k] = Some((ka.generation, kb.generation, free));
         }
         let free = self.kept_free(None);
@@ -155,8 +164,8 @@ impl ProtectiveChecker {
     }
 
     /// After the full proof (or a clearance table's lookup) proved every pair FREE with the
-    /// sweeps of the table's tier about each robot's reference: keeps those balls (of every robot that has sweeps: every robot
-    /// of a pair that can meet) and marks every pair proved for them.
+    /// sweeps of the table's tier about each robot's reference: keeps those balls (of every robot
+    /// that has sweeps: every robot of a pair that can meet) and marks every pair proved for them.
     pub(super) fn keep_references(&mut self) {
         for j in 0..self.kept.balls.len() {
             if self.robots[j].tier == Some((0, 0)) {
@@ -166,7 +175,10 @@ impl ProtectiveChecker {
         let balls = &self.kept.balls;
         let pairs = &self.exact.verdict().pairs;
         for (slot, p) in self.kept.pairs.iter_mut().zip(pairs) {
-            *slot = balls[p.a].as_ref().zip(balls[p.b].as_ref()).map(|(a, b)| (a.generation, b.generation, true));
+            *slot = balls[p.a]
+                .as_ref()
+                .zip(balls[p.b].as_ref())
+                .map(|(a, b)| (a.generation, b.generation, true));
         }
     }
 
@@ -187,7 +199,13 @@ impl ProtectiveChecker {
             Some(c) if self.exact.boxes_in_wcs(j, &c, &mut ball.boxes).is_ok() => ball.centre = c,
             _ => ball.boxes = reference.boxes,
         }
-        ball.sweeps = stop_sweeps_wcs(&robot.model, rot, &ball.centre, radius, self.model.tables[j].as_deref());
+        ball.sweeps = stop_sweeps_wcs(
+            &robot.model,
+            rot,
+            &ball.centre,
+            radius,
+            self.model.tables[j].as_deref(),
+        );
         ball.faces = [[self.model.no_faces; MAX_BOXES]; 2];
         ball.set_faces();
         ball.graded = graded_radii(&robot.model, radius);
@@ -219,8 +237,12 @@ mod tests {
     fn kept_balls_hold_their_own_boxes_and_the_stop() {
         let text = include_str!("../../../c_harness/scenarios.txt");
         for s in parse_scenarios(text).unwrap().iter().filter(|s| s.case == "practical") {
-            let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, alloc::vec![StopModel::DEFAULT; 2]).unwrap();
-            let mut c = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let cell = reference_cell(&s.cell)
+                .unwrap()
+                .with_stopping(1.0, alloc::vec![StopModel::DEFAULT; 2])
+                .unwrap();
+            let mut c =
+                ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
             let mut exact = ExactChecker::new(cell);
             let (mut tcps, mut moved, mut last) = ([Vec3::zeros(); 2], 0, [None; 2]);
             for tick in 0..RUN_TICKS {
@@ -236,11 +258,17 @@ mod tests {
                     at[j] = k.ball.centre;
                     exact.place_boxes(&at).unwrap();
                     for (x, y) in k.ball.boxes.as_slice().iter().zip(exact.boxes(j).as_slice()) {
-                        let close = (x.center - y.center).norm() < 1e-9 && (x.axes - y.axes).norm() < 1e-12;
-                        assert!(close && x.half == y.half, "{} tick {tick} robot {j}: {x:?} {y:?}", s.cell);
+                        let close =
+                            (x.center - y.center).norm() < 1e-9 && (x.axes - y.axes).norm() < 1e-12;
+                        assert!(
+                            close && x.half == y.half,
+                            "{} tick {tick} robot {j}: {x:?} {y:?}",
+                            s.cell
+                        );
                     }
                     let (_, (centre, radius)) = c.robots[j].stop_ball;
-                    let inside = (centre - k.ball.centre).norm() + radius <= k.ball.radius * (1.0 + 1e-12);
+                    let inside =
+                        (centre - k.ball.centre).norm() + radius <= k.ball.radius * (1.0 + 1e-12);
                     let (sc, ss) = (tcps[j], c.robots[j].stop_ball.0);
                     assert!(
                         inside || (sc - k.ball.centre).norm() + ss <= k.ball.radius * (1.0 + 1e-12),

@@ -9,11 +9,11 @@
 //! # Why a lookup proves FREE
 //! Let robot `j`'s stop ball be `B(c_j, R_j)` (its stop reference, module doc of
 //! `protective`, step 3: the capsule's ball when the boxes at its centre exist, else the ball
-//! of radius `S` around the TCP now): every TCP of the whole stop lies in it. Its sweeps (step 4, the table's tier of
-//! motor angles, either form) bound the displacement of every box point, for every
-//! reachable TCP of that ball, from the same point of the boxes at `c_j`; so no box point of
-//! robot `j` moves further than `d_j`, the largest [`crate::geometry::Sweep::radius`] of its boxes, from
-//! where it is at `c_j`, until `j` stands still. A clearance table certifies `L`: every
+//! of radius `S` around the TCP now): every TCP of the whole stop lies in it. Its sweeps (step 4,
+//! the table's tier of motor angles, either form) bound the displacement of every box point, for
+//! every reachable TCP of that ball, from the same point of the boxes at `c_j`; so no box point of
+//! robot `j` moves further than `d_j`, the largest [`crate::geometry::Sweep::radius`] of its boxes,
+//! from where it is at `c_j`, until `j` stands still. A clearance table certifies `L`: every
 //! configuration of the table cell of `(c_A, c_B)` (both TCPs, each in its own MCS) has
 //! clearance at least `L`, in particular `(c_A, c_B)` itself. Any point `x` of a box of A
 //! and `y` of a box of B during the stop come from points `x0`, `y0` of those boxes at
@@ -24,8 +24,8 @@
 //!
 //! Only FREE is answered this way, pair by pair. Where the bound does not prove a pair, the
 //! pair takes the full proof, unchanged, so table mode never answers worse than exact mode,
-//! and better only where the lookup's proof holds. A WARN from the lookup (`L > d_A + d_B` alone) is
-//! not answered: the full proof may still prove FREE there.
+//! and better only where the lookup's proof holds. A WARN from the lookup (`L > d_A + d_B` alone)
+//! is not answered: the full proof may still prove FREE there.
 //!
 //! # The clearance reported
 //! Unchanged: every tick with status OK computes the exact clearance before any proof.
@@ -83,12 +83,17 @@ impl ProtectiveChecker {
 
     /// Whether `bound` proves robots `a` and `b` apart with `warn_mm` to spare (module doc).
     fn pair_proved(&mut self, bound: ClearanceBound, a: usize, b: usize) -> bool {
-        let Some(at_centres) = bound(a, b, &[self.robots[a].reference.centre, self.robots[b].reference.centre]) else { return false };
+        let Some(at_centres) =
+            bound(a, b, &[self.robots[a].reference.centre, self.robots[b].reference.centre])
+        else {
+            return false;
+        };
         // A lower link's sweep at its platform joint's end, and a platform's or tool's sweep,
         // hold the ball of the stop's radius (module doc of `protective`, step 6), so
         // `d_j >= R_j`: where the bound cannot exceed
         // that, the sweeps are not computed (the proof may still need them).
-        let least = self.robots[a].reference.radius + self.robots[b].reference.radius + self.model.warn_mm;
+        let least =
+            self.robots[a].reference.radius + self.robots[b].reference.radius + self.model.warn_mm;
         if at_centres.partial_cmp(&least) != Some(core::cmp::Ordering::Greater) {
             return false;
         }

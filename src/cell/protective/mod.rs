@@ -91,9 +91,9 @@
 //!    picked: here its centre `p0` and the two points `p0 +- S w / |w|` of the ball
 //!    (`w = E_i - G_i`, the lower link of the box's arm at `p0`: the gradient of `th_i` is
 //!    parallel to `w`, so these are where the angle is largest and smallest to first order),
-//!    those that are reachable. Step 4's sweep of a box depends on the enclosure only through its arm's
-//!    `dth = max(th.hi - th(p0), th(p0) - th.lo)`, and grows with it on every axis, at both
-//!    ends (the elbow's chord `2 rf sin(dth / 2)`, the arc's `sin dth` and `1 - cos dth`, all
+//!    those that are reachable. Step 4's sweep of a box depends on the enclosure only through
+//!    its arm's `dth = max(th.hi - th(p0), th(p0) - th.lo)`, and grows with it on every axis,
+//!    at both ends (the elbow's chord `2 rf sin(dth / 2)`, the arc's `sin dth` and `1 - cos dth`, all
 //!    increasing on `[0, pi]`; the TCP terms do not depend on it). So the sweeps built from
 //!    the hull of those angles alone ([`ProtectiveChecker::least_sweeps`]: each angle taken
 //!    `ANGLE_SLACK` toward `th(p0)`, far above the rounding of the inverse kinematics, and
@@ -101,9 +101,9 @@
 //!    `>= 0`: every ball holds `BOUND_SLACK`) have, on every axis and in both forms, a support
 //!    at most that of the sweeps of any tier. When they do not prove the limiting box pair of
 //!    tier 1 apart on the axes of step 5 (with `warn_mm` for a WARN; the graded axis depends
-//!    on the reference boxes and radii, not on the tier), no refinement of tier 2 proves it: the pairs
-//!    before it stay proved (a narrower angle range, a smaller sweep), it stays the first
-//!    unproved one, and the verdict and limiting pair are final without tier 2's direct
+//!    on the reference boxes and radii, not on the tier), no refinement of tier 2 proves it:
+//!    the pairs before it stay proved (a narrower angle range, a smaller sweep), it stays the
+//!    first unproved one, and the verdict and limiting pair are final without tier 2's direct
 //!    enclosures. This test only ends a search for a proof; it never proves anything.
 //! 8. **Certain STOP, first.** Any box pair that steps 6 or 7 show no tier can prove apart
 //!    makes the tick STOP, whatever the other pairs give: the verdict does not depend on the
@@ -175,13 +175,13 @@ mod request;
 mod speed_limit;
 mod stop_sweeps;
 mod witness;
+pub use clock::{TickTime, TimingFault, MAX_INTERVAL_TICKS, MIN_INTERVAL_TICKS};
 pub use kept::{KEPT_MARGIN_MM, KEPT_WIDEN};
 pub use lookup::{ClearanceBound, LOOKUP_SLACK_MM};
-pub use clock::{TickTime, TimingFault, MAX_INTERVAL_TICKS, MIN_INTERVAL_TICKS};
 pub use path::{path_through_samples, StopPath, MAX_PATH_POINTS};
 pub use request::ProtectiveRequest;
-pub use stop_sweeps::{stop_sweeps_wcs, SweepForms};
 use stop_sweeps::{first_unproved_between, stop_sweeps_wcs_into, SweptBall};
+pub use stop_sweeps::{stop_sweeps_wcs, SweepForms};
 
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`STOP_SPLITS^3` per
 /// arm). The cubes here are tens to hundreds of mm, where finer splits shrink the sweeps by
@@ -328,9 +328,20 @@ impl ProtectiveReport {
     fn head(&self) -> ProtectiveReport {
         let (verdict, status, clearance_mm, closest, limiting) =
             (self.verdict, self.status, self.clearance_mm, self.closest, self.limiting);
-        let (kept_proof, table_lookup, table_pairs) = (self.kept_proof, self.table_lookup, self.table_pairs);
+        let (kept_proof, table_lookup, table_pairs) =
+            (self.kept_proof, self.table_lookup, self.table_pairs);
         let robots = alloc::vec::Vec::new();
-        ProtectiveReport { verdict, status, clearance_mm, closest, limiting, robots, kept_proof, table_lookup, table_pairs }
+        ProtectiveReport {
+            verdict,
+            status,
+            clearance_mm,
+            closest,
+            limiting,
+            robots,
+            kept_proof,
+            table_lookup,
+            table_pairs,
+        }
     }
 }
 
@@ -463,13 +474,17 @@ impl ProtectiveChecker {
 
     fn build(cell: Cell, warn_mm: Real, motor_tables: bool) -> Result<Self, CellError> {
         if !(warn_mm.is_finite() && warn_mm >= 0.0) {
-            return Err(CellError::Invalid(alloc::format!("warn_mm = {warn_mm} must be finite and >= 0")));
+            return Err(CellError::Invalid(alloc::format!(
+                "warn_mm = {warn_mm} must be finite and >= 0"
+            )));
         }
         let n = cell.robots.len();
-        let mut tables: alloc::vec::Vec<Option<Arc<MotorTable>>> = alloc::vec::Vec::with_capacity(n);
+        let mut tables: alloc::vec::Vec<Option<Arc<MotorTable>>> =
+            alloc::vec::Vec::with_capacity(n);
         for robot in &cell.robots {
             let table = if motor_tables {
-                let shared = tables.iter().flatten().find(|t| *t.delta() == robot.model.delta).cloned();
+                let shared =
+                    tables.iter().flatten().find(|t| *t.delta() == robot.model.delta).cloned();
                 Some(shared.unwrap_or_else(|| Arc::new(MotorTable::new(&robot.model.delta))))
             } else {
                 None
@@ -502,7 +517,11 @@ impl ProtectiveChecker {
             tier: None,
             stale: true,
         };
-        let pair = PairState { clearance: CoherentClearance::new(), axis: Vec3::zeros(), table_proved: false };
+        let pair = PairState {
+            clearance: CoherentClearance::new(),
+            axis: Vec3::zeros(),
+            table_proved: false,
+        };
         let model = Model {
             tables,
             warn_mm,
@@ -544,7 +563,8 @@ impl ProtectiveChecker {
         ProtectiveChecker { model: Model { speed_limits: on, ..self.model }, ..self }
     }
 
-    /// Turns the speed limits of the ticks to come on or off ([`ProtectiveChecker::with_speed_limits`]).
+    /// Turns the speed limits of the ticks to come on or off
+    /// ([`ProtectiveChecker::with_speed_limits`]).
     pub fn set_speed_limits(&mut self, on: bool) {
         self.model.speed_limits = on;
     }
@@ -640,10 +660,15 @@ impl ProtectiveChecker {
     /// # Errors
     /// [`QueryError::WrongRobotCount`] when the TCPs, or the paths when given, are not one per
     /// robot (the history and the last call's time are then left as they were).
-    pub fn check<'r>(&mut self, request: impl Into<ProtectiveRequest<'r>>) -> Result<&ProtectiveReport, QueryError> {
+    pub fn check<'r>(
+        &mut self,
+        request: impl Into<ProtectiveRequest<'r>>,
+    ) -> Result<&ProtectiveReport, QueryError> {
         let request = request.into();
         let n = self.cell().robots.len();
-        for len in [request.tcps_mcs.len(), if request.paths.is_empty() { n } else { request.paths.len() }] {
+        for len in
+            [request.tcps_mcs.len(), if request.paths.is_empty() { n } else { request.paths.len() }]
+        {
             if len != n {
                 return Err(QueryError::WrongRobotCount { expected: n, found: len });
             }
@@ -697,7 +722,11 @@ impl ProtectiveChecker {
     ///
     /// # Errors
     /// As [`ProtectiveChecker::check`].
-    pub fn check_with_table(&mut self, tcps_mcs: &[Vec3], bound: ClearanceBound) -> Result<&ProtectiveReport, QueryError> {
+    pub fn check_with_table(
+        &mut self,
+        tcps_mcs: &[Vec3],
+        bound: ClearanceBound,
+    ) -> Result<&ProtectiveReport, QueryError> {
         self.check(ProtectiveRequest::new(tcps_mcs).with_table(bound))
     }
 
@@ -717,12 +746,13 @@ impl ProtectiveChecker {
             }
             let Some(prev) = self.robots[j].history.tcp else { continue };
             let velocity = (tcp - prev) / dt;
-            let plausible = |x: Real, limit: Real| x <= limit * (1.0 + PLAUSIBLE_SLACK) + PLAUSIBLE_SLACK;
+            let plausible =
+                |x: Real, limit: Real| x <= limit * (1.0 + PLAUSIBLE_SLACK) + PLAUSIBLE_SLACK;
             // Two averages over consecutive intervals differ by at most `a_max` times the
             // distance between the intervals' middles.
-            let accel_ok = self.robots[j].history
-                .velocity
-                .is_none_or(|(v, before)| plausible((velocity - v).norm(), stop.max_accel_mm_s2 * (before + dt) / 2.0));
+            let accel_ok = self.robots[j].history.velocity.is_none_or(|(v, before)| {
+                plausible((velocity - v).norm(), stop.max_accel_mm_s2 * (before + dt) / 2.0)
+            });
             if !plausible(velocity.norm(), stop.max_speed_mm_s) || !accel_ok {
                 status = worse(status, ProtectiveStatus::ImplausibleMotion(j));
             }
@@ -776,15 +806,24 @@ impl ProtectiveChecker {
 
     /// The verdict with paths (counts checked by the caller): the better of the one without
     /// paths and the one along them.
-    fn paths_bounded(&mut self, tcps_mcs: &[Vec3], paths: &[Option<StopPath>], bound: Option<ClearanceBound>) {
+    fn paths_bounded(
+        &mut self,
+        tcps_mcs: &[Vec3],
+        paths: &[Option<StopPath>],
+        bound: Option<ClearanceBound>,
+    ) {
         self.check_bounded(tcps_mcs, bound);
         if self.report.status != ProtectiveStatus::Ok {
             return;
         }
-        let invalid = paths.iter().zip(tcps_mcs).position(|(p, tcp)| p.as_ref().is_some_and(|p| !path::path_is_valid(p, tcp)));
+        let invalid = paths
+            .iter()
+            .zip(tcps_mcs)
+            .position(|(p, tcp)| p.as_ref().is_some_and(|p| !path::path_is_valid(p, tcp)));
         if let Some(j) = invalid {
             let report = &mut self.report;
-            (report.verdict, report.status, report.limiting) = (Protective::Stop, ProtectiveStatus::InvalidPath(j), None);
+            (report.verdict, report.status, report.limiting) =
+                (Protective::Stop, ProtectiveStatus::InvalidPath(j), None);
             report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = 0.0);
             self.forget_motion();
             return;
@@ -842,7 +881,13 @@ impl ProtectiveChecker {
     /// is asked for); a proof kept for wider balls needs sweeps only where those widen; the
     /// table's bounds read this tick's sweeps of the table's tier, which the proof in tiers
     /// then reuses.
-    fn evaluate(&mut self, tcps_mcs: &[Vec3], status: ProtectiveStatus, from_history: bool, table: Option<ClearanceBound>) {
+    fn evaluate(
+        &mut self,
+        tcps_mcs: &[Vec3],
+        status: ProtectiveStatus,
+        from_history: bool,
+        table: Option<ClearanceBound>,
+    ) {
         let last = self.report.verdict;
         self.clear_report(status);
         if status != ProtectiveStatus::Ok {
@@ -868,8 +913,10 @@ impl ProtectiveChecker {
     /// The report of a tick not yet decided: STOP with `status`, nothing measured.
     fn clear_report(&mut self, status: ProtectiveStatus) {
         let report = &mut self.report;
-        (report.verdict, report.status, report.clearance_mm) = (Protective::Stop, status, Real::NAN);
-        (report.closest, report.limiting, report.kept_proof, report.table_lookup) = (None, None, false, false);
+        (report.verdict, report.status, report.clearance_mm) =
+            (Protective::Stop, status, Real::NAN);
+        (report.closest, report.limiting, report.kept_proof, report.table_lookup) =
+            (None, None, false, false);
         report.table_pairs = 0;
         self.pairs.iter_mut().for_each(|p| p.table_proved = false);
     }
@@ -919,7 +966,8 @@ impl ProtectiveChecker {
         }
         let was_stop = last == Protective::Stop;
         let closest = self.report.closest?;
-        self.reference_pair_stops(tcps_mcs, closest, was_stop).then_some(Settled::CertainStop(closest))
+        self.reference_pair_stops(tcps_mcs, closest, was_stop)
+            .then_some(Settled::CertainStop(closest))
     }
 
     /// FREE by balls wider than the stop balls, kept after a FREE tick (`protective/kept.rs`).
@@ -984,10 +1032,13 @@ impl ProtectiveChecker {
             Settled::Witnessed(pair) | Settled::CertainStop(pair) => {
                 (report.verdict, report.limiting) = (Protective::Stop, Some(pair))
             }
-            Settled::Proved(verdict, limiting) => (report.verdict, report.limiting) = (verdict, limiting),
+            Settled::Proved(verdict, limiting) => {
+                (report.verdict, report.limiting) = (verdict, limiting)
+            }
         }
         let seek = self.model.certain_stops_first && !matches!(settled, Settled::Witnessed(_));
-        if let (true, Protective::Stop, Some(p)) = (seek, self.report.verdict, self.report.closest) {
+        if let (true, Protective::Stop, Some(p)) = (seek, self.report.verdict, self.report.closest)
+        {
             self.seek_witness(p, points);
         }
     }
@@ -997,7 +1048,9 @@ impl ProtectiveChecker {
     /// pair by pair: a line's STOP is often found before most robots need any.
     fn prove(&mut self) -> (Protective, Option<BoxPair>) {
         let passes = [(0.0, Protective::Stop), (self.model.warn_mm, Protective::Warn)];
-        for (extra, verdict) in passes.into_iter().filter(|&(extra, v)| v == Protective::Stop || extra > 0.0) {
+        for (extra, verdict) in
+            passes.into_iter().filter(|&(extra, v)| v == Protective::Stop || extra > 0.0)
+        {
             for k in 0..self.exact.verdict().pairs.len() {
                 let p = self.exact.verdict().pairs[k];
                 if self.pairs[k].table_proved {
@@ -1009,7 +1062,9 @@ impl ProtectiveChecker {
                     }
                 }
                 let (ra, rb) = (&self.robots[p.a].reference, &self.robots[p.b].reference);
-                if let Some((box_a, box_b)) = first_unproved_between(ra, rb, extra, &self.pairs[k].axis) {
+                if let Some((box_a, box_b)) =
+                    first_unproved_between(ra, rb, extra, &self.pairs[k].axis)
+                {
                     return (verdict, Some(BoxPair { a: p.a, b: p.b, box_a, box_b }));
                 }
             }
@@ -1036,7 +1091,18 @@ impl ProtectiveChecker {
         let stop = cell.stops[j];
         let reaction_s = (stop.reaction_ms + cell.tick_ms) * 1e-3;
         let s = stop.stopping_distance(self.speed_bound(j, v), reaction_s);
-        (s, capsule_ball(&stop, self.calls.interval_s, reaction_s, tcp_mcs, &self.robots[j].velocity, v, s))
+        (
+            s,
+            capsule_ball(
+                &stop,
+                self.calls.interval_s,
+                reaction_s,
+                tcp_mcs,
+                &self.robots[j].velocity,
+                v,
+                s,
+            ),
+        )
     }
 
     /// Every robot's reference for this tick's stop ball ([`ProtectiveChecker::reference_at`]),
@@ -1058,9 +1124,15 @@ impl ProtectiveChecker {
 
     /// [`ProtectiveChecker::stop_reference`] from `S` and the ball already computed by
     /// [`ProtectiveChecker::stop_ball`] for this robot, TCP and speed.
-    fn reference_at(&mut self, j: usize, tcp_mcs: &Vec3, (s, (centre, radius)): (Real, (Vec3, Real))) -> Real {
+    fn reference_at(
+        &mut self,
+        j: usize,
+        tcp_mcs: &Vec3,
+        (s, (centre, radius)): (Real, (Vec3, Real)),
+    ) -> Real {
         let robot = &mut self.robots[j];
-        let (centre, radius) = match self.exact.boxes_in_wcs(j, &centre, &mut robot.reference.boxes) {
+        let (centre, radius) = match self.exact.boxes_in_wcs(j, &centre, &mut robot.reference.boxes)
+        {
             Ok(()) if centre != *tcp_mcs => (centre, radius),
             _ => {
                 robot.reference.boxes = *self.exact.boxes(j);
@@ -1068,7 +1140,8 @@ impl ProtectiveChecker {
             }
         };
         (robot.reference.centre, robot.reference.radius, robot.tier) = (centre, radius, None);
-        robot.reference.graded = certain_stop::graded_radii(&self.exact.cell().robots[j].model, radius);
+        robot.reference.graded =
+            certain_stop::graded_radii(&self.exact.cell().robots[j].model, radius);
         s
     }
 
@@ -1086,7 +1159,8 @@ impl ProtectiveChecker {
     /// arms in the bit mask `arms`).
     fn sweeps_at(&mut self, j: usize, tier: u32, arms: u8) {
         // Without a table, tier 1 is already the direct enclosure: a second tier repeats it.
-        let (tier, arms) = if tier == 0 || self.model.tables[j].is_none() { (0, 0) } else { (tier, arms) };
+        let (tier, arms) =
+            if tier == 0 || self.model.tables[j].is_none() { (0, 0) } else { (tier, arms) };
         if self.robots[j].tier == Some((tier, arms)) {
             return;
         }
@@ -1098,7 +1172,6 @@ impl ProtectiveChecker {
         r.set_faces();
         self.robots[j].tier = Some((tier, arms));
     }
-
 }
 
 /// How a step of the tick settled its verdict ([`ProtectiveChecker::evaluate`]).
@@ -1168,7 +1241,10 @@ fn worse(a: ProtectiveStatus, b: ProtectiveStatus) -> ProtectiveStatus {
 
 /// Whether `a` and `b` hold the same numbers, bit for bit (NaN equal to itself).
 fn same_bits(a: &[Vec3], b: &[Vec3]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.iter().zip(y.iter()).all(|(p, q)| p.to_bits() == q.to_bits()))
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| x.iter().zip(y.iter()).all(|(p, q)| p.to_bits() == q.to_bits()))
 }
 
 /// The signed clearance of the cell as of the exact checker's last check (SPEC §8: the gap
@@ -1216,8 +1292,12 @@ mod tests {
     fn certain_stops_first_change_no_verdict() {
         let text = include_str!("../../../c_harness/scenarios.txt");
         for s in crate::cell::trajectory::parse_scenarios(text).unwrap().iter() {
-            let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, vec![StopModel::DEFAULT; 2]).unwrap();
-            let mut first = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let cell = reference_cell(&s.cell)
+                .unwrap()
+                .with_stopping(1.0, vec![StopModel::DEFAULT; 2])
+                .unwrap();
+            let mut first =
+                ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
             let mut plain = first.clone();
             plain.model.certain_stops_first = false;
             let (mut tcps, mut early, mut stops) = ([Vec3::zeros(); 2], 0, 0);
@@ -1226,7 +1306,13 @@ mod tests {
                 let v = first.check(&tcps).unwrap().verdict;
                 early += usize::from(v == Protective::Stop && first.robots.iter().any(|r| r.stale));
                 stops += usize::from(v == Protective::Stop);
-                assert_eq!(plain.check(&tcps).unwrap().verdict, v, "{} {} tick {tick}", s.cell, s.case);
+                assert_eq!(
+                    plain.check(&tcps).unwrap().verdict,
+                    v,
+                    "{} {} tick {tick}",
+                    s.cell,
+                    s.case
+                );
             }
             let (cell, case) = (&s.cell, &s.case);
             assert!(early > 50, "{cell} {case}: {early} of {stops} STOPs settled by step 8");
@@ -1278,7 +1364,8 @@ mod tests {
             c.check(at(cycle, &tcps)).unwrap();
             assert!(cycle < 6000, "no witness on T2's collision run");
         }
-        let speeds_unknown = |c: &ProtectiveChecker| c.report().robots.iter().all(|r| r.speed_mm_s.is_infinite());
+        let speeds_unknown =
+            |c: &ProtectiveChecker| c.report().robots.iter().all(|r| r.speed_mm_s.is_infinite());
         // Each fault relative to the last call's cycle: the same one with other TCPs, one
         // before it, and past the largest interval.
         type Fault = (fn(u64) -> u64, TimingFault);
@@ -1295,7 +1382,10 @@ mod tests {
             }
             let r = c.check(at(time, &sent)).unwrap();
             assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Timing(fault)));
-            assert!(!c.witness.is_kept() && c.robots.iter().all(|r| r.history.tcp.is_none()), "{fault:?}");
+            assert!(
+                !c.witness.is_kept() && c.robots.iter().all(|r| r.history.tcp.is_none()),
+                "{fault:?}"
+            );
             // Back in step: the next call's speeds are unknown, its own witness search aside.
             cycle = time + 1;
             s.tcps_at(cycle as u32, &mut tcps);
@@ -1355,7 +1445,10 @@ mod tests {
         let (a, b) = (Vec3::new(-150.0, 0.0, -450.0), Vec3::new(150.0, 0.0, -450.0));
         c.check(&[a, b]).unwrap();
         let r = c.check(&[a + Vec3::new(10.0, 0.0, 0.0), b]).unwrap();
-        assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::ImplausibleMotion(0)));
+        assert_eq!(
+            (r.verdict, r.status),
+            (Protective::Stop, ProtectiveStatus::ImplausibleMotion(0))
+        );
         let r = c.check(&[a, Vec3::new(0.0, 0.0, 100.0)]).unwrap();
         assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Unreachable(1)));
         let r = c.check(&[a, Vec3::new(Real::NAN, 0.0, -450.0)]).unwrap();

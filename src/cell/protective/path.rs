@@ -27,7 +27,8 @@
 //!
 //! A path that breaks its promise at once (the TCP now is farther than `tol` from `Q`, a
 //! non-finite point or tolerance, a negative tolerance, no point) is
-//! [`ProtectiveStatus::InvalidPath`](super::ProtectiveStatus::InvalidPath): STOP. Nothing here allocates.
+//! [`ProtectiveStatus::InvalidPath`](super::ProtectiveStatus::InvalidPath): STOP. Nothing here
+//! allocates.
 
 use super::certain_stop::graded_radii;
 use super::stop_sweeps::SweptBall;
@@ -95,7 +96,8 @@ pub fn arc_range(points: &[Vec3], c: &Vec3, r: Real) -> Option<(Real, Real)> {
     for w in points.windows(2) {
         let d = w[1] - w[0];
         let len = d.norm();
-        // |w0 + t d - c|^2 <= r^2 for t in [0, 1]: t^2 |d|^2 + 2 t d.(w0 - c) + |w0 - c|^2 - r^2 <= 0.
+        // |w0 + t d - c|^2 <= r^2 for t in [0, 1]: t^2 |d|^2 + 2 t d.(w0 - c) + |w0 - c|^2 - r^2 <=
+        // 0.
         let f = w[0] - c;
         let (qa, qb, qc) = (d.norm_squared(), 2.0 * d.dot(&f), f.norm_squared() - r * r);
         if qa == 0.0 {
@@ -146,7 +148,12 @@ pub fn path_is_valid(path: &StopPath, tcp: &Vec3) -> bool {
 /// first sample at least `length_mm` along it (or the last sample, where the robot holds).
 /// Returns the number of points written, or `None` when `out` is too short for that: a path
 /// cut short would break its promise.
-pub fn path_through_samples(samples: &[Vec3], length_mm: Real, tolerance_mm: Real, out: &mut [Vec3]) -> Option<usize> {
+pub fn path_through_samples(
+    samples: &[Vec3],
+    length_mm: Real,
+    tolerance_mm: Real,
+    out: &mut [Vec3],
+) -> Option<usize> {
     *out.first_mut()? = *samples.first()?;
     let (mut n, mut start, mut arc) = (1, 0, 0.0);
     for i in 1..samples.len() {
@@ -187,7 +194,9 @@ impl ProtectiveChecker {
             (Some(p), Some(range)) => Some(piece_ball(p.points, range, p.tolerance_mm)),
             _ => None,
         };
-        let ball = ball.filter(|&(c, r)| r < reference.radius && self.exact.boxes_in_wcs(j, &c, &mut boxes).is_ok());
+        let ball = ball.filter(|&(c, r)| {
+            r < reference.radius && self.exact.boxes_in_wcs(j, &c, &mut boxes).is_ok()
+        });
         let (centre, radius, arc) = match ball {
             Some((c, r)) => (c, r, arc),
             None => {
@@ -195,7 +204,8 @@ impl ProtectiveChecker {
                 (reference.centre, reference.radius, None)
             }
         };
-        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.model.tables[j].as_deref());
+        let sweeps =
+            stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.model.tables[j].as_deref());
         let faces = [[self.model.no_faces; MAX_BOXES]; 2];
         let graded = graded_radii(&robot.model, radius);
         let mut ball = SweptBall { centre, radius, boxes, sweeps, faces, graded };
@@ -222,13 +232,8 @@ impl ProtectiveChecker {
         (depth_a, depth_b): (u32, u32),
         extra: Real,
     ) -> Option<BoxPair> {
-        let unproved = first_unproved_between(
-            &pa.ball,
-            &pb.ball,
-            extra,
-            &Vec3::zeros(),
-        )
-        .map(|(box_a, box_b)| BoxPair { a, b, box_a, box_b })?;
+        let unproved = first_unproved_between(&pa.ball, &pb.ball, extra, &Vec3::zeros())
+            .map(|(box_a, box_b)| BoxPair { a, b, box_a, box_b })?;
         let span = |p: &Piece| p.arc.map_or(-1.0, |(s0, s1)| s1 - s0);
         let split_a = depth_a < MAX_DEPTH && (span(pa) >= span(pb) || depth_b >= MAX_DEPTH);
         if split_a {
@@ -236,7 +241,9 @@ impl ProtectiveChecker {
                 let deeper = (depth_a + 1, depth_b);
                 return self
                     .prove_pieces((a, b), (path_a, path_b), &h1, pb, deeper, extra)
-                    .or_else(|| self.prove_pieces((a, b), (path_a, path_b), &h2, pb, deeper, extra));
+                    .or_else(|| {
+                        self.prove_pieces((a, b), (path_a, path_b), &h2, pb, deeper, extra)
+                    });
             }
         }
         if depth_b < MAX_DEPTH {
@@ -244,7 +251,9 @@ impl ProtectiveChecker {
                 let deeper = (depth_a, depth_b + 1);
                 return self
                     .prove_pieces((a, b), (path_a, path_b), pa, &h1, deeper, extra)
-                    .or_else(|| self.prove_pieces((a, b), (path_a, path_b), pa, &h2, deeper, extra));
+                    .or_else(|| {
+                        self.prove_pieces((a, b), (path_a, path_b), pa, &h2, deeper, extra)
+                    });
             }
         }
         Some(unproved)
@@ -272,7 +281,8 @@ impl ProtectiveChecker {
             for pair in &self.exact.verdict().pairs {
                 let (a, b) = (pair.a, pair.b);
                 let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
-                let found = self.prove_pieces((a, b), paths_ab, &whole(a), &whole(b), (0, 0), extra);
+                let found =
+                    self.prove_pieces((a, b), paths_ab, &whole(a), &whole(b), (0, 0), extra);
                 if found.is_some() {
                     return (verdict, found);
                 }
@@ -325,9 +335,16 @@ mod tests {
     #[test]
     fn a_path_through_samples_holds_every_sample_and_reaches_the_length() {
         // Samples along an L: 100 mm along x, then 100 mm along y, every 1 mm.
-        let samples: Vec<Vec3> = (0..=200)
-            .map(|i| if i <= 100 { v(i as Real, 0.0, 0.0) } else { v(100.0, (i - 100) as Real, 0.0) })
-            .collect();
+        let samples: Vec<Vec3> =
+            (0..=200)
+                .map(|i| {
+                    if i <= 100 {
+                        v(i as Real, 0.0, 0.0)
+                    } else {
+                        v(100.0, (i - 100) as Real, 0.0)
+                    }
+                })
+                .collect();
         let mut out = [Vec3::zeros(); 8];
         let n = path_through_samples(&samples, 150.0, 0.5, &mut out).unwrap();
         let path = &out[..n];
@@ -350,9 +367,15 @@ mod tests {
         assert!(path_is_valid(&path, &v(50.0, 0.5, -400.0)));
         assert!(!path_is_valid(&path, &v(50.0, 2.0, -400.0)));
         assert!(!path_is_valid(&StopPath { points: &[], tolerance_mm: 1.0 }, &v(0.0, 0.0, -400.0)));
-        assert!(!path_is_valid(&StopPath { tolerance_mm: Real::NAN, ..path }, &v(50.0, 0.0, -400.0)));
+        assert!(!path_is_valid(
+            &StopPath { tolerance_mm: Real::NAN, ..path },
+            &v(50.0, 0.0, -400.0)
+        ));
         assert!(!path_is_valid(&StopPath { tolerance_mm: -1.0, ..path }, &v(50.0, 0.0, -400.0)));
         let bad = [v(0.0, 0.0, -400.0), v(Real::INFINITY, 0.0, -400.0)];
-        assert!(!path_is_valid(&StopPath { points: &bad, tolerance_mm: 1.0 }, &v(0.0, 0.0, -400.0)));
+        assert!(!path_is_valid(
+            &StopPath { points: &bad, tolerance_mm: 1.0 },
+            &v(0.0, 0.0, -400.0)
+        ));
     }
 }

@@ -29,7 +29,8 @@ impl ProtectiveChecker {
             let tcp = &tcps_mcs[j];
             let start = self.robots[j].history.limit.filter(|_| from_history);
             let v = self.report.robots[j].speed_mm_s;
-            let floor = if proved_now && v <= self.cell().stops[j].max_speed_mm_s { v } else { 0.0 };
+            let floor =
+                if proved_now && v <= self.cell().stops[j].max_speed_mm_s { v } else { 0.0 };
             // What is left, but one test for each robot after this one (while there are any).
             let after = (n - 1 - i) as u32;
             let budget = if left > after { left - after } else { left.min(1) };
@@ -58,7 +59,11 @@ impl ProtectiveChecker {
         // `tier` None: only the certain-STOP test (no sweeps), which every tier needs to pass.
         let proved = |me: &mut Self, v: Real, tier: Option<u32>| {
             let s = me.stop_reference(j, tcp_mcs, v);
-            if me.kept.set_inside(j, &[(me.robots[j].reference.centre, me.robots[j].reference.radius), (*tcp_mcs, s)]) && me.kept_free(Some(j)) {
+            if me.kept.set_inside(
+                j,
+                &[(me.robots[j].reference.centre, me.robots[j].reference.radius), (*tcp_mcs, s)],
+            ) && me.kept_free(Some(j))
+            {
                 return true;
             }
             if me.report.closest.is_some_and(|h| (h.a == j || h.b == j) && me.ball_swept_meet(h)) {
@@ -91,7 +96,8 @@ impl ProtectiveChecker {
         // speeds, at least two steps apart), strictly between them: every search tests grid
         // speeds only, so that searches of the same proof end at the same bracket (`v_max` is
         // `2^LIMIT_STEPS` steps exactly; so is every grid speed a whole number of steps).
-        let middle = |lo: Real, hi: Real| lo + (0.5 * (hi - lo) / resolution).floor().max(1.0) * resolution;
+        let middle =
+            |lo: Real, hi: Real| lo + (0.5 * (hi - lo) / resolution).floor().max(1.0) * resolution;
         // From `lo` (proved) and `hi` (not), halves until they are `resolution` apart.
         let bisect = |me: &mut Self, (mut lo, mut hi): (Real, Real), tier: Option<u32>| {
             while hi - lo > resolution {
@@ -188,7 +194,9 @@ impl ProtectiveChecker {
                 }
                 step *= 2.0;
             }
-            let (Some(mut lo), Some(mut hi)) = (lo, hi) else { return (lo.unwrap_or(0.0), resolution) };
+            let (Some(mut lo), Some(mut hi)) = (lo, hi) else {
+                return (lo.unwrap_or(0.0), resolution);
+            };
             while hi - lo > resolution && hi > floor {
                 let mid = middle(lo, hi);
                 match test(me, mid) {

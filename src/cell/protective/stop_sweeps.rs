@@ -4,11 +4,11 @@
 
 use super::{BoxPair, STOP_SPLITS};
 use crate::cell::exact::PairVerdict;
-use crate::robot::motion_bound::{box_sweep_forms_into, theta_range, Enclosure};
 use crate::geometry::graded_closest::{graded_closest, GradedClosest};
 use crate::geometry::sweep::{swept_boxes_apart_either, Axes, FaceTerms};
 use crate::geometry::{Obb, Sweep};
 use crate::math::{Real, Vec3};
+use crate::robot::motion_bound::{box_sweep_forms_into, theta_range, Enclosure};
 use crate::robot::motor_table::MotorTable;
 use crate::robot::{RobotBoxes, RobotModel, MAX_BOXES};
 
@@ -36,7 +36,14 @@ impl SweptBall {
     /// sweep).
     pub(super) fn empty(faces: FaceTerms) -> SweptBall {
         let (sweeps, faces) = ([[Sweep::ZERO; MAX_BOXES]; 2], [[faces; MAX_BOXES]; 2]);
-        SweptBall { centre: Vec3::zeros(), radius: 0.0, boxes: RobotBoxes::empty(), sweeps, faces, graded: [[0.0; 2]; MAX_BOXES] }
+        SweptBall {
+            centre: Vec3::zeros(),
+            radius: 0.0,
+            boxes: RobotBoxes::empty(),
+            sweeps,
+            faces,
+            graded: [[0.0; 2]; MAX_BOXES],
+        }
     }
 
     /// Sets the face terms of every box from its sweeps.
@@ -86,21 +93,25 @@ pub(super) fn stop_sweeps_wcs_into(
         core::array::from_fn(|arm| theta_range(d, arm, lo, hi, splits))
     };
     let filled = match table.filter(|t| t.delta() == d) {
-        Some(t) => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| match t.enclose(lo, hi) {
-            Some(th) if precise > 0 => {
-                let refine = |arm: usize| arms >> arm & 1 == 1;
-                core::array::from_fn(|arm| {
-                    if refine(arm) {
-                        th[arm].intersect(theta_range(d, arm, lo, hi, precise))
-                    } else {
-                        th[arm]
-                    }
-                })
+        Some(t) => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| {
+            match t.enclose(lo, hi) {
+                Some(th) if precise > 0 => {
+                    let refine = |arm: usize| arms >> arm & 1 == 1;
+                    core::array::from_fn(|arm| {
+                        if refine(arm) {
+                            th[arm].intersect(theta_range(d, arm, lo, hi, precise))
+                        } else {
+                            th[arm]
+                        }
+                    })
+                }
+                Some(th) => th,
+                None => direct(lo, hi, STOP_SPLITS),
             }
-            Some(th) => th,
-            None => direct(lo, hi, STOP_SPLITS),
         }),
-        None => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| direct(lo, hi, STOP_SPLITS)),
+        None => box_sweep_forms_into(out, model, tcp_mcs, s, tcp_mcs, |lo, hi| {
+            direct(lo, hi, STOP_SPLITS)
+        }),
     };
     write_forms(out, filled, rot_wcs);
 }
@@ -131,7 +142,9 @@ pub(super) fn first_unproved<'a>(
     only: Option<usize>,
     extra: Real,
 ) -> Option<BoxPair> {
-    for (k, p) in pairs.iter().enumerate().filter(|(_, p)| only.is_none_or(|j| p.a == j || p.b == j)) {
+    for (k, p) in
+        pairs.iter().enumerate().filter(|(_, p)| only.is_none_or(|j| p.a == j || p.b == j))
+    {
         if let Some((box_a, box_b)) = first_unproved_between(ball(p.a), ball(p.b), extra, axis(k)) {
             return Some(BoxPair { a: p.a, b: p.b, box_a, box_b });
         }
@@ -181,14 +194,22 @@ fn swept_pair_apart(
 /// pair's (module doc of `protective`, step 5). Every sweep of a box holds its graded ball
 /// (step 6), so the direction looks where the sweeps come nearest; a function of the boxes and
 /// radii alone, so that the certain STOPs (steps 6 and 7) test the very axis the proof would.
-pub(super) fn graded_points((a, ra): (&Obb, [Real; 2]), (b, rb): (&Obb, [Real; 2]), extra: Real) -> GradedClosest {
+pub(super) fn graded_points(
+    (a, ra): (&Obb, [Real; 2]),
+    (b, rb): (&Obb, [Real; 2]),
+    extra: Real,
+) -> GradedClosest {
     graded_closest(a, ra.map(|r| r + extra), b, rb, &b.center)
 }
 
 /// Both forms of a sweep with `extra` mm added to their balls: the forms themselves for 0
 /// (`ball + 0` is `ball`: the tests of the speed limits ask this many times per tick), else
 /// copies kept in `wider`.
-fn with_extra<'a>(forms: [&'a Sweep; 2], extra: Real, wider: &'a mut Option<[Sweep; 2]>) -> [&'a Sweep; 2] {
+fn with_extra<'a>(
+    forms: [&'a Sweep; 2],
+    extra: Real,
+    wider: &'a mut Option<[Sweep; 2]>,
+) -> [&'a Sweep; 2] {
     if extra == 0.0 {
         return forms;
     }
@@ -202,11 +223,18 @@ pub(super) type GradedRadii = [[Real; 2]; MAX_BOXES];
 
 /// The first box pair `(i, k)` of two robots' swept boxes not proved apart with `extra` mm
 /// added to the first robot's sweeps, any combination of sweep forms allowed, on the 15 axes
-/// of each box pair, on `axis` or on the pair's graded axis ([`graded_points`]) (computed only for the pairs
-/// that the others leave unproved).
-pub(super) fn first_unproved_between(a: &SweptBall, b: &SweptBall, extra: Real, axis: &Vec3) -> Option<(usize, usize)> {
-    let (boxes_a, sweeps_a, faces_a, radii_a) = (a.boxes.as_slice(), &a.sweeps, &a.faces, &a.graded);
-    let (boxes_b, sweeps_b, faces_b, radii_b) = (b.boxes.as_slice(), &b.sweeps, &b.faces, &b.graded);
+/// of each box pair, on `axis` or on the pair's graded axis ([`graded_points`]) (computed only for
+/// the pairs that the others leave unproved).
+pub(super) fn first_unproved_between(
+    a: &SweptBall,
+    b: &SweptBall,
+    extra: Real,
+    axis: &Vec3,
+) -> Option<(usize, usize)> {
+    let (boxes_a, sweeps_a, faces_a, radii_a) =
+        (a.boxes.as_slice(), &a.sweeps, &a.faces, &a.graded);
+    let (boxes_b, sweeps_b, faces_b, radii_b) =
+        (b.boxes.as_slice(), &b.sweeps, &b.faces, &b.graded);
     let mut copy = None;
     if extra != 0.0 {
         let terms = copy.insert(*faces_a);
@@ -224,7 +252,12 @@ pub(super) fn first_unproved_between(a: &SweptBall, b: &SweptBall, extra: Real, 
         for (k, box_b) in boxes_b.iter().enumerate() {
             let (fa, fb) = ([&widened[0][i], &widened[1][i]], [&faces_b[0][k], &faces_b[1][k]]);
             let sb = [&sweeps_b[0][k], &sweeps_b[1][k]];
-            if !swept_pair_apart((box_a, sa, fa, radii_a[i]), (box_b, sb, fb, radii_b[k]), extra, axis) {
+            if !swept_pair_apart(
+                (box_a, sa, fa, radii_a[i]),
+                (box_b, sb, fb, radii_b[k]),
+                extra,
+                axis,
+            ) {
                 return Some((i, k));
             }
         }

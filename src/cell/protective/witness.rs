@@ -69,7 +69,8 @@ impl ProtectiveChecker {
         let w = self.witness.witness?;
         let inside = |j: usize, q: &Vec3| {
             let (s, (centre, radius)) = self.robots[j].stop_ball;
-            (q - centre).norm() <= radius - INSIDE_SLACK_MM && (q - tcps_mcs[j]).norm() <= s - INSIDE_SLACK_MM
+            (q - centre).norm() <= radius - INSIDE_SLACK_MM
+                && (q - tcps_mcs[j]).norm() <= s - INSIDE_SLACK_MM
         };
         (inside(w.pair.a, &w.tcps[0]) && inside(w.pair.b, &w.tcps[1])).then_some(w.pair)
     }
@@ -96,18 +97,29 @@ impl ProtectiveChecker {
         let Some(u) = toward.try_normalize(0.0) else { return };
         let (rot_a, rot_b) = (self.exact.rotation(closest.a), self.exact.rotation(closest.b));
         let (ua, ub) = (rot_a.transpose() * u, -(rot_b.transpose() * u));
-        let ((_, (ca, sa)), (_, (cb, sb))) = (self.robots[closest.a].stop_ball, self.robots[closest.b].stop_ball);
+        let ((_, (ca, sa)), (_, (cb, sb))) =
+            (self.robots[closest.a].stop_ball, self.robots[closest.b].stop_ball);
         for f in REACH_FRACTIONS {
             let (qa, qb) = (ca + ua * (f * sa), cb + ub * (f * sb));
-            let (Ok(ika), Ok(ikb)) =
-                (ra.model.delta.inverse_kinematics_cos_sin(&qa), rb.model.delta.inverse_kinematics_cos_sin(&qb))
-            else {
+            let (Ok(ika), Ok(ikb)) = (
+                ra.model.delta.inverse_kinematics_cos_sin(&qa),
+                rb.model.delta.inverse_kinematics_cos_sin(&qb),
+            ) else {
                 continue;
             };
-            let a = ra.model.box_from_cos_sin(&qa, &ika, closest.box_a).transformed(rot_a, &ra.placement.t);
-            let b = rb.model.box_from_cos_sin(&qb, &ikb, closest.box_b).transformed(rot_b, &rb.placement.t);
+            let a = ra
+                .model
+                .box_from_cos_sin(&qa, &ika, closest.box_a)
+                .transformed(rot_a, &ra.placement.t);
+            let b = rb
+                .model
+                .box_from_cos_sin(&qb, &ikb, closest.box_b)
+                .transformed(rot_b, &rb.placement.t);
             if boxes_overlap_deeply(&a, &b) {
-                self.witness = KeptWitness { witness: Some(Witness { pair: closest, tcps: [qa, qb] }), backoff: 0 };
+                self.witness = KeptWitness {
+                    witness: Some(Witness { pair: closest, tcps: [qa, qb] }),
+                    backoff: 0,
+                };
                 return;
             }
         }
@@ -131,22 +143,42 @@ mod tests {
     fn witnesses_are_collisions_within_the_stop() {
         let text = include_str!("../../../c_harness/scenarios.txt");
         for s in parse_scenarios(text).unwrap() {
-            let cell = reference_cell(&s.cell).unwrap().with_stopping(1.0, alloc::vec![StopModel::DEFAULT; 2]).unwrap();
-            let mut c = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
+            let cell = reference_cell(&s.cell)
+                .unwrap()
+                .with_stopping(1.0, alloc::vec![StopModel::DEFAULT; 2])
+                .unwrap();
+            let mut c =
+                ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
             let mut exact = ExactChecker::new(cell);
             let (mut tcps, mut witnessed, mut stops) = ([Vec3::zeros(); 2], 0, 0);
             for tick in 0..RUN_TICKS {
                 s.tcps_at(tick, &mut tcps);
                 let r = c.check(&tcps).unwrap().clone();
                 stops += usize::from(r.verdict == Protective::Stop);
-                let Some(w) = c.witness.witness.filter(|_| r.verdict == Protective::Stop) else { continue };
+                let Some(w) = c.witness.witness.filter(|_| r.verdict == Protective::Stop) else {
+                    continue;
+                };
                 witnessed += 1;
                 for (j, q) in [(w.pair.a, w.tcps[0]), (w.pair.b, w.tcps[1])] {
-                    assert!((q - tcps[j]).norm() <= r.robots[j].protective_mm, "{} {} tick {tick}", s.cell, s.case);
+                    assert!(
+                        (q - tcps[j]).norm() <= r.robots[j].protective_mm,
+                        "{} {} tick {tick}",
+                        s.cell,
+                        s.case
+                    );
                 }
-                assert!(exact.check(&w.tcps).unwrap().collides(), "{} {} tick {tick}: {w:?}", s.cell, s.case);
+                assert!(
+                    exact.check(&w.tcps).unwrap().collides(),
+                    "{} {} tick {tick}: {w:?}",
+                    s.cell,
+                    s.case
+                );
             }
-            std::eprintln!("{} {}: {witnessed} of {stops} STOP ticks with a witness", s.cell, s.case);
+            std::eprintln!(
+                "{} {}: {witnessed} of {stops} STOP ticks with a witness",
+                s.cell,
+                s.case
+            );
             if s.case == "collision" {
                 assert!(3 * witnessed > stops, "{} {}: {witnessed} of {stops}", s.cell, s.case);
             }

@@ -45,10 +45,16 @@ pub(crate) fn clearance_counts(
         return Err(format!("{} labels for {} x {nb} pairs", labels.len(), rows.count(na)));
     }
     let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
-    let (sweeps_a, empty_a, refs_a) =
-        (cell_sweeps(&ra.model, &grid_a), unreachable_cells(&ra.model, &grid_a), references(&ra.model, &grid_a));
-    let (sweeps_b, empty_b, refs_b) =
-        (cell_sweeps(&rb.model, &grid_b), unreachable_cells(&rb.model, &grid_b), references(&rb.model, &grid_b));
+    let (sweeps_a, empty_a, refs_a) = (
+        cell_sweeps(&ra.model, &grid_a),
+        unreachable_cells(&ra.model, &grid_a),
+        references(&ra.model, &grid_a),
+    );
+    let (sweeps_b, empty_b, refs_b) = (
+        cell_sweeps(&rb.model, &grid_b),
+        unreachable_cells(&rb.model, &grid_b),
+        references(&rb.model, &grid_b),
+    );
     let b = SampleBoxes::new(&rb.model, &rb.placement, &refs_b, |s| {
         if empty_b[s] {
             Inflation::Unreachable
@@ -60,10 +66,14 @@ pub(crate) fn clearance_counts(
     let a_at: Vec<SampleBoxes> = ladder_mm
         .iter()
         .map(|&extra| {
-            SampleBoxes::new(&ra.model, &ra.placement, &refs_a, |s| match (empty_a[s], inflation(sweeps_a[s])) {
-                (true, _) => Inflation::Unreachable,
-                (false, Inflation::Swept(sw)) => Inflation::Swept(sw.map(|w| Sweep { ball: w.ball + extra, ..w })),
-                (false, other) => other,
+            SampleBoxes::new(&ra.model, &ra.placement, &refs_a, |s| {
+                match (empty_a[s], inflation(sweeps_a[s])) {
+                    (true, _) => Inflation::Unreachable,
+                    (false, Inflation::Swept(sw)) => {
+                        Inflation::Swept(sw.map(|w| Sweep { ball: w.ball + extra, ..w }))
+                    }
+                    (false, other) => other,
+                }
             })
         })
         .collect();
@@ -77,7 +87,9 @@ pub(crate) fn clearance_counts(
             if labels[j * nb + ib] == Label::Free {
                 *c = proved_levels(ladder_mm, |i| {
                     let a = &a_at[i];
-                    a.slot[ia] == Slot::Boxes && b.slot[ib] == Slot::Boxes && !entries_collide(a, ia, &b, ib)
+                    a.slot[ia] == Slot::Boxes
+                        && b.slot[ib] == Slot::Boxes
+                        && !entries_collide(a, ia, &b, ib)
                 });
             }
         }

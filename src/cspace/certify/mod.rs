@@ -89,18 +89,17 @@ pub use subdivided_labels::SubdividedLabels;
 use crate::cell::{Cell, RobotSpec};
 use crate::cspace::guarantee::CELL_SPLITS;
 use crate::cspace::label::{
-    entries_collide, label_pairs, label_rows_except, two_robot_grids, Inflation, Progress, RowLabeller, Rows,
-    SampleBoxes,
+    entries_collide, label_pairs, label_rows_except, two_robot_grids, Inflation, Progress,
+    RowLabeller, Rows, SampleBoxes,
 };
-use crate::cspace::symmetry::{in_stored_half, mirror_samples, reflection_y};
 use crate::cspace::sampler::{SampleGrid, Workspace};
+use crate::cspace::symmetry::{in_stored_half, mirror_samples, reflection_y};
 use crate::cspace::{Label, LabelledSpace, PairLabels};
-use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
+use crate::robot::MAX_BOXES;
 use refine::{octants_prove_free, sub_cell_masks, sub_cells, Levels, SubOctants, UnknownCells};
 use sweeps::{cell_sweeps, inflation, octants, reference_octants, references, unreachable_cells};
-
 
 /// Sub-boxes per axis when enclosing the motor angles over an octant (an octant is half as
 /// wide as a cell, so this gives the same sub-box size as [`CELL_SPLITS`] on a cell).
@@ -179,7 +178,11 @@ impl MirrorRows {
             return None;
         }
         let b = mirror_samples(grid_b).into_iter().collect::<Option<Vec<_>>>()?;
-        let a = grid_a.cells.iter().zip(mirror_samples(grid_a)).map(|(&c, m)| m.filter(|_| !in_stored_half(grid_a, c)));
+        let a = grid_a
+            .cells
+            .iter()
+            .zip(mirror_samples(grid_a))
+            .map(|(&c, m)| m.filter(|_| !in_stored_half(grid_a, c)));
         Some(MirrorRows { a: a.collect(), b })
     }
 
@@ -187,7 +190,12 @@ impl MirrorRows {
     /// mirror row, read from `labels` when `rows` holds it and labelled by `row_of` otherwise
     /// (the rows of a shard): label `(ia, ib)` is that of `(a[ia], b[ib])`. Rows are written in
     /// parallel, the mirror rows read from a copy of the labels (a quarter byte per pair).
-    fn fill(&self, labels: &mut PairLabels, rows: Rows, row_of: impl Fn(usize) -> Vec<Label> + Sync) {
+    fn fill(
+        &self,
+        labels: &mut PairLabels,
+        rows: Rows,
+        row_of: impl Fn(usize) -> Vec<Label> + Sync,
+    ) {
         if self.b.is_empty() {
             return;
         }
@@ -244,7 +252,12 @@ pub fn label_space_certified(
     ws: &Workspace,
     progress: Progress,
 ) -> Result<CertifiedSpace, String> {
-    label_space_certified_with(cell, k, ws, &CertifyConfig { refinement: Refinement::Octants, progress })
+    label_space_certified_with(
+        cell,
+        k,
+        ws,
+        &CertifyConfig { refinement: Refinement::Octants, progress },
+    )
 }
 
 /// As [`label_space_certified`], and every pair labelled collision is subdivided into its 64
@@ -259,7 +272,12 @@ pub fn label_space_subdivided(
     ws: &Workspace,
     progress: Progress,
 ) -> Result<CertifiedSpace, String> {
-    label_space_certified_with(cell, k, ws, &CertifyConfig { refinement: Refinement::SubCells, progress })
+    label_space_certified_with(
+        cell,
+        k,
+        ws,
+        &CertifyConfig { refinement: Refinement::SubCells, progress },
+    )
 }
 
 /// Certified labels of every sample pair of the two-robot `cell` at `k` cells per axis,
@@ -343,13 +361,17 @@ pub(crate) fn certify_rows_then<R>(
     let (grid_a, grid_b) = two_robot_grids(cell, k, ws)?;
     let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
     let (sweeps_a, sweeps_b) = (cell_sweeps(&ra.model, &grid_a), cell_sweeps(&rb.model, &grid_b));
-    let (empty_a, empty_b) = (unreachable_cells(&ra.model, &grid_a), unreachable_cells(&rb.model, &grid_b));
+    let (empty_a, empty_b) =
+        (unreachable_cells(&ra.model, &grid_a), unreachable_cells(&rb.model, &grid_b));
     let (refs_a, refs_b) = (references(&ra.model, &grid_a), references(&rb.model, &grid_b));
     let a0 = whole_cell_boxes(ra, &refs_a, &sweeps_a, &empty_a);
     let b0 = whole_cell_boxes(rb, &refs_b, &sweeps_b, &empty_b);
-    let radii = |ss: &[[Sweep; MAX_BOXES]]| ss.iter().map(|s| s.map(|w| w.radius())).collect::<Vec<_>>();
+    let radii =
+        |ss: &[[Sweep; MAX_BOXES]]| ss.iter().map(|s| s.map(|w| w.radius())).collect::<Vec<_>>();
     let (bounds_a, bounds_b) = (radii(&sweeps_a), radii(&sweeps_b));
-    let used = |bs: &[[Real; MAX_BOXES]]| bs.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0, Real::max);
+    let used = |bs: &[[Real; MAX_BOXES]]| {
+        bs.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0, Real::max)
+    };
     let margin = used(&bounds_a).max(used(&bounds_b));
     let certified = |labels, sub, sub_secs: f64, grid_a, grid_b| {
         let space = LabelledSpace { grid_a, grid_b, labels, margin };
@@ -373,16 +395,19 @@ pub(crate) fn certify_rows_then<R>(
         Levels::with_references(&b0, &b1, reference_octants(&grid_b, &refs_b)),
     );
     if subdivide {
-        (la.subs, lb.subs) = (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
+        (la.subs, lb.subs) =
+            (Some(SubOctants::new(ra, &grid_a)), Some(SubOctants::new(rb, &grid_b)));
     }
-    let collides = |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
+    let collides =
+        |ia, ib| entries_collide(&xa, ia, &xb, ib) || !octants_prove_free(&la, &lb, ia, ib);
     // A symmetric cell's lower half takes its mirror rows' labels (module doc, "Symmetric cells").
     let mirror = MirrorRows::of(cell, &grid_a, &grid_b);
     let reflected = |ia: usize| mirror.as_ref().is_some_and(|m| m.a[ia].is_some());
     let labeller = RowLabeller::new(&b0);
     let unknown = UnknownCells::new(&la, &lb);
     let refine_row = |ia, row: &mut [Label]| unknown.refine_row(&la, &lb, ia, row);
-    let mut labels = label_rows_except(&labeller, &a0, collides, rows, progress, reflected, refine_row);
+    let mut labels =
+        label_rows_except(&labeller, &a0, collides, rows, progress, reflected, refine_row);
     if let Some(m) = &mirror {
         m.fill(&mut labels, rows, |ia| {
             let mut row = vec![Label::Collision; b0.len()];
@@ -399,14 +424,20 @@ pub(crate) fn certify_rows_then<R>(
     }
     let start = std::time::Instant::now();
     let stored = stored_half(cell, &grid_a);
-    let sub = subdivide.then(|| sub_cells(&la, &lb, &labels, rows, |ia| stored.as_ref().is_none_or(|s| s[ia])));
+    let sub = subdivide
+        .then(|| sub_cells(&la, &lb, &labels, rows, |ia| stored.as_ref().is_none_or(|s| s[ia])));
     let sub_secs = start.elapsed().as_secs_f64();
     Ok(then(certified(labels, sub, sub_secs, ga, gb), None))
 }
 
 /// One robot's level-1 boxes: at each sample's reference point `refs[s]`, swept by its
 /// whole-cell displacement sets (`Unreachable` where the whole cell is, `empty[s]`).
-fn whole_cell_boxes(robot: &RobotSpec, refs: &[Vec3], sweeps: &[[Sweep; MAX_BOXES]], empty: &[bool]) -> SampleBoxes {
+fn whole_cell_boxes(
+    robot: &RobotSpec,
+    refs: &[Vec3],
+    sweeps: &[[Sweep; MAX_BOXES]],
+    empty: &[bool],
+) -> SampleBoxes {
     let inflate = |s: usize| if empty[s] { Inflation::Unreachable } else { inflation(sweeps[s]) };
     SampleBoxes::new(&robot.model, &robot.placement, refs, inflate)
 }
@@ -422,10 +453,10 @@ mod tests {
     use super::refine::*;
     use super::sweeps::octant_centre;
     use super::*;
-    use crate::geometry::Obb;
-    use crate::cspace::label::{all_box_pairs, Slot};
     use crate::cell::reference::reference_cell;
+    use crate::cspace::label::{all_box_pairs, Slot};
     use crate::cspace::{label_space, Label};
+    use crate::geometry::Obb;
 
     /// Certified labels only add collisions to the exact centre labels, are "unreachable" only
     /// where the centre is, and refinement only removes collisions that level 1 could not
@@ -436,11 +467,14 @@ mod tests {
         for name in ["T2", "T3"] {
             let cell = reference_cell(name).unwrap();
             let exact = label_space(&cell, 16, &ws, 0.0, Progress::Silent).unwrap();
-            let whole_cells = CertifyConfig { refinement: Refinement::WholeCells, progress: Progress::Silent };
+            let whole_cells =
+                CertifyConfig { refinement: Refinement::WholeCells, progress: Progress::Silent };
             let coarse = label_space_certified_with(&cell, 16, &ws, &whole_cells).unwrap();
             let fine = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap();
             let (mut freed, mut added) = (0, 0);
-            for ((e, c), f) in exact.labels.iter().zip(coarse.space.labels.iter()).zip(fine.space.labels.iter()) {
+            for ((e, c), f) in
+                exact.labels.iter().zip(coarse.space.labels.iter()).zip(fine.space.labels.iter())
+            {
                 assert!(f != Label::Unreachable || e == Label::Unreachable);
                 assert_eq!(c == Label::Unreachable, f == Label::Unreachable);
                 assert!(e != Label::Collision || f == Label::Collision);
@@ -457,10 +491,20 @@ mod tests {
     fn level_boxes(cell: &Cell, k: u32) -> (SampleBoxes, SampleBoxes, SampleBoxes, SampleBoxes) {
         let (grid_a, grid_b) = two_robot_grids(cell, k, &Workspace::THESIS).unwrap();
         let whole = |r: &RobotSpec, g: &SampleGrid| {
-            whole_cell_boxes(r, &references(&r.model, g), &cell_sweeps(&r.model, g), &unreachable_cells(&r.model, g))
+            whole_cell_boxes(
+                r,
+                &references(&r.model, g),
+                &cell_sweeps(&r.model, g),
+                &unreachable_cells(&r.model, g),
+            )
         };
         let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
-        (whole(ra, &grid_a), octant_boxes(ra, &grid_a), whole(rb, &grid_b), octant_boxes(rb, &grid_b))
+        (
+            whole(ra, &grid_a),
+            octant_boxes(ra, &grid_a),
+            whole(rb, &grid_b),
+            octant_boxes(rb, &grid_b),
+        )
     }
 
     /// The labels of A's lower half taken from the mirror rows ([`MirrorRows`]) are those the
@@ -492,7 +536,8 @@ mod tests {
     #[allow(clippy::type_complexity)]
     fn cell_at_16(
         name: &str,
-    ) -> (Cell, (SampleGrid, SampleGrid), (SampleBoxes, SampleBoxes, SampleBoxes, SampleBoxes)) {
+    ) -> (Cell, (SampleGrid, SampleGrid), (SampleBoxes, SampleBoxes, SampleBoxes, SampleBoxes))
+    {
         let cell = reference_cell(name).unwrap();
         let grids = two_robot_grids(&cell, 16, &Workspace::THESIS).unwrap();
         let boxes = level_boxes(&cell, 16);
@@ -508,7 +553,9 @@ mod tests {
         held: bool,
     ) -> Levels<'a> {
         let mut levels = match held {
-            true => Levels::with_references(whole, octs, reference_octants(g, &references(&r.model, g))),
+            true => {
+                Levels::with_references(whole, octs, reference_octants(g, &references(&r.model, g)))
+            }
             false => Levels::new(whole, octs),
         };
         levels.subs = Some(SubOctants::new(r, g));
@@ -522,7 +569,8 @@ mod tests {
     fn sub_cells_are_those_of_the_plain_octant_tests() {
         for name in ["T1", "T2", "T3"] {
             let cell = reference_cell(name).unwrap();
-            let c = label_space_subdivided(&cell, 16, &Workspace::THESIS, Progress::Silent).unwrap();
+            let c =
+                label_space_subdivided(&cell, 16, &Workspace::THESIS, Progress::Silent).unwrap();
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let nb = b0.len();
             let mut want = SubCells::default();
@@ -530,7 +578,9 @@ mod tests {
             let stored = stored_half(&cell, &c.space.grid_a);
             assert_eq!(stored.is_some(), name != "T3");
             let kept = |p: usize| stored.as_ref().is_none_or(|s| s[p / nb]);
-            for (p, _) in c.space.labels.iter().enumerate().filter(|&(p, l)| l == Label::Collision && kept(p)) {
+            for (p, _) in
+                c.space.labels.iter().enumerate().filter(|&(p, l)| l == Label::Collision && kept(p))
+            {
                 let (care, collision) = octant_pairs(&a0, &a1, &b0, &b1, p / nb, p % nb, false);
                 want.pairs.push(p as u64);
                 want.care.push(care);
@@ -543,7 +593,11 @@ mod tests {
                 "{name}: the fast sub-cells differ from the plain ones"
             );
             let got = c.sub.as_ref().unwrap();
-            assert_eq!((&got.pairs, &got.care), (&want.pairs, &want.care), "{name}: pairs and care masks");
+            assert_eq!(
+                (&got.pairs, &got.care),
+                (&want.pairs, &want.care),
+                "{name}: pairs and care masks"
+            );
             let (mut before, mut after) = (0, 0);
             for (g, w) in got.collision.iter().zip(&want.collision) {
                 assert_eq!(g & !w, 0, "{name}: level 3 made a sub-cell a collision");
@@ -555,7 +609,11 @@ mod tests {
             for ia in (0..a0.len()).filter(|&ia| !unreachable(&a0, ia)) {
                 for ib in (0..nb).filter(|&ib| !unreachable(&b0, ib)) {
                     let plain = octant_pairs(&a0, &a1, &b0, &b1, ia, ib, true).1 == 0;
-                    assert_eq!(octants_prove_free(&a, &b, ia, ib), plain, "{name} pair ({ia}, {ib})");
+                    assert_eq!(
+                        octants_prove_free(&a, &b, ia, ib),
+                        plain,
+                        "{name} pair ({ia}, {ib})"
+                    );
                 }
             }
         }
@@ -591,12 +649,24 @@ mod tests {
                             }
                             met += 1;
                             let (x, y) = (p / 8, p % 8);
-                            assert!(boxes_may_touch(&a1, sa * na + x, &b1, sb * nb + y), "{name} octants {sa} {sb}");
+                            assert!(
+                                boxes_may_touch(&a1, sa * na + x, &b1, sb * nb + y),
+                                "{name} octants {sa} {sb}"
+                            );
                             let (i, j) = (sa * na + x, ib * nb + y);
-                            assert!(boxes_may_touch(&a1, i, &b0, j), "{name} octant {sa}, cell {ib}");
+                            assert!(
+                                boxes_may_touch(&a1, i, &b0, j),
+                                "{name} octant {sa}, cell {ib}"
+                            );
                             let (i, j) = (ia * na + x, sb * nb + y);
-                            assert!(boxes_may_touch(&a0, i, &b1, j), "{name} cell {ia}, octant {sb}");
-                            assert!(boxes_may_touch(&a0, ia * na + x, &b0, ib * nb + y), "{name} cells {ia} {ib}");
+                            assert!(
+                                boxes_may_touch(&a0, i, &b1, j),
+                                "{name} cell {ia}, octant {sb}"
+                            );
+                            assert!(
+                                boxes_may_touch(&a0, ia * na + x, &b0, ib * nb + y),
+                                "{name} cells {ia} {ib}"
+                            );
                         }
                     }
                 }
@@ -613,19 +683,29 @@ mod tests {
         let ws = Workspace::THESIS;
         for name in ["T1", "T2", "T3"] {
             let (cell, (grid_a, grid_b), (a0, a1, b0, b1)) = cell_at_16(name);
-            let labels = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap().space.labels;
+            let labels =
+                label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap().space.labels;
             let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
             let levels = |fast: bool| {
-                (levels_with_subs((&a0, &a1), ra, &grid_a, fast), levels_with_subs((&b0, &b1), rb, &grid_b, fast))
+                (
+                    levels_with_subs((&a0, &a1), ra, &grid_a, fast),
+                    levels_with_subs((&b0, &b1), rb, &grid_b, fast),
+                )
             };
             let ((fa, fb), (pa, pb)) = (levels(true), levels(false));
             let nb = b0.len();
             let collisions = labels.iter().enumerate().filter(|&(_, l)| l == Label::Collision);
-            let decided = collisions.filter(|&(p, _)| held_by_references(&fa, &fb, p / nb, p % nb) != 0).count();
+            let decided = collisions
+                .filter(|&(p, _)| held_by_references(&fa, &fb, p / nb, p % nb) != 0)
+                .count();
             let fast = sub_cells(&fa, &fb, &labels, Rows::ALL, |_| true);
             let plain = sub_cells(&pa, &pb, &labels, Rows::ALL, |_| true);
             assert!(fast == plain, "{name}: the references' exit changed sub-cells");
-            assert!(decided > 1000, "{name}: {decided} of {} pairs decided by the references", fast.pairs.len());
+            assert!(
+                decided > 1000,
+                "{name}: {decided} of {} pairs decided by the references",
+                fast.pairs.len()
+            );
         }
     }
 
@@ -661,7 +741,8 @@ mod tests {
         let ws = Workspace::THESIS;
         for name in ["T1", "T2", "T3"] {
             let (cell, (grid_a, grid_b), (a0, a1, b0, b1)) = cell_at_16(name);
-            let labels = label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap().space.labels;
+            let labels =
+                label_space_certified(&cell, 16, &ws, Progress::Silent).unwrap().space.labels;
             let (ra, rb) = (&cell.robots[0], &cell.robots[1]);
             let a = levels_with_subs((&a0, &a1), ra, &grid_a, true);
             let b = levels_with_subs((&b0, &b1), rb, &grid_b, true);
@@ -669,11 +750,14 @@ mod tests {
             let all = all_box_pairs(a0.per_entry, b0.per_entry);
             let boxes = |s: &SampleBoxes, e: usize| s.slot[e] == Slot::Boxes;
             let (mut pairs, mut freed) = (0, 0);
-            for (p, _) in labels.iter().enumerate().filter(|&(_, l)| l == Label::Collision).step_by(3) {
+            for (p, _) in
+                labels.iter().enumerate().filter(|&(_, l)| l == Label::Collision).step_by(3)
+            {
                 let (ia, ib) = (p / nb, p % nb);
                 let (care, level_2) = octant_pairs(&a0, &a1, &b0, &b1, ia, ib, false);
                 let (whole_a, whole_b) = (boxes(&a0, ia), boxes(&b0, ib));
-                let open0 = if whole_a && whole_b { collision_mask(&a0, ia, &b0, ib, all) } else { all };
+                let open0 =
+                    if whole_a && whole_b { collision_mask(&a0, ia, &b0, ib, all) } else { all };
                 let mut want = level_2;
                 for (i, j) in (0..8).flat_map(|i| (0..8).map(move |j| (i, j))) {
                     let (sa, sb, bit) = (8 * ia + i, 8 * ib + j, 1u64 << sub_cell_index(i, j));
@@ -681,14 +765,19 @@ mod tests {
                         continue;
                     }
                     let row = if whole_b { collision_mask(&a1, sa, &b0, ib, open0) } else { open0 };
-                    let column = if whole_a { collision_mask(&a0, ia, &b1, sb, open0) } else { open0 };
+                    let column =
+                        if whole_a { collision_mask(&a0, ia, &b1, sb, open0) } else { open0 };
                     let open = collision_mask(&a1, sa, &b1, sb, row & column);
                     if sub_octants_prove_free_plainly(&a, &b, sa, sb, open) {
                         want &= !bit;
                         freed += 1;
                     }
                 }
-                assert_eq!(sub_cell_masks(&a, &b, ia, ib, false), (care, want), "{name} pair ({ia}, {ib})");
+                assert_eq!(
+                    sub_cell_masks(&a, &b, ia, ib, false),
+                    (care, want),
+                    "{name} pair ({ia}, {ib})"
+                );
                 pairs += 1;
             }
             assert!(freed > 1000, "{name}: {freed} octant pairs freed by level 3 in {pairs} pairs");
@@ -717,7 +806,9 @@ mod tests {
                     if open0 == 0 {
                         continue;
                     }
-                    for (sa, sb) in (0..8).flat_map(|i| (0..8).map(move |j| (8 * ia + i, 8 * ib + j))) {
+                    for (sa, sb) in
+                        (0..8).flat_map(|i| (0..8).map(move |j| (8 * ia + i, 8 * ib + j)))
+                    {
                         if !boxes(&a1, sa) || !boxes(&b1, sb) {
                             continue;
                         }
@@ -728,8 +819,13 @@ mod tests {
                             continue;
                         }
                         let first = open.trailing_zeros() as usize;
-                        let fast = sub_octants_prove_free(&a, &b, sa, sb, first, || open, &mut hint);
-                        assert_eq!(fast, sub_octants_prove_free_plainly(&a, &b, sa, sb, open), "{name} {sa} {sb}");
+                        let fast =
+                            sub_octants_prove_free(&a, &b, sa, sb, first, || open, &mut hint);
+                        assert_eq!(
+                            fast,
+                            sub_octants_prove_free_plainly(&a, &b, sa, sb, open),
+                            "{name} {sa} {sb}"
+                        );
                         (tried, freed) = (tried + 1, freed + fast as usize);
                     }
                 }
@@ -759,17 +855,23 @@ mod tests {
                     }
                     tried += 1;
                     let got = sub_cell_masks(&a, &b, ia, ib, false);
-                    assert_eq!(got, octant_pairs(&a0, &a1, &b0, &b1, ia, ib, false), "{name} pair ({ia}, {ib})");
-                    whole += cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) as usize;
-                    let octant_meets = |c: &[Option<Obb>], s: usize, d: &[Option<Obb>], e: usize, f: usize| {
-                        (0..8).any(|i| {
-                            if f == 0 {
-                                cores_meet(c, 8 * s + i, na, d, e, nb, all)
-                            } else {
-                                cores_meet(c, s, na, d, 8 * e + i, nb, all)
-                            }
-                        })
-                    };
+                    assert_eq!(
+                        got,
+                        octant_pairs(&a0, &a1, &b0, &b1, ia, ib, false),
+                        "{name} pair ({ia}, {ib})"
+                    );
+                    whole +=
+                        cores_meet(&a.whole_cores, ia, na, &b.whole_cores, ib, nb, all) as usize;
+                    let octant_meets =
+                        |c: &[Option<Obb>], s: usize, d: &[Option<Obb>], e: usize, f: usize| {
+                            (0..8).any(|i| {
+                                if f == 0 {
+                                    cores_meet(c, 8 * s + i, na, d, e, nb, all)
+                                } else {
+                                    cores_meet(c, s, na, d, 8 * e + i, nb, all)
+                                }
+                            })
+                        };
                     row += octant_meets(&a.oct_cores, ia, &b.whole_cores, ib, 0) as usize;
                     column += octant_meets(&a.whole_cores, ia, &b.oct_cores, ib, 1) as usize;
                 }
@@ -797,14 +899,20 @@ mod tests {
             let c = label_space_subdivided(&cell, 16, &ws, Progress::Silent).unwrap();
             let (a0, a1, b0, b1) = level_boxes(&cell, 16);
             let stored = stored_half(&cell, &c.space.grid_a);
-            let plain = sub_cells(&Levels::new(&a0, &a1), &Levels::new(&b0, &b1), &c.space.labels, Rows::ALL, |ia| {
-                stored.as_ref().is_none_or(|s| s[ia])
-            });
+            let plain = sub_cells(
+                &Levels::new(&a0, &a1),
+                &Levels::new(&b0, &b1),
+                &c.space.labels,
+                Rows::ALL,
+                |ia| stored.as_ref().is_none_or(|s| s[ia]),
+            );
             assert_eq!(plain.pairs, c.sub.as_ref().unwrap().pairs);
             let got = c.sub.as_ref().unwrap();
             let (ga, gb, nb) = (&c.space.grid_a, &c.space.grid_b, c.space.grid_b.cells.len());
             let mut exact = ExactChecker::new(Cell { method: SatMethod::Sat, ..cell.clone() });
-            let octant = |g: &SampleGrid, s: usize, o: usize| octant_centre(&g.sample_center(s), o, 0.25 * g.r);
+            let octant = |g: &SampleGrid, s: usize, o: usize| {
+                octant_centre(&g.sample_center(s), o, 0.25 * g.r)
+            };
             let (mut freed, mut checked, mut mirrored) = (0, 0, 0);
             for (e, &pair) in got.pairs.iter().enumerate() {
                 let (ia, ib) = (pair as usize / nb, pair as usize % nb);
@@ -840,8 +948,14 @@ mod tests {
                     }
                 }
             }
-            assert!(freed > 1000 && checked > 8 * freed, "{name}: {freed} freed sub-cells, {checked} configurations");
-            assert!(stored.is_none() || mirrored > 8 * freed, "{name}: {mirrored} mirror configurations");
+            assert!(
+                freed > 1000 && checked > 8 * freed,
+                "{name}: {freed} freed sub-cells, {checked} configurations"
+            );
+            assert!(
+                stored.is_none() || mirrored > 8 * freed,
+                "{name}: {mirrored} mirror configurations"
+            );
         }
     }
 }

@@ -2,11 +2,12 @@
 //! free with the octants' own sweeps, sub-octant pairs for what level 2 leaves open, and the
 //! sub-cell labels ([`SubCells`]) of the pairs that stay collisions.
 
+use super::sweeps::{inflation, octant_centre, octant_sweeps};
+use super::{sub_cell_index, SubCells};
 use crate::cell::RobotSpec;
-use crate::robot::motion_bound::reference_point;
 use crate::cspace::label::{
-    aabbs_apart, all_box_pairs, bounds_apart, boxes_may_touch, collision_mask, entries_apart, Inflation, Rows,
-    SampleBoxes, Slot, SweptBounds, SweptBox,
+    aabbs_apart, all_box_pairs, bounds_apart, boxes_may_touch, collision_mask, entries_apart,
+    Inflation, Rows, SampleBoxes, Slot, SweptBounds, SweptBox,
 };
 use crate::cspace::sampler::SampleGrid;
 use crate::cspace::{Label, PairLabels};
@@ -14,16 +15,14 @@ use crate::geometry::sat::separating_axis;
 use crate::geometry::sweep::{boxes_overlap_deeply, core};
 use crate::geometry::Obb;
 use crate::math::{max_or_nan, min_or_nan, Real, Vec3};
+use crate::robot::motion_bound::reference_point;
 use rayon::prelude::*;
-use super::sweeps::{inflation, octant_centre, octant_sweeps};
-use super::{sub_cell_index, SubCells};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;
 
 /// Rows of A whose sub-cells are found together ([`sub_cells`]; a cache blocking, any value
 /// gives the same answers).
 const SUB_CELL_ROWS: usize = 16;
-
 
 /// One robot's boxes at both levels with their cores ([`core`](fn@core): what every
 /// configuration of the (sub)cell covers; `None` for a box without one or an entry without
@@ -43,11 +42,22 @@ pub(super) struct Levels<'a> {
 
 impl<'a> Levels<'a> {
     pub(super) fn new(whole: &'a SampleBoxes, octs: &'a SampleBoxes) -> Self {
-        Levels { whole, octs, whole_cores: cores(whole), oct_cores: cores(octs), ref_octants: None, subs: None }
+        Levels {
+            whole,
+            octs,
+            whole_cores: cores(whole),
+            oct_cores: cores(octs),
+            ref_octants: None,
+            subs: None,
+        }
     }
 
     /// As [`Levels::new`], with the octants holding each sample's reference TCP.
-    pub(super) fn with_references(whole: &'a SampleBoxes, octs: &'a SampleBoxes, ref_octants: Vec<u8>) -> Self {
+    pub(super) fn with_references(
+        whole: &'a SampleBoxes,
+        octs: &'a SampleBoxes,
+        ref_octants: Vec<u8>,
+    ) -> Self {
         Levels { ref_octants: Some(ref_octants), ..Levels::new(whole, octs) }
     }
 }
@@ -91,8 +101,11 @@ impl<'a> SubOctants<'a> {
             let octant = octant_centre(&self.grid.sample_center(e / 8), e % 8, 0.25 * r);
             let h = 0.125 * r;
             let cs: Vec<Vec3> = (0..8).map(|u| octant_centre(&octant, u, h)).collect();
-            let refs: Vec<Vec3> = cs.iter().map(|c| reference_point(&model.delta, c, h).unwrap_or(*c)).collect();
-            let inflate = |u: usize| octant_sweeps(model, &cs[u], h, &refs[u]).map_or(Inflation::Vacuous, inflation);
+            let refs: Vec<Vec3> =
+                cs.iter().map(|c| reference_point(&model.delta, c, h).unwrap_or(*c)).collect();
+            let inflate = |u: usize| {
+                octant_sweeps(model, &cs[u], h, &refs[u]).map_or(Inflation::Vacuous, inflation)
+            };
             SampleBoxes::new(model, &self.robot.placement, &refs, inflate)
         })
     }
@@ -102,7 +115,8 @@ impl<'a> SubOctants<'a> {
 /// boxes and their bounds, the per-entry bounds and slots, and the vectors' headers.
 pub(crate) fn sub_octant_bytes(boxes: usize) -> usize {
     let per_box = size_of::<SweptBox>() + size_of::<SweptBounds>();
-    8 * (boxes * per_box + 2 * size_of::<[Real; 3]>() + size_of::<Slot>()) + 5 * size_of::<Vec<u8>>()
+    8 * (boxes * per_box + 2 * size_of::<[Real; 3]>() + size_of::<Slot>())
+        + 5 * size_of::<Vec<u8>>()
 }
 
 /// Whether level 3 proves octant pair (A's entry `sa`, B's entry `sb`) free: for each pair
@@ -136,9 +150,14 @@ pub(super) fn sub_octants_prove_free(
     // Each test's answers on each box pair, kept from the first time it is asked: the rows
     // (sub-octant `u` against B's octant), the columns (A's octant against sub-octant `v`)
     // and the hinted sub-octant pair, which the hinted exit and the full loop both ask.
-    let (mut rows, mut columns, mut hinted_pair) = ([Known::default(); 8], [Known::default(); 8], Known::default());
-    let row = |known: &mut Known, u: usize, mask: u64| known.open(mask, |m| collision_mask(x, u, b1, sb, m));
-    let column = |known: &mut Known, v: usize, mask: u64| known.open(mask, |m| collision_mask(a1, sa, y, v, m));
+    let (mut rows, mut columns, mut hinted_pair) =
+        ([Known::default(); 8], [Known::default(); 8], Known::default());
+    let row = |known: &mut Known, u: usize, mask: u64| {
+        known.open(mask, |m| collision_mask(x, u, b1, sb, m))
+    };
+    let column = |known: &mut Known, v: usize, mask: u64| {
+        known.open(mask, |m| collision_mask(a1, sa, y, v, m))
+    };
     // The pair that failed last first, on box pair `first`, finest test first: a collision
     // usually fails there.
     let (u0, v0) = (*hint / 8, *hint % 8);
@@ -151,7 +170,9 @@ pub(super) fn sub_octants_prove_free(
         return false;
     }
     let open = open();
-    if cores_meet(&a.oct_cores, sa, na, &b.oct_cores, sb, nb, open) || hinted && stays(open & !(1 << first)) {
+    if cores_meet(&a.oct_cores, sa, na, &b.oct_cores, sb, nb, open)
+        || hinted && stays(open & !(1 << first))
+    {
         return false;
     }
     // Then each sub-octant against the other octant, and the finest test for what is left. A
@@ -164,7 +185,11 @@ pub(super) fn sub_octants_prove_free(
         }
         for v in (0..8).filter(|&v| y.slot[v] == Slot::Boxes) {
             let both = left & column(&mut columns[v], v, left);
-            let met = if (u, v) == (u0, v0) { hinted_pair.open(both, |m| fine(u, v, m)) } else { fine(u, v, both) };
+            let met = if (u, v) == (u0, v0) {
+                hinted_pair.open(both, |m| fine(u, v, m))
+            } else {
+                fine(u, v, both)
+            };
             if met != 0 {
                 *hint = 8 * u + v;
                 return false;
@@ -218,7 +243,13 @@ impl Known {
 ///   sub-octant pair holding them is tried.
 ///
 /// It only skips tests whose answers it predicts; a "not free" is never a wrong answer.
-pub(super) fn meet_at_references(x: &SampleBoxes, ea: usize, y: &SampleBoxes, eb: usize, bit: usize) -> bool {
+pub(super) fn meet_at_references(
+    x: &SampleBoxes,
+    ea: usize,
+    y: &SampleBoxes,
+    eb: usize,
+    bit: usize,
+) -> bool {
     let (i, j) = (ea * x.per_entry + bit / 8, eb * y.per_entry + bit % 8);
     !bounds_apart(&x.bounds[i], &y.bounds[j]) && meet(&x.boxes[i], &y.boxes[j])
 }
@@ -275,7 +306,8 @@ pub(super) fn held_by_references(a: &Levels, b: &Levels, ia: usize, ib: usize) -
     if !met {
         return 0;
     }
-    let column = (0..8).filter(|&j| in_b >> j & 1 == 1).fold(0u64, |m, j| m | 1 << sub_cell_index(0, j));
+    let column =
+        (0..8).filter(|&j| in_b >> j & 1 == 1).fold(0u64, |m, j| m | 1 << sub_cell_index(0, j));
     (0..8).filter(|&i| in_a >> i & 1 == 1).fold(0, |m, i| m | column << sub_cell_index(i, 0))
 }
 
@@ -294,7 +326,15 @@ pub(super) fn cores(boxes: &SampleBoxes) -> Vec<Option<Obb>> {
 /// Whether some box pair among `mask` (as [`collision_mask`]) of A's entry `ia` and B's entry
 /// `ib` certainly intersects: their cores overlap deeply ([`boxes_overlap_deeply`]), so the
 /// boxes meet for every configuration of the two (sub)cells.
-pub(super) fn cores_meet(a: &[Option<Obb>], ia: usize, na: usize, b: &[Option<Obb>], ib: usize, nb: usize, mask: u64) -> bool {
+pub(super) fn cores_meet(
+    a: &[Option<Obb>],
+    ia: usize,
+    na: usize,
+    b: &[Option<Obb>],
+    ib: usize,
+    nb: usize,
+    mask: u64,
+) -> bool {
     let mut rest = mask;
     while rest != 0 {
         let bit = rest.trailing_zeros() as usize;
@@ -348,8 +388,11 @@ pub(super) fn sub_cells(
     // Each block's rows are freed as they are copied, and the copies never reallocate: the
     // peak stays near one copy of the sub-cells (at k = 64 on T2, gigabytes).
     let n = rows.iter().map(Vec::len).sum();
-    let mut out =
-        SubCells { pairs: Vec::with_capacity(n), care: Vec::with_capacity(n), collision: Vec::with_capacity(n) };
+    let mut out = SubCells {
+        pairs: Vec::with_capacity(n),
+        care: Vec::with_capacity(n),
+        collision: Vec::with_capacity(n),
+    };
     for (pair, care, collision) in rows.into_iter().flatten() {
         out.pairs.push(pair);
         out.care.push(care);
@@ -358,15 +401,17 @@ pub(super) fn sub_cells(
     out
 }
 
-
 /// The sub-cells of `(ia, ib)` that hold reachable TCPs of both robots: neither octant is
 /// [`Slot::Vacuous`].
 pub(super) fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize) -> u64 {
     // `sub_cell_index(i, j) = 8 sub_cell_index(i, 0) + sub_cell_index(0, j)`: B's occupied
     // octants as one byte, shifted to each occupied octant of A's byte.
-    let column =
-        (0..8).filter(|&j| b1.slot[8 * ib + j] != Slot::Vacuous).fold(0u64, |m, j| m | 1 << sub_cell_index(0, j));
-    (0..8).filter(|&i| a1.slot[8 * ia + i] != Slot::Vacuous).fold(0, |m, i| m | column << sub_cell_index(i, 0))
+    let column = (0..8)
+        .filter(|&j| b1.slot[8 * ib + j] != Slot::Vacuous)
+        .fold(0u64, |m, j| m | 1 << sub_cell_index(0, j));
+    (0..8)
+        .filter(|&i| a1.slot[8 * ia + i] != Slot::Vacuous)
+        .fold(0, |m, i| m | column << sub_cell_index(i, 0))
 }
 
 /// `(care, collision)` over the 64 octant pairs of `(ia, ib)`, as `octant_pairs` gives
@@ -388,7 +433,13 @@ pub(super) fn care_mask(a1: &SampleBoxes, ia: usize, b1: &SampleBoxes, ib: usize
 ///   its first box pair that no test proves.
 ///
 /// With `first_only`, stops at the first octant pair not proved free.
-pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first_only: bool) -> (u64, u64) {
+pub(super) fn sub_cell_masks(
+    a: &Levels,
+    b: &Levels,
+    ia: usize,
+    ib: usize,
+    first_only: bool,
+) -> (u64, u64) {
     let (a0, a1, b0, b1) = (a.whole, a.octs, b.whole, b.octs);
     let (na, nb) = (a0.per_entry, b0.per_entry);
     let care = care_mask(a1, ia, b1, ib);
@@ -430,7 +481,8 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
                 continue;
             }
             let (sa, sb) = (8 * ia + i, 8 * ib + j);
-            let decided = !boxes(a1, sa) || !boxes(b1, sb) || row_meet || column_meet || held & bit != 0;
+            let decided =
+                !boxes(a1, sa) || !boxes(b1, sb) || row_meet || column_meet || held & bit != 0;
             // Whether box pair `p` stays open: no test of the octant pair proves it.
             let mut open = |p: usize| {
                 rows.open(i, p, || !whole_b || touch(a1, sa, b0, ib, p))
@@ -463,7 +515,8 @@ pub(super) fn sub_cell_masks(a: &Levels, b: &Levels, ia: usize, ib: usize, first
                         // the search above did not reach, each tested once (every test is a
                         // function of its boxes, so the answers are those of testing all again).
                         let left = || {
-                            let rest = hint_first(open0 & !closed & !(1 << p), p).filter(|&q| open(q));
+                            let rest =
+                                hint_first(open0 & !closed & !(1 << p), p).filter(|&q| open(q));
                             rest.fold(1u64 << p, |m, q| m | 1 << q)
                         };
                         if sub_octants_prove_free(a, b, sa, sb, p, left, &mut hint3) {
@@ -541,7 +594,11 @@ pub(super) fn octant_pairs(
         if a_slot == Slot::Vacuous {
             continue;
         }
-        let open_a = if a_slot == Slot::Boxes && whole_b { collision_mask(a1, sa, b0, ib, open0) } else { open0 };
+        let open_a = if a_slot == Slot::Boxes && whole_b {
+            collision_mask(a1, sa, b0, ib, open0)
+        } else {
+            open0
+        };
         for j in 0..8 {
             let sb = 8 * ib + j;
             let b_slot = b1.slot[sb];
@@ -552,7 +609,9 @@ pub(super) fn octant_pairs(
             care |= bit;
             let proved = a_slot == Slot::Boxes && b_slot == Slot::Boxes && {
                 let open = if whole_a { collision_mask(a0, ia, b1, sb, open_a) } else { open_a };
-                open == 0 || entries_apart(a1, sa, b1, sb) || collision_mask(a1, sa, b1, sb, open) == 0
+                open == 0
+                    || entries_apart(a1, sa, b1, sb)
+                    || collision_mask(a1, sa, b1, sb, open) == 0
             };
             if !proved {
                 collision |= bit;
@@ -571,7 +630,13 @@ pub(super) fn octant_pairs(
 /// every pair of sub-octants with boxes each box pair of `open` is proved disjoint by
 /// (A sub-octant, B sub-octant), (A sub-octant, B octant) or (A octant, B sub-octant).
 #[cfg(test)]
-pub(super) fn sub_octants_prove_free_plainly(a: &Levels, b: &Levels, sa: usize, sb: usize, open: u64) -> bool {
+pub(super) fn sub_octants_prove_free_plainly(
+    a: &Levels,
+    b: &Levels,
+    sa: usize,
+    sb: usize,
+    open: u64,
+) -> bool {
     let (Some(sub_a), Some(sub_b)) = (&a.subs, &b.subs) else { return false };
     let (a1, b1, na, nb) = (a.octs, b.octs, a.octs.per_entry, b.octs.per_entry);
     let (x, y) = (sub_a.of(sa), sub_b.of(sb));
@@ -620,7 +685,8 @@ impl UnknownCells {
         let mut retry = |ib: usize| {
             if row[ib] == Label::Collision
                 && b0.slot[ib] != Slot::Unreachable
-                && (cover_apart(&self.cover_a[ia], &self.cover_b[ib]) || octants_prove_free(a, b, ia, ib))
+                && (cover_apart(&self.cover_a[ia], &self.cover_b[ib])
+                    || octants_prove_free(a, b, ia, ib))
             {
                 row[ib] = Label::Free;
             }
@@ -656,7 +722,10 @@ pub(super) fn octant_covers(octs: &SampleBoxes) -> Vec<Option<([Real; 3], [Real;
 }
 
 /// Whether two octant covers are apart (AABBs disjoint by more than the slack).
-pub(super) fn cover_apart(a: &Option<([Real; 3], [Real; 3])>, b: &Option<([Real; 3], [Real; 3])>) -> bool {
+pub(super) fn cover_apart(
+    a: &Option<([Real; 3], [Real; 3])>,
+    b: &Option<([Real; 3], [Real; 3])>,
+) -> bool {
     match (a, b) {
         (Some((alo, ahi)), Some((blo, bhi))) => aabbs_apart(alo, ahi, blo, bhi),
         _ => false,

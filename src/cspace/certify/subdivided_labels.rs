@@ -2,13 +2,12 @@
 //! spelled out on the grid of `2 k` cells per axis, so that the thesis's tables of them can be
 //! built as a baseline for the shared table of sub-cells.
 
+use super::{sub_cell_index, CertifiedSpace, SubCells};
 use crate::cell::Cell;
 use crate::cspace::label::two_robot_grids;
 use crate::cspace::sampler::{SampleGrid, Workspace};
 use crate::cspace::symmetry::{mirror_samples, reflection_y};
 use crate::cspace::{Label, LabelledSpace, PairLabels};
-use super::{sub_cell_index, CertifiedSpace, SubCells};
-
 
 /// Per sample of a grid: the index of its mirror sample (`iy -> k - 1 - iy`), if sampled.
 type Mirrors = Vec<Option<usize>>;
@@ -44,22 +43,32 @@ impl<'a> SubdividedLabels<'a> {
     ///
     /// # Errors
     /// When `certified` has no sub-cells, or as [`crate::cspace::label_space`].
-    pub fn new(cell: &Cell, ws: &Workspace, certified: &'a CertifiedSpace) -> Result<SubdividedLabels<'a>, String> {
+    pub fn new(
+        cell: &Cell,
+        ws: &Workspace,
+        certified: &'a CertifiedSpace,
+    ) -> Result<SubdividedLabels<'a>, String> {
         let sub = certified.sub.as_ref().ok_or("the labelling has no sub-cells")?;
         let coarse = &certified.space;
         let (grid_a, grid_b) = two_robot_grids(cell, 2 * coarse.grid_a.k, ws)?;
         let parents = |fine: &SampleGrid, coarse: &SampleGrid| -> Vec<Option<(u32, u8)>> {
             let of = |c: &[u16; 3]| {
                 let p = coarse.index_of([c[0] / 2, c[1] / 2, c[2] / 2])?;
-                Some((p as u32, (c[0] & 1) as u8 | ((c[1] & 1) as u8) << 1 | ((c[2] & 1) as u8) << 2))
+                Some((
+                    p as u32,
+                    (c[0] & 1) as u8 | ((c[1] & 1) as u8) << 1 | ((c[2] & 1) as u8) << 2,
+                ))
             };
             fine.cells.iter().map(of).collect()
         };
-        let (parent_a, parent_b) = (parents(&grid_a, &coarse.grid_a), parents(&grid_b, &coarse.grid_b));
+        let (parent_a, parent_b) =
+            (parents(&grid_a, &coarse.grid_a), parents(&grid_b, &coarse.grid_b));
         let nb0 = coarse.grid_b.cells.len() as u64;
-        let row_start =
-            (0..=coarse.grid_a.cells.len() as u64).map(|ia| sub.pairs.partition_point(|&p| p < ia * nb0)).collect();
-        let mirrors = reflection_y(cell).then(|| (mirror_samples(&coarse.grid_a), mirror_samples(&coarse.grid_b)));
+        let row_start = (0..=coarse.grid_a.cells.len() as u64)
+            .map(|ia| sub.pairs.partition_point(|&p| p < ia * nb0))
+            .collect();
+        let mirrors = reflection_y(cell)
+            .then(|| (mirror_samples(&coarse.grid_a), mirror_samples(&coarse.grid_b)));
         Ok(SubdividedLabels { coarse, sub, grid_a, grid_b, parent_a, parent_b, row_start, mirrors })
     }
 
@@ -67,7 +76,9 @@ impl<'a> SubdividedLabels<'a> {
     pub fn to_dense(&self) -> LabelledSpace {
         let nb = self.grid_b.cells.len();
         let ibs: Vec<u32> = (0..nb as u32).collect();
-        let labels = PairLabels::from_rows(self.grid_a.cells.len(), nb, |ia, row| self.row(Some(ia), &ibs, row));
+        let labels = PairLabels::from_rows(self.grid_a.cells.len(), nb, |ia, row| {
+            self.row(Some(ia), &ibs, row)
+        });
         let (grid_a, grid_b) = (self.grid_a.clone(), self.grid_b.clone());
         LabelledSpace { grid_a, grid_b, labels, margin: self.coarse.margin }
     }
@@ -112,7 +123,8 @@ impl<'a> SubdividedLabels<'a> {
             return Some(label);
         }
         let (first, last) = (self.row_start[pa], self.row_start[pa + 1]);
-        let e = first + self.sub.pairs[first..last].binary_search(&((pa * nb0 + pb) as u64)).ok()?;
+        let e =
+            first + self.sub.pairs[first..last].binary_search(&((pa * nb0 + pb) as u64)).ok()?;
         let bit = 1u64 << sub_cell_index(i, j);
         Some(if self.sub.care[e] & bit == 0 {
             Label::Unreachable
@@ -145,22 +157,25 @@ mod tests {
         let sub = c.sub.as_ref().unwrap();
         let (coarse, nb0) = (&c.space, c.space.grid_b.cells.len());
         let up = |g: &SampleGrid, x: &[u16; 3]| g.index_of([x[0] / 2, x[1] / 2, x[2] / 2]);
-        let octant = |x: &[u16; 3]| usize::from(x[0] & 1) | usize::from(x[1] & 1) << 1 | usize::from(x[2] & 1) << 2;
-        // The label spelled from the pair's own sub-cells; `None` for a collision pair without.
-        let own = |ca: &[u16; 3], cb: &[u16; 3]| match (up(&coarse.grid_a, ca), up(&coarse.grid_b, cb)) {
-            (Some(ia), Some(ib)) => match sub.get((ia * nb0 + ib) as u64) {
-                Some((care, collision)) => {
-                    let bit = 1u64 << sub_cell_index(octant(ca), octant(cb));
-                    Some(match (care & bit != 0, collision & bit != 0) {
-                        (false, _) => Label::Unreachable,
-                        (true, true) => Label::Collision,
-                        (true, false) => Label::Free,
-                    })
-                }
-                None => Some(coarse.label(ia, ib)).filter(|&l| l != Label::Collision),
-            },
-            _ => Some(Label::Unreachable),
+        let octant = |x: &[u16; 3]| {
+            usize::from(x[0] & 1) | usize::from(x[1] & 1) << 1 | usize::from(x[2] & 1) << 2
         };
+        // The label spelled from the pair's own sub-cells; `None` for a collision pair without.
+        let own =
+            |ca: &[u16; 3], cb: &[u16; 3]| match (up(&coarse.grid_a, ca), up(&coarse.grid_b, cb)) {
+                (Some(ia), Some(ib)) => match sub.get((ia * nb0 + ib) as u64) {
+                    Some((care, collision)) => {
+                        let bit = 1u64 << sub_cell_index(octant(ca), octant(cb));
+                        Some(match (care & bit != 0, collision & bit != 0) {
+                            (false, _) => Label::Unreachable,
+                            (true, true) => Label::Collision,
+                            (true, false) => Label::Free,
+                        })
+                    }
+                    None => Some(coarse.label(ia, ib)).filter(|&l| l != Label::Collision),
+                },
+                _ => Some(Label::Unreachable),
+            };
         let (mut seen, mut freed, mut mirrored) = (0, 0, 0);
         for (ja, ca) in fine.grid_a.cells.iter().enumerate() {
             for (jb, cb) in fine.grid_b.cells.iter().enumerate() {
@@ -174,7 +189,10 @@ mod tests {
                 assert_eq!(fine.label(ja, jb), want, "fine pair ({ja}, {jb})");
             }
         }
-        assert!(seen > 0 && freed > 0 && mirrored > 0, "{seen} pairs, {freed} sub-cells freed, {mirrored} mirrored");
+        assert!(
+            seen > 0 && freed > 0 && mirrored > 0,
+            "{seen} pairs, {freed} sub-cells freed, {mirrored} mirrored"
+        );
     }
 
     /// Whether the parent pair of fine cells `ca`, `cb` is labelled collision at `k`.

@@ -3,18 +3,17 @@
 //! symmetric cell gets symmetric labels (thesis 3.2.8), and which cells are proved
 //! unreachable.
 
+use super::OCTANT_SPLITS;
 use crate::cspace::guarantee::box_sweeps;
-use crate::robot::motion_bound::{cube_box_sweeps, cube_unreachable, reference_point};
 use crate::cspace::label::Inflation;
 use crate::cspace::sampler::SampleGrid;
 use crate::cspace::symmetry::mirror_cell;
-use crate::robot::MAX_BOXES;
 use crate::geometry::Sweep;
 use crate::math::{Real, Vec3};
+use crate::robot::motion_bound::{cube_box_sweeps, cube_unreachable, reference_point};
+use crate::robot::MAX_BOXES;
 use crate::robot::{BoxKind, RobotModel};
 use rayon::prelude::*;
-use super::OCTANT_SPLITS;
-
 
 /// Per sample: whether its whole cell is proved unreachable ([`cube_unreachable`]; only
 /// samples whose centre is unreachable are tried). Mirror-symmetric: a sample counts only
@@ -22,9 +21,14 @@ use super::OCTANT_SPLITS;
 pub(super) fn unreachable_cells(model: &RobotModel, grid: &SampleGrid) -> Vec<bool> {
     let raw: Vec<bool> = (0..grid.cells.len())
         .into_par_iter()
-        .map(|s| !grid.reachable[s] && cube_unreachable(&model.delta, &grid.sample_center(s), 0.5 * grid.r))
+        .map(|s| {
+            !grid.reachable[s]
+                && cube_unreachable(&model.delta, &grid.sample_center(s), 0.5 * grid.r)
+        })
         .collect();
-    (0..raw.len()).map(|s| raw[s] && grid.index_of(mirror_cell(grid, grid.cells[s])).is_none_or(|m| raw[m])).collect()
+    (0..raw.len())
+        .map(|s| raw[s] && grid.index_of(mirror_cell(grid, grid.cells[s])).is_none_or(|m| raw[m]))
+        .collect()
 }
 
 /// Box index of the mirror image under `y -> -y` (arms 1 and 2 swap).
@@ -42,8 +46,18 @@ pub(super) fn mirror_box(model: &RobotModel, j: usize) -> usize {
 /// arms 1 and 2 swap with equal motor angles, up to rounding: the table merges each label
 /// with its mirror's anyway, [`crate::table`]), so each term of `b` lies in the same term of
 /// the result.
-pub(super) fn mirror_max(model: &RobotModel, a: &[Sweep; MAX_BOXES], b: &[Sweep; MAX_BOXES]) -> [Sweep; MAX_BOXES] {
-    std::array::from_fn(|j| if j < model.box_count() { larger(&a[j], &b[mirror_box(model, j)]) } else { a[j] })
+pub(super) fn mirror_max(
+    model: &RobotModel,
+    a: &[Sweep; MAX_BOXES],
+    b: &[Sweep; MAX_BOXES],
+) -> [Sweep; MAX_BOXES] {
+    std::array::from_fn(|j| {
+        if j < model.box_count() {
+            larger(&a[j], &b[mirror_box(model, j)])
+        } else {
+            a[j]
+        }
+    })
 }
 
 pub(super) fn larger(a: &Sweep, b: &Sweep) -> Sweep {
@@ -61,7 +75,8 @@ pub(super) fn larger(a: &Sweep, b: &Sweep) -> Sweep {
             a.arc[i]
         }
     });
-    let ends = std::array::from_fn(|k| (a.ends[k].0.max(b.ends[k].0), a.ends[k].1.max(b.ends[k].1)));
+    let ends =
+        std::array::from_fn(|k| (a.ends[k].0.max(b.ends[k].0), a.ends[k].1.max(b.ends[k].1)));
     // A segment of either is held by the ball of its length (the table's sweeps have none).
     let ball = a.ball.max(b.ball) + a.line.norm().max(b.line.norm());
     Sweep { cube, round: a.round.max(b.round), arc, ends, ball, line: Vec3::zeros() }
@@ -112,18 +127,28 @@ pub(super) fn octants_holding(c: &Vec3, h: Real, p: &Vec3) -> u8 {
     if !(c.amax() < HOLD_RANGE && p.amax() < HOLD_RANGE) {
         return 0;
     }
-    (0..8).filter(|&o| (p - octant_centre(c, o, h)).amax() <= h + HOLD_SLACK).fold(0, |m, o| m | 1 << o)
+    (0..8)
+        .filter(|&o| (p - octant_centre(c, o, h)).amax() <= h + HOLD_SLACK)
+        .fold(0, |m, o| m | 1 << o)
 }
 
 /// Per sample: the octants holding its reference point `refs[s]` ([`octants_holding`]).
 pub(super) fn reference_octants(grid: &SampleGrid, refs: &[Vec3]) -> Vec<u8> {
-    refs.iter().enumerate().map(|(s, p)| octants_holding(&grid.sample_center(s), 0.25 * grid.r, p)).collect()
+    refs.iter()
+        .enumerate()
+        .map(|(s, p)| octants_holding(&grid.sample_center(s), 0.25 * grid.r, p))
+        .collect()
 }
 
 /// The box sweeps over the cube of centre `c` and half-side `h` (about `reference`, with
 /// [`OCTANT_SPLITS`]), or `None` when the cube is proved to hold no reachable TCP or has no
 /// bound: the octants and sub-octants of levels 2 and 3.
-pub(super) fn octant_sweeps(model: &RobotModel, c: &Vec3, h: Real, reference: &Vec3) -> Option<[Sweep; MAX_BOXES]> {
+pub(super) fn octant_sweeps(
+    model: &RobotModel,
+    c: &Vec3,
+    h: Real,
+    reference: &Vec3,
+) -> Option<[Sweep; MAX_BOXES]> {
     let vacuous = !model.delta.is_reachable(c) && cube_unreachable(&model.delta, c, h);
     if vacuous {
         return None;
@@ -145,7 +170,8 @@ pub(super) fn references(model: &RobotModel, grid: &SampleGrid) -> Vec<Vec3> {
 
 /// Whole-cell displacement sets of every sample, made mirror-symmetric.
 pub(super) fn cell_sweeps(model: &RobotModel, grid: &SampleGrid) -> Vec<[Sweep; MAX_BOXES]> {
-    let raw: Vec<_> = (0..grid.cells.len()).into_par_iter().map(|s| box_sweeps(model, grid, s)).collect();
+    let raw: Vec<_> =
+        (0..grid.cells.len()).into_par_iter().map(|s| box_sweeps(model, grid, s)).collect();
     (0..raw.len())
         .map(|s| match grid.index_of(mirror_cell(grid, grid.cells[s])) {
             Some(m) => mirror_max(model, &raw[s], &raw[m]),
@@ -160,13 +186,16 @@ pub(super) fn cell_sweeps(model: &RobotModel, grid: &SampleGrid) -> Vec<[Sweep; 
 pub(super) fn octants(model: &RobotModel, grid: &SampleGrid) -> (Vec<Vec3>, Vec<Inflation>) {
     let q = 0.25 * grid.r;
     let n = grid.cells.len() * 8;
-    let cs: Vec<Vec3> = (0..n).map(|e| octant_centre(&grid.sample_center(e / 8), e % 8, q)).collect();
-    let refs: Vec<Vec3> = cs.par_iter().map(|c| reference_point(&model.delta, c, q).unwrap_or(*c)).collect();
+    let cs: Vec<Vec3> =
+        (0..n).map(|e| octant_centre(&grid.sample_center(e / 8), e % 8, q)).collect();
+    let refs: Vec<Vec3> =
+        cs.par_iter().map(|c| reference_point(&model.delta, c, q).unwrap_or(*c)).collect();
     let raw: Vec<Option<[Sweep; MAX_BOXES]>> =
         (0..n).into_par_iter().map(|e| octant_sweeps(model, &cs[e], q, &refs[e])).collect();
     let inflation = (0..n)
         .map(|e| {
-            let mirror = grid.index_of(mirror_cell(grid, grid.cells[e / 8])).map(|m| 8 * m + ((e % 8) ^ 2));
+            let mirror =
+                grid.index_of(mirror_cell(grid, grid.cells[e / 8])).map(|m| 8 * m + ((e % 8) ^ 2));
             let b = match (raw[e], mirror.and_then(|m| raw[m])) {
                 (None, None) => return Inflation::Vacuous,
                 (Some(a), Some(b)) => mirror_max(model, &a, &b),
@@ -220,9 +249,15 @@ mod tests {
             let held = octants_holding(&c, h, &p);
             assert_ne!(held, 0, "{p:?} in the cube of {c:?}, h {h}");
             for o in (0..8).filter(|o| held >> o & 1 == 1) {
-                assert!((p - octant_centre(&c, o, h)).amax() <= h + 1e-12, "octant {o} of {c:?} holds {p:?}");
+                assert!(
+                    (p - octant_centre(&c, o, h)).amax() <= h + 1e-12,
+                    "octant {o} of {c:?} holds {p:?}"
+                );
             }
         }
-        assert_eq!(octants_holding(&Vec3::new(2000.0, 0.0, 0.0), 1.0, &Vec3::new(2000.0, 0.0, 0.0)), 0);
+        assert_eq!(
+            octants_holding(&Vec3::new(2000.0, 0.0, 0.0), 1.0, &Vec3::new(2000.0, 0.0, 0.0)),
+            0
+        );
     }
 }

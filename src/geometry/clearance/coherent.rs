@@ -29,8 +29,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use super::{
-    boxes_clearance, edge_pair, finite, obb_clearance_with_feature, rel, sign, Best, Clearance, Feature, PairClearance,
-    Rel, MAX_PAIRS, PARALLEL_NORM2,
+    boxes_clearance, edge_pair, finite, obb_clearance_with_feature, rel, sign, Best, Clearance,
+    Feature, PairClearance, Rel, MAX_PAIRS, PARALLEL_NORM2,
 };
 use crate::geometry::obb::Obb;
 use crate::math::{float, Real, Vec3};
@@ -54,7 +54,8 @@ struct PairMemory {
     feature: Feature,
 }
 
-/// The clearance of one pair of robots, remembered from call to call ([`CoherentClearance::boxes_clearance`]).
+/// The clearance of one pair of robots, remembered from call to call
+/// ([`CoherentClearance::boxes_clearance`]).
 #[derive(Clone, Debug)]
 pub struct CoherentClearance {
     pairs: [PairMemory; MAX_PAIRS],
@@ -95,7 +96,8 @@ impl CoherentClearance {
             let (ba, bb) = (&a[i], &b[l]);
             let memory = &mut self.pairs[k];
             // NaN never skips: a box with a NaN is computed and shows as a NaN distance.
-            let skip = memory.direction != Vec3::zeros() && gap_along(ba, bb, &memory.direction) >= out.distance;
+            let skip = memory.direction != Vec3::zeros()
+                && gap_along(ba, bb, &memory.direction) >= out.distance;
             if !skip {
                 let c = pair_clearance(ba, bb, memory);
                 if !(c.distance >= out.distance) {
@@ -144,7 +146,8 @@ fn pair_clearance(a: &Obb, b: &Obb, memory: &mut PairMemory) -> Clearance {
     // points are too close to give a direction (rounding of the coordinates), none is kept.
     let d = (c.point_b - c.point_a) * c.distance.signum();
     let length = d.norm();
-    memory.direction = if length > DIRECTION_MIN_MM && length.is_finite() { d / length } else { Vec3::zeros() };
+    memory.direction =
+        if length > DIRECTION_MIN_MM && length.is_finite() { d / length } else { Vec3::zeros() };
     memory.feature = feature;
     c
 }
@@ -169,10 +172,12 @@ fn warm(a: &Obb, b: &Obb, feature: Feature) -> Option<(Clearance, Vec3)> {
     let (r, t) = (&rel.r, &rel.t);
     let centres = u[0] * t[0] + u[1] * t[1] + u[2] * t[2];
     let sa = rel.a[0] * u[0].abs() + rel.a[1] * u[1].abs() + rel.a[2] * u[2].abs();
-    let sb: Real = (0..3).map(|l| rel.b[l] * (u[0] * r[0][l] + u[1] * r[1][l] + u[2] * r[2][l]).abs()).sum();
+    let sb: Real =
+        (0..3).map(|l| rel.b[l] * (u[0] * r[0][l] + u[1] * r[1][l] + u[2] * r[2][l]).abs()).sum();
     // The same slack as `separated`'s shortcut: the size of the problem times 1e-13.
     let size = rel.t.iter().chain(&rel.a).chain(&rel.b).map(|x| x.abs()).sum::<Real>();
-    (d <= centres - sa - sb + 1e-13 * size).then(|| (best.clearance(a), a.axes * Vec3::new(u[0], u[1], u[2])))
+    (d <= centres - sa - sb + 1e-13 * size)
+        .then(|| (best.clearance(a), a.axes * Vec3::new(u[0], u[1], u[2])))
 }
 
 /// The closest points of the two features now (A's frame); `None` for edges now parallel.
@@ -183,8 +188,9 @@ fn feature_points(rel: &Rel, feature: Feature) -> Option<Best> {
         Feature::None => None,
         Feature::VertexOfB(sg) => {
             let s = sg.map(Real::from);
-            let q: [Real; 3] =
-                core::array::from_fn(|k| t[k] + s[0] * b[0] * r[k][0] + s[1] * b[1] * r[k][1] + s[2] * b[2] * r[k][2]);
+            let q: [Real; 3] = core::array::from_fn(|k| {
+                t[k] + s[0] * b[0] * r[k][0] + s[1] * b[1] * r[k][1] + s[2] * b[2] * r[k][2]
+            });
             let p: [Real; 3] = core::array::from_fn(|k| q[k].clamp(-a[k], a[k]));
             let d2 = (0..3).map(|k| (q[k] - p[k]) * (q[k] - p[k])).sum();
             Some(Best { d2, p, q, feature })
@@ -194,7 +200,9 @@ fn feature_points(rel: &Rel, feature: Feature) -> Option<Best> {
             let xb: [Real; 3] = core::array::from_fn(|l| {
                 (-tb[l] + p[0] * r[0][l] + p[1] * r[1][l] + p[2] * r[2][l]).clamp(-b[l], b[l])
             });
-            let q: [Real; 3] = core::array::from_fn(|k| t[k] + r[k][0] * xb[0] + r[k][1] * xb[1] + r[k][2] * xb[2]);
+            let q: [Real; 3] = core::array::from_fn(|k| {
+                t[k] + r[k][0] * xb[0] + r[k][1] * xb[1] + r[k][2] * xb[2]
+            });
             let d2 = (0..3).map(|k| (q[k] - p[k]) * (q[k] - p[k])).sum();
             Some(Best { d2, p, q, feature })
         }
@@ -232,7 +240,9 @@ mod tests {
     /// Three links per robot, B's some 80-400 mm from A's, both turned at random.
     fn robots(rng: &mut TestRng) -> ([Obb; 3], [Obb; 3]) {
         let link = Vec3::new(150.0, 8.0, 8.0);
-        let a = core::array::from_fn(|i| Obb::new(Vec3::new(0.0, 60.0 * i as Real, 0.0), rotation(rng, 3.0), link));
+        let a = core::array::from_fn(|i| {
+            Obb::new(Vec3::new(0.0, 60.0 * i as Real, 0.0), rotation(rng, 3.0), link)
+        });
         let b = core::array::from_fn(|i| {
             let x = 240.0 + 160.0 * rng.unit();
             Obb::new(Vec3::new(x, 60.0 * i as Real, 0.0), rotation(rng, 3.0), link)
@@ -250,13 +260,20 @@ mod tests {
             for _ in 0..60 {
                 // Whether last call's closest pair is certified from its features now.
                 let k = memory.closest;
-                warm_starts += usize::from(warm(&a[k / 3], &b[k % 3], memory.pairs[k].feature).is_some());
+                warm_starts +=
+                    usize::from(warm(&a[k / 3], &b[k % 3], memory.pairs[k].feature).is_some());
                 let cold = boxes_clearance(&a, &b);
                 let coherent = memory.boxes_clearance(&a, &b);
                 let scale = 1e-9 * (1.0 + cold.distance.abs());
-                assert!((coherent.distance - cold.distance).abs() <= scale, "{coherent:?} {cold:?}");
+                assert!(
+                    (coherent.distance - cold.distance).abs() <= scale,
+                    "{coherent:?} {cold:?}"
+                );
                 let pair = obb_clearance(&a[coherent.box_a], &b[coherent.box_b]).distance;
-                assert!((pair - coherent.distance).abs() <= scale, "the pair named realises it: {pair} {coherent:?}");
+                assert!(
+                    (pair - coherent.distance).abs() <= scale,
+                    "the pair named realises it: {pair} {coherent:?}"
+                );
                 let gap = (coherent.point_b - coherent.point_a).norm();
                 assert!((gap - coherent.distance.abs()).abs() <= scale, "{coherent:?}");
                 total += 1;
@@ -271,8 +288,16 @@ mod tests {
     fn the_gap_along_any_direction_is_a_lower_bound() {
         let mut rng = TestRng(5);
         for _ in 0..100_000 {
-            let a = Obb::new(rng.vec(50.0), rotation(&mut rng, 3.0), rng.vec(40.0).abs() + Vec3::repeat(1.0));
-            let b = Obb::new(rng.vec(150.0), rotation(&mut rng, 3.0), rng.vec(40.0).abs() + Vec3::repeat(1.0));
+            let a = Obb::new(
+                rng.vec(50.0),
+                rotation(&mut rng, 3.0),
+                rng.vec(40.0).abs() + Vec3::repeat(1.0),
+            );
+            let b = Obb::new(
+                rng.vec(150.0),
+                rotation(&mut rng, 3.0),
+                rng.vec(40.0).abs() + Vec3::repeat(1.0),
+            );
             let n = (rng.vec(1.0) + Vec3::new(1e-3, 0.0, 0.0)).normalize();
             let exact = obb_clearance(&a, &b).distance;
             assert!(gap_along(&a, &b, &n) <= exact, "{a:?} {b:?} {n}");
@@ -288,7 +313,10 @@ mod tests {
             let mut memory = CoherentClearance::new();
             let c = memory.boxes_clearance(&a, &b);
             let n = memory.pairs[0].direction;
-            assert!(n == Vec3::zeros() || (n.norm() - 1.0).abs() < 1e-12, "overlap {overlap}: {c:?}, direction {n}");
+            assert!(
+                n == Vec3::zeros() || (n.norm() - 1.0).abs() < 1e-12,
+                "overlap {overlap}: {c:?}, direction {n}"
+            );
             assert!(gap_along(&a[0], &b[0], &n) <= c.distance || n == Vec3::zeros());
         }
     }

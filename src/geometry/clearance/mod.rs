@@ -124,7 +124,8 @@ fn rel(a: &Obb, b: &Obb) -> Rel {
 /// Whether every input number is finite (a NaN or an infinity anywhere gives `false`).
 #[inline(always)]
 fn finite(a: &Obb, b: &Obb) -> bool {
-    let s = a.center.sum() + a.axes.sum() + a.half.sum() + b.center.sum() + b.axes.sum() + b.half.sum();
+    let s =
+        a.center.sum() + a.axes.sum() + a.half.sum() + b.center.sum() + b.axes.sum() + b.half.sum();
     (s * 0.0) == 0.0
 }
 
@@ -150,7 +151,11 @@ fn axis_terms(rel: &Rel, k: usize) -> AxisTerms {
             AxisTerms {
                 lhs: t[i],
                 rhs: a[i] + b[0] * r[i][0].abs() + b[1] * r[i][1].abs() + b[2] * r[i][2].abs(),
-                rhs_guarded: a[i] + b[0] * g(r[i][0]) + b[1] * g(r[i][1]) + b[2] * g(r[i][2]) + SAT_TOUCH_TOLERANCE,
+                rhs_guarded: a[i]
+                    + b[0] * g(r[i][0])
+                    + b[1] * g(r[i][1])
+                    + b[2] * g(r[i][2])
+                    + SAT_TOUCH_TOLERANCE,
                 norm2: 1.0,
             }
         }
@@ -159,7 +164,11 @@ fn axis_terms(rel: &Rel, k: usize) -> AxisTerms {
             AxisTerms {
                 lhs: rel.tb[j],
                 rhs: a[0] * r[0][j].abs() + a[1] * r[1][j].abs() + a[2] * r[2][j].abs() + b[j],
-                rhs_guarded: a[0] * g(r[0][j]) + a[1] * g(r[1][j]) + a[2] * g(r[2][j]) + b[j] + SAT_TOUCH_TOLERANCE,
+                rhs_guarded: a[0] * g(r[0][j])
+                    + a[1] * g(r[1][j])
+                    + a[2] * g(r[2][j])
+                    + b[j]
+                    + SAT_TOUCH_TOLERANCE,
                 norm2: 1.0,
             }
         }
@@ -168,7 +177,10 @@ fn axis_terms(rel: &Rel, k: usize) -> AxisTerms {
             let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
             AxisTerms {
                 lhs: t[i2] * r[i1][j] - t[i1] * r[i2][j],
-                rhs: a[i1] * r[i2][j].abs() + a[i2] * r[i1][j].abs() + b[j1] * r[i][j2].abs() + b[j2] * r[i][j1].abs(),
+                rhs: a[i1] * r[i2][j].abs()
+                    + a[i2] * r[i1][j].abs()
+                    + b[j1] * r[i][j2].abs()
+                    + b[j2] * r[i][j1].abs(),
                 rhs_guarded: a[i1] * g(r[i2][j])
                     + a[i2] * g(r[i1][j])
                     + b[j1] * g(r[i][j2])
@@ -314,7 +326,10 @@ pub fn obb_clearance(a: &Obb, b: &Obb) -> Clearance {
 /// [`obb_clearance`] and, when apart, the features its closest points lie on.
 fn obb_clearance_with_feature(a: &Obb, b: &Obb) -> (Clearance, Feature) {
     if !finite(a, b) {
-        return (Clearance { distance: Real::NAN, point_a: a.center, point_b: b.center }, Feature::None);
+        return (
+            Clearance { distance: Real::NAN, point_a: a.center, point_b: b.center },
+            Feature::None,
+        );
     }
     let rel = rel(a, b);
     let axes = all_axes(&rel);
@@ -388,7 +403,11 @@ impl Best {
     /// The clearance these points give, in the world frame (`a` is box A).
     #[inline(always)]
     fn clearance(&self, a: &Obb) -> Clearance {
-        Clearance { distance: float::sqrt(self.d2), point_a: to_world(a, &self.p), point_b: to_world(a, &self.q) }
+        Clearance {
+            distance: float::sqrt(self.d2),
+            point_a: to_world(a, &self.p),
+            point_b: to_world(a, &self.q),
+        }
     }
 }
 
@@ -509,8 +528,9 @@ fn supporting_features(rel: &Rel, k: usize, lhs: Real) -> Best {
         0..=2 => {
             // B's vertex lowest along side * A_k, in A's frame, and its clamp into A.
             let sg: [Real; 3] = core::array::from_fn(|l| -side * sign(r[k][l]));
-            let q: [Real; 3] =
-                core::array::from_fn(|m| t[m] + sg[0] * b[0] * r[m][0] + sg[1] * b[1] * r[m][1] + sg[2] * b[2] * r[m][2]);
+            let q: [Real; 3] = core::array::from_fn(|m| {
+                t[m] + sg[0] * b[0] * r[m][0] + sg[1] * b[1] * r[m][1] + sg[2] * b[2] * r[m][2]
+            });
             let p: [Real; 3] = core::array::from_fn(|m| q[m].clamp(-a[m], a[m]));
             let feature = Feature::VertexOfB(signs(sg));
             Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q, feature }
@@ -522,13 +542,21 @@ fn supporting_features(rel: &Rel, k: usize, lhs: Real) -> Best {
             let xb: [Real; 3] = core::array::from_fn(|l| {
                 (-tb[l] + p[0] * r[0][l] + p[1] * r[1][l] + p[2] * r[2][l]).clamp(-b[l], b[l])
             });
-            let q: [Real; 3] =
-                core::array::from_fn(|m| t[m] + r[m][0] * xb[0] + r[m][1] * xb[1] + r[m][2] * xb[2]);
-            let feature = Feature::VertexOfA(core::array::from_fn(|m| if side * sign(r[m][j]) < 0.0 { -1 } else { 1 }));
+            let q: [Real; 3] = core::array::from_fn(|m| {
+                t[m] + r[m][0] * xb[0] + r[m][1] * xb[1] + r[m][2] * xb[2]
+            });
+            let feature = Feature::VertexOfA(core::array::from_fn(|m| {
+                if side * sign(r[m][j]) < 0.0 {
+                    -1
+                } else {
+                    1
+                }
+            }));
             Best { d2: (0..3).map(|m| (q[m] - p[m]) * (q[m] - p[m])).sum(), p, q, feature }
         }
         _ => {
-            let mut best = Best { d2: Real::INFINITY, p: [0.0; 3], q: [0.0; 3], feature: Feature::None };
+            let mut best =
+                Best { d2: Real::INFINITY, p: [0.0; 3], q: [0.0; 3], feature: Feature::None };
             edge_axis(rel, (k - 6) / 3, (k - 6) % 3, &mut best);
             best
         }
@@ -570,16 +598,29 @@ fn vertices(rel: &Rel) -> Best {
     }
     let sgn = |v: usize, m: usize| if v >> m & 1 == 0 { -1.0 } else { 1.0 };
     if d2b[vb] <= d2a[va] {
-        let q: [Real; 3] = core::array::from_fn(|k| t[k] + (0..3).map(|l| sgn(vb, l) * b[l] * r[k][l]).sum::<Real>());
+        let q: [Real; 3] = core::array::from_fn(|k| {
+            t[k] + (0..3).map(|l| sgn(vb, l) * b[l] * r[k][l]).sum::<Real>()
+        });
         let p = core::array::from_fn(|k| q[k].clamp(-a[k], a[k]));
-        Best { d2: d2b[vb], p, q, feature: Feature::VertexOfB(core::array::from_fn(|l| sgn(vb, l) as i8)) }
+        Best {
+            d2: d2b[vb],
+            p,
+            q,
+            feature: Feature::VertexOfB(core::array::from_fn(|l| sgn(vb, l) as i8)),
+        }
     } else {
         // A's vertex in A's frame, and its closest point of B (clamped in B's frame) back in A's.
         let p: [Real; 3] = core::array::from_fn(|k| sgn(va, k) * a[k]);
-        let xb: [Real; 3] =
-            core::array::from_fn(|l| (-tb[l] + (0..3).map(|k| p[k] * r[k][l]).sum::<Real>()).clamp(-b[l], b[l]));
+        let xb: [Real; 3] = core::array::from_fn(|l| {
+            (-tb[l] + (0..3).map(|k| p[k] * r[k][l]).sum::<Real>()).clamp(-b[l], b[l])
+        });
         let q = core::array::from_fn(|k| t[k] + (0..3).map(|l| r[k][l] * xb[l]).sum::<Real>());
-        Best { d2: d2a[va], p, q, feature: Feature::VertexOfA(core::array::from_fn(|k| sgn(va, k) as i8)) }
+        Best {
+            d2: d2a[va],
+            p,
+            q,
+            feature: Feature::VertexOfA(core::array::from_fn(|k| sgn(va, k) as i8)),
+        }
     }
 }
 
@@ -628,9 +669,12 @@ fn edge_pair(rel: &Rel, i: usize, j: usize, n2: Real, sg: [Real; 4], best: &mut 
     let u = (wr + c * s).clamp(-b[j], b[j]);
     p[i] = s;
     let q: [Real; 3] = core::array::from_fn(|k| q0[k] + u * r[k][j]);
-    let d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
+    let d2 = (p[0] - q[0]) * (p[0] - q[0])
+        + (p[1] - q[1]) * (p[1] - q[1])
+        + (p[2] - q[2]) * (p[2] - q[2]);
     if d2 < best.d2 {
-        *best = Best { d2, p, q, feature: Feature::Edges { i: i as u8, j: j as u8, sg: signs(sg) } };
+        *best =
+            Best { d2, p, q, feature: Feature::Edges { i: i as u8, j: j as u8, sg: signs(sg) } };
     }
 }
 
@@ -671,8 +715,15 @@ mod tests {
         assert!((c.point_b - c.point_a - Vec3::new(3.0, 0.0, 0.0)).norm() < 1e-12, "{c:?}");
         let c = obb_clearance(&a, &cube(Vec3::new(4.0, 4.0, 4.0), 1.0));
         assert!((c.distance - 12f64.sqrt()).abs() < 1e-12, "corner to corner {c:?}");
-        assert!((c.point_a - Vec3::repeat(1.0)).norm() < 1e-12 && (c.point_b - Vec3::repeat(3.0)).norm() < 1e-12);
-        assert_eq!(obb_clearance(&a, &cube(Vec3::new(2.0, 0.0, 0.0), 1.0)).distance, 0.0, "touching");
+        assert!(
+            (c.point_a - Vec3::repeat(1.0)).norm() < 1e-12
+                && (c.point_b - Vec3::repeat(3.0)).norm() < 1e-12
+        );
+        assert_eq!(
+            obb_clearance(&a, &cube(Vec3::new(2.0, 0.0, 0.0), 1.0)).distance,
+            0.0,
+            "touching"
+        );
         // Overlapping by 0.5 along x and 1.5 along y: the depth is the smaller overlap.
         let b = cube(Vec3::new(1.5, 0.5, 0.0), 1.0);
         let c = obb_clearance(&a, &b);
@@ -695,7 +746,10 @@ mod tests {
         assert!((c.distance - 0.5).abs() < 1e-12, "{c:?}");
         assert!((c.point_a - Vec3::new(0.0, 0.0, 2f64.sqrt())).norm() < 1e-12, "{c:?}");
         let lb = obb_clearance_lower_bound(&a, &b);
-        assert!(lb <= 0.5 && lb > 0.5 - 1e-8, "the edge axis gives the bound, less the SAT guards: {lb}");
+        assert!(
+            lb <= 0.5 && lb > 0.5 - 1e-8,
+            "the edge axis gives the bound, less the SAT guards: {lb}"
+        );
     }
 
     #[test]
@@ -714,7 +768,12 @@ mod tests {
         let mut rng = crate::test_rng::TestRng(0x5eed_c1ea);
         for _ in 0..20_000 {
             let rot = |r: &mut crate::test_rng::TestRng| {
-                *nalgebra::Rotation3::from_euler_angles(r.unit() * 3.2, r.unit() * 3.2, r.unit() * 3.2).matrix()
+                *nalgebra::Rotation3::from_euler_angles(
+                    r.unit() * 3.2,
+                    r.unit() * 3.2,
+                    r.unit() * 3.2,
+                )
+                .matrix()
             };
             let a = Obb::new(rng.vec(5.0), rot(&mut rng), rng.vec(2.0).abs().add_scalar(0.1));
             let b = Obb::new(rng.vec(5.0), rot(&mut rng), rng.vec(2.0).abs().add_scalar(0.1));

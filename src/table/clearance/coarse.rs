@@ -10,7 +10,10 @@ fn coarse_grid(grid: &SampleGrid, shift: u32) -> (SampleGrid, Vec<u32>) {
     let mut cells: Vec<CellIndex> = grid.cells.iter().map(|c| c.map(|v| v >> shift)).collect();
     cells.sort_unstable();
     cells.dedup();
-    let index = grid.cells.iter().map(|c| cells.binary_search(&c.map(|v| v >> shift)).expect("a coarse cell") as u32);
+    let index = grid
+        .cells
+        .iter()
+        .map(|c| cells.binary_search(&c.map(|v| v >> shift)).expect("a coarse cell") as u32);
     let index = index.collect();
     let reachable = vec![true; cells.len()];
     let coarse = SampleGrid {
@@ -28,7 +31,12 @@ fn coarse_grid(grid: &SampleGrid, shift: u32) -> (SampleGrid, Vec<u32>) {
 /// count among its free pairs, and is labelled free when that is `n_top` (every level),
 /// collision otherwise; a coarse pair with no free pair in it is unreachable ("don't care":
 /// the exact tree answers its cells).
-pub(super) fn coarsen(space: &LabelledSpace, counts: &[u8], shift: u32, n_top: u8) -> (LabelledSpace, Vec<u8>) {
+pub(super) fn coarsen(
+    space: &LabelledSpace,
+    counts: &[u8],
+    shift: u32,
+    n_top: u8,
+) -> (LabelledSpace, Vec<u8>) {
     let (ga, ia_of) = coarse_grid(&space.grid_a, shift);
     let (gb, ib_of) = coarse_grid(&space.grid_b, shift);
     let (nb, cnb) = (space.grid_b.cells.len(), gb.cells.len());

@@ -76,13 +76,19 @@ impl Ladder {
     pub fn new(mm: &[f64]) -> Result<Ladder, TableError> {
         let bad = |what: alloc::string::String| TableError::BadInput { what };
         if mm.is_empty() || mm.len() > MAX_RUNGS {
-            return Err(bad(format!("a clearance ladder has 1 to {MAX_RUNGS} levels, got {}", mm.len())));
+            return Err(bad(format!(
+                "a clearance ladder has 1 to {MAX_RUNGS} levels, got {}",
+                mm.len()
+            )));
         }
         if let Some(v) = mm.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
             return Err(bad(format!("clearance level {v} mm must be finite and >= 0")));
         }
         if let Some(w) = mm.windows(2).find(|w| w[0] >= w[1]) {
-            return Err(bad(format!("clearance levels must increase: {} mm then {} mm", w[0], w[1])));
+            return Err(bad(format!(
+                "clearance levels must increase: {} mm then {} mm",
+                w[0], w[1]
+            )));
         }
         let mut out = [0.0; MAX_RUNGS];
         out[..mm.len()].copy_from_slice(mm);
@@ -145,7 +151,8 @@ impl LevelGrid {
         let mut words = vec![0u64; cells.div_ceil(16)];
         let mask = (1usize << bits) - 1;
         for i in 0..cells {
-            let c: [u16; 6] = core::array::from_fn(|j| (i >> (bits as usize * (5 - j)) & mask) as u16);
+            let c: [u16; 6] =
+                core::array::from_fn(|j| (i >> (bits as usize * (5 - j)) & mask) as u16);
             let count = count_of(level_tree.query_word(c), n).min(15) as u64;
             words[i / 16] |= count << (4 * (i % 16));
         }
@@ -190,12 +197,32 @@ impl TreeParts {
     fn of(t: &SharedQuadtree6d) -> TreeParts {
         let p: SharedParts = t.parts();
         let children = p.children.to_u32();
-        TreeParts { masks: p.masks, bases: p.bases, depth_start: p.depth_start, children, leaves: p.leaves }
+        TreeParts {
+            masks: p.masks,
+            bases: p.bases,
+            depth_start: p.depth_start,
+            children,
+            leaves: p.leaves,
+        }
     }
 
-    fn tree(self, levels: u32, sub_levels: u32, symmetric: bool) -> Result<SharedQuadtree6d, TableError> {
+    fn tree(
+        self,
+        levels: u32,
+        sub_levels: u32,
+        symmetric: bool,
+    ) -> Result<SharedQuadtree6d, TableError> {
         let TreeParts { masks, bases, depth_start, children, leaves } = self;
-        SharedQuadtree6d::from_parts(levels, sub_levels, symmetric, masks, bases, depth_start, children, leaves)
+        SharedQuadtree6d::from_parts(
+            levels,
+            sub_levels,
+            symmetric,
+            masks,
+            bases,
+            depth_start,
+            children,
+            leaves,
+        )
     }
 
     /// The child indices as the file packs them (`format.rs`, variant 8): each inner depth's
@@ -205,7 +232,9 @@ impl TreeParts {
         let mut out = Vec::new();
         let mut children = self.children.iter();
         // A valid tree's depth runs hold exactly its child indices.
-        for (count, targets) in depth_runs(&self.masks, &self.depth_start, self.leaves.len()).into_iter().flatten() {
+        for (count, targets) in
+            depth_runs(&self.masks, &self.depth_start, self.leaves.len()).into_iter().flatten()
+        {
             let width = child_width(targets);
             for _ in 0..count {
                 let c = children.next().copied().unwrap_or(0);
@@ -229,7 +258,10 @@ impl TreeParts {
         what: &str,
     ) -> Result<Vec<u32>, TableError> {
         let runs = depth_runs(masks, depth_start, leaves).ok_or_else(|| {
-            corrupt(format!("{what}: depth starts {depth_start:?} do not cover its {} nodes", masks.len()))
+            corrupt(format!(
+                "{what}: depth starts {depth_start:?} do not cover its {} nodes",
+                masks.len()
+            ))
         })?;
         let mut out = Vec::new();
         for (count, targets) in runs {
@@ -239,7 +271,10 @@ impl TreeParts {
                 corrupt(format!("{what}: {count} child indices of {width} bytes, the section has {left} bytes left"))
             })?;
             let (run, rest) = bytes.split_at(n);
-            out.extend(run.chunks_exact(width).map(|c| c.iter().rev().fold(0u32, |v, &b| v << 8 | u32::from(b))));
+            out.extend(
+                run.chunks_exact(width)
+                    .map(|c| c.iter().rev().fold(0u32, |v, &b| v << 8 | u32::from(b))),
+            );
             *bytes = rest;
         }
         Ok(out)
@@ -259,7 +294,11 @@ pub(crate) fn child_width(targets: usize) -> usize {
 /// Per inner depth: how many child indices its nodes hold (their non-uniform children) and
 /// how many entries those point into (the next depth's nodes; the leaves, for the last inner
 /// depth). `None` when `depth_start` is not `0`, non-decreasing, ending at the node count.
-fn depth_runs(masks: &[[u64; 2]], depth_start: &[u32], leaves: usize) -> Option<Vec<(usize, usize)>> {
+fn depth_runs(
+    masks: &[[u64; 2]],
+    depth_start: &[u32],
+    leaves: usize,
+) -> Option<Vec<(usize, usize)>> {
     let starts: Vec<usize> = depth_start.iter().map(|&d| d as usize).collect();
     let ordered = starts.windows(2).all(|w| w[0] <= w[1]);
     if starts.len() < 2 || starts[0] != 0 || !ordered || starts[starts.len() - 1] != masks.len() {
@@ -267,7 +306,8 @@ fn depth_runs(masks: &[[u64; 2]], depth_start: &[u32], leaves: usize) -> Option<
     }
     let depths = starts.len() - 1;
     let runs = (0..depths).map(|d| {
-        let count = masks[starts[d]..starts[d + 1]].iter().map(|m| m[0].count_ones() as usize).sum();
+        let count =
+            masks[starts[d]..starts[d + 1]].iter().map(|m| m[0].count_ones() as usize).sum();
         let targets = if d + 1 < depths { starts[d + 2] - starts[d + 1] } else { leaves };
         (count, targets)
     });
@@ -278,13 +318,18 @@ fn depth_runs(masks: &[[u64; 2]], depth_start: &[u32], leaves: usize) -> Option<
 /// node's masks, a word per leaf, four bytes per depth start, base and child index.
 fn stored_bytes(tree: &SharedQuadtree6d) -> usize {
     let p = tree.parts();
-    16 * p.masks.len() + 8 * p.leaves.len() + 4 * (p.depth_start.len() + p.bases.len() + p.children.len())
+    16 * p.masks.len()
+        + 8 * p.leaves.len()
+        + 4 * (p.depth_start.len() + p.bases.len() + p.children.len())
 }
 
 /// As [`stored_bytes`], the child indices packed as a clearance table file holds them.
 fn packed_bytes(tree: &SharedQuadtree6d) -> usize {
     let p = TreeParts::of(tree);
-    16 * p.masks.len() + 8 * p.leaves.len() + 4 * (p.depth_start.len() + p.bases.len()) + p.packed_children().len()
+    16 * p.masks.len()
+        + 8 * p.leaves.len()
+        + 4 * (p.depth_start.len() + p.bases.len())
+        + p.packed_children().len()
 }
 
 /// A clearance table (module doc).
@@ -316,7 +361,11 @@ impl ClearanceTable {
     ) -> Result<ClearanceTable, TableError> {
         if counts.len() != space.labels.len() {
             return Err(TableError::BadInput {
-                what: format!("{} clearance counts for {} labelled pairs", counts.len(), space.labels.len()),
+                what: format!(
+                    "{} clearance counts for {} labelled pairs",
+                    counts.len(),
+                    space.labels.len()
+                ),
             });
         }
         let exact = SharedQuadtree6d::build(space, symmetry)?;
@@ -356,12 +405,18 @@ impl ClearanceTable {
 
     /// The table of two validated trees, with its level grid when the table with it is at
     /// most [`SIZE_BUDGET`] times the exact tree in memory.
-    fn assemble(exact: SharedQuadtree6d, level_tree: SharedQuadtree6d, shift: u32, ladder: Ladder) -> ClearanceTable {
+    fn assemble(
+        exact: SharedQuadtree6d,
+        level_tree: SharedQuadtree6d,
+        shift: u32,
+        ladder: Ladder,
+    ) -> ClearanceTable {
         let floor = usize::from(ladder.mm[0] == 0.0);
         let mut t = ClearanceTable { exact, level_tree, grid: None, floor, shift, ladder };
         let bits = t.levels() - shift;
         let budget = SIZE_BUDGET.saturating_mul(t.exact.memory_bytes());
-        if LevelGrid::bytes_for(bits).is_some_and(|g| t.memory_bytes().saturating_add(g) <= budget) {
+        if LevelGrid::bytes_for(bits).is_some_and(|g| t.memory_bytes().saturating_add(g) <= budget)
+        {
             t.grid = Some(LevelGrid::of(&t.level_tree, bits, t.ladder.len()));
         }
         t
@@ -390,16 +445,20 @@ impl ClearanceTable {
         exact: TreeParts,
         level_tree: TreeParts,
     ) -> Result<ClearanceTable, TableError> {
-        let ladder = Ladder::new(ladder_mm).map_err(|e| corrupt(format!("clearance ladder: {e}")))?;
+        let ladder =
+            Ladder::new(ladder_mm).map_err(|e| corrupt(format!("clearance ladder: {e}")))?;
         let n = ladder.len();
         if levels < 2 || shift > levels - 2 {
             return Err(corrupt(format!(
                 "clearance level tree shift = {shift} with levels = {levels}: need levels - shift >= 2"
             )));
         }
-        let bad_leaf = |&w: &u64| !(1..n).contains(&count_of(w, n)) || word_of(count_of(w, n), n) != w;
+        let bad_leaf =
+            |&w: &u64| !(1..n).contains(&count_of(w, n)) || word_of(count_of(w, n), n) != w;
         if let Some((i, w)) = level_tree.leaves.iter().enumerate().find(|(_, w)| bad_leaf(w)) {
-            return Err(corrupt(format!("clearance leaf {i} = {w:#018x} is not the word of a level below the top")));
+            return Err(corrupt(format!(
+                "clearance leaf {i} = {w:#018x} is not the word of a level below the top"
+            )));
         }
         let exact = exact.tree(levels, 0, symmetric)?;
         let level_tree = level_tree.tree(levels - shift, 1, symmetric)?;
@@ -414,7 +473,10 @@ impl ClearanceTable {
     pub fn level_count(&self, cell: [u16; 6]) -> usize {
         let count = match &self.grid {
             Some(grid) => grid.count(cell, self.shift),
-            None => count_of(self.level_tree.query_word(cell.map(|v| v >> self.shift)), self.ladder.len()),
+            None => count_of(
+                self.level_tree.query_word(cell.map(|v| v >> self.shift)),
+                self.ladder.len(),
+            ),
         };
         let collision = self.exact.query(cell);
         // A free cell has level 0 proved when the ladder starts at 0 mm.
@@ -557,7 +619,8 @@ mod tests {
     /// Seeded counts: 0 on pairs not free, on free ones 1 to `n` from a hash of the pair.
     fn counts_for(space: &crate::cspace::LabelledSpace, n: usize) -> Vec<u8> {
         let hash = |i: usize| ((i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 58) as usize;
-        let count = |(i, l): (usize, Label)| if l == Label::Free { (1 + hash(i) % n) as u8 } else { 0 };
+        let count =
+            |(i, l): (usize, Label)| if l == Label::Free { (1 + hash(i) % n) as u8 } else { 0 };
         space.labels.iter().enumerate().map(count).collect()
     }
 
@@ -580,7 +643,9 @@ mod tests {
             let view = crate::table::space::SpaceView::new(&s, symmetric).unwrap();
             let nb = s.grid_b.cells.len();
             for shift in 0..=levels - 2 {
-                let t = ClearanceTable::build_at(&s, &counts, ladder, symmetry, boolean.clone(), shift).unwrap();
+                let t =
+                    ClearanceTable::build_at(&s, &counts, ladder, symmetry, boolean.clone(), shift)
+                        .unwrap();
                 let (gridded, treed) = (t.clone().with_grid(true), t.clone().with_grid(false));
                 assert!(gridded.has_level_grid() && !treed.has_level_grid());
                 let mut seen = vec![0usize; ladder.len() + 1];
@@ -599,9 +664,21 @@ mod tests {
                         let got = t.level_count(cell);
                         // The two-descent lookup, spelled out: the reference of both layouts.
                         let word = t.level_tree().query_word(cell.map(|v| v >> shift));
-                        let by_tree = if boolean.query(cell) { 0 } else { count_of(word, ladder.len()).max(1) };
-                        assert_eq!(gridded.level_count(cell), by_tree, "{pattern:?} {shift} {cell:?}: grid");
-                        assert_eq!(treed.level_count(cell), by_tree, "{pattern:?} {shift} {cell:?}: tree");
+                        let by_tree = if boolean.query(cell) {
+                            0
+                        } else {
+                            count_of(word, ladder.len()).max(1)
+                        };
+                        assert_eq!(
+                            gridded.level_count(cell),
+                            by_tree,
+                            "{pattern:?} {shift} {cell:?}: grid"
+                        );
+                        assert_eq!(
+                            treed.level_count(cell),
+                            by_tree,
+                            "{pattern:?} {shift} {cell:?}: tree"
+                        );
                         assert_eq!(got, by_tree, "{pattern:?} {shift} {cell:?}");
                         assert_eq!(got == 0, boolean.query(cell), "{pattern:?} {shift} {cell:?}");
                         assert!(got <= own, "{pattern:?} {shift} {cell:?}: {got} > {own}");
@@ -614,9 +691,13 @@ mod tests {
                 }
                 // Coarse level trees may hold only the smallest level; the finest holds them all.
                 let distinct = seen.iter().filter(|&&c| c > 0).count();
-                assert!(distinct >= if shift == 0 { 3 } else { 2 }, "{pattern:?} {shift}: levels seen {seen:?}");
+                assert!(
+                    distinct >= if shift == 0 { 3 } else { 2 },
+                    "{pattern:?} {shift}: levels seen {seen:?}"
+                );
                 let (e, l) = t.parts();
-                let back = ClearanceTable::from_parts(levels, symmetric, ladder.mm(), shift, e, l).unwrap();
+                let back = ClearanceTable::from_parts(levels, symmetric, ladder.mm(), shift, e, l)
+                    .unwrap();
                 assert_eq!(back, t);
                 let k6 = (1u64 << levels).pow(6);
                 assert_eq!(t.cells_per_level().iter().sum::<u64>(), k6);
@@ -633,12 +714,19 @@ mod tests {
         let ladder = Ladder::default_ladder();
         // The file less its 192-byte header (no cell parameters) and 8-byte checksum.
         let sections = |t: Table, s: &crate::cspace::LabelledSpace| {
-            let header = Header::for_space(s, 0, crate::cspace::Workspace::THESIS, Certification::SweptBound);
+            let header = Header::for_space(
+                s,
+                0,
+                crate::cspace::Workspace::THESIS,
+                Certification::SweptBound,
+            );
             to_bytes(&t, &header).len() - 192 - 8
         };
-        for (pattern, levels, symmetric) in
-            [(Pattern::Blobs, 4, true), (Pattern::Noise { p: 0.3, seed: 1 }, 4, false), (Pattern::Blobs, 3, false)]
-        {
+        for (pattern, levels, symmetric) in [
+            (Pattern::Blobs, 4, true),
+            (Pattern::Noise { p: 0.3, seed: 1 }, 4, false),
+            (Pattern::Blobs, 3, false),
+        ] {
             let s = space(levels, pattern);
             let counts = counts_for(&s, ladder.len());
             let symmetry = Symmetry::from_flag(symmetric);
@@ -648,11 +736,20 @@ mod tests {
                     && t.stored_bytes() <= SIZE_BUDGET * stored_bytes(&exact)
             };
             let t = ClearanceTable::build(&s, &counts, ladder, symmetry).unwrap();
-            assert_eq!(sections(Table::Clearance(alloc::boxed::Box::new(t.clone())), &s), t.stored_bytes());
+            assert_eq!(
+                sections(Table::Clearance(alloc::boxed::Box::new(t.clone())), &s),
+                t.stored_bytes()
+            );
             assert_eq!(sections(Table::Shared(exact.clone()), &s), stored_bytes(&exact));
-            assert!(fits(&t) || t.shift() == levels - 2, "{pattern:?}: shift {} does not fit", t.shift());
+            assert!(
+                fits(&t) || t.shift() == levels - 2,
+                "{pattern:?}: shift {} does not fit",
+                t.shift()
+            );
             for finer in 0..t.shift() {
-                let f = ClearanceTable::build_at(&s, &counts, ladder, symmetry, exact.clone(), finer).unwrap();
+                let f =
+                    ClearanceTable::build_at(&s, &counts, ladder, symmetry, exact.clone(), finer)
+                        .unwrap();
                 assert!(!fits(&f), "{pattern:?}: shift {finer} fits, finer than {}", t.shift());
             }
         }

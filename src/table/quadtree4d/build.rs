@@ -3,15 +3,18 @@
 
 use super::grouping::Grouping;
 use super::{shape, LinearQuadtree4d, SliceAxes};
+use crate::cspace::symmetry::Symmetry;
 use crate::cspace::{Label, LabelledSpace};
 use crate::table::error::TableError;
 use crate::table::space::SpaceView;
-use crate::cspace::symmetry::Symmetry;
 use std::collections::BTreeMap;
 
-
 /// Samples of one robot grouped by its two quadtree coordinates `(ix, second)`.
-pub(super) fn ranges(cells: &[[u16; 3]], keep: impl Fn(usize) -> bool, second: usize) -> BTreeMap<(u16, u16), Vec<usize>> {
+pub(super) fn ranges(
+    cells: &[[u16; 3]],
+    keep: impl Fn(usize) -> bool,
+    second: usize,
+) -> BTreeMap<(u16, u16), Vec<usize>> {
     let mut m: BTreeMap<(u16, u16), Vec<usize>> = BTreeMap::new();
     for (i, c) in cells.iter().enumerate().filter(|(i, _)| keep(*i)) {
         m.entry((c[0], c[second])).or_default().push(i);
@@ -55,8 +58,10 @@ impl LinearQuadtree4d {
         let mut grouping = Grouping::new(levels, symmetric, axes, t);
         let (mut s, mut care) = (vec![0u64; wps], vec![0u64; wps]);
         // Thesis order x, x', z, z': the A and B maps are sorted by (ix, second).
-        let xs_a: Vec<u16> = ra.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
-        let xs_b: Vec<u16> = rb.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
+        let xs_a: Vec<u16> =
+            ra.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
+        let xs_b: Vec<u16> =
+            rb.keys().map(|k| k.0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
         for &xa in &xs_a {
             for &xb in &xs_b {
                 for ((_, za), ias) in ra.range((xa, 0)..=(xa, u16::MAX)) {

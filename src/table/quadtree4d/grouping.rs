@@ -80,7 +80,15 @@ impl ExactGroups {
     /// representatives in chunks of `chunk_blocks` blocks (the builder: [`CHUNK_BLOCKS`]).
     fn new(wps: usize, rows: usize, cols: usize, chunk_blocks: usize) -> ExactGroups {
         assert!((1..=MAX_CHUNK_BLOCKS).contains(&chunk_blocks), "chunk_blocks = {chunk_blocks}");
-        ExactGroups { wps, rows, cols, reps: Vec::new(), by_tile: HashMap::new(), sliced: Vec::new(), chunk_blocks }
+        ExactGroups {
+            wps,
+            rows,
+            cols,
+            reps: Vec::new(),
+            by_tile: HashMap::new(),
+            sliced: Vec::new(),
+            chunk_blocks,
+        }
     }
 
     fn count(&self) -> usize {
@@ -89,7 +97,11 @@ impl ExactGroups {
 
     /// The tiles of side `side` of `words`, each as (index, bits: row `r` of the tile at bit
     /// `side * r`), and the bits of a tile with all of them set.
-    fn tiles<'w>(&self, words: &'w [u64], side: usize) -> (impl Iterator<Item = (u32, u64)> + 'w, u64) {
+    fn tiles<'w>(
+        &self,
+        words: &'w [u64],
+        side: usize,
+    ) -> (impl Iterator<Item = (u32, u64)> + 'w, u64) {
         let (cols, across) = (self.cols, self.cols / side);
         let mask = (1u64 << side) - 1;
         let tiles = (0..(self.rows / side) * across).map(move |t| {
@@ -174,7 +186,10 @@ impl ExactGroups {
 
     /// The first group whose representative `R` has `R ∩ C = S`, or a new group made of `S`.
     fn group(&mut self, s: &[u64], care: &[u64]) -> u32 {
-        debug_assert!(s.iter().zip(care).all(|(&s, &c)| s & !c == 0), "a collision bit outside the care mask");
+        debug_assert!(
+            s.iter().zip(care).all(|(&s, &c)| s & !c == 0),
+            "a collision bit outside the care mask"
+        );
         let found = match self.rarest_tile(s, care) {
             Some(None) => None,
             Some(Some(groups)) => groups.iter().copied().find(|&g| self.fits(g, s, care)),
@@ -219,7 +234,15 @@ pub(super) struct Grouping {
 impl Grouping {
     pub(super) fn new(levels: u32, symmetric: bool, axes: SliceAxes, t: u32) -> Grouping {
         let (a0, wps) = shape(levels, symmetric, axes);
-        let tree = LinearQuadtree4d { levels, symmetric, axes, t, codes: vec![], slice_of: vec![], slices: vec![] };
+        let tree = LinearQuadtree4d {
+            levels,
+            symmetric,
+            axes,
+            t,
+            codes: vec![],
+            slice_of: vec![],
+            slices: vec![],
+        };
         let k = 1usize << levels;
         let exact = (t == 0).then(|| ExactGroups::new(wps, k - a0 as usize, k, CHUNK_BLOCKS));
         Grouping { tree, wps, g_add: Vec::new(), exact, nodes: Vec::new() }
@@ -246,7 +269,7 @@ impl Grouping {
 
 impl LinearQuadtree4d {
     /// The group `s` joins (its representative updated), or a new one (Algorithm 8 l. 7-19).
-        fn group(&mut self, s: &[u64], care: &[u64], g_add: &mut Vec<u32>, wps: usize) -> u32 {
+    fn group(&mut self, s: &[u64], care: &[u64], g_add: &mut Vec<u32>, wps: usize) -> u32 {
         for (g, rep) in self.slices.chunks_exact_mut(wps).enumerate() {
             if let Some(add) = try_join(s, care, rep, g_add[g], self.t) {
                 rep.iter_mut().zip(s).for_each(|(r, &s)| *r |= s);
@@ -273,7 +296,11 @@ mod tests {
         assert_eq!(try_join(&[0b1111], &all, &rep, 1, 1), None, "|add| = 1 is not < 1");
         assert_eq!(try_join(&[0b1111], &all, &rep, 2, 2), Some(1));
         assert_eq!(try_join(&[0b0011], &all, &rep, 2, 1), None, "|sub| = 1 is not < 1");
-        assert_eq!(try_join(&[0b0011], &[0b1011], &rep, 2, 1), Some(0), "a don't-care bit is not counted");
+        assert_eq!(
+            try_join(&[0b0011], &[0b1011], &rep, 2, 1),
+            Some(0),
+            "a don't-care bit is not counted"
+        );
     }
 
     /// Slices made from a few patterns, each seen through one of a few care masks (some with
@@ -287,7 +314,8 @@ mod tests {
             rng.0
         };
         let wps = 4;
-        let patterns: Vec<Vec<u64>> = (0..200).map(|_| (0..wps).map(|_| next()).collect()).collect();
+        let patterns: Vec<Vec<u64>> =
+            (0..200).map(|_| (0..wps).map(|_| next()).collect()).collect();
         let mut chain = vec![vec![!0u64; wps]];
         for _ in 0..3 {
             let wider = chain.last().unwrap().clone();
@@ -323,7 +351,11 @@ mod tests {
             match exact.rarest_tile(&s, &care) {
                 Some(Some(groups)) => {
                     by_tile += 1;
-                    assert_eq!(groups.iter().copied().find(|&g| exact.fits(g, &s, &care)), old, "slice {i}");
+                    assert_eq!(
+                        groups.iter().copied().find(|&g| exact.fits(g, &s, &care)),
+                        old,
+                        "slice {i}"
+                    );
                 }
                 Some(None) => {
                     no_entry += 1;

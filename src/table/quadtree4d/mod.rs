@@ -98,21 +98,37 @@ impl LinearQuadtree4d {
             return Err(corrupt(format!("levels = {levels} must be in 1..={MAX_LEVELS}")));
         }
         if let Some(i) = codes.iter().position(|&c| c >> (4 * levels) != 0) {
-            return Err(corrupt(format!("codes[{i}] = {:#x} has bits above {levels} 4-bit levels", codes[i])));
+            return Err(corrupt(format!(
+                "codes[{i}] = {:#x} has bits above {levels} 4-bit levels",
+                codes[i]
+            )));
         }
         if let Some(i) = codes.windows(2).position(|w| w[0] >= w[1]) {
-            return Err(corrupt(format!("codes[{}] is not greater than codes[{i}]: codes are not sorted", i + 1)));
+            return Err(corrupt(format!(
+                "codes[{}] is not greater than codes[{i}]: codes are not sorted",
+                i + 1
+            )));
         }
         let (_, wps) = shape(levels, symmetric, axes);
         if slices.len() % wps != 0 {
-            return Err(corrupt(format!("slices has {} words, not a multiple of {wps} per slice", slices.len())));
+            return Err(corrupt(format!(
+                "slices has {} words, not a multiple of {wps} per slice",
+                slices.len()
+            )));
         }
         let count = slices.len() / wps;
         if slice_of.len() != codes.len() {
-            return Err(corrupt(format!("slice_of has {} entries for {} codes", slice_of.len(), codes.len())));
+            return Err(corrupt(format!(
+                "slice_of has {} entries for {} codes",
+                slice_of.len(),
+                codes.len()
+            )));
         }
         if let Some(i) = slice_of.iter().position(|&s| s as usize >= count) {
-            return Err(corrupt(format!("slice_of[{i}] = {} is not below the slice count {count}", slice_of[i])));
+            return Err(corrupt(format!(
+                "slice_of[{i}] = {} is not below the slice count {count}",
+                slice_of[i]
+            )));
         }
         Ok(LinearQuadtree4d { levels, symmetric, axes, t, codes, slice_of, slices })
     }
@@ -126,7 +142,8 @@ impl LinearQuadtree4d {
             return true;
         };
         let (second, ignored) = self.axes.dims();
-        let Ok(i) = self.codes.binary_search(&encode([c[0], c[second], c[3], c[3 + second]], 4)) else {
+        let Ok(i) = self.codes.binary_search(&encode([c[0], c[second], c[3], c[3 + second]], 4))
+        else {
             return false;
         };
         let (a0, wps) = shape(self.levels, self.symmetric, self.axes);
@@ -167,7 +184,10 @@ impl LinearQuadtree4d {
 
     /// Bytes this table occupies in memory (struct plus its arrays).
     pub fn memory_bytes(&self) -> usize {
-        core::mem::size_of::<Self>() + 8 * self.codes.len() + 4 * self.slice_of.len() + 8 * self.slices.len()
+        core::mem::size_of::<Self>()
+            + 8 * self.codes.len()
+            + 4 * self.slice_of.len()
+            + 8 * self.slices.len()
     }
 
     /// The thesis's figure, `8 m + s b^2 / 8 + 8 b + 76` (Observation 3.2.3), for slices of
@@ -185,11 +205,35 @@ mod tests {
     #[test]
     fn from_parts_rejects_bad_slice_indices() {
         let (_, wps) = shape(2, false, SliceAxes::YY);
-        let ok = LinearQuadtree4d::from_parts(2, false, SliceAxes::YY, 0, vec![3], vec![0], vec![0; wps]);
+        let ok = LinearQuadtree4d::from_parts(
+            2,
+            false,
+            SliceAxes::YY,
+            0,
+            vec![3],
+            vec![0],
+            vec![0; wps],
+        );
         assert!(ok.is_ok());
-        let bad = LinearQuadtree4d::from_parts(2, false, SliceAxes::YY, 0, vec![3], vec![1], vec![0; wps]);
+        let bad = LinearQuadtree4d::from_parts(
+            2,
+            false,
+            SliceAxes::YY,
+            0,
+            vec![3],
+            vec![1],
+            vec![0; wps],
+        );
         assert!(bad.is_err(), "slice index out of range");
-        let bad = LinearQuadtree4d::from_parts(2, false, SliceAxes::YY, 0, vec![3, 3], vec![0, 0], vec![0; wps]);
+        let bad = LinearQuadtree4d::from_parts(
+            2,
+            false,
+            SliceAxes::YY,
+            0,
+            vec![3, 3],
+            vec![0, 0],
+            vec![0; wps],
+        );
         assert!(bad.is_err(), "duplicate code");
     }
 }

@@ -6,20 +6,19 @@
 use super::build::{put, ranges};
 use super::grouping::Grouping;
 use super::{shape, LinearQuadtree4d, SliceAxes};
+use crate::cspace::symmetry::Symmetry;
 use crate::cspace::{Label, SubdividedLabels};
 use crate::table::error::TableError;
-use crate::cspace::symmetry::Symmetry;
 use crate::table::space::{check_grids, merge, reflections, NONE};
 use rayon::prelude::*;
 
 impl LinearQuadtree4d {
-
     /// The table [`build`](Self::build) makes from [`SubdividedLabels::to_dense`]
     /// (the same table, tested), without those dense labels ([`subdivided_slices`]).
     ///
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ.
-        pub fn build_subdivided(
+    pub fn build_subdivided(
         labels: &SubdividedLabels,
         symmetry: Symmetry,
         axes: SliceAxes,
@@ -53,7 +52,8 @@ pub fn subdivided_slices(
     let (a0, wps) = shape(levels, symmetric, axes);
     let ra = ranges(&ga.cells, |i| !symmetric || u32::from(ga.cells[i][1]) >= k / 2, second);
     let rb = ranges(&gb.cells, |_| true, second);
-    let (refl_a, refl_b) = if symmetric { (reflections(ga), reflections(gb)) } else { (vec![], vec![]) };
+    let (refl_a, refl_b) =
+        if symmetric { (reflections(ga), reflections(gb)) } else { (vec![], vec![]) };
     let coarse = labels.coarse();
     let (ca0, cb0, k0) = (&coarse.grid_a.cells, &coarse.grid_b.cells, coarse.grid_a.k as u16);
     let nb0 = cb0.len().max(1);
@@ -85,8 +85,10 @@ pub fn subdivided_slices(
     let slice = |f: &[u16; 4]| -> Option<(Vec<u64>, Vec<u64>)> {
         let (ias, ibs) = (&ra[&(f[0], f[1])], &rb[&(f[2], f[3])]);
         let own_b: Vec<u32> = ibs.iter().map(|&ib| ib as u32).collect();
-        let mirror_b: Vec<u32> = if symmetric { ibs.iter().map(|&ib| refl_b[ib]).collect() } else { vec![] };
-        let (mut own, mut mirror) = (vec![Label::Unreachable; ibs.len()], vec![Label::Unreachable; ibs.len()]);
+        let mirror_b: Vec<u32> =
+            if symmetric { ibs.iter().map(|&ib| refl_b[ib]).collect() } else { vec![] };
+        let (mut own, mut mirror) =
+            (vec![Label::Unreachable; ibs.len()], vec![Label::Unreachable; ibs.len()]);
         let (mut s, mut care, mut any) = (vec![0u64; wps], vec![0u64; wps], false);
         for &ia in ias {
             labels.row(Some(ia), &own_b, &mut own);
@@ -141,7 +143,10 @@ impl SliceBound {
         let k = 1usize << levels;
         let rows = k - a0 as usize;
         let mut windows = Vec::new();
-        for side in [rows / 16, rows / 8, rows / 4, rows / 2, rows].into_iter().filter(|w| (4..=64).contains(w)) {
+        for side in [rows / 16, rows / 8, rows / 4, rows / 2, rows]
+            .into_iter()
+            .filter(|w| (4..=64).contains(w))
+        {
             for r0 in (0..=rows - side).step_by(side / 2) {
                 for c0 in (0..=k - side).step_by(side / 2) {
                     windows.push(((r0, c0, side), Default::default()));
@@ -160,7 +165,8 @@ impl SliceBound {
             let rows = *r0..*r0 + *side;
             if rows.clone().all(|r| window_bits(care, r * k + *c0, *side) == full) {
                 let h = rows.fold(0u64, |h, r| {
-                    (h.rotate_left(5) ^ window_bits(s, r * k + *c0, *side)).wrapping_mul(0x517c_c1b7_2722_0a95)
+                    (h.rotate_left(5) ^ window_bits(s, r * k + *c0, *side))
+                        .wrapping_mul(0x517c_c1b7_2722_0a95)
                 });
                 seen.insert(h);
             }
@@ -175,7 +181,9 @@ impl SliceBound {
     /// At least this many bytes in memory ([`LinearQuadtree4d::memory_bytes`]): the codes
     /// and slice indices, and the groups' slices.
     pub fn bytes_at_least(&self) -> usize {
-        core::mem::size_of::<LinearQuadtree4d>() + 12 * self.codes + 8 * self.wps * self.groups_at_least().0
+        core::mem::size_of::<LinearQuadtree4d>()
+            + 12 * self.codes
+            + 8 * self.wps * self.groups_at_least().0
     }
 }
 
@@ -198,7 +206,6 @@ mod tests {
     use super::*;
     use crate::cspace::Symmetry;
 
-
     /// The builder without dense labels makes the table the dense builder makes from the
     /// sub-cell labels: the same ranges, slices and groups (so the same order), on T1 and T2
     /// (symmetric) and T3 (not), for both slice axes, exact and lossy; and [`SliceBound`]
@@ -210,7 +217,8 @@ mod tests {
         use crate::cspace::{label_space_subdivided, Progress, SubdividedLabels, Workspace};
         for name in ["T1", "T2", "T3"] {
             let cell = reference_cell(name).unwrap();
-            let mut certified = label_space_subdivided(&cell, 16, &Workspace::THESIS, Progress::Silent).unwrap();
+            let mut certified =
+                label_space_subdivided(&cell, 16, &Workspace::THESIS, Progress::Silent).unwrap();
             // Every fifth pair's sub-cells all collisions: labels no longer mirror-symmetric,
             // so the symmetric tables must merge each pair with its mirror as the dense one does.
             let sub = certified.sub.as_mut().unwrap();
@@ -220,17 +228,34 @@ mod tests {
             let symmetric = reflection_y(&cell);
             for axes in [SliceAxes::YY, SliceAxes::ZZ] {
                 for t in [0, 40] {
-                    let want = LinearQuadtree4d::build(&dense, Symmetry::from_flag(symmetric), axes, t).unwrap();
-                    let got = LinearQuadtree4d::build_subdivided(&sparse, Symmetry::from_flag(symmetric), axes, t).unwrap();
-                    assert!(want.codes.len() > 100 && want.slice_count() > 10, "{name} {axes:?} t={t}: too small");
+                    let want =
+                        LinearQuadtree4d::build(&dense, Symmetry::from_flag(symmetric), axes, t)
+                            .unwrap();
+                    let got = LinearQuadtree4d::build_subdivided(
+                        &sparse,
+                        Symmetry::from_flag(symmetric),
+                        axes,
+                        t,
+                    )
+                    .unwrap();
+                    assert!(
+                        want.codes.len() > 100 && want.slice_count() > 10,
+                        "{name} {axes:?} t={t}: too small"
+                    );
                     assert!(got == want, "{name} {axes:?} t={t}: the tables differ");
                     if t == 0 {
                         // The lower bound is not above the table it bounds, and not trivial.
                         let mut bound = SliceBound::new(sparse.grid_a.levels, symmetric, axes);
-                        subdivided_slices(&sparse, symmetric, axes, |_, s, care| bound.add(s, care)).unwrap();
+                        subdivided_slices(&sparse, symmetric, axes, |_, s, care| {
+                            bound.add(s, care)
+                        })
+                        .unwrap();
                         let (groups, _) = bound.groups_at_least();
                         assert_eq!(bound.codes, got.codes.len(), "{name} {axes:?}");
-                        assert!(groups > 10 && groups <= got.slice_count(), "{name} {axes:?}: {groups} groups");
+                        assert!(
+                            groups > 10 && groups <= got.slice_count(),
+                            "{name} {axes:?}: {groups} groups"
+                        );
                         assert!(bound.bytes_at_least() <= got.memory_bytes(), "{name} {axes:?}");
                     }
                 }

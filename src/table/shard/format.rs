@@ -38,13 +38,13 @@
 //! ```
 
 use super::error::{corrupt, ShardError};
-use crate::table::reader::Reader;
 use super::ShardIndex;
 use crate::cell::{fingerprint_of, fnv1a64};
 use crate::cspace::{CellIndex, SampleGrid, Symmetry, Workspace};
 use crate::math::Vec3;
 use crate::table::build::{Labelling, RowLabels};
 use crate::table::clearance::MAX_RUNGS;
+use crate::table::reader::Reader;
 use crate::table::{Certification, Header, Ladder, TableKind};
 
 /// The first eight bytes of every shard file.
@@ -118,7 +118,11 @@ pub(super) fn to_bytes(info: &ShardInfo, labels: &RowLabels) -> Vec<u8> {
     let (ga, gb) = (&labels.space.grid_a, &labels.space.grid_b);
     let n = labels.space.labels.len();
     let mut out = Vec::with_capacity(
-        FIXED_LEN + 8 * h.cell_parameters.len() + 7 * (ga.cells.len() + gb.cells.len()) + n / 4 + 32,
+        FIXED_LEN
+            + 8 * h.cell_parameters.len()
+            + 7 * (ga.cells.len() + gb.cells.len())
+            + n / 4
+            + 32,
     );
     put(&mut out, &MAGIC);
     let kind = TableKind::ALL.iter().position(|&k| k == info.kind).unwrap_or(0) as u32;
@@ -141,7 +145,13 @@ pub(super) fn to_bytes(info: &ShardInfo, labels: &RowLabels) -> Vec<u8> {
     let clearance = labels.clearance.first().filter(|_| info.kind == TableKind::Clearance);
     put(&mut out, &(clearance.map_or(0, |(l, _)| l.len()) as u32).to_le_bytes());
     let sub = labels.sub.as_ref();
-    for v in [h.cell_parameters.len(), ga.cells.len(), gb.cells.len(), info.rows, sub.map_or(0, |s| s.pairs.len())] {
+    for v in [
+        h.cell_parameters.len(),
+        ga.cells.len(),
+        gb.cells.len(),
+        info.rows,
+        sub.map_or(0, |s| s.pairs.len()),
+    ] {
         put(&mut out, &(v as u64).to_le_bytes());
     }
     h.cell_parameters.iter().for_each(|v| put(&mut out, &v.to_le_bytes()));
@@ -180,7 +190,13 @@ fn read_prefix(r: &mut Reader<ShardError>) -> Result<(), ShardError> {
 }
 
 /// One robot's grid: `n` cells and their reachability, at spacing `r` from `origin`.
-fn read_grid(r: &mut Reader<ShardError>, n: usize, k: u32, spacing: f64, origin: [f64; 3]) -> Result<SampleGrid, ShardError> {
+fn read_grid(
+    r: &mut Reader<ShardError>,
+    n: usize,
+    k: u32,
+    spacing: f64,
+    origin: [f64; 3],
+) -> Result<SampleGrid, ShardError> {
     let cells: Vec<CellIndex> = r
         .items(n, 6, "grid cells")?
         .chunks_exact(6)
@@ -197,7 +213,14 @@ fn read_grid(r: &mut Reader<ShardError>, n: usize, k: u32, spacing: f64, origin:
         return Err(corrupt("grid reachability byte other than 0 or 1"));
     }
     let reachable = reach.iter().map(|&b| b == 1).collect();
-    Ok(SampleGrid { k, levels: k.trailing_zeros(), r: spacing, origin: Vec3::from(origin), cells, reachable })
+    Ok(SampleGrid {
+        k,
+        levels: k.trailing_zeros(),
+        r: spacing,
+        origin: Vec3::from(origin),
+        cells,
+        reachable,
+    })
 }
 
 /// Reads and validates a shard file (see the module doc); its labels and sub-cells stay in
@@ -210,14 +233,15 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     let mut r = Reader::<ShardError>::new(bytes);
     read_prefix(&mut r)?;
     let (index, count, k) = (r.u32("shard index")?, r.u32("shard count")?, r.u32("k")?);
-    let shard = ShardIndex::new(index, count).map_err(|_| corrupt(format!("shard {index} of {count}")))?;
+    let shard =
+        ShardIndex::new(index, count).map_err(|_| corrupt(format!("shard {index} of {count}")))?;
     if !(2..=1 << crate::table::code::MAX_LEVELS).contains(&k) || !k.is_power_of_two() {
         return Err(corrupt(format!("k = {k} is not a power of two from 2 to 256")));
     }
     let kind_number = r.u32("table kind")?;
-    let kind = *TableKind::ALL
-        .get(kind_number as usize)
-        .ok_or_else(|| corrupt(format!("table kind = {kind_number}, expected 0 to {}", TableKind::ALL.len() - 1)))?;
+    let kind = *TableKind::ALL.get(kind_number as usize).ok_or_else(|| {
+        corrupt(format!("table kind = {kind_number}, expected 0 to {}", TableKind::ALL.len() - 1))
+    })?;
     let t = r.u32("threshold t")?;
     let labelling = match r.u32("labelling")? {
         0 => Labelling::Certified,
@@ -230,15 +254,23 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
         v => return Err(corrupt(format!("symmetry = {v}, expected 0 or 1"))),
     };
     let flags = r.u32("flags")?;
-    if t != 0 && !kind.has_threshold() || flags > 1 || (flags == 1) != (kind == TableKind::SharedSub) {
+    if t != 0 && !kind.has_threshold()
+        || flags > 1
+        || (flags == 1) != (kind == TableKind::SharedSub)
+    {
         return Err(corrupt(format!("kind {kind} with threshold t = {t} and flags = {flags:#x}")));
     }
     let (label_secs, sub_secs) = (r.f64("label seconds")?, r.f64("sub-cell seconds")?);
     let cell_fingerprint = r.u64("cell fingerprint")?;
     let spacing = r.f64("r")?;
     let (origin_a, origin_b) = (r.f64x3("origin_a")?, r.f64x3("origin_b")?);
-    let ws: [f64; 5] =
-        [r.f64("workspace")?, r.f64("workspace")?, r.f64("workspace")?, r.f64("workspace")?, r.f64("workspace")?];
+    let ws: [f64; 5] = [
+        r.f64("workspace")?,
+        r.f64("workspace")?,
+        r.f64("workspace")?,
+        r.f64("workspace")?,
+        r.f64("workspace")?,
+    ];
     let margin = r.f64("margin")?;
     let certification = match r.u32("certification")? {
         1 => Certification::ThesisBlowUp,
@@ -248,13 +280,21 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     let rungs = r.u32("clearance levels")?;
     let clearance = kind == TableKind::Clearance;
     if clearance != (1..=MAX_RUNGS as u32).contains(&rungs) || !clearance && rungs != 0 {
-        return Err(corrupt(format!("kind {kind} with {rungs} clearance levels (clearance: 1 to {MAX_RUNGS}, else 0)")));
+        return Err(corrupt(format!(
+            "kind {kind} with {rungs} clearance levels (clearance: 1 to {MAX_RUNGS}, else 0)"
+        )));
     }
     let n_params = r.u64("cell parameter count")?;
-    let (na, nb, rows, m) =
-        (r.size("samples of A")?, r.size("samples of B")?, r.size("rows")?, r.size("sub-cell count")?);
+    let (na, nb, rows, m) = (
+        r.size("samples of A")?,
+        r.size("samples of B")?,
+        r.size("rows")?,
+        r.size("sub-cell count")?,
+    );
     if n_params > MAX_CELL_PARAMETERS {
-        return Err(corrupt(format!("cell parameter count = {n_params} exceeds {MAX_CELL_PARAMETERS}")));
+        return Err(corrupt(format!(
+            "cell parameter count = {n_params} exceeds {MAX_CELL_PARAMETERS}"
+        )));
     }
     if rows != shard.rows().count(na) {
         return Err(corrupt(format!(
@@ -265,7 +305,8 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     if m > 0 && kind != TableKind::SharedSub {
         return Err(corrupt(format!("{m} sub-cell entries in a shard of kind {kind}")));
     }
-    let cell_parameters = (0..n_params).map(|_| r.f64("cell parameter")).collect::<Result<Vec<_>, _>>()?;
+    let cell_parameters =
+        (0..n_params).map(|_| r.f64("cell parameter")).collect::<Result<Vec<_>, _>>()?;
     if fingerprint_of(cell_parameters.iter().copied()) != cell_fingerprint {
         return Err(corrupt("cell parameters do not give the recorded cell fingerprint"));
     }
@@ -282,13 +323,23 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>, ShardError> {
     check_labels(labels, pairs)?;
     check_sub_cells(sub, shard, na, nb)?;
     let ladder = match clearance {
-        true => Some(Ladder::new(&ladder_mm).map_err(|e| corrupt(format!("clearance ladder: {e}")))?),
+        true => {
+            Some(Ladder::new(&ladder_mm).map_err(|e| corrupt(format!("clearance ladder: {e}")))?)
+        }
         false => None,
     };
     check_counts(counts, labels, rungs)?;
     let workspace = Workspace { zu: ws[0], hcy: ws[1], rcy: ws[2], hco: ws[3], rco: ws[4] };
-    let header =
-        Header { cell_fingerprint, r: spacing, origin_a, origin_b, workspace, margin, certification, cell_parameters };
+    let header = Header {
+        cell_fingerprint,
+        r: spacing,
+        origin_a,
+        origin_b,
+        workspace,
+        margin,
+        certification,
+        cell_parameters,
+    };
     let info = ShardInfo {
         shard,
         k,
@@ -335,7 +386,9 @@ fn check_counts(counts: &[u8], packed: &[u8], n: u32) -> Result<(), ShardError> 
     for (j, &c) in counts.iter().enumerate() {
         let free = packed[j / 4] >> (2 * (j % 4)) & 3 == 0;
         if u32::from(c) > n || c > 0 && !free {
-            return Err(corrupt(format!("clearance count {c} of pair {j}: above {n} levels, or on a pair not free")));
+            return Err(corrupt(format!(
+                "clearance count {c} of pair {j}: above {n} levels, or on a pair not free"
+            )));
         }
     }
     Ok(())
@@ -347,8 +400,13 @@ fn check_sub_cells(sub: &[u8], shard: ShardIndex, na: usize, nb: usize) -> Resul
     for e in sub.chunks_exact(24) {
         let pair = u64::from_le_bytes(core::array::from_fn(|i| e[i]));
         let ia = pair / nb.max(1) as u64;
-        if ia >= na as u64 || ia % u64::from(shard.count()) != u64::from(shard.index()) || last >= Some(pair) {
-            return Err(corrupt(format!("sub-cell pair {pair} is not in this shard's rows, or out of order")));
+        if ia >= na as u64
+            || ia % u64::from(shard.count()) != u64::from(shard.index())
+            || last >= Some(pair)
+        {
+            return Err(corrupt(format!(
+                "sub-cell pair {pair} is not in this shard's rows, or out of order"
+            )));
         }
         last = Some(pair);
     }

@@ -27,7 +27,10 @@ pub fn merge_shards(
     files: &[String],
     read: &mut dyn FnMut(&str) -> Result<Vec<u8>, String>,
 ) -> Result<(Header, Table, BuildReport), ShardError> {
-    let in_file = |file: &str, error: ShardError| ShardError::InFile { file: file.to_string(), error: Box::new(error) };
+    let in_file = |file: &str, error: ShardError| ShardError::InFile {
+        file: file.to_string(),
+        error: Box::new(error),
+    };
     let mut first: Option<First> = None;
     let mut secs = (0.0, 0.0);
     for name in files {
@@ -37,14 +40,22 @@ pub fn merge_shards(
             None => first.insert(First::new(name, &s)),
             Some(f) => {
                 if let Some(what) = differs(f, &s) {
-                    return Err(ShardError::Foreign { file: name.clone(), first: f.name.clone(), what });
+                    return Err(ShardError::Foreign {
+                        file: name.clone(),
+                        first: f.name.clone(),
+                        what,
+                    });
                 }
                 f
             }
         };
         let i = s.info.shard.index() as usize;
         if let Some(other) = f.holder[i].replace(name.clone()) {
-            return Err(ShardError::Duplicate { index: i as u32, first: other, second: name.clone() });
+            return Err(ShardError::Duplicate {
+                index: i as u32,
+                first: other,
+                second: name.clone(),
+            });
         }
         let (rows, nb) = (s.info.shard.rows(), s.info.samples.1);
         let mut row = vec![Label::Free; nb];
@@ -62,29 +73,39 @@ pub fn merge_shards(
         secs = (secs.0 + s.info.label_secs, secs.1 + s.info.sub_secs);
     }
     let f = first.ok_or(ShardError::NoShards)?;
-    let missing: Vec<u32> = (0..f.holder.len() as u32).filter(|&i| f.holder[i as usize].is_none()).collect();
+    let missing: Vec<u32> =
+        (0..f.holder.len() as u32).filter(|&i| f.holder[i as usize].is_none()).collect();
     if !missing.is_empty() {
         return Err(ShardError::Missing { missing, count: f.holder.len() as u32 });
     }
-    let cells = if f.info.kind == TableKind::SharedSub { sub_cells_in_order(&f, read)? } else { SubCells::default() };
+    let cells = if f.info.kind == TableKind::SharedSub {
+        sub_cells_in_order(&f, read)?
+    } else {
+        SubCells::default()
+    };
     let info = f.info;
-    let space = LabelledSpace { grid_a: f.grid_a, grid_b: f.grid_b, labels: f.labels, margin: info.header.margin };
+    let space = LabelledSpace {
+        grid_a: f.grid_a,
+        grid_b: f.grid_b,
+        labels: f.labels,
+        margin: info.header.margin,
+    };
     let sub = (info.kind == TableKind::SharedSub).then_some(cells);
     let clearance: Vec<_> = info.ladder.map(|l| (l, f.counts)).into_iter().collect();
     let variant = match info.ladder {
         Some(ladder) => Variant::Clearance(ladder),
         None => info.kind.variant(info.t),
     };
-    let labels =
-        RowLabels {
-            space,
-            sub,
-            sub_secs: secs.1,
-            certification: info.header.certification,
-            labelling: info.labelling,
-            clearance,
-        };
-    let (mut tables, report) = assemble(labels, info.symmetry, &[variant], secs.0).map_err(ShardError::Build)?;
+    let labels = RowLabels {
+        space,
+        sub,
+        sub_secs: secs.1,
+        certification: info.header.certification,
+        labelling: info.labelling,
+        clearance,
+    };
+    let (mut tables, report) =
+        assemble(labels, info.symmetry, &[variant], secs.0).map_err(ShardError::Build)?;
     let table = tables.pop().ok_or(ShardError::NoShards)?;
     Ok((info.header, table, report))
 }
@@ -115,7 +136,9 @@ fn sub_cells_in_order(
         let Some(name) = name else { continue };
         let changed = |what: &str| ShardError::InFile {
             file: name.clone(),
-            error: Box::new(ShardError::Unreadable { what: format!("changed during the merge: {what}") }),
+            error: Box::new(ShardError::Unreadable {
+                what: format!("changed during the merge: {what}"),
+            }),
         };
         let bytes = read(name).map_err(|e| changed(&e))?;
         let s = parse(&bytes).map_err(|e| changed(&e.to_string()))?;
@@ -131,12 +154,15 @@ fn sub_cells_in_order(
             if at == ends[row] {
                 return Err(changed("more sub-cell entries"));
             }
-            (cells.pairs[at], cells.care[at], cells.collision[at]) = (entry(e, 0), entry(e, 1), entry(e, 2));
+            (cells.pairs[at], cells.care[at], cells.collision[at]) =
+                (entry(e, 0), entry(e, 1), entry(e, 2));
             next[row] += 1;
         }
     }
     if next != ends {
-        return Err(ShardError::Unreadable { what: "a shard changed during the merge: fewer sub-cell entries".into() });
+        return Err(ShardError::Unreadable {
+            what: "a shard changed during the merge: fewer sub-cell entries".into(),
+        });
     }
     Ok(cells)
 }
@@ -186,12 +212,20 @@ fn differs(a: &First, b: &Parsed) -> Option<String> {
     } else if (x.kind, x.t) != (y.kind, y.t) {
         format!("variant {} t = {}, not {} t = {}", y.kind, y.t, x.kind, x.t)
     } else if x.ladder != y.ladder {
-        format!("clearance levels {:?}, not {:?}", y.ladder.map(|l| l.mm().to_vec()), x.ladder.map(|l| l.mm().to_vec()))
+        format!(
+            "clearance levels {:?}, not {:?}",
+            y.ladder.map(|l| l.mm().to_vec()),
+            x.ladder.map(|l| l.mm().to_vec())
+        )
     } else if x.labelling != y.labelling {
         format!("labelling {:?}, not {:?}", y.labelling, x.labelling)
     } else if x.shard.count() != y.shard.count() {
         format!("one of {} shards, not of {}", y.shard.count(), x.shard.count())
-    } else if hx != hy || x.symmetry != y.symmetry || x.samples != y.samples || a.grid_bytes != b.grid_bytes {
+    } else if hx != hy
+        || x.symmetry != y.symmetry
+        || x.samples != y.samples
+        || a.grid_bytes != b.grid_bytes
+    {
         "the same cell and k, but another workspace, margin or sampling grid".to_string()
     } else {
         return None;

@@ -27,8 +27,8 @@ pub use merge::merge_shards;
 
 use super::build::{label_rows, BuildError, Labelling, Variant};
 use super::{Header, SliceAxes, TableKind};
-use crate::cspace::certify::clearance::clearance_counts;
 use crate::cell::Cell;
+use crate::cspace::certify::clearance::clearance_counts;
 use crate::cspace::{Progress, Rows, Symmetry, Workspace};
 use std::time::Instant;
 
@@ -172,7 +172,17 @@ mod tests {
         let cell = reference_cell("T3").unwrap();
         let shard = ShardIndex::new(0, 200).unwrap();
         let kind = (TableKind::SharedSub, 0);
-        build_shard(&cell, 16, &Workspace::THESIS, kind, Labelling::Certified, shard, Progress::Silent).unwrap().0
+        build_shard(
+            &cell,
+            16,
+            &Workspace::THESIS,
+            kind,
+            Labelling::Certified,
+            shard,
+            Progress::Silent,
+        )
+        .unwrap()
+        .0
     }
 
     /// `bytes` with the checksum recomputed, as a deliberate edit would leave it.
@@ -199,8 +209,13 @@ mod tests {
         assert_eq!((info.rows, info.shard.count()), (5, 200));
         assert!(info.sub_entries > 0, "the rows hold collision pairs with sub-cells");
         for n in 0..bytes.len() {
-            let e = parse(&bytes[..n]).err().unwrap_or_else(|| panic!("a shard cut to {n} bytes was read"));
-            assert!(matches!(e, ShardError::Truncated { .. } | ShardError::Corrupt { .. }), "cut to {n}: {e}");
+            let e = parse(&bytes[..n])
+                .err()
+                .unwrap_or_else(|| panic!("a shard cut to {n} bytes was read"));
+            assert!(
+                matches!(e, ShardError::Truncated { .. } | ShardError::Corrupt { .. }),
+                "cut to {n}: {e}"
+            );
         }
         for i in 0..bytes.len() {
             let mut flipped = bytes.clone();
@@ -217,17 +232,28 @@ mod tests {
         let shard = ShardIndex::new(1, 200).unwrap();
         let ladder = crate::table::Ladder::new(&[0.0, 20.0]).unwrap();
         let variant = Variant::Clearance(ladder);
-        let bytes =
-            build_shard_of(&cell, 16, &Workspace::THESIS, variant, Labelling::Certified, shard, Progress::Silent)
-                .unwrap()
-                .0;
+        let bytes = build_shard_of(
+            &cell,
+            16,
+            &Workspace::THESIS,
+            variant,
+            Labelling::Certified,
+            shard,
+            Progress::Silent,
+        )
+        .unwrap()
+        .0;
         let p = parse(&bytes).unwrap();
         assert_eq!(p.info.ladder, Some(ladder));
         assert_eq!(p.counts.len(), p.info.rows * p.info.samples.1);
-        assert!(p.counts.contains(&2) && p.counts.iter().all(|&c| c <= 2), "levels proved in the rows");
+        assert!(
+            p.counts.contains(&2) && p.counts.iter().all(|&c| c <= 2),
+            "levels proved in the rows"
+        );
         let start = bytes.len() - 8 - p.counts.len();
         let high = p.counts.iter().position(|&c| c > 0).unwrap();
-        let not_free = (0..p.counts.len()).find(|&j| p.labels[j / 4] >> (2 * (j % 4)) & 3 != 0).unwrap();
+        let not_free =
+            (0..p.counts.len()).find(|&j| p.labels[j / 4] >> (2 * (j % 4)) & 3 != 0).unwrap();
         for (at, v) in [(high, 3u8), (not_free, 1)] {
             let mut edited = bytes.clone();
             edited[start + at] = v;
@@ -235,7 +261,8 @@ mod tests {
             assert!(e.contains("clearance count"), "{e}");
         }
         let thesis = Labelling::ThesisMargin;
-        let thesis = build_shard_of(&cell, 16, &Workspace::THESIS, variant, thesis, shard, Progress::Silent);
+        let thesis =
+            build_shard_of(&cell, 16, &Workspace::THESIS, variant, thesis, shard, Progress::Silent);
         assert!(matches!(thesis, Err(BuildError::ClearanceNeedsCertified)));
     }
 
@@ -248,7 +275,17 @@ mod tests {
         let kind = (TableKind::SharedSub, 0);
         let shard = |i| {
             let index = ShardIndex::new(i, 2).unwrap();
-            build_shard(&cell, 16, &Workspace::THESIS, kind, Labelling::Certified, index, Progress::Silent).unwrap().0
+            build_shard(
+                &cell,
+                16,
+                &Workspace::THESIS,
+                kind,
+                Labelling::Certified,
+                index,
+                Progress::Silent,
+            )
+            .unwrap()
+            .0
         };
         let files = [shard(0), shard(1)];
         let names = ["s0".to_string(), "s1".to_string()];

@@ -9,16 +9,15 @@
 //! ahead keeps both cores busy.
 
 use super::SharedQuadtree6d;
+use crate::cspace::symmetry::Symmetry;
 use crate::cspace::{Label, LabelledSpace, SubCells};
 use crate::table::code::MAX_LEVELS;
 use crate::table::error::{bad_input, TableError};
 use crate::table::space::SpaceView;
-use crate::cspace::symmetry::Symmetry;
 use alloc::format;
 use std::collections::HashMap;
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 use std::time::{Duration, Instant};
-
 
 /// An inner node while building: non-uniform mask, collision mask, child ids.
 pub(super) type InnerNode = (u64, u64, Vec<u32>);
@@ -142,7 +141,13 @@ fn occupied(occ_a: &[Vec<bool>], occ_b: &[Vec<bool>], d: u32, (a, b): BlockAt) -
 /// The blocks at `depth` in the order [`Builder::build`] enters them (depth first, child
 /// order): the blocks whose sub-cells it fetches.
 fn blocks_in_order(occ_a: &[Vec<bool>], occ_b: &[Vec<bool>], depth: u32) -> Vec<BlockAt> {
-    fn visit(occ: (&[Vec<bool>], &[Vec<bool>]), d: u32, at: BlockAt, depth: u32, out: &mut Vec<BlockAt>) {
+    fn visit(
+        occ: (&[Vec<bool>], &[Vec<bool>]),
+        d: u32,
+        at: BlockAt,
+        depth: u32,
+        out: &mut Vec<BlockAt>,
+    ) {
         if !occupied(occ.0, occ.1, d, at) {
             return;
         }
@@ -162,7 +167,13 @@ fn blocks_in_order(occ_a: &[Vec<bool>], occ_b: &[Vec<bool>], depth: u32) -> Vec<
 /// The pairs of a block labelled collision (by their own label), numbered `ia * nb + ib`, in
 /// order: the pairs whose sub-cells [`Builder::subdivided_cell`] looks up inside the block
 /// (under symmetry too: a pair's sub-cells are its own, not merged with its mirror pair's).
-fn block_pairs(view: &SpaceView, dense: (&[u32], &[u32]), k: usize, depth: u32, (a, b): BlockAt) -> Vec<u64> {
+fn block_pairs(
+    view: &SpaceView,
+    dense: (&[u32], &[u32]),
+    k: usize,
+    depth: u32,
+    (a, b): BlockAt,
+) -> Vec<u64> {
     let side = k >> depth;
     let in_a = block_samples(dense.0, k, side, a);
     let in_b = block_samples(dense.1, k, side, b);
@@ -385,7 +396,10 @@ impl SharedQuadtree6d {
     /// # Errors
     /// [`TableError::BadInput`] when the grids differ or are not `2^levels` with
     /// `2 <= levels <= MAX_LEVELS`, or the label count is wrong.
-        pub fn build(space: &LabelledSpace, symmetry: Symmetry) -> Result<SharedQuadtree6d, TableError> {
+    pub fn build(
+        space: &LabelledSpace,
+        symmetry: Symmetry,
+    ) -> Result<SharedQuadtree6d, TableError> {
         Self::build_with(space, None, symmetry.is_mirrored(), None).map(|(table, _)| table)
     }
 
@@ -395,12 +409,13 @@ impl SharedQuadtree6d {
     ///
     /// # Errors
     /// As [`build`](Self::build).
-        pub fn build_subdivided(
+    pub fn build_subdivided(
         space: &LabelledSpace,
         sub: &SubCells,
         symmetry: Symmetry,
     ) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, Some(Fine::SubCells(sub)), symmetry.is_mirrored(), None).map(|(table, _)| table)
+        Self::build_with(space, Some(Fine::SubCells(sub)), symmetry.is_mirrored(), None)
+            .map(|(table, _)| table)
     }
 
     /// As [`build`](Self::build) with one more level whose leaves hold, per pair labelled
@@ -415,7 +430,8 @@ impl SharedQuadtree6d {
         word: &(dyn Fn(usize) -> u64 + Sync),
         symmetry: Symmetry,
     ) -> Result<SharedQuadtree6d, TableError> {
-        Self::build_with(space, Some(Fine::Words(word)), symmetry.is_mirrored(), None).map(|(table, _)| table)
+        Self::build_with(space, Some(Fine::Words(word)), symmetry.is_mirrored(), None)
+            .map(|(table, _)| table)
     }
 
     /// As [`build_subdivided`](Self::build_subdivided) with the sub-cells fetched from `source`
@@ -433,7 +449,12 @@ impl SharedQuadtree6d {
         block_depth: u32,
         symmetry: Symmetry,
     ) -> Result<(SharedQuadtree6d, Duration), TableError> {
-        Self::build_with(space, Some(Fine::Streamed), symmetry.is_mirrored(), Some((source, block_depth)))
+        Self::build_with(
+            space,
+            Some(Fine::Streamed),
+            symmetry.is_mirrored(),
+            Some((source, block_depth)),
+        )
     }
 
     fn build_with(
@@ -481,9 +502,11 @@ impl SharedQuadtree6d {
                 let (to_tree, next) = sync_channel(0);
                 let (view, dense) = (&view, (&dense_a[..], &dense_b[..]));
                 std::thread::scope(|scope| {
-                    scope.spawn(move || find_blocks(view, dense, k, depth, &order, source, to_tree));
+                    scope
+                        .spawn(move || find_blocks(view, dense, k, depth, &order, source, to_tree));
                     let block = SubCells::default();
-                    let stream = Stream { depth, block, next, waited: Duration::ZERO, out_of_order: false };
+                    let stream =
+                        Stream { depth, block, next, waited: Duration::ZERO, out_of_order: false };
                     let mut b = builder(Some(stream));
                     let root = b.build(0, [0; 3], [0; 3]);
                     // Dropping the receiver stops the finder should it have blocks left.
@@ -507,7 +530,8 @@ impl SharedQuadtree6d {
         mut inner_nodes: Vec<Vec<InnerNode>>,
         leaves: Vec<u64>,
     ) -> SharedQuadtree6d {
-        let (mut masks, mut bases, mut depth_start, mut children) = (vec![], vec![], vec![], vec![]);
+        let (mut masks, mut bases, mut depth_start, mut children) =
+            (vec![], vec![], vec![], vec![]);
         match root {
             // A uniform root is stored as one node with every child uniform.
             Part::Node(_) => {}

@@ -124,7 +124,12 @@ fn child_index(c: &[u16; 6], shift: u32) -> u32 {
 
 impl SharedQuadtree6d {
     /// The table of valid arrays, laid out for the query.
-    fn assemble(levels: u32, sub_levels: u32, symmetric: bool, arrays: pool::Arrays) -> SharedQuadtree6d {
+    fn assemble(
+        levels: u32,
+        sub_levels: u32,
+        symmetric: bool,
+        arrays: pool::Arrays,
+    ) -> SharedQuadtree6d {
         let pool = pool::Pool::new(levels + sub_levels, symmetric, &arrays);
         SharedQuadtree6d { levels, sub_levels, symmetric, pool }
     }
@@ -155,12 +160,18 @@ impl SharedQuadtree6d {
         }
         let depths = (levels + sub_levels) as usize - 1;
         if depth_start.len() != depths + 1 {
-            return Err(corrupt(format!("depth_start has {} entries, expected {}", depth_start.len(), depths + 1)));
+            return Err(corrupt(format!(
+                "depth_start has {} entries, expected {}",
+                depth_start.len(),
+                depths + 1
+            )));
         }
         if depth_start[0] != 0 || depth_start[1] != 1 {
             return Err(corrupt("depth 0 must hold exactly the root"));
         }
-        if depth_start.windows(2).any(|w| w[0] > w[1]) || depth_start[depths] as usize != masks.len() {
+        if depth_start.windows(2).any(|w| w[0] > w[1])
+            || depth_start[depths] as usize != masks.len()
+        {
             return Err(corrupt("depth_start is not increasing up to the node count"));
         }
         if bases.len() != masks.len() {
@@ -170,11 +181,17 @@ impl SharedQuadtree6d {
         // keeps no bases, and the parts read back from it must be the bytes loaded).
         let mut count = 0usize;
         for d in 0..depths {
-            let next = if d + 1 < depths { depth_start[d + 2] - depth_start[d + 1] } else { leaves.len() as u32 };
+            let next = if d + 1 < depths {
+                depth_start[d + 2] - depth_start[d + 1]
+            } else {
+                leaves.len() as u32
+            };
             for node in depth_start[d] as usize..depth_start[d + 1] as usize {
                 let [nonuniform, collision] = masks[node];
                 if nonuniform & collision != 0 {
-                    return Err(corrupt(format!("node {node}: a child is both uniform collision and a node")));
+                    return Err(corrupt(format!(
+                        "node {node}: a child is both uniform collision and a node"
+                    )));
                 }
                 let (base, n) = (bases[node] as usize, nonuniform.count_ones() as usize);
                 if base != count {
@@ -184,17 +201,31 @@ impl SharedQuadtree6d {
                 }
                 count += n;
                 let Some(ids) = children.get(base..base + n) else {
-                    return Err(corrupt(format!("node {node}: children {base}..{} outside the pool", base + n)));
+                    return Err(corrupt(format!(
+                        "node {node}: children {base}..{} outside the pool",
+                        base + n
+                    )));
                 };
                 if let Some(id) = ids.iter().find(|&&id| id >= next) {
-                    return Err(corrupt(format!("node {node}: child index {id} >= {next} nodes of depth {}", d + 1)));
+                    return Err(corrupt(format!(
+                        "node {node}: child index {id} >= {next} nodes of depth {}",
+                        d + 1
+                    )));
                 }
             }
         }
         if children.len() != count {
-            return Err(corrupt(format!("{} child indices for {count} non-uniform children", children.len())));
+            return Err(corrupt(format!(
+                "{} child indices for {count} non-uniform children",
+                children.len()
+            )));
         }
-        Ok(Self::assemble(levels, sub_levels, symmetric, (masks, bases, depth_start, children, leaves)))
+        Ok(Self::assemble(
+            levels,
+            sub_levels,
+            symmetric,
+            (masks, bases, depth_start, children, leaves),
+        ))
     }
 
     /// Whether the 6-D cell is stored as collision, its indices at `2^(levels + sub_levels)`
@@ -256,7 +287,13 @@ impl SharedQuadtree6d {
     /// them), read back from the query layout; allocates.
     pub fn parts(&self) -> SharedParts {
         let (masks, bases, depth_start, children, leaves) = self.pool.arrays();
-        SharedParts { masks, bases, depth_start, children: ChildIndices::from_u32(children), leaves }
+        SharedParts {
+            masks,
+            bases,
+            depth_start,
+            children: ChildIndices::from_u32(children),
+            leaves,
+        }
     }
 
     /// Inner nodes per depth, then the leaf count.
@@ -331,10 +368,19 @@ mod tests {
             for (ia, ca) in ga.cells.iter().enumerate().filter(|&(ia, _)| view.stored(ia)) {
                 for (ib, cb) in gb.cells.iter().enumerate() {
                     let cell = [ca[0], ca[1], ca[2], cb[0], cb[1], cb[2]];
-                    assert_eq!(shared.query_reads(cell).0, shared.query(cell), "{seed}: {cell:?} traced");
+                    assert_eq!(
+                        shared.query_reads(cell).0,
+                        shared.query(cell),
+                        "{seed}: {cell:?} traced"
+                    );
                     match view.label(ia, ib) {
-                        Label::Free => assert!(!shared.query(cell) && !d6.query(cell), "{seed}: {cell:?} free"),
-                        Label::Collision => assert!(shared.query(cell) && d6.query(cell), "{seed}: {cell:?} collision"),
+                        Label::Free => {
+                            assert!(!shared.query(cell) && !d6.query(cell), "{seed}: {cell:?} free")
+                        }
+                        Label::Collision => assert!(
+                            shared.query(cell) && d6.query(cell),
+                            "{seed}: {cell:?} collision"
+                        ),
                         Label::Unreachable => {}
                     }
                 }
@@ -364,8 +410,11 @@ mod tests {
     }
 
     /// The synthetic spaces the subdivided tables are tested on: pattern, levels, symmetric.
-    const SUBDIVIDED_SPACES: [(Pattern, u32, bool); 3] =
-        [(Pattern::Blobs, 3, false), (Pattern::Blobs, 4, true), (Pattern::Noise { p: 0.2, seed: 9 }, 3, true)];
+    const SUBDIVIDED_SPACES: [(Pattern, u32, bool); 3] = [
+        (Pattern::Blobs, 3, false),
+        (Pattern::Blobs, 4, true),
+        (Pattern::Noise { p: 0.2, seed: 9 }, 3, true),
+    ];
 
     /// With sub-cells, every sub-cell that is free or collision in its pair is answered
     /// exactly at the fine indices, and, for a symmetric table, so is its mirror sub-cell (both
@@ -376,7 +425,9 @@ mod tests {
         for (pattern, levels, symmetric) in SUBDIVIDED_SPACES {
             let space = space(levels, pattern);
             let sub = random_sub_cells(&space, u64::from(levels));
-            let t = SharedQuadtree6d::build_subdivided(&space, &sub, Symmetry::from_flag(symmetric)).unwrap();
+            let t =
+                SharedQuadtree6d::build_subdivided(&space, &sub, Symmetry::from_flag(symmetric))
+                    .unwrap();
             assert_eq!(t.sub_levels(), 1);
             let view = SpaceView::new(&space, symmetric).unwrap();
             let nb = space.grid_b.cells.len();
@@ -386,7 +437,8 @@ mod tests {
                 Label::Collision => sub.get((ia * nb + ib) as u64).unwrap(),
             };
             let (mut checked, mut free, mut hit) = (0, 0, 0);
-            for (ia, ca) in space.grid_a.cells.iter().enumerate().filter(|&(ia, _)| view.stored(ia)) {
+            for (ia, ca) in space.grid_a.cells.iter().enumerate().filter(|&(ia, _)| view.stored(ia))
+            {
                 for (ib, cb) in space.grid_b.cells.iter().enumerate() {
                     let (care, coll) = masks(ia, ib);
                     for c in 0..64u32 {
@@ -403,11 +455,20 @@ mod tests {
                             2 * cb[2] + bit(5),
                         ];
                         let want = coll >> c & 1 == 1;
-                        assert_eq!(t.query(fine), want, "{pattern:?}: pair ({ia}, {ib}) sub-cell {c}");
+                        assert_eq!(
+                            t.query(fine),
+                            want,
+                            "{pattern:?}: pair ({ia}, {ib}) sub-cell {c}"
+                        );
                         if symmetric {
                             let top = (2 << levels) - 1;
-                            let mirror = [fine[0], top - fine[1], fine[2], fine[3], top - fine[4], fine[5]];
-                            assert_eq!(t.query(mirror), want, "{pattern:?}: mirror of pair ({ia}, {ib}) sub-cell {c}");
+                            let mirror =
+                                [fine[0], top - fine[1], fine[2], fine[3], top - fine[4], fine[5]];
+                            assert_eq!(
+                                t.query(mirror),
+                                want,
+                                "{pattern:?}: mirror of pair ({ia}, {ib}) sub-cell {c}"
+                            );
                         }
                         checked += 1;
                         free += usize::from(!want);
@@ -415,7 +476,10 @@ mod tests {
                     }
                 }
             }
-            assert!(free > 0 && hit > 0, "{pattern:?}: {checked} checked, {free} free, {hit} collision");
+            assert!(
+                free > 0 && hit > 0,
+                "{pattern:?}: {checked} checked, {free} free, {hit} collision"
+            );
             // The file round trip keeps the sub-level.
             assert_eq!(round_trip(&t), t);
         }
@@ -442,7 +506,9 @@ mod tests {
             let symmetry = Symmetry::from_flag(symmetric);
             let whole = SharedQuadtree6d::build_subdivided(&space, &sub, symmetry).unwrap();
             for depth in 0..=levels {
-                let (t, _) = SharedQuadtree6d::build_streamed(&space, &mut Served(&sub), depth, symmetry).unwrap();
+                let (t, _) =
+                    SharedQuadtree6d::build_streamed(&space, &mut Served(&sub), depth, symmetry)
+                        .unwrap();
                 assert!(t == whole, "{pattern:?}, blocks at depth {depth}");
             }
         }
@@ -461,15 +527,26 @@ mod tests {
         let space = space(3, Pattern::Noise { p: 0.2, seed: 4 });
         let t = SharedQuadtree6d::build(&space, Symmetry::Whole).unwrap();
         let p = t.parts();
-        let (m, b, ds, c, l) =
-            (p.masks.to_vec(), p.bases.to_vec(), p.depth_start.to_vec(), p.children.to_u32(), p.leaves.to_vec());
+        let (m, b, ds, c, l) = (
+            p.masks.to_vec(),
+            p.bases.to_vec(),
+            p.depth_start.to_vec(),
+            p.children.to_u32(),
+            p.leaves.to_vec(),
+        );
         let ok = |m: Vec<[u64; 2]>, b: Vec<u32>, ds: Vec<u32>, c: Vec<u32>, l: Vec<u64>| {
             SharedQuadtree6d::from_parts(3, 0, false, m, b, ds, c, l).is_ok()
         };
         assert!(ok(m.clone(), b.clone(), ds.clone(), c.clone(), l.clone()));
-        assert!(!ok(m.clone(), b.clone(), ds.clone(), c.clone(), vec![]), "children point past the leaves");
+        assert!(
+            !ok(m.clone(), b.clone(), ds.clone(), c.clone(), vec![]),
+            "children point past the leaves"
+        );
         assert!(!ok(m.clone(), b.clone(), ds.clone(), vec![], l.clone()), "empty pool");
-        assert!(!ok(m.clone(), b.clone(), vec![0, 1], c.clone(), l.clone()), "depth_start too short");
+        assert!(
+            !ok(m.clone(), b.clone(), vec![0, 1], c.clone(), l.clone()),
+            "depth_start too short"
+        );
         let mut both = m.clone();
         both[0][1] |= both[0][0];
         assert!(!ok(both, b.clone(), ds.clone(), c.clone(), l.clone()), "overlapping masks");
@@ -478,7 +555,10 @@ mod tests {
         assert!(!ok(m.clone(), far, ds.clone(), c.clone(), l.clone()), "base past the pool");
         let mut shifted = b.clone();
         *shifted.last_mut().unwrap() -= 1;
-        assert!(!ok(m.clone(), shifted, ds.clone(), c.clone(), l.clone()), "bases not the running counts");
+        assert!(
+            !ok(m.clone(), shifted, ds.clone(), c.clone(), l.clone()),
+            "bases not the running counts"
+        );
         let mut longer = c.clone();
         longer.push(0);
         assert!(!ok(m, b, ds, longer, l), "an unused child index");

@@ -154,7 +154,11 @@ impl Pool {
             }
         };
         let mut words = Vec::with_capacity(region[depths as usize + 1] as usize);
-        pack(&mut words, top_entries(symmetric, top_depths, a, |d, id| 2 + target(d, id)), top_bits);
+        pack(
+            &mut words,
+            top_entries(symmetric, top_depths, a, |d, id| 2 + target(d, id)),
+            top_bits,
+        );
         for d in 0..depths as usize {
             for node in depth_start[d] as usize..depth_start[d + 1] as usize {
                 let [nonuniform, collision] = masks[node];
@@ -211,7 +215,8 @@ impl Pool {
     /// The top-table slot of the folded cell `c`.
     #[inline(always)]
     fn top_index(&self, c: &[u16; 6], fine: u32) -> usize {
-        let full = (0..self.top_depths).fold(0, |i, d| i << 6 | child_index(c, fine - 1 - d) as usize);
+        let full =
+            (0..self.top_depths).fold(0, |i, d| i << 6 | child_index(c, fine - 1 - d) as usize);
         squeeze(full, self.top_depths, self.symmetric)
     }
 
@@ -231,7 +236,8 @@ impl Pool {
                 return collision & bit != 0;
             }
             let rank = (nonuniform & (bit - 1)).count_ones() as usize;
-            node = self.region[d as usize + 1] as usize + slot_of(w, self.is_wide(d), node + 2, rank);
+            node =
+                self.region[d as usize + 1] as usize + slot_of(w, self.is_wide(d), node + 2, rank);
         }
         w[node] >> child_index(c, 0) & 1 == 1
     }
@@ -255,7 +261,8 @@ impl Pool {
                 return uniform(collision & bit != 0);
             }
             let rank = (nonuniform & (bit - 1)).count_ones() as usize;
-            node = self.region[d as usize + 1] as usize + slot_of(w, self.is_wide(d), node + 2, rank);
+            node =
+                self.region[d as usize + 1] as usize + slot_of(w, self.is_wide(d), node + 2, rank);
         }
         w[node]
     }
@@ -288,7 +295,8 @@ impl Pool {
             let rank = (nonuniform & (bit - 1)).count_ones() as usize;
             let (addr, bytes) = slot_addr(self.is_wide(d), node + 2, rank);
             reads.push((addr, bytes, step + 1));
-            node = self.region[d as usize + 1] as usize + slot_of(w, self.is_wide(d), node + 2, rank);
+            node =
+                self.region[d as usize + 1] as usize + slot_of(w, self.is_wide(d), node + 2, rank);
             step += 2;
         }
         reads.push((at(node), 8, step));
@@ -298,7 +306,8 @@ impl Pool {
     /// Inner nodes per depth, then the leaf count.
     pub(super) fn nodes_per_depth(&self) -> Vec<usize> {
         let d = self.depths as usize;
-        let mut v: Vec<usize> = self.depth_start[..=d].windows(2).map(|w| (w[1] - w[0]) as usize).collect();
+        let mut v: Vec<usize> =
+            self.depth_start[..=d].windows(2).map(|w| (w[1] - w[0]) as usize).collect();
         v.push((self.region[d + 1] - self.region[d]) as usize);
         v
     }
@@ -327,7 +336,12 @@ fn squeeze(full: usize, top_depths: u32, symmetric: bool) -> usize {
 
 /// The top table's slot values in slot order: 0 free, 1 collision, or `node(d, id)` for the
 /// non-uniform child `id` that a node of depth `d = top_depths - 1` reaches.
-fn top_entries(symmetric: bool, top_depths: u32, a: &Arrays, node: impl Fn(usize, u32) -> u64) -> Vec<u64> {
+fn top_entries(
+    symmetric: bool,
+    top_depths: u32,
+    a: &Arrays,
+    node: impl Fn(usize, u32) -> u64,
+) -> Vec<u64> {
     let (masks, bases, depth_start, children, _) = a;
     let full_slots = 1usize << (6 * top_depths);
     let ay_bit = 6 * (top_depths as usize - 1) + 4;
@@ -377,8 +391,11 @@ mod tests {
             if nonuniform & bit == 0 {
                 return collision & bit != 0;
             }
-            let child = children[bases[node] as usize + (nonuniform & (bit - 1)).count_ones() as usize] as usize;
-            node = if d + 1 < depths { depth_start[d as usize + 1] as usize + child } else { child };
+            let child = children
+                [bases[node] as usize + (nonuniform & (bit - 1)).count_ones() as usize]
+                as usize;
+            node =
+                if d + 1 < depths { depth_start[d as usize + 1] as usize + child } else { child };
         }
         leaves[node] >> child_index(&c, 0) & 1 == 1
     }
@@ -388,11 +405,7 @@ mod tests {
         let mut rng = crate::test_rng::TestRng(0x9e37_79b9_7f4a_7c15u64 ^ u64::from(levels));
         let all = k.pow(6) as usize <= n;
         (0..n.min(k.pow(6) as usize)).map(move |i| {
-            let v = if all {
-                i as u64
-            } else {
-                rng.next_u64()
-            };
+            let v = if all { i as u64 } else { rng.next_u64() };
             core::array::from_fn(|j| (v >> (levels as usize * j) & (k - 1)) as u16)
         })
     }
@@ -410,7 +423,9 @@ mod tests {
             (Pattern::AllCollision, 3, true),
             (Pattern::AllFree, 4, false),
         ] {
-            let t = SharedQuadtree6d::build(&space(levels, pattern), Symmetry::from_flag(symmetric)).unwrap();
+            let t =
+                SharedQuadtree6d::build(&space(levels, pattern), Symmetry::from_flag(symmetric))
+                    .unwrap();
             let p = t.parts();
             let a = (p.masks, p.bases, p.depth_start, p.children.to_u32(), p.leaves);
             for wide in [None, Some(u32::MAX)] {
@@ -423,7 +438,11 @@ mod tests {
                 for cell in cells(levels, 1 << 20) {
                     let c = fold(cell, 1 << levels, symmetric).unwrap();
                     let want = canonical_query(&a, levels, symmetric, cell);
-                    assert_eq!(pool.query(&c, levels), want, "{pattern:?} {levels} {bits}: {cell:?}");
+                    assert_eq!(
+                        pool.query(&c, levels),
+                        want,
+                        "{pattern:?} {levels} {bits}: {cell:?}"
+                    );
                     assert_eq!(pool.query_reads(&c, levels).0, want);
                 }
             }
@@ -448,6 +467,9 @@ mod tests {
         assert_eq!((0..5).map(|i| slot::<16>(&w, 0, i)).collect::<Vec<_>>(), [1, 2, 3, 4, 5]);
         let mut w = vec![];
         pack(&mut w, [7, u64::from(u32::MAX), 9], 32);
-        assert_eq!((0..3).map(|i| slot::<32>(&w, 0, i)).collect::<Vec<_>>(), [7, u32::MAX as usize, 9]);
+        assert_eq!(
+            (0..3).map(|i| slot::<32>(&w, 0, i)).collect::<Vec<_>>(),
+            [7, u32::MAX as usize, 9]
+        );
     }
 }
