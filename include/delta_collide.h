@@ -772,10 +772,11 @@ void dc_protective_reset(struct DcCollider *handle);
  tick of `dc_set_stop_model` earlier. Correct only when called exactly once per cycle, at
  the cycle's nominal time: called twice in one cycle it reads a moving robot as standing.
  `dc_protective_query_timed` takes the cycle and fails closed on every timing fault: use
- it in the tick loop. Works in exact and table mode (it reads the exact boxes). In table mode with a clearance table, a tick whose certified clearance bound
- exceeds both robots' motion bounds over their stops plus `warn_mm` is FREE by the lookup,
- without the box-pair proof (`dc_table_protective_lookups`); every other tick takes the
- exact protective check, as in exact mode. The report is filled alike in both modes.
+ it in the tick loop. Works in exact and table mode (it reads the exact boxes). In table mode
+ with a clearance table, a tick whose certified clearance bound exceeds both robots' motion
+ bounds over their stops plus `warn_mm` is FREE by the lookup, without the box-pair proof
+ (`dc_table_protective_lookups`); every other tick takes the exact protective check, as in exact
+ mode. The report is filled alike in both modes.
 
  Writes `*out_verdict` (and `*out_report` when not NULL) on every call:
  `DC_VERDICT_FREE` (proved: every stop the models allow keeps the boxes apart),
@@ -799,9 +800,9 @@ DcStatus dc_protective_query(struct DcCollider *handle, const struct DcVec3 *tcp
  `dc_protective_query` (untimed: exactly once per cycle, at its nominal time; the timed
  call takes the paths in its request) for a controller that knows the path each robot's
  stop will follow (a path-maintaining stop: its next set-points), which brings STOPs down
- toward the ticks where a stop really cannot avoid contact. `paths[j]` is robot `j`'s `DcStopPath`
- (`n_points` 0: not known; that robot is then bounded as by `dc_protective_query`). The
- verdict is the better of the proof without paths and the proof along them; the speed
+ toward the ticks where a stop really cannot avoid contact. `paths[j]` is robot `j`'s
+ `DcStopPath` (`n_points` 0: not known; that robot is then bounded as by `dc_protective_query`).
+ The verdict is the better of the proof without paths and the proof along them; the speed
  limits are those without paths. Statuses: those of `dc_protective_query`, and
  `DC_STATUS_NULL_POINTER` (paths NULL, or a path's points NULL with `n_points` > 0),
  `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths` differs from the robot count),
@@ -845,9 +846,9 @@ struct DcProtectiveRequest dc_protective_request_default(void);
  Statuses: those of `dc_protective_query_with_paths`, the timing statuses above,
  `DC_STATUS_NULL_POINTER` (request NULL, or paths NULL with `n_paths` > 0),
  `DC_STATUS_INVALID_ARGUMENT` (a `struct_size` that is not this header's
- `sizeof(DcProtectiveRequest)`, an unknown `clock`), `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths` neither 0 nor the robot
- count), `DC_STATUS_BUSY` (the handle is in another call). `*out_verdict` and
- `*out_report` are written on every call. Never allocates, locks or does I/O.
+ `sizeof(DcProtectiveRequest)`, an unknown `clock`), `DC_STATUS_WRONG_ROBOT_COUNT` (`n_paths`
+ neither 0 nor the robot count), `DC_STATUS_BUSY` (the handle is in another call). `*out_verdict`
+ and `*out_report` are written on every call. Never allocates, locks or does I/O.
 
  # Safety
  `handle` must be NULL or a live handle from `dc_init*`; `request` must be NULL or point
