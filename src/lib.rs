@@ -6,11 +6,12 @@
 //!
 //! | module | what | thesis | SPEC |
 //! |---|---|---|---|
-//! | [`math`] | scalar and vector aliases, named tolerances | | §1 |
-//! | [`geometry`] | oriented boxes, separating axis test, witness cache, box distance | 2.4, 3.1 |
-//! §3 |
-//! | [`robot`] | Delta3 kinematics, the box model of one robot | 2.2, 2.5, 2.6 | §2, §3 |
-//! | [`cell`] | robots, placements, the exact check of a whole cell | 2.3, 3.1.4 | §1, §5 |
+//! | [`math`] | scalar and vector aliases, named tolerances, interval arithmetic | | §1 |
+//! | [`geometry`] | oriented boxes, separating axis test, witness cache, swept boxes, clearance | 2.4, 3.1 | §3, §8 |
+//! | [`robot`] | Delta3 kinematics, one robot's boxes, its motion bound, its stopping model | 2.2-2.7 | §2, §3, §8 |
+//! | [`cell`] | robots, placements, the exact check of a cell, the protective verdict | 2.3, 3.1 | §1, §5, §8 |
+//! | [`cspace`] | the sampled configuration space of two robots and its certified labels | 3.2.2-3.2.8 | §4, §6 |
+//! | [`table`] | precomputed tables: quadtrees, files, bundles, shards, their queries | 3.2.4-3.2.6 | §6 |
 //! | [`ffi`] | the only `extern "C"` surface (opaque handle, POU lifecycle) | App. A | |
 //!
 //! # Features
