@@ -11,26 +11,12 @@ use crate::cell::protective::{
     StopPath, TickTime, TimingFault, DEFAULT_WARN_MM,
 };
 use crate::cell::{Cell, ExactChecker, MAX_ROBOTS};
-use crate::ffi::convert::{cell_error_status, table_error_status};
+use crate::ffi::convert::{cell_error_status, table_error_status, InitError};
 use crate::ffi::types::*;
 use crate::math::Vec3;
 use crate::robot::StopModel;
 use crate::table::{is_bundle, BundleChecker, Confirmation, TableAnswer, TableChecker};
 use std::path::Path;
-
-/// Why a collider could not be made: the status for C and a message naming the cause and
-/// the fix (kept for `dc_last_init_error`).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(crate) struct InitError {
-    pub status: DcStatus,
-    pub message: String,
-}
-
-impl InitError {
-    pub(crate) fn new(status: DcStatus, message: impl Into<String>) -> Self {
-        InitError { status, message: message.into() }
-    }
-}
 
 /// How a collider answers.
 enum Checker {

@@ -1,11 +1,24 @@
 //! Safe conversions between the C structs and the crate's types (no `unsafe` here).
 
 use crate::cell::{Cell, CellError, Placement, RobotSpec, SatMethod};
-use crate::ffi::collider::InitError;
 use crate::ffi::types::*;
 use crate::math::Vec3;
 use crate::robot::{Delta3, ModelOptions, RobotModel, ToolBox};
 use crate::table::TableError;
+
+/// Why a collider could not be made: the status for C and a message naming the cause and
+/// the fix (kept for `dc_last_init_error`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct InitError {
+    pub status: DcStatus,
+    pub message: String,
+}
+
+impl InitError {
+    pub(crate) fn new(status: DcStatus, message: impl Into<String>) -> Self {
+        InitError { status, message: message.into() }
+    }
+}
 
 /// [`crate::robot::StopModel::DEFAULT`] as a C struct, `struct_size` set.
 pub(crate) fn stop_config_default() -> DcStopConfig {

@@ -1,8 +1,9 @@
 //! Making and freeing a handle (the POU's start-up and shut-down): from a C configuration, a
 //! cell file, a table or bundle in memory, or files; the last init error of each thread.
 
-use super::collider::{Collider, InitError};
+use super::collider::Collider;
 use super::convert;
+use super::convert::InitError;
 use super::handle::{boundary, DcCollider};
 use super::types::*;
 use std::cell::RefCell;

@@ -23,113 +23,13 @@ use crate::cspace::{
 };
 use crate::table::memory::{plan_memory, MemoryPlan};
 use crate::table::shared6d::SubCellBlocks;
+use crate::table::{BuildError, Variant};
 use crate::table::{
     Certification, ClearanceTable, Header, Ladder, LinearQuadtree4d, LinearQuadtree5d,
-    LinearQuadtree6d, SharedQuadtree6d, SliceAxes, Table, TableError,
+    LinearQuadtree6d, SharedQuadtree6d, Table, TableError,
 };
-use core::fmt;
 use rayon::prelude::*;
 use std::time::Instant;
-
-/// Why a table could not be built (apart from [`TableError`], which says why a table file
-/// could not be loaded).
-#[derive(Clone, Debug, PartialEq)]
-pub enum BuildError {
-    /// Tables are built for two-robot cells only.
-    NotTwoRobots {
-        /// The cell's name.
-        cell: String,
-        /// How many robots it has.
-        robots: usize,
-    },
-    /// The labelling refused the grid: `k` not a power of two, or too small to hold the
-    /// workspace (the message names the fix).
-    Labelling(String),
-    /// Sub-cells are certified: `SharedSubdivided` needs the certified labelling.
-    SubCellsNeedCertified,
-    /// Clearance levels are proofs: `Clearance` needs the certified labelling.
-    ClearanceNeedsCertified,
-    /// A builder refused the labels.
-    Table(TableError),
-    /// A build bounded to `max` bytes ([`build_table_bounded`]) needs more for its fixed
-    /// part ([`crate::table::memory`]).
-    Memory {
-        /// Bytes of the fixed part (estimated).
-        needed: u64,
-        /// Of `needed`: the labels.
-        labels: u64,
-        /// The bound.
-        max: u64,
-    },
-}
-
-impl fmt::Display for BuildError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            BuildError::NotTwoRobots { cell, robots } => {
-                write!(f, "tables are built for two-robot cells; {cell} has {robots}")
-            }
-            BuildError::Labelling(m) => f.write_str(m),
-            BuildError::SubCellsNeedCertified => f.write_str("sub-cells are certified; use the certified labelling"),
-            BuildError::ClearanceNeedsCertified => {
-                f.write_str("clearance levels are certified; use the certified labelling")
-            }
-            BuildError::Table(e) => write!(f, "{e}"),
-            BuildError::Memory { needed, labels, max } => write!(
-                f,
-                "the build needs about {} of memory whatever the block size (the robots' boxes and sweeps, \
-                 and {} of labels, 2 bits per sample pair), more than the {} allowed; allow more \
-                 memory, use a smaller k (each halving needs 64 times less for the labels) or shards",
-                gigabytes(*needed),
-                gigabytes(*labels),
-                gigabytes(*max)
-            ),
-        }
-    }
-}
-
-impl std::error::Error for BuildError {}
-
-fn gigabytes(bytes: u64) -> String {
-    format!("{:.2} GB", bytes as f64 / 1e9)
-}
-
-impl From<TableError> for BuildError {
-    fn from(e: TableError) -> BuildError {
-        BuildError::Table(e)
-    }
-}
-
-impl From<BuildError> for String {
-    fn from(e: BuildError) -> String {
-        e.to_string()
-    }
-}
-
-/// Which linear quadtree to build.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Variant {
-    /// Thesis 3.2.4: condensed 6-D linear quadtree.
-    D6,
-    /// Thesis 3.2.5: 5-D quadtree with `z'` collision intervals.
-    D5,
-    /// Thesis 3.2.6: 4-D quadtree of 2-D slices grouped with similarity threshold `t`.
-    D4 {
-        /// The two ignored dimensions.
-        axes: SliceAxes,
-        /// Similarity threshold (0: lossless).
-        t: u32,
-    },
-    /// The 6-D quadtree with shared subtrees ([`SharedQuadtree6d`]).
-    Shared,
-    /// As `Shared`, with every certified collision cell cut into 64 sub-cells
-    /// certified on their own ([`crate::cspace::label_space_subdivided`]; certified labelling
-    /// only).
-    SharedSubdivided,
-    /// Certified clearance levels of the ladder per grid cell ([`ClearanceTable`]; certified
-    /// labelling only).
-    Clearance(Ladder),
-}
 
 /// How the samples are labelled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

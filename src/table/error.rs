@@ -131,3 +131,84 @@ impl crate::table::reader::ReadError for TableError {
         corrupt(what)
     }
 }
+
+#[cfg(feature = "std")]
+/// Why a table could not be built (apart from [`TableError`], which says why a table file
+/// could not be loaded).
+#[derive(Clone, Debug, PartialEq)]
+pub enum BuildError {
+    /// Tables are built for two-robot cells only.
+    NotTwoRobots {
+        /// The cell's name.
+        cell: String,
+        /// How many robots it has.
+        robots: usize,
+    },
+    /// The labelling refused the grid: `k` not a power of two, or too small to hold the
+    /// workspace (the message names the fix).
+    Labelling(String),
+    /// Sub-cells are certified: `SharedSubdivided` needs the certified labelling.
+    SubCellsNeedCertified,
+    /// Clearance levels are proofs: `Clearance` needs the certified labelling.
+    ClearanceNeedsCertified,
+    /// A builder refused the labels.
+    Table(TableError),
+    /// A build bounded to `max` bytes ([`build_table_bounded`]) needs more for its fixed
+    /// part ([`crate::table::memory`]).
+    Memory {
+        /// Bytes of the fixed part (estimated).
+        needed: u64,
+        /// Of `needed`: the labels.
+        labels: u64,
+        /// The bound.
+        max: u64,
+    },
+}
+
+#[cfg(feature = "std")]
+impl core::fmt::Display for BuildError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            BuildError::NotTwoRobots { cell, robots } => {
+                write!(f, "tables are built for two-robot cells; {cell} has {robots}")
+            }
+            BuildError::Labelling(m) => f.write_str(m),
+            BuildError::SubCellsNeedCertified => f.write_str("sub-cells are certified; use the certified labelling"),
+            BuildError::ClearanceNeedsCertified => {
+                f.write_str("clearance levels are certified; use the certified labelling")
+            }
+            BuildError::Table(e) => write!(f, "{e}"),
+            BuildError::Memory { needed, labels, max } => write!(
+                f,
+                "the build needs about {} of memory whatever the block size (the robots' boxes and sweeps, \
+                 and {} of labels, 2 bits per sample pair), more than the {} allowed; allow more \
+                 memory, use a smaller k (each halving needs 64 times less for the labels) or shards",
+                gigabytes(*needed),
+                gigabytes(*labels),
+                gigabytes(*max)
+            ),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for BuildError {}
+
+#[cfg(feature = "std")]
+fn gigabytes(bytes: u64) -> String {
+    alloc::format!("{:.2} GB", bytes as f64 / 1e9)
+}
+
+#[cfg(feature = "std")]
+impl From<TableError> for BuildError {
+    fn from(e: TableError) -> BuildError {
+        BuildError::Table(e)
+    }
+}
+
+#[cfg(feature = "std")]
+impl From<BuildError> for String {
+    fn from(e: BuildError) -> String {
+        e.to_string()
+    }
+}

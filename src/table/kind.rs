@@ -2,7 +2,7 @@
 //! SPEC §6): the strings of the CLI's `--variant`, the variant number a table file stores,
 //! and the builder's [`Variant`](super::Variant). Adding a kind starts here.
 
-use super::{SliceAxes, Table};
+use super::{Ladder, SliceAxes, Table};
 use core::fmt;
 use core::str::FromStr;
 
@@ -139,6 +139,31 @@ impl FromStr for TableKind {
     fn from_str(s: &str) -> Result<TableKind, UnknownTableKind> {
         TableKind::ALL.into_iter().find(|k| k.name() == s).ok_or(UnknownTableKind)
     }
+}
+
+/// Which linear quadtree to build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variant {
+    /// Thesis 3.2.4: condensed 6-D linear quadtree.
+    D6,
+    /// Thesis 3.2.5: 5-D quadtree with `z'` collision intervals.
+    D5,
+    /// Thesis 3.2.6: 4-D quadtree of 2-D slices grouped with similarity threshold `t`.
+    D4 {
+        /// The two ignored dimensions.
+        axes: SliceAxes,
+        /// Similarity threshold (0: lossless).
+        t: u32,
+    },
+    /// The 6-D quadtree with shared subtrees ([`SharedQuadtree6d`](super::SharedQuadtree6d)).
+    Shared,
+    /// As `Shared`, with every certified collision cell cut into 64 sub-cells
+    /// certified on their own ([`crate::cspace::label_space_subdivided`]; certified labelling
+    /// only).
+    SharedSubdivided,
+    /// Certified clearance levels of the ladder per grid cell ([`ClearanceTable`](super::ClearanceTable); certified
+    /// labelling only).
+    Clearance(Ladder),
 }
 
 #[cfg(test)]

@@ -7,7 +7,8 @@
 //! were measured (peak resident of a build labelling few rows: T1 at k = 64, 2.15 GB for
 //! 2 x 47,548 samples, `docs/record/2026-11-24-shards.md`) and rounded up.
 
-use super::build::{BuildError, Variant};
+use super::error::BuildError;
+use super::kind::Variant;
 use crate::cspace::PairLabels;
 
 /// Bytes per sample of either robot that a labelling holds whatever the rows: boxes and

@@ -47,15 +47,17 @@ use alloc::{format, string::String};
 use alloc::{vec, vec::Vec};
 #[cfg(feature = "std")]
 pub use build::{
-    build_table, build_table_bounded, build_tables, memory_plan, BoundedBuild, BuildError,
-    BuildReport, Labelling, Variant,
+    build_table, build_table_bounded, build_tables, memory_plan, BoundedBuild, BuildReport,
+    Labelling,
 };
 pub use bundle::{bundle_from_bytes, bundle_to_bytes, is_bundle, pair_cell, Bundle, BundlePair};
 pub use bundle_checker::{BundleChecker, PairAnswer};
 pub use clearance::{ClearanceTable, Ladder};
+#[cfg(feature = "std")]
+pub use error::BuildError;
 pub use error::TableError;
 pub use format::{from_bytes, to_bytes, Certification, Header};
-pub use kind::{TableKind, UnknownTableKind};
+pub use kind::{TableKind, UnknownTableKind, Variant};
 pub use lookup::{Confirmation, TableAnswer, TableChecker};
 #[cfg(feature = "std")]
 pub use memory::{default_max_memory, parse_bytes, MemoryPlan, DEFAULT_MAX_MEMORY};

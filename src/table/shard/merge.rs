@@ -6,7 +6,8 @@ use super::error::ShardError;
 use super::format::{parse, Parsed, ShardInfo};
 use crate::cspace::pair_labels::label_in;
 use crate::cspace::{Label, LabelledSpace, PairLabels, SampleGrid, SubCells};
-use crate::table::build::{assemble, RowLabels, Variant};
+use crate::table::build::{assemble, RowLabels};
+use crate::table::Variant;
 use crate::table::{BuildReport, Header, Table, TableKind};
 
 /// Merges the shard files `files` (names, in any order; `read` gives a file's bytes) into

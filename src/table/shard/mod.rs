@@ -25,7 +25,8 @@ pub use error::ShardError;
 pub use format::{read_shard_info, ShardInfo, MAGIC, VERSION};
 pub use merge::merge_shards;
 
-use super::build::{label_rows, BuildError, Labelling, Variant};
+use super::build::{label_rows, Labelling};
+use super::{BuildError, Variant};
 use super::{Header, SliceAxes, TableKind};
 use crate::cell::Cell;
 use crate::cspace::certify::clearance::clearance_counts;
