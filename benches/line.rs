@@ -12,7 +12,7 @@
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, BenchmarkId, Criterion};
-use delta_collide::cell::protective::{Protective, ProtectiveChecker};
+use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveRequest};
 use delta_collide::cell::ExactChecker;
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::Vec3;
@@ -130,7 +130,11 @@ fn lines(c: &mut Criterion) {
             run.iter().map(|t| exact.check(t).unwrap().verdict).collect();
         let pairs: u64 = run
             .iter()
-            .map(|t| u64::from(lookup.check_with_table(t, &bound).unwrap().table_pairs))
+            .map(|t| {
+                u64::from(
+                    lookup.check(ProtectiveRequest::new(t).with_table(&bound)).unwrap().table_pairs,
+                )
+            })
             .sum();
         println!("{label}, stiff: {pairs} pairs proved by a lookup over {} ticks", run.len());
         for (name, table_mode) in [("protective", false), ("protective, table mode", true)] {
@@ -140,7 +144,9 @@ fn lines(c: &mut Criterion) {
                     checker.reset();
                 }
                 let r = match table_mode {
-                    true => checker.check_with_table(black_box(&run[k]), &bound).unwrap(),
+                    true => checker
+                        .check(ProtectiveRequest::new(black_box(&run[k])).with_table(&bound))
+                        .unwrap(),
                     false => checker.check(black_box(&run[k])).unwrap(),
                 };
                 // Table mode proves some pairs another way: never a worse verdict.

@@ -17,7 +17,7 @@
 //! most ticks are FREE and most FREE ticks reuse a kept proof.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use delta_collide::cell::protective::{Protective, ProtectiveChecker, StopPath};
+use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveRequest, StopPath};
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker};
@@ -159,7 +159,9 @@ fn replay(c: &mut Criterion, name: &str, cell: Cell) {
     let mut checker = ProtectiveChecker::new(cell.clone(), 10.0).unwrap().with_speed_limits(false);
     let verdicts: Vec<Protective> = ticks
         .iter()
-        .map(|(t, p)| checker.check_with_paths(t, &stop_paths(p)).unwrap().verdict)
+        .map(|(t, p)| {
+            checker.check(ProtectiveRequest::new(t).with_paths(&stop_paths(p))).unwrap().verdict
+        })
         .collect();
     let mut i = 0;
     group.bench_function(BenchmarkId::new("protective", "verdict with paths"), |b| {
@@ -171,7 +173,10 @@ fn replay(c: &mut Criterion, name: &str, cell: Cell) {
             i += 1;
             let (tcps, paths) = &ticks[k];
             assert_eq!(
-                checker.check_with_paths(black_box(tcps), &stop_paths(paths)).unwrap().verdict,
+                checker
+                    .check(ProtectiveRequest::new(black_box(tcps)).with_paths(&stop_paths(paths)))
+                    .unwrap()
+                    .verdict,
                 verdicts[k]
             );
         })

@@ -10,7 +10,7 @@
 //! Every verdict is computed before timing and asserted inside the loop.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use delta_collide::cell::protective::{Protective, ProtectiveChecker};
+use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveRequest};
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker};
@@ -77,7 +77,7 @@ fn group(c: &mut Criterion, model: &str, cell: &Cell, bytes: &[u8], ticks: &[[Ve
     let reports: Vec<(Protective, bool)> = ticks
         .iter()
         .map(|t| {
-            let r = table_mode.check_with_table(t, &bound).unwrap();
+            let r = table_mode.check(ProtectiveRequest::new(t).with_table(&bound)).unwrap();
             (r.verdict, r.table_lookup)
         })
         .collect();
@@ -107,7 +107,10 @@ fn group(c: &mut Criterion, model: &str, cell: &Cell, bytes: &[u8], ticks: &[[Ve
             // The verdict as in the first pass; whether the lookup or a proof kept from the
             // previous pass gives it may differ (kept proofs outlive `reset`).
             assert_eq!(
-                table_mode.check_with_table(black_box(&ticks[k]), &bound).unwrap().verdict,
+                table_mode
+                    .check(ProtectiveRequest::new(black_box(&ticks[k])).with_table(&bound))
+                    .unwrap()
+                    .verdict,
                 reports[k].0
             );
         })

@@ -6,7 +6,9 @@
 //! path's statuses, no allocation per tick, and the STOP counts on the scenarios with the
 //! programmed path ahead as the stop path.
 
-use delta_collide::cell::protective::{Protective, ProtectiveChecker, ProtectiveStatus, StopPath};
+use delta_collide::cell::protective::{
+    Protective, ProtectiveChecker, ProtectiveRequest, ProtectiveStatus, StopPath,
+};
 use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, RUN_TICKS};
 use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::math::{Real, Vec3};
@@ -104,7 +106,7 @@ fn brute_force(name: &str, stop: StopModel, ticks: usize, seed: u64) -> (usize, 
         let without = c.clone().check(&tcps).unwrap().verdict;
         let stop_paths: Vec<Option<StopPath>> =
             paths.iter().map(|p| Some(StopPath { points: p, tolerance_mm: tol })).collect();
-        let r = c.check_with_paths(&tcps, &stop_paths).unwrap().clone();
+        let r = c.check(ProtectiveRequest::new(&tcps).with_paths(&stop_paths)).unwrap().clone();
         assert_eq!(r.status, ProtectiveStatus::Ok, "tick {t}: {r:?}");
         assert!(r.verdict <= without, "tick {t}: a path made the verdict worse");
         if r.verdict == Protective::Stop {
@@ -151,7 +153,7 @@ fn a_broken_path_is_a_status_with_stop_and_the_history_is_forgotten() {
     let far = [Vec3::new(-150.0, 40.0, -450.0), Vec3::new(-150.0, 80.0, -450.0)];
     for (path, why) in [(&far[..], "the TCP is 40 mm from the path"), (&[][..], "no point")] {
         let paths = [Some(StopPath { points: path, tolerance_mm: 1.0 }), None];
-        let r = c.check_with_paths(&[a, b], &paths).unwrap();
+        let r = c.check(ProtectiveRequest::new(&[a, b]).with_paths(&paths)).unwrap();
         assert_eq!(
             (r.verdict, r.status),
             (Protective::Stop, ProtectiveStatus::InvalidPath(0)),
@@ -163,8 +165,14 @@ fn a_broken_path_is_a_status_with_stop_and_the_history_is_forgotten() {
     }
     let on = [a, a + Vec3::new(50.0, 0.0, 0.0)];
     let nan = [Some(StopPath { points: &on, tolerance_mm: Real::NAN }), None];
-    assert_eq!(c.check_with_paths(&[a, b], &nan).unwrap().status, ProtectiveStatus::InvalidPath(0));
-    assert!(c.check_with_paths(&[a, b], &[None]).is_err(), "one path per robot");
+    assert_eq!(
+        c.check(ProtectiveRequest::new(&[a, b]).with_paths(&nan)).unwrap().status,
+        ProtectiveStatus::InvalidPath(0)
+    );
+    assert!(
+        c.check(ProtectiveRequest::new(&[a, b]).with_paths(&[None])).is_err(),
+        "one path per robot"
+    );
 }
 
 /// The practical and collision scenarios with the programmed path ahead as each robot's stop
@@ -195,7 +203,7 @@ fn programmed_paths_ahead_bring_the_stops_of_the_scenarios_down() {
             let paths: Vec<Option<StopPath>> = (0..tcps.len())
                 .map(|j| Some(StopPath { points: &points[j][..lens[j]], tolerance_mm: 0.1 }))
                 .collect();
-            let r = with.check_with_paths(&tcps, &paths).unwrap();
+            let r = with.check(ProtectiveRequest::new(&tcps).with_paths(&paths)).unwrap();
             assert!(r.verdict <= v0, "{} {} tick {tick}: worse with paths", s.cell, s.case);
             stops_with += (r.verdict == Protective::Stop) as u32;
             warn_with += (r.verdict == Protective::Warn) as u32;

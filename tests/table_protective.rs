@@ -12,7 +12,7 @@
 
 use delta_collide::cell::parse_cell;
 use delta_collide::cell::protective::{
-    ClearanceBound, Protective, ProtectiveChecker, ProtectiveStatus,
+    ClearanceBound, Protective, ProtectiveChecker, ProtectiveRequest, ProtectiveStatus,
 };
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
@@ -151,8 +151,8 @@ fn brute_force(
         });
         let prev = [tcps[0] - v_fd[0] * tick, tcps[1] - v_fd[1] * tick];
         checker.reset();
-        checker.check_with_table(&prev, &bound).unwrap();
-        let r = checker.check_with_table(&tcps, &bound).unwrap().clone();
+        checker.check(ProtectiveRequest::new(&prev).with_table(&bound)).unwrap();
+        let r = checker.check(ProtectiveRequest::new(&tcps).with_table(&bound)).unwrap().clone();
         if !r.table_lookup {
             continue;
         }
@@ -278,7 +278,7 @@ fn side_by_side(
     for t in 0..RUN_TICKS {
         s.tcps_at(t, &mut tcps);
         let e = exact.check(&tcps).unwrap().clone();
-        let r = lookup.check_with_table(&tcps, bound).unwrap();
+        let r = lookup.check(ProtectiveRequest::new(&tcps).with_table(bound)).unwrap();
         out.counts[0][e.verdict as usize] += 1;
         out.counts[1][r.verdict as usize] += 1;
         out.pairs += u64::from(r.table_pairs);
@@ -381,7 +381,11 @@ fn a_boolean_table_changes_nothing() {
     for t in 0..1_500 {
         s.tcps_at(t, &mut tcps);
         let e = exact.check(&tcps).unwrap().clone();
-        assert_eq!(lookup.check_with_table(&tcps, &bound).unwrap(), &e, "tick {t}");
+        assert_eq!(
+            lookup.check(ProtectiveRequest::new(&tcps).with_table(&bound)).unwrap(),
+            &e,
+            "tick {t}"
+        );
     }
 }
 
@@ -409,8 +413,8 @@ fn a_table_mode_tick_never_allocates() {
     let mut lookups = 0;
     for [prev, tcps] in &states {
         c.reset();
-        c.check_with_table(prev, &bound).unwrap();
-        lookups += c.check_with_table(tcps, &bound).unwrap().table_pairs;
+        c.check(ProtectiveRequest::new(prev).with_table(&bound)).unwrap();
+        lookups += c.check(ProtectiveRequest::new(tcps).with_table(&bound)).unwrap().table_pairs;
     }
     assert_eq!(allocations(), before);
     assert!(lookups > 10, "{lookups} pairs proved by a lookup: the lookup path was not exercised");

@@ -144,7 +144,7 @@
 //! settled by a kept proof or a certain STOP, a pair whose table bound exceeds both robots'
 //! motion bounds (the largest displacement of any box point under step 4's sweeps) plus
 //! `warn_mm` is proved by the lookup, without its box-pair proof; the tick is FREE by the
-//! lookups when every pair is ([`ProtectiveChecker::check_with_table`],
+//! lookups when every pair is ([`ProtectiveRequest::with_table`],
 //! [`ProtectiveReport::table_lookup`], [`ProtectiveReport::table_pairs`]); the other pairs
 //! take the proof above, unchanged.
 //!
@@ -300,7 +300,7 @@ pub struct ProtectiveReport {
     /// wider than this tick's (`protective/kept.rs`) rather than by this tick's own proof.
     pub kept_proof: bool,
     /// Whether the verdict is FREE by the clearance table's bound alone, without a swept-box
-    /// proof (`protective/lookup.rs`; only with [`ProtectiveChecker::check_with_table`]).
+    /// proof (`protective/lookup.rs`; only with [`ProtectiveRequest::with_table`]).
     pub table_lookup: bool,
     /// How many pairs that can meet the table's bound proved apart this tick, which the
     /// swept-box proof then skipped (all of them when `table_lookup`).
@@ -649,8 +649,9 @@ impl ProtectiveChecker {
     /// One tick: robot `j`'s TCP now is `request.tcps_mcs[j]` (its MCS); its speed comes from
     /// its TCP at the previous call and the interval between the two calls' times
     /// (`protective/clock.rs`); with paths, the verdict is also proved along them
-    /// ([`ProtectiveChecker::check_with_paths`]); with a table, a tick its bound proves FREE is
-    /// answered from it ([`ProtectiveChecker::check_with_table`]). A slice of TCPs is an untimed
+    /// (`protective/path.rs`: the better of the verdicts without and along them, the speed
+    /// limits those without); with a table, a tick its bound proves FREE is answered from it
+    /// (`protective/lookup.rs`; a bound that proves nothing changes nothing). A slice of TCPs is an untimed
     /// request ([`TickTime::Nominal`]: one tick after the last call, whenever it comes).
     ///
     /// A call of the same cycle (or timestamp) as the last one with the same TCPs gets the
@@ -714,22 +715,6 @@ impl ProtectiveChecker {
         }
     }
 
-    /// One tick like [`ProtectiveChecker::check`] in table mode: `bound` gives a certified
-    /// lower bound on the clearance at any TCPs (a clearance table's), and where it alone
-    /// proves FREE the tick is answered from it ([`ProtectiveReport::table_lookup`]; the
-    /// proof is in `protective/lookup.rs`); every other tick is [`ProtectiveChecker::check`]'s.
-    /// A bound that proves nothing (`None` everywhere: a boolean table) changes nothing.
-    ///
-    /// # Errors
-    /// As [`ProtectiveChecker::check`].
-    pub fn check_with_table(
-        &mut self,
-        tcps_mcs: &[Vec3],
-        bound: ClearanceBound,
-    ) -> Result<&ProtectiveReport, QueryError> {
-        self.check(ProtectiveRequest::new(tcps_mcs).with_table(bound))
-    }
-
     /// The verdict without paths, the speeds bounded over `self.calls.interval_s` (module doc, step
     /// 1; counts checked by the caller).
     fn check_bounded(&mut self, tcps_mcs: &[Vec3], bound: Option<ClearanceBound>) {
@@ -771,37 +756,6 @@ impl ProtectiveChecker {
         } else {
             self.forget_motion();
         }
-    }
-
-    /// One tick like [`ProtectiveChecker::check`], where the controller also gives, per robot,
-    /// the path its stop will follow (`None`: not known), as a path-maintaining stop knows it
-    /// ([`StopPath`]: the promise it makes and the proof, in `protective/path.rs`). The
-    /// verdict is the better of the one without paths and the one over the paths: both are
-    /// proofs. The speed limits are those without paths (so they hold with any path).
-    ///
-    /// # Errors
-    /// [`QueryError::WrongRobotCount`] when either slice's length differs from the robot count
-    /// (the history is then left as it was).
-    pub fn check_with_paths(
-        &mut self,
-        tcps_mcs: &[Vec3],
-        paths: &[Option<StopPath>],
-    ) -> Result<&ProtectiveReport, QueryError> {
-        self.check(ProtectiveRequest::new(tcps_mcs).with_paths(paths))
-    }
-
-    /// [`ProtectiveChecker::check_with_paths`] in table mode: the tick without paths is
-    /// [`ProtectiveChecker::check_with_table`]'s (a FREE lookup needs no paths).
-    ///
-    /// # Errors
-    /// As [`ProtectiveChecker::check_with_paths`].
-    pub fn check_with_paths_and_table(
-        &mut self,
-        tcps_mcs: &[Vec3],
-        paths: &[Option<StopPath>],
-        bound: ClearanceBound,
-    ) -> Result<&ProtectiveReport, QueryError> {
-        self.check(ProtectiveRequest::new(tcps_mcs).with_paths(paths).with_table(bound))
     }
 
     /// The verdict with paths (counts checked by the caller): the better of the one without
