@@ -15,6 +15,7 @@
 use delta_collide::cell::parse_cell;
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::{Progress, Workspace};
+use delta_collide::ffi::{DC_STATUS_TIME_BACKWARDS, DC_VERDICT_STOP};
 use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::{build_tables, to_bytes, Labelling, Ladder, Variant};
 use std::path::{Path, PathBuf};
@@ -819,4 +820,80 @@ int main(int argc, char **argv)
         stdout.contains("whole 0, cut 1, stops 2"),
         "a collision and an error both stop: {stdout}"
     );
+}
+
+/// The README's protective example ("Stopping before contact"), compiled with the strict flags
+/// and run on T1 with robots standing apart and then one at full speed toward the other: the
+/// timed call answers the same cycle twice alike, and a cycle that goes back is STOP with its
+/// status.
+#[test]
+fn readme_protective_example_compiles_and_runs() {
+    let readme = std::fs::read_to_string(repo_root().join("README.md")).expect("README.md");
+    let section = readme.split("## Stopping before contact").nth(1).expect("the protective section");
+    let snippet = section.split("```c\n").nth(1).and_then(|s| s.split("```").next()).expect("a ```c block");
+    // The snippet's start-up lines run once; the rest is the tick, run per cycle.
+    let (startup, tick) = snippet.split_once("/* every tick */\n").expect("a `/* every tick */` line");
+    let program = format!(
+        r#"#include <stdio.h>
+#include <string.h>
+#include "delta_collide.h"
+static int stops, overrides;
+static void stop_all_robots(void) {{ stops++; }}
+static void override_speed(const double *limits) {{ overrides += limits[0] >= 0.0; }}
+int main(void)
+{{
+    DcRobotConfig robots[2];
+    DcCellConfig config;
+    DcCollider *h = NULL;
+    DcVerdict verdict = DC_VERDICT_STOP, first = DC_VERDICT_STOP;
+    DcStatus s;
+    DcVec3 tcps_mcs[2] = {{ {{ -150.0, 0.0, -450.0 }}, {{ 150.0, 0.0, -450.0 }} }};
+    unsigned long long cycle_counter;
+    int free_ticks = 0, same = 1;
+    robots[0] = robots[1] = dc_robot_config_thesis();
+    robots[1].translation.x = 450.0;
+    config.robots = robots; config.n_robots = 2; config.method = DC_METHOD_SAT;
+    if (dc_init(&config, &h) != DC_STATUS_OK) return 2;
+    {{
+{startup}
+    for (cycle_counter = 0; cycle_counter < 20; cycle_counter++) {{
+        int again;
+        for (again = 0; again < 2; again++) {{
+{tick}
+            if (again == 0) first = verdict; else same &= first == verdict;
+        }}
+        free_ticks += verdict == DC_VERDICT_FREE;
+    }}
+    req.time = 3;
+    s = dc_protective_query_timed(h, &req, &verdict, NULL);
+    printf("free %d same %d back %u %u stops %d overrides %d\n", free_ticks, same, (unsigned)s,
+           (unsigned)verdict, stops, overrides);
+    }}
+    dc_destroy(h);
+    return 0;
+}}
+"#
+    );
+    let dir = scratch_dir("c_harness_readme_protective");
+    let (src, exe) = (dir.join("readme_protective.c"), dir.join("readme_protective"));
+    std::fs::write(&src, program).unwrap();
+    let out = run(Command::new("cc")
+        .args(C_FLAGS)
+        .arg("-I")
+        .arg(repo_root().join("include"))
+        .arg(&src)
+        .arg(static_lib())
+        .args(NATIVE_LIBS)
+        .arg("-o")
+        .arg(&exe));
+    assert!(out.status.success(), "the README example does not compile:\n{}", text(&out.stderr));
+    let out = run(&mut Command::new(&exe));
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "README example failed: {stdout}");
+    // Standing apart: FREE after the first cycles (the first assumes full speed); the same
+    // cycle twice answers alike; cycle 3 after 19 goes back: DC_STATUS_TIME_BACKWARDS, STOP.
+    let back = format!("back {} {}", DC_STATUS_TIME_BACKWARDS, DC_VERDICT_STOP);
+    assert!(stdout.contains("same 1") && stdout.contains(&back), "{stdout}");
+    let free: u32 = stdout.split("free ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
+    assert!(free >= 15, "{stdout}");
 }

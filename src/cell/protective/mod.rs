@@ -425,10 +425,13 @@ struct Calls {
     interval_s: Real,
     /// The time of the last call (`None`: none since the checker was made or reset).
     time: Option<TickTime>,
-    /// The TCPs of the last call and its report: a call of the same cycle with the same TCPs
-    /// gets that report again.
+    /// The TCPs of the last call: a call of the same cycle with the same TCPs gets its report
+    /// again.
     last_tcps: alloc::vec::Vec<Vec3>,
+    /// The last call's report, put aside here when `check_at_speeds` wrote over it (then
+    /// `set_aside`): a tick copies nothing when nothing came between.
     cycle_report: ProtectiveReport,
+    set_aside: bool,
     /// Which robot's speed-limit search comes first this tick (and may use the most tests).
     limit_turn: usize,
 }
@@ -537,6 +540,7 @@ impl ProtectiveChecker {
             time: None,
             last_tcps: alloc::vec![Vec3::zeros(); n],
             cycle_report: report.clone(),
+            set_aside: false,
             limit_turn: 0,
         };
         Ok(ProtectiveChecker {
@@ -678,7 +682,9 @@ impl ProtectiveChecker {
         let tcps = request.tcps_mcs;
         match clock::interval(self.calls.time, request.time, tick_s) {
             clock::Interval::Same if same_bits(&self.calls.last_tcps, tcps) => {
-                self.report.clone_from(&self.calls.cycle_report);
+                if core::mem::take(&mut self.calls.set_aside) {
+                    self.report.clone_from(&self.calls.cycle_report);
+                }
                 return Ok(&self.report);
             }
             clock::Interval::Same => self.timing_fault(tcps, TimingFault::Repeated),
@@ -695,7 +701,7 @@ impl ProtectiveChecker {
         }
         self.calls.time = Some(request.time);
         self.calls.last_tcps.copy_from_slice(tcps);
-        self.calls.cycle_report.clone_from(&self.report);
+        self.calls.set_aside = false;
         Ok(&self.report)
     }
 
@@ -811,6 +817,10 @@ impl ProtectiveChecker {
             if len != n {
                 return Err(QueryError::WrongRobotCount { expected: n, found: len });
             }
+        }
+        // The last call's report, which a repeat of its cycle answers, is put aside first.
+        if !core::mem::replace(&mut self.calls.set_aside, true) {
+            self.calls.cycle_report.clone_from(&self.report);
         }
         // A given speed is the speed now: bounded as a measured one over one tick.
         self.calls.interval_s = self.cell().tick_ms * 1e-3;
