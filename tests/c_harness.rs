@@ -829,16 +829,19 @@ int main(int argc, char **argv)
 #[test]
 fn readme_protective_example_compiles_and_runs() {
     let readme = std::fs::read_to_string(repo_root().join("README.md")).expect("README.md");
-    let section = readme.split("## Stopping before contact").nth(1).expect("the protective section");
-    let snippet = section.split("```c\n").nth(1).and_then(|s| s.split("```").next()).expect("a ```c block");
+    let section =
+        readme.split("## Stopping before contact").nth(1).expect("the protective section");
+    let snippet =
+        section.split("```c\n").nth(1).and_then(|s| s.split("```").next()).expect("a ```c block");
     // The snippet's start-up lines run once; the rest is the tick, run per cycle.
-    let (startup, tick) = snippet.split_once("/* every tick */\n").expect("a `/* every tick */` line");
+    let (startup, tick) =
+        snippet.split_once("/* every tick */\n").expect("a `/* every tick */` line");
     let program = format!(
         r#"#include <stdio.h>
 #include <string.h>
 #include "delta_collide.h"
-static int stops, overrides;
-static void stop_all_robots(void) {{ stops++; }}
+static int stop_calls, overrides;
+static void stop_all_robots(void) {{ stop_calls++; }}
 static void override_speed(const double *limits) {{ overrides += limits[0] >= 0.0; }}
 int main(void)
 {{
@@ -867,7 +870,7 @@ int main(void)
     req.time = 3;
     s = dc_protective_query_timed(h, &req, &verdict, NULL);
     printf("free %d same %d back %u %u stops %d overrides %d\n", free_ticks, same, (unsigned)s,
-           (unsigned)verdict, stops, overrides);
+           (unsigned)verdict, stop_calls, overrides);
     }}
     dc_destroy(h);
     return 0;
@@ -894,6 +897,7 @@ int main(void)
     // cycle twice answers alike; cycle 3 after 19 goes back: DC_STATUS_TIME_BACKWARDS, STOP.
     let back = format!("back {} {}", DC_STATUS_TIME_BACKWARDS, DC_VERDICT_STOP);
     assert!(stdout.contains("same 1") && stdout.contains(&back), "{stdout}");
-    let free: u32 = stdout.split("free ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
+    let free: u32 =
+        stdout.split("free ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
     assert!(free >= 15, "{stdout}");
 }
