@@ -753,6 +753,25 @@ fn header_as_c89_is_recorded() {
     }
 }
 
+/// The C program `program` written to the scratch folder `name` and compiled with the strict
+/// flags against the library; the executable's path.
+fn compile_example(name: &str, program: &str) -> PathBuf {
+    let dir = scratch_dir(&format!("c_harness_{name}"));
+    let (src, exe) = (dir.join(format!("{name}.c")), dir.join(name));
+    std::fs::write(&src, program).unwrap();
+    let out = run(Command::new("cc")
+        .args(C_FLAGS)
+        .arg("-I")
+        .arg(repo_root().join("include"))
+        .arg(&src)
+        .arg(static_lib())
+        .args(NATIVE_LIBS)
+        .arg("-o")
+        .arg(&exe));
+    assert!(out.status.success(), "the README example does not compile:\n{}", text(&out.stderr));
+    exe
+}
+
 /// The README's table-mode example, compiled with the strict flags and run on T1's table: a
 /// colliding configuration stops the robots; a truncated table is reported with the field at
 /// fault and fails closed.
@@ -789,19 +808,7 @@ int main(int argc, char **argv)
 }}
 "#
     );
-    let dir = scratch_dir("c_harness_readme");
-    let (src, exe) = (dir.join("readme_example.c"), dir.join("readme_example"));
-    std::fs::write(&src, program).unwrap();
-    let out = run(Command::new("cc")
-        .args(C_FLAGS)
-        .arg("-I")
-        .arg(repo_root().join("include"))
-        .arg(&src)
-        .arg(static_lib())
-        .args(NATIVE_LIBS)
-        .arg("-o")
-        .arg(&exe));
-    assert!(out.status.success(), "the README example does not compile:\n{}", text(&out.stderr));
+    let exe = compile_example("readme_example", &program);
     let out = run(Command::new(&exe).arg(table_file(0)));
     let stdout = text(&out.stdout);
     assert!(out.status.success(), "README example failed: {stdout}");
@@ -877,19 +884,7 @@ int main(void)
 }}
 "#
     );
-    let dir = scratch_dir("c_harness_readme_protective");
-    let (src, exe) = (dir.join("readme_protective.c"), dir.join("readme_protective"));
-    std::fs::write(&src, program).unwrap();
-    let out = run(Command::new("cc")
-        .args(C_FLAGS)
-        .arg("-I")
-        .arg(repo_root().join("include"))
-        .arg(&src)
-        .arg(static_lib())
-        .args(NATIVE_LIBS)
-        .arg("-o")
-        .arg(&exe));
-    assert!(out.status.success(), "the README example does not compile:\n{}", text(&out.stderr));
+    let exe = compile_example("readme_protective", &program);
     let out = run(&mut Command::new(&exe));
     let stdout = text(&out.stdout);
     assert!(out.status.success(), "README example failed: {stdout}");

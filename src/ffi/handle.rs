@@ -132,3 +132,34 @@ pub(super) unsafe fn read_slice<'a, T>(ptr: *const T, len: usize) -> Result<&'a 
     // SAFETY: non-null, and the caller guarantees `len` readable elements.
     Ok(unsafe { std::slice::from_raw_parts(ptr, len) })
 }
+
+/// The body of a per-tick export: checks the pointers, runs `query` on the handle's collider
+/// with the TCPs (through [`live`]: a panic poisons the handle), and writes `report` (which
+/// starts as `stop`) and its verdict on every call, STOP on every status but OK.
+///
+/// # Safety
+/// `handle` must be NULL or live; `tcps_mcs` NULL or `n_tcps` readable elements; the outputs
+/// NULL or writable.
+pub(super) unsafe fn tick_entry<R: Verdicted>(
+    handle: *const DcCollider,
+    (tcps_mcs, n_tcps): (*const DcVec3, usize),
+    (out_verdict, out_report): (*mut DcVerdict, *mut R),
+    stop: R,
+    query: impl FnOnce(&mut Collider, &[DcVec3], &mut R) -> DcStatus,
+) -> DcStatus {
+    let mut report = stop;
+    let status = boundary(|| {
+        if out_verdict.is_null() {
+            return DC_STATUS_NULL_POINTER;
+        }
+        // SAFETY: the caller guarantees `n_tcps` readable elements when not NULL.
+        let tcps = match unsafe { read_slice(tcps_mcs, n_tcps) } {
+            Ok(tcps) => tcps,
+            Err(status) => return status,
+        };
+        // SAFETY: the caller guarantees `handle` is NULL or live.
+        flatten(unsafe { live(handle, |c| query(c, tcps, &mut report)) })
+    });
+    // SAFETY: the caller guarantees the out pointers are NULL or writable.
+    unsafe { write_out(status, report, out_verdict, out_report) }
+}

@@ -2,7 +2,7 @@
 //! their history.
 
 use super::collider::Collider;
-use super::handle::{boundary, flatten, live, read_slice, write_out, DcCollider};
+use super::handle::{live, tick_entry, DcCollider};
 use super::types::*;
 use crate::cell::protective::TickTime;
 
@@ -241,13 +241,10 @@ unsafe fn with_path_views(
     query(c, &views[..n_paths], report)
 }
 
-/// The common part of the protective entry points: checks the handle and the pointers, runs
-/// `query` on the handle's collider with the TCPs (a panic poisons the handle), and writes
-/// the outputs on every call, the verdict STOP on every status but OK.
+/// The common part of the protective entry points: [`tick_entry`] with a protective report.
 ///
 /// # Safety
-/// `handle` must be NULL or a live handle not used by another thread; `tcps_mcs` NULL or
-/// `n_tcps` readable elements; the outputs NULL or writable.
+/// As [`tick_entry`].
 unsafe fn protective_entry(
     handle: *mut DcCollider,
     tcps_mcs: *const DcVec3,
@@ -256,19 +253,7 @@ unsafe fn protective_entry(
     out_report: *mut DcProtectiveReport,
     query: impl FnOnce(&mut Collider, &[DcVec3], &mut DcProtectiveReport) -> DcStatus,
 ) -> DcStatus {
-    let mut report = DcProtectiveReport::STOP;
-    let status = boundary(|| {
-        if out_verdict.is_null() {
-            return DC_STATUS_NULL_POINTER;
-        }
-        // SAFETY: the caller guarantees `n_tcps` readable elements when not NULL.
-        let tcps = match unsafe { read_slice(tcps_mcs, n_tcps) } {
-            Ok(tcps) => tcps,
-            Err(status) => return status,
-        };
-        // SAFETY: the caller guarantees `handle` is NULL or live.
-        flatten(unsafe { live(handle, |c| query(c, tcps, &mut report)) })
-    });
-    // SAFETY: the caller guarantees the out pointers are NULL or writable.
-    unsafe { write_out(status, report, out_verdict, out_report) }
+    let stop = DcProtectiveReport::STOP;
+    // SAFETY: the caller's guarantees are passed on.
+    unsafe { tick_entry(handle, (tcps_mcs, n_tcps), (out_verdict, out_report), stop, query) }
 }

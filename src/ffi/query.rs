@@ -2,7 +2,7 @@
 //! mode's counters and clearance bound, the robot and pair counts.
 
 use super::collider::Collider;
-use super::handle::{boundary, flatten, live, read_slice, write_out, DcCollider};
+use super::handle::{boundary, flatten, live, tick_entry, DcCollider};
 use super::types::*;
 
 /// The per-tick query: do the robots collide with robot j's TCP at `tcps_mcs[j]` (its MCS)?
@@ -29,21 +29,13 @@ pub unsafe extern "C" fn dc_query(
     out_verdict: *mut DcVerdict,
     out_report: *mut DcQueryReport,
 ) -> DcStatus {
-    let mut report = DcQueryReport::STOP;
-    let status = boundary(|| {
-        if out_verdict.is_null() {
-            return DC_STATUS_NULL_POINTER;
-        }
-        // SAFETY: the caller guarantees `n_tcps` readable elements when not NULL.
-        let tcps = match unsafe { read_slice(tcps_mcs, n_tcps) } {
-            Ok(tcps) => tcps,
-            Err(status) => return status,
-        };
-        // SAFETY: the caller guarantees `handle` is NULL or live.
-        flatten(unsafe { live(handle, |c| c.query(tcps, &mut report)) })
-    });
-    // SAFETY: the caller guarantees the out pointers are NULL or writable.
-    unsafe { write_out(status, report, out_verdict, out_report) }
+    let stop = DcQueryReport::STOP;
+    // SAFETY: the caller's guarantees on the handle, the TCPs and the outputs are passed on.
+    unsafe {
+        tick_entry(handle, (tcps_mcs, n_tcps), (out_verdict, out_report), stop, |c, tcps, r| {
+            c.query(tcps, r)
+        })
+    }
 }
 
 /// Copies the per-pair results of the last query into `out[0..]` and their number into
