@@ -159,30 +159,37 @@ pub unsafe extern "C" fn dc_protective_query_timed(
             DcProtectiveRequest { tcps_mcs: std::ptr::null(), ..dc_protective_request_default() }
         }
     };
-    let time = request_time(&request);
-    let (paths, n_paths) = (request.paths, request.n_paths);
-    // SAFETY: the caller's guarantees on `handle`, the request's TCPs and the outputs are
-    // passed on; a NULL request reads as NULL TCPs.
+    let (tcps, n_tcps) = (request.tcps_mcs, request.n_tcps);
+    // SAFETY: the caller's guarantees on `handle`, the request's TCPs and paths and the
+    // outputs are passed on; a NULL request reads as NULL TCPs.
     unsafe {
-        protective_entry(
-            handle,
-            request.tcps_mcs,
-            request.n_tcps,
-            out_verdict,
-            out_report,
-            |c, tcps, report| {
-                match (time, n_paths) {
-                    (Err(status), _) => status,
-                    (Ok(time), 0) => c.protective_query(time, tcps, None, report),
-                    // SAFETY: the caller guarantees `n_paths` readable paths when not NULL.
-                    (Ok(time), _) => {
-                        with_path_views(c, paths, n_paths, report, |c, views, report| {
-                            c.protective_query(time, tcps, Some(views), report)
-                        })
-                    }
-                }
-            },
-        )
+        protective_entry(handle, tcps, n_tcps, out_verdict, out_report, |c, tcps, report| {
+            timed_query(c, &request, tcps, report)
+        })
+    }
+}
+
+/// The timed query of `request` on a collider, its TCPs read as `tcps`.
+///
+/// # Safety
+/// The request's `paths` must be NULL or point to `n_paths` readable `DcStopPath`, as for
+/// `dc_protective_query_with_paths`.
+unsafe fn timed_query(
+    c: &mut Collider,
+    request: &DcProtectiveRequest,
+    tcps: &[DcVec3],
+    report: &mut DcProtectiveReport,
+) -> DcStatus {
+    let (paths, n_paths) = (request.paths, request.n_paths);
+    match (request_time(request), n_paths) {
+        (Err(status), _) => status,
+        (Ok(time), 0) => c.protective_query(time, tcps, None, report),
+        // SAFETY: the caller guarantees `n_paths` readable paths when not NULL.
+        (Ok(time), _) => unsafe {
+            with_path_views(c, paths, n_paths, report, |c, views, report| {
+                c.protective_query(time, tcps, Some(views), report)
+            })
+        },
     }
 }
 

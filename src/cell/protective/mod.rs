@@ -115,9 +115,9 @@
 //!    references before the graded axes existed, settled no tick of the reference runs once
 //!    they did: `prot_tick` printed the same answers without it.)
 //! 9. **Certain STOP, kept.** Two reachable TCPs, one in each robot's stop ball, whose boxes
-//!    overlap, make every tick whose balls still hold them STOP (`protective/witness.rs`:
+//!    overlap, make every tick whose balls still hold them STOP (`protective/contact.rs`:
 //!    every sweep holds the boxes of every TCP of its ball). After a STOP the checker seeks
-//!    such a witness; a tick that it settles needs neither references nor sweeps.
+//!    such a contact; a tick that it settles needs neither references nor sweeps.
 //!
 //! The **speed limit** of a robot is the largest measured speed `|v_fd|` in `[0, v_max]` at
 //! which every pair involving it is still proved, the other robots as they are: bisection to
@@ -168,13 +168,13 @@ use alloc::sync::Arc;
 
 mod certain_stop;
 mod clock;
+mod contact;
 mod kept;
 mod lookup;
 mod path;
 mod request;
 mod speed_limit;
 mod stop_sweeps;
-mod witness;
 pub use clock::{TickTime, TimingFault, MAX_INTERVAL_TICKS, MIN_INTERVAL_TICKS};
 pub use kept::{KEPT_MARGIN_MM, KEPT_WIDEN};
 pub use lookup::{ClearanceBound, LOOKUP_SLACK_MM};
@@ -448,8 +448,8 @@ pub struct ProtectiveChecker {
     /// FREE proofs kept from earlier ticks (`protective/kept.rs`).
     kept: kept::Kept,
     /// Two TCPs in earlier stop balls whose boxes overlap, which make every tick whose stop
-    /// balls still hold them STOP (`protective/witness.rs`).
-    witness: witness::KeptWitness,
+    /// balls still hold them STOP (`protective/contact.rs`).
+    contact: contact::KeptContact,
     calls: Calls,
     report: ProtectiveReport,
 }
@@ -549,7 +549,7 @@ impl ProtectiveChecker {
             robots: alloc::vec![robot; n],
             pairs: alloc::vec![pair; n_pairs],
             kept,
-            witness: witness::KeptWitness::default(),
+            contact: contact::KeptContact::default(),
             calls,
             report,
         })
@@ -644,10 +644,10 @@ impl ProtectiveChecker {
         self.calls.time = None;
     }
 
-    /// Forgets every previous TCP, and the witness found from them.
+    /// Forgets every previous TCP, and the contact found from them.
     fn forget_motion(&mut self) {
         self.robots.iter_mut().for_each(|r| r.history = NO_HISTORY);
-        self.witness = witness::KeptWitness::default();
+        self.contact = contact::KeptContact::default();
     }
 
     /// One tick: robot `j`'s TCP now is `request.tcps_mcs[j]` (its MCS); its speed comes from
@@ -918,15 +918,15 @@ impl ProtectiveChecker {
         self.kept_free(None).then_some(Settled::KeptProof)
     }
 
-    /// STOP without a proof: by a witness kept from an earlier STOP tick (no inverse
+    /// STOP without a proof: by a contact kept from an earlier STOP tick (no inverse
     /// kinematics at all), else by steps 6 and 7 on the closest pair, which need two reference
     /// boxes, not every robot's (module doc, step 8).
     fn certain_stop(&mut self, tcps_mcs: &[Vec3], last: Protective) -> Option<Settled> {
         if !self.model.certain_stops_first {
             return None;
         }
-        if let Some(pair) = self.witness_holds(tcps_mcs) {
-            return Some(Settled::Witnessed(pair));
+        if let Some(pair) = self.contact_holds(tcps_mcs) {
+            return Some(Settled::Contact(pair));
         }
         let was_stop = last == Protective::Stop;
         let closest = self.report.closest?;
@@ -982,7 +982,7 @@ impl ProtectiveChecker {
         Settled::Proved(verdict, limiting)
     }
 
-    /// Writes the settled verdict into the report; a STOP not settled by a kept witness seeks
+    /// Writes the settled verdict into the report; a STOP not settled by a kept contact seeks
     /// one for the ticks that follow (from the closest pair and its points `points`).
     fn settle(&mut self, settled: Settled, points: [Vec3; 2]) {
         let report = &mut self.report;
@@ -993,17 +993,17 @@ impl ProtectiveChecker {
                 // The lookup proved FREE for every TCP of every stop ball: kept like a proof.
                 self.keep_references();
             }
-            Settled::Witnessed(pair) | Settled::CertainStop(pair) => {
+            Settled::Contact(pair) | Settled::CertainStop(pair) => {
                 (report.verdict, report.limiting) = (Protective::Stop, Some(pair))
             }
             Settled::Proved(verdict, limiting) => {
                 (report.verdict, report.limiting) = (verdict, limiting)
             }
         }
-        let seek = self.model.certain_stops_first && !matches!(settled, Settled::Witnessed(_));
+        let seek = self.model.certain_stops_first && !matches!(settled, Settled::Contact(_));
         if let (true, Protective::Stop, Some(p)) = (seek, self.report.verdict, self.report.closest)
         {
-            self.seek_witness(p, points);
+            self.seek_contact(p, points);
         }
     }
 
@@ -1143,8 +1143,8 @@ impl ProtectiveChecker {
 enum Settled {
     /// FREE by a proof kept from earlier ticks, or kept for wider balls.
     KeptProof,
-    /// STOP: a witness kept from an earlier tick still holds (module doc, step 9).
-    Witnessed(BoxPair),
+    /// STOP: a contact kept from an earlier tick still holds (module doc, step 9).
+    Contact(BoxPair),
     /// STOP: steps 6 or 7 show that no tier proves the closest pair apart.
     CertainStop(BoxPair),
     /// FREE by the clearance table's bounds.
@@ -1220,7 +1220,7 @@ pub fn clearance_now(exact: &ExactChecker) -> (Real, Option<BoxPair>) {
 }
 
 /// [`clearance_now`] with each robot pair's clearance from `pair_clearance(pair index, boxes
-/// of a, boxes of b)`, and the closest pair's witness points (WCS).
+/// of a, boxes of b)`, and the closest pair's closest points (WCS).
 fn clearance_over_pairs(
     exact: &ExactChecker,
     mut pair_clearance: impl FnMut(usize, &[Obb], &[Obb]) -> PairClearance,
@@ -1308,10 +1308,10 @@ mod tests {
 
     /// Every state kept between calls that a speed or a kept STOP depends on is forgotten by
     /// an error, a timing fault and `reset`: the next call has no previous TCP (full speed)
-    /// and no witness; `reset` also forgets the cycle, so a call of the same cycle with the
+    /// and no contact; `reset` also forgets the cycle, so a call of the same cycle with the
     /// same TCPs is computed again instead of answered from the last report.
     #[test]
-    fn errors_timing_faults_and_reset_forget_the_motion_and_the_witness() {
+    fn errors_timing_faults_and_reset_forget_the_motion_and_the_contact() {
         let text = include_str!("../../../c_harness/scenarios.txt");
         let s = crate::cell::trajectory::parse_scenarios(text).unwrap();
         let s = s.iter().find(|s| s.cell == "T2" && s.case == "collision").unwrap();
@@ -1321,12 +1321,12 @@ mod tests {
             ProtectiveRequest::new(tcps).at(TickTime::Cycle(cycle))
         }
         let mut cycle = 0;
-        // Drive the collision run until a witness is kept (a STOP tick that found one).
-        while !c.witness.is_kept() {
+        // Drive the collision run until a contact is kept (a STOP tick that found one).
+        while !c.contact.is_kept() {
             cycle += 1;
             s.tcps_at(cycle as u32, &mut tcps);
             c.check(at(cycle, &tcps)).unwrap();
-            assert!(cycle < 6000, "no witness on T2's collision run");
+            assert!(cycle < 6000, "no contact on T2's collision run");
         }
         let speeds_unknown =
             |c: &ProtectiveChecker| c.report().robots.iter().all(|r| r.speed_mm_s.is_infinite());
@@ -1347,16 +1347,16 @@ mod tests {
             let r = c.check(at(time, &sent)).unwrap();
             assert_eq!((r.verdict, r.status), (Protective::Stop, ProtectiveStatus::Timing(fault)));
             assert!(
-                !c.witness.is_kept() && c.robots.iter().all(|r| r.history.tcp.is_none()),
+                !c.contact.is_kept() && c.robots.iter().all(|r| r.history.tcp.is_none()),
                 "{fault:?}"
             );
-            // Back in step: the next call's speeds are unknown, its own witness search aside.
+            // Back in step: the next call's speeds are unknown, its own contact search aside.
             cycle = time + 1;
             s.tcps_at(cycle as u32, &mut tcps);
             c.check(at(cycle, &tcps)).unwrap();
             assert!(speeds_unknown(&c), "after {fault:?}");
-            // A kept witness needs a STOP tick with history: run on until the next is kept.
-            while !c.witness.is_kept() {
+            // A kept contact needs a STOP tick with history: run on until the next is kept.
+            while !c.contact.is_kept() {
                 cycle += 1;
                 s.tcps_at(cycle as u32, &mut tcps);
                 c.check(at(cycle, &tcps)).unwrap();
@@ -1365,7 +1365,7 @@ mod tests {
         let mut bad = tcps;
         bad[1].x = Real::NAN;
         assert_eq!(c.check(at(cycle + 1, &bad)).unwrap().status, ProtectiveStatus::NonFinite(1));
-        assert!(!c.witness.is_kept());
+        assert!(!c.contact.is_kept());
         s.tcps_at(cycle as u32 + 2, &mut tcps);
         c.check(at(cycle + 2, &tcps)).unwrap();
         assert!(speeds_unknown(&c));
@@ -1373,7 +1373,7 @@ mod tests {
         c.check(at(cycle + 3, &tcps)).unwrap();
         assert!(!speeds_unknown(&c));
         c.reset();
-        assert!(!c.witness.is_kept() && c.calls.time.is_none());
+        assert!(!c.contact.is_kept() && c.calls.time.is_none());
         c.check(at(cycle + 3, &tcps)).unwrap();
         assert!(speeds_unknown(&c), "after reset the same cycle is computed again");
     }
