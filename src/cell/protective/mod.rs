@@ -375,9 +375,6 @@ struct RobotState {
     reference: SweptBall,
     /// The tier the reference's sweeps were computed with (`None`: not for this reference).
     tier: Option<(u32, u8)>,
-    /// Whether the reference is an earlier tick's: the last tick ended before setting it (a
-    /// kept proof or a certain STOP without speed limits).
-    stale: bool,
 }
 
 /// What the checker keeps of one pair of robots that can meet.
@@ -418,7 +415,8 @@ struct Model {
 }
 
 /// What the sequence of calls left (`protective/clock.rs`): the last call's time, TCPs and
-/// report, this tick's interval, and whose limit search goes first.
+/// report, this tick's interval, whose limit search goes first, and whether the last tick
+/// set its references.
 #[derive(Clone, Debug)]
 struct Calls {
     /// The interval the speeds of this tick are bounded over (s).
@@ -434,6 +432,10 @@ struct Calls {
     set_aside: bool,
     /// Which robot's speed-limit search comes first this tick (and may use the most tests).
     limit_turn: usize,
+    /// Whether the last tick ended before setting the references of its stop balls (a kept
+    /// proof or a certain STOP without speed limits): every robot's reference is then an
+    /// earlier tick's.
+    references_stale: bool,
 }
 
 /// The protective check of one cell: the exact checker of the cell, what does not change,
@@ -518,7 +520,6 @@ impl ProtectiveChecker {
             limit_step: 0.0,
             reference: SweptBall::empty(no_faces),
             tier: None,
-            stale: true,
         };
         let pair = PairState {
             clearance: CoherentClearance::new(),
@@ -542,6 +543,7 @@ impl ProtectiveChecker {
             cycle_report: report.clone(),
             set_aside: false,
             limit_turn: 0,
+            references_stale: true,
         };
         Ok(ProtectiveChecker {
             exact,
@@ -687,8 +689,8 @@ impl ProtectiveChecker {
                 }
                 return Ok(&self.report);
             }
-            clock::Interval::Same => self.timing_fault(tcps, TimingFault::Repeated),
-            clock::Interval::Fault(fault) => self.timing_fault(tcps, fault),
+            clock::Interval::Same => self.timing_fault(TimingFault::Repeated),
+            clock::Interval::Fault(fault) => self.timing_fault(fault),
             clock::Interval::Unknown => {
                 self.forget_motion();
                 self.calls.interval_s = tick_s;
@@ -706,10 +708,10 @@ impl ProtectiveChecker {
     }
 
     /// A call whose time gives no interval: STOP, every previous TCP forgotten.
-    fn timing_fault(&mut self, tcps_mcs: &[Vec3], fault: TimingFault) {
+    fn timing_fault(&mut self, fault: TimingFault) {
         self.forget_motion();
         self.report.robots.fill(RobotProtection::UNKNOWN);
-        self.evaluate(tcps_mcs, ProtectiveStatus::Timing(fault), true, None);
+        self.clear_report(ProtectiveStatus::Timing(fault));
     }
 
     /// The tick of a request whose interval is `self.calls.interval_s` (counts checked).
@@ -791,7 +793,7 @@ impl ProtectiveChecker {
         if self.report.verdict != Protective::Free && paths.iter().any(Option::is_some) {
             // The proof along the paths reads this tick's references (a robot without a path
             // keeps its stop ball's), which a tick settled early has not set.
-            if self.robots.iter().any(|r| r.stale) {
+            if self.calls.references_stale {
                 self.set_references(tcps_mcs);
             }
             let (verdict, limiting) = self.prove_with_paths(tcps_mcs, paths);
@@ -862,7 +864,7 @@ impl ProtectiveChecker {
         if early.is_some() && !self.model.speed_limits {
             self.settle(early.unwrap_or(Settled::KeptProof), points);
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
-            self.robots.iter_mut().for_each(|r| r.stale = true);
+            self.calls.references_stale = true;
             return;
         }
         self.set_references(tcps_mcs);
@@ -1075,7 +1077,7 @@ impl ProtectiveChecker {
         for (j, tcp) in tcps_mcs.iter().enumerate() {
             self.reference_at(j, tcp, self.robots[j].stop_ball);
         }
-        self.robots.iter_mut().for_each(|r| r.stale = false);
+        self.calls.references_stale = false;
     }
 
     /// Sets robot `j`'s reference boxes, the centre and radius of the ball that holds its TCP
@@ -1268,7 +1270,7 @@ mod tests {
             for tick in 0..crate::cell::trajectory::RUN_TICKS {
                 s.tcps_at(tick, &mut tcps);
                 let v = first.check(&tcps).unwrap().verdict;
-                early += usize::from(v == Protective::Stop && first.robots.iter().any(|r| r.stale));
+                early += usize::from(v == Protective::Stop && first.calls.references_stale);
                 stops += usize::from(v == Protective::Stop);
                 assert_eq!(
                     plain.check(&tcps).unwrap().verdict,

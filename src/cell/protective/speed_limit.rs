@@ -60,13 +60,13 @@ impl ProtectiveChecker {
         let tier = if self.model.precise_limits { self.model.precise_splits } else { 0 };
         let mut proved = |v: Real, tier: Option<u32>| self.speed_proved(j, tcp_mcs, v, tier);
         // Tier 1 alone: the default limit (capped), and the floor of the precise one (not).
-        let (lo, hi, next_step) = match start {
+        let ((lo, hi), next_step) = match start {
             _ if tier == 0 => {
                 let (lo, step) = search.capped(start, |v| proved(v, Some(0)));
-                (lo, search.vmax, step)
+                ((lo, search.vmax), step)
             }
-            Some((h, _)) => search.near(h, |v| proved(v, Some(0))).with_step(search.resolution),
-            None => search.below(search.vmax, |v| proved(v, Some(0))).with_step(search.resolution),
+            Some((h, _)) => (search.near(h, |v| proved(v, Some(0))), search.resolution),
+            None => (search.below(search.vmax, |v| proved(v, Some(0))), search.resolution),
         };
         let limit = if tier == 0 || lo == search.vmax {
             lo
@@ -118,17 +118,6 @@ impl ProtectiveChecker {
 
 /// A bracket `(lo, hi)`: `lo` proved, `hi` not (or both the answer).
 type Bracket = (Real, Real);
-
-/// A bracket with the step of the next tick's first test above it.
-trait WithStep {
-    fn with_step(self, step: Real) -> (Real, Real, Real);
-}
-
-impl WithStep for Bracket {
-    fn with_step(self, step: Real) -> (Real, Real, Real) {
-        (self.0, self.1, step)
-    }
-}
 
 /// One robot's search for the largest proved speed (module doc): tests on the grid of
 /// `v_max / 2^LIMIT_STEPS` only, so that searches of the same proof end at the same bracket
