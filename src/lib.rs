@@ -12,6 +12,8 @@
 //! | [`cell`] | robots, placements, the exact check of a cell, the protective verdict | 2.3, 3.1 | §1, §5, §8 |
 //! | [`cspace`] | the sampled configuration space of two robots and its certified labels | 3.2.2-3.2.8 | §4, §6 |
 //! | [`table`] | precomputed tables: quadtrees, files, bundles, shards, their queries | 3.2.4-3.2.6 | §6 |
+//! | [`coord`] | coordination: speed overrides from the programmes ahead, right of way | | §9 |
+//! | [`sim`] | the closed-loop benchmark (feature `sim`): programmes, loop, zone interlock | | §9 |
 //! | [`ffi`] | the only `extern "C"` surface (opaque handle, POU lifecycle) | App. A | |
 //!
 //! # Features
@@ -32,12 +34,15 @@
 extern crate alloc;
 
 pub mod cell;
+pub mod coord;
 pub mod cspace;
 #[cfg(feature = "std")]
 pub mod ffi;
 pub mod geometry;
 pub mod math;
 pub mod robot;
+#[cfg(feature = "sim")]
+pub mod sim;
 pub mod table;
 #[cfg(test)]
 mod test_rng;

@@ -64,7 +64,8 @@ fn the_crate_map_names_every_top_level_module() {
 
 /// The layers, lowest first: a module may import its own layer and those below, never one
 /// above (`docs/ARCHITECTURE.md`, "Modules").
-const LAYERS: [&str; 7] = ["math", "geometry", "robot", "cell", "cspace", "table", "ffi"];
+const LAYERS: [&str; 9] =
+    ["math", "geometry", "robot", "cell", "cspace", "table", "coord", "ffi", "sim"];
 
 /// A file's text without its unit tests (which may reach up to build their cases).
 fn without_tests(text: &str) -> &str {

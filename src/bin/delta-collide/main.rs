@@ -26,6 +26,7 @@ mod replay;
 mod replay_plot;
 mod rows;
 mod shard;
+mod simulate;
 mod stop;
 
 use args::{BuildArgs, CheckArgs, Cli, Command, InspectArgs};
@@ -85,6 +86,7 @@ fn main() {
         if cli.quiet { Progress::Silent } else { Progress::Rows(progress::labelling_rows) };
     let result = match &cli.command {
         Command::Demo(a) => demo::demo(a),
+        Command::Simulate(a) => simulate::simulate(a).map_err(Failure::from),
         Command::Check(a) => check(a),
         Command::Replay(a) => replay::replay(a),
         Command::Build(a) => match &a.shard {

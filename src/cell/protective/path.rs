@@ -33,6 +33,7 @@
 use super::certain_stop::graded_radii;
 use super::stop_sweeps::SweptBall;
 use super::{first_unproved_between, stop_sweeps_wcs, BoxPair, Protective, ProtectiveChecker};
+use crate::geometry::distance::segment_distance;
 use crate::math::{Real, Vec3};
 use crate::robot::{RobotBoxes, MAX_BOXES};
 
@@ -123,6 +124,100 @@ pub fn arc_range(points: &[Vec3], c: &Vec3, r: Real) -> Option<(Real, Real)> {
     range.map(|(a, b)| (a, b.min(start)))
 }
 
+/// The arc range holding every TCP of a stop that starts at `c`, stays within `r - tol` of
+/// it and within `tol` of the polyline `points` (module doc, step 1), tighter than
+/// [`arc_range`] where the polyline leaves the ball and comes back.
+///
+/// Every TCP of the stop is within `tol` of a point of the polyline in the ball of radius
+/// `r`; those points form *runs*, arc intervals each inside the ball. The TCP's motion is a
+/// connected set covered by the closed `tol`-neighbourhoods of the runs, so it can only
+/// pass from one run's neighbourhood to another's where they meet, that is where the runs
+/// come within `2 tol` of each other. The cover is therefore the runs that a chain of such
+/// meetings joins to a run within `tol` of `c`; the range from the first to the last of them.
+/// Falls back to [`arc_range`] beyond [`MAX_PATH_POINTS`] points.
+pub fn arc_cover(points: &[Vec3], c: &Vec3, r: Real, tol: Real) -> Option<(Real, Real)> {
+    if points.len() < 2 || points.len() > MAX_PATH_POINTS {
+        return arc_range(points, c, r);
+    }
+    // Per segment, its part inside the ball: (segment, t0, t1, arc0, arc1).
+    let mut parts = [(0usize, 0.0, 0.0, 0.0, 0.0); MAX_PATH_POINTS];
+    let mut count = 0;
+    let mut start = 0.0;
+    for (k, w) in points.windows(2).enumerate() {
+        let d = w[1] - w[0];
+        let len = d.norm();
+        let f = w[0] - c;
+        let (qa, qb, qc) = (d.norm_squared(), 2.0 * d.dot(&f), f.norm_squared() - r * r);
+        let inside = if qa == 0.0 {
+            (qc <= 0.0).then_some((0.0, 1.0))
+        } else {
+            let disc = qb * qb - 4.0 * qa * qc;
+            (disc >= 0.0).then(|| {
+                let root = disc.sqrt();
+                (((-qb - root) / (2.0 * qa)).max(0.0), ((-qb + root) / (2.0 * qa)).min(1.0))
+            })
+        };
+        if let Some((t0, t1)) = inside.filter(|(t0, t1)| t0 <= t1) {
+            // Widened as in `arc_range`: rounding must not cut a point off.
+            let slack = 1e-12 * (len + r);
+            let (t0, t1) = ((t0 - slack).max(0.0), (t1 + slack).min(1.0));
+            parts[count] = (k, t0, t1, start + t0 * len, start + t1 * len);
+            count += 1;
+        }
+        start += len;
+    }
+    let parts = &parts[..count];
+    if parts.is_empty() {
+        return None;
+    }
+    // Runs: parts that join end to start (a part ending at its segment's end, the next
+    // starting at the next segment's start).
+    let mut run_of = [0usize; MAX_PATH_POINTS];
+    for i in 1..parts.len() {
+        let (prev, this) = (parts[i - 1], parts[i]);
+        let joined = this.0 == prev.0 + 1 && prev.2 >= 1.0 && this.1 <= 0.0;
+        run_of[i] = run_of[i - 1] + usize::from(!joined);
+    }
+    let runs = run_of[parts.len() - 1] + 1;
+    let segment = |i: usize| {
+        let (k, t0, t1, _, _) = parts[i];
+        let d = points[k + 1] - points[k];
+        (points[k] + d * t0, points[k] + d * t1)
+    };
+    let near = |a: usize, b: usize, within: Real| {
+        let limit = within * (1.0 + 1e-9) + 1e-9;
+        (0..parts.len()).filter(|&i| run_of[i] == a).any(|i| {
+            (0..parts.len()).filter(|&j| run_of[j] == b).any(|j| {
+                let ((p0, p1), (q0, q1)) = (segment(i), segment(j));
+                segment_distance(&p0, &p1, &q0, &q1) <= limit
+            })
+        })
+    };
+    let mut taken = [false; MAX_PATH_POINTS];
+    for i in 0..parts.len() {
+        let (p0, p1) = segment(i);
+        if segment_distance(&p0, &p1, c, c) <= tol * (1.0 + 1e-9) + 1e-9 {
+            taken[run_of[i]] = true;
+        }
+    }
+    // The chain of meetings: at most one run joins per round.
+    for _ in 0..runs {
+        let joins =
+            (0..runs).find(|&b| !taken[b] && (0..runs).any(|a| taken[a] && near(a, b, 2.0 * tol)));
+        match joins {
+            Some(b) => taken[b] = true,
+            None => break,
+        }
+    }
+    let mut range: Option<(Real, Real)> = None;
+    for (i, p) in parts.iter().enumerate().filter(|(i, _)| taken[run_of[*i]]) {
+        let _ = i;
+        range = Some(range.map_or((p.3, p.4), |(a, b)| (a.min(p.3), b.max(p.4))));
+    }
+    // No run near the TCP (it is not within `tol` of the path): the whole range.
+    range.or_else(|| arc_range(points, c, r))
+}
+
 /// The ball holding every point within `tol` of the polyline's arc range `[a, b]`.
 pub fn piece_ball(points: &[Vec3], (a, b): (Real, Real), tol: Real) -> (Vec3, Real) {
     let centre = point_at(points, 0.5 * (a + b));
@@ -204,8 +299,10 @@ impl ProtectiveChecker {
                 (reference.centre, reference.radius, None)
             }
         };
-        let sweeps =
-            stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.model.tables[j].as_deref());
+        // A path piece is far smaller than the table's cells: its own interval inverse
+        // kinematics encloses its angles far tighter than the cells around it would.
+        let table = if arc.is_some() { None } else { self.model.tables[j].as_deref() };
+        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, table);
         let faces = [[self.model.no_faces; MAX_BOXES]; 2];
         let graded = graded_radii(&robot.model, radius);
         let mut ball = SweptBall { centre, radius, boxes, sweeps, faces, graded };
@@ -270,7 +367,7 @@ impl ProtectiveChecker {
             let path = paths[j].as_ref();
             let arc = path.and_then(|p| {
                 let tol = p.tolerance_mm;
-                arc_range(p.points, &tcps_mcs[j], self.report.robots[j].protective_mm + tol)
+                arc_cover(p.points, &tcps_mcs[j], self.report.robots[j].protective_mm + tol, tol)
             });
             self.piece(j, path, arc)
         };
@@ -316,6 +413,25 @@ mod tests {
         let (a, b) = arc_range(&path, &v(0.0, 0.0, 0.0), 20.0).unwrap();
         assert_eq!(a, 0.0);
         assert!(b > 400.0, "the return leg ends inside the ball: {b}");
+    }
+
+    #[test]
+    fn the_cover_leaves_out_a_return_leg_only_where_no_motion_can_reach_it() {
+        // Out 300 mm along x, up 40 mm, back: the return leg passes the ball around the start
+        // again, 40 mm away from the out leg.
+        let path = [v(0.0, 0.0, 0.0), v(300.0, 0.0, 0.0), v(300.0, 0.0, 40.0), v(0.0, 0.0, 40.0)];
+        let c = v(0.0, 0.0, 0.0);
+        let (a, b) = arc_range(&path, &c, 60.0).unwrap();
+        assert!(b > 600.0, "{a} {b}");
+        let (a, b) = arc_cover(&path, &c, 60.0, 0.5).unwrap();
+        assert!(a == 0.0 && (b - 60.0).abs() < 1e-6, "only the out leg: {a} {b}");
+        // The same with the return leg 0.8 mm from the out leg: within 2 tol, it is joined.
+        let close = [v(0.0, 0.0, 0.0), v(300.0, 0.0, 0.0), v(300.0, 0.0, 0.8), v(0.0, 0.0, 0.8)];
+        let (_, b) = arc_cover(&close, &c, 60.0, 0.5).unwrap();
+        assert!(b > 600.0, "the legs meet: {b}");
+        // A TCP within tol of the return leg only starts from it.
+        let (a, _) = arc_cover(&path, &v(30.0, 0.0, 40.2), 60.0, 0.5).unwrap();
+        assert!(a > 300.0, "{a}");
     }
 
     #[test]

@@ -1,0 +1,82 @@
+//! `simulate`: the closed-loop benchmark (`delta_collide::sim`) on one cell, one table row per
+//! run and mode, and a summary per mode.
+
+use crate::args::SimulateArgs;
+use delta_collide::coord::CoordinationConfig;
+use delta_collide::sim::{programmes, run::run, Mode, ProgrammeConfig, Rng, SimConfig};
+
+/// Runs the benchmark and prints its figures.
+pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
+    let modes: Vec<Mode> = match a.mode.as_str() {
+        "all" => Mode::ALL.to_vec(),
+        name => vec![Mode::ALL.into_iter().find(|m| m.name() == name).ok_or(format!(
+            "--mode {name}: expected coordinate, limits, interlock, free or all"
+        ))?],
+    };
+    let programme =
+        ProgrammeConfig { ticks: a.ticks, gap_mm: a.gap_mm, ..ProgrammeConfig::default() };
+    let coordination =
+        CoordinationConfig { clearance_mm: a.clearance_mm, ..CoordinationConfig::default() };
+    println!(
+        "cell {}: {} robots, {} runs from seed {}, stop paths {}",
+        a.cell.name,
+        a.cell.robots.len(),
+        a.runs,
+        a.seed,
+        if a.paths { "on" } else { "off" }
+    );
+    println!(
+        "{:<11} {:>4} {:>10} {:>6} {:>5} {:>8} {:>8} {:>14} {:>24} {:>18}",
+        "mode",
+        "run",
+        "throughput",
+        "stops",
+        "dead",
+        "contact",
+        "finished",
+        "FREE/WARN/STOP",
+        "ours med/p99/max us",
+        "exact med/p99/max"
+    );
+    for mode in modes {
+        let config = SimConfig { mode, paths: a.paths, coordination, ..SimConfig::default() };
+        let mut kept = Vec::new();
+        for r in 0..a.runs {
+            let seed = a.seed + u64::from(r);
+            let progs = programmes(&a.cell, &programme, &mut Rng::new(seed));
+            let m = run(&a.cell, &progs, &config);
+            let us = |t: &delta_collide::sim::Timings| {
+                format!(
+                    "{:.1}/{:.1}/{:.1}",
+                    t.median as f64 / 1e3,
+                    t.p99 as f64 / 1e3,
+                    t.max as f64 / 1e3
+                )
+            };
+            println!(
+                "{:<11} {:>4} {:>9.1}% {:>6} {:>5} {:>8} {:>8} {:>14} {:>24} {:>18}",
+                mode.name(),
+                seed,
+                100.0 * m.throughput,
+                m.stop_events,
+                u8::from(m.deadlock),
+                m.contact_ticks + m.contact_stop_samples,
+                m.finished,
+                format!("{}/{}/{}", m.verdicts[0], m.verdicts[1], m.verdicts[2]),
+                us(&m.ours_ns),
+                us(&m.exact_ns),
+            );
+            kept.push(m);
+        }
+        let worst = kept.iter().map(|m| m.throughput).fold(f64::INFINITY, f64::min);
+        println!(
+            "{:<11} all  least {:.1}%, {} STOP events, {} deadlocks, {} contacts",
+            mode.name(),
+            100.0 * worst,
+            kept.iter().map(|m| m.stop_events).sum::<usize>(),
+            kept.iter().filter(|m| m.deadlock).count(),
+            kept.iter().map(|m| m.contact_ticks + m.contact_stop_samples).sum::<usize>(),
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,521 @@
+//! Coordination (SPEC §9): each robot's speed override from the robots' programmes ahead, so
+//! that a line keeps moving without the protective verdict having to stop it. The protective
+//! verdict (`cell::protective`) stays the last layer with its proof unchanged: nothing here is
+//! a proof, an override that the robots do not follow costs at most a STOP.
+//!
+//! # The rule and why it never deadlocks
+//! 1. **Diagram.** For each robot pair that can meet, the coordination diagram of their
+//!    programmes over the horizon (`diagram.rs`): a cell `(a, b)` is in conflict when the
+//!    boxes at sample `a` of one and sample `b` of the other may come within `clearance_mm`.
+//! 2. **Shadow.** Robot `i` *yielding* to `j` may advance only to samples whose whole column
+//!    over `j`'s horizon is free: wherever `j` goes next, and at whatever speed (it may slow or
+//!    stop without notice, as in Gregoire et al., arXiv 1306.0785), `i` standing there is
+//!    apart from it. Its *hold point* is the first sample with a conflicting column; it must be
+//!    able to stand before it: its stopping distance now (the stopping model's, one more tick
+//!    for the override's own latency) plus `hold_margin_mm` within the arc length to the
+//!    sample before. The column of a sample shrinks as `j` advances, so a sample once allowed
+//!    stays allowed.
+//! 3. **Right of way.** Per pair in conflict exactly one robot yields. A robot that cannot
+//!    stand before its hold point any more (it stands in the other's shadow, or is too fast to
+//!    stop short of it) cannot yield: the other does. A robot standing still, or moving along
+//!    its path away from the other (no conflict ahead of it but where it is), is therefore
+//!    never held. Otherwise the robot that reaches its hold point first at its programmed
+//!    speed has the right of way, and keeps it until the other would reach its own hold point
+//!    `hysteresis_ticks` sooner (so a decision is not undone every tick); ties go to the lower
+//!    index. The decision stands while the pair's windows hold a conflict.
+//! 4. **No cycle.** In a line the decisions are made consistent with one ranking of the robots
+//!    (`right_of_way.rs`: a topological order of the forced decisions, the others by
+//!    urgency), so the robot ranked first yields to no one. With its programme unfinished it
+//!    moves: some robot progresses at every tick, and no set of robots waits for each other.
+//!    A robot yields only to robots that move or will move, except to one whose programme ends
+//!    in its way, which no rule can resolve.
+//! 5. **Override.** A robot that yields gets the largest factor whose speed still lets it
+//!    stand before its hold point (bisection of the stopping distance); every factor is ramped
+//!    within shares of the stopping model's `max_accel_mm_s2` (SPEC §9).
+//!
+//! Nothing here allocates after [`Coordinator::new`]; each loop is bounded by
+//! [`MAX_SAMPLES`] samples per robot and the cell's robot pairs.
+
+pub mod diagram;
+pub mod right_of_way;
+pub mod speed;
+
+use crate::cell::{Cell, ExactChecker};
+use crate::math::{float, Real, Vec3};
+use alloc::vec;
+use alloc::vec::Vec;
+pub use diagram::MAX_SAMPLES;
+use diagram::{window, Diagram, Track};
+
+/// One robot's programme ahead, as its controller has it (SPEC §9): set-points at the nominal
+/// timing from `first_tick`, one every `stride_ticks` programme ticks, and how far along it
+/// the robot is.
+#[derive(Clone, Copy, Debug)]
+pub struct Programme<'a> {
+    /// The programme tick of `points[0]`, a multiple of `stride_ticks`.
+    pub first_tick: u64,
+    /// Programme ticks between two points (at least 1).
+    pub stride_ticks: u32,
+    /// The set-points (the robot's MCS, mm); the robot stands at the last one when its
+    /// programme ends there. Only the first [`MAX_SAMPLES`] from the robot's progress count.
+    pub points: &'a [Vec3],
+    /// The robot's progress now, in programme ticks, from `first_tick` to the last point's.
+    pub progress: Real,
+    /// The override the robot followed over the last tick (0 when it stands).
+    pub override_now: Real,
+}
+
+/// A call's inputs: one programme per robot.
+#[derive(Clone, Copy, Debug)]
+pub struct CoordinationRequest<'a> {
+    /// Robot `j`'s programme ahead.
+    pub programmes: &'a [Programme<'a>],
+}
+
+/// The coordination's settings (units in the names).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CoordinationConfig {
+    /// Two samples conflict when their boxes may come closer than this (mm): the room the
+    /// protective verdict needs beyond contact to prove a stop of the moving robot apart.
+    pub clearance_mm: Real,
+    /// Room kept between a yielding robot's stop and its hold point (mm).
+    pub hold_margin_mm: Real,
+    /// How much sooner the other robot must reach its hold point to take the right of way
+    /// (programme ticks).
+    pub hysteresis_ticks: Real,
+    /// Share of `max_accel_mm_s2` an override may add to the programme's speed per second.
+    pub speed_up_share: Real,
+    /// Share of `max_accel_mm_s2` an override may take from it per second.
+    pub slow_down_share: Real,
+}
+
+impl Default for CoordinationConfig {
+    fn default() -> Self {
+        CoordinationConfig {
+            clearance_mm: 40.0,
+            hold_margin_mm: 2.0,
+            hysteresis_ticks: 40.0,
+            speed_up_share: 0.25,
+            slow_down_share: 0.6,
+        }
+    }
+}
+
+/// Why a request cannot be coordinated (every robot's override is then 0).
+#[derive(Clone, Debug, PartialEq)]
+pub enum CoordinationError {
+    /// Not one programme per robot.
+    WrongRobotCount {
+        /// Robots of the cell.
+        expected: usize,
+        /// Programmes given.
+        found: usize,
+    },
+    /// A programme breaks its contract; the text names the robot and the field.
+    InvalidProgramme(alloc::string::String),
+}
+
+impl core::fmt::Display for CoordinationError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            CoordinationError::WrongRobotCount { expected, found } => {
+                write!(f, "expected {expected} programmes (one per robot), found {found}")
+            }
+            CoordinationError::InvalidProgramme(why) => write!(f, "invalid programme: {why}"),
+        }
+    }
+}
+
+/// What the coordination answers for one robot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RobotCoordination {
+    /// The override to apply over the next tick, in [0, 1].
+    pub override_factor: Real,
+    /// The robot it yields to and whose conflict sets its hold point, if any.
+    pub held_by: Option<usize>,
+    /// Arc length from the TCP now to the hold point (mm); infinite when not held.
+    pub hold_mm: Real,
+    /// Its place in this tick's ranking (0: yields to no one).
+    pub rank: usize,
+}
+
+/// The result of one call.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CoordinationReport {
+    /// One entry per robot.
+    pub robots: Vec<RobotCoordination>,
+    /// Diagram cells tested by this call (the per-tick work).
+    pub cells_tested: u64,
+}
+
+/// One robot's horizon this tick: where its samples start, how many, how far each is.
+#[derive(Clone, Copy, Debug)]
+struct Horizon {
+    /// Absolute number of the sample at or just behind the progress.
+    first: u64,
+    /// Samples from `first` on (at most [`MAX_SAMPLES`]).
+    count: usize,
+    /// Arc length from the TCP now to each sample (mm; 0 for the one behind).
+    arc_mm: [Real; MAX_SAMPLES],
+    /// The largest programmed speed over the next samples (mm/s).
+    speed_ahead_mm_s: Real,
+    /// The speed now, the override followed times the programmed speed (mm/s).
+    speed_now_mm_s: Real,
+    /// Programme ticks between two samples.
+    stride: Real,
+    /// Programme ticks from the sample `first` to the progress.
+    behind: Real,
+    /// Samples from `first` on that the robot can reach before it stands, stopped now.
+    reach: usize,
+}
+
+/// What one robot pair's diagram gives this tick: each robot's hold point if it yields.
+#[derive(Clone, Copy, Debug, Default)]
+struct PairHolds {
+    /// Whether the windows hold a conflict at all.
+    conflict: bool,
+    /// For robot `a`, then `b`: (arc length to its hold point, programme ticks to reach it).
+    hold: [(Real, Real); 2],
+    /// For robot `a`, then `b`: arc length to its first sample in conflict with where the
+    /// other robot can be until it stands (its samples within its stopping distance).
+    block: [Real; 2],
+    /// For robot `a`, then `b`: arc length to where it may rest short of its block.
+    harbour: [Real; 2],
+}
+
+/// The coordination of one cell: its model (the cell, the pairs, the settings) and its state
+/// (the samples in the horizon, the diagrams, the decisions).
+#[derive(Debug)]
+pub struct Coordinator {
+    exact: ExactChecker,
+    config: CoordinationConfig,
+    pairs: Vec<(usize, usize)>,
+    tracks: Vec<Track>,
+    diagrams: Vec<Diagram>,
+    horizons: Vec<Horizon>,
+    holds: Vec<PairHolds>,
+    /// Per pair, the robot with the right of way while its conflict lasts.
+    winners: Vec<Option<usize>>,
+    ranking: right_of_way::Ranking,
+    report: CoordinationReport,
+}
+
+impl Coordinator {
+    /// The coordination of `cell` (its pairs that can meet) with `config`.
+    pub fn new(cell: Cell, config: CoordinationConfig) -> Self {
+        let n = cell.robots.len();
+        let pairs = cell.pairs_that_can_meet();
+        let horizon = Horizon {
+            first: 0,
+            count: 0,
+            arc_mm: [0.0; MAX_SAMPLES],
+            speed_ahead_mm_s: 0.0,
+            speed_now_mm_s: 0.0,
+            stride: 1.0,
+            behind: 0.0,
+            reach: 1,
+        };
+        let idle = RobotCoordination {
+            override_factor: 0.0,
+            held_by: None,
+            hold_mm: Real::INFINITY,
+            rank: 0,
+        };
+        Coordinator {
+            exact: ExactChecker::new(cell),
+            config,
+            tracks: (0..n).map(|_| Track::default()).collect(),
+            diagrams: vec![Diagram::default(); pairs.len()],
+            horizons: vec![horizon; n],
+            holds: vec![PairHolds::default(); pairs.len()],
+            winners: vec![None; pairs.len()],
+            ranking: right_of_way::Ranking::new(n, pairs.len()),
+            report: CoordinationReport { robots: vec![idle; n], cells_tested: 0 },
+            pairs,
+        }
+    }
+
+    /// The cell coordinated.
+    pub fn cell(&self) -> &Cell {
+        self.exact.cell()
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &CoordinationConfig {
+        &self.config
+    }
+
+    /// The robot pairs coordinated (those that can meet).
+    pub fn pairs(&self) -> &[(usize, usize)] {
+        &self.pairs
+    }
+
+    /// The last report.
+    pub fn report(&self) -> &CoordinationReport {
+        &self.report
+    }
+
+    /// Forgets every decision and sample (a restart of the line).
+    pub fn reset(&mut self) {
+        let n = self.tracks.len();
+        self.tracks.iter_mut().for_each(|t| *t = Track::default());
+        self.diagrams.iter_mut().for_each(|d| *d = Diagram::default());
+        self.winners.iter_mut().for_each(|w| *w = None);
+        self.ranking = right_of_way::Ranking::new(n, self.pairs.len());
+    }
+
+    /// Each robot's override for the next tick (module doc): the chain `horizons`, `place`,
+    /// `pair_holds`, `decide`, `overrides`.
+    ///
+    /// # Errors
+    /// A wrong count of programmes, or one that breaks its contract ([`Programme`]): every
+    /// override in the report is then 0 and the decisions are forgotten.
+    pub fn coordinate(
+        &mut self,
+        request: &CoordinationRequest,
+    ) -> Result<&CoordinationReport, CoordinationError> {
+        let checked = self.horizons(request).and_then(|()| self.place(request));
+        if let Err(e) = checked {
+            self.winners.iter_mut().for_each(|w| *w = None);
+            for r in &mut self.report.robots {
+                *r = RobotCoordination {
+                    override_factor: 0.0,
+                    held_by: None,
+                    hold_mm: 0.0,
+                    rank: 0,
+                };
+            }
+            return Err(e);
+        }
+        let before: u64 = self.diagrams.iter().map(|d| d.tests).sum();
+        self.pair_holds();
+        self.decide();
+        self.overrides(request);
+        self.report.cells_tested = self.diagrams.iter().map(|d| d.tests).sum::<u64>() - before;
+        Ok(&self.report)
+    }
+
+    /// Step 1: checks each programme and measures its horizon.
+    fn horizons(&mut self, request: &CoordinationRequest) -> Result<(), CoordinationError> {
+        let n = self.tracks.len();
+        if request.programmes.len() != n {
+            return Err(CoordinationError::WrongRobotCount {
+                expected: n,
+                found: request.programmes.len(),
+            });
+        }
+        let tick_s = self.cell().tick_ms * 1e-3;
+        for (j, p) in request.programmes.iter().enumerate() {
+            let bad = |what: &str| {
+                Err(CoordinationError::InvalidProgramme(alloc::format!("robot {j}: {what}")))
+            };
+            if p.stride_ticks == 0 {
+                return bad("stride_ticks is 0");
+            }
+            if p.first_tick % u64::from(p.stride_ticks) != 0 {
+                return bad("first_tick is not a multiple of stride_ticks");
+            }
+            if p.points.is_empty() {
+                return bad("no points");
+            }
+            if !p.points.iter().all(|q| q.iter().all(|v| v.is_finite())) {
+                return bad("a point is not finite");
+            }
+            let stride = Real::from(p.stride_ticks);
+            let last = p.first_tick as Real + stride * (p.points.len() - 1) as Real;
+            if !(p.progress >= p.first_tick as Real && p.progress <= last) {
+                return bad("progress is not within the points' ticks");
+            }
+            if !(p.override_now >= 0.0 && p.override_now <= 1.0) {
+                return bad("override_now is not within [0, 1]");
+            }
+            let step = float::floor((p.progress - p.first_tick as Real) / stride) as usize;
+            let k0 = step.min(p.points.len() - 1);
+            let frac = (p.progress - p.first_tick as Real) / stride - k0 as Real;
+            let count = (p.points.len() - k0).min(MAX_SAMPLES);
+            let h = &mut self.horizons[j];
+            h.first = p.first_tick / u64::from(p.stride_ticks) + k0 as u64;
+            h.count = count;
+            h.stride = stride;
+            h.behind = frac * stride;
+            let pts = &p.points[k0..k0 + count];
+            let now = match pts.get(1) {
+                Some(next) => pts[0] + (next - pts[0]) * frac,
+                None => pts[0],
+            };
+            h.arc_mm[0] = 0.0;
+            let mut arc = 0.0;
+            let mut from = now;
+            for (k, p) in pts.iter().enumerate().skip(1) {
+                arc += (p - from).norm();
+                from = *p;
+                h.arc_mm[k] = arc;
+            }
+            let speed_of = |k: usize| (pts[k + 1] - pts[k]).norm() / (stride * tick_s);
+            let now_speed = if count > 1 { speed_of(0) } else { 0.0 };
+            h.speed_now_mm_s = p.override_now * now_speed;
+            h.speed_ahead_mm_s = (0..count.saturating_sub(1).min(speed::SPEED_AHEAD_SAMPLES))
+                .map(speed_of)
+                .fold(0.0, Real::max);
+            let stop = speed::stopping_mm(self.exact.cell(), j, h.speed_now_mm_s);
+            // The sample past the stop too: the robot may stand between it and the one before.
+            h.reach = (1..count).find(|&k| h.arc_mm[k] > stop).map_or(count, |k| k + 1);
+        }
+        Ok(())
+    }
+
+    /// Step 2: puts every robot's samples in its ring (only new or changed ones are placed).
+    fn place(&mut self, request: &CoordinationRequest) -> Result<(), CoordinationError> {
+        let growth = 0.5 * self.config.clearance_mm;
+        for (j, p) in request.programmes.iter().enumerate() {
+            let h = self.horizons[j];
+            let k0 = (h.first - p.first_tick / u64::from(p.stride_ticks)) as usize;
+            for k in 0..h.count {
+                self.tracks[j].place(&self.exact, j, h.first + k as u64, &p.points[k0 + k], growth);
+            }
+        }
+        for (d, &(a, b)) in self.diagrams.iter_mut().zip(&self.pairs) {
+            d.forget(self.tracks[a].replaced, self.tracks[b].replaced);
+        }
+        self.tracks.iter_mut().for_each(|t| t.replaced = 0);
+        Ok(())
+    }
+
+    /// Step 3: per pair, whether its windows conflict, each robot's hold point if it yields
+    /// (its first sample whose column over the other's horizon conflicts) and its first
+    /// sample in conflict with where the other can be until it stands.
+    fn pair_holds(&mut self) {
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+            let (ha, hb) = (&self.horizons[a], &self.horizons[b]);
+            let (wa, wb) = (window(ha.first, ha.count), window(hb.first, hb.count));
+            let (ra, rb) = (window(ha.first, ha.reach), window(hb.first, hb.reach));
+            let (ta, tb) = (&self.tracks[a], &self.tracks[b]);
+            let d = &mut self.diagrams[k];
+            let slot =
+                |t: &Track, h: &Horizon, s: usize| t.slot_of(h.first + s as u64).unwrap_or(0);
+            let first_a = (0..ha.count).find(|&s| d.row_conflicts(ta, tb, slot(ta, ha, s), wb));
+            let first_b = (0..hb.count).find(|&s| d.col_conflicts(ta, tb, slot(tb, hb, s), wa));
+            let (block_a, block_b) = if first_a.is_some() {
+                (
+                    (0..ha.count).find(|&s| d.row_conflicts(ta, tb, slot(ta, ha, s), rb)),
+                    (0..hb.count).find(|&s| d.col_conflicts(ta, tb, slot(tb, hb, s), ra)),
+                )
+            } else {
+                (None, None)
+            };
+            let room = |h: &Horizon, first: Option<usize>| {
+                first.map_or(Real::INFINITY, |s| h.arc_mm[s.saturating_sub(1)])
+            };
+            let hold = |h: &Horizon, first: Option<usize>| match first {
+                Some(s) => (room(h, first), s as Real * h.stride - h.behind),
+                None => (Real::INFINITY, Real::INFINITY),
+            };
+            // Where a robot that must stop short of the other may come to rest: the last sample
+            // before its block outside the other's shadow (not on the other's way ahead), so
+            // that waiting there never keeps the other from passing; its block when none is.
+            let harbour_a = block_a.map_or(Real::INFINITY, |end| {
+                (0..end)
+                    .rev()
+                    .find(|&s| !d.row_conflicts(ta, tb, slot(ta, ha, s), wb))
+                    .map_or(room(ha, block_a), |s| ha.arc_mm[s])
+            });
+            let harbour_b = block_b.map_or(Real::INFINITY, |end| {
+                (0..end)
+                    .rev()
+                    .find(|&s| !d.col_conflicts(ta, tb, slot(tb, hb, s), wa))
+                    .map_or(room(hb, block_b), |s| hb.arc_mm[s])
+            });
+            self.holds[k] = PairHolds {
+                conflict: first_a.is_some() || first_b.is_some(),
+                hold: [hold(ha, first_a), hold(hb, first_b)],
+                block: [room(ha, block_a), room(hb, block_b)],
+                harbour: [harbour_a, harbour_b],
+            };
+        }
+    }
+
+    /// Step 4: the right of way of every pair in conflict, consistent with one ranking.
+    fn decide(&mut self) {
+        let cell = self.exact.cell();
+        self.ranking.clear();
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+            let holds = &self.holds[k];
+            if !holds.conflict {
+                self.winners[k] = None;
+                continue;
+            }
+            let can_yield = |j: usize, side: usize| {
+                let stop = speed::stopping_mm(cell, j, self.horizons[j].speed_now_mm_s);
+                stop + self.config.hold_margin_mm <= holds.hold[side].0
+            };
+            let forced = match (can_yield(a, 0), can_yield(b, 1)) {
+                (false, true) => Some(a),
+                (true, false) => Some(b),
+                (true, true) => None,
+                // Neither can stand short of the other's shadow: the one with more room
+                // before where the other can be until it stands goes (the other stops).
+                (false, false) => Some(if holds.block[1] > holds.block[0] { b } else { a }),
+            };
+            let ticks = [holds.hold[0].1, holds.hold[1].1];
+            self.ranking.set_pair(k, forced, self.winners[k], ticks);
+        }
+        self.ranking.rank(&self.pairs, self.config.hysteresis_ticks);
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+            if self.holds[k].conflict {
+                self.winners[k] = Some(self.ranking.winner(a, b));
+            }
+        }
+    }
+
+    /// Step 5: each robot's override from its nearest hold point among the pairs it yields in.
+    fn overrides(&mut self, request: &CoordinationRequest) {
+        let cell = self.exact.cell();
+        let tick_s = cell.tick_ms * 1e-3;
+        for (j, r) in self.report.robots.iter_mut().enumerate() {
+            *r = RobotCoordination {
+                override_factor: 1.0,
+                held_by: None,
+                hold_mm: Real::INFINITY,
+                rank: self.ranking.rank_of(j),
+            };
+        }
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+            let Some(w) = self.winners[k] else { continue };
+            let (y, w_side, y_side) = if w == a { (b, 0, 1) } else { (a, 1, 0) };
+            // The yielder stands short of the winner's shadow; the winner short of where the
+            // yielder can be until it stands.
+            let (hold, harbour) = (self.holds[k].hold[y_side].0, self.holds[k].harbour[w_side]);
+            for (j, room) in [(y, hold), (w, harbour)] {
+                let r = &mut self.report.robots[j];
+                if room < r.hold_mm {
+                    r.hold_mm = room;
+                    r.held_by = Some(if j == y { w } else { y });
+                }
+            }
+        }
+        for (j, r) in self.report.robots.iter_mut().enumerate() {
+            let h = &self.horizons[j];
+            let stop = &cell.stops[j];
+            let target = if r.held_by.is_some() {
+                let room = r.hold_mm - self.config.hold_margin_mm;
+                let v = speed::allowed_speed(cell, j, room);
+                if h.speed_ahead_mm_s > 0.0 {
+                    (v / h.speed_ahead_mm_s).min(1.0)
+                } else if v > 0.0 {
+                    1.0
+                } else {
+                    0.0
+                }
+            } else {
+                1.0
+            };
+            r.override_factor = speed::ramped(
+                request.programmes[j].override_now,
+                target,
+                h.speed_ahead_mm_s,
+                stop.max_accel_mm_s2 * tick_s,
+                (self.config.speed_up_share, self.config.slow_down_share),
+            );
+        }
+    }
+}
