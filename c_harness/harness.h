@@ -163,4 +163,11 @@ void speed_override_scenarios(const HarnessOptions *options);
  * T1 collision only, on 200 ticks. */
 void timing_scenarios(const HarnessOptions *options);
 
+/* The coordination in the tick loop (coordination.c): on T1 two robots whose programmes place
+ * at the same point at the same ticks, every tick dc_coordinate's overrides applied to their
+ * progress and the timed protective query with its cycle, a STOP carried out as a stop along
+ * the paths; contact checked with the exact model every tick. --quick and --protective-quick
+ * run its first ticks only. */
+void coordination_scenarios(const HarnessOptions *options);
+
 #endif /* HARNESS_H */

@@ -14,7 +14,8 @@
  * the practical ones once more with the speed limits applied as a speed override
  * (speed_override.c). The four-robot line (line.c) runs its two cases in exact mode and with
  * the protective verdict. The timed protective query (timing.c) is called twice per cycle and
- * driven by schedules that repeat, skip and go back in time. Then the bad-input scenarios
+ * driven by schedules that repeat, skip and go back in time. The coordination (coordination.c)
+ * keeps two robots whose programmes place at the same point apart. Then the bad-input scenarios
  * (bad_input.c) check every documented error status and the fail-closed outputs, in both
  * modes.
  *
@@ -367,6 +368,7 @@ int main(int argc, char **argv)
     protective_scenarios(&options);
     speed_override_scenarios(&options);
     timing_scenarios(&options);
+    coordination_scenarios(&options);
     bad_input(&options);
     for (c = 0; c < 3; ++c) {
         for (k = 0; k < 2; ++k) {

@@ -429,6 +429,68 @@ int mr_stop_step(const MrTrajectory *traj, MrStop *stop, double dt_ms)
     return stop->moving;
 }
 
+MrStatus mr_pick_place_programme(const MrCell *cell, size_t robot, size_t other, int cycles, MrTrajectory *out)
+{
+    /* One cycle: (tick within the cycle, at the place point?, z). */
+    static const struct {
+        long tick;
+        int at_place;
+        double z;
+    } legs[] = {
+        { 80, 0, MR_PICK_Z },    /* dwell at the pick */
+        { 180, 0, MR_TRAVEL_Z }, /* lift */
+        { 430, 1, MR_TRAVEL_Z }, /* over the place point */
+        { 530, 1, MR_PLACE_Z },  /* down */
+        { 580, 1, MR_PLACE_Z },  /* dwell at the place */
+        { 680, 1, MR_TRAVEL_Z }, /* lift */
+        { 900, 0, MR_TRAVEL_Z }, /* back over the pick point */
+        { 1000, 0, MR_PICK_Z },  /* down */
+    };
+    const size_t n_legs = sizeof legs / sizeof legs[0];
+    const MrRobot *r;
+    double dx, dy, d, ux, uy, c, s, theta[3];
+    size_t w;
+    if (robot >= cell->n_robots || other >= cell->n_robots || robot == other) {
+        return MR_NOT_FOUND;
+    }
+    if (cycles < 1 || 1 + (size_t)cycles * n_legs > MR_MAX_WAYPOINTS) {
+        return MR_FULL;
+    }
+    r = &cell->robots[robot];
+    dx = cell->robots[other].translation[0] - r->translation[0];
+    dy = cell->robots[other].translation[1] - r->translation[1];
+    d = sqrt(dx * dx + dy * dy);
+    if (!(d > 0.0)) {
+        return MR_NOT_FOUND;
+    }
+    /* The direction to the other base in this robot's MCS: Rz(-alpha) applied. */
+    c = cos(r->alpha);
+    s = sin(r->alpha);
+    ux = (c * dx + s * dy) / d;
+    uy = (-s * dx + c * dy) / d;
+    memset(out, 0, sizeof *out);
+    out->n_waypoints = 1 + (size_t)cycles * n_legs;
+    out->tick[0] = 0;
+    out->tcp[0][0] = -MR_PICK_FAR_MM * ux;
+    out->tcp[0][1] = -MR_PICK_FAR_MM * uy;
+    out->tcp[0][2] = MR_PICK_Z;
+    for (w = 1; w < out->n_waypoints; ++w) {
+        size_t leg = (w - 1) % n_legs;
+        double along = legs[leg].at_place ? 0.5 * d : -MR_PICK_FAR_MM;
+        out->tick[w] = (long)((w - 1) / n_legs) * MR_PICK_PLACE_TICKS + legs[leg].tick;
+        out->tcp[w][0] = along * ux;
+        out->tcp[w][1] = along * uy;
+        out->tcp[w][2] = legs[leg].z;
+    }
+    for (w = 0; w < out->n_waypoints; ++w) {
+        MrStatus st = mr_inverse_kinematics(&r->geometry, out->tcp[w], theta);
+        if (st != MR_OK) {
+            return st;
+        }
+    }
+    return MR_OK;
+}
+
 MrStatus mr_load_scenario(const char *path, const char *cell, const char *name, size_t n_robots,
                           MrScenario *out)
 {

@@ -9,7 +9,8 @@
  *   - its own kinematics engine in C (SPEC section 2), written independently of the Rust
  *     one so that the harness can cross-check the two;
  *   - a trajectory generator: linear moves between waypoints with the minimum-jerk
- *     profile s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5, read from c_harness/scenarios.txt;
+ *     profile s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5, read from c_harness/scenarios.txt,
+ *     or generated (pick-and-place programmes for the coordination);
  *   - a 1 ms tick clock.
  * Units: mm and rad everywhere. TCPs are in each robot's own MCS.
  * C99, no VLAs, no dynamic allocation: every buffer is a fixed-size array.
@@ -159,6 +160,23 @@ void mr_stop_start(const MrOverride *now, double reaction_ms, double decel_mm_s2
 
 /* Advances the stop by dt_ms; returns nonzero while the robot still moves. */
 int mr_stop_step(const MrTrajectory *traj, MrStop *stop, double dt_ms);
+
+/* Pick-and-place programmes for the coordination (coordination.c): cycles of
+ * MR_PICK_PLACE_TICKS ticks, every robot at the same ticks. Robot `robot` picks on its far side
+ * from robot `other` (MR_PICK_FAR_MM from its base axis, away from the other base, at
+ * MR_PICK_Z), lifts to MR_TRAVEL_Z, moves over the midpoint between the two bases, places there
+ * (MR_PLACE_Z, a dwell), lifts, moves back and picks again; it ends at its pick point. Two
+ * robots given each other as `other` thus place at the same point at the same ticks: executed
+ * as programmed they collide. On T1 no move accelerates faster than 45 m/s^2 (min-jerk: 5.77
+ * times the distance over the duration squared), leaving room within the stopping model's
+ * max_accel_mm_s2 for the override's own changes. Returns MR_FULL when `cycles` do not fit MR_MAX_WAYPOINTS, the
+ * kinematics status of a waypoint the robot cannot reach, else MR_OK. */
+#define MR_PICK_PLACE_TICKS 1000
+#define MR_PICK_FAR_MM 150.0
+#define MR_PICK_Z (-470.0)
+#define MR_TRAVEL_Z (-400.0)
+#define MR_PLACE_Z (-440.0)
+MrStatus mr_pick_place_programme(const MrCell *cell, size_t robot, size_t other, int cycles, MrTrajectory *out);
 
 /* Reads the scenario (cell, case) from a scenarios file (format at the top of the file).
  * Every robot 0..n_robots-1 must have at least one waypoint. */

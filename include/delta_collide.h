@@ -45,9 +45,95 @@
 #define DC_MAX_PATH_POINTS 32
 
 /*
+ Most points of one `DcProgramme`.
+ */
+#define DC_MAX_PROGRAMME_POINTS 4096
+
+/*
  An initialised collision checker for one cell, in exact or table mode (opaque to C).
  */
 typedef struct DcCollider DcCollider;
+
+/*
+ One robot's programme ahead for `dc_coordinate` (SPEC section 9): its set-points at the
+ nominal timing, as its path planner has them, and how far along it the robot is. Point `k`
+ is the set-point of programme tick `first_tick + k * stride_ticks`; between two points the
+ robot moves on the straight line.
+ */
+typedef struct DcProgramme {
+  /*
+   The programme tick of the first point: a multiple of `stride_ticks`.
+   */
+  uint64_t first_tick;
+  /*
+   Programme ticks between two points (at least 1).
+   */
+  uint32_t stride_ticks;
+  /*
+   How many points (1 to `DC_MAX_PROGRAMME_POINTS`); the robot stands at the last one
+   when its programme ends there. Give at least its longest stop's worth.
+   */
+  uint32_t n_points;
+  /*
+   `n_points * 3` numbers: x, y, z of each point in the robot's MCS (mm).
+   */
+  const double *points;
+  /*
+   The robot's progress now, in programme ticks: from `first_tick` to the last point's
+   tick (at full speed one programme tick per controller tick).
+   */
+  double progress;
+  /*
+   The override the robot followed over the last tick, in [0, 1] (0 when it stands).
+   */
+  double override_now;
+} DcProgramme;
+
+/*
+ The inputs of `dc_coordinate`; start from `dc_coordination_request_default()`, which sets
+ `struct_size`.
+ */
+typedef struct DcCoordinationRequest {
+  /*
+   `sizeof(DcCoordinationRequest)` as the caller compiled it: lets later versions add fields.
+   */
+  uint32_t struct_size;
+  /*
+   How many programmes: one per robot of the cell.
+   */
+  uint32_t n_robots;
+  /*
+   Robot j's programme ahead is `programmes[j]`.
+   */
+  const struct DcProgramme *programmes;
+} DcCoordinationRequest;
+
+/*
+ Result code of every fallible function; `DC_STATUS_OK` is 0.
+ */
+typedef uint32_t DcStatus;
+
+/*
+ What `dc_coordinate` answers for one robot.
+ */
+typedef struct DcRobotCoordination {
+  /*
+   The override to apply over the next tick, in [0, 1] (the same as `out_overrides[j]`).
+   */
+  double override_factor;
+  /*
+   The robot it yields to (whose conflict sets its hold point), or -1 for none.
+   */
+  int32_t held_by;
+  /*
+   Arc length from the TCP now to the hold point (mm); `INFINITY` when not held.
+   */
+  double hold_mm;
+  /*
+   Its place in this tick's ranking (0: yields to no one).
+   */
+  uint32_t rank;
+} DcRobotCoordination;
 
 /*
  Delta3 geometry (SPEC section 2): lengths in mm, motor limits in rad.
@@ -168,11 +254,6 @@ typedef struct DcRobotConfig {
    */
   struct DcVec3 translation;
 } DcRobotConfig;
-
-/*
- Result code of every fallible function; `DC_STATUS_OK` is 0.
- */
-typedef uint32_t DcStatus;
 
 /*
  A cell: `n_robots` robot configurations and the exact test to use.
@@ -573,6 +654,19 @@ typedef uint32_t DcConfirmation;
 #define DC_STATUS_BUSY 25
 
 /*
+ Coordination (`dc_coordinate`): a programme breaks its contract: no points or more than
+ `DC_MAX_PROGRAMME_POINTS`, `stride_ticks` 0, `first_tick` not a multiple of
+ `stride_ticks`, or its last point's tick beyond `UINT64_MAX`.
+ */
+#define DC_STATUS_INVALID_PROGRAMME 26
+
+/*
+ Coordination (`dc_coordinate`): a programme's `progress` lies outside its points' ticks
+ (from `first_tick` to the last point's), or its `override_now` outside [0, 1].
+ */
+#define DC_STATUS_PROGRESS_OUT_OF_RANGE 27
+
+/*
  Could not decide (any error): stop the robots.
  */
 #define DC_VERDICT_STOP 0
@@ -635,6 +729,83 @@ typedef uint32_t DcConfirmation;
 #ifdef __cplusplus
 extern "C" {
 #endif /* __cplusplus */
+
+/*
+ A `DcCoordinationRequest` with `struct_size` set, no robots and no programmes: set
+ `n_robots` and `programmes` before each call.
+ */
+struct DcCoordinationRequest dc_coordination_request_default(void);
+
+/*
+ The coordination (SPEC section 9), the call for the tick loop before the protective query:
+ each robot's speed override for the next tick from the robots' programmes ahead, so that a
+ line keeps moving without the protective verdict having to stop it. Robot j yields to
+ another where their programmes conflict (their boxes may come within the coordination's
+ clearance, `dc_set_coordination_clearance`): it slows down to stand before the shared
+ region, the other goes on. `req->programmes[j]` is robot j's programme (`DcProgramme`);
+ of its points the coordination reads `dc_coordination_horizon()` from the one at or
+ behind the progress on (all are checked). The controller scales robot j's progress by
+ `out_overrides[j]` over the next tick, and passes what it followed as the next call's
+ `override_now`; each factor is ramped within the robot's `max_accel_mm_s2`
+ (`dc_set_stop_model`). Nothing here is a proof: the protective query stays the last word,
+ and an override the robots do not follow costs at most a STOP.
+
+ Writes `out_overrides[0 .. n_robots]` (and `out_robots[0 .. n_robots]` when not NULL) on
+ every call whose `req` is not NULL and holds `n_robots` (at most `DC_MAX_ROBOTS` entries;
+ with `req` NULL nothing can be written, the status alone says stand): the
+ overrides in [0, 1] with `DC_STATUS_OK`; on every other status every override is 0.0 (fail
+ closed: the robots stand), every robot `held_by` -1, and the decisions are forgotten.
+ Statuses: `DC_STATUS_NULL_POINTER` (handle, req, its programmes, a programme's points or
+ out_overrides NULL), `DC_STATUS_INVALID_ARGUMENT` (a `struct_size` smaller than this
+ header's `sizeof(DcCoordinationRequest)`), `DC_STATUS_WRONG_ROBOT_COUNT` (`n_robots` is not
+ the cell's robot count), `DC_STATUS_INVALID_PROGRAMME`, `DC_STATUS_NON_FINITE` (a point,
+ progress or override_now NaN or infinite), `DC_STATUS_PROGRESS_OUT_OF_RANGE`,
+ `DC_STATUS_BUSY` (nothing done), `DC_STATUS_PANIC` (destroy the handle). Never allocates,
+ locks or does I/O.
+
+ # Safety
+ `handle` must be NULL or a live handle from `dc_init*`; `req` must be NULL or point to a
+ readable `DcCoordinationRequest` of `struct_size` bytes, whose `programmes` is NULL or
+ points to `n_robots` readable `DcProgramme`, each with `points` NULL or pointing to
+ `3 * n_points` readable doubles; `out_overrides` must be NULL or hold `n_robots` writable
+ doubles, `out_robots` NULL or `n_robots` writable `DcRobotCoordination`.
+ */
+DcStatus dc_coordinate(struct DcCollider *handle, const struct DcCoordinationRequest *req, double *out_overrides, struct DcRobotCoordination *out_robots);
+
+/*
+ How many points of each programme `dc_coordinate` reads at most, from the one at or just
+ behind the robot's progress on (its horizon); points beyond are checked but not used. A
+ property of this library build (it may grow in later versions), not of a handle.
+ */
+uint32_t dc_coordination_horizon(void);
+
+/*
+ Forgets every decision and sample of the coordination (a restart of the line, or after a
+ STOP: the robots stand where the programmes did not expect them). NULL is a no-op; a panic
+ inside poisons the handle. Allocates nothing.
+
+ # Safety
+ `handle` must be NULL or a live handle.
+ */
+void dc_coordination_reset(struct DcCollider *handle);
+
+/*
+ Sets the coordination's clearance (mm, default 40): two robots' programme samples
+ conflict when their boxes may come closer than this, so it is the room the protective
+ verdict needs beyond contact to prove a stop of the moving robot apart (a larger one keeps
+ the robots further apart, and makes them wait more). The other settings are kept, the
+ decisions forgotten. Setup only, like
+ `dc_set_stop_model`: it allocates (the coordinator is made again); call it before the tick
+ loop. `dc_set_stop_model` keeps it.
+
+ Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_INVALID_ARGUMENT` (not finite
+ or not > 0; the handle keeps its clearance and `dc_last_init_error` says so),
+ `DC_STATUS_BUSY`, `DC_STATUS_PANIC` (a poisoned handle).
+
+ # Safety
+ `handle` must be NULL or a live handle.
+ */
+DcStatus dc_set_coordination_clearance(struct DcCollider *handle, double clearance_mm);
 
 /*
  The thesis robot (f 100, rf 150, re 400, e 40, limits [-pi/2, 2 pi/3], H 70, D 17.5,

@@ -7,7 +7,9 @@
 //! under valgrind memcheck. Also compiles the header into two C++ translation units (wasmtime's
 //! double-include check) and records whether it is valid C89. The four-robot line runs in
 //! exact mode and with the protective verdict (`c_harness/line.c`); the timed protective query
-//! runs twice per cycle and under adversarial schedules (`c_harness/timing.c`).
+//! runs twice per cycle and under adversarial schedules (`c_harness/timing.c`); the
+//! coordination keeps two robots whose programmes place at one point apart
+//! (`c_harness/coordination.c`).
 //!
 //! The static library is the one cargo builds in the same run: the test executable is
 //! `target/<profile>/deps/c_harness-HASH` and the library lies next to it in `deps/`.
@@ -339,6 +341,48 @@ fn assert_speed_override(stdout: &str) {
     }
 }
 
+/// The word (`yes` or `no`) that follows `before` in a harness output line.
+fn yes_no(line: &str, before: &str) -> bool {
+    let rest = line.split(before).nth(1).unwrap_or_else(|| panic!("no `{before}` in: {line}"));
+    match rest.split([' ', ',']).next().unwrap() {
+        "yes" => true,
+        "no" => false,
+        other => panic!("`{before}` is followed by `{other}`, not yes or no, in: {line}"),
+    }
+}
+
+/// The coordination's line (`c_harness/coordination.c`): on T1 two robots whose programmes
+/// place at the same point at the same ticks, driven by `dc_coordinate` and stopped by the
+/// timed protective query. The boxes never touch; whether the run finishes or deadlocks is a
+/// property of the coordination under development, reported here, not asserted.
+fn assert_coordination(stdout: &str) {
+    let prefix = "coordination T1: ";
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with(prefix))
+        .unwrap_or_else(|| panic!("no `{prefix}` line"));
+    let (programmed, taken) = (number(line, "programmed "), number(line, "taken "));
+    let (stops, contacts) = (number(line, "STOP events "), number(line, "contact ticks "));
+    let (finished, deadlock) = (yes_no(line, "finished "), yes_no(line, "deadlock "));
+    assert_eq!(contacts, 0.0, "the boxes touch: {line}");
+    assert!(programmed > 0.0 && taken > 0.0 && taken <= 4.0 * programmed, "{line}");
+    assert!(!(finished && deadlock), "{line}");
+    if finished {
+        assert!(taken >= programmed, "finished sooner than programmed: {line}");
+    }
+    let not_ok = number(line, "protective statuses not OK ");
+    println!(
+        "coordination T1: programmed {programmed} ticks, taken {taken} ticks ({}), STOP events \
+         {stops}, contact ticks {contacts}, deadlock {}, protective statuses not OK {not_ok}",
+        if finished {
+            format!("throughput kept {:.1} %", 100.0 * programmed / taken)
+        } else {
+            "not finished".to_string()
+        },
+        if deadlock { "yes" } else { "no" }
+    );
+}
+
 /// The four-robot line's lines (`c_harness/line.c`): in exact mode the practical case is FREE on
 /// every tick; the collision case stops after tick 3000, at the exact model's first colliding
 /// tick, on the pair R3-R4 (robots 2-3, `tests/line_scenarios.rs`). With the protective verdict
@@ -500,6 +544,7 @@ fn harness_passes_with_tables(kind: usize) {
     );
     assert_speed_override(&stdout);
     assert_timing(&stdout);
+    assert_coordination(&stdout);
     assert_line(&stdout);
     let runs = summaries(&stdout);
     assert_eq!(runs.len(), 6, "one table-mode summary per cell and case: {runs:?}");
@@ -673,6 +718,10 @@ fn c_harness_is_clean_under_valgrind_memcheck() {
     assert!(
         stdout.contains("colliding pairs at the stop 2-3"),
         "the line's collision case did not run under valgrind"
+    );
+    assert!(
+        stdout.contains("coordination T1 quick: "),
+        "the coordination's first ticks did not run under valgrind"
     );
 }
 

@@ -92,6 +92,12 @@ impl Track {
         self.replaced |= 1 << slot;
     }
 
+    /// Empties every slot (in place: no allocation).
+    pub fn clear(&mut self) {
+        self.slots.iter_mut().for_each(|s| s.number = u64::MAX);
+        self.replaced = u128::MAX;
+    }
+
     /// The slot of sample `number` when the ring holds it.
     pub fn slot_of(&self, number: u64) -> Option<usize> {
         let slot = (number % MAX_SAMPLES as u64) as usize;

@@ -32,6 +32,11 @@
 //! 5. **Override.** A robot that yields gets the largest factor whose speed still lets it
 //!    stand before its hold point (bisection of the stopping distance); every factor is ramped
 //!    within shares of the stopping model's `max_accel_mm_s2` (SPEC §9).
+//! 6. **Stalls.** Steps 2-4 decide within the horizon. A programme revealed later can come
+//!    back through where a robot waits while that robot's way is blocked by the other: each
+//!    waits for the other (measured by `delta-collide simulate`). When every robot with
+//!    somewhere to go has stood held for [`STALL_TICKS`], one is released in turn for
+//!    [`RELEASE_TICKS`]; the protective verdict decides whether it may move.
 //!
 //! Nothing here allocates after [`Coordinator::new`]; each loop is bounded by
 //! [`MAX_SAMPLES`] samples per robot and the cell's robot pairs.
@@ -111,8 +116,13 @@ pub enum CoordinationError {
         /// Programmes given.
         found: usize,
     },
-    /// A programme breaks its contract; the text names the robot and the field.
-    InvalidProgramme(alloc::string::String),
+    /// Robot `robot`'s programme breaks its contract: `what` says how.
+    InvalidProgramme {
+        /// The robot.
+        robot: usize,
+        /// What is wrong.
+        what: &'static str,
+    },
 }
 
 impl core::fmt::Display for CoordinationError {
@@ -121,7 +131,9 @@ impl core::fmt::Display for CoordinationError {
             CoordinationError::WrongRobotCount { expected, found } => {
                 write!(f, "expected {expected} programmes (one per robot), found {found}")
             }
-            CoordinationError::InvalidProgramme(why) => write!(f, "invalid programme: {why}"),
+            CoordinationError::InvalidProgramme { robot, what } => {
+                write!(f, "invalid programme of robot {robot}: {what}")
+            }
         }
     }
 }
@@ -197,7 +209,26 @@ pub struct Coordinator {
     /// Per pair, the robot with the right of way while its conflict lasts.
     winners: Vec<Option<usize>>,
     ranking: right_of_way::Ranking,
+    stall: Stall,
     report: CoordinationReport,
+}
+
+/// Ticks during which every robot with somewhere to go is held before one is released.
+pub const STALL_TICKS: u32 = 100;
+
+/// Ticks one released robot may move regardless of its holds.
+pub const RELEASE_TICKS: u32 = 300;
+
+/// An override (or a target) below this holds a robot.
+const HELD: Real = 1e-6;
+
+/// The breaking of a stall (module doc, step 6): how long every robot with somewhere to go
+/// has been held, the robot released and for how many more ticks, whose turn is next.
+#[derive(Clone, Copy, Debug, Default)]
+struct Stall {
+    ticks: u32,
+    released: Option<(usize, u32)>,
+    turn: usize,
 }
 
 impl Coordinator {
@@ -230,6 +261,7 @@ impl Coordinator {
             holds: vec![PairHolds::default(); pairs.len()],
             winners: vec![None; pairs.len()],
             ranking: right_of_way::Ranking::new(n, pairs.len()),
+            stall: Stall::default(),
             report: CoordinationReport { robots: vec![idle; n], cells_tested: 0 },
             pairs,
         }
@@ -255,13 +287,13 @@ impl Coordinator {
         &self.report
     }
 
-    /// Forgets every decision and sample (a restart of the line).
+    /// Forgets every decision and sample (a restart of the line); allocates nothing.
     pub fn reset(&mut self) {
-        let n = self.tracks.len();
-        self.tracks.iter_mut().for_each(|t| *t = Track::default());
+        self.tracks.iter_mut().for_each(Track::clear);
         self.diagrams.iter_mut().for_each(|d| *d = Diagram::default());
         self.winners.iter_mut().for_each(|w| *w = None);
-        self.ranking = right_of_way::Ranking::new(n, self.pairs.len());
+        self.ranking.reset();
+        self.stall = Stall::default();
     }
 
     /// Each robot's override for the next tick (module doc): the chain `horizons`, `place`,
@@ -306,9 +338,8 @@ impl Coordinator {
         }
         let tick_s = self.cell().tick_ms * 1e-3;
         for (j, p) in request.programmes.iter().enumerate() {
-            let bad = |what: &str| {
-                Err(CoordinationError::InvalidProgramme(alloc::format!("robot {j}: {what}")))
-            };
+            let bad =
+                |what: &'static str| Err(CoordinationError::InvalidProgramme { robot: j, what });
             if p.stride_ticks == 0 {
                 return bad("stride_ticks is 0");
             }
@@ -493,9 +524,10 @@ impl Coordinator {
                 }
             }
         }
+        let n = self.report.robots.len();
+        let mut targets = [0.0; crate::cell::MAX_ROBOTS];
         for (j, r) in self.report.robots.iter_mut().enumerate() {
             let h = &self.horizons[j];
-            let stop = &cell.stops[j];
             let target = if r.held_by.is_some() {
                 let room = r.hold_mm - self.config.hold_margin_mm;
                 let v = speed::allowed_speed(cell, j, room);
@@ -509,13 +541,48 @@ impl Coordinator {
             } else {
                 1.0
             };
+            targets[j] = target;
+        }
+        self.break_stall(request, &mut targets[..n]);
+        let cell = self.exact.cell();
+        for (j, r) in self.report.robots.iter_mut().enumerate() {
+            let h = &self.horizons[j];
+            let stop = &cell.stops[j];
             r.override_factor = speed::ramped(
                 request.programmes[j].override_now,
-                target,
+                targets[j],
                 h.speed_ahead_mm_s,
                 stop.max_accel_mm_s2 * tick_s,
                 (self.config.speed_up_share, self.config.slow_down_share),
             );
+        }
+    }
+
+    /// Step 6: when every robot with somewhere to go (its programme moves ahead) has stood
+    /// held for [`STALL_TICKS`], releases one of them, in turn, for [`RELEASE_TICKS`]: its
+    /// target is 1 whatever holds it. The protective verdict stays the proof of its motion.
+    fn break_stall(&mut self, request: &CoordinationRequest, targets: &mut [Real]) {
+        let wants = |j: usize| self.horizons[j].speed_ahead_mm_s > 0.0;
+        let n = targets.len();
+        if let Some((r, left)) = self.stall.released {
+            if left == 0 || !wants(r) {
+                self.stall.released = None;
+            } else {
+                self.stall.released = Some((r, left - 1));
+                targets[r] = 1.0;
+                self.report.robots[r].held_by = None;
+                return;
+            }
+        }
+        let held = |j: usize| targets[j] < HELD && request.programmes[j].override_now < HELD;
+        let stalled = (0..n).any(wants) && (0..n).filter(|&j| wants(j)).all(held);
+        self.stall.ticks = if stalled { self.stall.ticks.saturating_add(1) } else { 0 };
+        if self.stall.ticks >= STALL_TICKS {
+            // The next robot in turn that has somewhere to go (one exists: the stall says so).
+            let r = (0..n).map(|k| (self.stall.turn + k) % n).find(|&j| wants(j)).unwrap_or(0);
+            self.stall = Stall { ticks: 0, released: Some((r, RELEASE_TICKS)), turn: r + 1 };
+            targets[r] = 1.0;
+            self.report.robots[r].held_by = None;
         }
     }
 }

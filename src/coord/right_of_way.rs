@@ -48,6 +48,14 @@ impl Ranking {
         }
     }
 
+    /// Back to the ranking by index with no pair in conflict (in place: no allocation).
+    pub fn reset(&mut self) {
+        self.clear();
+        for (r, (o, k)) in self.order.iter_mut().zip(self.rank.iter_mut()).enumerate() {
+            (*o, *k) = (r, r);
+        }
+    }
+
     /// Marks every pair free of conflict.
     pub fn clear(&mut self) {
         self.wants.iter_mut().for_each(|w| w.conflict = false);

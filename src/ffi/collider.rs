@@ -2,8 +2,8 @@
 //! table, plus the per-tick buffers (thesis appendix A; table mode: thesis 3.2 query phase,
 //! SPEC §6). No `unsafe` here: `ffi/mod.rs` checks the pointers and calls these functions.
 //!
-//! Everything a tick needs is allocated when the collider is made; [`Collider::query`]
-//! allocates nothing in either mode.
+//! Everything a tick needs is allocated when the collider is made; [`Collider::query`], the
+//! protective queries and the coordination allocate nothing in either mode.
 
 use crate::cell::exact::PairState;
 use crate::cell::protective::{
@@ -12,6 +12,7 @@ use crate::cell::protective::{
 };
 use crate::cell::{Cell, ExactChecker, MAX_ROBOTS};
 use crate::ffi::convert::{cell_error_status, table_error_status, InitError};
+use crate::ffi::coordination::Coordination;
 use crate::ffi::types::*;
 use crate::math::Vec3;
 use crate::robot::StopModel;
@@ -42,6 +43,9 @@ pub(crate) struct Collider {
     /// Table mode: protective queries so far answered FREE by the clearance table's bound
     /// alone (kept across `dc_set_stop_model`).
     protective_lookups: u64,
+    /// The coordination of the cell (either mode: it reads the exact boxes), with its
+    /// buffers; made with the handle, remade by `dc_set_stop_model`.
+    coordination: Coordination,
 }
 
 /// The protective checker of a handle until `dc_set_stop_model` sets one: without the motor-angle
@@ -55,8 +59,10 @@ impl Collider {
     /// An exact-mode collider for `cell`.
     pub(crate) fn exact(cell: Cell) -> Collider {
         let n = cell.robots.len();
+        let protective = protective_for(&cell);
         Collider {
-            protective: protective_for(&cell),
+            coordination: Coordination::new(protective.cell().clone()),
+            protective,
             checker: Checker::Exact(Box::new(ExactChecker::new(cell))),
             tcps: vec![Vec3::zeros(); n],
             table_collides: false,
@@ -93,6 +99,7 @@ impl Collider {
             checker: Checker::Table(Box::new(checker)),
             tcps: vec![Vec3::zeros(); 2],
             table_collides: false,
+            coordination: Coordination::new(protective.cell().clone()),
             protective,
             path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; 2],
             protective_lookups: 0,
@@ -110,6 +117,7 @@ impl Collider {
             checker: Checker::Bundle(Box::new(checker)),
             tcps: vec![Vec3::zeros(); n],
             table_collides: false,
+            coordination: Coordination::new(protective.cell().clone()),
             protective,
             path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; n],
             protective_lookups: 0,
@@ -255,8 +263,14 @@ impl Collider {
         }
     }
 
+    /// The coordination of the cell and its buffers.
+    pub(crate) fn coordination(&mut self) -> &mut Coordination {
+        &mut self.coordination
+    }
+
     /// Replaces the tick, WARN threshold and stopping models of the protective verdict (and
-    /// forgets the previous TCPs).
+    /// forgets the previous TCPs), and remakes the coordination on them (its settings kept,
+    /// its decisions forgotten).
     pub(crate) fn set_stopping(
         &mut self,
         tick_ms: f64,
@@ -297,6 +311,7 @@ impl Collider {
             .map_err(|e| invalid(e.to_string()))?
             .with_speed_limits(limits)
             .with_limit_tests(tests);
+        self.coordination.set_cell(self.protective.cell().clone());
         Ok(())
     }
 

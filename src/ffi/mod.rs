@@ -8,7 +8,8 @@
 //! - Every pointer is checked; NaN and infinity are rejected.
 //! - `*out_verdict` and `*out_report`, when not NULL, are written on every call, and read
 //!   `DC_VERDICT_FREE` only together with `DC_STATUS_OK` (fail closed).
-//! - `dc_init*` allocate; `dc_query` never allocates, locks or does I/O.
+//! - `dc_init*` allocate; `dc_query`, the protective queries and `dc_coordinate` never
+//!   allocate, lock or do I/O.
 //! - Two modes behind one handle: exact (`dc_init`, `dc_init_from_cell_file`) and table
 //!   (`dc_init_with_table`, `dc_init_from_files`; a table, or a bundle of one table per pair
 //!   that can meet); `dc_query` is the same.
@@ -24,13 +25,15 @@
 //! # Files
 //! `handle.rs` (the handle and the guard of every call), `init.rs` (make and free a handle),
 //! `query.rs` (the collision query and its reports), `protective.rs` (the protective
-//! queries), `settings.rs` (setup calls), `status.rs` (status text, version),
+//! queries), `coordination.rs` (the coordination's overrides, and its state behind a
+//! handle), `settings.rs` (setup calls), `status.rs` (status text, version),
 //! `kinematics.rs` (the Delta3 kinematics); the safe state behind a handle in `collider.rs`,
 //! conversions from C in `convert.rs`, the C types in `types.rs`.
 #![allow(unsafe_code)]
 
 mod collider;
 mod convert;
+mod coordination;
 mod handle;
 mod init;
 mod kinematics;
@@ -41,6 +44,7 @@ mod status;
 pub mod types;
 
 pub use convert::table_error_status;
+pub use coordination::*;
 pub use handle::DcCollider;
 pub use init::*;
 pub use kinematics::*;

@@ -97,7 +97,7 @@ pub unsafe extern "C" fn dc_set_table_confirmation(
 ///
 /// # Safety
 /// `handle` must be NULL or a live handle not used by another thread.
-unsafe fn set_on_handle(
+pub(super) unsafe fn set_on_handle(
     handle: *mut DcCollider,
     set: impl FnOnce(&mut Collider) -> Result<(), String>,
 ) -> DcStatus {

@@ -4,7 +4,7 @@ use super::types::*;
 use std::ffi::{c_char, CStr};
 
 /// Each status and its text.
-const STATUS_TEXT: [(DcStatus, &CStr); 26] = [
+const STATUS_TEXT: [(DcStatus, &CStr); 28] = [
     (DC_STATUS_OK, c"ok"),
     (DC_STATUS_NULL_POINTER, c"a required pointer argument is NULL"),
     (DC_STATUS_NON_FINITE, c"an input number is NaN or infinite"),
@@ -31,6 +31,8 @@ const STATUS_TEXT: [(DcStatus, &CStr); 26] = [
     (DC_STATUS_TIME_EARLY, c"a timestamp less than half a tick after the last protective call's"),
     (DC_STATUS_CLOCK_CHANGED, c"a cycle counter after a timestamp, or a timestamp after a cycle counter"),
     (DC_STATUS_BUSY, c"the handle is in use by another call: give each task its own handle"),
+    (DC_STATUS_INVALID_PROGRAMME, c"a programme has no points or more than DC_MAX_PROGRAMME_POINTS, stride_ticks 0, or first_tick not a multiple of stride_ticks"),
+    (DC_STATUS_PROGRESS_OUT_OF_RANGE, c"a programme's progress lies outside its points' ticks, or its override_now outside [0, 1]"),
 ];
 
 /// A static, NUL-terminated English description of `status`; never NULL.

@@ -72,6 +72,13 @@ pub const DC_STATUS_CLOCK_CHANGED: DcStatus = 24;
 /// The handle is in use by another call (another task or thread) right now; nothing was
 /// done. A handle is for one task: give each task its own.
 pub const DC_STATUS_BUSY: DcStatus = 25;
+/// Coordination (`dc_coordinate`): a programme breaks its contract: no points or more than
+/// `DC_MAX_PROGRAMME_POINTS`, `stride_ticks` 0, `first_tick` not a multiple of
+/// `stride_ticks`, or its last point's tick beyond `UINT64_MAX`.
+pub const DC_STATUS_INVALID_PROGRAMME: DcStatus = 26;
+/// Coordination (`dc_coordinate`): a programme's `progress` lies outside its points' ticks
+/// (from `first_tick` to the last point's), or its `override_now` outside [0, 1].
+pub const DC_STATUS_PROGRESS_OUT_OF_RANGE: DcStatus = 27;
 
 /// What the controller should do; 0 is STOP so that zeroed memory fails closed.
 pub type DcVerdict = u32;
@@ -394,4 +401,63 @@ impl DcProtectiveReport {
         protective_mm: [0.0; 32],
         speed_limit_mm_s: [0.0; 32],
     };
+}
+
+/// Most points of one `DcProgramme`.
+pub const DC_MAX_PROGRAMME_POINTS: u32 = 4096;
+
+/// One robot's programme ahead for `dc_coordinate` (SPEC section 9): its set-points at the
+/// nominal timing, as its path planner has them, and how far along it the robot is. Point `k`
+/// is the set-point of programme tick `first_tick + k * stride_ticks`; between two points the
+/// robot moves on the straight line.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct DcProgramme {
+    /// The programme tick of the first point: a multiple of `stride_ticks`.
+    pub first_tick: u64,
+    /// Programme ticks between two points (at least 1).
+    pub stride_ticks: u32,
+    /// How many points (1 to `DC_MAX_PROGRAMME_POINTS`); the robot stands at the last one
+    /// when its programme ends there. Give at least its longest stop's worth.
+    pub n_points: u32,
+    /// `n_points * 3` numbers: x, y, z of each point in the robot's MCS (mm).
+    pub points: *const f64,
+    /// The robot's progress now, in programme ticks: from `first_tick` to the last point's
+    /// tick (at full speed one programme tick per controller tick).
+    pub progress: f64,
+    /// The override the robot followed over the last tick, in [0, 1] (0 when it stands).
+    pub override_now: f64,
+}
+
+/// The inputs of `dc_coordinate`; start from `dc_coordination_request_default()`, which sets
+/// `struct_size`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct DcCoordinationRequest {
+    /// `sizeof(DcCoordinationRequest)` as the caller compiled it: lets later versions add fields.
+    pub struct_size: u32,
+    /// How many programmes: one per robot of the cell.
+    pub n_robots: u32,
+    /// Robot j's programme ahead is `programmes[j]`.
+    pub programmes: *const DcProgramme,
+}
+
+/// What `dc_coordinate` answers for one robot.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DcRobotCoordination {
+    /// The override to apply over the next tick, in [0, 1] (the same as `out_overrides[j]`).
+    pub override_factor: f64,
+    /// The robot it yields to (whose conflict sets its hold point), or -1 for none.
+    pub held_by: i32,
+    /// Arc length from the TCP now to the hold point (mm); `INFINITY` when not held.
+    pub hold_mm: f64,
+    /// Its place in this tick's ranking (0: yields to no one).
+    pub rank: u32,
+}
+
+impl DcRobotCoordination {
+    /// What every robot gets on an error: stand, held by no one.
+    pub(crate) const STAND: DcRobotCoordination =
+        DcRobotCoordination { override_factor: 0.0, held_by: -1, hold_mm: 0.0, rank: 0 };
 }

@@ -50,6 +50,63 @@ fn rate_ahead(prog: &[Vec3], s: Real, ticks: usize) -> Real {
     prog[k..end].windows(2).map(|w| (w[1] - w[0]).norm()).fold(0.0, Real::max)
 }
 
+/// The controller's right of way over the speed limits: when every robot stands with a limit
+/// of 0 (each waits for the others), one robot at a time is released in turn and the others
+/// are held, so that they promise to stay where they are (a one-point stop path) and its
+/// limit is proved against them standing. A release ends once the robot has moved for
+/// [`RELEASE_TICKS`], or after as many ticks without moving (then the next robot's turn).
+#[derive(Clone, Copy, Debug, Default)]
+struct Release {
+    robot: Option<usize>,
+    since: u64,
+    turn: usize,
+}
+
+/// An override below this is a robot waiting (the limits of standing robots are their
+/// measured speeds, rounding's specks).
+const WAITING: Real = 1e-6;
+
+/// Ticks of one release (module doc of [`Release`]).
+const RELEASE_TICKS: u64 = 300;
+
+impl Release {
+    fn apply(&mut self, robots: &[Robot], targets: &mut [Real], cycle: u64) {
+        let n = robots.len();
+        let all_wait =
+            robots.iter().all(|r| r.override_now < WAITING) && targets.iter().all(|&t| t < WAITING);
+        if let Some(r) = self.robot {
+            if cycle - self.since >= RELEASE_TICKS {
+                self.robot = None;
+            } else {
+                for (j, t) in targets.iter_mut().enumerate() {
+                    if j != r {
+                        *t = 0.0;
+                    }
+                }
+                return;
+            }
+        }
+        if all_wait {
+            let r = self.turn % n;
+            self.turn += 1;
+            (self.robot, self.since) = (Some(r), cycle);
+        }
+    }
+}
+
+/// The override that holds a robot's speed at 0.9 of its speed limit (SPEC §8), at the
+/// programmed speed ahead `ahead_mm_s`; 0 for a limit that is NaN or negative.
+fn cap_of(limit_mm_s: Real, ahead_mm_s: Real) -> Real {
+    let cap = 0.9 * limit_mm_s;
+    if cap.is_nan() || cap < 0.0 {
+        0.0
+    } else if ahead_mm_s > 0.0 {
+        (cap / ahead_mm_s).min(1.0)
+    } else {
+        1.0
+    }
+}
+
 /// What the loop keeps per robot.
 #[derive(Clone, Copy, Debug)]
 struct Robot {
@@ -62,10 +119,10 @@ pub fn run(cell: &Cell, programmes: &Programmes, config: &SimConfig) -> RunMetri
     let n = cell.robots.len();
     let tick_s = cell.tick_ms * 1e-3;
     let mut exact = ExactChecker::new(cell.clone());
-    let limits = config.mode == Mode::Limits;
+    let with_limits = matches!(config.mode, Mode::Limits | Mode::Coordinate);
     let mut protective = ProtectiveChecker::new(cell.clone(), config.warn_mm)
         .expect("a cell that parsed builds a protective checker")
-        .with_speed_limits(limits);
+        .with_speed_limits(with_limits);
     let mut coordinator = Coordinator::new(cell.clone(), config.coordination);
     let mut interlock = (config.mode == Mode::Interlock)
         .then(|| Interlock::new(cell, programmes, config.coordination.clearance_mm, 2.0));
@@ -80,6 +137,10 @@ pub fn run(cell: &Cell, programmes: &Programmes, config: &SimConfig) -> RunMetri
     let mut travel_sum = 0.0;
     let mut paths_buf = vec![[Vec3::zeros(); PATH_POINTS]; n];
     let mut targets = vec![1.0; n];
+    let mut next = vec![0.0; n];
+    let mut limits: Vec<Real> = vec![0.0; n];
+    let mut last_verdict = Protective::Stop;
+    let mut release = Release::default();
     let mut points = vec![[Vec3::zeros(); MAX_SAMPLES]; n];
     let mut cycle: u64 = 0;
     let mut tick = 0usize;
@@ -151,7 +212,49 @@ pub fn run(cell: &Cell, programmes: &Programmes, config: &SimConfig) -> RunMetri
         }
         coord_ns.push(coordination);
 
-        // The protective verdict, with each robot's programme ahead as its stop path.
+        // The controller's override targets (the speed limits of the last verdict).
+        for j in 0..n {
+            let ahead = rate_ahead(&programmes[j], robots[j].progress, 8) / tick_s;
+            let target = match config.mode {
+                Mode::Free => 1.0,
+                Mode::Coordinate => targets[j].min(cap_of(limits[j], ahead)),
+                Mode::Limits if last_verdict == Protective::Stop => 0.0,
+                Mode::Limits => cap_of(limits[j], ahead),
+                Mode::Interlock => targets[j],
+            };
+            targets[j] = target;
+        }
+        if with_limits {
+            release.apply(&robots, &mut targets, cycle);
+        }
+        if let Some(lock) = interlock.as_mut() {
+            let progress: Vec<Real> = robots.iter().map(|r| r.progress).collect();
+            let now: Vec<Real> = (0..n)
+                .map(|j| {
+                    robots[j].override_now * rate_at(&programmes[j], robots[j].progress) / tick_s
+                })
+                .collect();
+            let ahead: Vec<Real> = (0..n)
+                .map(|j| rate_ahead(&programmes[j], robots[j].progress, 8) / tick_s)
+                .collect();
+            lock.targets(cell, programmes, &progress, &now, &ahead, &mut targets);
+        }
+        for j in 0..n {
+            let p = &programmes[j];
+            let ahead = rate_ahead(p, robots[j].progress, 8) / tick_s;
+            let a_tick = cell.stops[j].max_accel_mm_s2 * tick_s;
+            let shares = match config.mode {
+                Mode::Limits => (0.5, 0.5),
+                Mode::Coordinate => {
+                    (config.coordination.speed_up_share, config.coordination.slow_down_share)
+                }
+                _ => (0.2, 0.45),
+            };
+            next[j] = ramped(robots[j].override_now, targets[j], ahead, a_tick, shares);
+        }
+
+        // The protective verdict, with each robot's programme ahead as its stop path; a robot
+        // that stands and is held this tick promises to stay where it is.
         let mut stops: Vec<Option<StopPath>> = Vec::new();
         let mut found = [None; crate::cell::MAX_ROBOTS];
         if config.paths {
@@ -161,7 +264,8 @@ pub fn run(cell: &Cell, programmes: &Programmes, config: &SimConfig) -> RunMetri
                 let mut dense = [Vec3::zeros(); 400];
                 dense[0] = tcps[j];
                 let mut m = 1;
-                for q in p.iter().skip(k + 1).take(dense.len() - 1) {
+                let held = next[j] < WAITING && robots[j].override_now < WAITING;
+                for q in p.iter().skip(k + 1).take(if held { 0 } else { dense.len() - 1 }) {
                     dense[m] = *q;
                     m += 1;
                 }
@@ -190,10 +294,19 @@ pub fn run(cell: &Cell, programmes: &Programmes, config: &SimConfig) -> RunMetri
         let t0 = Instant::now();
         let answer = protective.check(request);
         let protective_ns = t0.elapsed().as_nanos() as u64;
-        let (verdict, limits_now): (Protective, Vec<Real>) = match answer {
-            Ok(r) => (r.verdict, r.robots.iter().map(|x| x.speed_limit_mm_s).collect()),
-            Err(_) => (Protective::Stop, vec![0.0; n]),
+        let verdict = match answer {
+            Ok(r) => {
+                for (l, x) in limits.iter_mut().zip(&r.robots) {
+                    *l = x.speed_limit_mm_s;
+                }
+                r.verdict
+            }
+            Err(_) => {
+                limits.iter_mut().for_each(|l| *l = 0.0);
+                Protective::Stop
+            }
         };
+        last_verdict = verdict;
         ours.push(coordination + protective_ns);
         metrics.verdicts[verdict as usize] += 1;
         drop(stops);
@@ -214,49 +327,9 @@ pub fn run(cell: &Cell, programmes: &Programmes, config: &SimConfig) -> RunMetri
             continue;
         }
 
-        // The controller applies its override.
-        for j in 0..n {
-            let ahead = rate_ahead(&programmes[j], robots[j].progress, 8) / tick_s;
-            let target = match config.mode {
-                Mode::Free => 1.0,
-                Mode::Coordinate => targets[j],
-                Mode::Limits => {
-                    let cap = 0.9 * limits_now[j];
-                    if verdict == Protective::Stop || cap.is_nan() || cap < 0.0 {
-                        0.0
-                    } else if ahead > 0.0 {
-                        (cap / ahead).min(1.0)
-                    } else {
-                        1.0
-                    }
-                }
-                Mode::Interlock => targets[j],
-            };
-            targets[j] = target;
-        }
-        if let Some(lock) = interlock.as_mut() {
-            let progress: Vec<Real> = robots.iter().map(|r| r.progress).collect();
-            let now: Vec<Real> = (0..n)
-                .map(|j| {
-                    robots[j].override_now * rate_at(&programmes[j], robots[j].progress) / tick_s
-                })
-                .collect();
-            let ahead: Vec<Real> = (0..n)
-                .map(|j| rate_ahead(&programmes[j], robots[j].progress, 8) / tick_s)
-                .collect();
-            lock.targets(cell, programmes, &progress, &now, &ahead, &mut targets);
-        }
         for j in 0..n {
             let p = &programmes[j];
-            let ahead = rate_ahead(p, robots[j].progress, 8) / tick_s;
-            let a_tick = cell.stops[j].max_accel_mm_s2 * tick_s;
-            let o = if config.mode == Mode::Coordinate {
-                targets[j]
-            } else {
-                let shares = if config.mode == Mode::Limits { (0.5, 0.5) } else { (0.2, 0.45) };
-                ramped(robots[j].override_now, targets[j], ahead, a_tick, shares)
-            };
-            let o = if verdict == Protective::Stop { 0.0 } else { o };
+            let o = if verdict == Protective::Stop { 0.0 } else { next[j] };
             let end = (p.len() - 1) as Real;
             robots[j].progress = (robots[j].progress + o).min(end);
             robots[j].override_now = if robots[j].progress >= end { 0.0 } else { o };

@@ -47,6 +47,7 @@ pub fn harness_sources() -> Vec<PathBuf> {
         sources.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
     let expected = [
         "bad_input.c",
+        "coordination.c",
         "harness.c",
         "line.c",
         "main.c",

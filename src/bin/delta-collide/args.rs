@@ -63,7 +63,7 @@ pub enum Command {
     /// from the first STOP (reaction, then braking along the path) stays clear, checked with
     /// the exact model every 0.1 ms.
     Demo(DemoArgs),
-    /// Run the closed-loop benchmark: seeded pick-and-place programmes, the library in the loop
+    /// Run the closed-loop benchmark of coordination on seeded programmes
     ///
     /// Draws dense pick-and-place programmes for the cell (seeded; timed by an offline
     /// interlock), then runs them tick by tick: the controller applies the coordination's

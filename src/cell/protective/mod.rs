@@ -790,15 +790,21 @@ impl ProtectiveChecker {
             self.forget_motion();
             return;
         }
-        if self.report.verdict != Protective::Free && paths.iter().any(Option::is_some) {
+        let along = paths.iter().any(Option::is_some);
+        if along && (self.report.verdict != Protective::Free || self.model.speed_limits) {
             // The proof along the paths reads this tick's references (a robot without a path
             // keeps its stop ball's), which a tick settled early has not set.
             if self.calls.references_stale {
                 self.set_references(tcps_mcs);
             }
-            let (verdict, limiting) = self.prove_with_paths(tcps_mcs, paths);
-            if verdict < self.report.verdict {
-                (self.report.verdict, self.report.limiting) = (verdict, limiting);
+            if self.report.verdict != Protective::Free {
+                let (verdict, limiting) = self.prove_with_paths(tcps_mcs, paths);
+                if verdict < self.report.verdict {
+                    (self.report.verdict, self.report.limiting) = (verdict, limiting);
+                }
+            }
+            if self.model.speed_limits {
+                self.path_limits(tcps_mcs, paths);
             }
         }
     }

@@ -45,6 +45,9 @@ pub const MAX_PATH_POINTS: usize = 32;
 /// Halvings of one robot's piece at most, per robot pair (up to `2^MAX_DEPTH` pieces).
 pub const MAX_DEPTH: u32 = 3;
 
+/// Tests of the proof along the paths that may raise one robot's speed limit per tick.
+pub const PATH_LIMIT_TESTS: u32 = 4;
+
 /// The path a robot's TCP will follow over its stop (module doc): the polyline through
 /// `points` (MCS, mm), left by at most `tolerance_mm`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -354,6 +357,78 @@ impl ProtectiveChecker {
             }
         }
         Some(unproved)
+    }
+
+    /// The piece of robot `j`'s whole stop of length `s` along its path (or its reference
+    /// ball without a path).
+    fn whole_piece(&self, j: usize, tcp_mcs: &Vec3, s: Real, path: Option<&StopPath>) -> Piece {
+        let arc = path.and_then(|p| {
+            let tol = p.tolerance_mm;
+            arc_cover(p.points, tcp_mcs, s + tol, tol)
+        });
+        self.piece(j, path, arc)
+    }
+
+    /// Whether every pair involving robot `j` is proved along the paths when `j` moves at
+    /// speed `v` (the others as they are). Replaces `j`'s reference.
+    fn path_speed_proved(
+        &mut self,
+        j: usize,
+        tcps_mcs: &[Vec3],
+        paths: &[Option<StopPath>],
+        v: Real,
+    ) -> bool {
+        let s = self.stop_reference(j, &tcps_mcs[j], v);
+        // Two ticks more along the path: a limit the controller applies must still be proved
+        // where the robot is when the next verdicts come.
+        let ahead = s + 2.0 * v * self.cell().tick_ms * 1e-3;
+        let piece_j = self.whole_piece(j, &tcps_mcs[j], ahead, paths[j].as_ref());
+        for pair in &self.exact.verdict().pairs {
+            let (a, b) = (pair.a, pair.b);
+            if a != j && b != j {
+                continue;
+            }
+            let other = if a == j { b } else { a };
+            let s_other = self.report.robots[other].protective_mm;
+            let piece_o = self.whole_piece(other, &tcps_mcs[other], s_other, paths[other].as_ref());
+            let (pa, pb) = if a == j { (&piece_j, &piece_o) } else { (&piece_o, &piece_j) };
+            let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
+            if self.prove_pieces((a, b), paths_ab, pa, pb, (0, 0), 0.0).is_some() {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Each robot's speed limit along the paths: the limit without paths is a speed the proof
+    /// along the paths holds too (it is taken only where better); from there, up to
+    /// [`PATH_LIMIT_TESTS`] tests of the proof along the paths raise it, one grid step of the
+    /// limits (`v_max / 2^LIMIT_STEPS`) above it, then steps of doubling length while they
+    /// hold, each over the robot's stop at that speed and two ticks of its motion. A robot
+    /// without a path keeps its limit.
+    pub(super) fn path_limits(&mut self, tcps_mcs: &[Vec3], paths: &[Option<StopPath>]) {
+        for j in 0..tcps_mcs.len() {
+            let r = self.report.robots[j];
+            if paths[j].is_none() || r.speed_limit_mm_s.is_nan() {
+                continue;
+            }
+            let v_max = self.cell().stops[j].max_speed_mm_s;
+            let grid = v_max / Real::from(1u32 << super::LIMIT_STEPS);
+            let mut lo = r.speed_limit_mm_s;
+            let saved = self.robots[j];
+            let inside = self.kept.inside(j);
+            let mut step = grid;
+            for _ in 0..PATH_LIMIT_TESTS {
+                let v = (lo + step).min(v_max);
+                if v <= lo || !self.path_speed_proved(j, tcps_mcs, paths, v) {
+                    break;
+                }
+                (lo, step) = (v, 2.0 * step);
+            }
+            self.robots[j] = saved;
+            self.kept.restore_inside(j, inside);
+            self.report.robots[j].speed_limit_mm_s = lo;
+        }
     }
 
     /// The verdict and limiting pair over the pieces of the paths (module doc), for the
