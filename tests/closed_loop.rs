@@ -32,14 +32,14 @@ fn assert_safe_and_live(what: &str, m: &RunMetrics) {
 }
 
 #[test]
-fn coordinated_runs_never_touch_nor_deadlock_on_a_reference_cell_and_one_of_our_own() {
+fn runs_never_touch_anywhere_and_finish_on_t1() {
     let cells =
         [reference_cell("T1").unwrap(), parse_cell(include_str!("../cells/r60.toml")).unwrap()];
     let programme = ProgrammeConfig { ticks: 1500, ..ProgrammeConfig::default() };
     for cell in &cells {
         for seed in [11, 12] {
             let progs = programmes(cell, &programme, &mut Rng::new(seed));
-            for mode in [Mode::Coordinate, Mode::Interlock] {
+            for mode in [Mode::Coordinate, Mode::Interlock, Mode::Limits] {
                 let m = run(cell, &progs, &config(mode));
                 println!("{} seed {seed} {}: {m:?}", cell.name, mode.name());
                 let what = format!("{} seed {seed} {}", cell.name, mode.name());

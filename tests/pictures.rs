@@ -281,3 +281,29 @@ fn eval_plots_distance_and_labels_along_both_scenarios() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn simulate_plots_the_coordination_diagram_with_its_obstacles_and_the_run() {
+    let file = path("diagram.png");
+    let text = ok(&cli(&[
+        "simulate",
+        "--cell",
+        "T1",
+        "--runs",
+        "1",
+        "--ticks",
+        "1200",
+        "--mode",
+        "coordinate",
+        "--paths",
+        "--plot",
+        &file,
+    ]));
+    assert!(text.contains("coordinate"), "{text}");
+    let pic = assert_picture(&file, 900, 940);
+    // Obstacles in grey (the place points are shared every cycle), the programmed timing in
+    // green, the run in blue.
+    assert!(pic.count(exactly([150, 150, 150])) > 5_000);
+    assert!(pic.count(exactly(FREE_TICK)) > 500);
+    assert!(pic.count(exactly([40, 90, 200])) > 500);
+}

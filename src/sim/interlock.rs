@@ -6,12 +6,11 @@
 //! gets when the neighbour does not hold it (the nearer robot first), and gives back when it
 //! has left the cuboid.
 
+use super::cells::conflict_cells;
 use super::programme::Programmes;
-use crate::cell::exact::{aabb_of, pair_state, PairState, RobotInWcs};
 use crate::cell::{Cell, ExactChecker};
 use crate::coord::speed::{allowed_speed, stopping_mm};
 use crate::math::{Real, Vec3};
-use crate::robot::RobotBoxes;
 
 /// Programme ticks between the samples that the zones are found from.
 const ZONE_STRIDE: usize = 4;
@@ -36,53 +35,20 @@ pub struct Interlock {
     margin_mm: Real,
 }
 
-/// Robot `j`'s boxes at `tcp`, grown by `growth`, with their AABB (None when unreachable).
-fn grown(
-    exact: &ExactChecker,
-    j: usize,
-    tcp: &Vec3,
-    growth: Real,
-) -> Option<(RobotBoxes, (Vec3, Vec3))> {
-    let mut boxes = RobotBoxes::empty();
-    exact.boxes_in_wcs(j, tcp, &mut boxes).ok()?;
-    for b in &mut boxes.boxes[..boxes.len] {
-        *b = b.inflated(growth);
-    }
-    let aabb = aabb_of(&boxes);
-    Some((boxes, aabb))
-}
-
 impl Interlock {
     /// The zones of `cell`'s pairs that can meet, from the whole `programmes` (offline, as an
     /// integrator sets them up), for robots that must come no closer than `clearance_mm`.
     pub fn new(cell: &Cell, programmes: &Programmes, clearance_mm: Real, margin_mm: Real) -> Self {
         let exact = ExactChecker::new(cell.clone());
-        let samples: Vec<Vec<_>> = programmes
-            .iter()
-            .enumerate()
-            .map(|(j, p)| {
-                p.iter()
-                    .step_by(ZONE_STRIDE)
-                    .map(|t| grown(&exact, j, t, 0.5 * clearance_mm))
-                    .collect()
-            })
-            .collect();
         let wcs = |j: usize, p: &Vec3| exact.rotation(j) * p + cell.robots[j].placement.t;
         let mut zones = Vec::new();
         for (a, b) in cell.pairs_that_can_meet() {
             let (mut lo, mut hi) = (Vec3::repeat(Real::INFINITY), Vec3::repeat(Real::NEG_INFINITY));
-            let mut marked = [vec![false; samples[a].len()], vec![false; samples[b].len()]];
-            for (i, sa) in samples[a].iter().enumerate() {
-                for (k, sb) in samples[b].iter().enumerate() {
-                    let hit = match (sa, sb) {
-                        (Some(x), Some(y)) => {
-                            let ra = RobotInWcs { boxes: x.0.as_slice(), aabb: &x.1 };
-                            let rb = RobotInWcs { boxes: y.0.as_slice(), aabb: &y.1 };
-                            !matches!(pair_state(&ra, &rb, None), PairState::Free)
-                        }
-                        _ => true,
-                    };
-                    if hit {
+            let c = conflict_cells(cell, programmes, (a, b), ZONE_STRIDE, clearance_mm);
+            let mut marked = [vec![false; c.rows], vec![false; c.cols]];
+            for i in 0..c.rows {
+                for k in 0..c.cols {
+                    if c.cells[i * c.cols + k] {
                         marked[0][i] = true;
                         marked[1][k] = true;
                     }

@@ -7,6 +7,7 @@
 //! Evaluation only (feature `sim`, which the CLI turns on): the controller's library does not
 //! need it.
 
+pub mod cells;
 pub mod interlock;
 pub mod programme;
 pub mod rng;

@@ -114,8 +114,27 @@ struct Robot {
     override_now: Real,
 }
 
+/// What a run did, tick by tick, for its pictures.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trace {
+    /// Per tick, each robot's progress (programme ticks).
+    pub progress: Vec<Vec<Real>>,
+    /// Per STOP event, each robot's progress when it was issued.
+    pub stops: Vec<Vec<Real>>,
+}
+
 /// Runs `programmes` on `cell` in closed loop (module doc).
 pub fn run(cell: &Cell, programmes: &Programmes, config: &SimConfig) -> RunMetrics {
+    run_traced(cell, programmes, config, None)
+}
+
+/// [`run`], recording each tick's progress into `trace` when one is given.
+pub fn run_traced(
+    cell: &Cell,
+    programmes: &Programmes,
+    config: &SimConfig,
+    mut trace: Option<&mut Trace>,
+) -> RunMetrics {
     let n = cell.robots.len();
     let tick_s = cell.tick_ms * 1e-3;
     let mut exact = ExactChecker::new(cell.clone());
@@ -315,6 +334,9 @@ pub fn run(cell: &Cell, programmes: &Programmes, config: &SimConfig) -> RunMetri
             .any(|j| robots[j].override_now * rate_at(&programmes[j], robots[j].progress) > 0.0);
         if verdict == Protective::Stop && moving {
             metrics.stop_events += 1;
+            if let Some(t) = trace.as_deref_mut() {
+                t.stops.push(robots.iter().map(|r| r.progress).collect());
+            }
             let (ticks, contacts) = simulate_stop(cell, &mut exact, programmes, &mut robots);
             metrics.contact_stop_samples += contacts;
             tick += ticks;
@@ -333,6 +355,9 @@ pub fn run(cell: &Cell, programmes: &Programmes, config: &SimConfig) -> RunMetri
             let end = (p.len() - 1) as Real;
             robots[j].progress = (robots[j].progress + o).min(end);
             robots[j].override_now = if robots[j].progress >= end { 0.0 } else { o };
+        }
+        if let Some(t) = trace.as_deref_mut() {
+            t.progress.push(robots.iter().map(|r| r.progress).collect());
         }
         tick += 1;
         cycle += 1;

@@ -216,6 +216,10 @@ pub struct SimulateArgs {
     /// Clearance the programmes' offline interlock keeps, executed as programmed (mm)
     #[arg(long, value_name = "MM", default_value_t = 10.0)]
     pub gap_mm: f64,
+    /// Draw the first run's coordination diagram of the first robot pair (the last mode
+    /// run) to this PNG file
+    #[arg(long, value_name = "FILE.png")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Arguments of `replay`.

@@ -15,6 +15,7 @@ mod bundle;
 mod clearance;
 mod confirm;
 mod demo;
+mod diagram_plot;
 mod eval;
 mod files;
 mod picture;

@@ -3,7 +3,9 @@
 
 use crate::args::SimulateArgs;
 use delta_collide::coord::CoordinationConfig;
-use delta_collide::sim::{programmes, run::run, Mode, ProgrammeConfig, Rng, SimConfig};
+use delta_collide::sim::cells::conflict_cells;
+use delta_collide::sim::run::{run_traced, Trace};
+use delta_collide::sim::{programmes, Mode, ProgrammeConfig, Rng, SimConfig};
 
 /// Runs the benchmark and prints its figures.
 pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
@@ -38,13 +40,29 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
         "ours med/p99/max us",
         "exact med/p99/max"
     );
-    for mode in modes {
+    let last = modes.len() - 1;
+    for (m, mode) in modes.into_iter().enumerate() {
         let config = SimConfig { mode, paths: a.paths, coordination, ..SimConfig::default() };
         let mut kept = Vec::new();
         for r in 0..a.runs {
             let seed = a.seed + u64::from(r);
             let progs = programmes(&a.cell, &programme, &mut Rng::new(seed));
-            let m = run(&a.cell, &progs, &config);
+            let plot = a.plot.as_ref().filter(|_| r == 0 && m == last);
+            let mut trace = Trace::default();
+            let m = run_traced(&a.cell, &progs, &config, plot.map(|_| &mut trace));
+            if let (Some(path), Some(&pair)) = (plot, a.cell.pairs_that_can_meet().first()) {
+                let cells = conflict_cells(&a.cell, &progs, pair, 8, a.clearance_mm);
+                let names = (&*a.cell.robots[pair.0].name, &*a.cell.robots[pair.1].name);
+                let title = format!(
+                    "{}, seed {seed}, {}{}: coordination diagram of {} and {}",
+                    a.cell.name,
+                    mode.name(),
+                    if a.paths { " with stop paths" } else { "" },
+                    names.0,
+                    names.1
+                );
+                crate::diagram_plot::draw_diagram(path, &title, names, pair, &cells, &trace)?;
+            }
             let us = |t: &delta_collide::sim::Timings| {
                 format!(
                     "{:.1}/{:.1}/{:.1}",
