@@ -130,7 +130,8 @@ typedef struct DcRobotCoordination {
    */
   double hold_mm;
   /*
-   Its place in this tick's ranking (0: yields to no one).
+   Its place in this tick's ranking (0: yields in no conflict; it may still stand short
+   of where another robot can be until that one stands).
    */
   uint32_t rank;
 } DcRobotCoordination;

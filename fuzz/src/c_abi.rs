@@ -25,7 +25,16 @@
 //!   `DC_STATUS_TIME_BACKWARDS`, the same time with other TCPs `DC_STATUS_TIME_REPEATED`, a
 //!   cycle more than `DC_MAX_INTERVAL_TICKS` later `DC_STATUS_TIME_JUMP`; the same clock, time
 //!   and TCPs (bit for bit) again answer that call's status, verdict and report unchanged.
+//! - The coordination (`dc_coordinate`): a status it documents, naming the cause in the
+//!   order it checks (NULL handle, request or `out_overrides`; a short `struct_size`; NULL
+//!   programmes; the robot count; a programme's point count, then its NULL points; then each
+//!   programme's ticks, non-finite numbers, progress or `override_now` out of range). Fail
+//!   closed: on every error each override written is 0.0 and each robot stands, held by no
+//!   one, wherever the request holds `n_robots`; with `DC_STATUS_OK` every override is in
+//!   [0, 1]; nothing is written past `n_robots`. `dc_set_coordination_clearance` takes
+//!   exactly the finite clearances above 0.
 
+mod coordinate;
 mod init;
 
 use super::input::{Encoder, Input};
@@ -39,7 +48,7 @@ pub const MAX_OPS: usize = 64;
 /// Live handles at most; a further init destroys the oldest.
 pub const MAX_HANDLES: usize = 4;
 /// Number of opcodes.
-const OPS: u8 = 13;
+const OPS: u8 = 15;
 
 /// The opcodes.
 #[derive(Clone, Copy, Debug)]
@@ -96,18 +105,32 @@ pub enum Op {
     /// 128 ns on `DC_CLOCK_NANOS`; that time minus 1 + byte % 8); NULL flags (byte: request,
     /// tcps, out_verdict, out_report).
     ProtectiveTimed = 12,
+    /// `dc_coordinate`: handle; a flag to send the handle's last answered programmes again
+    /// one tick on (each progress advanced by its override, which is the next
+    /// `override_now`), else a count (byte: < 192 the robot count, else byte % 40) and per
+    /// robot a programme (`coordinate::Programme::read`: stride, first tick, point count,
+    /// points, progress, override_now); `struct_size` (byte % 8: 0-2 right, then 0, 4, 8, a
+    /// byte short, 16 long); NULL flags (byte: request, programmes, out_overrides, out_robots,
+    /// the first programme's points, the last one's).
+    Coordinate = 13,
+    /// `dc_coordination_reset` or `dc_set_coordination_clearance`: handle, what (byte % 3:
+    /// reset, a clearance `f64`, a clearance of byte mm); then `dc_coordination_horizon` and
+    /// `dc_coordination_request_default`.
+    CoordinationSettings = 14,
 }
 
-/// A live handle, the robots it was made from and its timed protective calls.
+/// A live handle, the robots it was made from, its timed protective calls and its last
+/// answered coordination (which the next one may follow on from).
 struct Live {
     handle: *mut DcCollider,
     robots: Vec<DcRobotConfig>,
     timed: RefCell<Timed>,
+    coordinated: RefCell<Option<coordinate::Coordinated>>,
 }
 
 impl Live {
     fn new(handle: *mut DcCollider, robots: Vec<DcRobotConfig>) -> Live {
-        Live { handle, robots, timed: RefCell::default() }
+        Live { handle, robots, timed: RefCell::default(), coordinated: RefCell::default() }
     }
 }
 
@@ -154,7 +177,9 @@ pub fn c_abi(data: &[u8]) {
             9 => init::init_with_table(&mut input, &mut live),
             10 => init::init_from_files(&mut input, &mut live),
             11 => protective(&mut input, &live),
-            _ => protective_timed(&mut input, &live),
+            12 => protective_timed(&mut input, &live),
+            13 => coordinate::coordinate(&mut input, &live),
+            _ => coordinate::settings(&mut input, &live),
         }
     }
     for l in live {
@@ -832,7 +857,7 @@ fn status_str(input: &mut Input) {
     // SAFETY: `dc_status_str` returns a static NUL-terminated string.
     let text = unsafe { CStr::from_ptr(dc_status_str(status)) };
     assert!(!text.to_bytes().is_empty() && text.to_str().is_ok(), "status {status}: {text:?}");
-    if status <= DC_STATUS_BUSY {
+    if status <= DC_STATUS_PROGRESS_OUT_OF_RANGE {
         assert_ne!(text.to_bytes(), b"unknown status", "status {status} has no description");
     }
     // SAFETY: `dc_version` returns a static NUL-terminated string.
@@ -980,7 +1005,7 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.byte(Op::Forward as u8).byte(0).f64(f64::INFINITY).f64(0.0).f64(0.0).byte(4);
     out.push(("kinematics", e.bytes));
     let mut e = Encoder::default();
-    for s in 0..26 {
+    for s in 0..=DC_STATUS_PROGRESS_OUT_OF_RANGE as u8 {
         e.byte(Op::StatusStr as u8).byte(1).byte(s);
     }
     e.byte(Op::StatusStr as u8).byte(0).u32(u32::MAX);
@@ -1056,5 +1081,114 @@ pub fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     e.bytes.extend_from_slice(b"DCTABLE\0\x04\x03\x02\x01\x01\0\0\0");
     e.byte(0).byte(0).byte(0).byte(0).byte(200);
     out.push(("refused_tables", e.bytes));
+    // Coordinate: handle 0, not the last programmes again, the robot count; per programme its
+    // stride, first tick, point count and progress and override_now bytes (`Programme::read`);
+    // then struct_size and NULL flags.
+    let programme = |e: &mut Encoder,
+                     (stride, first): (&[u8], &[u8]),
+                     n: u8,
+                     points: &[[f64; 3]],
+                     (progress, override_now): (&[u8], &[u8])| {
+        e.bytes.extend_from_slice(stride);
+        e.bytes.extend_from_slice(first);
+        e.byte(n);
+        points.iter().for_each(|&p| {
+            e.point(p);
+        });
+        e.bytes.extend_from_slice(progress);
+        e.bytes.extend_from_slice(override_now);
+    };
+    // Each robot from its far side (x = -150 in its MCS, toward the other) to the midpoint of
+    // the bases and back, 40 points 4 ticks apart (156 ticks): they meet in the middle.
+    let towards = |toward: f64| -> Vec<[f64; 3]> {
+        (0..40)
+            .map(|k| {
+                let s = 1.0 - (f64::from(k) / 19.5 - 1.0).abs();
+                [toward * (-150.0 + 375.0 * s), 0.0, -450.0]
+            })
+            .collect()
+    };
+    let (a, b) = (towards(1.0), towards(-1.0));
+    let stride4: (&[u8], &[u8]) = (&[2, 3], &[0]);
+    let standing: (&[u8], &[u8]) = (&[4], &[3]);
+    let call = |e: &mut Encoder, handle: u8, count: u8, size: u8, nulls: u8, programmes: &[u8]| {
+        e.byte(Op::Coordinate as u8).byte(handle).byte(0).byte(count);
+        e.bytes.extend_from_slice(programmes);
+        e.byte(size).byte(nulls);
+    };
+    let again = |e: &mut Encoder, size: u8, nulls: u8| {
+        e.byte(Op::Coordinate as u8).byte(0).byte(1).byte(size).byte(nulls);
+    };
+    let bytes_of = |f: &dyn Fn(&mut Encoder)| {
+        let mut e = Encoder::default();
+        f(&mut e);
+        e.bytes
+    };
+    let line = bytes_of(&|e| {
+        programme(e, stride4, 40, &a, standing);
+        programme(e, stride4, 40, &b, standing);
+    });
+    // Within MAX_OPS calls: both standing at their first points, then 50 ticks following the
+    // overrides (robot 1 yields), some with no out_robots.
+    let mut e = Encoder::default();
+    init(&mut e, 2, 1, 0);
+    call(&mut e, 0, 0, 0, 0, &line);
+    for k in 0..50 {
+        again(&mut e, 0, if k % 7 == 3 { 8 } else { 0 });
+    }
+    // Refused, the outputs written 0.0 or left alone: struct_size 8 (n_robots readable) and 0,
+    // a NULL request, programmes and out_overrides; the first and the last points NULL; a NULL
+    // handle; one programme for two robots.
+    for (size, nulls) in [(5, 0), (3, 0), (0, 1), (0, 2), (0, 4), (0, 16), (0, 32 | 8)] {
+        again(&mut e, size, nulls);
+    }
+    call(&mut e, 1, 0, 0, 0, &line);
+    call(&mut e, 0, 201, 0, 0, &line[..line.len() / 2]);
+    out.push(("coordination_line", e.bytes));
+    // Robot 1's programme broken, robot 0's as before: no points, one above the maximum, the
+    // maximum (48 points then standing: answered), stride 0, a first tick that is no multiple of
+    // the stride, a last tick past u64::MAX, a NaN point, f64::MAX, an infinite progress, a
+    // progress before the first point and after the last, override_now 1.5.
+    let first_a = bytes_of(&|e| programme(e, stride4, 40, &a, standing));
+    let b48 = [b.as_slice(), &b[..8]].concat();
+    let mut broken: Vec<Vec<u8>> = vec![
+        bytes_of(&|e| programme(e, stride4, 0, &[], standing)),
+        bytes_of(&|e| programme(e, stride4, 255, &b48, standing)),
+        bytes_of(&|e| programme(e, stride4, 254, &b48, standing)),
+        bytes_of(&|e| programme(e, (&[0], &[0]), 40, &b, standing)),
+        bytes_of(&|e| programme(e, (&[2, 3], &[2, 6, 0, 0, 0, 0, 0, 0, 0]), 40, &b, standing)),
+        bytes_of(&|e| programme(e, (&[2, 3], &[3]), 2, &b[..2], standing)),
+    ];
+    let mut nan = b.clone();
+    nan[7][2] = f64::NAN;
+    let mut huge = b.clone();
+    huge[0] = [f64::MAX, -f64::MAX, -450.0];
+    huge[1] = [-f64::MAX, f64::MAX, -450.0];
+    broken.push(bytes_of(&|e| programme(e, stride4, 40, &nan, standing)));
+    broken.push(bytes_of(&|e| programme(e, stride4, 40, &huge, standing)));
+    broken.push(bytes_of(&|e| programme(e, stride4, 40, &b, (&[0, 0, 5], &[3]))));
+    broken.push(bytes_of(&|e| programme(e, stride4, 40, &b, (&[6, 0], &[3]))));
+    broken.push(bytes_of(&|e| programme(e, stride4, 40, &b, (&[7, 0], &[3]))));
+    let too_fast = bytes_of(&|e| {
+        e.byte(0).f64(1.5);
+    });
+    broken.push(bytes_of(&|e| programme(e, stride4, 40, &b, (&[4], &too_fast))));
+    let mut e = Encoder::default();
+    init(&mut e, 2, 1, 0);
+    for robot_1 in &broken {
+        call(&mut e, 0, 0, 0, 0, &[first_a.as_slice(), robot_1].concat());
+    }
+    // The settings: a reset, clearances of 0 and NaN (refused), of 100 mm and then of 40 again,
+    // each followed by the line from the start.
+    for what in [&[0][..], &[2, 0], &[1, 0, 4], &[2, 100], &[2, 40]] {
+        e.byte(Op::CoordinationSettings as u8).byte(0);
+        e.bytes.extend_from_slice(what);
+        call(&mut e, 0, 0, 0, 0, &line);
+        for _ in 0..5 {
+            again(&mut e, 0, 0);
+        }
+    }
+    e.byte(Op::CoordinationSettings as u8).byte(1).byte(1).byte(0).byte(13);
+    out.push(("coordination_programmes", e.bytes));
     out
 }

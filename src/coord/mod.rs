@@ -147,7 +147,8 @@ pub struct RobotCoordination {
     pub held_by: Option<usize>,
     /// Arc length from the TCP now to the hold point (mm); infinite when not held.
     pub hold_mm: Real,
-    /// Its place in this tick's ranking (0: yields to no one).
+    /// Its place in this tick's ranking (0: yields in no conflict; it may still stand short
+    /// of where another robot can be until that one stands).
     pub rank: usize,
 }
 

@@ -452,7 +452,8 @@ pub struct DcRobotCoordination {
     pub held_by: i32,
     /// Arc length from the TCP now to the hold point (mm); `INFINITY` when not held.
     pub hold_mm: f64,
-    /// Its place in this tick's ranking (0: yields to no one).
+    /// Its place in this tick's ranking (0: yields in no conflict; it may still stand short
+    /// of where another robot can be until that one stands).
     pub rank: u32,
 }
 
