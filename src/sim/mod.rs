@@ -27,7 +27,8 @@ pub enum Mode {
     Limits,
     /// The zone interlock (`interlock.rs`).
     Interlock,
-    /// The coordination (`coord`).
+    /// The coordination (`coord`), each override capped by the speed limits as in `Limits`,
+    /// with the same release in turn.
     Coordinate,
 }
 

@@ -1,10 +1,11 @@
 //! One closed-loop run (SPEC §9): every tick the controller reads each robot's TCP from its
 //! progress along its programme, asks the library (coordination, then the protective
 //! verdict), and applies the answer: the override, or a STOP. A STOP is simulated as the
-//! stopping model allows it, the reaction at the speed of the moment then braking along the
-//! path at `decel_mm_s2`. Every tick and every [`STOP_STEP_S`] of every stop is checked for
-//! contact by the exact check (`cell::exact`), which shares no code with the protective
-//! proof or the coordination.
+//! stopping model allows it: for the reaction and one tick each robot goes on along its
+//! programme at its override, then brakes along the path at `decel_mm_s2`. A robot held still
+//! this tick passes a one-point stop path (docs/PROTECTIVE.md). Every tick and every
+//! [`STOP_STEP_S`] of every stop is checked for contact by the exact check (`cell::exact`),
+//! which shares no code with the protective proof or the coordination.
 
 use super::interlock::Interlock;
 use super::programme::Programmes;
@@ -53,8 +54,8 @@ fn rate_ahead(prog: &[Vec3], s: Real, ticks: usize) -> Real {
 /// The controller's right of way over the speed limits: when every robot stands with a limit
 /// of 0 (each waits for the others), one robot at a time is released in turn and the others
 /// are held, so that they promise to stay where they are (a one-point stop path) and its
-/// limit is proved against them standing. A release ends once the robot has moved for
-/// [`RELEASE_TICKS`], or after as many ticks without moving (then the next robot's turn).
+/// limit is proved against them standing. A release lasts [`RELEASE_TICKS`]; when all wait
+/// again after it, the next robot has its turn.
 #[derive(Clone, Copy, Debug, Default)]
 struct Release {
     robot: Option<usize>,

@@ -213,8 +213,7 @@ pub fn arc_cover(points: &[Vec3], c: &Vec3, r: Real, tol: Real) -> Option<(Real,
         }
     }
     let mut range: Option<(Real, Real)> = None;
-    for (i, p) in parts.iter().enumerate().filter(|(i, _)| taken[run_of[*i]]) {
-        let _ = i;
+    for (_, p) in parts.iter().enumerate().filter(|(i, _)| taken[run_of[*i]]) {
         range = Some(range.map_or((p.3, p.4), |(a, b)| (a.min(p.3), b.max(p.4))));
     }
     // No run near the TCP (it is not within `tol` of the path): the whole range.
@@ -302,10 +301,8 @@ impl ProtectiveChecker {
                 (reference.centre, reference.radius, None)
             }
         };
-        // A path piece is far smaller than the table's cells: its own interval inverse
-        // kinematics encloses its angles far tighter than the cells around it would.
-        let table = if arc.is_some() { None } else { self.model.tables[j].as_deref() };
-        let sweeps = stop_sweeps_wcs(&robot.model, &rot, &centre, radius, table);
+        let sweeps =
+            stop_sweeps_wcs(&robot.model, &rot, &centre, radius, self.model.tables[j].as_deref());
         let faces = [[self.model.no_faces; MAX_BOXES]; 2];
         let graded = graded_radii(&robot.model, radius);
         let mut ball = SweptBall { centre, radius, boxes, sweeps, faces, graded };
