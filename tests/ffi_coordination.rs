@@ -5,6 +5,7 @@
 //! their horizon), and no allocation in `dc_coordinate` after the first call.
 
 mod ffi_common;
+mod protective_common;
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::Cell;
@@ -15,38 +16,7 @@ use delta_collide::ffi::*;
 use delta_collide::math::Vec3;
 use delta_collide::robot::StopModel;
 use ffi_common::{last_init_error, two_robot_cell};
-use std::alloc::{GlobalAlloc, Layout, System};
-
-/// Counts allocations per thread (tests run in parallel threads of one process).
-struct Counting;
-thread_local! {
-    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-}
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
-
-// SAFETY: forwards to the system allocator unchanged; only counts calls.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+use protective_common::allocations;
 
 /// Programme ticks between two points, as the C harness passes them.
 const STRIDE: u32 = 4;

@@ -131,7 +131,7 @@ impl Default for Diagram {
 }
 
 /// Whether two samples' grown boxes may touch (module doc).
-fn conflict(a: &Sample, b: &Sample) -> bool {
+fn conflict_of(a: &Sample, b: &Sample) -> bool {
     if !(a.reachable && b.reachable) {
         return true;
     }
@@ -163,26 +163,35 @@ impl Diagram {
     /// Whether sample slot `a` of `i` conflicts with any slot of `j` in `window` (bit per slot),
     /// testing the cells not yet known.
     pub fn row_conflicts(&mut self, ti: &Track, tj: &Track, a: usize, window: u128) -> bool {
-        if self.rows_conflict[a] & window != 0 {
-            return true;
-        }
-        for b in ones(window & !self.rows_known[a]) {
-            let hit = conflict(&ti.slots[a], &tj.slots[b]);
-            self.record(a, b, hit);
-            if hit {
-                return true;
-            }
-        }
-        false
+        self.line_conflicts(ti, tj, a, window, true)
     }
 
     /// Whether sample slot `b` of `j` conflicts with any slot of `i` in `window`.
     pub fn col_conflicts(&mut self, ti: &Track, tj: &Track, b: usize, window: u128) -> bool {
-        if self.cols_conflict[b] & window != 0 {
+        self.line_conflicts(ti, tj, b, window, false)
+    }
+
+    /// A row (`row`: slot `at` of `i` against `j`'s slots in `window`) or a column (slot `at`
+    /// of `j` against `i`'s): whether it holds a conflict, testing the cells not yet known.
+    fn line_conflicts(
+        &mut self,
+        ti: &Track,
+        tj: &Track,
+        at: usize,
+        window: u128,
+        row: bool,
+    ) -> bool {
+        let (known, conflict) = if row {
+            (self.rows_known[at], self.rows_conflict[at])
+        } else {
+            (self.cols_known[at], self.cols_conflict[at])
+        };
+        if conflict & window != 0 {
             return true;
         }
-        for a in ones(window & !self.cols_known[b]) {
-            let hit = conflict(&ti.slots[a], &tj.slots[b]);
+        for other in ones(window & !known) {
+            let (a, b) = if row { (at, other) } else { (other, at) };
+            let hit = conflict_of(&ti.slots[a], &tj.slots[b]);
             self.record(a, b, hit);
             if hit {
                 return true;

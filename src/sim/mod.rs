@@ -98,9 +98,14 @@ impl Timings {
             return Timings::default();
         }
         sample.sort_unstable();
-        let at = |q: Real| sample[((sample.len() - 1) as Real * q).round() as usize];
-        Timings { median: at(0.5), p99: at(0.99), max: sample[sample.len() - 1] }
+        let max = sample[sample.len() - 1];
+        Timings { median: percentile(sample, 0.5), p99: percentile(sample, 0.99), max }
     }
+}
+
+/// The value at quantile `q` of a sorted, non-empty sample: the nearest rank.
+pub fn percentile(sorted: &[u64], q: Real) -> u64 {
+    sorted[((sorted.len() - 1) as Real * q).round() as usize]
 }
 
 /// The figures of one run (SPEC §9 defines them).

@@ -153,9 +153,7 @@ pub(crate) fn spread(ns: &[u64]) -> String {
     format!("median {median} ns, p99.9 {p999} ns, max {max} ns over {} queries", ns.len())
 }
 
-pub(crate) fn percentile(sorted: &[u64], p: f64) -> u64 {
-    sorted[((sorted.len() - 1) as f64 * p).round() as usize]
-}
+pub(crate) use delta_collide::sim::percentile;
 
 fn check(args: &CheckArgs) -> Result<(), Failure> {
     let cell = &args.cell;

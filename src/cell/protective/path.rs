@@ -366,13 +366,15 @@ impl ProtectiveChecker {
         self.piece(j, path, arc)
     }
 
-    /// Whether every pair involving robot `j` is proved along the paths when `j` moves at
-    /// speed `v` (the others as they are). Replaces `j`'s reference.
-    fn path_speed_proved(
+    /// Whether the pair `(a, b)` with robot `j` one of them is proved along the paths when `j`
+    /// moves at speed `v`, the other robot's stop being `other` (its piece as it is).
+    /// Replaces `j`'s reference.
+    fn pair_speed_proved(
         &mut self,
+        (a, b): (usize, usize),
         j: usize,
-        tcps_mcs: &[Vec3],
-        paths: &[Option<StopPath>],
+        other: &Piece,
+        (tcps_mcs, paths): (&[Vec3], &[Option<StopPath>]),
         v: Real,
     ) -> bool {
         let s = self.stop_reference(j, &tcps_mcs[j], v);
@@ -380,29 +382,19 @@ impl ProtectiveChecker {
         // where the robot is when the next verdicts come.
         let ahead = s + 2.0 * v * self.cell().tick_ms * 1e-3;
         let piece_j = self.whole_piece(j, &tcps_mcs[j], ahead, paths[j].as_ref());
-        for pair in &self.exact.verdict().pairs {
-            let (a, b) = (pair.a, pair.b);
-            if a != j && b != j {
-                continue;
-            }
-            let other = if a == j { b } else { a };
-            let s_other = self.report.robots[other].protective_mm;
-            let piece_o = self.whole_piece(other, &tcps_mcs[other], s_other, paths[other].as_ref());
-            let (pa, pb) = if a == j { (&piece_j, &piece_o) } else { (&piece_o, &piece_j) };
-            let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
-            if self.prove_pieces((a, b), paths_ab, pa, pb, (0, 0), 0.0).is_some() {
-                return false;
-            }
-        }
-        true
+        let (pa, pb) = if a == j { (&piece_j, other) } else { (other, &piece_j) };
+        let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
+        self.prove_pieces((a, b), paths_ab, pa, pb, (0, 0), 0.0).is_none()
     }
 
     /// Each robot's speed limit along the paths: the limit without paths is a speed the proof
     /// along the paths holds too (it is taken only where better); from there, up to
-    /// [`PATH_LIMIT_TESTS`] tests of the proof along the paths raise it, one grid step of the
-    /// limits (`v_max / 2^LIMIT_STEPS`) above it, then steps of doubling length while they
-    /// hold, each over the robot's stop at that speed and two ticks of its motion. A robot
-    /// without a path keeps its limit.
+    /// [`PATH_LIMIT_TESTS`] speeds raise it, one grid step of the limits
+    /// (`v_max / 2^LIMIT_STEPS`) above it, then steps of doubling length, as far as every pair
+    /// involving the robot is proved at each, over the robot's stop at that speed and two ticks
+    /// of its motion. The speeds are tried pair by pair (each pair up to the first speed that
+    /// failed before), so that the other robot's piece is built once per pair: the limit is
+    /// the one speed by speed would find. A robot without a path keeps its limit.
     pub(super) fn path_limits(&mut self, tcps_mcs: &[Vec3], paths: &[Option<StopPath>]) {
         for j in 0..tcps_mcs.len() {
             let r = self.report.robots[j];
@@ -411,20 +403,36 @@ impl ProtectiveChecker {
             }
             let v_max = self.cell().stops[j].max_speed_mm_s;
             let grid = v_max / Real::from(1u32 << super::LIMIT_STEPS);
-            let mut lo = r.speed_limit_mm_s;
+            let lo = r.speed_limit_mm_s;
+            // The speeds to try: lo + grid, lo + 3 grid, lo + 7 grid, ..., at most v_max.
+            let mut speeds = [0.0; PATH_LIMIT_TESTS as usize];
+            let (mut count, mut last, mut step) = (0, lo, grid);
+            while count < speeds.len() && (last + step).min(v_max) > last {
+                last = (last + step).min(v_max);
+                (speeds[count], count, step) = (last, count + 1, 2.0 * step);
+            }
             let saved = self.robots[j];
             let inside = self.kept.inside(j);
-            let mut step = grid;
-            for _ in 0..PATH_LIMIT_TESTS {
-                let v = (lo + step).min(v_max);
-                if v <= lo || !self.path_speed_proved(j, tcps_mcs, paths, v) {
-                    break;
+            let mut proved = count;
+            for k in 0..self.exact.verdict().pairs.len() {
+                let pair = self.exact.verdict().pairs[k];
+                let (a, b) = (pair.a, pair.b);
+                if (a != j && b != j) || proved == 0 {
+                    continue;
                 }
-                (lo, step) = (v, 2.0 * step);
+                let o = if a == j { b } else { a };
+                let s_other = self.report.robots[o].protective_mm;
+                let other = self.whole_piece(o, &tcps_mcs[o], s_other, paths[o].as_ref());
+                proved = (0..proved)
+                    .find(|&i| {
+                        !self.pair_speed_proved((a, b), j, &other, (tcps_mcs, paths), speeds[i])
+                    })
+                    .unwrap_or(proved);
             }
             self.robots[j] = saved;
             self.kept.restore_inside(j, inside);
-            self.report.robots[j].speed_limit_mm_s = lo;
+            self.report.robots[j].speed_limit_mm_s =
+                if proved == 0 { lo } else { speeds[proved - 1] };
         }
     }
 
