@@ -137,6 +137,11 @@ typedef struct DcRobotCoordination {
 } DcRobotCoordination;
 
 /*
+ Who has the right of way where two programmes conflict (`dc_set_coordination_right_of_way`).
+ */
+typedef uint32_t DcRightOfWay;
+
+/*
  Delta3 geometry (SPEC section 2): lengths in mm, motor limits in rad.
  */
 typedef struct DcDelta3 {
@@ -700,6 +705,18 @@ typedef uint32_t DcConfirmation;
 #define DC_CLOCK_NANOS 1
 
 /*
+ The robot that reaches its hold point first at its programmed speed (the default): for
+ programmes each on a clock of its own.
+ */
+#define DC_RIGHT_OF_WAY_ARRIVAL 0
+
+/*
+ The robot the programmes put there first: for programmes whose ticks are one clock of the
+ line (a planner timed the robots together). No set of robots then waits for each other.
+ */
+#define DC_RIGHT_OF_WAY_PROGRAMMED 1
+
+/*
  No handle (`dc_mode(NULL)`).
  */
 #define DC_MODE_NONE 0
@@ -807,6 +824,25 @@ void dc_coordination_reset(struct DcCollider *handle);
  `handle` must be NULL or a live handle.
  */
 DcStatus dc_set_coordination_clearance(struct DcCollider *handle, double clearance_mm);
+
+/*
+ Sets who has the right of way where two programmes conflict (default
+ `DC_RIGHT_OF_WAY_ARRIVAL`). With `DC_RIGHT_OF_WAY_PROGRAMMED` the programmes' ticks must be
+ one clock of the line (`DcProgramme::first_tick` and `progress` counted alike for every
+ robot, as a planner that timed the robots together has them): a robot then waits at a
+ conflict only for a robot programmed to pass it at least two strides sooner, so the
+ robots keep their programmed order, and no set of robots waits for each other (README,
+ "Keeping a line moving"). The other settings are kept, the decisions forgotten. Setup
+ only, like `dc_set_coordination_clearance` (it allocates); `dc_set_stop_model` keeps it.
+
+ Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_INVALID_ARGUMENT` (another
+ value; the handle keeps its rule and `dc_last_init_error` says so), `DC_STATUS_BUSY`,
+ `DC_STATUS_PANIC` (a poisoned handle).
+
+ # Safety
+ `handle` must be NULL or a live handle.
+ */
+DcStatus dc_set_coordination_right_of_way(struct DcCollider *handle, DcRightOfWay rule);
 
 /*
  The thesis robot (f 100, rf 150, re 400, e 40, limits [-pi/2, 2 pi/3], H 70, D 17.5,

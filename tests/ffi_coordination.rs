@@ -10,7 +10,7 @@ mod protective_common;
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::Cell;
 use delta_collide::coord::{
-    CoordinationConfig, CoordinationRequest, Coordinator, Programme, RobotCoordination,
+    CoordinationConfig, CoordinationRequest, Coordinator, Programme, RightOfWay, RobotCoordination,
 };
 use delta_collide::ffi::*;
 use delta_collide::math::Vec3;
@@ -463,6 +463,35 @@ fn the_clearance_and_the_stop_models_reach_the_coordination() {
     assert!(seen.held_ticks > 0, "{seen:?}");
     assert_eq!(seen.allocations, 0, "dc_coordinate allocated");
     assert_eq!(seen.reset_allocations, 0, "dc_coordination_reset allocated");
+    // SAFETY: live handle, destroyed once.
+    unsafe { dc_destroy(h) };
+}
+
+#[test]
+fn the_right_of_way_reaches_the_coordination() {
+    let h = two_robot_cell(450.0, DC_METHOD_SAT_CACHE);
+    // SAFETY: live handle, or NULL.
+    unsafe {
+        for bad in [2, u32::MAX] {
+            assert_eq!(dc_set_coordination_right_of_way(h, bad), DC_STATUS_INVALID_ARGUMENT);
+            assert!(last_init_error().contains("right of way"), "{}", last_init_error());
+        }
+        assert_eq!(
+            dc_set_coordination_right_of_way(std::ptr::null_mut(), DC_RIGHT_OF_WAY_PROGRAMMED),
+            DC_STATUS_NULL_POINTER
+        );
+        assert_eq!(dc_set_coordination_right_of_way(h, DC_RIGHT_OF_WAY_PROGRAMMED), DC_STATUS_OK);
+        assert_eq!(last_init_error(), "");
+    }
+    // Bit for bit the Rust coordinator under the programmed order: the setting arrived.
+    let config = CoordinationConfig {
+        right_of_way: RightOfWay::Programmed,
+        ..CoordinationConfig::default()
+    };
+    let seen = closed_loop(h, t1(), config, 900, (usize::MAX, 400));
+    println!("programmed order: {seen:?}");
+    assert!(seen.held_ticks > 0, "{seen:?}");
+    assert_eq!(seen.allocations, 0, "dc_coordinate allocated");
     // SAFETY: live handle, destroyed once.
     unsafe { dc_destroy(h) };
 }

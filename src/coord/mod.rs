@@ -38,6 +38,33 @@
 //!    somewhere to go has stood held for [`STALL_TICKS`], one is released in turn for
 //!    [`RELEASE_TICKS`]; the protective verdict decides whether it may move.
 //!
+//! # Programmed order
+//! When the programmes' ticks are one clock of the line ([`RightOfWay::Programmed`]: a
+//! planner timed the robots together), steps 2-4 are replaced by one rule, the order in
+//! which the programme passes each conflict (the action dependency graph of Hoenig et al.,
+//! "Persistent and robust execution of MAPF schedules in warehouses", RA-L 2019, over the
+//! diagram's samples). Sample `s` of robot `i`, programmed at tick `t_s`, is *forbidden*
+//! while another robot `j` has not left a sample `u` in conflict with it that `j` is
+//! programmed to pass at least `L` sooner (`t_u + L <= t_s`, `L` =
+//! [`CoordinationConfig::order_slack_ticks`], at least the two strides together), or one
+//! where `j` can be until it stands; so is every sample so late that such `u` may lie beyond
+//! `j`'s horizon. Robot `i`'s hold point is its first forbidden sample ahead, and step 5 sets
+//! its override from it. A robot is never held for a sample that the other passes later, so
+//! the programme's own timing is never held, and:
+//!
+//! *No deadlock.* Say every unfinished robot stands at its hold, and `i` waits for `j` at
+//! `u` for its sample `s`: `j` has not left `u`, so its progress `p_j < t_u + stride_j <=
+//! t_s - L + stride_j <= t_s - stride_i`, and `i` stands at `p_i` at most a hold margin short
+//! of `t_s - stride_i`. Along every chain of waits the progress at the hold points falls by
+//! at least a stride, so no chain closes: the robot furthest behind is held by no time rule
+//! (its [`RobotCoordination::rank`] is 0). The argument needs every robot where the order
+//! lets it be: programmes ending in each other's way, a start, a STOP or an override not
+//! followed can leave robots where each is in the other's way, and then step 6 releases
+//! them in turn; whether a released robot can move is the protective verdict's to say
+//! (on dense cells it may not: docs/record/2026-12-02-programmed-order.md). Nor can the
+//! order help programmes that meet as timed (both robots at one place point at once): it
+//! keeps the robots near that timing, and the protective verdict stops them there.
+//!
 //! Nothing here allocates after [`Coordinator::new`]; each loop is bounded by
 //! [`MAX_SAMPLES`] samples per robot and the cell's robot pairs.
 
@@ -92,6 +119,23 @@ pub struct CoordinationConfig {
     pub speed_up_share: Real,
     /// Share of `max_accel_mm_s2` an override may take from it per second.
     pub slow_down_share: Real,
+    /// How the right of way of a conflict is decided.
+    pub right_of_way: RightOfWay,
+    /// Under [`RightOfWay::Programmed`], how much sooner (programme ticks) the other robot
+    /// must be programmed at a conflicting sample to have the right of way there; at least
+    /// the two robots' strides together (module doc, "Programmed order").
+    pub order_slack_ticks: Real,
+}
+
+/// How the right of way of a conflict is decided (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RightOfWay {
+    /// The robot that reaches its hold point first, for programmes each on a clock of its
+    /// own (steps 2-4).
+    Arrival,
+    /// The robot programmed to be there first, for programmes whose ticks are one clock of
+    /// the line (a planner that timed the robots together): step 3 of "Programmed order".
+    Programmed,
 }
 
 impl Default for CoordinationConfig {
@@ -102,6 +146,8 @@ impl Default for CoordinationConfig {
             hysteresis_ticks: 40.0,
             speed_up_share: 0.25,
             slow_down_share: 0.6,
+            right_of_way: RightOfWay::Arrival,
+            order_slack_ticks: 8.0,
         }
     }
 }
@@ -182,6 +228,18 @@ struct Horizon {
     reach: usize,
 }
 
+/// The largest programmed speed (mm/s) from the progress to sample `last` of horizon `h`,
+/// over at most [`speed::SPEED_AHEAD_SAMPLES`] samples.
+fn speed_until(h: &Horizon, last: usize, tick_s: Real) -> Real {
+    let end = last.min(h.count - 1).min(speed::SPEED_AHEAD_SAMPLES);
+    (0..end)
+        .map(|k| {
+            let ticks = if k == 0 { h.stride - h.behind } else { h.stride };
+            (h.arc_mm[k + 1] - h.arc_mm[k]) / (ticks.max(HOLD_SLACK_TICKS) * tick_s)
+        })
+        .fold(0.0, Real::max)
+}
+
 /// What one robot pair's diagram gives this tick: each robot's hold point if it yields.
 #[derive(Clone, Copy, Debug, Default)]
 struct PairHolds {
@@ -209,6 +267,8 @@ pub struct Coordinator {
     holds: Vec<PairHolds>,
     /// Per pair, the robot with the right of way while its conflict lasts.
     winners: Vec<Option<usize>>,
+    /// Per robot, under the programmed order, the tick of the sample before its hold point.
+    hold_ticks: Vec<Real>,
     ranking: right_of_way::Ranking,
     stall: Stall,
     report: CoordinationReport,
@@ -219,6 +279,10 @@ pub const STALL_TICKS: u32 = 100;
 
 /// Ticks one released robot may move regardless of its holds.
 pub const RELEASE_TICKS: u32 = 300;
+
+/// Programme ticks a robot held under the programmed order stays short of the sample before
+/// its hold point (a few micrometres at full speed).
+const HOLD_SLACK_TICKS: Real = 1e-3;
 
 /// An override (or a target) below this holds a robot.
 const HELD: Real = 1e-6;
@@ -261,6 +325,7 @@ impl Coordinator {
             horizons: vec![horizon; n],
             holds: vec![PairHolds::default(); pairs.len()],
             winners: vec![None; pairs.len()],
+            hold_ticks: vec![Real::INFINITY; n],
             ranking: right_of_way::Ranking::new(n, pairs.len()),
             stall: Stall::default(),
             report: CoordinationReport { robots: vec![idle; n], cells_tested: 0 },
@@ -321,8 +386,14 @@ impl Coordinator {
             return Err(e);
         }
         let before: u64 = self.diagrams.iter().map(|d| d.tests).sum();
-        self.pair_holds();
-        self.decide();
+        match self.config.right_of_way {
+            RightOfWay::Arrival => {
+                self.pair_holds();
+                self.decide();
+                self.holds_of_winners();
+            }
+            RightOfWay::Programmed => self.programmed_holds(request),
+        }
         self.overrides(request);
         self.report.cells_tested = self.diagrams.iter().map(|d| d.tests).sum::<u64>() - before;
         Ok(&self.report)
@@ -499,10 +570,9 @@ impl Coordinator {
         }
     }
 
-    /// Step 5: each robot's override from its nearest hold point among the pairs it yields in.
-    fn overrides(&mut self, request: &CoordinationRequest) {
-        let cell = self.exact.cell();
-        let tick_s = cell.tick_ms * 1e-3;
+    /// Step 4 of the arrival order: each robot's nearest hold point among the pairs it
+    /// yields in (and, for a robot with the right of way, where the yielder can be).
+    fn holds_of_winners(&mut self) {
         for (j, r) in self.report.robots.iter_mut().enumerate() {
             *r = RobotCoordination {
                 override_factor: 1.0,
@@ -525,22 +595,112 @@ impl Coordinator {
                 }
             }
         }
+    }
+
+    /// Step 3 of the programmed order (module doc): each robot's hold point, its first
+    /// forbidden sample ahead over every pair; its rank, how many robots are behind it in
+    /// progress (ties to the lower index).
+    fn programmed_holds(&mut self, request: &CoordinationRequest) {
+        let progress = |j: usize| request.programmes[j].progress;
+        self.hold_ticks.iter_mut().for_each(|t| *t = Real::INFINITY);
+        for (j, r) in self.report.robots.iter_mut().enumerate() {
+            let behind = (0..request.programmes.len())
+                .filter(|&i| progress(i) < progress(j) || (progress(i) == progress(j) && i < j))
+                .count();
+            *r = RobotCoordination {
+                override_factor: 1.0,
+                held_by: None,
+                hold_mm: Real::INFINITY,
+                rank: behind,
+            };
+        }
+        for k in 0..self.pairs.len() {
+            let (a, b) = self.pairs[k];
+            for (me, other) in [(a, b), (b, a)] {
+                let Some(s) = self.first_forbidden(k, me == a) else { continue };
+                let h = &self.horizons[me];
+                let tick = (h.first + s as u64 - 1) as Real * h.stride;
+                if tick < self.hold_ticks[me] {
+                    self.hold_ticks[me] = tick;
+                    let r = &mut self.report.robots[me];
+                    r.hold_mm = h.arc_mm[s - 1];
+                    r.held_by = Some(other);
+                }
+            }
+        }
+    }
+
+    /// Robot `me`'s first forbidden sample ahead (from 1 on) in pair `k`, `me` being the
+    /// pair's first robot when `row` (module doc, "Programmed order").
+    fn first_forbidden(&mut self, k: usize, row: bool) -> Option<usize> {
+        let (a, b) = self.pairs[k];
+        let (me, other) = if row { (a, b) } else { (b, a) };
+        let (hm, ho) = (&self.horizons[me], &self.horizons[other]);
+        let slack = self.config.order_slack_ticks.max(hm.stride + ho.stride);
+        let (ta, tb) = (&self.tracks[a], &self.tracks[b]);
+        let d = &mut self.diagrams[k];
+        let mine = if row { ta } else { tb };
+        let truncated = ho.count == MAX_SAMPLES;
+        (1..hm.count).find(|&s| {
+            let tick = (hm.first + s as u64) as Real * hm.stride;
+            // The other's samples programmed at least `slack` sooner: `first ..= last`.
+            let last = float::floor((tick - slack) / ho.stride);
+            let sooner = if last < ho.first as Real {
+                0
+            } else {
+                let m = (last - ho.first as Real) as u64 + 1;
+                if truncated && m > ho.count as u64 {
+                    return true;
+                }
+                m.min(ho.count as u64) as usize
+            };
+            let count = sooner.max(ho.reach);
+            let slot = mine.slot_of(hm.first + s as u64).unwrap_or(0);
+            let w = window(ho.first, count);
+            if row {
+                d.row_conflicts(ta, tb, slot, w)
+            } else {
+                d.col_conflicts(ta, tb, slot, w)
+            }
+        })
+    }
+
+    /// Step 5: each robot's override from its hold point.
+    fn overrides(&mut self, request: &CoordinationRequest) {
+        let cell = self.exact.cell();
+        let tick_s = cell.tick_ms * 1e-3;
         let n = self.report.robots.len();
         let mut targets = [0.0; crate::cell::MAX_ROBOTS];
         for (j, r) in self.report.robots.iter_mut().enumerate() {
             let h = &self.horizons[j];
-            let target = if r.held_by.is_some() {
-                let room = r.hold_mm - self.config.hold_margin_mm;
+            // The override whose speed stops within `room` at the largest programmed speed
+            // `ahead` the override must hold.
+            let by_speed = |room: Real, ahead: Real| {
                 let v = speed::allowed_speed(cell, j, room);
-                if h.speed_ahead_mm_s > 0.0 {
-                    (v / h.speed_ahead_mm_s).min(1.0)
+                if ahead > 0.0 {
+                    (v / ahead).min(1.0)
                 } else if v > 0.0 {
                     1.0
                 } else {
                     0.0
                 }
-            } else {
-                1.0
+            };
+            let target = match (r.held_by, self.config.right_of_way) {
+                (None, _) => 1.0,
+                (Some(_), RightOfWay::Arrival) => {
+                    by_speed(r.hold_mm - self.config.hold_margin_mm, h.speed_ahead_mm_s)
+                }
+                // Short of the sample before the hold point in progress too, so that a robot
+                // standing at its hold never covers the hold point; the speed that matters is
+                // the programme's up to there (through a programmed wait, any factor).
+                (Some(_), RightOfWay::Programmed) => {
+                    let hold = self.hold_ticks[j];
+                    let left = hold - HOLD_SLACK_TICKS - request.programmes[j].progress;
+                    let last = ((hold / h.stride) as u64).saturating_sub(h.first) as usize;
+                    let ahead = speed_until(h, last, tick_s);
+                    let speed = if ahead > 0.0 { by_speed(r.hold_mm, ahead) } else { 1.0 };
+                    speed.min(left.max(0.0))
+                }
             };
             targets[j] = target;
         }
@@ -559,11 +719,12 @@ impl Coordinator {
         }
     }
 
-    /// Step 6: when every robot with somewhere to go (its programme moves ahead) has stood
+    /// Step 6: when every robot with somewhere to go (a sample ahead) has stood
     /// held for [`STALL_TICKS`], releases one of them, in turn, for [`RELEASE_TICKS`]: its
     /// target is 1 whatever holds it. The protective verdict stays the proof of its motion.
     fn break_stall(&mut self, request: &CoordinationRequest, targets: &mut [Real]) {
-        let wants = |j: usize| self.horizons[j].speed_ahead_mm_s > 0.0;
+        // Somewhere to go: a sample ahead (a programmed wait is progress too).
+        let wants = |j: usize| self.horizons[j].count > 1;
         let n = targets.len();
         if let Some((r, left)) = self.stall.released {
             if left == 0 || !wants(r) {
@@ -584,6 +745,120 @@ impl Coordinator {
             self.stall = Stall { ticks: 0, released: Some((r, RELEASE_TICKS)), turn: r + 1 };
             targets[r] = 1.0;
             self.report.robots[r].held_by = None;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::reference::reference_cell;
+    use crate::geometry::clearance::boxes_clearance;
+    use crate::robot::RobotBoxes;
+
+    /// Robot `j`'s MCS point of the WCS point `p`.
+    fn mcs(cell: &Cell, j: usize, p: Vec3) -> Vec3 {
+        let pl = &cell.robots[j].placement;
+        pl.rotation().transpose() * (p - pl.t)
+    }
+
+    /// One point per tick: from `far` to `place` over ticks `go .. go + 100`, held 60 ticks,
+    /// back over 100, then at `far` until tick 600 (linear legs: the test needs positions,
+    /// not a smooth profile).
+    fn visit(far: Vec3, place: Vec3, go: usize) -> Vec<Vec3> {
+        (0..=600)
+            .map(|t| {
+                let f = match t {
+                    t if t < go => 0.0,
+                    t if t < go + 100 => (t - go) as Real / 100.0,
+                    t if t < go + 160 => 1.0,
+                    t if t < go + 260 => 1.0 - (t - go - 160) as Real / 100.0,
+                    _ => 0.0,
+                };
+                far + (place - far) * f
+            })
+            .collect()
+    }
+
+    /// Brute force with the exact clearance (not the diagram's grown boxes): the first tick of
+    /// `mine` (robot `me`) within `clearance_mm` of any point of `other`'s (robot `you`)
+    /// programmed at least `slack` ticks sooner.
+    fn first_meeting(
+        cell: &Cell,
+        (me, mine): (usize, &[Vec3]),
+        (you, other): (usize, &[Vec3]),
+        clearance_mm: Real,
+        slack: usize,
+    ) -> Option<usize> {
+        let exact = ExactChecker::new(cell.clone());
+        let (mut a, mut b) = (RobotBoxes::empty(), RobotBoxes::empty());
+        (0..mine.len()).find(|&t| {
+            exact.boxes_in_wcs(me, &mine[t], &mut a).unwrap();
+            (0..=t.saturating_sub(slack)).any(|u| {
+                exact.boxes_in_wcs(you, &other[u], &mut b).unwrap();
+                boxes_clearance(a.as_slice(), b.as_slice()).distance < clearance_mm
+            })
+        })
+    }
+
+    #[test]
+    fn the_robot_programmed_later_yields_and_the_earlier_goes() {
+        let cell = reference_cell("T1").unwrap();
+        // Place points 80 mm apart between the bases (450 mm apart), pick points on the far
+        // sides: executed at once, the two visits collide.
+        let at = |j: usize, x: [Real; 2]| mcs(&cell, j, Vec3::new(x[j], 0.0, -480.0));
+        let (place, far) = (|j| at(j, [185.0, 265.0]), |j| at(j, [-120.0, 570.0]));
+        // The clearance of T1's benchmark programmes: at 40 mm a robot at the midpoint comes
+        // within the clearance of the other's links standing at its far side.
+        let config = CoordinationConfig {
+            clearance_mm: 10.0,
+            right_of_way: RightOfWay::Programmed,
+            ..CoordinationConfig::default()
+        };
+        let exact = ExactChecker::new(cell.clone());
+        let (mut a, mut b) = (RobotBoxes::empty(), RobotBoxes::empty());
+        exact.boxes_in_wcs(0, &place(0), &mut a).unwrap();
+        exact.boxes_in_wcs(1, &place(1), &mut b).unwrap();
+        assert!(boxes_clearance(a.as_slice(), b.as_slice()).distance < 0.0, "no conflict");
+        for first in [0, 1] {
+            // Robot `first` visits the shared place point at tick 0, the other at tick 300.
+            let progs: Vec<Vec<Vec3>> =
+                (0..2).map(|j| visit(far(j), place(j), if j == first { 0 } else { 300 })).collect();
+            let later = 1 - first;
+            let mut coordinator = Coordinator::new(cell.clone(), config);
+            let stride = 4;
+            let horizon: Vec<Vec<Vec3>> = progs
+                .iter()
+                .map(|p| p.iter().step_by(stride).take(MAX_SAMPLES).copied().collect())
+                .collect();
+            let programmes: Vec<Programme> = horizon
+                .iter()
+                .map(|points| Programme {
+                    first_tick: 0,
+                    stride_ticks: stride as u32,
+                    points,
+                    progress: 0.0,
+                    override_now: 0.0,
+                })
+                .collect();
+            let report = coordinator.coordinate(&CoordinationRequest { programmes: &programmes });
+            let r = report.unwrap().robots.clone();
+            assert_eq!(r[first].held_by, None, "robot {first} is programmed there first: {r:?}");
+            assert_eq!(r[later].held_by, Some(first), "robot {later} must yield: {r:?}");
+            // It holds before the first point where it would come within the clearance of
+            // where the other is programmed sooner (the diagram's boxes hold the exact ones,
+            // so its hold point comes no later than the brute force's).
+            let meet = first_meeting(
+                &cell,
+                (later, &progs[later]),
+                (first, &progs[first]),
+                config.clearance_mm,
+                config.order_slack_ticks as usize,
+            )
+            .expect("the programmes meet");
+            let arc: Real = progs[later][..meet].windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+            assert!(r[later].hold_mm <= arc, "hold {} mm, meeting at {arc} mm", r[later].hold_mm);
+            assert_eq!((r[0].rank, r[1].rank), (0, 1), "ties go to the lower index");
         }
     }
 }

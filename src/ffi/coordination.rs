@@ -8,7 +8,7 @@ use super::types::*;
 use crate::cell::{Cell, MAX_ROBOTS};
 use crate::coord::{
     CoordinationConfig, CoordinationError, CoordinationReport, CoordinationRequest, Coordinator,
-    Programme, RobotCoordination, MAX_SAMPLES,
+    Programme, RightOfWay, RobotCoordination, MAX_SAMPLES,
 };
 use crate::math::Vec3;
 use std::mem::{offset_of, size_of};
@@ -52,6 +52,23 @@ impl Coordination {
             ));
         }
         let config = CoordinationConfig { clearance_mm, ..*self.coordinator.config() };
+        self.coordinator = Coordinator::new(self.coordinator.cell().clone(), config);
+        Ok(())
+    }
+
+    /// Remakes the coordinator with the right of way `rule`, or says why not.
+    fn set_right_of_way(&mut self, rule: DcRightOfWay) -> Result<(), String> {
+        let right_of_way = match rule {
+            DC_RIGHT_OF_WAY_ARRIVAL => RightOfWay::Arrival,
+            DC_RIGHT_OF_WAY_PROGRAMMED => RightOfWay::Programmed,
+            _ => {
+                return Err(format!(
+                    "right of way {rule}: give DC_RIGHT_OF_WAY_ARRIVAL (0) or \
+                     DC_RIGHT_OF_WAY_PROGRAMMED (1)"
+                ))
+            }
+        };
+        let config = CoordinationConfig { right_of_way, ..*self.coordinator.config() };
         self.coordinator = Coordinator::new(self.coordinator.cell().clone(), config);
         Ok(())
     }
@@ -361,4 +378,28 @@ pub unsafe extern "C" fn dc_set_coordination_clearance(
 ) -> DcStatus {
     // SAFETY: the caller guarantees `handle` is NULL or live.
     unsafe { set_on_handle(handle, |c| c.coordination().set_clearance(clearance_mm)) }
+}
+
+/// Sets who has the right of way where two programmes conflict (default
+/// `DC_RIGHT_OF_WAY_ARRIVAL`). With `DC_RIGHT_OF_WAY_PROGRAMMED` the programmes' ticks must be
+/// one clock of the line (`DcProgramme::first_tick` and `progress` counted alike for every
+/// robot, as a planner that timed the robots together has them): a robot then waits at a
+/// conflict only for a robot programmed to pass it at least two strides sooner, so the
+/// robots keep their programmed order, and no set of robots waits for each other (README,
+/// "Keeping a line moving"). The other settings are kept, the decisions forgotten. Setup
+/// only, like `dc_set_coordination_clearance` (it allocates); `dc_set_stop_model` keeps it.
+///
+/// Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_INVALID_ARGUMENT` (another
+/// value; the handle keeps its rule and `dc_last_init_error` says so), `DC_STATUS_BUSY`,
+/// `DC_STATUS_PANIC` (a poisoned handle).
+///
+/// # Safety
+/// `handle` must be NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn dc_set_coordination_right_of_way(
+    handle: *mut DcCollider,
+    rule: DcRightOfWay,
+) -> DcStatus {
+    // SAFETY: the caller guarantees `handle` is NULL or live.
+    unsafe { set_on_handle(handle, |c| c.coordination().set_right_of_way(rule)) }
 }

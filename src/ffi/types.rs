@@ -100,6 +100,15 @@ pub const DC_CLOCK_CYCLE: DcClock = 0;
 /// A monotonic timestamp in nanoseconds of the moment the TCPs were measured.
 pub const DC_CLOCK_NANOS: DcClock = 1;
 
+/// Who has the right of way where two programmes conflict (`dc_set_coordination_right_of_way`).
+pub type DcRightOfWay = u32;
+/// The robot that reaches its hold point first at its programmed speed (the default): for
+/// programmes each on a clock of its own.
+pub const DC_RIGHT_OF_WAY_ARRIVAL: DcRightOfWay = 0;
+/// The robot the programmes put there first: for programmes whose ticks are one clock of the
+/// line (a planner timed the robots together). No set of robots then waits for each other.
+pub const DC_RIGHT_OF_WAY_PROGRAMMED: DcRightOfWay = 1;
+
 /// Most ticks between two timed protective calls whose interval still bounds the speeds; a
 /// longer gap answers `DC_STATUS_TIME_JUMP`.
 pub const DC_MAX_INTERVAL_TICKS: u64 = 4;

@@ -2,8 +2,9 @@
 //! progress along its programme, asks the library (coordination, then the protective
 //! verdict), and applies the answer: the override, or a STOP. A STOP is simulated as the
 //! stopping model allows it: for the reaction and one tick each robot goes on along its
-//! programme at its override, then brakes along the path at `decel_mm_s2`. A robot held still
-//! this tick passes a one-point stop path (docs/PROTECTIVE.md). Every tick and every
+//! programme at its override, then brakes along the path at `decel_mm_s2`. A robot standing
+//! and held this tick (by the coordination, else by the override) passes a one-point stop
+//! path (docs/PROTECTIVE.md). Every tick and every
 //! [`STOP_STEP_S`] of every stop is checked for contact by the exact check (`cell::exact`),
 //! which shares no code with the protective proof or the coordination.
 
@@ -157,6 +158,7 @@ pub fn run_traced(
     let mut travel_sum = 0.0;
     let mut paths_buf = vec![[Vec3::zeros(); PATH_POINTS]; n];
     let mut targets = vec![1.0; n];
+    let mut wanted = vec![1.0; n];
     let mut next = vec![0.0; n];
     let mut limits: Vec<Real> = vec![0.0; n];
     let mut last_verdict = Protective::Stop;
@@ -231,6 +233,9 @@ pub fn run_traced(
             }
         }
         coord_ns.push(coordination);
+        // What the coordination asks before the controller's cap: a robot it lets move shows
+        // the protective verdict its path, so that its speed limit is the one along the path.
+        wanted.copy_from_slice(&targets);
 
         // The controller's override targets (the speed limits of the last verdict).
         for j in 0..n {
@@ -244,7 +249,8 @@ pub fn run_traced(
             };
             targets[j] = target;
         }
-        if with_limits {
+        // The coordination has its own right of way; the speed limits alone need this one.
+        if config.mode == Mode::Limits {
             release.apply(&robots, &mut targets, cycle);
         }
         if let Some(lock) = interlock.as_mut() {
@@ -284,7 +290,8 @@ pub fn run_traced(
                 let mut dense = [Vec3::zeros(); 400];
                 dense[0] = tcps[j];
                 let mut m = 1;
-                let held = next[j] < WAITING && robots[j].override_now < WAITING;
+                let stays = if config.mode == Mode::Coordinate { wanted[j] } else { next[j] };
+                let held = stays < WAITING && robots[j].override_now < WAITING;
                 for q in p.iter().skip(k + 1).take(if held { 0 } else { dense.len() - 1 }) {
                     dense[m] = *q;
                     m += 1;

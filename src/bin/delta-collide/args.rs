@@ -213,6 +213,11 @@ pub struct SimulateArgs {
     /// The clearance the coordination's diagram keeps between programme samples (mm)
     #[arg(long, value_name = "MM", default_value_t = 40.0)]
     pub clearance_mm: f64,
+    /// Who has the right of way at a conflict: the robot programmed there first (the
+    /// programmes share one clock) or the one that arrives first
+    #[arg(long, value_name = "RULE", default_value = "arrival")]
+    #[arg(value_parser = ["programmed", "arrival"])]
+    pub right_of_way: String,
     /// Clearance the programmes' offline interlock keeps, executed as programmed (mm)
     #[arg(long, value_name = "MM", default_value_t = 10.0)]
     pub gap_mm: f64,

@@ -2,7 +2,7 @@
 //! run and mode, and a summary per mode.
 
 use crate::args::SimulateArgs;
-use delta_collide::coord::CoordinationConfig;
+use delta_collide::coord::{CoordinationConfig, RightOfWay};
 use delta_collide::sim::cells::conflict_cells;
 use delta_collide::sim::run::{run_traced, Trace};
 use delta_collide::sim::{programmes, Mode, ProgrammeConfig, Rng, SimConfig};
@@ -17,8 +17,15 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
     };
     let programme =
         ProgrammeConfig { ticks: a.ticks, gap_mm: a.gap_mm, ..ProgrammeConfig::default() };
-    let coordination =
-        CoordinationConfig { clearance_mm: a.clearance_mm, ..CoordinationConfig::default() };
+    let right_of_way = match a.right_of_way.as_str() {
+        "arrival" => RightOfWay::Arrival,
+        _ => RightOfWay::Programmed,
+    };
+    let coordination = CoordinationConfig {
+        clearance_mm: a.clearance_mm,
+        right_of_way,
+        ..CoordinationConfig::default()
+    };
     println!(
         "cell {}: {} robots, {} runs from seed {}, stop paths {}",
         a.cell.name,
