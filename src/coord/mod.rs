@@ -49,19 +49,21 @@
 //! [`CoordinationConfig::order_slack_ticks`], at least the two strides together), or one
 //! where `j` can be until it stands; so is every sample so late that such `u` may lie beyond
 //! `j`'s horizon. Robot `i`'s hold point is its first forbidden sample ahead, and step 5 sets
-//! its override from it. A robot is never held for a sample that the other passes later, so
-//! the programme's own timing is never held, and:
+//! its override from it, in progress too: it comes no nearer than [`HOLD_SLACK_TICKS`] to
+//! the tick `t_s - stride_i` of the sample before. A robot is never held for a sample the
+//! other is programmed to pass later (unless the other can be there before it stands), so
+//! robots that keep to a timing that keeps them apart are not held, and:
 //!
-//! *No deadlock.* Say every unfinished robot stands at its hold, and `i` waits for `j` at
-//! `u` for its sample `s`: `j` has not left `u`, so its progress `p_j < t_u + stride_j <=
-//! t_s - L + stride_j <= t_s - stride_i`, and `i` stands at `p_i` at most a hold margin short
-//! of `t_s - stride_i`. Along every chain of waits the progress at the hold points falls by
-//! at least a stride, so no chain closes: the robot furthest behind is held by no time rule
-//! (its [`RobotCoordination::rank`] is 0). The argument needs every robot where the order
-//! lets it be: programmes ending in each other's way, a start, a STOP or an override not
-//! followed can leave robots where each is in the other's way, and then step 6 releases
-//! them in turn; whether a released robot can move is the protective verdict's to say
-//! (on dense cells it may not: docs/record/2026-12-02-programmed-order.md). Nor can the
+//! *No deadlock.* A robot has left sample `u` once its progress is within that slack of the
+//! next sample. Say every unfinished robot stands at its hold, and `i` waits for `j` at `u`
+//! for its sample `s`: `j` has not left `u`, so its progress `p_j < t_u + stride_j - slack
+//! <= t_s - L + stride_j - slack <= t_s - stride_i - slack`, where `i` stands. Along every
+//! chain of waits the progress falls, so no chain closes: the robot furthest behind is held
+//! by no time rule (its [`RobotCoordination::rank`] is 0). The argument needs every robot
+//! where the order lets it be: programmes ending in each other's way, a start, a STOP or an
+//! override not followed can leave robots where each is in the other's way, and then step 6
+//! releases them in turn; whether a released robot can move is the protective verdict's to
+//! say (on dense cells it may not: docs/record/2026-12-02-programmed-order.md). Nor can the
 //! order help programmes that meet as timed (both robots at one place point at once): it
 //! keeps the robots near that timing, and the protective verdict stops them there.
 //!
@@ -641,22 +643,26 @@ impl Coordinator {
         let d = &mut self.diagrams[k];
         let mine = if row { ta } else { tb };
         let truncated = ho.count == MAX_SAMPLES;
+        // A robot within the hold's slack of its next sample has left the one behind (it
+        // stands there at its hold: module doc, "No deadlock").
+        let left_first = ho.count > 1 && ho.behind >= ho.stride - HOLD_SLACK_TICKS;
+        let from = ho.first + u64::from(left_first);
         (1..hm.count).find(|&s| {
             let tick = (hm.first + s as u64) as Real * hm.stride;
-            // The other's samples programmed at least `slack` sooner: `first ..= last`.
+            // The other's samples programmed at least `slack` sooner that it has not left:
+            // `from ..= last`.
             let last = float::floor((tick - slack) / ho.stride);
-            let sooner = if last < ho.first as Real {
+            let sooner = if last < from as Real {
                 0
             } else {
-                let m = (last - ho.first as Real) as u64 + 1;
-                if truncated && m > ho.count as u64 {
+                let m = (last - from as Real) as u64 + 1;
+                if truncated && m > (ho.first + ho.count as u64 - from) {
                     return true;
                 }
-                m.min(ho.count as u64) as usize
+                m.min(ho.first + ho.count as u64 - from) as usize
             };
-            let count = sooner.max(ho.reach);
             let slot = mine.slot_of(hm.first + s as u64).unwrap_or(0);
-            let w = window(ho.first, count);
+            let w = window(from, sooner) | window(ho.first, ho.reach);
             if row {
                 d.row_conflicts(ta, tb, slot, w)
             } else {
