@@ -240,6 +240,11 @@ static void bad_requests(DcCollider *h, const DcProgramme good[2])
               && dc_set_coordination_clearance(NULL, 40.0) == DC_STATUS_NULL_POINTER
               && dc_set_coordination_clearance(h, 40.0) == DC_STATUS_OK,
           "coordination: dc_set_coordination_clearance's statuses");
+    check(dc_set_coordination_right_of_way(h, 2) == DC_STATUS_INVALID_ARGUMENT
+              && dc_set_coordination_right_of_way(NULL, DC_RIGHT_OF_WAY_ARRIVAL) == DC_STATUS_NULL_POINTER
+              && dc_set_coordination_right_of_way(h, DC_RIGHT_OF_WAY_PROGRAMMED) == DC_STATUS_OK
+              && dc_set_coordination_right_of_way(h, DC_RIGHT_OF_WAY_ARRIVAL) == DC_STATUS_OK,
+          "coordination: dc_set_coordination_right_of_way's statuses");
     check(dc_coordination_horizon() >= 1, "coordination: dc_coordination_horizon() is 0");
     check(strcmp(dc_status_str(DC_STATUS_INVALID_PROGRAMME), "unknown status") != 0
               && strcmp(dc_status_str(DC_STATUS_PROGRESS_OUT_OF_RANGE), "unknown status") != 0,
@@ -439,6 +444,28 @@ void coordination_scenarios(const HarnessOptions *options)
            st.deadlock ? "yes" : "no", st.held_ticks, st.least_override, st.least_clearance, st.protective.n,
            st.protective.n > 0 ? " (the first: " : "", st.protective.n > 0 ? dc_status_str(st.protective.first) : "",
            st.protective.n > 0 ? ")" : "");
+    {
+        /* The controller's view of its own ticks: every call counted, in the library's time. */
+        DcTickStats ts;
+        memset(&ts, 0, sizeof ts);
+        ts.struct_size = (uint32_t)sizeof ts;
+        s = dc_tick_stats(h, &ts);
+        check(s == DC_STATUS_OK && ts.coordinate.calls >= (uint64_t)st.ticks / 2
+                  && ts.protective.calls >= (uint64_t)st.ticks / 2 && ts.coordinate.largest_ns >= ts.coordinate.mean_ns,
+              "coordination %s: dc_tick_stats (status %u) counted %llu dc_coordinate and %llu protective calls in %ld "
+              "ticks",
+              COORD_CELL, (unsigned)s, (unsigned long long)ts.coordinate.calls,
+              (unsigned long long)ts.protective.calls, st.ticks);
+        printf("coordination %s tick stats: dc_coordinate %llu calls, mean %.1f us, largest %.1f us, largest work %llu "
+               "cells; protective %llu calls, mean %.1f us, largest %.1f us\n",
+               COORD_CELL, (unsigned long long)ts.coordinate.calls, 1e-3 * (double)ts.coordinate.mean_ns,
+               1e-3 * (double)ts.coordinate.largest_ns, (unsigned long long)ts.coordinate.largest_work,
+               (unsigned long long)ts.protective.calls, 1e-3 * (double)ts.protective.mean_ns,
+               1e-3 * (double)ts.protective.largest_ns);
+        check(dc_tick_stats_reset(h) == DC_STATUS_OK && dc_tick_stats(h, &ts) == DC_STATUS_OK
+                  && ts.coordinate.calls == 0,
+              "coordination %s: dc_tick_stats_reset", COORD_CELL);
+    }
     dc_destroy(h);
     dc_destroy(exact);
 }

@@ -517,6 +517,63 @@ typedef struct DcStopConfig {
 typedef uint32_t DcConfirmation;
 
 /*
+ One kind of call's figures in `DcTickStats`.
+ */
+typedef struct DcCallStats {
+  /*
+   Calls counted.
+   */
+  uint64_t calls;
+  /*
+   Time of the last call inside the library (ns).
+   */
+  uint64_t last_ns;
+  /*
+   Time of the longest call (ns).
+   */
+  uint64_t largest_ns;
+  /*
+   Mean time of the calls counted (ns; 0 without calls).
+   */
+  uint64_t mean_ns;
+  /*
+   Work units of the last call (`dc_tick_stats`).
+   */
+  uint64_t last_work;
+  /*
+   Work units of the call with the most.
+   */
+  uint64_t largest_work;
+  /*
+   Calls that used their whole work budget.
+   */
+  uint64_t budget_spent;
+} DcCallStats;
+
+/*
+ A handle's tick statistics (`dc_tick_stats`): set `struct_size` to
+ `sizeof(DcTickStats)` before the call.
+ */
+typedef struct DcTickStats {
+  /*
+   `sizeof(DcTickStats)` of the caller's header; written back as this library's.
+   */
+  uint32_t struct_size;
+  /*
+   `dc_query`.
+   */
+  struct DcCallStats query;
+  /*
+   `dc_protective_query`, `dc_protective_query_with_paths`, `dc_protective_query_timed`.
+   */
+  struct DcCallStats protective;
+  /*
+   `dc_coordinate`.
+   */
+  struct DcCallStats coordinate;
+} DcTickStats;
+
+/*
  The call succeeded.
  */
 #define DC_STATUS_OK 0
@@ -1252,6 +1309,38 @@ DcStatus dc_set_speed_limits(struct DcCollider *handle, uint32_t on);
  `handle` must be NULL or a live handle not used by another thread.
  */
 DcStatus dc_set_limit_tests(struct DcCollider *handle, uint32_t tests);
+
+/*
+ Writes the handle's tick statistics to `*out`, whose `struct_size` the caller sets to
+ `sizeof(DcTickStats)` first (a later, larger version is filled as far as this one knows;
+ `struct_size` is then this version's). Counted since the handle was made or since
+ `dc_tick_stats_reset`: `query` for `dc_query`, `protective` for every protective query,
+ `coordinate` for `dc_coordinate`; a call that finds the handle busy is not counted. Times
+ are inside the library, from the monotonic clock; work units are the speed limits' proof
+ tests (`dc_set_limit_tests` caps them per tick; `budget_spent` counts the ticks that used
+ the whole cap, their limits then the largest speeds proved so far) and the coordination's
+ diagram cells; `dc_query` reports no work (its box tests are fixed by the cell). Cheap
+ enough for every tick: it copies about 200 bytes and allocates nothing.
+
+ Statuses: `DC_STATUS_NULL_POINTER` (handle or out NULL), `DC_STATUS_INVALID_ARGUMENT`
+ (`out->struct_size` smaller than this header's `sizeof(DcTickStats)`; nothing written),
+ `DC_STATUS_BUSY`, `DC_STATUS_PANIC` (a poisoned handle).
+
+ # Safety
+ `handle` must be NULL or live; `out` must be NULL or point to a writable `DcTickStats`
+ whose `struct_size` is readable.
+ */
+DcStatus dc_tick_stats(struct DcCollider *handle, struct DcTickStats *out);
+
+/*
+ Zeroes the handle's tick statistics (`dc_tick_stats`), e.g. after start-up, so that the
+ largest times are those of the line running. Allocates nothing. Statuses:
+ `DC_STATUS_NULL_POINTER`, `DC_STATUS_BUSY`, `DC_STATUS_PANIC`.
+
+ # Safety
+ `handle` must be NULL or live.
+ */
+DcStatus dc_tick_stats_reset(struct DcCollider *handle);
 
 /*
  A static, NUL-terminated English description of `status`; never NULL.

@@ -17,6 +17,7 @@ use delta_collide::math::Vec3;
 use delta_collide::robot::StopModel;
 use ffi_common::{last_init_error, two_robot_cell};
 use protective_common::allocations;
+use std::mem::size_of;
 
 /// Programme ticks between two points, as the C harness passes them.
 const STRIDE: u32 = 4;
@@ -491,6 +492,13 @@ fn the_right_of_way_reaches_the_coordination() {
     let seen = closed_loop(h, t1(), config, 900, (usize::MAX, 400));
     println!("programmed order: {seen:?}");
     assert!(seen.held_ticks > 0, "{seen:?}");
+    // The tick statistics counted each dc_coordinate, with its diagram cells as work.
+    let mut stats =
+        DcTickStats { struct_size: size_of::<DcTickStats>() as u32, ..Default::default() };
+    // SAFETY: live handle, writable out with its size set.
+    assert_eq!(unsafe { dc_tick_stats(h, &mut stats) }, DC_STATUS_OK);
+    let c = stats.coordinate;
+    assert!(c.calls >= 900 && c.largest_work > 0 && c.largest_ns >= c.mean_ns, "{c:?}");
     assert_eq!(seen.allocations, 0, "dc_coordinate allocated");
     // SAFETY: live handle, destroyed once.
     unsafe { dc_destroy(h) };

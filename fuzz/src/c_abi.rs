@@ -32,7 +32,8 @@
 //!   closed: on every error each override written is 0.0 and each robot stands, held by no
 //!   one, wherever the request holds `n_robots`; with `DC_STATUS_OK` every override is in
 //!   [0, 1]; nothing is written past `n_robots`. `dc_set_coordination_clearance` takes
-//!   exactly the finite clearances above 0.
+//!   exactly the finite clearances above 0, `dc_set_coordination_right_of_way` exactly its
+//!   two rules.
 
 mod coordinate;
 mod init;

@@ -13,11 +13,13 @@ use crate::cell::protective::{
 use crate::cell::{Cell, ExactChecker, MAX_ROBOTS};
 use crate::ffi::convert::{cell_error_status, table_error_status, InitError};
 use crate::ffi::coordination::Coordination;
+use crate::ffi::stats::TickStats;
 use crate::ffi::types::*;
 use crate::math::Vec3;
 use crate::robot::StopModel;
 use crate::table::{is_bundle, BundleChecker, Confirmation, TableAnswer, TableChecker};
 use std::path::Path;
+use std::time::Instant;
 
 /// How a collider answers.
 enum Checker {
@@ -46,6 +48,8 @@ pub(crate) struct Collider {
     /// The coordination of the cell (either mode: it reads the exact boxes), with its
     /// buffers; made with the handle, remade by `dc_set_stop_model`.
     coordination: Coordination,
+    /// Per kind of call, its time and work so far (`dc_tick_stats`).
+    pub(crate) stats: TickStats,
 }
 
 /// The protective checker of a handle until `dc_set_stop_model` sets one: without the motor-angle
@@ -62,6 +66,7 @@ impl Collider {
         let protective = protective_for(&cell);
         Collider {
             coordination: Coordination::new(protective.cell().clone()),
+            stats: TickStats::default(),
             protective,
             checker: Checker::Exact(Box::new(ExactChecker::new(cell))),
             tcps: vec![Vec3::zeros(); n],
@@ -100,6 +105,7 @@ impl Collider {
             tcps: vec![Vec3::zeros(); 2],
             table_collides: false,
             coordination: Coordination::new(protective.cell().clone()),
+            stats: TickStats::default(),
             protective,
             path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; 2],
             protective_lookups: 0,
@@ -118,6 +124,7 @@ impl Collider {
             tcps: vec![Vec3::zeros(); n],
             table_collides: false,
             coordination: Coordination::new(protective.cell().clone()),
+            stats: TickStats::default(),
             protective,
             path_points: vec![[Vec3::zeros(); DC_MAX_PATH_POINTS]; n],
             protective_lookups: 0,
@@ -200,6 +207,13 @@ impl Collider {
     /// The per-tick query: fills `report` (which starts as [`DcQueryReport::STOP`]) and
     /// returns the status; the verdict in `report` is decided only with `DC_STATUS_OK`.
     pub(crate) fn query(&mut self, tcps: &[DcVec3], report: &mut DcQueryReport) -> DcStatus {
+        let started = Instant::now();
+        let status = self.query_untimed(tcps, report);
+        self.stats.query.record(started.elapsed(), 0, false);
+        status
+    }
+
+    fn query_untimed(&mut self, tcps: &[DcVec3], report: &mut DcQueryReport) -> DcStatus {
         self.table_collides = false;
         if tcps.len() != self.tcps.len() {
             return DC_STATUS_WRONG_ROBOT_COUNT;
@@ -336,6 +350,22 @@ impl Collider {
     /// [`DcProtectiveReport::STOP`]) and returns the status; the verdict is FREE or WARN only
     /// with `DC_STATUS_OK`.
     pub(crate) fn protective_query(
+        &mut self,
+        time: TickTime,
+        tcps: &[DcVec3],
+        paths: Option<&[(&[DcVec3], f64)]>,
+        report: &mut DcProtectiveReport,
+    ) -> DcStatus {
+        let started = Instant::now();
+        let status = self.protective_query_untimed(time, tcps, paths, report);
+        let r = self.protective.report();
+        let tests = if status == DC_STATUS_OK { r.limit_tests } else { 0 };
+        let spent = status == DC_STATUS_OK && r.limit_budget_spent;
+        self.stats.protective.record(started.elapsed(), u64::from(tests), spent);
+        status
+    }
+
+    fn protective_query_untimed(
         &mut self,
         time: TickTime,
         tcps: &[DcVec3],

@@ -2,6 +2,7 @@
 //! programmes ahead (`crate::coord`), its reset and its clearance; the state behind it in
 //! every handle ([`Coordination`]), with the buffers the programmes' points are converted into.
 
+use super::collider::Collider;
 use super::handle::{boundary, flatten, live, DcCollider};
 use super::settings::set_on_handle;
 use super::types::*;
@@ -12,6 +13,7 @@ use crate::coord::{
 };
 use crate::math::Vec3;
 use std::mem::{offset_of, size_of};
+use std::time::Instant;
 
 // The header states this bound as a number (cbindgen writes no paths): keep them equal.
 const _: () = assert!(DC_MAX_ROBOTS == MAX_ROBOTS);
@@ -71,6 +73,11 @@ impl Coordination {
         let config = CoordinationConfig { right_of_way, ..*self.coordinator.config() };
         self.coordinator = Coordinator::new(self.coordinator.cell().clone(), config);
         Ok(())
+    }
+
+    /// Diagram cells the last call tested.
+    fn cells_tested(&self) -> u64 {
+        self.coordinator.report().cells_tested
     }
 
     /// Forgets every decision and sample ([`Coordinator::reset`]).
@@ -226,16 +233,20 @@ pub unsafe extern "C" fn dc_coordinate(
 ) -> DcStatus {
     // SAFETY: the caller guarantees `req` is NULL or readable for its `struct_size`.
     let n_out = unsafe { outputs_of(req) };
-    let coordinate = |coordination: &mut Coordination| {
+    let coordinate = |c: &mut Collider| {
+        let started = Instant::now();
+        let coordination = c.coordination();
         // SAFETY: the caller's guarantees on the request and the outputs are passed on.
         let status = unsafe { coordinate_on(coordination, req, out_overrides, out_robots) };
         if status != DC_STATUS_OK {
             coordination.forget();
         }
+        let cells = if status == DC_STATUS_OK { coordination.cells_tested() } else { 0 };
+        c.stats.coordinate.record(started.elapsed(), cells, false);
         status
     };
     // SAFETY: the caller guarantees `handle` is NULL or live.
-    let status = boundary(|| flatten(unsafe { live(handle, |c| coordinate(c.coordination())) }));
+    let status = boundary(|| flatten(unsafe { live(handle, coordinate) }));
     if status != DC_STATUS_OK {
         // SAFETY: the caller guarantees `n_out` writable elements behind each output not NULL.
         unsafe { write_standing(n_out, out_overrides, out_robots) };

@@ -26,7 +26,8 @@
 //! `handle.rs` (the handle and the guard of every call), `init.rs` (make and free a handle),
 //! `query.rs` (the collision query and its reports), `protective.rs` (the protective
 //! queries), `coordination.rs` (the coordination's overrides, and its state behind a
-//! handle), `settings.rs` (setup calls), `status.rs` (status text, version),
+//! handle), `settings.rs` (setup calls), `stats.rs` (the tick statistics), `status.rs`
+//! (status text, version),
 //! `kinematics.rs` (the Delta3 kinematics); the safe state behind a handle in `collider.rs`,
 //! conversions from C in `convert.rs`, the C types in `types.rs`.
 #![allow(unsafe_code)]
@@ -40,6 +41,7 @@ mod kinematics;
 mod protective;
 mod query;
 mod settings;
+mod stats;
 mod status;
 pub mod types;
 
@@ -51,5 +53,6 @@ pub use kinematics::*;
 pub use protective::*;
 pub use query::*;
 pub use settings::*;
+pub use stats::*;
 pub use status::*;
 pub use types::*;

@@ -471,3 +471,38 @@ impl DcRobotCoordination {
     pub(crate) const STAND: DcRobotCoordination =
         DcRobotCoordination { override_factor: 0.0, held_by: -1, hold_mm: 0.0, rank: 0 };
 }
+
+/// One kind of call's figures in `DcTickStats`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DcCallStats {
+    /// Calls counted.
+    pub calls: u64,
+    /// Time of the last call inside the library (ns).
+    pub last_ns: u64,
+    /// Time of the longest call (ns).
+    pub largest_ns: u64,
+    /// Mean time of the calls counted (ns; 0 without calls).
+    pub mean_ns: u64,
+    /// Work units of the last call (`dc_tick_stats`).
+    pub last_work: u64,
+    /// Work units of the call with the most.
+    pub largest_work: u64,
+    /// Calls that used their whole work budget.
+    pub budget_spent: u64,
+}
+
+/// A handle's tick statistics (`dc_tick_stats`): set `struct_size` to
+/// `sizeof(DcTickStats)` before the call.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DcTickStats {
+    /// `sizeof(DcTickStats)` of the caller's header; written back as this library's.
+    pub struct_size: u32,
+    /// `dc_query`.
+    pub query: DcCallStats,
+    /// `dc_protective_query`, `dc_protective_query_with_paths`, `dc_protective_query_timed`.
+    pub protective: DcCallStats,
+    /// `dc_coordinate`.
+    pub coordinate: DcCallStats,
+}

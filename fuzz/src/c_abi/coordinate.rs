@@ -318,36 +318,55 @@ fn expected(
     early.or_else(|| programmes.iter().find_map(Programme::late)).unwrap_or(DC_STATUS_OK)
 }
 
-/// `Op::CoordinationSettings`: `dc_coordination_reset` (NULL a no-op) or
-/// `dc_set_coordination_clearance` (OK for a finite clearance above 0, else
-/// `DC_STATUS_INVALID_ARGUMENT` with a message in `dc_last_init_error`, cleared on success);
-/// then `dc_coordination_horizon` and `dc_coordination_request_default`, which take nothing.
+/// `Op::CoordinationSettings`: `dc_coordination_reset` (NULL a no-op),
+/// `dc_set_coordination_clearance` (OK for a finite clearance above 0) or
+/// `dc_set_coordination_right_of_way` (OK for `DC_RIGHT_OF_WAY_ARRIVAL` or `_PROGRAMMED`),
+/// else `DC_STATUS_INVALID_ARGUMENT` with a message in `dc_last_init_error`, cleared on
+/// success; then `dc_tick_stats` (its struct size checked) and `dc_coordination_horizon` and
+/// `dc_coordination_request_default`, which take nothing.
 pub(super) fn settings(input: &mut Input, live: &[Live]) {
     let l = pick(input, live);
-    let clearance = match input.byte() % 3 {
-        0 => None,
-        1 => Some(input.f64()),
-        _ => Some(f64::from(input.byte())),
-    };
-    match clearance {
-        // SAFETY: NULL or live.
-        None => unsafe { dc_coordination_reset(handle_of(l)) },
-        Some(mm) => {
+    let (status, expected, what) = match input.byte() % 4 {
+        0 => {
+            // SAFETY: NULL or live.
+            unsafe { dc_coordination_reset(handle_of(l)) };
+            (DC_STATUS_OK, DC_STATUS_OK, String::new())
+        }
+        3 => {
+            let rule = DcRightOfWay::from(input.byte() % 4);
+            // SAFETY: NULL or live.
+            let status = unsafe { dc_set_coordination_right_of_way(handle_of(l), rule) };
+            let valid = rule == DC_RIGHT_OF_WAY_ARRIVAL || rule == DC_RIGHT_OF_WAY_PROGRAMMED;
+            (status, setter_status(l, valid), format!("dc_set_coordination_right_of_way({rule})"))
+        }
+        b => {
+            let mm = if b == 1 { input.f64() } else { f64::from(input.byte()) };
             // SAFETY: NULL or live.
             let status = unsafe { dc_set_coordination_clearance(handle_of(l), mm) };
-            let expected = match (l, mm > 0.0 && mm.is_finite()) {
-                (None, _) => DC_STATUS_NULL_POINTER,
-                (_, true) => DC_STATUS_OK,
-                _ => DC_STATUS_INVALID_ARGUMENT,
-            };
-            assert_eq!(status, expected, "dc_set_coordination_clearance({mm})");
-            if l.is_some() {
-                // SAFETY: NULL and 0 ask for the length only.
-                let len = unsafe { dc_last_init_error(std::ptr::null_mut(), 0) };
-                assert_eq!(len == 0, status == DC_STATUS_OK, "status {status}, {len}-byte error");
-            }
+            let valid = mm > 0.0 && mm.is_finite();
+            (status, setter_status(l, valid), format!("dc_set_coordination_clearance({mm})"))
         }
+    };
+    assert_eq!(status, expected, "{what}");
+    if l.is_some() && !what.is_empty() {
+        // SAFETY: NULL and 0 ask for the length only.
+        let len = unsafe { dc_last_init_error(std::ptr::null_mut(), 0) };
+        assert_eq!(len == 0, status == DC_STATUS_OK, "status {status}, {len}-byte error");
     }
+    // The tick statistics: any handle, a struct size too small or right.
+    let full = size_of::<DcTickStats>() as u32;
+    let size = if input.byte() % 2 == 0 { full } else { full - 8 };
+    let mut stats = DcTickStats { struct_size: size, ..Default::default() };
+    // SAFETY: NULL or live; `stats` writable.
+    let status = unsafe { dc_tick_stats(handle_of(l), &mut stats) };
+    let expected = match (l, size == full) {
+        (None, _) => DC_STATUS_NULL_POINTER,
+        (_, true) => DC_STATUS_OK,
+        _ => DC_STATUS_INVALID_ARGUMENT,
+    };
+    assert_eq!(status, expected, "dc_tick_stats with struct_size {size}");
+    let c = stats.coordinate;
+    assert!(c.largest_ns >= c.last_ns && c.largest_work >= c.last_work, "{stats:?}");
     // A property of the build: the point at or behind the progress at least.
     assert!(dc_coordination_horizon() >= 1, "horizon {}", dc_coordination_horizon());
     let d = dc_coordination_request_default();
@@ -357,4 +376,13 @@ pub(super) fn settings(input: &mut Input, live: &[Live]) {
             && d.programmes.is_null(),
         "{d:?}"
     );
+}
+
+/// The status of a setter on handle `l` (NULL when `None`) with a `valid` argument.
+fn setter_status(l: Option<&Live>, valid: bool) -> DcStatus {
+    match (l, valid) {
+        (None, _) => DC_STATUS_NULL_POINTER,
+        (_, true) => DC_STATUS_OK,
+        _ => DC_STATUS_INVALID_ARGUMENT,
+    }
 }

@@ -305,6 +305,12 @@ pub struct ProtectiveReport {
     /// How many pairs that can meet the table's bound proved apart this tick, which the
     /// swept-box proof then skipped (all of them when `table_lookup`).
     pub table_pairs: u32,
+    /// Proof tests the speed limits' searches made this tick (the per-tick work they take;
+    /// [`ProtectiveChecker::with_limit_tests`] caps it).
+    pub limit_tests: u32,
+    /// Whether the searches used the whole cap this tick: some limit is then the largest speed
+    /// proved so far, its search going on next tick.
+    pub limit_budget_spent: bool,
 }
 
 impl Clone for ProtectiveReport {
@@ -330,6 +336,7 @@ impl ProtectiveReport {
             (self.verdict, self.status, self.clearance_mm, self.closest, self.limiting);
         let (kept_proof, table_lookup, table_pairs) =
             (self.kept_proof, self.table_lookup, self.table_pairs);
+        let (limit_tests, limit_budget_spent) = (self.limit_tests, self.limit_budget_spent);
         let robots = alloc::vec::Vec::new();
         ProtectiveReport {
             verdict,
@@ -341,6 +348,8 @@ impl ProtectiveReport {
             kept_proof,
             table_lookup,
             table_pairs,
+            limit_tests,
+            limit_budget_spent,
         }
     }
 }
@@ -512,6 +521,8 @@ impl ProtectiveChecker {
             kept_proof: false,
             table_lookup: false,
             table_pairs: 0,
+            limit_tests: 0,
+            limit_budget_spent: false,
         };
         let robot = RobotState {
             history: NO_HISTORY,
@@ -889,7 +900,7 @@ impl ProtectiveChecker {
             (Protective::Stop, status, Real::NAN);
         (report.closest, report.limiting, report.kept_proof, report.table_lookup) =
             (None, None, false, false);
-        report.table_pairs = 0;
+        (report.table_pairs, report.limit_tests, report.limit_budget_spent) = (0, 0, false);
         self.pairs.iter_mut().for_each(|p| p.table_proved = false);
     }
 

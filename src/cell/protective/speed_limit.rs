@@ -11,6 +11,7 @@ impl ProtectiveChecker {
     /// Each robot's speed limit when they are asked for (else NaN), with this tick's stop
     /// references of every robot already set (the limits search about them).
     pub(super) fn speed_limits_of(&mut self, tcps_mcs: &[Vec3], from_history: bool) {
+        (self.report.limit_tests, self.report.limit_budget_spent) = (0, false);
         if !self.model.speed_limits {
             self.report.robots.iter_mut().for_each(|r| r.speed_limit_mm_s = Real::NAN);
             return;
@@ -38,6 +39,8 @@ impl ProtectiveChecker {
             left -= used;
             (self.report.robots[j].speed_limit_mm_s, self.robots[j].limit_step) = (limit, step);
         }
+        self.report.limit_tests = cap - left;
+        self.report.limit_budget_spent = n > 0 && left == 0;
     }
 
     /// Robot `j`'s speed limit (module doc), the other robots' sweeps as they are: the search
