@@ -1326,3 +1326,47 @@ fn replay_with_stop_paths_from_the_rows_ahead_stops_less() {
     let tolerance_alone = cli(&["replay", "--cell", "T1", "--path-tolerance-mm", "1"]);
     assert_eq!(tolerance_alone.status.code(), Some(2), "--path-tolerance-mm needs --stop-path-mm");
 }
+
+/// The finds: `check` took a first line split by semicolons for a header and wrote
+/// nothing with exit 0; `build --k -1` answered "unexpected argument"; `check --clearance`
+/// wrote 3 decimals of a clearance exact to 1e-13 mm.
+#[test]
+fn csv_numbers_round_trip_and_bad_first_lines_and_negative_values_are_named() {
+    let out = cli_stdin(&["check", "--cell", "T1"], "150;0;-450;-150;0;-450\n");
+    assert_eq!(out.status.code(), Some(1), "{}", stdout(&out));
+    let e = stderr(&out);
+    assert!(e.contains("line 1") && e.contains("x,y,z,x2,y2,z2"), "{e}");
+    let out = cli_stdin(&["check", "--cell", "T1"], "a,b,c,d,e,f\n-150,0,-450,150,0,-450\n");
+    assert_eq!(out.status.code(), Some(1), "a header that names no column: {}", stdout(&out));
+
+    let out = cli(&["build", "--cell", "T1", "--k", "-1", "--output", "unused.dct"]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = stderr(&out);
+    assert!(e.contains("--k") && e.contains("power of two"), "{e}");
+
+    // Each clearance written reads back as the library's double, bit for bit, and is the
+    // shortest such text; --decimals 3 writes three.
+    let rows =
+        [[-150.0, 0.0, -450.0, 150.0, 0.0, -450.0], [40.0, 10.0, -470.0, -60.0, 0.0, -430.0]];
+    let input: String = rows
+        .iter()
+        .map(|r| r.iter().map(|v| format!("{v}")).collect::<Vec<_>>().join(",") + "\n")
+        .collect();
+    let out = cli_stdin(&["check", "--cell", "T1", "--clearance"], &input);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let mut exact = ExactChecker::new(reference_cell("T1").unwrap());
+    for (line, r) in stdout(&out).lines().skip(1).zip(&rows) {
+        let tcps = [Vec3::new(r[0], r[1], r[2]), Vec3::new(r[3], r[4], r[5])];
+        exact.check(&tcps).unwrap();
+        let want = delta_collide::cell::protective::clearance_now(&exact).0;
+        let text = line.split(',').nth(2).unwrap();
+        let got: f64 = text.parse().unwrap();
+        assert_eq!(got.to_bits(), want.to_bits(), "{text} against {want:e}");
+        assert_eq!(text, format!("{want}"), "not the shortest text");
+    }
+    let out = cli_stdin(&["check", "--cell", "T1", "--clearance", "--decimals", "3"], &input);
+    for line in stdout(&out).lines().skip(1) {
+        let text = line.split(',').nth(2).unwrap();
+        assert_eq!(text.split('.').nth(1).map(str::len), Some(3), "{line}");
+    }
+}

@@ -8,7 +8,7 @@
 
 use clap::builder::{PossibleValue, TypedValueParser};
 use clap::error::{ContextKind, ContextValue, ErrorKind};
-use clap::{Args, CommandFactory, Parser, Subcommand, ValueEnum};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 use delta_collide::cell::reference::{reference_cell, REFERENCE_CELL_FILES};
 use delta_collide::cell::Cell;
 use delta_collide::math::Vec3;
@@ -188,6 +188,10 @@ pub struct CheckArgs {
     /// 1 when that pair collides, 0 when not, NA when either TCP is unreachable
     #[arg(long)]
     pub pairs: bool,
+    /// Write each number with N decimals [default: the shortest text that reads back as the
+    /// same double]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(0..=17))]
+    pub decimals: Option<u8>,
 }
 
 #[derive(Args, Debug)]
@@ -254,6 +258,10 @@ pub struct ReplayArgs {
     /// names): that pair's exact signed clearance (mm), NA when the tick's status is not ok
     #[arg(long)]
     pub pairs: bool,
+    /// Write each number with N decimals [default: the shortest text that reads back as the
+    /// same double]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(0..=17))]
+    pub decimals: Option<u8>,
     /// Table mode: a tick this clearance table (build --variant clearance, same cell; for a
     /// line, its bundle) proves FREE is answered by its lookup alone; pairs it proves apart
     /// skip the exact protective check, which decides the others; the share answered by the
@@ -509,7 +517,13 @@ impl Cli {
     /// The parsed command line; on a usage error (unknown, repeated, contradictory or badly
     /// typed flags) prints clap's message and exits with 2, on `--help`/`--version` exits 0.
     pub fn parse_checked() -> Cli {
-        let cli = Cli::try_parse().unwrap_or_else(|e| e.exit());
+        // A negative number after a flag is its value, so that the flag's parser names it and
+        // its valid values (`--k -1`), not an unexpected argument.
+        let command = Cli::command().mut_subcommands(|c| c.allow_negative_numbers(true));
+        let cli = command
+            .try_get_matches()
+            .and_then(|m| Cli::from_arg_matches(&m))
+            .unwrap_or_else(|e| e.exit());
         if let Err(e) = cli.check() {
             e.exit();
         }

@@ -161,7 +161,7 @@ fn check(args: &CheckArgs) -> Result<(), Failure> {
     let mut table =
         args.table.as_deref().map(|p| load_table_or_bundle(cell, p, confirmation)).transpose()?;
     let mut input = open_input(args.input.as_deref())?;
-    let columns = Columns { clearance: args.clearance, pairs: args.pairs };
+    let columns = Columns { clearance: args.clearance, pairs: args.pairs, decimals: args.decimals };
     let mut rows = |out: &mut dyn Write| check_rows(&mut input, out, cell, table.as_mut(), columns);
     match &args.output {
         Some(path) => files::write_file(path, |w| rows(w))?,
@@ -209,6 +209,8 @@ struct Columns {
     clearance: bool,
     /// `collide_A_B` per pair that can meet (table mode: its one pair, the table's answer).
     pairs: bool,
+    /// Decimals of the numbers written (`rows::real`).
+    decimals: Option<u8>,
 }
 
 /// Answers every row of `input` on `out`, after the line `reachable,collide` and the
@@ -260,7 +262,7 @@ fn check_rows(
             let mm = bound.clearance_bound(tcps).unwrap_or(f64::NEG_INFINITY);
             match answer {
                 TableAnswer::Unreachable(_) => write!(out, ",NA"),
-                _ => write!(out, ",{mm:.3}"),
+                _ => write!(out, ",{}", rows::real(mm, columns.decimals)),
             }
             .map_err(write_err)?;
         } else if columns.clearance {
@@ -271,7 +273,7 @@ fn check_rows(
             match clearance::signed_clearance(&checker)
                 .filter(|_| !matches!(answer, TableAnswer::Unreachable(_)))
             {
-                Some(d) => write!(out, ",{d:.3}"),
+                Some(d) => write!(out, ",{}", rows::real(d, columns.decimals)),
                 None => write!(out, ",NA"),
             }
             .map_err(write_err)?;

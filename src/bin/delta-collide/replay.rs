@@ -5,6 +5,7 @@
 use crate::args::ReplayArgs;
 use crate::clearance::{pair_clearances, signed_clearance};
 use crate::replay_plot::{draw_replay, ReplayTrace};
+use crate::rows::real;
 use crate::{load_table_or_bundle, open_input, write_output, Failure, Loaded};
 use delta_collide::cell::protective::{
     path_through_samples, Protective, ProtectiveChecker, ProtectiveRequest, ProtectiveStatus,
@@ -30,7 +31,8 @@ pub fn replay(args: &ReplayArgs) -> Result<(), Failure> {
         .map(|length_mm| PathsAhead { length_mm, tolerance_mm: args.path_tolerance_mm });
     let mut lookups = Lookups::default();
     write_output(args.output.as_deref(), |out| {
-        let columns = Columns { table: table.as_ref(), paths, pairs: args.pairs };
+        let columns =
+            Columns { table: table.as_ref(), paths, pairs: args.pairs, decimals: args.decimals };
         lookups = replay_rows(&mut input, out, &mut checker, columns, trace.as_mut())?;
         Ok(())
     })?;
@@ -71,6 +73,7 @@ struct Columns<'a> {
     table: Option<&'a Loaded>,
     paths: Option<PathsAhead>,
     pairs: bool,
+    decimals: Option<u8>,
 }
 
 /// What the table's lookups answered over a replay: whole ticks, pairs, of all ticks.
@@ -102,7 +105,7 @@ fn replay_rows(
     input: &mut dyn BufRead,
     out: &mut dyn Write,
     checker: &mut ProtectiveChecker,
-    Columns { table, paths, pairs }: Columns<'_>,
+    Columns { table, paths, pairs, decimals }: Columns<'_>,
     mut trace: Option<&mut ReplayTrace>,
 ) -> Result<Lookups, String> {
     let bound =
@@ -186,13 +189,14 @@ fn replay_rows(
             ProtectiveStatus::InvalidPath(j) => format!("invalid path {}", names[j]),
             ProtectiveStatus::Timing(fault) => format!("timing {fault:?}").to_lowercase(),
         };
-        let mut row = format!("{},{verdict},{:.3},{status}", ticks[tick], r.clearance_mm);
-        r.robots.iter().for_each(|x| row += &format!(",{:.3}", x.protective_mm));
-        r.robots.iter().for_each(|x| row += &format!(",{:.1}", x.speed_limit_mm_s));
+        let num = |v: f64| real(v, decimals);
+        let mut row = format!("{},{verdict},{},{status}", ticks[tick], num(r.clearance_mm));
+        r.robots.iter().for_each(|x| row += &format!(",{}", num(x.protective_mm)));
+        r.robots.iter().for_each(|x| row += &format!(",{}", num(x.speed_limit_mm_s)));
         if pairs {
             let ok = r.status == ProtectiveStatus::Ok;
             match ok.then(|| pair_clearances(checker.exact())).flatten() {
-                Some(c) => c.iter().for_each(|d| row += &format!(",{d:.3}")),
+                Some(c) => c.iter().for_each(|d| row += &format!(",{}", num(*d))),
                 None => (0..checker.exact().verdict().pairs.len()).for_each(|_| row += ",NA"),
             }
         }

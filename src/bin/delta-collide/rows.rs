@@ -1,13 +1,23 @@
 //! Rows of TCPs from a CSV input, as `check` and `replay` read them: `x,y,z` of each robot in
-//! its own MCS. Blank lines are skipped; a first line is a header only when none of its fields
-//! is a number (so a malformed first data row is an error). A header that names every robot's
-//! columns (`x,y,z` for the first robot, `x2,y2,z2` for the second, and so on) selects them
-//! by name, and its other columns (`tick`, anything else) are ignored; otherwise a row is
-//! exactly `3 n` numbers in robot order.
+//! its own MCS; and the text of the numbers they write. Blank lines are skipped; a first line
+//! none of whose fields is a number is a header, and must name every robot's columns (`x,y,z`
+//! for the first robot, `x2,y2,z2` for the second, and so on), which it selects by name, its
+//! other columns (`tick`, anything else) ignored; any other first line (a malformed row, a
+//! line split by semicolons) is an error naming line 1. Without a header a row is exactly
+//! `3 n` numbers in robot order.
 
 use crate::args::clip;
 use delta_collide::math::Vec3;
 use std::io::BufRead;
+
+/// The CSV text of `v`: with `decimals` that many, else the shortest text that reads back as
+/// the same double (Rust's `{}` for `f64`; `inf`, `-inf`, `NaN` as they are).
+pub fn real(v: f64, decimals: Option<u8>) -> String {
+    match decimals {
+        Some(d) => format!("{v:.*}", usize::from(d)),
+        None => format!("{v}"),
+    }
+}
 
 /// Where a row's numbers are.
 enum Layout {
@@ -17,17 +27,22 @@ enum Layout {
     Named { xyz: Vec<usize>, tick: Option<usize> },
 }
 
-/// The layout a header gives for `n` robots.
-fn layout(header: &str, n: usize) -> Layout {
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let find = |name: &str| names.iter().position(|f| f.eq_ignore_ascii_case(name));
-    let xyz: Option<Vec<usize>> = (0..n)
+/// The names of `n` robots' columns: `x,y,z,x2,y2,z2,...`.
+fn column_names(n: usize) -> String {
+    let names: Vec<String> = (0..n)
         .flat_map(|j| {
             let suffix = if j == 0 { String::new() } else { (j + 1).to_string() };
             ["x", "y", "z"].map(|c| format!("{c}{suffix}"))
         })
-        .map(|name| find(&name))
         .collect();
+    names.join(",")
+}
+
+/// The layout a header gives for `n` robots.
+fn layout(header: &str, n: usize) -> Layout {
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    let find = |name: &str| names.iter().position(|f| f.eq_ignore_ascii_case(name));
+    let xyz: Option<Vec<usize>> = column_names(n).split(',').map(find).collect();
     match xyz {
         Some(xyz) => Layout::Named { xyz, tick: find("tick") },
         None => Layout::InOrder,
@@ -58,6 +73,15 @@ pub fn for_each_row(
         first = false;
         if header {
             columns = layout(line, n);
+            if matches!(columns, Layout::InOrder) {
+                return Err(format!(
+                    "line {line_no}: `{}` is neither a header naming the columns {} (others, \
+                     such as tick, ignored) nor {} numbers separated by commas",
+                    clip(line),
+                    column_names(n),
+                    3 * n
+                ));
+            }
             continue;
         }
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
