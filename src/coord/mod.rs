@@ -112,7 +112,8 @@ pub struct CoordinationConfig {
     /// Two samples conflict when their boxes may come closer than this (mm): the room the
     /// protective verdict needs beyond contact to prove a stop of the moving robot apart.
     pub clearance_mm: Real,
-    /// Room kept between a yielding robot's stop and its hold point (mm).
+    /// Room kept between a yielding robot's stop and its hold point (mm), in the arrival order
+    /// (the programmed order stops short of its hold point in progress instead).
     pub hold_margin_mm: Real,
     /// How much sooner the other robot must reach its hold point to take the right of way
     /// (programme ticks).

@@ -1,10 +1,10 @@
 //! Rows of TCPs from a CSV input, as `check` and `replay` read them: `x,y,z` of each robot in
 //! its own MCS; and the text of the numbers they write. Blank lines are skipped; a first line
 //! none of whose fields is a number is a header, and must name every robot's columns (`x,y,z`
-//! for the first robot, `x2,y2,z2` for the second, and so on), which it selects by name, its
-//! other columns (`tick`, anything else) ignored; any other first line (a malformed row, a
-//! line split by semicolons) is an error naming line 1. Without a header a row is exactly
-//! `3 n` numbers in robot order.
+//! or `x1,y1,z1` for the first robot, `x2,y2,z2` for the second, and so on), selected by
+//! name, its other columns (`tick`, anything else) ignored; any other first line (a malformed
+//! row, a line split by semicolons) is an error naming line 1. Without a header a row is
+//! exactly `3 n` numbers in robot order.
 
 use crate::args::clip;
 use delta_collide::math::Vec3;
@@ -42,7 +42,12 @@ fn column_names(n: usize) -> String {
 fn layout(header: &str, n: usize) -> Layout {
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
     let find = |name: &str| names.iter().position(|f| f.eq_ignore_ascii_case(name));
-    let xyz: Option<Vec<usize>> = column_names(n).split(',').map(find).collect();
+    // The first robot's columns also as `x1,y1,z1`.
+    let find_robot = |name: &str| match name {
+        "x" | "y" | "z" => find(name).or_else(|| find(&format!("{name}1"))),
+        _ => find(name),
+    };
+    let xyz: Option<Vec<usize>> = column_names(n).split(',').map(find_robot).collect();
     match xyz {
         Some(xyz) => Layout::Named { xyz, tick: find("tick") },
         None => Layout::InOrder,
