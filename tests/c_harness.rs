@@ -26,7 +26,7 @@ use std::sync::OnceLock;
 
 mod harness_build;
 mod native_libs;
-use harness_build::{repo_root, run, scratch_dir, text, C_FLAGS};
+use harness_build::{in_ci, repo_root, run, scratch_dir, static_lib, text, C_FLAGS};
 use native_libs::NATIVE_LIBS;
 
 /// Sanitizer flags (gcc): every report aborts the run.
@@ -38,23 +38,6 @@ const TABLE_K: u32 = 32;
 
 /// The reference cells, in the order of the harness's `--table` arguments.
 const CELLS: [&str; 3] = ["T1", "T2", "T3"];
-
-/// The static library built in this cargo run. `cargo test` writes it next to the test
-/// executable (`target/<profile>/deps/libdelta_collide.a`) and does not copy it up to
-/// `target/<profile>/` (only `cargo build` does), so the copy there may be stale or absent.
-fn static_lib() -> PathBuf {
-    let exe = std::env::current_exe().expect("path of the test executable");
-    let deps_dir = exe.parent().expect("exe lies in target/<profile>/deps");
-    let profile_dir = deps_dir.parent().expect("deps lies in target/<profile>");
-    let candidates = [deps_dir.join("libdelta_collide.a"), profile_dir.join("libdelta_collide.a")];
-    candidates
-        .iter()
-        .find(|p| p.is_file())
-        .unwrap_or_else(|| {
-            panic!("static library not found at {candidates:?} (crate-type staticlib?)")
-        })
-        .clone()
-}
 
 /// Parses the last `N passed, M failed` line of the harness output.
 fn verdict_line(stdout: &str) -> Option<(u64, u64)> {
@@ -658,11 +641,6 @@ fn c_harness_is_clean_under_address_and_undefined_behavior_sanitizers() {
         &format!("c_harness under ASan + UBSan (LSan {})", if detect_leaks { "on" } else { "off" }),
         &out,
     );
-}
-
-/// Whether this run is in CI, where a missing tool is an error rather than a skip.
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0")
 }
 
 #[test]

@@ -21,7 +21,7 @@ mod native_libs;
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::table::{build_tables, to_bytes, Labelling, Variant};
-use harness_build::{both, compile_harness, repo_root, run, scratch_dir};
+use harness_build::{both, compile_harness, in_ci, repo_root, run, scratch_dir};
 use native_libs::{native_static_libs, CROSS_NATIVE_LIBS, NATIVE_LIBS};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -59,11 +59,6 @@ const ARMV7: Target = Target {
     elf_machine: 40, // EM_ARM
     packages: "gcc-arm-linux-gnueabihf libc6-dev-armhf-cross qemu-user",
 };
-
-/// Whether this run is CI's (`CI` set and not "false"), where nothing may be skipped.
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0")
-}
 
 /// `Err(what to install)` unless `program --version` runs.
 fn tool(program: &str, install: &str) -> Result<(), String> {

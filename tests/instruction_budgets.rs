@@ -11,10 +11,9 @@
 mod harness_build;
 mod native_libs;
 
-use harness_build::{repo_root, run, scratch_dir, text, C_FLAGS};
+use harness_build::{in_ci, repo_root, run, scratch_dir, static_lib, text, C_FLAGS};
 use native_libs::NATIVE_LIBS;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 use std::process::Command;
 
 /// Per entry point, the most instructions one call may take: about 1.5 times the largest
@@ -25,19 +24,6 @@ const BUDGETS: [(&str, u64); 3] = [
     ("dc_protective_query", 500_000),
     ("dc_protective_query_with_paths", 1_100_000),
 ];
-
-/// The static library of this cargo run (as `tests/c_harness.rs` finds it).
-fn static_lib() -> PathBuf {
-    let exe = std::env::current_exe().expect("path of the test executable");
-    let deps = exe.parent().expect("exe lies in target/<profile>/deps");
-    let candidates =
-        [deps.join("libdelta_collide.a"), deps.parent().unwrap().join("libdelta_collide.a")];
-    candidates.iter().find(|p| p.is_file()).expect("the static library").clone()
-}
-
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0")
-}
 
 /// The largest instruction count of one call of each entry point, from the dump files in
 /// `dir` (each holds one call: its trigger names the entry point, `summary:` its count).

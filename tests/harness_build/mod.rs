@@ -20,6 +20,29 @@ pub fn scratch_dir(name: &str) -> PathBuf {
     dir
 }
 
+/// Whether this run is CI's (`CI` set and not "false" or "0"), where a missing tool is an
+/// error rather than a skip.
+pub fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0")
+}
+
+/// The static library built in this cargo run. `cargo test` writes it next to the test
+/// executable (`target/<profile>/deps/libdelta_collide.a`) and does not copy it up to
+/// `target/<profile>/` (only `cargo build` does), so the copy there may be stale or absent.
+pub fn static_lib() -> PathBuf {
+    let exe = std::env::current_exe().expect("path of the test executable");
+    let deps_dir = exe.parent().expect("exe lies in target/<profile>/deps");
+    let profile_dir = deps_dir.parent().expect("deps lies in target/<profile>");
+    let candidates = [deps_dir.join("libdelta_collide.a"), profile_dir.join("libdelta_collide.a")];
+    candidates
+        .iter()
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| {
+            panic!("static library not found at {candidates:?} (crate-type staticlib?)")
+        })
+        .clone()
+}
+
 /// Runs a command, returning its output; panics with the command line when it cannot start.
 pub fn run(cmd: &mut Command) -> Output {
     cmd.output().unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"))
