@@ -29,8 +29,8 @@ fn config(values: &[f64], robots: usize, i: usize, out: &mut [Vec3]) {
 }
 
 /// The exact check of every configuration of `tcps` (N, robots, 3), into `reachable` (N,)
-/// bool, `collide` (N,) bool (false when unreachable) and `pairs` (N, pairs) bool, each pair
-/// that can meet in `cell.pairs` order.
+/// bool, `collide` (N,) bool (false unless every TCP is reachable) and `pairs` (N, pairs) bool,
+/// each pair that can meet in `cell.pairs` order (false when one of its TCPs is unreachable).
 #[pyfunction]
 pub fn check_into(
     py: Python<'_>,
@@ -59,8 +59,10 @@ pub fn check_into(
             for i in 0..n {
                 config(values, robots, i, buf);
                 let v = checker.check(buf).map_err(|e| e.to_string())?;
+                // As `dc_query` and the CLI: no verdict unless every TCP is reachable; the
+                // pairs of reachable robots are still decided.
                 r[i] = v.all_reachable();
-                c[i] = v.collides();
+                c[i] = r[i] && v.collides();
                 for (k, pair) in v.pairs.iter().enumerate() {
                     p[i * n_pairs + k] = matches!(pair.state, PairState::Collides(..));
                 }

@@ -59,10 +59,10 @@ __all__ = [
 VERDICT_STOP, VERDICT_FREE, VERDICT_WARN = 0, 1, 3
 
 
-def _rows(tcps) -> int:
+def _rows(tcps, arg: str = "tcps", rows: str = "N") -> int:
     shape = getattr(tcps, "shape", None)
-    if shape is None or len(shape) == 0:
-        raise ValueError(f"tcps must be a numpy array of shape (N, robots, 3), not {type(tcps).__name__}")
+    if not isinstance(tcps, np.ndarray) or len(shape) == 0:
+        raise ValueError(f"{arg} must be a numpy array of shape ({rows}, robots, 3), not {type(tcps).__name__}")
     return shape[0]
 
 
@@ -152,7 +152,7 @@ def protective(
     never leaves by more than ``path_tolerance_mm``. The first call on a cell (or with another
     ``warn_mm``) builds its motor-angle tables."""
     if out is None:
-        t, r = _rows(run), cell.n_robots
+        t, r = _rows(run, "run", "T"), cell.n_robots
         out = Protective(
             np.empty(t, dtype=np.uint32),
             np.empty(t, dtype=np.uint32),
