@@ -17,7 +17,8 @@
  * driven by schedules that repeat, skip and go back in time. The coordination (coordination.c)
  * keeps two robots whose programmes place at the same point apart. Then the bad-input scenarios
  * (bad_input.c) check every documented error status and the fail-closed outputs, in both
- * modes.
+ * modes, and the function block around the POU (pou_fb_call, plc/README.md's state machine)
+ * goes through its lifecycle.
  *
  * Usage (from the repository root):
  *   c_harness [--quick] [--tmp DIR] [--table T1=PATH] [--table T2=PATH] [--table T3=PATH]
@@ -332,6 +333,150 @@ static void kinematics_grid(void)
     printf("kinematics grid: %lu TCPs, %lu reachable, max |dtheta| %.2e rad\n", n, reach, max_d);
 }
 
+/* ------------------------------------------------------------ the function block's lifecycle */
+
+/* One step of the function block scenario: what one call must leave in the outputs. */
+typedef struct FbExpect {
+    int valid, error;
+    uint32_t error_id;
+    unsigned diag_code;
+    DcVerdict verdict;
+} FbExpect;
+
+static FbExpect fb_expect(int valid, int error, uint32_t error_id, unsigned diag_code, DcVerdict verdict)
+{
+    FbExpect e;
+    e.valid = valid;
+    e.error = error;
+    e.error_id = error_id;
+    e.diag_code = diag_code;
+    e.verdict = verdict;
+    return e;
+}
+
+/* One call of the block, its transitions printed as `T<row> FROM -> TO` (tests/c_harness.rs
+ * compares them with plc/README.md's table) and its outputs checked against want. */
+static void fb_step(PouFb *fb, int step, const char *what, FbExpect w)
+{
+    const FbExpect *want = &w;
+    char taken[96] = "";
+    int k;
+    pou_fb_call(fb);
+    for (k = 0; k < fb->n_taken; ++k) {
+        char one[40];
+        sprintf(one, "%sT%d %s -> %s", k > 0 ? ", " : "", fb->taken[k].row, pou_fb_state_name(fb->taken[k].from),
+                pou_fb_state_name(fb->taken[k].to));
+        strcat(taken, one);
+    }
+    printf("pou fb step %d %s: %s; valid %d busy %d error %d error_id %lu diag 16#%04X verdict %lu\n", step, what,
+           taken, fb->valid, fb->busy, fb->error, (unsigned long)fb->error_id, fb->diag_code,
+           (unsigned long)fb->verdict);
+    check(fb->n_taken >= 1, "pou fb step %d %s: no transition", step, what);
+    check(fb->valid == want->valid && fb->busy == want->valid && fb->error == want->error,
+          "pou fb step %d %s: valid %d busy %d error %d, expected valid %d error %d", step, what, fb->valid, fb->busy,
+          fb->error, want->valid, want->error);
+    check(fb->error_id == want->error_id && fb->diag_code == want->diag_code,
+          "pou fb step %d %s: error_id %lu diag 16#%04X, expected %lu 16#%04X", step, what,
+          (unsigned long)fb->error_id, fb->diag_code, (unsigned long)want->error_id, want->diag_code);
+    check(fb->verdict == want->verdict && fb->report.verdict == want->verdict,
+          "pou fb step %d %s: verdict %lu (report %lu), expected %lu", step, what, (unsigned long)fb->verdict,
+          (unsigned long)fb->report.verdict, (unsigned long)want->verdict);
+    /* The rule of both blocks, whatever the step: STOP whenever Valid is FALSE. */
+    check(fb->valid || (fb->verdict == DC_VERDICT_STOP && !fb->free), "pou fb step %d %s: not valid but not STOP",
+          step, what);
+    check(fb->free == (fb->valid && fb->verdict == DC_VERDICT_FREE), "pou fb step %d %s: free %d", step, what,
+          fb->free);
+    check(fb->error || fb->state != POU_FB_ERROR, "pou fb step %d %s: error state without Error", step, what);
+}
+
+/* FB_DeltaCollide's lifecycle on T1, executed: enable with a table that fails validation, a
+ * reset with Enable held (the restart interlock), re-enable, FREE and COLLISION ticks, NaN
+ * TCPs, disable and reset in error, too many robots, and a plain disable. The table mode runs
+ * on T1's table when it was given, else exact mode. */
+static void pou_fb_scenario(const HarnessOptions *options)
+{
+    static const uint8_t zeros[4096];
+    const HarnessTable *t1 = &options->tables[0];
+    const uint8_t *bad = t1->bytes != NULL ? t1->bytes : zeros;
+    const size_t bad_len = t1->bytes != NULL && t1->len > 4096 ? 4096 : sizeof zeros;
+    DcRobotConfig robots[MR_MAX_ROBOTS];
+    DcCellConfig config;
+    DcCollider *probe = NULL;
+    MrCell cell;
+    PouFb fb;
+    DcStatus bad_status;
+    int step = 0;
+    const DcVerdict stop = DC_VERDICT_STOP;
+
+    if (!check(mr_register_cell("T1", &cell) == MR_OK, "pou fb: registry has no cell T1")) {
+        return;
+    }
+    pou_cell_config(&cell, DC_METHOD_SAT, robots, &config);
+    /* The status the library gives these bytes directly: the block must report it unchanged. */
+    bad_status = dc_init_with_table(&config, bad, bad_len, &probe);
+    check(probe == NULL && bad_status >= DC_STATUS_TABLE_TRUNCATED && bad_status <= DC_STATUS_TABLE_WRONG_PAIR
+              && bad_status != DC_STATUS_IMPLAUSIBLE_MOTION,
+          "pou fb: the bad table's init gives %s, not a table status", dc_status_str(bad_status));
+    check(t1->bytes == NULL || bad_status == DC_STATUS_TABLE_TRUNCATED, "pou fb: T1's table cut to 4096 bytes: %s",
+          dc_status_str(bad_status));
+    dc_destroy(probe);
+
+    pou_fb_start(&fb);
+    fb.config = &config;
+    fb.n_robots = 2;
+    fb.tcps[0] = vec3(-150.0, 0.0, -450.0); /* standing apart: FREE */
+    fb.tcps[1] = vec3(150.0, 0.0, -450.0);
+
+    fb_step(&fb, ++step, "idle", fb_expect(0, 0, 0, 0x0000u, stop));
+    fb.enable = 1, fb.table = bad, fb.table_len = bad_len;
+    fb_step(&fb, ++step, "enable with a table that fails validation",
+            fb_expect(0, 1, bad_status, 0xC100u | bad_status, stop));
+    check(fb.handle == NULL && fb.init_message[0] != '\0', "pou fb: no InitMessage after the failed init");
+    check(t1->bytes == NULL || strstr(fb.init_message, "truncated") != NULL, "pou fb: InitMessage `%s`",
+          fb.init_message);
+    fb_step(&fb, ++step, "error held", fb_expect(0, 1, bad_status, 0xC100u | bad_status, stop));
+    fb.reset = 1;
+    fb_step(&fb, ++step, "reset with Enable held", fb_expect(0, 0, 0, 0x0001u, stop));
+    fb.reset = 0;
+    fb_step(&fb, ++step, "Enable held after the reset (restart interlock)", fb_expect(0, 0, 0, 0x0001u, stop));
+    fb.enable = 0;
+    fb_step(&fb, ++step, "disable", fb_expect(0, 0, 0, 0x0000u, stop));
+
+    fb.enable = 1, fb.table = t1->bytes, fb.table_len = t1->len;
+    fb_step(&fb, ++step, t1->bytes != NULL ? "re-enable (table mode), apart" : "re-enable (exact mode), apart",
+            fb_expect(1, 0, 0, 0x8000u, DC_VERDICT_FREE));
+    check(dc_mode(fb.handle) == (t1->bytes != NULL ? DC_MODE_TABLE : DC_MODE_EXACT), "pou fb: mode %lu",
+          (unsigned long)dc_mode(fb.handle));
+    fb.tcps[0] = vec3(180.0, 0.0, -450.0); /* the README's colliding configuration */
+    fb.tcps[1] = vec3(-180.0, 0.0, -450.0);
+    fb_step(&fb, ++step, "colliding TCPs", fb_expect(1, 0, 0, 0x8001u, DC_VERDICT_COLLISION));
+    fb.tcps[0].x = NAN;
+    fb_step(&fb, ++step, "NaN TCPs", fb_expect(0, 1, DC_STATUS_NON_FINITE, 0xC202u, stop));
+    check(fb.report.unreachable_mask == 1u && fb.handle != NULL, "pou fb: NaN: mask %lu, handle kept %d",
+          (unsigned long)fb.report.unreachable_mask, fb.handle != NULL);
+    fb.tcps[0].x = 180.0; /* finite again: the error stays latched */
+    fb_step(&fb, ++step, "finite TCPs, error latched", fb_expect(0, 1, DC_STATUS_NON_FINITE, 0xC202u, stop));
+    fb.enable = 0;
+    fb_step(&fb, ++step, "disable in error", fb_expect(0, 1, DC_STATUS_NON_FINITE, 0xC202u, stop));
+    check(fb.handle == NULL, "pou fb: the handle outlived Enable FALSE in error");
+    fb.reset = 1;
+    fb_step(&fb, ++step, "reset", fb_expect(0, 0, 0, 0x0000u, stop));
+
+    fb.reset = 0, fb.enable = 1, fb.table = NULL, fb.n_robots = DC_MAX_ROBOTS + 1;
+    fb_step(&fb, ++step, "enable (exact mode) with too many robots",
+            fb_expect(0, 1, POU_FB_ERR_TOO_MANY_ROBOTS, 0xC301u, stop));
+    fb.enable = 0;
+    fb_step(&fb, ++step, "disable in error", fb_expect(0, 1, POU_FB_ERR_TOO_MANY_ROBOTS, 0xC301u, stop));
+    fb.reset = 1;
+    fb_step(&fb, ++step, "reset", fb_expect(0, 0, 0, 0x0000u, stop));
+    fb.reset = 0, fb.enable = 1, fb.n_robots = 2;
+    fb_step(&fb, ++step, "enable (exact mode), colliding", fb_expect(1, 0, 0, 0x8001u, DC_VERDICT_COLLISION));
+    fb.enable = 0;
+    fb_step(&fb, ++step, "disable", fb_expect(0, 0, 0, 0x0000u, stop));
+    check(fb.handle == NULL, "pou fb: the handle outlived the disable");
+    printf("pou fb: %d steps\n", step);
+}
+
 int main(int argc, char **argv)
 {
     static const char *cells[] = { "T1", "T2", "T3" };
@@ -370,6 +515,7 @@ int main(int argc, char **argv)
     timing_scenarios(&options);
     coordination_scenarios(&options);
     bad_input(&options);
+    pou_fb_scenario(&options);
     for (c = 0; c < 3; ++c) {
         for (k = 0; k < 2; ++k) {
             char t[24], e[24], x[24];

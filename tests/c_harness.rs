@@ -473,6 +473,56 @@ fn assert_timing(stdout: &str) {
     }
 }
 
+/// The state machine of plc/README.md (`| Tn | FROM | when | TO | action |`): (row, from, to).
+fn plc_transition_table() -> Vec<(u32, String, String)> {
+    let readme = std::fs::read_to_string(repo_root().join("plc/README.md")).expect("plc/README.md");
+    let section = readme.split("### State machine").nth(1).expect("a state machine section");
+    let section = section.split("\n#").next().unwrap();
+    section
+        .lines()
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            let row = cells.get(1)?.strip_prefix('T')?.parse().ok()?;
+            Some((row, cells[2].to_string(), cells[4].to_string()))
+        })
+        .collect()
+}
+
+/// The function block's lifecycle (`pou_fb_call` in `c_harness/pou.c`, the C copy of
+/// plc/src/FB_DeltaCollide.st): every transition it printed is a row of plc/README.md's
+/// table, with that row's states, every row was taken, and no step left FREE or a verdict
+/// other than STOP without `valid 1`.
+fn assert_pou_fb(stdout: &str) {
+    let table = plc_transition_table();
+    assert!(table.len() >= 9, "plc/README.md's transition table: {table:?}");
+    let steps: Vec<&str> = stdout.lines().filter(|l| l.starts_with("pou fb step ")).collect();
+    let announced = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("pou fb: ")?.strip_suffix(" steps")?.parse::<usize>().ok())
+        .expect("a `pou fb: N steps` line");
+    assert_eq!(steps.len(), announced, "{steps:#?}");
+    let mut taken = std::collections::BTreeSet::new();
+    for line in &steps {
+        let (_, rest) = line.split_once(": ").unwrap();
+        let (transitions, outputs) = rest.split_once("; ").unwrap();
+        for t in transitions.split(", ") {
+            let (row, states) = t.split_once(' ').unwrap_or_else(|| panic!("{line}"));
+            let row: u32 = row.strip_prefix('T').and_then(|r| r.parse().ok()).expect(line);
+            let (from, to) = states.split_once(" -> ").expect(line);
+            assert!(
+                table.iter().any(|(r, f, t)| *r == row && f == from && t == to),
+                "T{row} {from} -> {to} is not a row of plc/README.md's table: {line}"
+            );
+            taken.insert(row);
+        }
+        if outputs.contains("valid 0") {
+            assert!(outputs.ends_with("verdict 0"), "not valid but not STOP: {line}");
+        }
+    }
+    let rows: std::collections::BTreeSet<u32> = table.iter().map(|(r, _, _)| *r).collect();
+    assert_eq!(taken, rows, "rows of plc/README.md's table the C POU never took");
+}
+
 /// The harness's `summary` lines: (cell, case, table stop tick, first exact collision tick).
 fn summaries(stdout: &str) -> Vec<(String, String, Option<u64>, Option<u64>)> {
     let tick = |s: &str| s.trim_end_matches(',').parse().ok();
@@ -529,6 +579,7 @@ fn harness_passes_with_tables(kind: usize) {
     assert_timing(&stdout);
     assert_coordination(&stdout);
     assert_line(&stdout);
+    assert_pou_fb(&stdout);
     let runs = summaries(&stdout);
     assert_eq!(runs.len(), 6, "one table-mode summary per cell and case: {runs:?}");
     for (cell, case, table_stop, exact_first) in &runs {
@@ -701,6 +752,7 @@ fn c_harness_is_clean_under_valgrind_memcheck() {
         stdout.contains("coordination T1 quick: "),
         "the coordination's first ticks did not run under valgrind"
     );
+    assert_pou_fb(&stdout);
 }
 
 #[test]
