@@ -17,22 +17,15 @@ fn dtype_of(obj: &Bound<'_, PyAny>) -> String {
 
 /// `want` as text: `(N, 2, 3)` with `None` for any length.
 fn shape_text(want: &[Option<usize>], names: &[&str]) -> String {
-    let parts: Vec<String> = want
-        .iter()
-        .zip(names)
-        .map(|(w, n)| w.map_or(n.to_string(), |v| v.to_string()))
-        .collect();
+    let parts: Vec<String> =
+        want.iter().zip(names).map(|(w, n)| w.map_or(n.to_string(), |v| v.to_string())).collect();
     format!("({})", parts.join(", "))
 }
 
 /// Checks `shape` against `want` (a `None` entry takes any length).
-fn check_shape(
-    arg: &str,
-    shape: &[usize],
-    want: &[Option<usize>],
-    names: &[&str],
-) -> PyResult<()> {
-    let fits = shape.len() == want.len() && shape.iter().zip(want).all(|(s, w)| w.is_none_or(|w| *s == w));
+fn check_shape(arg: &str, shape: &[usize], want: &[Option<usize>], names: &[&str]) -> PyResult<()> {
+    let fits =
+        shape.len() == want.len() && shape.iter().zip(want).all(|(s, w)| w.is_none_or(|w| *s == w));
     if fits {
         Ok(())
     } else {
@@ -95,7 +88,9 @@ pub fn output<'py, T: Element>(
         return Err(PyValueError::new_err(format!("{arg} must be C-contiguous")));
     }
     array.try_readwrite().map_err(|e| {
-        PyValueError::new_err(format!("{arg} must be writeable and not overlap another argument ({e})"))
+        PyValueError::new_err(format!(
+            "{arg} must be writeable and not overlap another argument ({e})"
+        ))
     })
 }
 
@@ -110,9 +105,5 @@ pub fn finite(arg: &str, values: &[f64], shape: &[usize]) -> Result<(), String> 
         rest /= len.max(&1);
     }
     let index: Vec<String> = index.iter().map(|i| i.to_string()).collect();
-    Err(format!(
-        "{arg}[{}] = {}: every coordinate must be finite",
-        index.join(", "),
-        values[at]
-    ))
+    Err(format!("{arg}[{}] = {}: every coordinate must be finite", index.join(", "), values[at]))
 }

@@ -8,8 +8,8 @@ use crate::pycell::PyCell;
 use delta_collide::cell::exact::PairState;
 use delta_collide::cell::protective::clearance_now;
 use delta_collide::math::Vec3;
-use pyo3::exceptions::PyValueError;
 use numpy::PyUntypedArrayMethods;
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 /// `tcps` as `(N, robots, 3)` float64: its numbers and N.
@@ -126,12 +126,8 @@ pub fn boxes_into(
     let dims = [Some(n), Some(robots), Some(nb)];
     let names = ["N", "robots", "MAX_BOXES"];
     let mut c = output::<f64>("centers", centers, &[dims[0], dims[1], dims[2], Some(3)], &names)?;
-    let mut a = output::<f64>(
-        "axes",
-        axes,
-        &[dims[0], dims[1], dims[2], Some(3), Some(3)],
-        &names,
-    )?;
+    let mut a =
+        output::<f64>("axes", axes, &[dims[0], dims[1], dims[2], Some(3), Some(3)], &names)?;
     let mut h = output::<f64>("half", half, &[dims[0], dims[1], dims[2], Some(3)], &names)?;
     let shape = t.shape().to_vec();
     let values = t.as_slice()?;

@@ -12,8 +12,8 @@ use delta_collide::cell::protective::{
 };
 use delta_collide::cell::MAX_ROBOTS;
 use delta_collide::math::Vec3;
-use pyo3::exceptions::PyValueError;
 use numpy::PyUntypedArrayMethods;
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 /// The C ABI's verdict number (`DC_VERDICT_*`).
@@ -170,10 +170,9 @@ fn run_ticks(
                 for (sp, pts) in stop_paths[..robots].iter_mut().zip(&points) {
                     *sp = Some(StopPath { points: &pts[..n_points], tolerance_mm });
                 }
-                let request = delta_collide::cell::protective::ProtectiveRequest::new(
-                    &tcps[..robots],
-                )
-                .with_paths(&stop_paths[..robots]);
+                let request =
+                    delta_collide::cell::protective::ProtectiveRequest::new(&tcps[..robots])
+                        .with_paths(&stop_paths[..robots]);
                 checker.check(request)
             }
         }

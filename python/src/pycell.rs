@@ -209,7 +209,11 @@ impl PyCell {
     }
 
     fn __repr__(&self) -> String {
-        format!("Cell({:?}, {} robots, {} pairs can meet)", self.cell.name, self.cell.robots.len(),
-            self.cell.pairs_that_can_meet().len())
+        format!(
+            "Cell({:?}, {} robots, {} pairs can meet)",
+            self.cell.name,
+            self.cell.robots.len(),
+            self.cell.pairs_that_can_meet().len()
+        )
     }
 }

@@ -22,7 +22,7 @@ fn rows(py: Python<'_>, rows: &[Vec<f64>], width: usize) -> PyResult<Py<PyAny>> 
 /// `ticks` programme ticks with `gap_mm` between the robots; `clearance_mm` the coordination's
 /// clearance (None: its default); `right_of_way` "arrival" or "programmed". A dict of the
 /// run's figures, with `progress` (ticks, robots) and `stops` (events, robots) arrays and the
-/// programmes (robots, programme ticks + 1, 3).
+/// programmes (robots, programme ticks + 1, 3; a robot that ends earlier stands at its last point).
 #[pyfunction]
 #[pyo3(signature = (cell, mode="coordinate", paths=true, seed=1, ticks=6000, gap_mm=10.0,
     clearance_mm=None, right_of_way="arrival"))]
@@ -97,9 +97,11 @@ pub fn simulate<'py>(
     d.set_item("progress", rows(py, &trace.progress, n)?)?;
     d.set_item("stops", rows(py, &trace.stops, n)?)?;
     let longest = progs.iter().map(Vec::len).max().unwrap_or(0);
-    let mut flat = vec![f64::NAN; n * longest * 3];
+    // A robot whose programme ends earlier stands at its last point (as the loop parks it).
+    let mut flat = vec![0.0; n * longest * 3];
     for (j, p) in progs.iter().enumerate() {
-        for (k, v) in p.iter().enumerate() {
+        for k in 0..longest {
+            let v = p[k.min(p.len() - 1)];
             flat[(j * longest + k) * 3..(j * longest + k) * 3 + 3].copy_from_slice(v.as_slice());
         }
     }

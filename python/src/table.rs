@@ -14,8 +14,8 @@ use delta_collide::table::{
     build_table_bounded, default_max_memory, from_bytes, is_bundle, memory_plan, to_bytes,
     BoundedBuild, Labelling, Ladder, Table, TableAnswer, TableChecker, TableKind, Variant,
 };
-use pyo3::exceptions::PyValueError;
 use numpy::PyUntypedArrayMethods;
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Mutex;
@@ -98,9 +98,8 @@ impl PyTable {
         let cell = match cell {
             Some(c) => c,
             None => {
-                let (header, _) = from_bytes(&bytes).map_err(|e| {
-                    TableError::new_err(format!("{what}: {e}"))
-                })?;
+                let (header, _) =
+                    from_bytes(&bytes).map_err(|e| TableError::new_err(format!("{what}: {e}")))?;
                 let found = REFERENCE_CELL_FILES
                     .iter()
                     .filter_map(|(n, _)| reference_cell(n))
@@ -137,9 +136,8 @@ impl PyTable {
         progress: Option<Py<PyAny>>,
         max_memory: Option<u64>,
     ) -> PyResult<PyTable> {
-        let kind: TableKind = variant
-            .parse()
-            .map_err(|e: delta_collide::table::UnknownTableKind| {
+        let kind: TableKind =
+            variant.parse().map_err(|e: delta_collide::table::UnknownTableKind| {
                 PyValueError::new_err(format!("variant = {variant:?}: {e}"))
             })?;
         let variant = match (kind, levels) {
@@ -170,7 +168,8 @@ impl PyTable {
             default_max_memory(fixed, None)
         });
         let with_progress = progress.is_some();
-        let progress_fn = if with_progress { Progress::Rows(report_rows) } else { Progress::Silent };
+        let progress_fn =
+            if with_progress { Progress::Rows(report_rows) } else { Progress::Silent };
         let build = BoundedBuild { k, ws, variant, labelling, progress: progress_fn, max_memory };
         let bytes = py.detach(|| {
             let _turn = BUILDING.lock().unwrap_or_else(|e| e.into_inner());
@@ -297,7 +296,12 @@ impl PyTable {
 
     fn __repr__(&self) -> PyResult<String> {
         let (_, table) = from_bytes(&self.bytes).map_err(table_error)?;
-        Ok(format!("Table({}, k={}, {} bytes)", table.name(), 1u32 << table.levels(), self.bytes.len()))
+        Ok(format!(
+            "Table({}, k={}, {} bytes)",
+            table.name(),
+            1u32 << table.levels(),
+            self.bytes.len()
+        ))
     }
 }
 

@@ -64,10 +64,10 @@ def render(cell, tcps, path=None, title=None):
     return _finish(fig, path)
 
 
-def quilt(table, tcp_b, zs=(-800.0, -900.0, -1000.0), path=None, half_width=400.0, n=120):
+def quilt(table, tcp_b, zs=(-350.0, -450.0, -520.0), path=None, half_width=400.0, n=120):
     """A table's labels over 2-D slices: robot A's TCP over an x-y grid (its MCS) at each depth
-    of ``zs``, robot B's TCP fixed at ``tcp_b`` (B's MCS). White free, dark collision, grey
-    unreachable; the labels alone (no exact confirmation). Returns the figure; the images are
+    of ``zs``, robot B's TCP fixed at ``tcp_b`` (B's MCS). White free, black collision, light
+    grey unreachable; the labels alone (no exact confirmation). Returns the figure; the images are
     ``fig.quilt_images`` (len(zs), n, n) of 0 free, 1 collision, 2 unreachable."""
     from . import query
 
@@ -81,9 +81,12 @@ def quilt(table, tcp_b, zs=(-800.0, -900.0, -1000.0), path=None, half_width=400.
         tcps[:, 1] = tcp_b
         q = query(table, tcps, confirm="none")
         images[s] = np.where(~q.reachable, 2, q.collide.astype(np.uint8)).reshape(n, n)
+    from matplotlib.colors import ListedColormap
+
+    colours = ListedColormap(["white", "black", "lightgrey"])
     fig, axes = plt.subplots(1, len(zs), figsize=(4 * len(zs), 4), squeeze=False)
     for ax, z, img in zip(axes[0], zs, images):
-        ax.imshow(img, origin="lower", extent=[-half_width, half_width] * 2, cmap="Greys", vmin=0, vmax=2.5)
+        ax.imshow(img, origin="lower", extent=[-half_width, half_width] * 2, cmap=colours, vmin=0, vmax=2)
         ax.set_title(f"A at z = {z:g} mm")
         ax.set_xlabel("x (mm)")
         ax.set_ylabel("y (mm)")
