@@ -7,8 +7,9 @@ tree-sitter-iec61131-3-st==0.1.2):
     python plc/check_st.py [--src plc/src] [--header include/delta_collide.h]
                            [--readme plc/README.md]
 
-1. Every .st file parses without error with blark and with tree-sitter, and a broken copy of
-   each (an END_ keyword misspelt, a semicolon dropped) fails both.
+1. Every .st file parses without error with blark and with tree-sitter, and two broken copies
+   of each (its first END_ keyword misspelt; the `:` of its first declaration written `=`)
+   fail both.
 2. blark's and tree-sitter's readings of the declarations agree: the external functions, the
    structs, the function blocks' VAR_INPUT and VAR_OUTPUT, the global constants.
 3. Those declarations agree with the header: each external's name (and external_name
