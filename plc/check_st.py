@@ -17,7 +17,8 @@ tree-sitter-iec61131-3-st==0.1.2):
    against struct DcX; each constant's value; the types mapped by the table of
    plc/README.md, "Types". Each call of an external names all its parameters in order.
 4. Every DC_STATUS_* of the header is a CASE label of F_DcKnownStatus and a row of the
-   ErrorID table in plc/README.md, with the ErrorID and DiagCodes of the documented rule.
+   ErrorID table in plc/README.md, with the ErrorID and DiagCodes of the documented rule;
+   every DiagCode the code sets is a row of the README's DiagCode table.
 5. The transitions that FB_DeltaCollide and FB_DeltaProtect take (each `Transition := N`
    right after a `State := E_DcFbState.X` inside a CASE on State) are exactly the rows of the
    transition table in plc/README.md, "State machine".
@@ -492,6 +493,32 @@ def check_status_mapping(trees, defines, readme):
           f"README documents statuses the header lacks: {sorted(set(documented) - set(statuses))}")
 
 
+def check_diag_codes(trees, readme):
+    """Every DiagCode the code can set is a row of plc/README.md's DiagCode table: the
+    literals assigned to DiagCode in the blocks, and the bases F_DcDiagError combines with
+    an ErrorID (16#C100 OR id is the row 16#C1xx)."""
+    section = readme.split("### ErrorID and DiagCode", 1)[1]
+    documented = set(re.findall(r"^\| (16#[0-9A-Fa-fx]{4}) \|", section, flags=re.M))
+    found = set()
+    for tree in trees.values():
+        for n in walk(tree.root_node):
+            if n.type != "assignment_statement":
+                continue
+            left = txt(n.child_by_field_name("left"))
+            if left not in ("DiagCode", "F_DcDiagError"):
+                continue
+            right = n.child_by_field_name("right")
+            if right.type == "integer_literal":
+                found.add(f"16#{st_int(txt(right)):04X}")
+            elif right.type == "binary_expression":
+                base = st_int(txt(right.child_by_field_name("left")))
+                found.add(f"16#{base >> 8:02X}xx")
+    check(len(found) >= 8, f"DiagCodes found in the code: {sorted(found)}")
+    for code in sorted(found):
+        check(code in documented, f"DiagCode {code} is set by the code but has no row in the README")
+    print(f"DiagCodes set by the code, each documented: {' '.join(sorted(found))}")
+
+
 def read_transition_table(readme):
     section = readme.split("### State machine", 1)[1].split("\n#", 1)[0]
     rows = re.findall(r"^\| T(\d+) \| (\w+) \| [^|]+ \| (\w+) \|", section, flags=re.M)
@@ -573,6 +600,7 @@ def main():
         check(False, str(e))
         externals = {}
     check_status_mapping(trees, defines, readme)
+    check_diag_codes(trees, readme)
     check_transitions(trees, readme)
     print(f"externals checked against the header: {', '.join(sorted(externals))}")
     print(f"check_st: {PASSED} passed, {FAILED} failed")

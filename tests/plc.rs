@@ -190,7 +190,7 @@ fn checker_fails_when_the_header_changes_under_the_blocks() {
 }
 
 /// The blocks and the README are checked against each other: a transition to a state the
-/// table does not give, or a status without its row, fails.
+/// table does not give, a status without its row, a DiagCode or type row changed, fails.
 #[test]
 fn checker_fails_on_a_wrong_transition_or_an_undocumented_status() {
     let Some(python) = python_or_skip("checker_fails_on_a_wrong_transition") else {
@@ -243,5 +243,11 @@ fn checker_fails_on_a_wrong_transition_or_an_undocumented_status() {
         "--readme",
         &altered(&readme, "| `size_t` | `__UXINT` |", "| `size_t` | `UDINT` |", "r3.md"),
         "dc_init_with_table: parameter #2",
+    );
+    assert_fails(
+        python,
+        "--readme",
+        &altered(&readme, "| 16#8002 |", "| 16#8012 |", "r4.md"),
+        "DiagCode 16#8002 is set by the code but has no row",
     );
 }
