@@ -14,6 +14,8 @@ import pytest
 import delta_collide as dc
 
 REPO = Path(os.environ.get("DELTA_COLLIDE_REPO", Path(__file__).resolve().parents[2]))
+# Hypothesis's example database under target/, never beside the sources.
+os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY", str(REPO / "target" / "py-hypothesis"))
 CELL_FILES = ["cells/t1.toml", "cells/t2.toml", "cells/t3.toml", "cells/line4.toml"]
 
 

@@ -234,3 +234,18 @@ def test_pictures_are_drawn_and_saved(tmp_path, t1, table16):
     dc.plot_run(dc.protective(t1, run), path=tmp_path / "p.png")
     dc.plot_run(dc.simulate(t1, seed=1, ticks=600), path=tmp_path / "s.png")
     assert (tmp_path / "p.png").stat().st_size > 1000 and (tmp_path / "s.png").stat().st_size > 1000
+
+
+def test_stop_paths_are_checked(t1):
+    run = np.ascontiguousarray(np.repeat([[[0.0, 0.0, -450.0], [0.0, 0.0, -450.0]]], 4, axis=0))
+    with pytest.raises(ValueError, match="paths has 33 points"):
+        dc.protective(t1, run, np.zeros((4, 2, 33, 3)))
+    with pytest.raises(ValueError, match=r"paths has shape \[3, 2, 2, 3\]"):
+        dc.protective(t1, run, np.zeros((3, 2, 2, 3)))
+    with pytest.raises(ValueError, match="path_tolerance_mm"):
+        dc.protective(t1, run, np.zeros((4, 2, 2, 3)), path_tolerance_mm=-1.0)
+    # A TCP farther from its path than the tolerance: STOP with DC_STATUS_INVALID_ARGUMENT (9).
+    far = np.zeros((4, 2, 2, 3))
+    far[..., 2] = -300.0
+    p = dc.protective(t1, run, far, path_tolerance_mm=1.0)
+    assert (p.verdict == dc.VERDICT_STOP).all() and (p.status == 9).all()
