@@ -4,15 +4,17 @@
 
 use crate::arrays::{finite, input, output};
 use crate::count_alloc;
-use crate::errors::{build_error, table_error, TableError};
+use crate::errors::{build_error, table_error, BuildError, TableError};
 use crate::pycell::PyCell;
 use delta_collide::cell::reference::{reference_cell, REFERENCE_CELL_FILES};
-use delta_collide::cell::Confirmation;
+use delta_collide::cell::{Confirmation, MAX_ROBOTS};
 use delta_collide::cspace::{Progress, Workspace};
 use delta_collide::math::Vec3;
+use delta_collide::table::bundle::build_bundle;
 use delta_collide::table::{
-    build_table_bounded, default_max_memory, from_bytes, is_bundle, memory_plan, to_bytes,
-    BoundedBuild, Labelling, Ladder, Table, TableAnswer, TableChecker, TableKind, Variant,
+    build_table_bounded, bundle_from_bytes, default_max_memory, from_bytes, is_bundle, memory_plan,
+    to_bytes, BoundedBuild, BundleChecker, Labelling, Ladder, Table, TableAnswer, TableChecker,
+    TableKind, Variant,
 };
 use numpy::PyUntypedArrayMethods;
 use pyo3::exceptions::PyValueError;
@@ -20,12 +22,35 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Mutex;
 
-/// A table with its cell: queries go through the library's table checker.
+/// A table (two robots) or a bundle of tables (a line of robots) with its cell: queries go
+/// through the library's table or bundle checker, as table mode's `dc_query`.
 #[pyclass(name = "Table", module = "delta_collide", frozen)]
 pub struct PyTable {
     bytes: Vec<u8>,
-    checker: Mutex<TableChecker>,
+    checker: Mutex<Checker>,
     cell: Py<PyCell>,
+}
+
+/// The checker of a table file or of a bundle.
+enum Checker {
+    Table(Box<TableChecker>),
+    Bundle(Box<BundleChecker>),
+}
+
+impl Checker {
+    fn confirmation(&self) -> Confirmation {
+        match self {
+            Checker::Table(t) => t.confirmation(),
+            Checker::Bundle(b) => b.confirmation(),
+        }
+    }
+
+    fn set_confirmation(&mut self, confirmation: Confirmation) {
+        match self {
+            Checker::Table(t) => t.set_confirmation(confirmation),
+            Checker::Bundle(b) => b.set_confirmation(confirmation),
+        }
+    }
 }
 
 /// The Python callback of the build under way (one build with progress at a time).
@@ -66,15 +91,17 @@ impl PyTable {
         confirm: Option<&str>,
         what: &str,
     ) -> PyResult<PyTable> {
-        if is_bundle(&bytes) {
-            return Err(TableError::new_err(format!(
-                "{what}: a bundle of tables; this package reads two-robot tables only"
-            )));
-        }
         let c = cell.get();
         let confirmation = confirmation(confirm, c)?;
-        let checker = TableChecker::with_confirmation(c.cell.clone(), &bytes, confirmation)
-            .map_err(|e| TableError::new_err(format!("{what}: {e}")))?;
+        let at = |e: delta_collide::table::TableError| TableError::new_err(format!("{what}: {e}"));
+        // As the CLI and `dc_init_with_table`: a bundle, or any table for more than two robots.
+        let checker = if c.cell.robots.len() == 2 && !is_bundle(&bytes) {
+            let t = TableChecker::with_confirmation(c.cell.clone(), &bytes, confirmation);
+            Checker::Table(Box::new(t.map_err(at)?))
+        } else {
+            let b = BundleChecker::new(c.cell.clone(), &bytes, confirmation);
+            Checker::Bundle(Box::new(b.map_err(at)?))
+        };
         let _ = py;
         Ok(PyTable { bytes, checker: Mutex::new(checker), cell })
     }
@@ -98,17 +125,18 @@ impl PyTable {
         let cell = match cell {
             Some(c) => c,
             None => {
-                let (header, _) =
-                    from_bytes(&bytes).map_err(|e| TableError::new_err(format!("{what}: {e}")))?;
+                let fingerprint = bundle_from_bytes(&bytes)
+                    .map_err(|e| TableError::new_err(format!("{what}: {e}")))?
+                    .cell_fingerprint;
                 let found = REFERENCE_CELL_FILES
                     .iter()
                     .filter_map(|(n, _)| reference_cell(n))
-                    .find(|c| c.fingerprint() == header.cell_fingerprint)
+                    .find(|c| c.fingerprint() == fingerprint)
                     .ok_or_else(|| {
                         TableError::new_err(format!(
                             "{what}: built for cell fingerprint {:#018x}, no reference cell; \
                              pass cell=Cell.from_file(...) of the cell it was built for",
-                            header.cell_fingerprint
+                            fingerprint
                         ))
                     })?;
                 Py::new(py, PyCell::new(found, Confirmation::Exact))?
@@ -178,15 +206,23 @@ impl PyTable {
                     *PROGRESS.lock().unwrap_or_else(|e| e.into_inner()) = progress;
                 });
             }
-            let built = build_table_bounded(&c.cell, &build);
+            // A line of robots: a bundle of one table per relative placement that can meet.
+            let built = if c.cell.robots.len() > 2 {
+                build_bundle(&c.cell, k, &ws, variant, labelling, progress_fn)
+                    .map(|b| b.bytes)
+                    .map_err(BuildError::new_err)
+            } else {
+                build_table_bounded(&c.cell, &build)
+                    .map(|(header, table, _)| to_bytes(&table, &header))
+                    .map_err(build_error)
+            };
             if with_progress {
                 Python::attach(|_| {
                     PROGRESS.lock().unwrap_or_else(|e| e.into_inner()).take();
                 });
             }
-            built.map(|(header, table, _)| to_bytes(&table, &header))
-        });
-        let bytes = bytes.map_err(build_error)?;
+            built
+        })?;
         PyTable::from_bytes(py, bytes, cell, None, "built table")
     }
 
@@ -208,45 +244,87 @@ impl PyTable {
         self.cell.clone_ref(py)
     }
 
-    /// What the table file holds, as `delta-collide inspect` prints it.
+    /// What the table file holds, as `delta-collide inspect` prints it; a bundle: `bundle`
+    /// True, its `tables` (each as a table's dict) and `pairs` (robot a, robot b, table).
     fn inspect<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let (h, table) = from_bytes(&self.bytes).map_err(table_error)?;
-        inspect_dict(py, &h, &table, self.bytes.len())
+        if !is_bundle(&self.bytes) {
+            let (h, table) = from_bytes(&self.bytes).map_err(table_error)?;
+            let d = inspect_dict(py, &h, &table, self.bytes.len())?;
+            d.set_item("bundle", false)?;
+            return Ok(d);
+        }
+        let b = bundle_from_bytes(&self.bytes).map_err(table_error)?;
+        let d = PyDict::new(py);
+        d.set_item("bundle", true)?;
+        d.set_item("cell_fingerprint", b.cell_fingerprint)?;
+        d.set_item("robots", b.robots)?;
+        d.set_item("file_bytes", self.bytes.len())?;
+        let tables = pyo3::types::PyList::empty(py);
+        for (h, t) in &b.tables {
+            tables.append(inspect_dict(py, h, t, 0)?)?;
+        }
+        d.set_item("tables", tables)?;
+        let pairs: Vec<(usize, usize, usize)> =
+            b.pairs.iter().map(|p| (p.a, p.b, p.table)).collect();
+        d.set_item("pairs", pairs)?;
+        Ok(d)
     }
 
-    /// Table mode over every configuration of `tcps` (N, 2, 3) into `reachable` (N,) bool and
-    /// `collide` (N,) bool (false when unreachable), as `dc_query` answers each tick.
-    /// `confirm` "exact" or "none" for this call only (default: the table's).
-    #[pyo3(signature = (tcps, reachable, collide, confirm=None))]
+    /// Table mode over every configuration of `tcps` (N, robots, 3) into `reachable` (N,)
+    /// bool, `collide` (N,) bool (false unless every TCP is reachable) and `pairs` (N, pairs)
+    /// bool (each pair that can meet, `cell.pairs` order), as `dc_query` and
+    /// `dc_pair_results` answer each tick; `confirm` "exact" or "none" for this call only
+    /// (default: the table's).
+    #[pyo3(signature = (tcps, reachable, collide, pairs, confirm=None))]
     fn query_into(
         &self,
         py: Python<'_>,
         tcps: &Bound<'_, PyAny>,
         reachable: &Bound<'_, PyAny>,
         collide: &Bound<'_, PyAny>,
+        pairs: &Bound<'_, PyAny>,
         confirm: Option<&str>,
     ) -> PyResult<()> {
+        let cell = self.cell.get();
         let confirm = match confirm {
-            Some(name) => Some(confirmation(Some(name), self.cell.get())?),
+            Some(name) => Some(confirmation(Some(name), cell)?),
             None => None,
         };
-        let t = input::<f64>("tcps", tcps, &[None, Some(2), Some(3)], &["N", "robots", "3"])?;
+        let robots = cell.cell.robots.len();
+        let n_pairs = cell.cell.pairs_that_can_meet().len();
+        let t = input::<f64>("tcps", tcps, &[None, Some(robots), Some(3)], &TCPS)?;
         let n = t.shape()[0];
         let mut r = output::<bool>("reachable", reachable, &[Some(n)], &["N"])?;
         let mut c = output::<bool>("collide", collide, &[Some(n)], &["N"])?;
+        let mut p = output::<bool>("pairs", pairs, &[Some(n), Some(n_pairs)], &["N", "pairs"])?;
         let shape = t.shape().to_vec();
         let values = t.as_slice()?;
-        let (r, c) = (r.as_slice_mut()?, c.as_slice_mut()?);
+        let (r, c, p) = (r.as_slice_mut()?, c.as_slice_mut()?, p.as_slice_mut()?);
         py.detach(|| {
             count_alloc::work(|| {
                 finite("tcps", values, &shape)?;
                 let mut checker = self.checker.lock().map_err(|_| "the table is poisoned")?;
                 let kept = checker.confirmation();
                 checker.set_confirmation(confirm.unwrap_or(kept));
+                let mut buf = [Vec3::zeros(); MAX_ROBOTS];
+                let buf = &mut buf[..robots];
                 for i in 0..n {
-                    let tcps = pair(values, i);
-                    let answer = checker.check(&tcps).map_err(|e| e.to_string())?;
-                    (r[i], c[i]) = match answer {
+                    load(values, robots, i, buf);
+                    let answer = match &mut *checker {
+                        Checker::Table(t) => {
+                            let a = t.check(buf);
+                            p[i] = a == Ok(TableAnswer::Collision);
+                            a
+                        }
+                        Checker::Bundle(b) => {
+                            let a = b.check(buf);
+                            for (k, pair) in b.pairs().iter().enumerate() {
+                                p[i * n_pairs + k] = pair.answer == TableAnswer::Collision;
+                            }
+                            a
+                        }
+                    };
+                    (r[i], c[i]) = match answer.map_err(|e| e.to_string())? {
                         TableAnswer::Free => (true, false),
                         TableAnswer::Collision => (true, true),
                         TableAnswer::Unreachable(_) => (false, false),
@@ -260,15 +338,19 @@ impl PyTable {
     }
 
     /// The certified lower bound on the clearance (mm) of the grid cell of every configuration
-    /// of `tcps` (N, 2, 3) into `out` (N,) float64: `-inf` where nothing is proved (no level,
-    /// outside the grid, a boolean table), NaN where a TCP is unreachable.
+    /// of `tcps` (N, robots, 3) into `out` (N,) float64: `-inf` where nothing is proved (no
+    /// level, outside the grid, a boolean table), NaN where a TCP is unreachable. A bundle's
+    /// bound is the least of its pairs' (`dc_table_clearance_bound` answers `-inf` for a
+    /// bundle).
     fn clearance_bound_into(
         &self,
         py: Python<'_>,
         tcps: &Bound<'_, PyAny>,
         out: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
-        let t = input::<f64>("tcps", tcps, &[None, Some(2), Some(3)], &["N", "robots", "3"])?;
+        let cell = self.cell.get();
+        let robots = cell.cell.robots.len();
+        let t = input::<f64>("tcps", tcps, &[None, Some(robots), Some(3)], &TCPS)?;
         let n = t.shape()[0];
         let mut o = output::<f64>("out", out, &[Some(n)], &["N"])?;
         let shape = t.shape().to_vec();
@@ -278,14 +360,23 @@ impl PyTable {
             count_alloc::work(|| {
                 finite("tcps", values, &shape)?;
                 let checker = self.checker.lock().map_err(|_| "the table is poisoned")?;
+                let mut buf = [Vec3::zeros(); MAX_ROBOTS];
+                let buf = &mut buf[..robots];
                 for (i, slot) in o.iter_mut().enumerate() {
-                    let tcps = pair(values, i);
-                    *slot = match checker.located_clearance_bound(&tcps) {
-                        Ok(bound) if checker.table().as_clearance().is_some() => {
-                            bound.unwrap_or(f64::NEG_INFINITY)
-                        }
-                        Ok(_) => f64::NEG_INFINITY,
-                        Err(_) => f64::NAN,
+                    load(values, robots, i, buf);
+                    *slot = match &*checker {
+                        Checker::Table(t) => match t.located_clearance_bound(buf) {
+                            Ok(bound) if t.table().as_clearance().is_some() => {
+                                bound.unwrap_or(f64::NEG_INFINITY)
+                            }
+                            Ok(_) => f64::NEG_INFINITY,
+                            Err(_) => f64::NAN,
+                        },
+                        Checker::Bundle(b) if b.unreachable_mask(buf) != 0 => f64::NAN,
+                        Checker::Bundle(b) => b.pairs().iter().fold(f64::INFINITY, |m, p| {
+                            let pair = [buf[p.a], buf[p.b]];
+                            m.min(b.clearance_bound(p.a, p.b, &pair).unwrap_or(f64::NEG_INFINITY))
+                        }),
                     };
                 }
                 Ok::<(), String>(())
@@ -295,6 +386,14 @@ impl PyTable {
     }
 
     fn __repr__(&self) -> PyResult<String> {
+        if is_bundle(&self.bytes) {
+            let b = bundle_from_bytes(&self.bytes).map_err(table_error)?;
+            return Ok(format!(
+                "Table(bundle of {} tables, {} bytes)",
+                b.tables.len(),
+                self.bytes.len()
+            ));
+        }
         let (_, table) = from_bytes(&self.bytes).map_err(table_error)?;
         Ok(format!(
             "Table({}, k={}, {} bytes)",
@@ -305,14 +404,15 @@ impl PyTable {
     }
 }
 
-/// The two TCPs of configuration `i`.
+const TCPS: [&str; 3] = ["N", "robots", "3"];
+
+/// The TCPs of configuration `i` into `out`.
 #[inline(always)]
-fn pair(values: &[f64], i: usize) -> [Vec3; 2] {
-    let k = 6 * i;
-    [
-        Vec3::new(values[k], values[k + 1], values[k + 2]),
-        Vec3::new(values[k + 3], values[k + 4], values[k + 5]),
-    ]
+fn load(values: &[f64], robots: usize, i: usize, out: &mut [Vec3]) {
+    for (j, t) in out.iter_mut().enumerate() {
+        let k = 3 * (i * robots + j);
+        *t = Vec3::new(values[k], values[k + 1], values[k + 2]);
+    }
 }
 
 fn inspect_dict<'py>(

@@ -194,3 +194,43 @@ def test_table_mode_equals_dc_query_and_clearance_bound(cabi, tmp_path):
                     assert np.isnan(bound[i]), i
         assert ours.collide.any() and (ours.reachable & ~ours.collide).any()
     assert np.isfinite(bound).any() and np.isneginf(bound).any()
+
+
+def test_bundle_mode_equals_dc_query_and_pair_results(cabi, tmp_path):
+    """A line of four robots: one table per relative placement that can meet, in a bundle."""
+    from conftest import REPO
+
+    cell_file = REPO / "cells" / "line4.toml"
+    cell = dc.Cell.from_file(cell_file)
+    bundle = dc.Table.build(cell, 16, "clearance")
+    info = bundle.inspect()
+    assert info["bundle"] and len(info["pairs"]) == len(cell.pairs)
+    path = tmp_path / "line4.dcb"
+    bundle.save(path)
+    loaded = dc.Table.load(path, cell)
+    rng = np.random.default_rng(9)
+    # Neighbours reaching toward each other, so that pairs of the line collide.
+    tcps = random_tcps(rng, 1500, 4)
+    tcps[:, :, 0] = rng.uniform(-250.0, 250.0, (1500, 4))
+    tcps[:, :, 2] = rng.uniform(-520.0, -380.0, (1500, 4))
+    tcps = np.ascontiguousarray(tcps)
+    n_pairs = len(cell.pairs)
+    pairs = (DcPairResult * n_pairs)()
+    got_len = ctypes.c_size_t()
+    for confirm, c_confirm in (("exact", 1), ("none", 0)):
+        ours = loaded.query(tcps, confirm=confirm)
+        verdict = ctypes.c_uint32()
+        report = DcQueryReport()
+        with Handle(cabi, cell_file, path) as h:
+            assert cabi.dc_set_table_confirmation(h.h, c_confirm) == DC_STATUS_OK
+            for i, config in enumerate(tcps):
+                status = cabi.dc_query(h.h, vec3s(config), 4, ctypes.byref(verdict), ctypes.byref(report))
+                assert ours.reachable[i] == (status == DC_STATUS_OK), i
+                assert ours.collide[i] == (status == DC_STATUS_OK and verdict.value == DC_VERDICT_COLLISION), i
+                assert cabi.dc_pair_results(h.h, pairs, n_pairs, ctypes.byref(got_len)) == DC_STATUS_OK
+                assert [bool(pairs[k].collides) for k in range(n_pairs)] == ours.pairs[i].tolist(), i
+        assert ours.collide.any() and (ours.reachable & ~ours.collide).any()
+    # The bundle's bound (the least of its pairs') never exceeds the exact clearance.
+    bound, exact = loaded.clearance_bound(tcps), dc.clearance(cell, tcps)
+    proved = np.isfinite(bound)
+    assert proved.any() and (bound[proved] <= exact[proved]).all()

@@ -177,20 +177,22 @@ def protective(
 
 
 def query(table: Table, tcps: np.ndarray, out: Check | None = None, confirm: str | None = None) -> Check:
-    """Table mode over (N, 2, 3) configurations, as ``dc_query`` answers each tick:
-    ``reachable``, ``collide`` (and ``pairs``, the one pair). ``confirm`` "none" answers the
-    table's labels alone, "exact" confirms a COLLISION lookup with the exact check."""
+    """Table mode over (N, robots, 3) configurations, as ``dc_query`` and
+    ``dc_pair_results`` answer each tick: ``reachable``, ``collide``, ``pairs`` (one column
+    per pair of ``table.cell.pairs``). ``confirm`` "none" answers the table's labels alone,
+    "exact" confirms a COLLISION lookup with the exact check (default: the table's)."""
     if out is None:
         n = _rows(tcps)
-        out = Check(np.empty(n, dtype=bool), np.empty(n, dtype=bool), np.empty((n, 1), dtype=bool))
-    table.query_into(tcps, out.reachable, out.collide, confirm)
-    out.pairs[:, 0] = out.collide
+        pairs = len(table.cell.pairs)
+        out = Check(np.empty(n, dtype=bool), np.empty(n, dtype=bool), np.empty((n, pairs), dtype=bool))
+    table.query_into(tcps, out.reachable, out.collide, out.pairs, confirm)
     return out
 
 
 def clearance_bound(table: Table, tcps: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """A clearance table's certified lower bound on the clearance (mm) per configuration:
-    -inf where nothing is proved, NaN where a TCP is unreachable."""
+    -inf where nothing is proved, NaN where a TCP is unreachable; for a bundle the least of
+    its pairs' bounds."""
     if out is None:
         out = np.empty(_rows(tcps), dtype=np.float64)
     table.clearance_bound_into(tcps, out)
