@@ -6,9 +6,11 @@
 use crate::arrays::{finite, input, output};
 use crate::count_alloc;
 use crate::errors::cell_error;
-use crate::pycell::PyCell;
+use crate::pycell::{Protectives, PyCell};
+use crate::table::PyTable;
 use delta_collide::cell::protective::{
-    Protective, ProtectiveChecker, ProtectiveStatus, StopPath, TimingFault, MAX_PATH_POINTS,
+    ClearanceBound, Protective, ProtectiveChecker, ProtectiveRequest, ProtectiveStatus, StopPath,
+    TimingFault, MAX_PATH_POINTS,
 };
 use delta_collide::cell::MAX_ROBOTS;
 use delta_collide::math::Vec3;
@@ -57,7 +59,7 @@ struct Outputs<'a> {
 /// `protective_mm` and `speed_limit` (T, robots) float64 (mm, mm/s; speed limits NaN when off).
 #[pyfunction]
 #[pyo3(signature = (cell, run, paths, path_tolerance_mm, warn_mm, speed_limits, verdict, status,
-    clearance, protective_mm, speed_limit))]
+    clearance, protective_mm, speed_limit, table=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn protective_into(
     py: Python<'_>,
@@ -72,8 +74,18 @@ pub fn protective_into(
     clearance: &Bound<'_, PyAny>,
     protective_mm: &Bound<'_, PyAny>,
     speed_limit: &Bound<'_, PyAny>,
+    table: Option<&PyTable>,
 ) -> PyResult<()> {
     let robots = cell.cell.robots.len();
+    if let Some(t) = table {
+        if t.cell.get().cell.fingerprint() != cell.cell.fingerprint() {
+            return Err(PyValueError::new_err(format!(
+                "table was built for cell {:?}, not for this cell {:?}: pass its own table",
+                t.cell.get().cell.name,
+                cell.cell.name
+            )));
+        }
+    }
     let r = input::<f64>("run", run, &[None, Some(robots), Some(3)], &["T", "robots", "3"])?;
     let t = r.shape()[0];
     let p = match paths {
@@ -104,11 +116,13 @@ pub fn protective_into(
     let mut sl = output::<f64>("speed_limit", speed_limit, &per_robot, &["T", "robots"])?;
     {
         let mut slot = cell.protective.lock().map_err(|_| PyValueError::new_err("poisoned"))?;
-        if slot.as_ref().is_none_or(|(w, _)| w.to_bits() != warn_mm.to_bits()) {
+        if slot.as_ref().is_none_or(|p| p.warn_mm.to_bits() != warn_mm.to_bits()) {
             // Made once per cell and warn_mm (its motor-angle tables take a while): outside
             // the counted work, like the controller's `dc_set_stop_model` at start-up.
             let made = py.detach(|| ProtectiveChecker::new(cell.cell.clone(), warn_mm));
-            *slot = Some((warn_mm, made.map_err(cell_error)?));
+            let pristine = made.map_err(cell_error)?;
+            let work = pristine.clone();
+            *slot = Some(Protectives { warn_mm, pristine, work, used: false });
         }
     }
     let shape = r.shape().to_vec();
@@ -132,51 +146,81 @@ pub fn protective_into(
                 finite("paths", pv, ps)?;
             }
             let mut slot = cell.protective.lock().map_err(|_| "the cell's checker is poisoned")?;
-            let (_, checker) = slot.as_mut().ok_or("no protective checker")?;
+            let p = slot.as_mut().ok_or("no protective checker")?;
+            if std::mem::replace(&mut p.used, true) {
+                // A copy of the pristine state: a fixed number of allocations whatever the
+                // run's length (the library has no call that forgets its warm starts).
+                count_alloc::outside_work(|| p.work.clone_from(&p.pristine));
+            }
+            let checker = &mut p.work;
             checker.set_speed_limits(speed_limits);
             checker.reset();
-            run_ticks(checker, values, path_values, n_points, path_tolerance_mm, robots, &mut out)
+            let inputs = Inputs {
+                values,
+                paths: path_values,
+                n_points,
+                tolerance_mm: path_tolerance_mm,
+                robots,
+            };
+            match table {
+                None => run_ticks(checker, &inputs, None, &mut out),
+                Some(t) => {
+                    let guard = t.checker.lock().map_err(|_| "the table is poisoned")?;
+                    // As table mode's `dc_protective_query`: the bound of clearance tables only.
+                    let bound = |a: usize, b: usize, tcps: &[Vec3]| guard.pair_bound(a, b, tcps);
+                    let bound: ClearanceBound = &bound;
+                    run_ticks(checker, &inputs, guard.has_clearance().then_some(bound), &mut out)
+                }
+            }
         })
     })
     .map_err(PyValueError::new_err)
 }
 
-/// The ticks of one run (inputs checked).
-fn run_ticks(
-    checker: &mut ProtectiveChecker,
-    values: &[f64],
-    paths: Option<&[f64]>,
+/// A run's inputs, checked: TCPs (T, robots, 3) and stop paths (T, robots, P, 3) as numbers.
+struct Inputs<'a> {
+    values: &'a [f64],
+    paths: Option<&'a [f64]>,
     n_points: usize,
     tolerance_mm: f64,
     robots: usize,
+}
+
+/// The ticks of one run, with the clearance table's `bound` when given.
+fn run_ticks(
+    checker: &mut ProtectiveChecker,
+    inputs: &Inputs,
+    bound: Option<ClearanceBound>,
     out: &mut Outputs,
 ) -> Result<(), String> {
+    let (robots, n_points) = (inputs.robots, inputs.n_points);
     let mut tcps = [Vec3::zeros(); MAX_ROBOTS];
     let mut points = [[Vec3::zeros(); MAX_PATH_POINTS]; MAX_ROBOTS];
     let at = |k: usize, v: &[f64]| Vec3::new(v[k], v[k + 1], v[k + 2]);
     for i in 0..out.verdict.len() {
         for (j, tcp) in tcps[..robots].iter_mut().enumerate() {
-            *tcp = at(3 * (i * robots + j), values);
+            *tcp = at(3 * (i * robots + j), inputs.values);
         }
-        let report = match paths {
-            None => checker.check(&tcps[..robots]),
-            Some(pv) => {
-                for (j, robot_points) in points[..robots].iter_mut().enumerate() {
-                    for (q, point) in robot_points[..n_points].iter_mut().enumerate() {
-                        *point = at(3 * ((i * robots + j) * n_points + q), pv);
-                    }
+        let mut stop_paths: [Option<StopPath>; MAX_ROBOTS] = [None; MAX_ROBOTS];
+        let mut n_paths = 0;
+        if let Some(pv) = inputs.paths {
+            for (j, robot_points) in points[..robots].iter_mut().enumerate() {
+                for (q, point) in robot_points[..n_points].iter_mut().enumerate() {
+                    *point = at(3 * ((i * robots + j) * n_points + q), pv);
                 }
-                let mut stop_paths: [Option<StopPath>; MAX_ROBOTS] = [None; MAX_ROBOTS];
-                for (sp, pts) in stop_paths[..robots].iter_mut().zip(&points) {
-                    *sp = Some(StopPath { points: &pts[..n_points], tolerance_mm });
-                }
-                let request =
-                    delta_collide::cell::protective::ProtectiveRequest::new(&tcps[..robots])
-                        .with_paths(&stop_paths[..robots]);
-                checker.check(request)
             }
+            for (sp, pts) in stop_paths[..robots].iter_mut().zip(&points) {
+                *sp =
+                    Some(StopPath { points: &pts[..n_points], tolerance_mm: inputs.tolerance_mm });
+            }
+            n_paths = robots;
         }
-        .map_err(|e| e.to_string())?;
+        let mut request =
+            ProtectiveRequest::new(&tcps[..robots]).with_paths(&stop_paths[..n_paths]);
+        if let Some(b) = bound {
+            request = request.with_table(b);
+        }
+        let report = checker.check(request).map_err(|e| e.to_string())?;
         out.verdict[i] = verdict_code(report.verdict);
         out.status[i] = status_code(report.status);
         out.clearance[i] = report.clearance_mm;

@@ -19,8 +19,20 @@ pub struct PyCell {
     pub confirmation: Confirmation,
     /// The exact checker of `check` and `clearance` (one call at a time per cell).
     pub exact: Mutex<ExactChecker>,
-    /// The protective checker of `protective`, made on first use, and its `warn_mm`.
-    pub protective: Mutex<Option<(f64, ProtectiveChecker)>>,
+    /// The protective checkers of `protective`, made on first use.
+    pub protective: Mutex<Option<Protectives>>,
+}
+
+/// The protective checker of a `warn_mm` as made (`pristine`, never run) and the one a run
+/// uses (`work`), reset to the pristine one before each run: besides the previous TCPs a
+/// checker keeps warm starts of each pair's clearance (`CoherentClearance`), which change the
+/// last bits of the reported clearance; so each run answers as a fresh C handle does.
+pub struct Protectives {
+    pub warn_mm: f64,
+    pub pristine: ProtectiveChecker,
+    pub work: ProtectiveChecker,
+    /// Whether `work` has run since it was last reset.
+    pub used: bool,
 }
 
 impl PyCell {

@@ -27,17 +27,34 @@ use std::sync::Mutex;
 #[pyclass(name = "Table", module = "delta_collide", frozen)]
 pub struct PyTable {
     bytes: Vec<u8>,
-    checker: Mutex<Checker>,
-    cell: Py<PyCell>,
+    pub(crate) checker: Mutex<Checker>,
+    pub(crate) cell: Py<PyCell>,
 }
 
 /// The checker of a table file or of a bundle.
-enum Checker {
+pub(crate) enum Checker {
     Table(Box<TableChecker>),
     Bundle(Box<BundleChecker>),
 }
 
 impl Checker {
+    /// The clearance table's bound of robots `a`, `b` at their TCPs `tcps` (`[tcp_a, tcp_b]`),
+    /// as table mode's protective query reads it; `None` without clearance tables.
+    pub(crate) fn pair_bound(&self, a: usize, b: usize, tcps: &[Vec3]) -> Option<f64> {
+        match self {
+            Checker::Table(t) => t.clearance_bound(tcps),
+            Checker::Bundle(bundle) => bundle.clearance_bound(a, b, tcps),
+        }
+    }
+
+    /// Whether the protective query of table mode uses the bound (clearance tables only).
+    pub(crate) fn has_clearance(&self) -> bool {
+        match self {
+            Checker::Table(t) => t.table().as_clearance().is_some(),
+            Checker::Bundle(b) => b.has_clearance(),
+        }
+    }
+
     fn confirmation(&self) -> Confirmation {
         match self {
             Checker::Table(t) => t.confirmation(),

@@ -133,15 +133,21 @@ def test_out_forms_allocate_nothing_in_the_library(t1, table16):
         "query": lambda: table16.query(tcps, out=q),
         "clearance_bound": lambda: table16.clearance_bound(tcps, out=b),
         "boxes": lambda: dc.boxes(t1, tcps[:100], out=bx),
-        "protective": lambda: dc.protective(t1, run, out=p),
     }
     for name, call in calls.items():
         total, in_work = work_allocations(call)
         assert in_work == 0, f"{name}: {in_work} allocations in the library's work"
         # A handful per array for numpy's borrow flags, never per configuration.
         assert total <= 16, f"{name}: {total} allocations in the call"
-    # The counter counts: a call without out= makes its outputs (numpy's memory), and a
-    # build allocates in the library.
+    # The protective verdict: nothing per tick; before the first tick, a copy of the pristine
+    # checker state (so that each run answers as a fresh C handle), the same for any length.
+    long_run = np.ascontiguousarray(np.repeat(tcps[:1], 500, axis=0))
+    p_long = dc.protective(t1, long_run)
+    short = work_allocations(lambda: dc.protective(t1, run, out=p))
+    long = work_allocations(lambda: dc.protective(t1, long_run, out=p_long))
+    assert short[1] == 0 and long[1] == 0
+    assert short[0] == long[0] <= 64, (short, long)
+    # The counter counts: a build allocates in the library.
     total, in_work = work_allocations(lambda: dc.Table.build(t1, 16, "shared"))
     assert total > 100
 
@@ -249,3 +255,18 @@ def test_stop_paths_are_checked(t1):
     far[..., 2] = -300.0
     p = dc.protective(t1, run, far, path_tolerance_mm=1.0)
     assert (p.verdict == dc.VERDICT_STOP).all() and (p.status == 9).all()
+
+
+def test_a_run_answers_the_same_whatever_ran_before(t1):
+    """Each run starts from the checker as made (no previous TCPs, no warm starts)."""
+    rng = np.random.default_rng(10)
+    a = toward_each_other(t1, rng, 1)
+    steps = np.linspace(0.0, 1.0, 120)[:, None, None]
+    run_a = np.ascontiguousarray(a + steps * np.array([[60.0, 0.0, 0.0], [-60.0, 0.0, 0.0]]))
+    run_b = np.ascontiguousarray(run_a[::-1])
+    first = dc.protective(t1, run_a)
+    dc.protective(t1, run_b)
+    again = dc.protective(t1, run_a)
+    for key in ("verdict", "status", "clearance", "protective_mm", "speed_limit"):
+        x, y = getattr(first, key), getattr(again, key)
+        assert np.array_equal(x.view(np.uint8), y.view(np.uint8)), key

@@ -110,7 +110,7 @@ def stop_paths(run: np.ndarray, points: int) -> np.ndarray:
     return np.ascontiguousarray(run[idx].transpose(0, 2, 1, 3))
 
 
-def c_protective(cabi, cell_file, cell, run, warn_mm, paths=None, tolerance=0.0):
+def c_protective(cabi, cell_file, cell, run, warn_mm, paths=None, tolerance=0.0, table_path=None):
     n = cell.n_robots
     configs = (type(cabi.dc_stop_config_default()) * n)()
     for j, r in enumerate(cell.robots):
@@ -123,7 +123,7 @@ def c_protective(cabi, cell_file, cell, run, warn_mm, paths=None, tolerance=0.0)
     out = {k: [] for k in ("verdict", "status", "clearance", "protective_mm", "speed_limit")}
     verdict = ctypes.c_uint32()
     report = DcProtectiveReport()
-    with Handle(cabi, cell_file) as h:
+    with Handle(cabi, cell_file, table_path) as h:
         assert cabi.dc_set_stop_model(h.h, cell.tick_ms, warn_mm, configs, n) == DC_STATUS_OK
         for i, config in enumerate(run):
             if paths is None:
@@ -234,3 +234,28 @@ def test_bundle_mode_equals_dc_query_and_pair_results(cabi, tmp_path):
     bound, exact = loaded.clearance_bound(tcps), dc.clearance(cell, tcps)
     proved = np.isfinite(bound)
     assert proved.any() and (bound[proved] <= exact[proved]).all()
+
+
+def test_protective_in_table_mode_equals_dc_protective_query(cabi, tmp_path):
+    """With a clearance table the protective verdict may answer a tick from the table's bound
+    alone (table mode's `dc_protective_query`): the same answers, tick by tick."""
+    from conftest import REPO
+
+    cell_file = REPO / "cells" / "t1.toml"
+    cell = dc.Cell.from_file(cell_file)
+    table = dc.Table.build(cell, 16, "clearance")
+    path = tmp_path / "t1c16.dct"
+    table.save(path)
+    # Apart and slow most of the time, so that the bound proves ticks; near at the middle.
+    run = approach(cell, 400)
+    ours = dc.protective(cell, run, table=table)
+    plain = dc.protective(cell, run)
+    theirs = c_protective(cabi, cell_file, cell, run, 10.0, table_path=path)
+    assert np.array_equal(ours.verdict, theirs["verdict"])
+    assert np.array_equal(ours.status, theirs["status"])
+    for key in ("clearance", "protective_mm", "speed_limit"):
+        assert np.array_equal(bits(getattr(ours, key)), bits(theirs[key])), key
+    # The table changes what is proved, never the exact clearance.
+    assert np.array_equal(bits(ours.clearance), bits(plain.clearance))
+    with pytest.raises(ValueError, match="table was built for cell"):
+        dc.protective(dc.Cell.reference("T2"), run, table=table)

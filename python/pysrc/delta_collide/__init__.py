@@ -144,13 +144,16 @@ def protective(
     path_tolerance_mm: float = 0.0,
     warn_mm: float = 10.0,
     speed_limits: bool = True,
+    table: Table | None = None,
     out: Protective | None = None,
 ) -> Protective:
     """The protective verdict (SPEC section 8) tick after tick over ``run`` (T, robots, 3),
     one controller tick (``cell.tick_ms``) apart, from a checker that knows no earlier TCP;
     ``paths`` (T, robots, P, 3), P <= 32: each robot's stop path at each tick, which its TCP
     never leaves by more than ``path_tolerance_mm``. The first call on a cell (or with another
-    ``warn_mm``) builds its motor-angle tables."""
+    ``warn_mm``) builds its motor-angle tables. With a clearance ``table`` of the cell, as
+    table mode: a tick whose stop balls the table's bound proves apart is FREE without the
+    swept-box proof (``delta-collide replay --table``)."""
     if out is None:
         t, r = _rows(run, "run", "T"), cell.n_robots
         out = Protective(
@@ -172,6 +175,7 @@ def protective(
         out.clearance,
         out.protective_mm,
         out.speed_limit,
+        table,
     )
     return out
 
