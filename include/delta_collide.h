@@ -356,7 +356,8 @@ typedef struct DcProtectiveReport {
  The path one robot's TCP will follow over its stop, as a controller performing a
  path-maintaining stop knows it (SPEC section 8, "Where the controller knows more"), for
  `dc_protective_query_with_paths`. It promises that from this tick until the robot stands
- still its TCP stays within `tolerance_mm` of the polyline through `points`. `n_points` 0
+ still its TCP follows the polyline through `points` in order (the point it follows never
+ goes back) and stays within `tolerance_mm` of it. `n_points` 0
  (with `points` NULL or not): no path known for this robot.
  */
 typedef struct DcStopPath {

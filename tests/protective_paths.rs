@@ -1,8 +1,9 @@
 //! The protective verdict with controller-supplied stop paths (SPEC §8, "Where the controller
-//! knows more") against brute force: whenever it proves a tick (FREE or WARN), every TCP the
-//! promise and the stopping model allow (any point of the path within the stopping distance
-//! along it, moved by up to the tolerance in any direction) is checked with the exact model,
-//! for both robots in every combination; none may bring two boxes into contact. Also the
+//! knows more") against brute force: whenever it proves a tick (FREE or WARN), stops that the
+//! promise and the stopping model allow (the fastest, the slowest and random speed profiles
+//! along each path, offset within the tolerance) are checked with the exact model every
+//! 0.2 ms, the two robots at the same moments, every profile of one with every profile of the
+//! other; none may bring two boxes into contact. Also the
 //! path's statuses, no allocation per tick, and the STOP counts on the scenarios with the
 //! programmed path ahead as the stop path.
 
@@ -10,7 +11,7 @@ use delta_collide::cell::protective::{
     Protective, ProtectiveChecker, ProtectiveRequest, ProtectiveStatus, StopPath,
 };
 use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, RUN_TICKS};
-use delta_collide::cell::{Cell, ExactChecker};
+use delta_collide::cell::ExactChecker;
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
 use rand::rngs::StdRng;
@@ -49,47 +50,120 @@ fn random_path(tcp: &Vec3, velocity: &Vec3, tol: Real, rng: &mut StdRng) -> Vec<
     points
 }
 
-/// Every TCP robot `j` may reach under the promise: points of its path up to arc length `s`
-/// (plus the reachable part of the start's neighbourhood), each moved by `tol` in a random
-/// direction; only reachable ones.
-fn reachable_samples(
-    cell: &Cell,
-    j: usize,
+/// Samples of a stop over time (s): every [`STEP_S`] until the robot stands.
+const STEP_S: Real = 0.2e-3;
+
+/// One stop of robot `j` that the promise and the model allow, as its TCP every [`STEP_S`]:
+/// the TCP follows `path` (offset by up to `tol`) with a speed profile that starts within
+/// `a_max dt` of the measured velocity `vel`, does anything within `a_max` and `v_max` for the
+/// reaction (the verdict's latency of one tick included), then brakes at a deceleration
+/// between `decel` and `a_max`. `kind` 0 is the fastest such stop, 1 the slowest, others
+/// random. `None` when no speed along the path agrees with `vel`, or when the TCP would move
+/// faster than the acceleration bound allows (a corner taken at speed): such a motion is
+/// not one the model allows.
+#[allow(clippy::too_many_arguments)]
+fn stop_motion(
+    stop: &StopModel,
+    tick_s: Real,
     path: &[Vec3],
-    s: Real,
+    tcp: &Vec3,
+    vel: &Vec3,
     tol: Real,
-    n: usize,
+    kind: usize,
     rng: &mut StdRng,
-) -> Vec<Vec3> {
-    let delta = &cell.robots[j].model.delta;
+) -> Option<Vec<Vec3>> {
+    let (a, vmax, dec) = (stop.max_accel_mm_s2, stop.max_speed_mm_s, stop.decel_mm_s2);
+    let reaction = stop.reaction_ms * 1e-3 + tick_s;
+    // The path's first direction and the speeds along it within `a dt` of the measured one.
+    let first = path.windows(2).map(|w| w[1] - w[0]).find(|d| d.norm() > 1e-9)?;
+    let u = first.normalize();
+    let along = vel.dot(&u);
+    let across = (vel - u * along).norm();
+    let slack = a * tick_s;
+    if across > slack {
+        return None;
+    }
+    let half = (slack * slack - across * across).sqrt();
+    let (v_lo, v_hi) = ((along - half).max(0.0), (along + half).min(vmax));
+    if v_lo > v_hi {
+        return None;
+    }
+    let mut v = match kind {
+        0 => v_hi,
+        1 => v_lo,
+        _ => rng.random_range(v_lo..=v_hi),
+    };
+    let react_accel = match kind {
+        0 => a,
+        1 => -a,
+        _ => rng.random_range(-a..=a),
+    };
+    let brake = match kind {
+        0 => dec,
+        1 => a,
+        _ => rng.random_range(dec..=a),
+    };
+    // The start: the path's nearest point to the TCP, the offset kept for the whole stop.
+    let (mut s, mut best) = (0.0, Real::INFINITY);
     let total: Real = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
-    let reach = s.min(total);
-    let mut out = Vec::with_capacity(n);
-    for i in 0..n {
-        // The far end, the start, and points between (the worst motion goes as far as it may).
-        let arc = match i {
-            0 => reach,
-            1 => 0.0,
-            _ => rng.random_range(0.0..=reach),
-        };
-        let offset = if i < 2 { Vec3::zeros() } else { unit(rng) * tol };
-        let p = along(path, arc) + offset;
-        if delta.is_reachable(&p) {
-            out.push(p);
+    for i in 0..=2000 {
+        let x = total * i as Real / 2000.0;
+        let d = (along_path(path, x) - tcp).norm();
+        if d < best {
+            (s, best) = (x, d);
         }
     }
-    out
+    let offset = tcp - along_path(path, s);
+    if offset.norm() > tol {
+        return None;
+    }
+    let mut out = vec![*tcp];
+    let mut t = 0.0;
+    while v > 0.0 || t < reaction {
+        let acc = if t < reaction { react_accel } else { -brake };
+        let v_next = (v + acc * STEP_S).clamp(0.0, vmax);
+        s += 0.5 * (v + v_next) * STEP_S;
+        (v, t) = (v_next, t + STEP_S);
+        let p = along_path(path, s) + offset;
+        // A necessary condition of the acceleration bound (the velocity stays within
+        // `a (dt + t)` of the measured one): a motion breaking it is not the model's.
+        if (p - tcp - vel * t).norm() > a * (tick_s * t + 0.5 * t * t) + 1e-6 {
+            return None;
+        }
+        out.push(p);
+        if t > 1.0 {
+            break;
+        }
+    }
+    Some(out)
 }
 
-/// Random ticks of two robots moving with paths; returns (ticks proved only thanks to the
-/// paths, ticks checked).
-fn brute_force(name: &str, stop: StopModel, ticks: usize, seed: u64) -> (usize, usize) {
+/// The point at arc length `s` of `path`, clamped (the test's own walk).
+fn along_path(path: &[Vec3], s: Real) -> Vec3 {
+    along(path, s.max(0.0))
+}
+
+/// What [`brute_force`] counted.
+#[derive(Debug)]
+struct Counts {
+    /// Ticks proved (FREE or WARN) with paths, all checked.
+    checked: usize,
+    /// Of those, ticks that are STOP without paths.
+    gained: usize,
+    /// Of those, ticks proved only with the stops cut into time slices.
+    sliced: usize,
+}
+
+/// Random ticks of two robots moving with paths. Each proved tick is checked against stops the
+/// model allows, the two robots' positions taken at the same moments (the verdict pairs them
+/// in time).
+fn brute_force(name: &str, stop: StopModel, ticks: usize, seed: u64) -> Counts {
     let cell = cell(name, stop);
     let mut c = ProtectiveChecker::new(cell.clone(), 5.0).unwrap().with_speed_limits(false);
     let mut exact = ExactChecker::new(cell.clone());
     let mut rng = StdRng::seed_from_u64(seed);
     let tick_s = cell.tick_ms * 1e-3;
-    let (mut gained, mut checked) = (0, 0);
+    let mut counts = Counts { checked: 0, gained: 0, sliced: 0 };
     for t in 0..ticks {
         let tcps = [tcp_toward_other(&cell, 0, &mut rng), tcp_toward_other(&cell, 1, &mut rng)];
         let vel: [Vec3; 2] = std::array::from_fn(|_| {
@@ -112,35 +186,56 @@ fn brute_force(name: &str, stop: StopModel, ticks: usize, seed: u64) -> (usize, 
         if r.verdict == Protective::Stop {
             continue;
         }
-        checked += 1;
-        gained += (without == Protective::Stop) as usize;
-        let reach: Vec<Real> = r.robots.iter().map(|x| x.protective_mm).collect();
-        let a = reachable_samples(&cell, 0, &paths[0], reach[0], tol, 24, &mut rng);
-        let b = reachable_samples(&cell, 1, &paths[1], reach[1], tol, 24, &mut rng);
-        for pa in &a {
-            for pb in &b {
-                let v = exact.check(&[*pa, *pb]).unwrap();
-                assert!(
-                    !v.collides(),
-                    "tick {t}: {:?} with paths, but the stop can bring the boxes into contact at {pa:?} {pb:?}\n\
-                     tcps {tcps:?} vel {vel:?} tol {tol} paths {paths:?}",
-                    r.verdict
-                );
+        counts.checked += 1;
+        counts.gained += (without == Protective::Stop) as usize;
+        counts.sliced += usize::from(r.time_sliced);
+        let motions: Vec<Vec<Vec<Vec3>>> = (0..2)
+            .map(|j| {
+                (0..10)
+                    .filter_map(|kind| {
+                        let m = stop_motion(
+                            &stop, tick_s, &paths[j], &tcps[j], &vel[j], tol, kind, &mut rng,
+                        );
+                        m.filter(|m| m.iter().all(|p| cell.robots[j].model.delta.is_reachable(p)))
+                    })
+                    .collect()
+            })
+            .collect();
+        for ma in &motions[0] {
+            for mb in &motions[1] {
+                for i in 0..ma.len().max(mb.len()) {
+                    let (pa, pb) = (ma[i.min(ma.len() - 1)], mb[i.min(mb.len() - 1)]);
+                    let v = exact.check(&[pa, pb]).unwrap();
+                    assert!(
+                        !v.collides(),
+                        "tick {t}: {:?} with paths, but a stop brings the boxes into contact \
+                         {:.2} ms in, at {pa:?} {pb:?}\n\
+                         tcps {tcps:?} vel {vel:?} tol {tol} paths {paths:?}",
+                        r.verdict,
+                        i as Real * STEP_S * 1e3
+                    );
+                }
             }
         }
     }
-    (gained, checked)
+    counts
 }
 
 #[test]
-fn verdicts_proved_along_paths_survive_every_position_the_paths_allow() {
+fn verdicts_proved_along_paths_survive_every_stop_the_paths_allow() {
+    let mut sliced = 0;
     for (name, stop, seed) in [("T1", STIFF, 1), ("T2", StopModel::DEFAULT, 2), ("T3", STIFF, 3)] {
-        let (gained, checked) = brute_force(name, stop, 1_500, seed);
+        let c = brute_force(name, stop, 1_500, seed);
         println!(
-            "{name}: {checked} ticks proved with paths, {gained} of them only thanks to the paths"
+            "{name}: {} ticks proved with paths, {} of them only thanks to the paths, {} only \
+             in time slices",
+            c.checked, c.gained, c.sliced
         );
-        assert!(gained >= 50, "{name}: the paths should prove ticks the ball cannot ({gained})");
+        assert!(c.gained >= 50, "{name}: the paths should prove ticks the ball cannot ({c:?})");
+        sliced += c.sliced;
     }
+    // The time slices are where the stops' positions are paired in time: they must be checked.
+    assert!(sliced >= 10, "only {sliced} ticks proved in time slices were checked");
 }
 
 #[test]

@@ -173,6 +173,7 @@ mod kept;
 mod lookup;
 mod path;
 mod request;
+mod slices;
 mod speed_limit;
 mod stop_sweeps;
 pub use clock::{TickTime, TimingFault, MAX_INTERVAL_TICKS, MIN_INTERVAL_TICKS};
@@ -302,6 +303,9 @@ pub struct ProtectiveReport {
     /// Whether the verdict is FREE by the clearance table's bound alone, without a swept-box
     /// proof (`protective/lookup.rs`; only with [`ProtectiveRequest::with_table`]).
     pub table_lookup: bool,
+    /// Whether some pair is proved only with its stop cut into time slices (`slices.rs`;
+    /// only with stop paths).
+    pub time_sliced: bool,
     /// How many pairs that can meet the table's bound proved apart this tick, which the
     /// swept-box proof then skipped (all of them when `table_lookup`).
     pub table_pairs: u32,
@@ -334,8 +338,8 @@ impl ProtectiveReport {
     fn head(&self) -> ProtectiveReport {
         let (verdict, status, clearance_mm, closest, limiting) =
             (self.verdict, self.status, self.clearance_mm, self.closest, self.limiting);
-        let (kept_proof, table_lookup, table_pairs) =
-            (self.kept_proof, self.table_lookup, self.table_pairs);
+        let (kept_proof, table_lookup, table_pairs, time_sliced) =
+            (self.kept_proof, self.table_lookup, self.table_pairs, self.time_sliced);
         let (limit_tests, limit_budget_spent) = (self.limit_tests, self.limit_budget_spent);
         let robots = alloc::vec::Vec::new();
         ProtectiveReport {
@@ -347,6 +351,7 @@ impl ProtectiveReport {
             robots,
             kept_proof,
             table_lookup,
+            time_sliced,
             table_pairs,
             limit_tests,
             limit_budget_spent,
@@ -520,6 +525,7 @@ impl ProtectiveChecker {
             robots: alloc::vec![RobotProtection::UNKNOWN; n],
             kept_proof: false,
             table_lookup: false,
+            time_sliced: false,
             table_pairs: 0,
             limit_tests: 0,
             limit_budget_spent: false,
@@ -655,6 +661,14 @@ impl ProtectiveChecker {
     pub fn reset(&mut self) {
         self.forget_motion();
         self.calls.time = None;
+        // What only speeds a tick up goes too (kept proofs, the clearances' warm starts):
+        // a checker reset answers bit for bit as a new one would.
+        self.kept.clear();
+        for pair in &mut self.pairs {
+            (pair.clearance, pair.axis, pair.table_proved) =
+                (CoherentClearance::new(), Vec3::zeros(), false);
+        }
+        (self.calls.limit_turn, self.calls.references_stale) = (0, true);
     }
 
     /// Forgets every previous TCP, and the contact found from them.
@@ -809,9 +823,10 @@ impl ProtectiveChecker {
                 self.set_references(tcps_mcs);
             }
             if self.report.verdict != Protective::Free {
-                let (verdict, limiting) = self.prove_with_paths(tcps_mcs, paths);
+                let (verdict, limiting, sliced) = self.prove_with_paths(tcps_mcs, paths);
                 if verdict < self.report.verdict {
                     (self.report.verdict, self.report.limiting) = (verdict, limiting);
+                    self.report.time_sliced = sliced;
                 }
             }
             if self.model.speed_limits {
@@ -901,6 +916,7 @@ impl ProtectiveChecker {
         (report.closest, report.limiting, report.kept_proof, report.table_lookup) =
             (None, None, false, false);
         (report.table_pairs, report.limit_tests, report.limit_budget_spent) = (0, 0, false);
+        report.time_sliced = false;
         self.pairs.iter_mut().for_each(|p| p.table_proved = false);
     }
 

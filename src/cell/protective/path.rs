@@ -24,6 +24,14 @@
 //!    paths. A piece whose ball is not smaller than that ball, or whose centre is unreachable,
 //!    uses that ball too. The path verdict is taken only where it is better than the verdict
 //!    without paths (both are proofs).
+//! 4. **In time.** A pair that steps 1-2 leave unproved is tried again with both stops cut
+//!    into time slices (`slices.rs`): per slice, the arc range each robot can be in at those
+//!    moments, proved apart as in step 2; every slice proved: the pair is. This pairs the
+//!    robots' positions at the same time, which steps 1-2 do not (a robot leaving the place
+//!    the other is heading for). It needs the path followed in order (the commanded arc
+//!    position never goes back) and the stopping model's acceleration bound for braking too.
+//!    The speed limits do not: in the closed-loop benchmark, limits raised by it let robots
+//!    close in faster and cost more STOPs than they saved.
 //!
 //! A path that breaks its promise at once (the TCP now is farther than `tol` from `Q`, a
 //! non-finite point or tolerance, a negative tolerance, no point) is
@@ -31,6 +39,7 @@
 //! allocates.
 
 use super::certain_stop::graded_radii;
+use super::slices::{slice_arcs, stands_by, StopMotion, SLICES};
 use super::stop_sweeps::SweptBall;
 use super::{first_unproved_between, stop_sweeps_wcs, BoxPair, Protective, ProtectiveChecker};
 use crate::geometry::distance::segment_distance;
@@ -49,7 +58,8 @@ pub const MAX_DEPTH: u32 = 3;
 pub const PATH_LIMIT_TESTS: u32 = 4;
 
 /// The path a robot's TCP will follow over its stop (module doc): the polyline through
-/// `points` (MCS, mm), left by at most `tolerance_mm`.
+/// `points` (MCS, mm), in order (the point of the polyline it follows never goes back), left
+/// by at most `tolerance_mm`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StopPath<'a> {
     /// The polyline's vertices, in the order the TCP follows them (MCS, mm).
@@ -387,6 +397,61 @@ impl ProtectiveChecker {
         self.prove_pieces((a, b), paths_ab, pa, pb, (0, 0), 0.0).is_none()
     }
 
+    /// Robot `j`'s motion over its stop (`slices.rs`) from TCP `tcp_mcs`, as this tick
+    /// measured it (no velocity when its speed is unknown).
+    fn stop_motion(&self, j: usize, tcp_mcs: &Vec3) -> StopMotion {
+        let cell = self.cell();
+        let stop = cell.stops[j];
+        let v = self.report.robots[j].speed_mm_s;
+        StopMotion {
+            tcp: *tcp_mcs,
+            velocity: v.is_finite().then_some(self.robots[j].velocity),
+            speed_bound_mm_s: self.speed_bound(j, v),
+            interval_s: self.calls.interval_s,
+            reaction_s: (stop.reaction_ms + cell.tick_ms) * 1e-3,
+            stop,
+        }
+    }
+
+    /// Whether robots `a < b` are proved apart slice by slice (`slices.rs`, module doc step
+    /// 4), their motions `motions` (a robot without a path is its reference ball in every
+    /// slice).
+    fn proved_in_slices(
+        &self,
+        (a, b): (usize, usize),
+        motions: (&StopMotion, &StopMotion),
+        paths: (Option<&StopPath>, Option<&StopPath>),
+        extra: Real,
+    ) -> bool {
+        let end = stands_by(motions.0).max(stands_by(motions.1));
+        let mut arcs = [[None; SLICES]; 2];
+        for (side, (m, path)) in [(motions.0, paths.0), (motions.1, paths.1)].iter().enumerate() {
+            let Some(path) = path else { continue };
+            let mut ranges = [(0.0, 0.0); SLICES];
+            if !slice_arcs(m, path, end, &mut ranges) {
+                return false;
+            }
+            for (slot, range) in arcs[side].iter_mut().zip(ranges) {
+                *slot = Some(range);
+            }
+        }
+        // A piece is built again only where its range changed (a robot at rest keeps it).
+        let reuse = |last: Option<Piece>, j: usize, path, arc| match last {
+            Some(p) if p.arc == arc => p,
+            _ => self.piece(j, path, arc),
+        };
+        let (mut last_a, mut last_b) = (None, None);
+        for (&arc_a, &arc_b) in arcs[0].iter().zip(&arcs[1]) {
+            let pa = reuse(last_a.take(), a, paths.0, arc_a);
+            let pb = reuse(last_b.take(), b, paths.1, arc_b);
+            if self.prove_pieces((a, b), paths, &pa, &pb, (0, 0), extra).is_some() {
+                return false;
+            }
+            (last_a, last_b) = (Some(pa), Some(pb));
+        }
+        true
+    }
+
     /// Each robot's speed limit along the paths: the limit without paths is a speed the proof
     /// along the paths holds too (it is taken only where better); from there, up to
     /// [`PATH_LIMIT_TESTS`] speeds raise it, one grid step of the limits
@@ -437,12 +502,13 @@ impl ProtectiveChecker {
     }
 
     /// The verdict and limiting pair over the pieces of the paths (module doc), for the
-    /// references and reaches of the last evaluation.
+    /// references and reaches of the last evaluation; and whether some pair needed its stop
+    /// cut into time slices (step 4) for that verdict.
     pub(super) fn prove_with_paths(
         &self,
         tcps_mcs: &[Vec3],
         paths: &[Option<StopPath>],
-    ) -> (Protective, Option<BoxPair>) {
+    ) -> (Protective, Option<BoxPair>, bool) {
         let whole = |j: usize| -> Piece {
             let path = paths[j].as_ref();
             let arc = path.and_then(|p| {
@@ -451,21 +517,30 @@ impl ProtectiveChecker {
             });
             self.piece(j, path, arc)
         };
+        let motion = |j: usize| self.stop_motion(j, &tcps_mcs[j]);
+        // Whether the last pass proved a pair only in slices (the flag of the verdict it gave).
+        let mut sliced_before = false;
         for (extra, verdict) in [(0.0, Protective::Stop), (self.model.warn_mm, Protective::Warn)] {
             if extra == 0.0 && verdict == Protective::Warn {
                 break;
             }
+            let mut sliced = false;
             for pair in &self.exact.verdict().pairs {
                 let (a, b) = (pair.a, pair.b);
                 let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
-                let found =
-                    self.prove_pieces((a, b), paths_ab, &whole(a), &whole(b), (0, 0), extra);
-                if found.is_some() {
-                    return (verdict, found);
+                let Some(found) =
+                    self.prove_pieces((a, b), paths_ab, &whole(a), &whole(b), (0, 0), extra)
+                else {
+                    continue;
+                };
+                if !self.proved_in_slices((a, b), (&motion(a), &motion(b)), paths_ab, extra) {
+                    return (verdict, Some(found), sliced_before);
                 }
+                sliced = true;
             }
+            sliced_before = sliced;
         }
-        (Protective::Free, None)
+        (Protective::Free, None, sliced_before)
     }
 }
 
