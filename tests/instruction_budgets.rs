@@ -5,8 +5,10 @@
 //! instructions does not depend on the machine's load or clock, and scales to a controller's
 //! CPU by its instructions per second (docs/record/2026-12-02-instruction-budgets.md).
 //!
-//! The inputs are one approach, not yet a search for each entry point's worst case; the
-//! coordination and the table queries are not measured here.
+//! The first protective tick after init, after a STOP and after `dc_protective_reset` are
+//! held to the same budget (no first-tick spike). The inputs are one approach, not yet a
+//! search for each entry point's worst case; the coordination and the table queries are not
+//! measured here.
 
 mod harness_build;
 mod native_libs;
@@ -83,6 +85,17 @@ fn each_entry_point_stays_within_its_instruction_budget() {
         assert!(calls >= 50, "{call}: only {calls} calls measured");
         if largest > budget {
             over.push(format!("{call}: {largest} instructions > budget {budget}"));
+        }
+    }
+    // No first-tick spike: the first tick after init, after the STOP and after a reset stay
+    // within the budget of the protective query (everything is allocated and built at init).
+    for first in ["first_after_init", "first_after_stop", "first_after_reset"] {
+        let budget = BUDGETS[1].1;
+        let (count, calls) = *counts.get(first).unwrap_or_else(|| panic!("no {first} counted"));
+        println!("{first}: {count} instructions, budget {budget}");
+        assert_eq!(calls, 1, "{first}");
+        if count > budget {
+            over.push(format!("{first}: {count} instructions > budget {budget}"));
         }
     }
     assert!(over.is_empty(), "over budget: {over:?}");

@@ -5,9 +5,9 @@
 //! monotonicity, the speed limit, no allocation per tick, and the counts on the scenarios.
 
 use delta_collide::cell::protective::{
-    Protective, ProtectiveChecker, ProtectiveReport, ProtectiveStatus,
+    Protective, ProtectiveChecker, ProtectiveReport, ProtectiveRequest, ProtectiveStatus, StopPath,
 };
-use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
+use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, Scenario, RUN_TICKS};
 use delta_collide::cell::ExactChecker;
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
@@ -542,6 +542,54 @@ fn speed_limits_off_give_the_same_verdicts_and_nan_limits() {
     unsafe {
         dc_destroy(on);
         dc_destroy(off);
+    }
+}
+
+/// Reports of `checker` over ticks `ticks` of scenario `s`, with the programmed path ahead as
+/// the stop paths on even ticks.
+fn run_reports(
+    checker: &mut ProtectiveChecker,
+    s: &Scenario,
+    ticks: std::ops::Range<u32>,
+) -> Vec<ProtectiveReport> {
+    let mut tcps = vec![Vec3::zeros(); s.robots.len()];
+    let mut points = vec![[Vec3::zeros(); 32]; s.robots.len()];
+    let mut out = Vec::new();
+    for tick in ticks {
+        s.tcps_at(tick, &mut tcps);
+        let lens: Vec<usize> = (0..tcps.len())
+            .map(|j| path_ahead(&s.robots[j], tick, 400.0, &mut points[j]))
+            .collect();
+        let paths: Vec<Option<StopPath>> = (0..tcps.len())
+            .map(|j| Some(StopPath { points: &points[j][..lens[j]], tolerance_mm: 0.1 }))
+            .collect();
+        let request = ProtectiveRequest::new(&tcps);
+        let request = if tick % 2 == 0 { request.with_paths(&paths) } else { request };
+        out.push(checker.check(request).unwrap().clone());
+    }
+    out
+}
+
+/// A checker reset answers a run bit for bit as a new one does (no warm start or kept proof
+/// of the run before it survives), with paths too, and the reset allocates nothing.
+#[test]
+fn a_reset_checker_answers_as_a_new_one() {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
+    for s in parse_scenarios(&text).unwrap().iter().filter(|s| s.case == "practical") {
+        let fresh = ProtectiveChecker::new(cell(&s.cell, StopModel::DEFAULT), 10.0).unwrap();
+        let mut used = fresh.clone();
+        run_reports(&mut used, s, 1_000..1_700);
+        let before = allocations();
+        used.reset();
+        assert_eq!(allocations(), before, "{}: the reset allocated", s.cell);
+        let again = run_reports(&mut used, s, 0..1_500);
+        let new = run_reports(&mut fresh.clone(), s, 0..1_500);
+        for (tick, (a, b)) in again.iter().zip(&new).enumerate() {
+            assert_eq!(a.clearance_mm.to_bits(), b.clearance_mm.to_bits(), "{} {tick}", s.cell);
+            assert_eq!(a, b, "{} tick {tick}", s.cell);
+        }
     }
 }
 

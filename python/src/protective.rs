@@ -120,9 +120,7 @@ pub fn protective_into(
             // Made once per cell and warn_mm (its motor-angle tables take a while): outside
             // the counted work, like the controller's `dc_set_stop_model` at start-up.
             let made = py.detach(|| ProtectiveChecker::new(cell.cell.clone(), warn_mm));
-            let pristine = made.map_err(cell_error)?;
-            let work = pristine.clone();
-            *slot = Some(Protectives { warn_mm, pristine, work, used: false });
+            *slot = Some(Protectives { warn_mm, work: made.map_err(cell_error)? });
         }
     }
     let shape = r.shape().to_vec();
@@ -147,11 +145,6 @@ pub fn protective_into(
             }
             let mut slot = cell.protective.lock().map_err(|_| "the cell's checker is poisoned")?;
             let p = slot.as_mut().ok_or("no protective checker")?;
-            if std::mem::replace(&mut p.used, true) {
-                // A copy of the pristine state: a fixed number of allocations whatever the
-                // run's length (the library has no call that forgets its warm starts).
-                count_alloc::outside_work(|| p.work.clone_from(&p.pristine));
-            }
             let checker = &mut p.work;
             checker.set_speed_limits(speed_limits);
             checker.reset();

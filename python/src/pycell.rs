@@ -23,16 +23,12 @@ pub struct PyCell {
     pub protective: Mutex<Option<Protectives>>,
 }
 
-/// The protective checker of a `warn_mm` as made (`pristine`, never run) and the one a run
-/// uses (`work`), reset to the pristine one before each run: besides the previous TCPs a
-/// checker keeps warm starts of each pair's clearance (`CoherentClearance`), which change the
-/// last bits of the reported clearance; so each run answers as a fresh C handle does.
+/// The protective checker of a `warn_mm`, reset before each run (`ProtectiveChecker::reset`
+/// forgets the previous TCPs and the warm starts of each pair's clearance): each run answers
+/// as a fresh C handle does.
 pub struct Protectives {
     pub warn_mm: f64,
-    pub pristine: ProtectiveChecker,
     pub work: ProtectiveChecker,
-    /// Whether `work` has run since it was last reset.
-    pub used: bool,
 }
 
 impl PyCell {

@@ -6,7 +6,8 @@
  * robot B comes toward it at 1.2 m/s along x, from apart until the first STOP: the proofs get
  * harder as the robots near each other (WARN, the limits' searches, the stop paths' pieces).
  * Each tick answers dc_query, then the protective query, without paths on even ticks and with
- * them on odd ones (A's path one point, B's its next 62 mm in 32 points).
+ * them on odd ones (A's path one point, B's its next 62 mm in 32 points). The first protective
+ * tick after init, after the STOP and after dc_protective_reset are parts of their own.
  */
 #include <stdio.h>
 #include <string.h>
@@ -56,7 +57,10 @@ int main(void)
         paths[0].points = path[0], paths[0].n_points = 1, paths[0].tolerance_mm = 0.5;
         paths[1].points = path[1], paths[1].n_points = 32, paths[1].tolerance_mm = 0.5;
         MEASURED("dc_query", s |= dc_query(h, tcps, 2, &verdict, &qr));
-        if (t % 2 == 0) {
+        if (t == 0) {
+            /* The first tick after init: no previous TCP, full speed assumed. */
+            MEASURED("first_after_init", s |= dc_protective_query(h, tcps, 2, &verdict, &pr));
+        } else if (t % 2 == 0) {
             MEASURED("dc_protective_query", s |= dc_protective_query(h, tcps, 2, &verdict, &pr));
         } else {
             MEASURED("dc_protective_query_with_paths",
@@ -67,6 +71,16 @@ int main(void)
             return 4;
         }
         if (verdict == DC_VERDICT_STOP && t > 10) break;
+    }
+    /* The tick after the STOP (robot B still moving while it reacts) and the first after a
+     * reset. */
+    tcps[1].x -= 1.2;
+    MEASURED("first_after_stop", s |= dc_protective_query(h, tcps, 2, &verdict, &pr));
+    dc_protective_reset(h);
+    MEASURED("first_after_reset", s |= dc_protective_query(h, tcps, 2, &verdict, &pr));
+    if (s != DC_STATUS_OK) {
+        printf("status %u after the STOP\n", (unsigned)s);
+        return 6;
     }
     {
         /* The time of the same calls (meaningful when run natively, not under valgrind). */

@@ -79,6 +79,14 @@ impl Kept {
         }
     }
 
+    /// Forgets everything kept, as [`Kept::new`] (no allocation).
+    pub(super) fn clear(&mut self) {
+        self.balls.fill(None);
+        self.inside.fill(false);
+        self.pairs.fill(None);
+        (self.next_generation, self.backoff) = (0, 0);
+    }
+
     /// Records whether robot `j`'s stop, held by each of `balls` (centre MCS, radius), lies
     /// in its kept ball; returns that.
     pub(super) fn set_inside(&mut self, j: usize, balls: &[(Vec3, Real)]) -> bool {
