@@ -367,9 +367,11 @@ struct History {
     /// The last speed limit (mm/s): where this tick's search starts; and the step of its
     /// first test above that limit (mm/s; module doc).
     limit: Option<(Real, Real)>,
+    /// The last speed limit along the paths (mm/s; `path.rs`): where that search starts.
+    path_limit: Option<Real>,
 }
 
-const NO_HISTORY: History = History { tcp: None, velocity: None, limit: None };
+const NO_HISTORY: History = History { tcp: None, velocity: None, limit: None, path_limit: None };
 
 /// What the checker keeps of one robot: what the previous calls left (its history, where
 /// its limit search goes on) and this tick's stop (the measured velocity, the stop ball, the

@@ -22,7 +22,8 @@
 //!    halves ([`MAX_DEPTH`] halvings per robot at most); all pairs proved: FREE.
 //! 3. **Fallback.** A robot without a path is one piece: the ball of the verdict without
 //!    paths. A piece whose ball is not smaller than that ball, or whose centre is unreachable,
-//!    uses that ball too. The path verdict is taken only where it is better than the verdict
+//!    uses that ball too (it holds every TCP of the stop), and keeps its arc range: its halves
+//!    may be smaller or reachable. The path verdict is taken only where it is better than the verdict
 //!    without paths (both are proofs).
 //! 4. **In time.** A pair that steps 1-2 leave unproved is tried again with both stops cut
 //!    into time slices (`slices.rs`): per slice, the arc range each robot can be in at those
@@ -308,7 +309,7 @@ impl ProtectiveChecker {
             Some((c, r)) => (c, r, arc),
             None => {
                 boxes = reference.boxes;
-                (reference.centre, reference.radius, None)
+                (reference.centre, reference.radius, arc)
             }
         };
         let sweeps =
@@ -453,52 +454,71 @@ impl ProtectiveChecker {
     }
 
     /// Each robot's speed limit along the paths: the limit without paths is a speed the proof
-    /// along the paths holds too (it is taken only where better); from there, up to
-    /// [`PATH_LIMIT_TESTS`] speeds raise it, one grid step of the limits
-    /// (`v_max / 2^LIMIT_STEPS`) above it, then steps of doubling length, as far as every pair
-    /// involving the robot is proved at each, over the robot's stop at that speed and two ticks
-    /// of its motion. The speeds are tried pair by pair (each pair up to the first speed that
-    /// failed before), so that the other robot's piece is built once per pair: the limit is
-    /// the one speed by speed would find. A robot without a path keeps its limit.
+    /// along the paths holds too (it is taken only where better). Up to [`PATH_LIMIT_TESTS`]
+    /// speeds are tested, each for every pair involving the robot, over the robot's stop at
+    /// that speed and two ticks of its motion: first the last tick's limit along the paths
+    /// (the search goes on from there: a limit that must climb from the one without paths
+    /// every tick stays within a few grid steps of it), then, above the highest speed proved,
+    /// one grid step of the limits (`v_max / 2^LIMIT_STEPS`) and steps of doubling length;
+    /// after a failed test, halfway between the highest speed proved and the lowest failed.
+    /// A robot without a path keeps its limit.
     pub(super) fn path_limits(&mut self, tcps_mcs: &[Vec3], paths: &[Option<StopPath>]) {
         for j in 0..tcps_mcs.len() {
             let r = self.report.robots[j];
+            let last = self.robots[j].history.path_limit;
+            self.robots[j].history.path_limit = None;
             if paths[j].is_none() || r.speed_limit_mm_s.is_nan() {
                 continue;
             }
             let v_max = self.cell().stops[j].max_speed_mm_s;
             let grid = v_max / Real::from(1u32 << super::LIMIT_STEPS);
-            let lo = r.speed_limit_mm_s;
-            // The speeds to try: lo + grid, lo + 3 grid, lo + 7 grid, ..., at most v_max.
-            let mut speeds = [0.0; PATH_LIMIT_TESTS as usize];
-            let (mut count, mut last, mut step) = (0, lo, grid);
-            while count < speeds.len() && (last + step).min(v_max) > last {
-                last = (last + step).min(v_max);
-                (speeds[count], count, step) = (last, count + 1, 2.0 * step);
-            }
+            let (mut proved, mut failed) = (r.speed_limit_mm_s, Real::INFINITY);
+            let mut next = last.filter(|&l| l > proved).unwrap_or(proved + grid).min(v_max);
+            let mut step = grid;
             let saved = self.robots[j];
             let inside = self.kept.inside(j);
-            let mut proved = count;
-            for k in 0..self.exact.verdict().pairs.len() {
-                let pair = self.exact.verdict().pairs[k];
-                let (a, b) = (pair.a, pair.b);
-                if (a != j && b != j) || proved == 0 {
-                    continue;
+            for _ in 0..PATH_LIMIT_TESTS {
+                if !(next > proved && next < failed) {
+                    break;
                 }
-                let o = if a == j { b } else { a };
-                let s_other = self.report.robots[o].protective_mm;
-                let other = self.whole_piece(o, &tcps_mcs[o], s_other, paths[o].as_ref());
-                proved = (0..proved)
-                    .find(|&i| {
-                        !self.pair_speed_proved((a, b), j, &other, (tcps_mcs, paths), speeds[i])
-                    })
-                    .unwrap_or(proved);
+                if self.speed_proved_along(j, tcps_mcs, paths, next) {
+                    proved = next;
+                    next = (proved + step).min(v_max).min(0.5 * (proved + failed));
+                    step *= 2.0;
+                } else {
+                    failed = next;
+                    next = 0.5 * (proved + failed);
+                }
             }
             self.robots[j] = saved;
             self.kept.restore_inside(j, inside);
-            self.report.robots[j].speed_limit_mm_s =
-                if proved == 0 { lo } else { speeds[proved - 1] };
+            self.report.robots[j].speed_limit_mm_s = proved;
+            self.robots[j].history.path_limit = Some(proved);
         }
+    }
+
+    /// Whether every pair involving robot `j` is proved along the paths with `j` at speed `v`.
+    fn speed_proved_along(
+        &mut self,
+        j: usize,
+        tcps_mcs: &[Vec3],
+        paths: &[Option<StopPath>],
+        v: Real,
+    ) -> bool {
+        for k in 0..self.exact.verdict().pairs.len() {
+            let pair = self.exact.verdict().pairs[k];
+            let (a, b) = (pair.a, pair.b);
+            if a != j && b != j {
+                continue;
+            }
+            let o = if a == j { b } else { a };
+            let s_other = self.report.robots[o].protective_mm;
+            let other = self.whole_piece(o, &tcps_mcs[o], s_other, paths[o].as_ref());
+            if !self.pair_speed_proved((a, b), j, &other, (tcps_mcs, paths), v) {
+                return false;
+            }
+        }
+        true
     }
 
     /// The verdict and limiting pair over the pieces of the paths (module doc), for the
