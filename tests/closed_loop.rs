@@ -5,9 +5,10 @@
 //! row). Contact is checked by the exact model every tick and every 0.2 ms of every simulated
 //! stop; none may occur in any run. Liveness (no deadlock, every programme finished) is
 //! asserted where the coordination reaches it today: the seeded runs of T1 and the
-//! adversarial programmes under the arrival order, and no deadlock under the programmed order
-//! on R60 and D380; elsewhere it is printed, not asserted: there a STOP at standstill can hold
-//! the robots for good (docs/record/2026-12-02-programmed-order.md).
+//! adversarial programmes under the arrival order, no deadlock under the programmed order on
+//! R60 and D380, and 75 % of the throughput kept under it on T1-T3 and H80; elsewhere it is
+//! printed, not asserted: there a STOP at standstill can hold the robots for good
+//! (docs/record/2026-12-02-path-limits.md).
 
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::minimum_jerk;
@@ -210,6 +211,37 @@ fn the_programmed_order_keeps_moving_where_the_arrival_order_deadlocks() {
             let what = format!("{} seed {seed} programmed order", cell.name);
             assert_safe(&what, &m);
             assert!(!m.deadlock, "{what}: deadlock: {m:?}");
+        }
+    }
+}
+
+#[test]
+fn the_programmed_order_keeps_most_of_the_throughput_on_two_robot_cells() {
+    // Seeds no rule was tuned on; SPEC §9's target is 95 % (the record has the full runs:
+    // 83-96 % on these cells). Here each run must finish without deadlock and keep 75 %.
+    let cells = [
+        reference_cell("T1").unwrap(),
+        reference_cell("T2").unwrap(),
+        reference_cell("T3").unwrap(),
+        parse_cell(include_str!("../cells/h80.toml")).unwrap(),
+    ];
+    let programme = ProgrammeConfig { ticks: 1500, ..ProgrammeConfig::default() };
+    let sim = SimConfig {
+        coordination: CoordinationConfig {
+            clearance_mm: 10.0,
+            right_of_way: RightOfWay::Programmed,
+            ..CoordinationConfig::default()
+        },
+        ..config(Mode::Coordinate)
+    };
+    for cell in &cells {
+        for seed in [51, 52] {
+            let progs = programmes(cell, &programme, &mut Rng::new(seed));
+            let m = run(cell, &progs, &sim);
+            let what = format!("{} seed {seed} programmed order", cell.name);
+            println!("{what}: {:.1} %, {} STOP events", 100.0 * m.throughput, m.stop_events);
+            assert_safe_and_live(&what, &m);
+            assert!(m.throughput >= 0.75, "{what}: {:.1} % kept", 100.0 * m.throughput);
         }
     }
 }
