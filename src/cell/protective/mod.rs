@@ -468,6 +468,8 @@ pub struct ProtectiveChecker {
     /// Two TCPs in earlier stop balls whose boxes overlap, which make every tick whose stop
     /// balls still hold them STOP (`protective/contact.rs`).
     contact: contact::KeptContact,
+    /// Each robot's piece of its whole stop along its path this tick (`path.rs`).
+    whole_pieces: alloc::vec::Vec<Option<path::Piece>>,
     calls: Calls,
     report: ProtectiveReport,
 }
@@ -571,6 +573,7 @@ impl ProtectiveChecker {
             pairs: alloc::vec![pair; n_pairs],
             kept,
             contact: contact::KeptContact::default(),
+            whole_pieces: alloc::vec![None; n],
             calls,
             report,
         })
@@ -824,6 +827,7 @@ impl ProtectiveChecker {
             if self.calls.references_stale {
                 self.set_references(tcps_mcs);
             }
+            self.set_whole_pieces(tcps_mcs, paths);
             if self.report.verdict != Protective::Free {
                 let (verdict, limiting, sliced) = self.prove_with_paths(tcps_mcs, paths);
                 if verdict < self.report.verdict {

@@ -285,7 +285,8 @@ pub fn path_through_samples(
 
 /// One piece of a robot's stop: the ball holding its TCPs, its boxes at the ball's centre and
 /// their sweeps over the ball.
-struct Piece {
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Piece {
     /// The arc range of the path (`None`: the ball of the verdict without paths).
     arc: Option<(Real, Real)>,
     ball: SweptBall,
@@ -453,6 +454,22 @@ impl ProtectiveChecker {
         true
     }
 
+    /// Each robot's piece of its whole stop at its measured speed (module doc, step 1), for
+    /// the references of this tick: built once a tick, read by the verdict and by every test
+    /// of the speed limits along the paths.
+    pub(super) fn set_whole_pieces(&mut self, tcps_mcs: &[Vec3], paths: &[Option<StopPath>]) {
+        for j in 0..tcps_mcs.len() {
+            let s = self.report.robots[j].protective_mm;
+            let piece = self.whole_piece(j, &tcps_mcs[j], s, paths[j].as_ref());
+            self.whole_pieces[j] = Some(piece);
+        }
+    }
+
+    /// Robot `j`'s piece of [`ProtectiveChecker::set_whole_pieces`].
+    fn whole_of(&self, j: usize) -> &Piece {
+        self.whole_pieces[j].as_ref().expect("set_whole_pieces ran this tick")
+    }
+
     /// Each robot's speed limit along the paths: the limit without paths is a speed the proof
     /// along the paths holds too (it is taken only where better). Up to [`PATH_LIMIT_TESTS`]
     /// speeds are tested, each for every pair involving the robot, over the robot's stop at
@@ -511,9 +528,7 @@ impl ProtectiveChecker {
             if a != j && b != j {
                 continue;
             }
-            let o = if a == j { b } else { a };
-            let s_other = self.report.robots[o].protective_mm;
-            let other = self.whole_piece(o, &tcps_mcs[o], s_other, paths[o].as_ref());
+            let other = *self.whole_of(if a == j { b } else { a });
             if !self.pair_speed_proved((a, b), j, &other, (tcps_mcs, paths), v) {
                 return false;
             }
@@ -522,21 +537,13 @@ impl ProtectiveChecker {
     }
 
     /// The verdict and limiting pair over the pieces of the paths (module doc), for the
-    /// references and reaches of the last evaluation; and whether some pair needed its stop
+    /// pieces of [`ProtectiveChecker::set_whole_pieces`]; and whether some pair needed its stop
     /// cut into time slices (step 4) for that verdict.
     pub(super) fn prove_with_paths(
         &self,
         tcps_mcs: &[Vec3],
         paths: &[Option<StopPath>],
     ) -> (Protective, Option<BoxPair>, bool) {
-        let whole = |j: usize| -> Piece {
-            let path = paths[j].as_ref();
-            let arc = path.and_then(|p| {
-                let tol = p.tolerance_mm;
-                arc_cover(p.points, &tcps_mcs[j], self.report.robots[j].protective_mm + tol, tol)
-            });
-            self.piece(j, path, arc)
-        };
         let motion = |j: usize| self.stop_motion(j, &tcps_mcs[j]);
         // Whether the last pass proved a pair only in slices (the flag of the verdict it gave).
         let mut sliced_before = false;
@@ -548,8 +555,9 @@ impl ProtectiveChecker {
             for pair in &self.exact.verdict().pairs {
                 let (a, b) = (pair.a, pair.b);
                 let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
+                let (whole_a, whole_b) = (self.whole_of(a), self.whole_of(b));
                 let Some(found) =
-                    self.prove_pieces((a, b), paths_ab, &whole(a), &whole(b), (0, 0), extra)
+                    self.prove_pieces((a, b), paths_ab, whole_a, whole_b, (0, 0), extra)
                 else {
                     continue;
                 };
