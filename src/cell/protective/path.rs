@@ -283,6 +283,9 @@ pub fn path_through_samples(
     Some(n)
 }
 
+/// A piece's halves, built when first needed (`None`: it has no range to halve).
+type Halves = core::cell::OnceCell<Option<(Piece, Piece)>>;
+
 /// One piece of a robot's stop: the ball holding its TCPs, its boxes at the ball's centre and
 /// their sweeps over the ball.
 #[derive(Clone, Copy, Debug)]
@@ -331,37 +334,65 @@ impl ProtectiveChecker {
 
     /// The first box pair of robots `a < b` not proved apart over pieces `pa`, `pb`, halving
     /// the larger piece (module doc, step 2) while `depth_a`, `depth_b` allow.
-    #[allow(clippy::too_many_arguments)]
     fn prove_pieces(
+        &self,
+        ab: (usize, usize),
+        paths: (Option<&StopPath>, Option<&StopPath>),
+        pa: &Piece,
+        pb: &Piece,
+        depths: (u32, u32),
+        extra: Real,
+    ) -> Option<BoxPair> {
+        let pieces = [(pa, &Halves::new()), (pb, &Halves::new())];
+        self.prove_halving(ab, paths, pieces, depths, extra)
+    }
+
+    /// [`ProtectiveChecker::prove_pieces`], with each piece's halves built at most once:
+    /// a piece that stays while the other is halved is halved itself in both branches.
+    fn prove_halving(
         &self,
         (a, b): (usize, usize),
         (path_a, path_b): (Option<&StopPath>, Option<&StopPath>),
-        pa: &Piece,
-        pb: &Piece,
+        [(pa, halves_a), (pb, halves_b)]: [(&Piece, &Halves); 2],
         (depth_a, depth_b): (u32, u32),
         extra: Real,
     ) -> Option<BoxPair> {
         let unproved = first_unproved_between(&pa.ball, &pb.ball, extra, &Vec3::zeros())
             .map(|(box_a, box_b)| BoxPair { a, b, box_a, box_b })?;
+        let paths = (path_a, path_b);
         let span = |p: &Piece| p.arc.map_or(-1.0, |(s0, s1)| s1 - s0);
         let split_a = depth_a < MAX_DEPTH && (span(pa) >= span(pb) || depth_b >= MAX_DEPTH);
         if split_a {
-            if let Some((h1, h2)) = self.halves(a, path_a, pa) {
+            if let Some((h1, h2)) = halves_a.get_or_init(|| self.halves(a, path_a, pa)) {
                 let deeper = (depth_a + 1, depth_b);
+                let (c1, c2) = (Halves::new(), Halves::new());
                 return self
-                    .prove_pieces((a, b), (path_a, path_b), &h1, pb, deeper, extra)
+                    .prove_halving((a, b), paths, [(h1, &c1), (pb, halves_b)], deeper, extra)
                     .or_else(|| {
-                        self.prove_pieces((a, b), (path_a, path_b), &h2, pb, deeper, extra)
+                        self.prove_halving(
+                            (a, b),
+                            paths,
+                            [(h2, &c2), (pb, halves_b)],
+                            deeper,
+                            extra,
+                        )
                     });
             }
         }
         if depth_b < MAX_DEPTH {
-            if let Some((h1, h2)) = self.halves(b, path_b, pb) {
+            if let Some((h1, h2)) = halves_b.get_or_init(|| self.halves(b, path_b, pb)) {
                 let deeper = (depth_a, depth_b + 1);
+                let (c1, c2) = (Halves::new(), Halves::new());
                 return self
-                    .prove_pieces((a, b), (path_a, path_b), pa, &h1, deeper, extra)
+                    .prove_halving((a, b), paths, [(pa, halves_a), (h1, &c1)], deeper, extra)
                     .or_else(|| {
-                        self.prove_pieces((a, b), (path_a, path_b), pa, &h2, deeper, extra)
+                        self.prove_halving(
+                            (a, b),
+                            paths,
+                            [(pa, halves_a), (h2, &c2)],
+                            deeper,
+                            extra,
+                        )
                     });
             }
         }
