@@ -185,6 +185,18 @@ fn three_robots_in_a_row_never_touch() {
     }
 }
 
+/// Coordination under the programmed order at the programmes' own clearance, stop paths on.
+fn programmed_order() -> SimConfig {
+    SimConfig {
+        coordination: CoordinationConfig {
+            clearance_mm: 10.0,
+            right_of_way: RightOfWay::Programmed,
+            ..CoordinationConfig::default()
+        },
+        ..config(Mode::Coordinate)
+    }
+}
+
 #[test]
 fn the_programmed_order_keeps_moving_where_the_arrival_order_deadlocks() {
     // Cells of our own where the arrival order deadlocks with stop paths; the programmed
@@ -195,14 +207,7 @@ fn the_programmed_order_keeps_moving_where_the_arrival_order_deadlocks() {
         parse_cell(include_str!("../cells/d380.toml")).unwrap(),
     ];
     let programme = ProgrammeConfig { ticks: 1500, ..ProgrammeConfig::default() };
-    let sim = SimConfig {
-        coordination: CoordinationConfig {
-            clearance_mm: 10.0,
-            right_of_way: RightOfWay::Programmed,
-            ..CoordinationConfig::default()
-        },
-        ..config(Mode::Coordinate)
-    };
+    let sim = programmed_order();
     for cell in &cells {
         for seed in [11, 12] {
             let progs = programmes(cell, &programme, &mut Rng::new(seed));
@@ -226,14 +231,7 @@ fn the_programmed_order_keeps_most_of_the_throughput_on_two_robot_cells() {
         parse_cell(include_str!("../cells/h80.toml")).unwrap(),
     ];
     let programme = ProgrammeConfig { ticks: 1500, ..ProgrammeConfig::default() };
-    let sim = SimConfig {
-        coordination: CoordinationConfig {
-            clearance_mm: 10.0,
-            right_of_way: RightOfWay::Programmed,
-            ..CoordinationConfig::default()
-        },
-        ..config(Mode::Coordinate)
-    };
+    let sim = programmed_order();
     for cell in &cells {
         for seed in [51, 52] {
             let progs = programmes(cell, &programme, &mut Rng::new(seed));

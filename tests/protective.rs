@@ -5,9 +5,9 @@
 //! monotonicity, the speed limit, no allocation per tick, and the counts on the scenarios.
 
 use delta_collide::cell::protective::{
-    Protective, ProtectiveChecker, ProtectiveReport, ProtectiveRequest, ProtectiveStatus, StopPath,
+    Protective, ProtectiveChecker, ProtectiveReport, ProtectiveRequest, ProtectiveStatus,
 };
-use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, Scenario, RUN_TICKS};
+use delta_collide::cell::trajectory::{parse_scenarios, Scenario, RUN_TICKS};
 use delta_collide::cell::ExactChecker;
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
@@ -16,8 +16,8 @@ use rand::{RngExt, SeedableRng};
 
 mod protective_common;
 use protective_common::{
-    allocations, assert_stops_never_touch, cell, tcp_near_reach_boundary, tcp_toward_other, unit,
-    STIFF,
+    allocations, assert_stops_never_touch, cell, programmed_paths, tcp_near_reach_boundary,
+    tcp_toward_other, unit, STIFF,
 };
 
 /// Random states near each other; for each FREE one, random stops are simulated.
@@ -557,12 +557,7 @@ fn run_reports(
     let mut out = Vec::new();
     for tick in ticks {
         s.tcps_at(tick, &mut tcps);
-        let lens: Vec<usize> = (0..tcps.len())
-            .map(|j| path_ahead(&s.robots[j], tick, 400.0, &mut points[j]))
-            .collect();
-        let paths: Vec<Option<StopPath>> = (0..tcps.len())
-            .map(|j| Some(StopPath { points: &points[j][..lens[j]], tolerance_mm: 0.1 }))
-            .collect();
+        let paths = programmed_paths(s, tick, &mut points);
         let request = ProtectiveRequest::new(&tcps);
         let request = if tick % 2 == 0 { request.with_paths(&paths) } else { request };
         out.push(checker.check(request).unwrap().clone());

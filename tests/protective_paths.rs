@@ -10,7 +10,7 @@
 use delta_collide::cell::protective::{
     Protective, ProtectiveChecker, ProtectiveRequest, ProtectiveStatus, StopPath,
 };
-use delta_collide::cell::trajectory::{parse_scenarios, path_ahead, RUN_TICKS};
+use delta_collide::cell::trajectory::{parse_scenarios, RUN_TICKS};
 use delta_collide::cell::ExactChecker;
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
@@ -18,7 +18,7 @@ use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
 mod protective_common;
-use protective_common::{cell, tcp_toward_other, unit, STIFF};
+use protective_common::{cell, programmed_paths, tcp_toward_other, unit, STIFF};
 
 /// The point at arc length `s` of the polyline `points` (written here, not the library's).
 fn along(points: &[Vec3], s: Real) -> Vec3 {
@@ -292,12 +292,7 @@ fn programmed_paths_ahead_bring_the_stops_of_the_scenarios_down() {
         for tick in 0..RUN_TICKS {
             s.tcps_at(tick, &mut tcps);
             let v0 = without.check(&tcps).unwrap().verdict;
-            let lens: Vec<usize> = (0..tcps.len())
-                .map(|j| path_ahead(&s.robots[j], tick, 400.0, &mut points[j]))
-                .collect();
-            let paths: Vec<Option<StopPath>> = (0..tcps.len())
-                .map(|j| Some(StopPath { points: &points[j][..lens[j]], tolerance_mm: 0.1 }))
-                .collect();
+            let paths = programmed_paths(s, tick, &mut points);
             let r = with.check(ProtectiveRequest::new(&tcps).with_paths(&paths)).unwrap();
             assert!(r.verdict <= v0, "{} {} tick {tick}: worse with paths", s.cell, s.case);
             stops_with += (r.verdict == Protective::Stop) as u32;

@@ -7,7 +7,9 @@
 
 pub mod adversary;
 
+use delta_collide::cell::protective::StopPath;
 use delta_collide::cell::reference::reference_cell;
+use delta_collide::cell::trajectory::{path_ahead, Scenario};
 use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::math::{Real, Vec3};
 use delta_collide::robot::StopModel;
@@ -262,4 +264,21 @@ pub fn pushed_to_reach_boundary(
             return q;
         }
     }
+}
+
+/// Each robot's programmed path ahead at `tick` of scenario `s` (400 mm, 0.1 mm tolerance) as
+/// its stop path, its points written into `points` (one buffer per robot).
+pub fn programmed_paths<'a>(
+    s: &Scenario,
+    tick: u32,
+    points: &'a mut [[Vec3; 32]],
+) -> Vec<Option<StopPath<'a>>> {
+    points
+        .iter_mut()
+        .enumerate()
+        .map(|(j, buf)| {
+            let len = path_ahead(&s.robots[j], tick, 400.0, buf);
+            Some(StopPath { points: &buf[..len], tolerance_mm: 0.1 })
+        })
+        .collect()
 }
