@@ -2,10 +2,20 @@
 //! (for inputs) finiteness checked, with a `ValueError` that names the argument and what it
 //! must be.
 
+use delta_collide::math::Vec3;
 use numpy::{Element, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyReadwriteArrayDyn};
 use numpy::{PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+
+/// The TCPs of configuration `i` of a C-ordered (N, robots, 3) array's `values` into `out`.
+#[inline(always)]
+pub fn configuration(values: &[f64], robots: usize, i: usize, out: &mut [Vec3]) {
+    for (j, t) in out.iter_mut().enumerate() {
+        let k = 3 * (i * robots + j);
+        *t = Vec3::new(values[k], values[k + 1], values[k + 2]);
+    }
+}
 
 /// The dtype name of `obj` as numpy prints it, or its Python type when it is no array.
 fn dtype_of(obj: &Bound<'_, PyAny>) -> String {

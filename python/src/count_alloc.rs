@@ -60,15 +60,6 @@ pub fn work<R>(work: impl FnOnce() -> R) -> R {
     out
 }
 
-/// Runs `f` inside a call's work without counting it as work (a copy of fixed size made
-/// before the loop).
-pub fn outside_work<R>(f: impl FnOnce() -> R) -> R {
-    let was = WORKING.with(|w| w.replace(false));
-    let out = f();
-    WORKING.with(|w| w.set(was));
-    out
-}
-
 /// Allocations so far: in all, and during calls' work.
 pub fn counts() -> (u64, u64) {
     (TOTAL.load(Ordering::Relaxed), IN_WORK.load(Ordering::Relaxed))

@@ -2,7 +2,7 @@
 //! (thesis 3.1), its exact signed clearance (SPEC §8) and its boxes, one configuration after
 //! the other with the cell's checker, the GIL released, nothing allocated.
 
-use crate::arrays::{finite, input, output};
+use crate::arrays::{configuration, finite, input, output};
 use crate::count_alloc;
 use crate::pycell::PyCell;
 use delta_collide::cell::exact::PairState;
@@ -18,15 +18,6 @@ fn tcps_shape(cell: &PyCell) -> [Option<usize>; 3] {
 }
 
 const TCPS: [&str; 3] = ["N", "robots", "3"];
-
-/// Robot j's TCP of configuration i.
-#[inline(always)]
-fn config(values: &[f64], robots: usize, i: usize, out: &mut [Vec3]) {
-    for (j, t) in out.iter_mut().enumerate() {
-        let k = 3 * (i * robots + j);
-        *t = Vec3::new(values[k], values[k + 1], values[k + 2]);
-    }
-}
 
 /// The exact check of every configuration of `tcps` (N, robots, 3), into `reachable` (N,)
 /// bool, `collide` (N,) bool (false unless every TCP is reachable) and `pairs` (N, pairs) bool,
@@ -57,7 +48,7 @@ pub fn check_into(
             let mut buf = [Vec3::zeros(); delta_collide::cell::MAX_ROBOTS];
             let buf = &mut buf[..robots];
             for i in 0..n {
-                config(values, robots, i, buf);
+                configuration(values, robots, i, buf);
                 let v = checker.check(buf).map_err(|e| e.to_string())?;
                 // As `dc_query` and the CLI: no verdict unless every TCP is reachable; the
                 // pairs of reachable robots are still decided.
@@ -97,7 +88,7 @@ pub fn clearance_into(
             let mut buf = [Vec3::zeros(); delta_collide::cell::MAX_ROBOTS];
             let buf = &mut buf[..robots];
             for (i, slot) in o.iter_mut().enumerate() {
-                config(values, robots, i, buf);
+                configuration(values, robots, i, buf);
                 let v = checker.place_boxes(buf).map_err(|e| e.to_string())?;
                 *slot = if v.all_reachable() { clearance_now(&checker).0 } else { f64::NAN };
             }

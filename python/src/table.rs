@@ -2,7 +2,7 @@
 //! built, loaded from a file or saved, queried over arrays of configurations as table mode
 //! answers each tick (`dc_query`), with its clearance bound (`dc_table_clearance_bound`).
 
-use crate::arrays::{finite, input, output};
+use crate::arrays::{configuration, finite, input, output};
 use crate::count_alloc;
 use crate::errors::{build_error, table_error, BuildError, TableError};
 use crate::pycell::PyCell;
@@ -326,7 +326,7 @@ impl PyTable {
                 let mut buf = [Vec3::zeros(); MAX_ROBOTS];
                 let buf = &mut buf[..robots];
                 for i in 0..n {
-                    load(values, robots, i, buf);
+                    configuration(values, robots, i, buf);
                     let answer = match &mut *checker {
                         Checker::Table(t) => {
                             let a = t.check(buf);
@@ -380,7 +380,7 @@ impl PyTable {
                 let mut buf = [Vec3::zeros(); MAX_ROBOTS];
                 let buf = &mut buf[..robots];
                 for (i, slot) in o.iter_mut().enumerate() {
-                    load(values, robots, i, buf);
+                    configuration(values, robots, i, buf);
                     *slot = match &*checker {
                         Checker::Table(t) => match t.located_clearance_bound(buf) {
                             Ok(bound) if t.table().as_clearance().is_some() => {
@@ -422,15 +422,6 @@ impl PyTable {
 }
 
 const TCPS: [&str; 3] = ["N", "robots", "3"];
-
-/// The TCPs of configuration `i` into `out`.
-#[inline(always)]
-fn load(values: &[f64], robots: usize, i: usize, out: &mut [Vec3]) {
-    for (j, t) in out.iter_mut().enumerate() {
-        let k = 3 * (i * robots + j);
-        *t = Vec3::new(values[k], values[k + 1], values[k + 2]);
-    }
-}
 
 fn inspect_dict<'py>(
     py: Python<'py>,
