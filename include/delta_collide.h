@@ -45,6 +45,12 @@
 #define DC_MAX_PATH_POINTS 32
 
 /*
+ Units of work a protective query spends per tick on the proof along the stop paths until
+ `dc_set_path_work` sets another cap.
+ */
+#define DC_DEFAULT_PATH_WORK 2000
+
+/*
  Most points of one `DcProgramme`.
  */
 #define DC_MAX_PROGRAMME_POINTS 4096
@@ -1312,15 +1318,36 @@ DcStatus dc_set_speed_limits(struct DcCollider *handle, uint32_t on);
 DcStatus dc_set_limit_tests(struct DcCollider *handle, uint32_t tests);
 
 /*
+ Caps the units of work that `dc_protective_query_with_paths` spends per tick on the proof
+ along the stop paths: its halvings of the paths into pieces, its time slices and its
+ speed limits' tests along the paths, each unit one piece's stop sweeps or one proof of two
+ pieces apart (a few thousand instructions; docs/record/2026-12-02-work-budget.md). The
+ default is `DC_DEFAULT_PATH_WORK`; 0 answers as `dc_protective_query` does; `UINT32_MAX`
+ sets no cap. A step that finds too few units left is not taken and what it would have
+ proved stays unproved: the verdict is then at best the one without paths, a speed limit
+ the highest speed proved so far (`dc_tick_stats` counts such calls in `budget_spent`). So
+ the cap bounds the work that grows with the inputs, and running out answers the safe way.
+ Setup only, like `dc_set_stop_model`, and kept by it.
+
+ Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_PANIC` (a poisoned handle).
+
+ # Safety
+ `handle` must be NULL or a live handle not used by another thread.
+ */
+DcStatus dc_set_path_work(struct DcCollider *handle, uint32_t units);
+
+/*
  Writes the handle's tick statistics to `*out`, whose `struct_size` the caller sets to
  `sizeof(DcTickStats)` first (a later, larger version is filled as far as this one knows;
  `struct_size` is then this version's). Counted since the handle was made or since
  `dc_tick_stats_reset`: `query` for `dc_query`, `protective` for every protective query,
  `coordinate` for `dc_coordinate`; a call that finds the handle busy is not counted. Times
- are inside the library, from the monotonic clock; work units are the speed limits' proof
- tests (`dc_set_limit_tests` caps them per tick; `budget_spent` counts the ticks that used
- the whole cap, their limits then the largest speeds proved so far) and the coordination's
- diagram cells; `dc_query` reports no work (its box tests are fixed by the cell). Cheap
+ are inside the library, from the monotonic clock. A protective call's work is its speed
+ limits' proof tests (`dc_set_limit_tests` caps them per tick) plus the units of its proof
+ along the stop paths (`dc_set_path_work` caps them), each about one stop's sweeps or one
+ swept-box proof; `budget_spent` counts the calls that used either whole cap (their limits
+ then the largest speeds proved so far, their verdict at best the one without paths). The
+ coordination's work is its diagram cells; `dc_query` reports no work (its box tests are fixed by the cell). Cheap
  enough for every tick: it copies about 200 bytes and allocates nothing.
 
  Statuses: `DC_STATUS_NULL_POINTER` (handle or out NULL), `DC_STATUS_INVALID_ARGUMENT`

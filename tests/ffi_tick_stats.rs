@@ -82,6 +82,69 @@ fn each_kind_of_call_is_counted_timed_and_reset() {
     unsafe { dc_destroy(h) };
 }
 
+/// A protective query with paths of T1: robot 1 at `x` comes toward robot 0 along x, its
+/// stop path the next 60 mm of that line; robot 0 stands, its path its one point.
+fn protective_with_paths(h: *mut DcCollider, x: f64) -> DcStatus {
+    let tcps = [DcVec3 { x: -150.0, y: 0.0, z: -450.0 }, DcVec3 { x, y: 0.0, z: -450.0 }];
+    let ahead: Vec<DcVec3> =
+        (0..16).map(|k| DcVec3 { x: x - 4.0 * f64::from(k), y: 0.0, z: -450.0 }).collect();
+    let paths = [
+        DcStopPath { points: &tcps[0], n_points: 1, tolerance_mm: 0.5 },
+        DcStopPath { points: ahead.as_ptr(), n_points: ahead.len(), tolerance_mm: 0.5 },
+    ];
+    let mut verdict = DC_VERDICT_STOP;
+    let mut report = std::mem::MaybeUninit::<DcProtectiveReport>::zeroed();
+    // SAFETY: live handle, two readable TCPs and paths, writable outputs.
+    unsafe {
+        dc_protective_query_with_paths(
+            h,
+            tcps.as_ptr(),
+            2,
+            paths.as_ptr(),
+            2,
+            &mut verdict,
+            report.as_mut_ptr(),
+        )
+    }
+}
+
+/// `dc_set_path_work`: the work of a query with paths is its limit tests plus its units along
+/// the paths, within the caps; a small cap is spent and counted, and the setting outlives
+/// `dc_set_stop_model`.
+#[test]
+fn the_work_along_the_paths_is_capped_and_counted() {
+    let h = two_robot_cell(450.0, DC_METHOD_SAT_CACHE);
+    let stops = [dc_stop_config_default(); 2];
+    // SAFETY: live handle or NULL; two readable configs.
+    unsafe {
+        assert_eq!(dc_set_path_work(std::ptr::null_mut(), 5), DC_STATUS_NULL_POINTER);
+        assert_eq!(dc_set_path_work(h, 5), DC_STATUS_OK);
+        assert_eq!(dc_set_stop_model(h, 1.0, 10.0, stops.as_ptr(), 2), DC_STATUS_OK);
+        assert_eq!(dc_set_limit_tests(h, 3), DC_STATUS_OK);
+    }
+    for k in 0..40 {
+        assert_eq!(protective_with_paths(h, 120.0 - f64::from(k) * 1.0), DC_STATUS_OK);
+    }
+    let p = stats(h).protective;
+    assert!(p.largest_work <= 3 + 5, "at most 3 tests and 5 units: {p:?}");
+    assert!(p.budget_spent >= 30, "a cap of 5 units is spent: {p:?}");
+    // No cap: more work than 5 units on the same ticks, and none of it cut short.
+    // SAFETY: live handle.
+    unsafe {
+        dc_protective_reset(h);
+        assert_eq!(dc_tick_stats_reset(h), DC_STATUS_OK);
+        assert_eq!(dc_set_limit_tests(h, u32::MAX), DC_STATUS_OK);
+        assert_eq!(dc_set_path_work(h, u32::MAX), DC_STATUS_OK);
+    }
+    for k in 0..40 {
+        assert_eq!(protective_with_paths(h, 120.0 - f64::from(k) * 1.0), DC_STATUS_OK);
+    }
+    let p = stats(h).protective;
+    assert!(p.largest_work > 8 && p.budget_spent == 0, "{p:?}");
+    // SAFETY: live handle, destroyed once.
+    unsafe { dc_destroy(h) };
+}
+
 #[test]
 fn bad_arguments_have_their_status_and_write_nothing() {
     let h = two_robot_cell(450.0, DC_METHOD_SAT);

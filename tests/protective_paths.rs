@@ -315,3 +315,55 @@ fn programmed_paths_ahead_bring_the_stops_of_the_scenarios_down() {
         }
     }
 }
+
+/// The work budget along the paths (`ProtectiveChecker::with_path_work`) on the practical and
+/// collision scenarios with the programmed path ahead, speed limits on: no tick spends more
+/// units than its budget; a tick that did not run out answers as without a cap; one that ran
+/// out is never better than without a cap nor worse than without paths; with no units at
+/// all the answer is bit for bit the one without paths.
+#[test]
+fn a_work_budget_bounds_the_work_along_the_paths_and_only_loses_proofs() {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/c_harness/scenarios.txt"))
+            .unwrap();
+    let budgets = [0, 10, 60, u32::MAX];
+    let mut ran_out = [0u32; 4];
+    let mut most = [0u32; 4];
+    for s in parse_scenarios(&text).unwrap().iter().filter(|s| s.cell != "T3") {
+        let cell = cell(&s.cell, StopModel::DEFAULT);
+        let mut plain = ProtectiveChecker::new(cell, 10.0).unwrap();
+        let mut capped: Vec<_> = budgets.iter().map(|&b| plain.clone().with_path_work(b)).collect();
+        let mut tcps = vec![Vec3::zeros(); s.robots.len()];
+        let mut points = vec![[Vec3::zeros(); 32]; s.robots.len()];
+        for tick in (0..RUN_TICKS).take(2_000) {
+            s.tcps_at(tick, &mut tcps);
+            let without = plain.check(&tcps).unwrap().clone();
+            let paths = programmed_paths(s, tick, &mut points);
+            let reports: Vec<_> = capped
+                .iter_mut()
+                .map(|c| c.check(ProtectiveRequest::new(&tcps).with_paths(&paths)).unwrap().clone())
+                .collect();
+            let full = &reports[3];
+            let at = format!("{} {} tick {tick}", s.cell, s.case);
+            for (k, r) in reports.iter().enumerate() {
+                assert!(r.path_work <= budgets[k], "{at}: {} units of {}", r.path_work, budgets[k]);
+                assert!(r.verdict <= without.verdict, "{at}: worse than without paths");
+                assert!(r.verdict >= full.verdict, "{at}: better than without a cap");
+                if !r.path_work_spent {
+                    assert_eq!(r.verdict, full.verdict, "{at}: a budget not spent changed it");
+                }
+                ran_out[k] += u32::from(r.path_work_spent);
+                most[k] = most[k].max(r.path_work);
+            }
+            let limits = |r: &delta_collide::cell::protective::ProtectiveReport| {
+                r.robots.iter().map(|x| x.speed_limit_mm_s.to_bits()).collect::<Vec<_>>()
+            };
+            assert_eq!(reports[0].verdict, without.verdict, "{at}: no units, not as without");
+            assert_eq!(limits(&reports[0]), limits(&without), "{at}: no units, other limits");
+        }
+    }
+    println!("ticks that ran out per budget {budgets:?}: {ran_out:?}; most units spent {most:?}");
+    // The caps bind where the proof along the paths needs more (else this tests nothing).
+    assert!(ran_out[1] > 100 && ran_out[2] > 10, "{ran_out:?}");
+    assert!(ran_out[3] == 0 && most[3] > budgets[2], "{most:?}");
+}

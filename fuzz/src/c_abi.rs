@@ -66,8 +66,8 @@ pub enum Op {
     /// `dc_pair_results`: handle, capacity (byte * 2), NULL flags (byte: out, out_len).
     PairResults = 2,
     /// `dc_robot_count`, `dc_pair_count`, `dc_mode`, `dc_table_fallbacks`,
-    /// `dc_table_confirmations`, then `dc_set_table_confirmation`, `dc_set_speed_limits` and
-    /// `dc_set_limit_tests`: handle.
+    /// `dc_table_confirmations`, then `dc_set_table_confirmation`, `dc_set_speed_limits`,
+    /// `dc_set_limit_tests` and `dc_set_path_work`: handle.
     Counts = 3,
     /// `dc_delta3_inverse_kinematics`: edits (byte % 4) of the thesis geometry, point, NULL
     /// flags (byte: geometry, out_theta).
@@ -786,6 +786,11 @@ fn counts(input: &mut Input, live: &[Live]) {
     let status = unsafe { dc_set_limit_tests(handle_of(l), tests) };
     let expected = if l.is_none() { DC_STATUS_NULL_POINTER } else { DC_STATUS_OK };
     assert_eq!(status, expected, "dc_set_limit_tests({tests})");
+    // And the cap on the work along the stop paths, likewise.
+    let units = [0, 1, 40, u32::MAX][((fallbacks + robots as u64) % 4) as usize];
+    // SAFETY: NULL or live.
+    let status = unsafe { dc_set_path_work(handle_of(l), units) };
+    assert_eq!(status, expected, "dc_set_path_work({units})");
 }
 
 /// The thesis geometry with up to three edits; also says whether it is unedited.

@@ -321,10 +321,12 @@ impl Collider {
             .with_stopping(tick_ms, models)
             .map_err(|e| invalid(e.to_string()))?;
         let (limits, tests) = (self.protective.speed_limits(), self.protective.limit_tests());
+        let path_work = self.protective.path_work();
         self.protective = ProtectiveChecker::new(cell, warn_mm)
             .map_err(|e| invalid(e.to_string()))?
             .with_speed_limits(limits)
-            .with_limit_tests(tests);
+            .with_limit_tests(tests)
+            .with_path_work(path_work);
         self.coordination.set_cell(self.protective.cell().clone());
         Ok(())
     }
@@ -332,6 +334,11 @@ impl Collider {
     /// Caps the speeds the speed-limit searches test per tick, all robots together.
     pub(crate) fn set_limit_tests(&mut self, tests: u32) {
         self.protective.set_limit_tests(tests);
+    }
+
+    /// Caps the units of work the proof along the stop paths spends per tick.
+    pub(crate) fn set_path_work(&mut self, units: u32) {
+        self.protective.set_path_work(units);
     }
 
     /// Whether the protective queries to come find each robot's speed limit.
@@ -359,9 +366,10 @@ impl Collider {
         let started = Instant::now();
         let status = self.protective_query_untimed(time, tcps, paths, report);
         let r = self.protective.report();
-        let tests = if status == DC_STATUS_OK { r.limit_tests } else { 0 };
-        let spent = status == DC_STATUS_OK && r.limit_budget_spent;
-        self.stats.protective.record(started.elapsed(), u64::from(tests), spent);
+        let ok = status == DC_STATUS_OK;
+        let work = if ok { u64::from(r.limit_tests) + u64::from(r.path_work) } else { 0 };
+        let spent = ok && (r.limit_budget_spent || r.path_work_spent);
+        self.stats.protective.record(started.elapsed(), work, spent);
         status
     }
 
@@ -505,6 +513,7 @@ fn timing_status(fault: TimingFault) -> DcStatus {
 // The header states these bounds as numbers (cbindgen writes no paths): keep them equal.
 const _: () = assert!(DC_MAX_INTERVAL_TICKS == crate::cell::protective::MAX_INTERVAL_TICKS);
 const _: () = assert!(DC_MAX_PATH_POINTS == crate::cell::protective::MAX_PATH_POINTS);
+const _: () = assert!(DC_DEFAULT_PATH_WORK == crate::cell::protective::DEFAULT_PATH_WORK);
 
 fn query_exact(checker: &mut ExactChecker, tcps: &[Vec3], report: &mut DcQueryReport) -> DcStatus {
     let Ok(v) = checker.check(tcps) else { return DC_STATUS_WRONG_ROBOT_COUNT };

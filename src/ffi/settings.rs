@@ -162,3 +162,29 @@ pub unsafe extern "C" fn dc_set_limit_tests(handle: *mut DcCollider, tests: u32)
         })
     }
 }
+
+/// Caps the units of work that `dc_protective_query_with_paths` spends per tick on the proof
+/// along the stop paths: its halvings of the paths into pieces, its time slices and its
+/// speed limits' tests along the paths, each unit one piece's stop sweeps or one proof of two
+/// pieces apart (a few thousand instructions; docs/record/2026-12-02-work-budget.md). The
+/// default is `DC_DEFAULT_PATH_WORK`; 0 answers as `dc_protective_query` does; `UINT32_MAX`
+/// sets no cap. A step that finds too few units left is not taken and what it would have
+/// proved stays unproved: the verdict is then at best the one without paths, a speed limit
+/// the highest speed proved so far (`dc_tick_stats` counts such calls in `budget_spent`). So
+/// the cap bounds the work that grows with the inputs, and running out answers the safe way.
+/// Setup only, like `dc_set_stop_model`, and kept by it.
+///
+/// Statuses: `DC_STATUS_NULL_POINTER` (handle NULL), `DC_STATUS_PANIC` (a poisoned handle).
+///
+/// # Safety
+/// `handle` must be NULL or a live handle not used by another thread.
+#[no_mangle]
+pub unsafe extern "C" fn dc_set_path_work(handle: *mut DcCollider, units: u32) -> DcStatus {
+    // SAFETY: the caller guarantees `handle` is NULL or live and unshared.
+    unsafe {
+        set_on_handle(handle, |c| {
+            c.set_path_work(units);
+            Ok(())
+        })
+    }
+}

@@ -61,10 +61,12 @@ pub(crate) struct TickStats {
 /// `struct_size` is then this version's). Counted since the handle was made or since
 /// `dc_tick_stats_reset`: `query` for `dc_query`, `protective` for every protective query,
 /// `coordinate` for `dc_coordinate`; a call that finds the handle busy is not counted. Times
-/// are inside the library, from the monotonic clock; work units are the speed limits' proof
-/// tests (`dc_set_limit_tests` caps them per tick; `budget_spent` counts the ticks that used
-/// the whole cap, their limits then the largest speeds proved so far) and the coordination's
-/// diagram cells; `dc_query` reports no work (its box tests are fixed by the cell). Cheap
+/// are inside the library, from the monotonic clock. A protective call's work is its speed
+/// limits' proof tests (`dc_set_limit_tests` caps them per tick) plus the units of its proof
+/// along the stop paths (`dc_set_path_work` caps them), each about one stop's sweeps or one
+/// swept-box proof; `budget_spent` counts the calls that used either whole cap (their limits
+/// then the largest speeds proved so far, their verdict at best the one without paths). The
+/// coordination's work is its diagram cells; `dc_query` reports no work (its box tests are fixed by the cell). Cheap
 /// enough for every tick: it copies about 200 bytes and allocates nothing.
 ///
 /// Statuses: `DC_STATUS_NULL_POINTER` (handle or out NULL), `DC_STATUS_INVALID_ARGUMENT`

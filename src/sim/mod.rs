@@ -64,6 +64,9 @@ pub struct SimConfig {
     pub path_length_mm: Real,
     /// A run that has not finished after this many times its programmed ticks ends.
     pub max_ticks_factor: Real,
+    /// Units of work the protective verdict may spend per tick along the stop paths
+    /// ([`ProtectiveChecker::with_path_work`](crate::cell::protective::ProtectiveChecker)).
+    pub path_work: u32,
 }
 
 impl Default for SimConfig {
@@ -76,6 +79,7 @@ impl Default for SimConfig {
             stride_ticks: 4,
             path_length_mm: 400.0,
             max_ticks_factor: 4.0,
+            path_work: crate::cell::protective::DEFAULT_PATH_WORK,
         }
     }
 }
@@ -137,4 +141,8 @@ pub struct RunMetrics {
     pub exact_ns: Timings,
     /// The most diagram cells one call tested.
     pub cells_tested_max: u64,
+    /// The most units of work one protective call spent along the stop paths.
+    pub path_work_max: u32,
+    /// Protective calls that ran out of their work along the paths.
+    pub path_work_spent: usize,
 }

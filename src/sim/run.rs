@@ -143,7 +143,8 @@ pub fn run_traced(
     let with_limits = matches!(config.mode, Mode::Limits | Mode::Coordinate);
     let mut protective = ProtectiveChecker::new(cell.clone(), config.warn_mm)
         .expect("a cell that parsed builds a protective checker")
-        .with_speed_limits(with_limits);
+        .with_speed_limits(with_limits)
+        .with_path_work(config.path_work);
     let mut coordinator = Coordinator::new(cell.clone(), config.coordination);
     let mut interlock = (config.mode == Mode::Interlock)
         .then(|| Interlock::new(cell, programmes, config.coordination.clearance_mm, 2.0));
@@ -326,6 +327,8 @@ pub fn run_traced(
                 for (l, x) in limits.iter_mut().zip(&r.robots) {
                     *l = x.speed_limit_mm_s;
                 }
+                metrics.path_work_max = metrics.path_work_max.max(r.path_work);
+                metrics.path_work_spent += usize::from(r.path_work_spent);
                 r.verdict
             }
             Err(_) => {

@@ -225,6 +225,9 @@ pub struct SimulateArgs {
     /// Clearance the programmes' offline interlock keeps, executed as programmed (mm)
     #[arg(long, value_name = "MM", default_value_t = 10.0)]
     pub gap_mm: f64,
+    /// Units of work the protective verdict may spend per tick along the stop paths
+    #[arg(long, value_name = "UNITS", default_value_t = delta_collide::cell::protective::DEFAULT_PATH_WORK)]
+    pub path_work: u32,
     /// Draw the first run's coordination diagram of the first robot pair (the last mode
     /// run) to this PNG file
     #[arg(long, value_name = "FILE.png")]

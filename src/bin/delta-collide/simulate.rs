@@ -35,7 +35,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
         if a.paths { "on" } else { "off" }
     );
     println!(
-        "{:<11} {:>4} {:>10} {:>6} {:>5} {:>8} {:>8} {:>14} {:>24} {:>18}",
+        "{:<11} {:>4} {:>10} {:>6} {:>5} {:>8} {:>8} {:>14} {:>24} {:>18} {:>12}",
         "mode",
         "run",
         "throughput",
@@ -45,11 +45,18 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
         "finished",
         "FREE/WARN/STOP",
         "ours med/p99/max us",
-        "exact med/p99/max"
+        "exact med/p99/max",
+        "work max/out"
     );
     let last = modes.len() - 1;
     for (m, mode) in modes.into_iter().enumerate() {
-        let config = SimConfig { mode, paths: a.paths, coordination, ..SimConfig::default() };
+        let config = SimConfig {
+            mode,
+            paths: a.paths,
+            coordination,
+            path_work: a.path_work,
+            ..SimConfig::default()
+        };
         let mut kept = Vec::new();
         for r in 0..a.runs {
             let seed = a.seed + u64::from(r);
@@ -79,7 +86,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
                 )
             };
             println!(
-                "{:<11} {:>4} {:>9.1}% {:>6} {:>5} {:>8} {:>8} {:>14} {:>24} {:>18}",
+                "{:<11} {:>4} {:>9.1}% {:>6} {:>5} {:>8} {:>8} {:>14} {:>24} {:>18} {:>12}",
                 mode.name(),
                 seed,
                 100.0 * m.throughput,
@@ -90,6 +97,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
                 format!("{}/{}/{}", m.verdicts[0], m.verdicts[1], m.verdicts[2]),
                 us(&m.ours_ns),
                 us(&m.exact_ns),
+                format!("{}/{}", m.path_work_max, m.path_work_spent),
             );
             kept.push(m);
         }

@@ -176,6 +176,7 @@ mod request;
 mod slices;
 mod speed_limit;
 mod stop_sweeps;
+mod work;
 pub use clock::{TickTime, TimingFault, MAX_INTERVAL_TICKS, MIN_INTERVAL_TICKS};
 pub use kept::{KEPT_MARGIN_MM, KEPT_WIDEN};
 pub use lookup::{ClearanceBound, LOOKUP_SLACK_MM};
@@ -183,6 +184,7 @@ pub use path::{path_through_samples, StopPath, MAX_PATH_POINTS};
 pub use request::ProtectiveRequest;
 use stop_sweeps::{first_unproved_between, stop_sweeps_wcs_into, SweptBall};
 pub use stop_sweeps::{stop_sweeps_wcs, SweepForms};
+pub use work::DEFAULT_PATH_WORK;
 
 /// Sub-boxes per axis when enclosing the motor angles over the stopping cube (`STOP_SPLITS^3` per
 /// arm). The cubes here are tens to hundreds of mm, where finer splits shrink the sweeps by
@@ -315,6 +317,13 @@ pub struct ProtectiveReport {
     /// Whether the searches used the whole cap this tick: some limit is then the largest speed
     /// proved so far, its search going on next tick.
     pub limit_budget_spent: bool,
+    /// Units of work the proof along the stop paths spent this tick (`protective/work.rs`;
+    /// [`ProtectiveChecker::with_path_work`] caps it); 0 without paths.
+    pub path_work: u32,
+    /// Whether the proof along the paths left a step untaken for want of units this tick:
+    /// the verdict is then at best the one without paths, or a speed limit the highest speed
+    /// proved so far.
+    pub path_work_spent: bool,
 }
 
 impl Clone for ProtectiveReport {
@@ -341,6 +350,7 @@ impl ProtectiveReport {
         let (kept_proof, table_lookup, table_pairs, time_sliced) =
             (self.kept_proof, self.table_lookup, self.table_pairs, self.time_sliced);
         let (limit_tests, limit_budget_spent) = (self.limit_tests, self.limit_budget_spent);
+        let (path_work, path_work_spent) = (self.path_work, self.path_work_spent);
         let robots = alloc::vec::Vec::new();
         ProtectiveReport {
             verdict,
@@ -355,6 +365,8 @@ impl ProtectiveReport {
             table_pairs,
             limit_tests,
             limit_budget_spent,
+            path_work,
+            path_work_spent,
         }
     }
 }
@@ -423,6 +435,8 @@ struct Model {
     /// Speeds tested per tick at most, all robots together, by the searches of the table
     /// tier's limits.
     limit_tests: u32,
+    /// Units of work the proof along the paths may spend per tick (`protective/work.rs`).
+    path_work: u32,
     /// Whether the certain STOPs are tried on the closest pair before any reference is set
     /// (module doc, step 8; off only in the test that checks it changes no verdict).
     certain_stops_first: bool,
@@ -470,6 +484,8 @@ pub struct ProtectiveChecker {
     contact: contact::KeptContact,
     /// Each robot's piece of its whole stop along its path this tick (`path.rs`).
     whole_pieces: alloc::vec::Vec<Option<path::Piece>>,
+    /// The work the proof along the paths spends this tick (`protective/work.rs`).
+    work: work::PathWork,
     calls: Calls,
     report: ProtectiveReport,
 }
@@ -533,6 +549,8 @@ impl ProtectiveChecker {
             table_pairs: 0,
             limit_tests: 0,
             limit_budget_spent: false,
+            path_work: 0,
+            path_work_spent: false,
         };
         let robot = RobotState {
             history: NO_HISTORY,
@@ -554,6 +572,7 @@ impl ProtectiveChecker {
             precise_splits: PRECISE_SPLITS,
             precise_limits: false,
             limit_tests: n as u32 + DEFAULT_EXTRA_LIMIT_TESTS,
+            path_work: DEFAULT_PATH_WORK,
             certain_stops_first: true,
             no_faces,
         };
@@ -574,6 +593,7 @@ impl ProtectiveChecker {
             kept,
             contact: contact::KeptContact::default(),
             whole_pieces: alloc::vec![None; n],
+            work: work::PathWork::default(),
             calls,
             report,
         })
@@ -642,6 +662,29 @@ impl ProtectiveChecker {
     /// The cap on speeds tested per tick ([`ProtectiveChecker::with_limit_tests`]).
     pub fn limit_tests(&self) -> u32 {
         self.model.limit_tests
+    }
+
+    /// This checker spending at most `units` of work per tick on the proof along the stop
+    /// paths ([`DEFAULT_PATH_WORK`] by default; 0: the verdict and limits without paths;
+    /// `u32::MAX`: no cap). The part of a tick whose work grows with the inputs (`path.rs`:
+    /// halvings, time slices, the limits' tests along the paths) then stays within a count
+    /// the caller sets; a step without the units it needs is not taken and what it would
+    /// have proved stays unproved (`protective/work.rs`): the verdict is at best the one
+    /// without paths, a limit the highest speed proved. The rest of a tick is bounded by its
+    /// tiers and by [`ProtectiveChecker::with_limit_tests`].
+    pub fn with_path_work(self, units: u32) -> Self {
+        ProtectiveChecker { model: Model { path_work: units, ..self.model }, ..self }
+    }
+
+    /// Sets the cap on the work along the paths from the next tick on
+    /// ([`ProtectiveChecker::with_path_work`]).
+    pub fn set_path_work(&mut self, units: u32) {
+        self.model.path_work = units;
+    }
+
+    /// The cap on the work along the paths per tick ([`ProtectiveChecker::with_path_work`]).
+    pub fn path_work(&self) -> u32 {
+        self.model.path_work
     }
 
     /// The WARN threshold (mm).
@@ -827,7 +870,17 @@ impl ProtectiveChecker {
             if self.calls.references_stale {
                 self.set_references(tcps_mcs);
             }
-            self.set_whole_pieces(tcps_mcs, paths);
+            self.work.start(self.model.path_work);
+            self.along_paths(tcps_mcs, paths);
+            (self.report.path_work, self.report.path_work_spent) =
+                (self.work.used(), self.work.ran_out());
+        }
+    }
+
+    /// The proof along the paths and its speed limits, within the tick's work (`path.rs`,
+    /// `work.rs`).
+    fn along_paths(&mut self, tcps_mcs: &[Vec3], paths: &[Option<StopPath>]) {
+        if self.set_whole_pieces(tcps_mcs, paths) {
             if self.report.verdict != Protective::Free {
                 let (verdict, limiting, sliced) = self.prove_with_paths(tcps_mcs, paths);
                 if verdict < self.report.verdict {
@@ -922,7 +975,7 @@ impl ProtectiveChecker {
         (report.closest, report.limiting, report.kept_proof, report.table_lookup) =
             (None, None, false, false);
         (report.table_pairs, report.limit_tests, report.limit_budget_spent) = (0, 0, false);
-        report.time_sliced = false;
+        (report.time_sliced, report.path_work, report.path_work_spent) = (false, 0, false);
         self.pairs.iter_mut().for_each(|p| p.table_proved = false);
     }
 

@@ -326,8 +326,12 @@ impl ProtectiveChecker {
     }
 
     /// The halves of `piece` of robot `j`, when it has a path range to split.
+    /// `None` too when the work budget has not the two units left (`work.rs`).
     fn halves(&self, j: usize, path: Option<&StopPath>, piece: &Piece) -> Option<(Piece, Piece)> {
         let (a, b) = piece.arc?;
+        if !self.work.spend(2) {
+            return None;
+        }
         let m = 0.5 * (a + b);
         Some((self.piece(j, path, Some((a, m))), self.piece(j, path, Some((m, b)))))
     }
@@ -357,6 +361,9 @@ impl ProtectiveChecker {
         (depth_a, depth_b): (u32, u32),
         extra: Real,
     ) -> Option<BoxPair> {
+        if !self.work.spend(1) {
+            return Some(self.out_of_work_pair(a, b));
+        }
         let unproved = first_unproved_between(&pa.ball, &pb.ball, extra, &Vec3::zeros())
             .map(|(box_a, box_b)| BoxPair { a, b, box_a, box_b })?;
         let paths = (path_a, path_b);
@@ -399,6 +406,13 @@ impl ProtectiveChecker {
         Some(unproved)
     }
 
+    /// The box pair reported for robots `a < b` when the work budget leaves them unproved:
+    /// the limiting pair of the verdict without paths when it is theirs, else their first.
+    fn out_of_work_pair(&self, a: usize, b: usize) -> BoxPair {
+        let first = BoxPair { a, b, box_a: 0, box_b: 0 };
+        self.report.limiting.filter(|p| (p.a, p.b) == (a, b)).unwrap_or(first)
+    }
+
     /// The piece of robot `j`'s whole stop of length `s` along its path (or its reference
     /// ball without a path).
     fn whole_piece(&self, j: usize, tcp_mcs: &Vec3, s: Real, path: Option<&StopPath>) -> Piece {
@@ -420,6 +434,9 @@ impl ProtectiveChecker {
         (tcps_mcs, paths): (&[Vec3], &[Option<StopPath>]),
         v: Real,
     ) -> bool {
+        if !self.work.spend(1) {
+            return false;
+        }
         let s = self.stop_reference(j, &tcps_mcs[j], v);
         // Two ticks more along the path: a limit the controller applies must still be proved
         // where the robot is when the next verdicts come.
@@ -468,15 +485,16 @@ impl ProtectiveChecker {
                 *slot = Some(range);
             }
         }
-        // A piece is built again only where its range changed (a robot at rest keeps it).
+        // A piece is built again only where its range changed (a robot at rest keeps it), and
+        // only with a unit of work left for it.
         let reuse = |last: Option<Piece>, j: usize, path, arc| match last {
-            Some(p) if p.arc == arc => p,
-            _ => self.piece(j, path, arc),
+            Some(p) if p.arc == arc => Some(p),
+            _ => self.work.spend(1).then(|| self.piece(j, path, arc)),
         };
         let (mut last_a, mut last_b) = (None, None);
         for (&arc_a, &arc_b) in arcs[0].iter().zip(&arcs[1]) {
-            let pa = reuse(last_a.take(), a, paths.0, arc_a);
-            let pb = reuse(last_b.take(), b, paths.1, arc_b);
+            let Some(pa) = reuse(last_a.take(), a, paths.0, arc_a) else { return false };
+            let Some(pb) = reuse(last_b.take(), b, paths.1, arc_b) else { return false };
             if self.prove_pieces((a, b), paths, &pa, &pb, (0, 0), extra).is_some() {
                 return false;
             }
@@ -487,13 +505,22 @@ impl ProtectiveChecker {
 
     /// Each robot's piece of its whole stop at its measured speed (module doc, step 1), for
     /// the references of this tick: built once a tick, read by the verdict and by every test
-    /// of the speed limits along the paths.
-    pub(super) fn set_whole_pieces(&mut self, tcps_mcs: &[Vec3], paths: &[Option<StopPath>]) {
+    /// of the speed limits along the paths. `false`, with no piece built, when the work
+    /// budget has not one unit per robot (`work.rs`).
+    pub(super) fn set_whole_pieces(
+        &mut self,
+        tcps_mcs: &[Vec3],
+        paths: &[Option<StopPath>],
+    ) -> bool {
+        if !self.work.spend(tcps_mcs.len() as u32) {
+            return false;
+        }
         for j in 0..tcps_mcs.len() {
             let s = self.report.robots[j].protective_mm;
             let piece = self.whole_piece(j, &tcps_mcs[j], s, paths[j].as_ref());
             self.whole_pieces[j] = Some(piece);
         }
+        true
     }
 
     /// Robot `j`'s piece of [`ProtectiveChecker::set_whole_pieces`].
@@ -533,6 +560,10 @@ impl ProtectiveChecker {
                     proved = next;
                     next = (proved + step).min(v_max).min(0.5 * (proved + failed));
                     step *= 2.0;
+                } else if self.work.ran_out() {
+                    // Not a failed proof: no work left to finish it. The limit is the highest
+                    // speed proved.
+                    break;
                 } else {
                     failed = next;
                     next = 0.5 * (proved + failed);
