@@ -1370,3 +1370,35 @@ fn csv_numbers_round_trip_and_bad_first_lines_and_negative_values_are_named() {
         assert_eq!(text.split('.').nth(1).map(str::len), Some(3), "{line}");
     }
 }
+
+#[test]
+fn simulate_writes_a_trace_with_one_row_per_tick() {
+    let dir = fresh_dir("simulate_trace");
+    let file = dir.join("run.csv");
+    let out = cli(&[
+        "simulate",
+        "--cell",
+        "T1",
+        "--runs",
+        "1",
+        "--ticks",
+        "300",
+        "--mode",
+        "coordinate",
+        "--trace",
+        file.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&file).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 13, "tick, five columns per robot, verdict, clearance: {header:?}");
+    assert_eq!((header[0], header[11], header[12]), ("tick", "verdict", "clearance_mm"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert!(rows.len() >= 300, "{} rows for a programme of 300 ticks", rows.len());
+    for r in &rows {
+        assert_eq!(r.len(), header.len(), "{r:?}");
+        assert!(["FREE", "WARN", "STOP"].contains(&r[11]), "{r:?}");
+        assert!(r[12].parse::<f64>().is_ok_and(|c| c > 0.0), "a contact in {r:?}");
+    }
+}

@@ -10,12 +10,13 @@
 //! printed, not asserted: there a STOP at standstill can hold the robots for good
 //! (docs/record/2026-12-02-path-limits.md).
 
+use delta_collide::cell::protective::Protective;
 use delta_collide::cell::reference::reference_cell;
 use delta_collide::cell::trajectory::minimum_jerk;
 use delta_collide::cell::{parse_cell, Cell};
 use delta_collide::coord::{CoordinationConfig, RightOfWay};
 use delta_collide::math::{Real, Vec3};
-use delta_collide::sim::run::run;
+use delta_collide::sim::run::{run, run_traced, Trace};
 use delta_collide::sim::{
     programmes, Mode, ProgrammeConfig, Programmes, Rng, RunMetrics, SimConfig,
 };
@@ -242,4 +243,30 @@ fn the_programmed_order_keeps_most_of_the_throughput_on_two_robot_cells() {
             assert!(m.throughput >= 0.75, "{what}: {:.1} % kept", 100.0 * m.throughput);
         }
     }
+}
+
+#[test]
+fn a_trace_holds_one_record_per_tick_that_agrees_with_the_metrics() {
+    let cell = reference_cell("T1").unwrap();
+    let programme = ProgrammeConfig { ticks: 600, ..ProgrammeConfig::default() };
+    let progs = programmes(&cell, &programme, &mut Rng::new(3));
+    let mut trace = Trace::default();
+    let m = run_traced(&cell, &progs, &programmed_order(), Some(&mut trace));
+    assert_safe("T1 seed 3 traced", &m);
+    // One record per verdict, ticks increasing (a STOP skips the ticks of its stop).
+    assert_eq!(trace.ticks.len(), m.verdicts.iter().sum::<usize>());
+    assert!(trace.ticks.windows(2).all(|w| w[0].tick < w[1].tick));
+    let count = |v: Protective| trace.ticks.iter().filter(|t| t.verdict == Some(v)).count();
+    let verdicts = [Protective::Free, Protective::Warn, Protective::Stop];
+    assert_eq!(verdicts.map(count), m.verdicts);
+    for (j, _) in cell.robots.iter().enumerate() {
+        // Progress never goes back; overrides are factors; a robot is held by another one.
+        assert!(trace.ticks.windows(2).all(|w| w[1].progress[j] >= w[0].progress[j]));
+        for t in &trace.ticks {
+            assert!((0.0..=1.0).contains(&t.coordination[j]), "{t:?}");
+            assert!((0.0..=1.0).contains(&t.override_now[j]), "{t:?}");
+            assert!(t.held_by[j].is_none_or(|h| h != j && h < cell.robots.len()), "{t:?}");
+        }
+    }
+    assert!(trace.ticks.iter().any(|t| t.held_by.iter().any(Option::is_some)), "no hold at all");
 }

@@ -116,13 +116,36 @@ struct Robot {
     override_now: Real,
 }
 
-/// What a run did, tick by tick, for its pictures.
+/// What a run did, tick by tick, for its pictures and its trace file.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Trace {
     /// Per tick, each robot's progress (programme ticks).
     pub progress: Vec<Vec<Real>>,
     /// Per STOP event, each robot's progress when it was issued.
     pub stops: Vec<Vec<Real>>,
+    /// Per tick, what the controller asked and was answered.
+    pub ticks: Vec<TickRecord>,
+}
+
+/// One tick of a run as the controller saw it (before the tick's motion).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TickRecord {
+    /// The loop's tick (a STOP's simulated ticks are skipped).
+    pub tick: usize,
+    /// Per robot, its progress (programme ticks).
+    pub progress: Vec<Real>,
+    /// Per robot, the override it followed over the last tick.
+    pub override_now: Vec<Real>,
+    /// Per robot, the coordination's override (1 outside coordinate mode).
+    pub coordination: Vec<Real>,
+    /// Per robot, the robot whose conflict holds it, if any.
+    pub held_by: Vec<Option<usize>>,
+    /// The protective verdict.
+    pub verdict: Option<Protective>,
+    /// Per robot, the protective verdict's speed limit (mm/s).
+    pub limit_mm_s: Vec<Real>,
+    /// The exact signed clearance of the cell (mm).
+    pub clearance_mm: Real,
 }
 
 /// Runs `programmes` on `cell` in closed loop (module doc).
@@ -160,6 +183,7 @@ pub fn run_traced(
     let mut paths_buf = vec![[Vec3::zeros(); PATH_POINTS]; n];
     let mut targets = vec![1.0; n];
     let mut wanted = vec![1.0; n];
+    let mut held_by: Vec<Option<usize>> = vec![None; n];
     let mut next = vec![0.0; n];
     let mut limits: Vec<Real> = vec![0.0; n];
     let mut last_verdict = Protective::Stop;
@@ -227,6 +251,9 @@ pub fn run_traced(
                 Ok(report) => {
                     for (t, r) in targets.iter_mut().zip(&report.robots) {
                         *t = r.override_factor;
+                    }
+                    for (h, r) in held_by.iter_mut().zip(&report.robots) {
+                        *h = r.held_by;
                     }
                     metrics.cells_tested_max = metrics.cells_tested_max.max(report.cells_tested);
                 }
@@ -337,6 +364,22 @@ pub fn run_traced(
             }
         };
         last_verdict = verdict;
+        if let Some(t) = trace.as_deref_mut() {
+            t.ticks.push(TickRecord {
+                tick,
+                progress: robots.iter().map(|r| r.progress).collect(),
+                override_now: robots.iter().map(|r| r.override_now).collect(),
+                coordination: if config.mode == Mode::Coordinate {
+                    wanted.clone()
+                } else {
+                    vec![1.0; n]
+                },
+                held_by: held_by.clone(),
+                verdict: Some(verdict),
+                limit_mm_s: limits.clone(),
+                clearance_mm: protective.report().clearance_mm,
+            });
+        }
         ours.push(coordination + protective_ns);
         metrics.verdicts[verdict as usize] += 1;
         drop(stops);

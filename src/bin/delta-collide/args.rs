@@ -232,6 +232,11 @@ pub struct SimulateArgs {
     /// run) to this PNG file
     #[arg(long, value_name = "FILE.png")]
     pub plot: Option<PathBuf>,
+    /// Write the first run of the last mode, tick by tick, to this CSV file: each robot's
+    /// progress, override followed, coordination's override and holder, the verdict, each
+    /// speed limit and the exact clearance
+    #[arg(long, value_name = "FILE.csv")]
+    pub trace: Option<PathBuf>,
 }
 
 /// Arguments of `replay`.

@@ -1,5 +1,6 @@
 //! Output files that are either complete or untouched: every command that writes a file
-//! (`check`, `build`, `render`, `quilt`, `eval --plot`, `man`) writes through [`write_file`].
+//! (`check`, `build`, `render`, `quilt`, `eval --plot`, `simulate --trace`, `man`) writes
+//! through [`write_file`].
 
 use std::fs::File;
 use std::io::{BufWriter, Write};

@@ -2,10 +2,12 @@
 //! run and mode, and a summary per mode.
 
 use crate::args::SimulateArgs;
+use delta_collide::cell::protective::Protective;
 use delta_collide::coord::{CoordinationConfig, RightOfWay};
 use delta_collide::sim::cells::conflict_cells;
 use delta_collide::sim::run::{run_traced, Trace};
 use delta_collide::sim::{programmes, Mode, ProgrammeConfig, Rng, SimConfig};
+use std::io::Write;
 
 /// Runs the benchmark and prints its figures.
 pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
@@ -61,9 +63,18 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
         for r in 0..a.runs {
             let seed = a.seed + u64::from(r);
             let progs = programmes(&a.cell, &programme, &mut Rng::new(seed));
-            let plot = a.plot.as_ref().filter(|_| r == 0 && m == last);
+            let first = r == 0 && m == last;
+            let plot = a.plot.as_ref().filter(|_| first);
+            let csv = a.trace.as_ref().filter(|_| first);
             let mut trace = Trace::default();
-            let m = run_traced(&a.cell, &progs, &config, plot.map(|_| &mut trace));
+            let traced = (plot.is_some() || csv.is_some()).then_some(&mut trace);
+            let m = run_traced(&a.cell, &progs, &config, traced);
+            if let Some(path) = csv {
+                let text = trace_csv(&trace, a.cell.robots.len());
+                crate::files::write_file(path, |out| {
+                    out.write_all(text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
+                })?;
+            }
             if let (Some(path), Some(&pair)) = (plot, a.cell.pairs_that_can_meet().first()) {
                 let cells = conflict_cells(&a.cell, &progs, pair, 8, a.clearance_mm);
                 let names = (&*a.cell.robots[pair.0].name, &*a.cell.robots[pair.1].name);
@@ -112,4 +123,32 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// The trace file (`--trace`): a header, then one row per tick of the loop.
+fn trace_csv(trace: &Trace, n: usize) -> String {
+    let mut out = String::from("tick");
+    for key in ["progress", "override", "coordination", "held_by", "limit_mm_s"] {
+        for j in 0..n {
+            out.push_str(&format!(",{key}_{j}"));
+        }
+    }
+    out.push_str(",verdict,clearance_mm\n");
+    for t in &trace.ticks {
+        out.push_str(&t.tick.to_string());
+        for column in [&t.progress, &t.override_now, &t.coordination] {
+            column.iter().for_each(|x| out.push_str(&format!(",{x:.4}")));
+        }
+        for h in &t.held_by {
+            out.push_str(&h.map_or(",".to_string(), |j| format!(",{j}")));
+        }
+        t.limit_mm_s.iter().for_each(|x| out.push_str(&format!(",{x:.1}")));
+        let verdict = match t.verdict {
+            Some(Protective::Free) => "FREE",
+            Some(Protective::Warn) => "WARN",
+            Some(Protective::Stop) | None => "STOP",
+        };
+        out.push_str(&format!(",{verdict},{:.3}\n", t.clearance_mm));
+    }
+    out
 }
