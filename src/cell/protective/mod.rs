@@ -484,6 +484,9 @@ pub struct ProtectiveChecker {
     contact: contact::KeptContact,
     /// Each robot's piece of its whole stop along its path this tick (`path.rs`).
     whole_pieces: alloc::vec::Vec<Option<path::Piece>>,
+    /// Each robot's halving tree of its whole piece this tick (`path.rs`): the halves that
+    /// the verdict and every test of the speed limits along the paths build once.
+    whole_halves: alloc::vec::Vec<[path::Halves; path::TREE_NODES]>,
     /// The work the proof along the paths spends this tick (`protective/work.rs`).
     work: work::PathWork,
     calls: Calls,
@@ -593,6 +596,7 @@ impl ProtectiveChecker {
             kept,
             contact: contact::KeptContact::default(),
             whole_pieces: alloc::vec![None; n],
+            whole_halves: (0..n).map(|_| core::array::from_fn(|_| path::Halves::new())).collect(),
             work: work::PathWork::default(),
             calls,
             report,

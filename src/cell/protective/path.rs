@@ -284,7 +284,41 @@ pub fn path_through_samples(
 }
 
 /// A piece's halves, built when first needed (`None`: it has no range to halve).
-type Halves = core::cell::OnceCell<Option<(Piece, Piece)>>;
+pub(super) type Halves = core::cell::OnceCell<Option<(Piece, Piece)>>;
+
+/// Pieces of a halving tree that are halved themselves (depths 0 to `MAX_DEPTH - 1`): node
+/// `k`'s halves are nodes `2k + 1` and `2k + 2`.
+pub(super) const TREE_NODES: usize = (1 << MAX_DEPTH) - 1;
+
+/// Where a piece's halves are kept: in the tick's halving tree of a robot's whole stop (node
+/// `k`: the verdict and every test of the speed limits read the same halves), or in the frame
+/// of one proof.
+#[derive(Clone, Copy)]
+struct Slot<'s> {
+    halves: &'s Halves,
+    tree: Option<(&'s [Halves; TREE_NODES], usize)>,
+}
+
+impl<'s> Slot<'s> {
+    /// The root of `tree`, or a slot of one proof when there is none.
+    fn root(tree: Option<&'s [Halves; TREE_NODES]>, local: &'s Halves) -> Slot<'s> {
+        match tree {
+            Some(t) => Slot { halves: &t[0], tree: Some((t, 0)) },
+            None => Slot { halves: local, tree: None },
+        }
+    }
+
+    /// The slots of this piece's two halves: the tree's nodes below it, else `local`.
+    fn children(self, local: &'s [Halves; 2]) -> [Slot<'s>; 2] {
+        match self.tree {
+            Some((t, k)) if 2 * k + 2 < TREE_NODES => {
+                let node = |i: usize| Slot { halves: &t[i], tree: Some((t, i)) };
+                [node(2 * k + 1), node(2 * k + 2)]
+            }
+            _ => [Slot { halves: &local[0], tree: None }, Slot { halves: &local[1], tree: None }],
+        }
+    }
+}
 
 /// One piece of a robot's stop: the ball holding its TCPs, its boxes at the ball's centre and
 /// their sweeps over the ball.
@@ -337,18 +371,21 @@ impl ProtectiveChecker {
     }
 
     /// The first box pair of robots `a < b` not proved apart over pieces `pa`, `pb`, halving
-    /// the larger piece (module doc, step 2) while `depth_a`, `depth_b` allow.
+    /// the larger piece (module doc, step 2) while `depth_a`, `depth_b` allow; a piece that is
+    /// a robot's whole stop this tick takes its halves from that robot's tree (`trees`).
+    #[allow(clippy::too_many_arguments)]
     fn prove_pieces(
         &self,
         ab: (usize, usize),
         paths: (Option<&StopPath>, Option<&StopPath>),
-        pa: &Piece,
-        pb: &Piece,
+        (pa, pb): (&Piece, &Piece),
+        trees: (Option<&[Halves; TREE_NODES]>, Option<&[Halves; TREE_NODES]>),
         depths: (u32, u32),
         extra: Real,
     ) -> Option<BoxPair> {
-        let pieces = [(pa, &Halves::new()), (pb, &Halves::new())];
-        self.prove_halving(ab, paths, pieces, depths, extra)
+        let local = [Halves::new(), Halves::new()];
+        let slots = [(pa, Slot::root(trees.0, &local[0])), (pb, Slot::root(trees.1, &local[1]))];
+        self.prove_halving(ab, paths, slots, depths, extra)
     }
 
     /// [`ProtectiveChecker::prove_pieces`], with each piece's halves built at most once:
@@ -357,7 +394,7 @@ impl ProtectiveChecker {
         &self,
         (a, b): (usize, usize),
         (path_a, path_b): (Option<&StopPath>, Option<&StopPath>),
-        [(pa, halves_a), (pb, halves_b)]: [(&Piece, &Halves); 2],
+        [(pa, slot_a), (pb, slot_b)]: [(&Piece, Slot); 2],
         (depth_a, depth_b): (u32, u32),
         extra: Real,
     ) -> Option<BoxPair> {
@@ -370,36 +407,26 @@ impl ProtectiveChecker {
         let span = |p: &Piece| p.arc.map_or(-1.0, |(s0, s1)| s1 - s0);
         let split_a = depth_a < MAX_DEPTH && (span(pa) >= span(pb) || depth_b >= MAX_DEPTH);
         if split_a {
-            if let Some((h1, h2)) = halves_a.get_or_init(|| self.halves(a, path_a, pa)) {
+            if let Some((h1, h2)) = slot_a.halves.get_or_init(|| self.halves(a, path_a, pa)) {
                 let deeper = (depth_a + 1, depth_b);
-                let (c1, c2) = (Halves::new(), Halves::new());
+                let local = [Halves::new(), Halves::new()];
+                let [c1, c2] = slot_a.children(&local);
                 return self
-                    .prove_halving((a, b), paths, [(h1, &c1), (pb, halves_b)], deeper, extra)
+                    .prove_halving((a, b), paths, [(h1, c1), (pb, slot_b)], deeper, extra)
                     .or_else(|| {
-                        self.prove_halving(
-                            (a, b),
-                            paths,
-                            [(h2, &c2), (pb, halves_b)],
-                            deeper,
-                            extra,
-                        )
+                        self.prove_halving((a, b), paths, [(h2, c2), (pb, slot_b)], deeper, extra)
                     });
             }
         }
         if depth_b < MAX_DEPTH {
-            if let Some((h1, h2)) = halves_b.get_or_init(|| self.halves(b, path_b, pb)) {
+            if let Some((h1, h2)) = slot_b.halves.get_or_init(|| self.halves(b, path_b, pb)) {
                 let deeper = (depth_a, depth_b + 1);
-                let (c1, c2) = (Halves::new(), Halves::new());
+                let local = [Halves::new(), Halves::new()];
+                let [c1, c2] = slot_b.children(&local);
                 return self
-                    .prove_halving((a, b), paths, [(pa, halves_a), (h1, &c1)], deeper, extra)
+                    .prove_halving((a, b), paths, [(pa, slot_a), (h1, c1)], deeper, extra)
                     .or_else(|| {
-                        self.prove_halving(
-                            (a, b),
-                            paths,
-                            [(pa, halves_a), (h2, &c2)],
-                            deeper,
-                            extra,
-                        )
+                        self.prove_halving((a, b), paths, [(pa, slot_a), (h2, c2)], deeper, extra)
                     });
             }
         }
@@ -442,9 +469,14 @@ impl ProtectiveChecker {
         // where the robot is when the next verdicts come.
         let ahead = s + 2.0 * v * self.cell().tick_ms * 1e-3;
         let piece_j = self.whole_piece(j, &tcps_mcs[j], ahead, paths[j].as_ref());
-        let (pa, pb) = if a == j { (&piece_j, other) } else { (other, &piece_j) };
+        let tree = Some(&self.whole_halves[if a == j { b } else { a }]);
+        let (pieces, trees) = if a == j {
+            ((&piece_j, other), (None, tree))
+        } else {
+            ((other, &piece_j), (tree, None))
+        };
         let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
-        self.prove_pieces((a, b), paths_ab, pa, pb, (0, 0), 0.0).is_none()
+        self.prove_pieces((a, b), paths_ab, pieces, trees, (0, 0), 0.0).is_none()
     }
 
     /// Robot `j`'s motion over its stop (`slices.rs`) from TCP `tcp_mcs`, as this tick
@@ -495,7 +527,7 @@ impl ProtectiveChecker {
         for (&arc_a, &arc_b) in arcs[0].iter().zip(&arcs[1]) {
             let Some(pa) = reuse(last_a.take(), a, paths.0, arc_a) else { return false };
             let Some(pb) = reuse(last_b.take(), b, paths.1, arc_b) else { return false };
-            if self.prove_pieces((a, b), paths, &pa, &pb, (0, 0), extra).is_some() {
+            if self.prove_pieces((a, b), paths, (&pa, &pb), (None, None), (0, 0), extra).is_some() {
                 return false;
             }
             (last_a, last_b) = (Some(pa), Some(pb));
@@ -519,6 +551,7 @@ impl ProtectiveChecker {
             let s = self.report.robots[j].protective_mm;
             let piece = self.whole_piece(j, &tcps_mcs[j], s, paths[j].as_ref());
             self.whole_pieces[j] = Some(piece);
+            self.whole_halves[j].iter_mut().for_each(|h| *h = Halves::new());
         }
         true
     }
@@ -617,9 +650,9 @@ impl ProtectiveChecker {
             for pair in &self.exact.verdict().pairs {
                 let (a, b) = (pair.a, pair.b);
                 let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
-                let (whole_a, whole_b) = (self.whole_of(a), self.whole_of(b));
-                let Some(found) =
-                    self.prove_pieces((a, b), paths_ab, whole_a, whole_b, (0, 0), extra)
+                let wholes = (self.whole_of(a), self.whole_of(b));
+                let trees = (Some(&self.whole_halves[a]), Some(&self.whole_halves[b]));
+                let Some(found) = self.prove_pieces((a, b), paths_ab, wholes, trees, (0, 0), extra)
                 else {
                     continue;
                 };
