@@ -450,35 +450,6 @@ impl ProtectiveChecker {
         self.piece(j, path, arc)
     }
 
-    /// Whether the pair `(a, b)` with robot `j` one of them is proved along the paths when `j`
-    /// moves at speed `v`, the other robot's stop being `other` (its piece as it is).
-    /// Replaces `j`'s reference.
-    fn pair_speed_proved(
-        &mut self,
-        (a, b): (usize, usize),
-        j: usize,
-        other: &Piece,
-        (tcps_mcs, paths): (&[Vec3], &[Option<StopPath>]),
-        v: Real,
-    ) -> bool {
-        if !self.work.spend(1) {
-            return false;
-        }
-        let s = self.stop_reference(j, &tcps_mcs[j], v);
-        // Two ticks more along the path: a limit the controller applies must still be proved
-        // where the robot is when the next verdicts come.
-        let ahead = s + 2.0 * v * self.cell().tick_ms * 1e-3;
-        let piece_j = self.whole_piece(j, &tcps_mcs[j], ahead, paths[j].as_ref());
-        let tree = Some(&self.whole_halves[if a == j { b } else { a }]);
-        let (pieces, trees) = if a == j {
-            ((&piece_j, other), (None, tree))
-        } else {
-            ((other, &piece_j), (tree, None))
-        };
-        let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
-        self.prove_pieces((a, b), paths_ab, pieces, trees, (0, 0), 0.0).is_none()
-    }
-
     /// Robot `j`'s motion over its stop (`slices.rs`) from TCP `tcp_mcs`, as this tick
     /// measured it (no velocity when its speed is unknown).
     fn stop_motion(&self, j: usize, tcp_mcs: &Vec3) -> StopMotion {
@@ -609,7 +580,9 @@ impl ProtectiveChecker {
         }
     }
 
-    /// Whether every pair involving robot `j` is proved along the paths with `j` at speed `v`.
+    /// Whether every pair involving robot `j` is proved along the paths with `j` at speed `v`:
+    /// `j`'s stop at that speed and two ticks of its motion, one piece against each other
+    /// robot's whole stop as it is. Replaces `j`'s reference.
     fn speed_proved_along(
         &mut self,
         j: usize,
@@ -617,18 +590,26 @@ impl ProtectiveChecker {
         paths: &[Option<StopPath>],
         v: Real,
     ) -> bool {
-        for k in 0..self.exact.verdict().pairs.len() {
-            let pair = self.exact.verdict().pairs[k];
-            let (a, b) = (pair.a, pair.b);
-            if a != j && b != j {
-                continue;
-            }
-            let other = *self.whole_of(if a == j { b } else { a });
-            if !self.pair_speed_proved((a, b), j, &other, (tcps_mcs, paths), v) {
-                return false;
-            }
+        if !self.work.spend(1) {
+            return false;
         }
-        true
+        let s = self.stop_reference(j, &tcps_mcs[j], v);
+        // Two ticks more along the path: a limit the controller applies must still be proved
+        // where the robot is when the next verdicts come.
+        let ahead = s + 2.0 * v * self.cell().tick_ms * 1e-3;
+        let piece_j = self.whole_piece(j, &tcps_mcs[j], ahead, paths[j].as_ref());
+        self.exact.verdict().pairs.iter().filter(|p| p.a == j || p.b == j).all(|pair| {
+            let (a, b) = (pair.a, pair.b);
+            let o = if a == j { b } else { a };
+            let (other, tree) = (self.whole_of(o), Some(&self.whole_halves[o]));
+            let (pieces, trees) = if a == j {
+                ((&piece_j, other), (None, tree))
+            } else {
+                ((other, &piece_j), (tree, None))
+            };
+            let paths_ab = (paths[a].as_ref(), paths[b].as_ref());
+            self.prove_pieces((a, b), paths_ab, pieces, trees, (0, 0), 0.0).is_none()
+        })
     }
 
     /// The verdict and limiting pair over the pieces of the paths (module doc), for the
