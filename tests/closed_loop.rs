@@ -256,7 +256,7 @@ fn a_trace_holds_one_record_per_tick_that_agrees_with_the_metrics() {
     // One record per verdict, ticks increasing (a STOP skips the ticks of its stop).
     assert_eq!(trace.ticks.len(), m.verdicts.iter().sum::<usize>());
     assert!(trace.ticks.windows(2).all(|w| w[0].tick < w[1].tick));
-    let count = |v: Protective| trace.ticks.iter().filter(|t| t.verdict == Some(v)).count();
+    let count = |v: Protective| trace.ticks.iter().filter(|t| t.verdict == v).count();
     let verdicts = [Protective::Free, Protective::Warn, Protective::Stop];
     assert_eq!(verdicts.map(count), m.verdicts);
     for (j, _) in cell.robots.iter().enumerate() {

@@ -128,7 +128,7 @@ pub struct Trace {
 }
 
 /// One tick of a run as the controller saw it (before the tick's motion).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct TickRecord {
     /// The loop's tick (a STOP's simulated ticks are skipped).
     pub tick: usize,
@@ -141,7 +141,7 @@ pub struct TickRecord {
     /// Per robot, the robot whose conflict holds it, if any.
     pub held_by: Vec<Option<usize>>,
     /// The protective verdict.
-    pub verdict: Option<Protective>,
+    pub verdict: Protective,
     /// Per robot, the protective verdict's speed limit (mm/s).
     pub limit_mm_s: Vec<Real>,
     /// The exact signed clearance of the cell (mm).
@@ -375,7 +375,7 @@ pub fn run_traced(
                     vec![1.0; n]
                 },
                 held_by: held_by.clone(),
-                verdict: Some(verdict),
+                verdict,
                 limit_mm_s: limits.clone(),
                 clearance_mm: protective.report().clearance_mm,
             });

@@ -144,9 +144,9 @@ fn trace_csv(trace: &Trace, n: usize) -> String {
         }
         t.limit_mm_s.iter().for_each(|x| out.push_str(&format!(",{x:.1}")));
         let verdict = match t.verdict {
-            Some(Protective::Free) => "FREE",
-            Some(Protective::Warn) => "WARN",
-            Some(Protective::Stop) | None => "STOP",
+            Protective::Free => "FREE",
+            Protective::Warn => "WARN",
+            Protective::Stop => "STOP",
         };
         out.push_str(&format!(",{verdict},{:.3}\n", t.clearance_mm));
     }

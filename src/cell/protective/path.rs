@@ -373,7 +373,6 @@ impl ProtectiveChecker {
     /// The first box pair of robots `a < b` not proved apart over pieces `pa`, `pb`, halving
     /// the larger piece (module doc, step 2) while `depth_a`, `depth_b` allow; a piece that is
     /// a robot's whole stop this tick takes its halves from that robot's tree (`trees`).
-    #[allow(clippy::too_many_arguments)]
     fn prove_pieces(
         &self,
         ab: (usize, usize),
