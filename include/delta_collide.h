@@ -48,7 +48,7 @@
  Units of work a protective query spends per tick on the proof along the stop paths until
  `dc_set_path_work` sets another cap.
  */
-#define DC_DEFAULT_PATH_WORK 2000
+#define DC_DEFAULT_PATH_WORK 500
 
 /*
  Most points of one `DcProgramme`.
@@ -1321,8 +1321,9 @@ DcStatus dc_set_limit_tests(struct DcCollider *handle, uint32_t tests);
  Caps the units of work that `dc_protective_query_with_paths` spends per tick on the proof
  along the stop paths: its halvings of the paths into pieces, its time slices and its
  speed limits' tests along the paths, each unit one piece's stop sweeps or one proof of two
- pieces apart (a few thousand instructions; docs/record/2026-12-02-work-budget.md). The
- default is `DC_DEFAULT_PATH_WORK`; 0 answers as `dc_protective_query` does; `UINT32_MAX`
+ pieces apart (about 21,000 x86-64 instructions; docs/record/2026-12-02-worst-cases.md).
+ The default is `DC_DEFAULT_PATH_WORK`, which keeps the worst call found by search within
+ a 1 ms tick on the machine of the records; 0 answers as `dc_protective_query` does; `UINT32_MAX`
  sets no cap. A step that finds too few units left is not taken and what it would have
  proved stays unproved: the verdict is then at best the one without paths, a speed limit
  the highest speed proved so far (`dc_tick_stats` counts such calls in `budget_spent`). So

@@ -48,7 +48,7 @@ const WORST_BUDGETS: [(&str, u64); 6] = [
     ("query_line8", 25_000),
     ("protective_t1", 520_000),
     ("protective_t2", 450_000),
-    ("paths_t1", 39_000_000),
+    ("paths_t1", 12_200_000),
     ("protective_line8", 2_400_000),
 ];
 

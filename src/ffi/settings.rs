@@ -166,8 +166,9 @@ pub unsafe extern "C" fn dc_set_limit_tests(handle: *mut DcCollider, tests: u32)
 /// Caps the units of work that `dc_protective_query_with_paths` spends per tick on the proof
 /// along the stop paths: its halvings of the paths into pieces, its time slices and its
 /// speed limits' tests along the paths, each unit one piece's stop sweeps or one proof of two
-/// pieces apart (a few thousand instructions; docs/record/2026-12-02-work-budget.md). The
-/// default is `DC_DEFAULT_PATH_WORK`; 0 answers as `dc_protective_query` does; `UINT32_MAX`
+/// pieces apart (about 21,000 x86-64 instructions; docs/record/2026-12-02-worst-cases.md).
+/// The default is `DC_DEFAULT_PATH_WORK`, which keeps the worst call found by search within
+/// a 1 ms tick on the machine of the records; 0 answers as `dc_protective_query` does; `UINT32_MAX`
 /// sets no cap. A step that finds too few units left is not taken and what it would have
 /// proved stays unproved: the verdict is then at best the one without paths, a speed limit
 /// the highest speed proved so far (`dc_tick_stats` counts such calls in `budget_spent`). So

@@ -316,7 +316,7 @@ pub const DC_MAX_PATH_POINTS: usize = 32;
 
 /// Units of work a protective query spends per tick on the proof along the stop paths until
 /// `dc_set_path_work` sets another cap.
-pub const DC_DEFAULT_PATH_WORK: u32 = 2_000;
+pub const DC_DEFAULT_PATH_WORK: u32 = 500;
 
 /// The path one robot's TCP will follow over its stop, as a controller performing a
 /// path-maintaining stop knows it (SPEC section 8, "Where the controller knows more"), for
