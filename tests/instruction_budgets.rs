@@ -24,7 +24,7 @@
 mod harness_build;
 mod native_libs;
 
-use harness_build::{in_ci, repo_root, run, scratch_dir, static_lib, text, C_FLAGS};
+use harness_build::{budget_program, in_ci, repo_root, run, scratch_dir, text};
 use native_libs::NATIVE_LIBS;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -125,17 +125,7 @@ fn each_entry_point_stays_within_its_instruction_budget() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         std::fs::remove_file(entry.unwrap().path()).unwrap();
     }
-    let exe = dir.join("instruction_budgets");
-    let out = run(Command::new("cc")
-        .args(C_FLAGS)
-        .arg("-I")
-        .arg(repo_root().join("include"))
-        .arg(repo_root().join("tests/data/instruction_budgets.c"))
-        .arg(static_lib())
-        .args(NATIVE_LIBS)
-        .arg("-o")
-        .arg(&exe));
-    assert!(out.status.success(), "the program does not compile:\n{}", text(&out.stderr));
+    let exe = budget_program(&dir, NATIVE_LIBS);
     let out = run(Command::new("valgrind")
         .args(["--tool=callgrind", "--collect-atstart=no", "--dump-line=no"])
         .arg(format!("--callgrind-out-file={}/callgrind.out.%p", dir.display()))

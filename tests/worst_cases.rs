@@ -42,13 +42,13 @@ use delta_collide::cell::protective::{ProtectiveStatus, StopPath};
 use delta_collide::cell::{Cell, ExactChecker};
 use delta_collide::geometry::clearance::boxes_clearance;
 use delta_collide::math::{Real, Vec3};
-use harness_build::{in_ci, repo_root, run, scratch_dir, static_lib, text, C_FLAGS};
+use harness_build::{budget_program, in_ci, repo_root, run, scratch_dir, text};
 use native_libs::NATIVE_LIBS;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 /// Which entry point a case file drives (its `call` line).
@@ -182,6 +182,14 @@ struct Genome {
 struct Case {
     tcps: Vec<Vec<Vec3>>,
     paths: Vec<Vec<(Vec<Vec3>, Real)>>,
+}
+
+impl Case {
+    /// Tick `t`'s stop paths, one per robot (none for a call without paths).
+    fn stop_paths(&self, t: usize) -> Vec<Option<StopPath<'_>>> {
+        let at = self.paths.get(t).into_iter().flatten();
+        at.map(|(points, tol)| Some(StopPath { points, tolerance_mm: *tol })).collect()
+    }
 }
 
 impl Genome {
@@ -430,13 +438,7 @@ impl Sampler {
         checker.reset();
         let mut verdict = Protective::Stop;
         for (t, tcps) in case.tcps.iter().enumerate() {
-            let paths: Vec<Option<StopPath>> = case
-                .paths
-                .get(t)
-                .into_iter()
-                .flatten()
-                .map(|(points, tol)| Some(StopPath { points, tolerance_mm: *tol }))
-                .collect();
+            let paths = case.stop_paths(t);
             verdict =
                 checker.check(ProtectiveRequest::new(tcps).with_paths(&paths)).unwrap().verdict;
         }
@@ -702,22 +704,6 @@ fn clamp_norm(v: Vec3, max: Real) -> Vec3 {
     }
 }
 
-/// The program `tests/data/instruction_budgets.c`, compiled into `dir`.
-fn driver(dir: &Path) -> PathBuf {
-    let exe = dir.join("instruction_budgets");
-    let out = run(Command::new("cc")
-        .args(C_FLAGS)
-        .arg("-I")
-        .arg(repo_root().join("include"))
-        .arg(repo_root().join("tests/data/instruction_budgets.c"))
-        .arg(static_lib())
-        .args(NATIVE_LIBS)
-        .arg("-o")
-        .arg(&exe));
-    assert!(out.status.success(), "the program does not compile:\n{}", text(&out.stderr));
-    exe
-}
-
 /// Runs `exe args` under callgrind, each measured call collected alone and dumped in `dir`:
 /// its standard output and each part's count (the dump's trigger names the part).
 fn callgrind(exe: &Path, args: &[&str], dir: &Path) -> (String, BTreeMap<String, u64>) {
@@ -890,7 +876,7 @@ fn search_for_the_worst_inputs_of_each_entry_point() {
     let seed = env("DC_WORST_CASES_SEED", 49);
     let generations = env("DC_WORST_CASES_GENERATIONS", 25) as usize;
     let dir = scratch_dir("worst_cases");
-    let exe = driver(&dir);
+    let exe = budget_program(&dir, NATIVE_LIBS);
     let out_dir = if std::env::var_os("DC_REGENERATE_WORST_CASES").is_some() {
         repo_root().join("tests/data/worst_cases")
     } else {
@@ -960,13 +946,7 @@ fn stored_worst_cases_are_inputs_a_controller_can_give() {
             let Some(checker) = checker.as_mut() else { continue };
             checker.reset();
             for (t, tcps) in case.tcps.iter().enumerate() {
-                let paths: Vec<Option<StopPath>> = case
-                    .paths
-                    .get(t)
-                    .into_iter()
-                    .flatten()
-                    .map(|(points, tol)| Some(StopPath { points, tolerance_mm: *tol }))
-                    .collect();
+                let paths = case.stop_paths(t);
                 let request = ProtectiveRequest::new(tcps);
                 let status = checker.check(request.with_paths(&paths)).unwrap().status;
                 assert_eq!(status, ProtectiveStatus::Ok, "{what}, tick {t}");

@@ -103,3 +103,20 @@ pub fn compile_harness(cc: &str, extra: &[&str], lib: &Path, libs: &[&str], exe:
         .arg(exe));
     assert!(out.status.success(), "{cc} {extra:?} failed on the harness:\n{}", both(&out));
 }
+
+/// The program `tests/data/instruction_budgets.c` compiled into `dir` against the static
+/// library and its native libraries `libs` (`native_libs::NATIVE_LIBS`).
+pub fn budget_program(dir: &Path, libs: &[&str]) -> PathBuf {
+    let exe = dir.join("instruction_budgets");
+    let out = run(Command::new("cc")
+        .args(C_FLAGS)
+        .arg("-I")
+        .arg(repo_root().join("include"))
+        .arg(repo_root().join("tests/data/instruction_budgets.c"))
+        .arg(static_lib())
+        .args(libs)
+        .arg("-o")
+        .arg(&exe));
+    assert!(out.status.success(), "the program does not compile:\n{}", text(&out.stderr));
+    exe
+}
